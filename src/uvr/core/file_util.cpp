@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/core/file_util.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+std::vector<char> readFileBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throwError(ErrorKind::Io, path, "is a folder, not a file");
+    in.seekg(0, std::ios::end);
+    std::streamoff size = in.tellg();
+    if (size < 0) throwError(ErrorKind::Io, path, "cannot determine the file size");
+    in.seekg(0, std::ios::beg);
+    std::vector<char> bytes(static_cast<size_t>(size));
+    if (size > 0 && !in.read(bytes.data(), size)) throwError(ErrorKind::Io, path, "read failed");
+    return bytes;
+}
+
+std::uint64_t fileSize(const std::string& path) {
+    std::error_code ec;
+    auto size = std::filesystem::file_size(path, ec);
+    if (ec) throwError(ErrorKind::Io, path, "cannot open: " + ec.message());
+    return size;
+}
+
+void writeFileAtomically(const std::string& path,
+                         const std::function<void(const std::string&)>& write) {
+    std::string tmp = path + ".tmp" + std::to_string(::getpid());
+    try {
+        write(tmp);
+    } catch (...) {
+        std::remove(tmp.c_str());
+        throw;
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::remove(tmp.c_str());
+        throwError(ErrorKind::Io, path, "cannot write: " + ec.message());
+    }
+}
+
+std::string fileExtension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+std::string parentFolder(const std::string& path) {
+    return std::filesystem::path(path).parent_path().string();
+}
+
+void checkAllocation(const std::string& file, const std::string& what, std::uint64_t count,
+                     std::uint64_t elementSize, std::uint64_t limitBytes) {
+    if (limitBytes == 0) return;
+    if (elementSize != 0 && count > limitBytes / elementSize) {
+        throwError(ErrorKind::Resource, file,
+                   what + ": " + std::to_string(count) + " entries of " +
+                       std::to_string(elementSize) + " bytes exceed the memory limit of " +
+                       std::to_string(limitBytes) + " bytes");
+    }
+}
+
+}  // namespace uvr

@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace uvr {
+
+/// Reads a whole file into memory; throws Error(Io) naming the file on failure.
+std::vector<char> readFileBytes(const std::string& path);
+
+/// Size of a file in bytes; throws Error(Io) when it cannot be opened.
+std::uint64_t fileSize(const std::string& path);
+
+/// Writes a file atomically: write(tmpPath) fills a temporary file beside path, which is renamed
+/// over path only when write returns normally; on any exception the temporary is removed, so
+/// path is never left half-written.
+void writeFileAtomically(const std::string& path,
+                         const std::function<void(const std::string&)>& write);
+
+/// Lower-cased extension of a path including the dot (".vtu"), or "" if none.
+std::string fileExtension(const std::string& path);
+
+/// Folder part of a path ("" for a bare file name).
+std::string parentFolder(const std::string& path);
+
+/// Refuses an allocation of count * elementSize bytes above limitBytes (0 = no limit) with
+/// Error(Resource) naming the file and what was being allocated.
+void checkAllocation(const std::string& file, const std::string& what, std::uint64_t count,
+                     std::uint64_t elementSize, std::uint64_t limitBytes);
+
+}  // namespace uvr

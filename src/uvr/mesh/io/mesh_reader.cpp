@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/mesh/io/mesh_reader.h"
+
+#include <cstring>
+#include <fstream>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+#include "uvr/mesh/io/native.h"
+#include "uvr/mesh/io/vtk_legacy.h"
+#include "uvr/mesh/io/vtu.h"
+
+namespace uvr {
+
+namespace {
+
+enum class Format { Legacy, Vtu, Pvtu, Native, Unknown };
+
+Format sniffFormat(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
+    char head[512] = {};
+    in.read(head, sizeof(head) - 1);
+    const std::string text(head, static_cast<size_t>(in.gcount()));
+    if (text.size() >= 8 && std::memcmp(text.data(), kNativeMagic, 8) == 0) return Format::Native;
+    if (text.rfind("# vtk DataFile", 0) == 0) return Format::Legacy;
+    if (text.find("PUnstructuredGrid") != std::string::npos) return Format::Pvtu;
+    if (text.find("<VTKFile") != std::string::npos) return Format::Vtu;
+    const std::string ext = fileExtension(path);
+    if (ext == ".vtk") return Format::Legacy;
+    if (ext == ".vtu") return Format::Vtu;
+    if (ext == ".pvtu") return Format::Pvtu;
+    if (ext == ".uvrm") return Format::Native;
+    return Format::Unknown;
+}
+
+}  // namespace
+
+Mesh readMesh(const std::string& path, const ReadOptions& options) {
+    switch (sniffFormat(path)) {
+        case Format::Legacy:
+            return readVtkLegacy(path, options);
+        case Format::Vtu:
+            return readVtu(path, options);
+        case Format::Pvtu:
+            return readPvtu(path, options);
+        case Format::Native:
+            return readNative(path, options);
+        case Format::Unknown:
+            break;
+    }
+    throwError(ErrorKind::Parse, path,
+               "unrecognised file format: expected a legacy VTK file ('# vtk DataFile' header), "
+               "VTK XML (.vtu/.pvtu) or a native uvr mesh (.uvrm)");
+}
+
+void writeMesh(const Mesh& mesh, const std::string& path) {
+    if (fileExtension(path) != ".uvrm")
+        throwError(ErrorKind::Argument, path,
+                   "can only write the native format: the output name must end in .uvrm");
+    writeNative(mesh, path);
+}
+
+}  // namespace uvr

@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <string>
+
+#include "uvr/mesh/io/read_options.h"
+#include "uvr/mesh/mesh.h"
+
+namespace uvr {
+
+/// Reads a VTK XML UnstructuredGrid (.vtu): ascii, inline base64 binary, appended raw and appended
+/// base64 data, optional zlib compression, UInt32/UInt64 headers, either byte order, all numeric
+/// types, one or more Pieces. Throws Error naming file and element/byte offset when malformed.
+Mesh readVtu(const std::string& path, const ReadOptions& options = {});
+
+/// Reads a parallel VTK XML UnstructuredGrid (.pvtu): every piece's .vtu, relative to the .pvtu's
+/// folder, merged into one mesh (point indices offset per piece).
+Mesh readPvtu(const std::string& path, const ReadOptions& options = {});
+
+}  // namespace uvr

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/mesh/mesh.h"
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+const char* associationName(Association a) {
+    return a == Association::Point ? "point" : "cell";
+}
+
+void Mesh::addCell(CellType type, std::span<const std::uint32_t> ids) {
+    UVR_CHECK(static_cast<int>(ids.size()) == cornerCount(type),
+              cellTypeName(type) << " given " << ids.size() << " indices");
+    cellTypes.push_back(type);
+    cellIndices.insert(cellIndices.end(), ids.begin(), ids.end());
+    cellOffsets.push_back(cellIndices.size());
+}
+
+Bounds3f Mesh::bounds() const {
+    Bounds3f b;
+    for (const Vec3f& p : points) b.extend(p);
+    return b;
+}
+
+const Field* Mesh::findField(const std::string& name, Association association) const {
+    for (const Field& f : fields)
+        if (f.name == name && f.association == association) return &f;
+    return nullptr;
+}
+
+}  // namespace uvr

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "uvr/core/vec.h"
+#include "uvr/mesh/mesh.h"
+
+namespace uvr {
+
+/// Shapes `uvr generate` can make; all lie inside [-1, 1]^3.
+enum class ProceduralShape {
+    Box,     ///< jittered tetrahedralised cube [-1,1]^3
+    Shell,   ///< hollow, non-convex solid (a thick torus tube with an empty core)
+    Graded,  ///< cube whose cell size varies 100x from one corner to the other
+};
+
+/// Analytic point fields; each is written as a point field of this name.
+enum class ProceduralField {
+    Constant,       ///< "constant": 1 everywhere
+    Linear,         ///< "linear": x + 2y - z (reproduced exactly by linear interpolation)
+    Jet,            ///< "jet": a turbulent plume rising along +y (smooth, deterministic noise)
+    MarschnerLobb,  ///< "marschner_lobb": Marschner & Lobb 1994 test signal over [-1,1]^3
+};
+
+/// What to generate.
+struct ProceduralSpec {
+    ProceduralShape shape = ProceduralShape::Box;
+    std::uint64_t targetCells = 100000;  ///< approximate tetrahedron count (result within ~2x)
+    std::uint64_t seed = 1;              ///< same seed and spec, same mesh, bit for bit
+    float jitter = 0.2f;                 ///< interior point jitter as a fraction of local spacing
+    /// Fields written, in this order (the first is the default render field).
+    std::vector<ProceduralField> fields{ProceduralField::Jet, ProceduralField::MarschnerLobb,
+                                        ProceduralField::Linear, ProceduralField::Constant};
+};
+
+/// Generates a tetrahedral mesh with no inverted or zero-volume cells; progress(fraction in [0,1])
+/// is called now and then when given.
+Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>& progress = {});
+
+/// The analytic value of a procedural field at p (what the mesh stores at its points).
+float proceduralFieldValue(ProceduralField field, Vec3f p);
+
+/// Field name as written into the mesh ("jet", ...).
+const char* proceduralFieldName(ProceduralField field);
+/// Shape name as the CLI spells it ("box", "shell", "graded").
+const char* proceduralShapeName(ProceduralShape shape);
+/// Parses a shape name; throws Error(Argument) listing the valid names.
+ProceduralShape parseProceduralShape(const std::string& name);
+/// Parses a field name; throws Error(Argument) listing the valid names.
+ProceduralField parseProceduralField(const std::string& name);
+
+}  // namespace uvr

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <sys/wait.h>
+
+namespace uvr::testing {
+
+/// Path of a real mesh in ../shared/data; the test is skipped when the folder is absent.
+inline std::string sharedData(const std::string& name) {
+    return std::string(UVR_SHARED_DATA_DIR) + "/" + name;
+}
+
+/// True when the shared data folder is present (tests that need it GTEST_SKIP otherwise).
+inline bool haveSharedData() {
+    return std::filesystem::exists(sharedData("spx.vtk"));
+}
+
+/// A fresh, empty folder for this test's files under the system temp folder.
+inline std::string scratchDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::filesystem::path dir = std::filesystem::temp_directory_path() / "uvr_tests" /
+                                (std::string(info->test_suite_name()) + "." + info->name());
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir.string();
+}
+
+/// Writes text (or bytes) to a file and returns its path.
+inline std::string writeFile(const std::string& path, const std::string& contents) {
+    std::ofstream out(path, std::ios::binary);
+    out << contents;
+    return path;
+}
+
+/// Debian's system Python (with python3-vtk9, python3-meshio, python3-skimage), not a pyenv one.
+inline const char* systemPython() {
+    return "/usr/bin/python3";
+}
+
+/// True when the system Python can import the module.
+inline bool pythonHas(const std::string& module) {
+    std::string cmd = std::string(systemPython()) + " -c 'import " + module + "' >/dev/null 2>&1";
+    return std::system(cmd.c_str()) == 0;
+}
+
+/// Path of the uvr command-line binary built beside the tests.
+inline std::string uvrBinary() {
+    return UVR_BIN_PATH;
+}
+
+/// Runs a shell command, returning its exit status (the shell's, 0..255).
+inline int runCommand(const std::string& cmd) {
+    int status = std::system(cmd.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 255;
+}
+
+}  // namespace uvr::testing
