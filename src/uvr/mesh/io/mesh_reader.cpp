@@ -55,10 +55,11 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
 }
 
 void writeMesh(const Mesh& mesh, const std::string& path) {
-    if (fileExtension(path) != ".uvrm")
-        throwError(ErrorKind::Argument, path,
-                   "can only write the native format: the output name must end in .uvrm");
-    writeNative(mesh, path);
+    const std::string ext = fileExtension(path);
+    if (ext == ".uvrm") return writeNative(mesh, path);
+    if (ext == ".vtu") return writeVtu(mesh, path);
+    throwError(ErrorKind::Argument, path,
+               "cannot write this format: the output name must end in .uvrm (native) or .vtu");
 }
 
 }  // namespace uvr

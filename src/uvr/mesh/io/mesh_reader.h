@@ -12,8 +12,8 @@ namespace uvr {
 /// bytes first and extension second; throws Error naming the file on failure.
 Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 
-/// Writes a mesh in the format its extension names (only .uvrm); throws Error(Argument) for
-/// other extensions. The file is written atomically.
+/// Writes a mesh in the format its extension names (.uvrm native or .vtu); throws
+/// Error(Argument) for other extensions. The file is written atomically.
 void writeMesh(const Mesh& mesh, const std::string& path);
 
 }  // namespace uvr

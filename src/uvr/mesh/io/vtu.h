@@ -18,3 +18,11 @@ Mesh readVtu(const std::string& path, const ReadOptions& options = {});
 Mesh readPvtu(const std::string& path, const ReadOptions& options = {});
 
 }  // namespace uvr
+
+namespace uvr {
+
+/// Writes a VTK XML UnstructuredGrid (.vtu) with raw appended little-endian data (Float32 points,
+/// Int64 connectivity/offsets, UInt8 types, Float32 fields), atomically; ParaView reads it.
+void writeVtu(const Mesh& mesh, const std::string& path);
+
+}  // namespace uvr
