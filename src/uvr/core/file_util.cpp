@@ -53,6 +53,19 @@ void writeFileAtomically(const std::string& path,
     }
 }
 
+void checkOutputPath(const std::string& path) {
+    if (path.empty()) throwError(ErrorKind::Argument, "", "empty output file name");
+    std::string folder = parentFolder(path);
+    if (folder.empty()) folder = ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec))
+        throwError(ErrorKind::Io, path, "cannot write: folder '" + folder + "' does not exist");
+    if (::access(folder.c_str(), W_OK) != 0)
+        throwError(ErrorKind::Io, path, "cannot write: folder '" + folder + "' is not writable");
+    if (std::filesystem::is_directory(path, ec))
+        throwError(ErrorKind::Io, path, "cannot write: is a folder");
+}
+
 std::string fileExtension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),

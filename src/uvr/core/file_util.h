@@ -20,6 +20,10 @@ std::uint64_t fileSize(const std::string& path);
 void writeFileAtomically(const std::string& path,
                          const std::function<void(const std::string&)>& write);
 
+/// Throws Error(Io) unless path's folder exists and is writable (checked before long work, so
+/// a bad output path fails fast).
+void checkOutputPath(const std::string& path);
+
 /// Lower-cased extension of a path including the dot (".vtu"), or "" if none.
 std::string fileExtension(const std::string& path);
 

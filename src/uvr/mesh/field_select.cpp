@@ -1,1 +1,136 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/field_select.h"
+
+#include <cmath>
+#include <limits>
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+namespace {
+
+std::string describeFields(const Mesh& mesh) {
+    if (mesh.fields.empty()) return "the mesh has no fields";
+    std::string s = "available:";
+    for (const Field& f : mesh.fields)
+        s += " " + f.name + ":" + associationName(f.association) +
+             (f.components > 1 ? "(" + std::to_string(f.components) + " components)" : "");
+    return s;
+}
+
+}  // namespace
+
+FieldSpec parseFieldSpec(const std::string& text) {
+    FieldSpec spec;
+    size_t pos = text.find(':');
+    spec.name = text.substr(0, pos);
+    while (pos != std::string::npos) {
+        size_t next = text.find(':', pos + 1);
+        std::string part = text.substr(pos + 1, next == std::string::npos ? std::string::npos
+                                                                           : next - pos - 1);
+        if (part == "point") {
+            spec.association = Association::Point;
+        } else if (part == "cell") {
+            spec.association = Association::Cell;
+        } else if (part == "magnitude") {
+            spec.component = -1;
+        } else if (part == "x" || part == "y" || part == "z") {
+            spec.component = part[0] - 'x';
+        } else if (!part.empty() && part.find_first_not_of("0123456789") == std::string::npos &&
+                   part.size() < 6) {
+            spec.component = std::stoi(part);
+        } else {
+            throwError(ErrorKind::Argument, "",
+                       "--field '" + text + "': unknown qualifier '" + part +
+                           "' (expected point, cell, magnitude, x, y, z or a component number)");
+        }
+        pos = next;
+    }
+    return spec;
+}
+
+ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
+    const Field* field = nullptr;
+    if (spec.name.empty()) {
+        for (const Field& f : mesh.fields)
+            if (f.components == 1 && (!spec.association || f.association == *spec.association)) {
+                field = &f;
+                break;
+            }
+        if (!field)
+            for (const Field& f : mesh.fields)
+                if (!spec.association || f.association == *spec.association) {
+                    field = &f;
+                    break;
+                }
+        if (!field)
+            throwError(ErrorKind::Argument, "", "no field to render: " + describeFields(mesh));
+    } else {
+        int matches = 0;
+        for (const Field& f : mesh.fields) {
+            if (f.name != spec.name) continue;
+            if (spec.association && f.association != *spec.association) continue;
+            if (!field) field = &f;
+            ++matches;
+        }
+        if (!field)
+            throwError(ErrorKind::Argument, "",
+                       "--field '" + spec.name +
+                           (spec.association ? std::string(":") + associationName(*spec.association)
+                                             : "") +
+                           "' not found; " + describeFields(mesh));
+        if (matches > 1)
+            throwError(ErrorKind::Argument, "",
+                       "--field '" + spec.name +
+                           "' exists as point and cell data: add ':point' or ':cell'");
+    }
+    const std::uint64_t tuples = field->association == Association::Point ? mesh.pointCount()
+                                                                           : mesh.cellCount();
+    UVR_CHECK(field->tupleCount() == tuples && field->values.size() == tuples * field->components,
+              "field '" << field->name << "' holds " << field->values.size() << " values for "
+                        << tuples << " tuples");
+    if (spec.component >= field->components)
+        throwError(ErrorKind::Argument, "",
+                   "--field '" + field->name + "': component " + std::to_string(spec.component) +
+                       " does not exist (the field has " + std::to_string(field->components) +
+                       ")");
+    ScalarField out;
+    out.name = field->name;
+    out.association = field->association;
+    const int nc = field->components;
+    if (nc == 1) {
+        out.values = field->values;
+        return out;
+    }
+    out.values.resize(tuples);
+    if (spec.component >= 0) {
+        out.name += ":" + std::to_string(spec.component);
+        for (std::uint64_t i = 0; i < tuples; ++i)
+            out.values[i] = field->values[i * nc + spec.component];
+    } else {
+        out.name += ":magnitude";
+        for (std::uint64_t i = 0; i < tuples; ++i) {
+            double s = 0;
+            for (int c = 0; c < nc; ++c) {
+                double v = field->values[i * nc + c];
+                s += v * v;
+            }
+            out.values[i] = static_cast<float>(std::sqrt(s));
+        }
+    }
+    return out;
+}
+
+std::pair<float, float> finiteRange(const std::vector<float>& values) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (float v : values)
+        if (std::isfinite(v)) {
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+    if (lo > hi) return {0.f, 0.f};
+    return {lo, hi};
+}
+
+}  // namespace uvr

@@ -1,1 +1,177 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/tet_mesh.h"
+
+#include <cmath>
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+namespace {
+
+/// Faces of a positively oriented VTK cell, counter-clockwise seen from outside (VTK's face
+/// lists); -1 pads triangles.
+struct FaceList {
+    int count;
+    int v[6][4];
+};
+
+const FaceList& cellFaces(CellType type) {
+    static const FaceList kTet{4, {{0, 2, 1, -1}, {0, 1, 3, -1}, {1, 2, 3, -1}, {0, 3, 2, -1}}};
+    static const FaceList kHex{6,
+                               {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1},
+                                {4, 5, 6, 7}}};
+    static const FaceList kWedge{
+        5, {{0, 1, 2, -1}, {3, 5, 4, -1}, {0, 3, 4, 1}, {1, 4, 5, 2}, {2, 5, 3, 0}}};
+    static const FaceList kPyramid{
+        5, {{0, 3, 2, 1}, {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {3, 0, 4, -1}}};
+    switch (type) {
+        case CellType::Tetra: return kTet;
+        case CellType::Hexahedron: return kHex;
+        case CellType::Wedge: return kWedge;
+        case CellType::Pyramid: return kPyramid;
+    }
+    return kTet;
+}
+
+double det6(const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& d) {
+    const double bx = double(b.x) - a.x, by = double(b.y) - a.y, bz = double(b.z) - a.z;
+    const double cx = double(c.x) - a.x, cy = double(c.y) - a.y, cz = double(c.z) - a.z;
+    const double dx = double(d.x) - a.x, dy = double(d.y) - a.y, dz = double(d.z) - a.z;
+    return bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx);
+}
+
+/// A tetrahedron whose |6V| is below this fraction of (longest edge)^3 counts as zero-volume.
+constexpr double kZeroVolumeRelative = 1e-7;
+
+}  // namespace
+
+int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[6][4]) {
+    if (type == CellType::Tetra) {
+        out[0][0] = 0, out[0][1] = 1, out[0][2] = 2, out[0][3] = 3;
+        return 1;
+    }
+    const int n = cornerCount(type);
+    int apex = 0;
+    for (int i = 1; i < n; ++i)
+        if (ids[i] < ids[apex]) apex = i;
+    const FaceList& faces = cellFaces(type);
+    int count = 0;
+    auto emit = [&](int a, int b, int c) {
+        // (a, b, c) is counter-clockwise from outside and apex lies inside: (a, c, b, apex) > 0.
+        out[count][0] = static_cast<std::uint8_t>(a);
+        out[count][1] = static_cast<std::uint8_t>(c);
+        out[count][2] = static_cast<std::uint8_t>(b);
+        out[count][3] = static_cast<std::uint8_t>(apex);
+        ++count;
+    };
+    for (int f = 0; f < faces.count; ++f) {
+        const int* v = faces.v[f];
+        const int nv = v[3] < 0 ? 3 : 4;
+        bool hasApex = false;
+        for (int k = 0; k < nv; ++k) hasApex |= v[k] == apex;
+        if (hasApex) continue;
+        if (nv == 3) {
+            emit(v[0], v[1], v[2]);
+            continue;
+        }
+        // Quadrilateral: split along the diagonal through its smallest global index.
+        int minK = 0;
+        for (int k = 1; k < 4; ++k)
+            if (ids[v[k]] < ids[v[minK]]) minK = k;
+        if (minK % 2 == 0) {
+            emit(v[0], v[1], v[2]);
+            emit(v[0], v[2], v[3]);
+        } else {
+            emit(v[1], v[2], v[3]);
+            emit(v[1], v[3], v[0]);
+        }
+    }
+    return count;
+}
+
+CellSplit splitCell(const Mesh& mesh, std::uint64_t c) {
+    const auto ids = mesh.cell(c);
+    const CellType type = mesh.cellTypes[c];
+    std::uint8_t local[6][4];
+    const int n = splitCellIntoTets(type, ids.data(), local);
+    CellSplit split;
+    double total = 0.0, longest = 0.0;
+    int positive = 0, negative = 0;
+    double vols[6];
+    for (int t = 0; t < n; ++t) {
+        const Vec3f p[4] = {mesh.points[ids[local[t][0]]], mesh.points[ids[local[t][1]]],
+                            mesh.points[ids[local[t][2]]], mesh.points[ids[local[t][3]]]};
+        vols[t] = det6(p[0], p[1], p[2], p[3]);
+        total += vols[t];
+        double l = 0.0;
+        for (int i = 0; i < 4; ++i)
+            for (int j = i + 1; j < 4; ++j) {
+                const double dx = double(p[i].x) - p[j].x, dy = double(p[i].y) - p[j].y,
+                             dz = double(p[i].z) - p[j].z;
+                l = std::fmax(l, dx * dx + dy * dy + dz * dz);
+            }
+        longest = std::fmax(longest, l);
+    }
+    const double scale = longest * std::sqrt(longest);  // (longest edge)^3
+    const double eps = kZeroVolumeRelative * scale;
+    for (int t = 0; t < n; ++t) {
+        if (std::fabs(vols[t]) <= eps || !std::isfinite(vols[t])) continue;
+        (vols[t] > 0 ? positive : negative)++;
+        Tet tet{{ids[local[t][0]], ids[local[t][1]], ids[local[t][2]], ids[local[t][3]]}};
+        if (vols[t] < 0) std::swap(tet.v[1], tet.v[2]);
+        split.tets[split.count] = tet;
+        split.volume6[split.count] = std::fabs(vols[t]);
+        ++split.count;
+    }
+    if (!(std::fabs(total) > eps))
+        split.shape = CellShape::ZeroVolume;
+    else if (negative > 0 && positive > 0)
+        split.shape = CellShape::Distorted;
+    else if (negative > 0)
+        split.shape = CellShape::Inverted;
+    return split;
+}
+
+TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
+    TetMesh out;
+    out.points = mesh.points;
+    out.association = field.association;
+    out.fieldName = field.name;
+    const bool cellData = field.association == Association::Cell;
+    UVR_CHECK(field.values.size() == (cellData ? mesh.cellCount() : mesh.pointCount()),
+              "field '" << field.name << "' has " << field.values.size() << " values");
+    std::uint64_t estimate = 0;
+    for (CellType t : mesh.cellTypes) estimate += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
+    out.tets.reserve(estimate);
+    if (cellData) out.values.reserve(estimate);
+    for (std::uint64_t c = 0; c < mesh.cellCount(); ++c) {
+        const CellSplit split = splitCell(mesh, c);
+        for (int t = 0; t < split.count; ++t) {
+            out.tets.push_back(split.tets[t]);
+            out.totalVolume += split.volume6[t] / 6.0;
+            if (cellData) out.values.push_back(field.values[c]);
+        }
+    }
+    if (!cellData) out.values = field.values;
+    // Bounds and value range over what the tets actually use.
+    std::vector<bool> used(out.points.size(), false);
+    for (const Tet& t : out.tets)
+        for (std::uint32_t v : t.v) used[v] = true;
+    float lo = INFINITY, hi = -INFINITY;
+    for (std::size_t i = 0; i < out.points.size(); ++i) {
+        if (!used[i]) continue;
+        out.bounds.extend(out.points[i]);
+        if (!cellData && std::isfinite(out.values[i])) {
+            lo = std::fmin(lo, out.values[i]);
+            hi = std::fmax(hi, out.values[i]);
+        }
+    }
+    if (cellData)
+        for (float v : out.values)
+            if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);
+    if (lo <= hi) out.valueMin = lo, out.valueMax = hi;
+    return out;
+}
+
+}  // namespace uvr

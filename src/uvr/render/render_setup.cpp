@@ -1,1 +1,114 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/render/render_setup.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const ProgressFn& progress) {
+    PreparedMesh out;
+    out.sourceCells = mesh.cellCount();
+    auto start = std::chrono::steady_clock::now();
+    if (progress) progress("splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra");
+    out.tets = tetrahedralize(mesh, field);
+    out.splitSeconds = secondsSince(start);
+
+    start = std::chrono::steady_clock::now();
+    if (progress) progress("building the BVH over " + std::to_string(out.tets.tets.size()) + " tetrahedra");
+    std::vector<Bounds3f> boxes(out.tets.tets.size());
+    std::vector<Vec3f> centers(out.tets.tets.size());
+    for (std::size_t t = 0; t < boxes.size(); ++t) {
+        for (std::uint32_t v : out.tets.tets[t].v) boxes[t].extend(out.tets.points[v]);
+        centers[t] = boxes[t].center();
+    }
+    out.bvh = buildBvh(boxes, centers);
+    out.bvhSeconds = secondsSince(start);
+
+    start = std::chrono::steady_clock::now();
+    if (progress) progress("finding face neighbours");
+    out.neighbors = buildTetNeighbors(out.tets);
+    out.adjacencySeconds = secondsSince(start);
+    return out;
+}
+
+float defaultStep(const TetMesh& mesh) {
+    if (mesh.tets.empty() || !(mesh.totalVolume > 0.0)) return 0.01f * std::fmax(mesh.bounds.diagonal(), 1e-30f);
+    return static_cast<float>(0.5 * std::cbrt(mesh.totalVolume / double(mesh.tets.size())));
+}
+
+float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount) {
+    const double d = bounds.diagonal();
+    if (cellCount == 0 || !(d > 0.0)) return 1.f;
+    return static_cast<float>(d / std::cbrt(double(cellCount)));
+}
+
+void validateSettings(const RenderSettings& s) {
+    auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
+    constexpr int kMaxSide = 16384;
+    if (s.width < 1 || s.height < 1 || s.width > kMaxSide || s.height > kMaxSide)
+        bad("--size " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+            ": each side must be between 1 and " + std::to_string(kMaxSide));
+    if (!std::isfinite(s.step) || s.step < 0.f)
+        bad("--step " + std::to_string(s.step) + ": expected a positive finite distance");
+    if (!std::isfinite(s.opacityUnit) || s.opacityUnit < 0.f)
+        bad("--opacity-unit " + std::to_string(s.opacityUnit) +
+            ": expected a positive finite distance");
+    if (!(s.terminationAlpha > 0.f && s.terminationAlpha <= 1.f))
+        bad("early termination threshold must lie in (0, 1]");
+    if (s.range && !(std::isfinite(s.range->first) && std::isfinite(s.range->second) &&
+                     s.range->first <= s.range->second))
+        bad("--range " + std::to_string(s.range->first) + "," + std::to_string(s.range->second) +
+            ": expected finite lo <= hi");
+    if (s.tfTableSize < 2 || s.tfTableSize > (1 << 20)) bad("transfer function table size out of range");
+    if (s.tf.colors.empty() || s.tf.opacities.empty())
+        bad("transfer function needs at least one colour and one opacity point");
+    if (s.camera) validateCamera(*s.camera);
+}
+
+SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
+    SceneView v;
+    v.locator = mesh.locator();
+    v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi};
+    v.bounds = mesh.tets.bounds;
+    v.params = params;
+    return v;
+}
+
+FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings) {
+    validateSettings(settings);
+    FrameSetup f;
+    f.tfTable = settings.tf.bake(settings.tfTableSize);
+    f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
+    f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
+    const float aspect = float(settings.width) / float(settings.height);
+    f.camera = settings.camera ? *settings.camera : resetCamera(mesh.tets.bounds, aspect);
+    validateCamera(f.camera);
+    f.rays = makeCameraRays(f.camera, settings.width, settings.height);
+    f.params.step = settings.step > 0.f ? settings.step : defaultStep(mesh.tets);
+    f.params.opacityUnit = settings.opacityUnit > 0.f
+                               ? settings.opacityUnit
+                               : defaultOpacityUnit(mesh.tets.bounds, mesh.sourceCells);
+    f.params.terminationAlpha = settings.terminationAlpha;
+    // A ray of the bounds' diagonal must not need more samples than a float counts exactly.
+    const double samplesPerRay = mesh.tets.bounds.diagonal() / f.params.step;
+    if (samplesPerRay > 1e7)
+        throwError(ErrorKind::Argument, "",
+                   "--step " + std::to_string(f.params.step) + " would take " +
+                       std::to_string(static_cast<long long>(samplesPerRay)) +
+                       " samples per ray (at most 10 million)");
+    return f;
+}
+
+}  // namespace uvr

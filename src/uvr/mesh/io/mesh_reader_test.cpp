@@ -1,1 +1,41 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/io/mesh_reader.h"
+
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+TEST(MeshReader, DispatchesByContentNotJustExtension) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    // A legacy file under a misleading name is still read as legacy VTK.
+    std::filesystem::copy_file(testing::sharedData("tetraMesh.vtk"), dir + "/mesh.dat");
+    EXPECT_EQ(readMesh(dir + "/mesh.dat").cellCount(), 160u);
+    // The native round trip through writeMesh/readMesh.
+    const Mesh spx = readMesh(testing::sharedData("spx.vtk"));
+    writeMesh(spx, dir + "/spx.uvrm");
+    const Mesh back = readMesh(dir + "/spx.uvrm");
+    EXPECT_EQ(back.points.size(), spx.points.size());
+    EXPECT_EQ(back.cellIndices, spx.cellIndices);
+}
+
+TEST(MeshReader, UnknownFormatsAndOutputsAreClearErrors) {
+    const std::string dir = testing::scratchDir();
+    testing::writeFile(dir + "/x.stl", "solid nothing\n");
+    try {
+        readMesh(dir + "/x.stl");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Parse);
+        EXPECT_NE(std::string(e.what()).find("unrecognised file format"), std::string::npos);
+    }
+    EXPECT_THROW(readMesh(dir + "/absent.vtk"), Error);
+    EXPECT_THROW(writeMesh(Mesh{}, dir + "/out.obj"), Error);
+}
+
+}  // namespace
+}  // namespace uvr

@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: MIT
+#include "cli_common.h"
+
+#include <omp.h>
+
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace uvr::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+[[noreturn]] void badFlag(const std::string& flag, const std::string& text, const std::string& what) {
+    throwError(ErrorKind::Argument, "", flag + " '" + text + "': expected " + what);
+}
+
+bool parseFloat(std::string_view s, float& out) {
+    while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+    while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+    const char* end = s.data() + s.size();
+    auto [ptr, ec] = std::from_chars(s.data(), end, out);
+    return ec == std::errc() && ptr == end && std::isfinite(out);
+}
+
+std::vector<float> parseFloats(const std::string& flag, const std::string& text, size_t count,
+                               const std::string& what) {
+    std::vector<float> out;
+    size_t pos = 0;
+    while (true) {
+        size_t comma = text.find(',', pos);
+        float v;
+        if (!parseFloat(std::string_view(text).substr(pos, comma == std::string::npos ? std::string::npos : comma - pos), v))
+            badFlag(flag, text, what);
+        out.push_back(v);
+        if (comma == std::string::npos) break;
+        pos = comma + 1;
+    }
+    if (out.size() != count) badFlag(flag, text, what);
+    return out;
+}
+
+}  // namespace
+
+void Log::step(const std::string& message) const {
+    if (!quiet) std::fprintf(stderr, "uvr: %s\n", message.c_str());
+}
+
+void Log::done(const std::string& message, Clock::time_point start) const {
+    if (!quiet)
+        std::fprintf(stderr, "uvr: %s (%.2f s)\n", message.c_str(),
+                     std::chrono::duration<double>(Clock::now() - start).count());
+}
+
+Vec3f parseVec3(const std::string& flag, const std::string& text) {
+    auto v = parseFloats(flag, text, 3, "three finite numbers x,y,z");
+    return {v[0], v[1], v[2]};
+}
+
+std::pair<float, float> parseRange(const std::string& flag, const std::string& text) {
+    auto v = parseFloats(flag, text, 2, "two finite numbers lo,hi with lo <= hi");
+    if (v[0] > v[1]) badFlag(flag, text, "two finite numbers lo,hi with lo <= hi");
+    return {v[0], v[1]};
+}
+
+std::pair<int, int> parseSize(const std::string& flag, const std::string& text) {
+    const size_t x = text.find_first_of("xX");
+    int w = 0, h = 0;
+    auto parseInt = [&](std::string_view s, int& out) {
+        auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+        return ec == std::errc() && ptr == s.data() + s.size() && !s.empty();
+    };
+    if (x == std::string::npos || !parseInt(std::string_view(text).substr(0, x), w) ||
+        !parseInt(std::string_view(text).substr(x + 1), h) || w < 1 || h < 1 || w > 16384 ||
+        h > 16384)
+        badFlag(flag, text, "WIDTHxHEIGHT with each side between 1 and 16384, e.g. 1024x768");
+    return {w, h};
+}
+
+void RenderFlags::registerOn(CLI::App& app) {
+    app.add_option("-o,--output", output, "Output PNG file")->required();
+    app.add_option("--field", field,
+                   "Field to render: NAME[:point|:cell][:magnitude|:x|:y|:z|:N] "
+                   "(default: the first scalar field)");
+    app.add_option("--tf", tf,
+                   "Colour map: a preset (cool-to-warm, viridis, black-body, grayscale, ...) or "
+                   "a ParaView colour-map JSON export")
+        ->capture_default_str();
+    app.add_option("--opacity", opacity,
+                   "Opacity: ramp, ramp:A, constant:A, step:T[:A] (binary) or x0:a0,x1:a1,... "
+                   "over the normalised range (default: the JSON's Points, else ramp)");
+    app.add_option("--range", range, "Value range lo,hi the transfer function spans "
+                                     "(default: the field's range)");
+    app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
+    app.add_option("--camera", cameraFile, "ParaView camera file (.pvcc)");
+    app.add_option("--camera-position", cameraPosition, "Camera position x,y,z");
+    app.add_option("--camera-focal", cameraFocal, "Camera focal point x,y,z");
+    app.add_option("--camera-up", cameraUp, "Camera view up x,y,z");
+    app.add_option("--view-angle", viewAngle, "Vertical view angle in degrees (default 30)");
+    app.add_option("--azimuth", azimuth, "Rotate the camera about view up, degrees");
+    app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees");
+    app.add_option("--step", step,
+                   "Sample spacing s1 (default: 0.5 * cube root of the mean tetrahedron volume)");
+    app.add_option("--opacity-unit", opacityUnit,
+                   "Distance over which a TF opacity applies (default: ParaView's "
+                   "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))");
+    app.add_option("--background", background,
+                   "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)");
+    app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
+    app.add_option("--threads", threads, "CPU threads (default: all cores)")
+        ->check(CLI::Range(0, 4096));
+}
+
+RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
+    RenderSettings s;
+    std::tie(s.width, s.height) = parseSize("--size", size);
+    s.tf = loadTransferFunction(tf);
+    if (!opacity.empty()) applyOpacitySpec(s.tf, opacity);
+    if (!range.empty()) s.range = parseRange("--range", range);
+    s.step = step;
+    s.opacityUnit = opacityUnit;
+    if (!(std::isfinite(step) && step >= 0.f))
+        throwError(ErrorKind::Argument, "", "--step must be a positive finite distance");
+    if (!(std::isfinite(opacityUnit) && opacityUnit >= 0.f))
+        throwError(ErrorKind::Argument, "", "--opacity-unit must be a positive finite distance");
+    Camera cam = resetCamera(bounds, float(s.width) / float(s.height));
+    bool custom = false;
+    if (!cameraFile.empty()) cam = loadPvcc(cameraFile), custom = true;
+    if (!cameraPosition.empty()) cam.position = parseVec3("--camera-position", cameraPosition), custom = true;
+    if (!cameraFocal.empty()) cam.focalPoint = parseVec3("--camera-focal", cameraFocal), custom = true;
+    if (!cameraUp.empty()) cam.viewUp = parseVec3("--camera-up", cameraUp), custom = true;
+    if (viewAngle) cam.viewAngle = *viewAngle, custom = true;
+    if (!std::isfinite(azimuth) || !std::isfinite(elevation))
+        throwError(ErrorKind::Argument, "", "--azimuth/--elevation must be finite");
+    validateCamera(cam);
+    if (azimuth != 0.f || elevation != 0.f) cam = orbitCamera(cam, azimuth, elevation), custom = true;
+    if (custom) s.camera = cam;
+    return s;
+}
+
+Mesh loadMesh(const std::string& path, const Log& log) {
+    auto start = Clock::now();
+    log.step("reading " + path);
+    Mesh mesh = readMesh(path);
+    validateStructure(mesh, path);
+    log.done("read " + std::to_string(mesh.pointCount()) + " points, " +
+                 std::to_string(mesh.cellCount()) + " cells",
+             start);
+    for (const std::string& note : mesh.notes) log.step("note: " + note);
+    return mesh;
+}
+
+RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
+                            const Log& log) {
+    if (flags.threads > 0) omp_set_num_threads(flags.threads);
+    std::optional<Vec3f> background;
+    if (!flags.background.empty()) {
+        background = parseVec3("--background", flags.background);
+        for (int i = 0; i < 3; ++i)
+            if ((*background)[i] < 0.f || (*background)[i] > 1.f)
+                throwError(ErrorKind::Argument, "",
+                           "--background '" + flags.background + "': components must lie in [0,1]");
+    }
+    checkOutputPath(flags.output);
+    if (!flags.statsFile.empty()) checkOutputPath(flags.statsFile);
+    const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
+    auto start = Clock::now();
+    const ValidationReport report = validateMesh(mesh, source);
+    for (const std::string& f : report.findings()) log.step("validation: " + f);
+    // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
+    const RenderSettings settings = flags.settings(mesh.bounds());
+    validateSettings(settings);
+    PreparedMesh prepared = prepareMesh(mesh, field, [&](const std::string& s) { log.step(s); });
+    log.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
+    log.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
+             std::to_string(settings.height));
+    RenderResult result = renderReferenceCpu(prepared, settings);
+    char line[200];
+    std::snprintf(line, sizeof line, "rendered in %.3f s: %llu samples, %.1f per pixel, step %g",
+                  result.stats.seconds, static_cast<unsigned long long>(result.stats.samples),
+                  result.stats.meanSamplesPerPixel(), result.setup.params.step);
+    log.step(line);
+    writePng(flags.output, result.image, background);
+    log.step("wrote " + flags.output);
+    if (!flags.statsFile.empty()) {
+        nlohmann::json j;
+        j["source"] = source;
+        j["field"] = field.name;
+        j["device"] = "cpu";
+        j["threads"] = omp_get_max_threads();
+        j["method"] = "reference";
+        j["image"] = {{"width", settings.width}, {"height", settings.height}};
+        j["mesh"] = {{"points", mesh.pointCount()},
+                     {"cells", mesh.cellCount()},
+                     {"tetrahedra", prepared.tets.tets.size()}};
+        j["prepare_seconds"] = {{"split", prepared.splitSeconds},
+                                {"bvh", prepared.bvhSeconds},
+                                {"adjacency", prepared.adjacencySeconds}};
+        j["render_seconds"] = result.stats.seconds;
+        j["samples"] = result.stats.samples;
+        j["mean_samples_per_pixel"] = result.stats.meanSamplesPerPixel();
+        j["samples_per_second"] =
+            result.stats.seconds > 0 ? double(result.stats.samples) / result.stats.seconds : 0.0;
+        j["walk_steps"] = result.stats.walkSteps;
+        j["bvh_queries"] = result.stats.bvhQueries;
+        j["step"] = result.setup.params.step;
+        j["opacity_unit"] = result.setup.params.opacityUnit;
+        j["range"] = {result.setup.rangeLo, result.setup.rangeHi};
+        const Camera& c = result.setup.camera;
+        j["camera"] = {{"position", {c.position.x, c.position.y, c.position.z}},
+                       {"focal_point", {c.focalPoint.x, c.focalPoint.y, c.focalPoint.z}},
+                       {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
+                       {"view_angle", c.viewAngle}};
+        writeFileAtomically(flags.statsFile, [&](const std::string& tmp) {
+            std::ofstream out(tmp);
+            out << j.dump(2) << "\n";
+            if (!out) throwError(ErrorKind::Io, flags.statsFile, "cannot write");
+        });
+        log.step("wrote " + flags.statsFile);
+    }
+    return result;
+}
+
+}  // namespace uvr::cli

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <optional>
+#include <string>
+
+#include "uvr/uvr.h"
+
+namespace uvr::cli {
+
+/// Progress messages on stderr ("uvr: reading x.vtk"), silenced by --quiet.
+class Log {
+public:
+    bool quiet = false;
+    /// Prints a step message.
+    void step(const std::string& message) const;
+    /// Prints a message with the seconds since `start`.
+    void done(const std::string& message, std::chrono::steady_clock::time_point start) const;
+};
+
+/// Parses "x,y,z" for a flag; throws Error(Argument) naming the flag.
+Vec3f parseVec3(const std::string& flag, const std::string& text);
+/// Parses "lo,hi" for a flag; throws Error(Argument) naming the flag.
+std::pair<float, float> parseRange(const std::string& flag, const std::string& text);
+/// Parses "WxH" for a flag; throws Error(Argument) naming the flag.
+std::pair<int, int> parseSize(const std::string& flag, const std::string& text);
+
+/// Render options shared by `render` and `demo`, registered on a subcommand.
+struct RenderFlags {
+    std::string output;
+    std::string field;
+    std::string tf = "cool-to-warm";
+    std::string opacity;
+    std::string range;
+    std::string size = "1024x1024";
+    std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
+    std::optional<float> viewAngle;
+    float azimuth = 0.f, elevation = 0.f;
+    float step = 0.f;
+    float opacityUnit = 0.f;
+    std::string background;
+    std::string statsFile;
+    int threads = 0;
+
+    /// Adds the flags to a subcommand.
+    void registerOn(CLI::App& app);
+    /// Parses the flags into render settings; the default camera fits the bounds.
+    RenderSettings settings(const Bounds3f& bounds) const;
+};
+
+/// Loads a mesh with progress messages and validation; prints findings.
+Mesh loadMesh(const std::string& path, const Log& log);
+
+/// Prepares, renders and writes the PNG (and stats JSON); returns the result.
+RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
+                            const Log& log);
+
+/// Registers the subcommands.
+void addInfoCommand(CLI::App& app, Log& log);
+void addRenderCommand(CLI::App& app, Log& log);
+void addDemoCommand(CLI::App& app, Log& log);
+void addConvertCommand(CLI::App& app, Log& log);
+void addGenerateCommand(CLI::App& app, Log& log);
+
+}  // namespace uvr::cli

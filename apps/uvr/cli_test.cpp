@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: MIT
+// End-to-end tests of the uvr command-line tool: exit codes, messages, outputs.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "test_support.h"
+#include "uvr/render/image.h"
+
+namespace uvr {
+namespace {
+
+struct Run {
+    int code = -1;
+    std::string out, err;
+};
+
+/// Runs `uvr ARGS` in dir, capturing stdout and stderr.
+Run uvr(const std::string& args, const std::string& dir) {
+    const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+    Run r;
+    r.code = testing::runCommand(testing::uvrBinary() + " " + args + " >" + out + " 2>" + err);
+    auto slurp = [](const std::string& p) {
+        std::ifstream in(p);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    };
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+TEST(Cli, HelpListsEverySubcommand) {
+    const std::string dir = testing::scratchDir();
+    const Run r = uvr("--help", dir);
+    EXPECT_EQ(r.code, 0);
+    for (const char* cmd : {"info", "render", "demo", "convert", "generate"})
+        EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
+    const Run rh = uvr("render --help", dir);
+    EXPECT_EQ(rh.code, 0);
+    EXPECT_NE(rh.out.find("--opacity"), std::string::npos);
+}
+
+TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string spx = testing::sharedData("spx.vtk");
+    const std::string out = dir + "/o.png";
+    for (const std::string& args :
+         {"render " + spx + " -o " + out + " --size 0x10",
+          "render " + spx + " -o " + out + " --size 100000x100000",
+          "render " + spx + " -o " + out + " --step -1",
+          "render " + spx + " -o " + out + " --step nan",
+          "render " + spx + " -o " + out + " --range 5,1",
+          "render " + spx + " -o " + out + " --camera-position nan,0,0",
+          "render " + spx + " -o " + out + " --field nosuch",
+          "render " + spx + " -o " + out + " --tf nosuch",
+          "render " + spx + " -o " + out + " --opacity zigzag",
+          "render " + spx + " -o " + dir + "/missing/o.png",
+          "render " + spx + " --bogus -o " + out, "render " + spx, "frobnicate"}) {
+        const Run r = uvr("-q " + args, dir);
+        EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+        EXPECT_EQ(lineCount(r.err), 1) << args << "\n" << r.err;
+        EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(out)) << args;
+    }
+}
+
+TEST(Cli, BadFilesExitWithCode2NamingTheFile) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    // A binary file cut in half.
+    std::ifstream in(testing::sharedData("post.vtk"), std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    testing::writeFile(dir + "/cut.vtk", bytes.substr(0, bytes.size() / 2));
+    for (const std::string& file : {dir + "/cut.vtk", dir + "/absent.vtk"}) {
+        const Run r = uvr("-q render " + file + " -o " + dir + "/o.png", dir);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1) << r.err;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir + "/o.png"));
+}
+
+TEST(Cli, InfoOnEveryRealFile) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::map<std::string, std::pair<int, int>> counts = {
+        {"spx.vtk", {2896, 12936}},          {"post.vtk", {2288, 8750}},
+        {"tetraMesh.vtk", {55, 160}},        {"bluntfin_tets.vtk", {40960, 187395}},
+        {"post_tets.vtk", {109744, 513375}}, {"cylinder_quadratic_as_tets.vtk", {465, 1522}},
+        {"hexa.vtk", {12167, 10648}},        {"fire_ug.vtu", {12323, 10462}}};
+    for (const auto& [name, pc] : counts) {
+        const Run r = uvr("-q info --json " + testing::sharedData(name), dir);
+        ASSERT_EQ(r.code, 0) << name << r.err;
+        const auto j = nlohmann::json::parse(r.out);
+        EXPECT_EQ(j["points"], pc.first) << name;
+        EXPECT_EQ(j["cells"], pc.second) << name;
+        EXPECT_FALSE(j["fields"].empty()) << name;
+        const Run text = uvr("-q info " + testing::sharedData(name), dir);
+        EXPECT_EQ(text.code, 0);
+        EXPECT_NE(text.out.find("validation:"), std::string::npos);
+    }
+}
+
+TEST(Cli, RenderWritesPngAndStats) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const Run r = uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
+                          "/spx.png --size 64x48 --stats " + dir + "/s.json --tf viridis",
+                      dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Image img = readPng(dir + "/spx.png");
+    EXPECT_EQ(img.width, 64);
+    EXPECT_EQ(img.height, 48);
+    EXPECT_GT(img.at(32, 24).w, 0.f);  // the mesh covers the centre
+    EXPECT_EQ(img.at(0, 0).w, 0.f);    // and not the corner
+    std::ifstream in(dir + "/s.json");
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_GT(j["samples"].get<double>(), 0);
+    EXPECT_EQ(j["image"]["width"], 64);
+    EXPECT_EQ(j["mesh"]["cells"], 12936);
+    EXPECT_GT(j["render_seconds"].get<double>(), 0);
+}
+
+TEST(Cli, ConvertedMeshRendersIdentically) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string src = testing::sharedData("bluntfin_tets.vtk");
+    ASSERT_EQ(uvr("-q convert " + src + " " + dir + "/b.uvrm", dir).code, 0);
+    const std::string common = " --size 48x48 --field speed --background 0,0,0";
+    ASSERT_EQ(uvr("-q render " + src + " -o " + dir + "/a.png" + common, dir).code, 0);
+    ASSERT_EQ(uvr("-q render " + dir + "/b.uvrm -o " + dir + "/b.png" + common, dir).code, 0);
+    const Image a = readPng(dir + "/a.png"), b = readPng(dir + "/b.png");
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    for (size_t i = 0; i < a.pixels.size(); ++i) ASSERT_EQ(a.pixels[i].x, b.pixels[i].x);
+}
+
+TEST(Cli, GenerateAndDemo) {
+    const std::string dir = testing::scratchDir();
+    Run r = uvr("-q generate shell --cells 2000 -o " + dir + "/s.uvrm", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = uvr("-q info --json " + dir + "/s.uvrm", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_GT(nlohmann::json::parse(r.out)["cells"].get<int>(), 1000);
+    EXPECT_EQ(uvr("-q generate cube -o " + dir + "/c.uvrm", dir).code, 2);
+    r = uvr("-q demo --cells 5000 --size 32x32 -o " + dir + "/demo.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(readPng(dir + "/demo.png").width, 32);
+}
+
+}  // namespace
+}  // namespace uvr

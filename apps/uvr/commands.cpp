@@ -1,0 +1,188 @@
+// SPDX-License-Identifier: MIT
+#include <cstdio>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+
+namespace uvr::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string fmt(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
+}
+
+}  // namespace
+
+void addInfoCommand(CLI::App& app, Log& log) {
+    auto* cmd = app.add_subcommand("info", "Print counts, fields, bounds and validation findings");
+    auto file = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    cmd->add_flag("--json", *json, "Print JSON instead of text");
+    cmd->callback([file, json, &log] {
+        const Mesh mesh = loadMesh(*file, log);
+        const ValidationReport report = validateMesh(mesh, *file);
+        std::map<std::string, std::uint64_t> byType;
+        for (CellType t : mesh.cellTypes) ++byType[cellTypeName(t)];
+        const Bounds3f b = mesh.bounds();
+        nlohmann::json j;
+        j["file"] = *file;
+        j["points"] = mesh.pointCount();
+        j["cells"] = mesh.cellCount();
+        j["cell_types"] = byType;
+        if (!b.empty())
+            j["bounds"] = {{b.lo.x, b.hi.x}, {b.lo.y, b.hi.y}, {b.lo.z, b.hi.z}};
+        j["fields"] = nlohmann::json::array();
+        for (const Field& f : mesh.fields) {
+            const ScalarField s = selectScalarField(
+                mesh, FieldSpec{f.name, f.association, -1});
+            const auto [lo, hi] = finiteRange(s.values);
+            j["fields"].push_back({{"name", f.name},
+                                   {"association", associationName(f.association)},
+                                   {"components", f.components},
+                                   {"range", {lo, hi}}});
+        }
+        j["validation"] = report.findings();
+        j["notes"] = mesh.notes;
+        if (*json) {
+            std::printf("%s\n", j.dump(2).c_str());
+            return;
+        }
+        std::printf("file:    %s\n", file->c_str());
+        std::printf("points:  %llu\n", static_cast<unsigned long long>(mesh.pointCount()));
+        std::printf("cells:   %llu", static_cast<unsigned long long>(mesh.cellCount()));
+        const char* sep = " (";
+        for (const auto& [name, count] : byType) {
+            std::printf("%s%s %llu", sep, name.c_str(), static_cast<unsigned long long>(count));
+            sep = ", ";
+        }
+        std::printf("%s\n", byType.empty() ? "" : ")");
+        if (!b.empty())
+            std::printf("bounds:  x [%s, %s]  y [%s, %s]  z [%s, %s]\n", fmt(b.lo.x).c_str(),
+                        fmt(b.hi.x).c_str(), fmt(b.lo.y).c_str(), fmt(b.hi.y).c_str(),
+                        fmt(b.lo.z).c_str(), fmt(b.hi.z).c_str());
+        std::printf("fields:\n");
+        if (mesh.fields.empty()) std::printf("  (none)\n");
+        for (const auto& f : j["fields"]) {
+            const int nc = f["components"];
+            std::printf("  %-24s %-5s %d component%s  %srange [%s, %s]\n",
+                        f["name"].get<std::string>().c_str(),
+                        f["association"].get<std::string>().c_str(), nc, nc == 1 ? " " : "s",
+                        nc == 1 ? "" : "magnitude ", fmt(f["range"][0].get<double>()).c_str(),
+                        fmt(f["range"][1].get<double>()).c_str());
+        }
+        std::printf("validation:\n");
+        if (report.findings().empty()) std::printf("  no problems found\n");
+        for (const std::string& s : report.findings()) std::printf("  %s\n", s.c_str());
+        for (const std::string& s : mesh.notes) std::printf("note: %s\n", s.c_str());
+    });
+}
+
+void addRenderCommand(CLI::App& app, Log& log) {
+    auto* cmd = app.add_subcommand("render", "Render a mesh file to a PNG (CPU reference marcher)");
+    auto file = std::make_shared<std::string>();
+    auto flags = std::make_shared<RenderFlags>();
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    flags->registerOn(*cmd);
+    cmd->callback([file, flags, &log] {
+        const Mesh mesh = loadMesh(*file, log);
+        renderAndWrite(mesh, *file, *flags, log);
+    });
+}
+
+void addDemoCommand(CLI::App& app, Log& log) {
+    auto* cmd = app.add_subcommand(
+        "demo", "Generate the built-in procedural data set (a turbulent jet in a jittered "
+                "tetrahedral box) and render it to a PNG");
+    auto flags = std::make_shared<RenderFlags>();
+    auto cells = std::make_shared<std::uint64_t>(400000);
+    flags->output = "uvr-demo.png";
+    flags->tf = "black-body";
+    flags->opacity = "0:0,0.25:0.05,0.6:0.6,1:1";
+    flags->background = "0.1,0.1,0.12";
+    flags->registerOn(*cmd);
+    cmd->get_option("--output")->required(false)->capture_default_str();
+    cmd->add_option("--cells", *cells, "Approximate tetrahedron count")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(2000000000)));
+    cmd->callback([flags, cells, &log] {
+        ProceduralSpec spec;
+        spec.shape = ProceduralShape::Box;
+        spec.targetCells = *cells;
+        auto start = Clock::now();
+        log.step("generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)");
+        const Mesh mesh = generateMesh(spec);
+        log.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra", start);
+        renderAndWrite(mesh, "demo", *flags, log);
+    });
+}
+
+void addConvertCommand(CLI::App& app, Log& log) {
+    auto* cmd = app.add_subcommand(
+        "convert", "Convert a mesh between formats (any readable format to .uvrm or .vtu)");
+    auto in = std::make_shared<std::string>();
+    auto out = std::make_shared<std::string>();
+    cmd->add_option("IN", *in, "Input mesh")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
+    cmd->callback([in, out, &log] {
+        checkOutputPath(*out);
+        const Mesh mesh = loadMesh(*in, log);
+        auto start = Clock::now();
+        writeMesh(mesh, *out);
+        log.done("wrote " + *out, start);
+    });
+}
+
+void addGenerateCommand(CLI::App& app, Log& log) {
+    auto* cmd = app.add_subcommand("generate", "Write a procedural tetrahedral mesh");
+    auto shape = std::make_shared<std::string>("box");
+    auto out = std::make_shared<std::string>();
+    auto spec = std::make_shared<ProceduralSpec>();
+    auto fields = std::make_shared<std::vector<std::string>>();
+    cmd->add_option("SHAPE", *shape, "box, shell (hollow, non-convex) or graded (100x cell sizes)")
+        ->capture_default_str();
+    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm or .vtu)")->required();
+    cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
+    cmd->add_option("--seed", spec->seed, "Random seed (same seed, same mesh)")->capture_default_str();
+    cmd->add_option("--jitter", spec->jitter, "Interior point jitter, fraction of the spacing")
+        ->capture_default_str()
+        ->check(CLI::Range(0.f, 0.3f));
+    cmd->add_option("--fields", *fields,
+                    "Fields to write, first is the default: jet, marschner_lobb, linear, constant")
+        ->delimiter(',');
+    cmd->callback([shape, out, spec, fields, &log] {
+        checkOutputPath(*out);
+        spec->shape = parseProceduralShape(*shape);
+        if (!fields->empty()) {
+            spec->fields.clear();
+            for (const std::string& f : *fields) spec->fields.push_back(parseProceduralField(f));
+        }
+        auto start = Clock::now();
+        log.step("generating " + std::string(proceduralShapeName(spec->shape)) + " with about " +
+                 std::to_string(spec->targetCells) + " tetrahedra");
+        int lastPercent = -10;
+        const Mesh mesh = generateMesh(*spec, [&](double f) {
+            const int percent = static_cast<int>(f * 100);
+            if (percent >= lastPercent + 10) {
+                lastPercent = percent;
+                log.step("  " + std::to_string(percent) + "%");
+            }
+        });
+        log.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
+                     std::to_string(mesh.cellCount()) + " tetrahedra",
+                 start);
+        start = Clock::now();
+        writeMesh(mesh, *out);
+        log.done("wrote " + *out, start);
+    });
+}
+
+}  // namespace uvr::cli

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: MIT
+// Benchmarks of mesh preparation and the CPU reference marcher on procedural meshes.
+// Record results in docs/PERFORMANCE.md with device, commit, date and command.
+#include <benchmark/benchmark.h>
+
+#include <map>
+
+#include "uvr/uvr.h"
+
+namespace {
+
+const uvr::Mesh& boxMesh(std::uint64_t cells) {
+    static std::map<std::uint64_t, uvr::Mesh> cache;
+    auto it = cache.find(cells);
+    if (it == cache.end()) {
+        uvr::ProceduralSpec spec;
+        spec.targetCells = cells;
+        it = cache.emplace(cells, uvr::generateMesh(spec)).first;
+    }
+    return it->second;
+}
+
+void BM_Generate(benchmark::State& state) {
+    uvr::ProceduralSpec spec;
+    spec.targetCells = static_cast<std::uint64_t>(state.range(0));
+    for (auto _ : state) benchmark::DoNotOptimize(uvr::generateMesh(spec));
+    state.counters["tets"] = static_cast<double>(spec.targetCells);
+}
+
+void BM_Prepare(benchmark::State& state) {
+    const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
+    const uvr::ScalarField field = uvr::selectScalarField(mesh, {});
+    for (auto _ : state) benchmark::DoNotOptimize(uvr::prepareMesh(mesh, field));
+    state.counters["tets/s"] = benchmark::Counter(static_cast<double>(mesh.cellCount()),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_RenderReference(benchmark::State& state) {
+    const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
+    const uvr::PreparedMesh prepared = uvr::prepareMesh(mesh, uvr::selectScalarField(mesh, {}));
+    uvr::RenderSettings settings;
+    settings.width = settings.height = static_cast<int>(state.range(1));
+    settings.tf = uvr::transferFunctionPreset("cool-to-warm");
+    std::uint64_t samples = 0;
+    for (auto _ : state) {
+        const uvr::RenderResult r = uvr::renderReferenceCpu(prepared, settings);
+        samples += r.stats.samples;
+        state.SetIterationTime(r.stats.seconds);
+    }
+    state.counters["samples/s"] =
+        benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+}
+
+}  // namespace
+
+BENCHMARK(BM_Generate)->Arg(1000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Prepare)->Arg(1000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderReference)
+    ->Args({1000, 32})
+    ->Args({1000000, 512})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();

@@ -1,0 +1,17 @@
+#!/bin/sh
+# SPDX-License-Identifier: MIT
+# Installs every build and test dependency of uvr from Debian 12's packages (run as root).
+set -eu
+export DEBIAN_FRONTEND=noninteractive
+PACKAGES="g++ cmake make pkg-config
+  zlib1g-dev libpng-dev libexpat1-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
+  python3 python3-numpy python3-vtk9 python3-meshio python3-skimage"
+missing=""
+for p in $PACKAGES; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  apt-get update -q
+  apt-get install -y -q --no-install-recommends $missing
+fi

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "uvr/core/bounds.h"
+#include "uvr/core/host_device.h"
+
+namespace uvr {
+
+/// A BVH node (32 bytes): a leaf when count > 0 (primitives primIds[first .. first+count)), else
+/// an inner node whose children are nodes[first] and nodes[first + 1].
+struct BvhNode {
+    Bounds3f box;
+    std::uint32_t first = 0;
+    std::uint32_t count = 0;
+};
+
+/// Plain-data view of a BVH for CPU and GPU kernels; node 0 is the root.
+struct BvhView {
+    const BvhNode* nodes = nullptr;
+    const std::uint32_t* primIds = nullptr;
+    std::uint32_t nodeCount = 0;
+};
+
+/// Deepest stack a BVH traversal needs; the builder guarantees the tree is no deeper.
+inline constexpr int kBvhMaxDepth = 64;
+
+/// Calls visit(primId) for every primitive whose leaf box contains p, until visit returns true;
+/// returns whether it did.
+template <class Visit>
+UVR_HOST_DEVICE bool bvhVisitPoint(const BvhView& bvh, Vec3f p, Visit&& visit) {
+    if (bvh.nodeCount == 0) return false;
+    std::uint32_t stack[kBvhMaxDepth];
+    int top = 0;
+    std::uint32_t node = 0;
+    while (true) {
+        const BvhNode& n = bvh.nodes[node];
+        if (n.box.contains(p)) {
+            if (n.count > 0) {
+                for (std::uint32_t i = 0; i < n.count; ++i)
+                    if (visit(bvh.primIds[n.first + i])) return true;
+            } else {
+                stack[top++] = n.first + 1;
+                node = n.first;
+                continue;
+            }
+        }
+        if (top == 0) return false;
+        node = stack[--top];
+    }
+}
+
+/// Build parameters.
+struct BvhBuildOptions {
+    int maxLeafSize = 4;  ///< primitives per leaf at most (unless they cannot be split)
+    int bins = 16;        ///< SAH bins per axis
+};
+
+/// A bounding volume hierarchy over boxes, stored as flat arrays.
+struct Bvh {
+    std::vector<BvhNode> nodes;
+    std::vector<std::uint32_t> primIds;
+
+    /// View for kernels; the Bvh must outlive it.
+    BvhView view() const {
+        return {nodes.data(), primIds.data(), static_cast<std::uint32_t>(nodes.size())};
+    }
+};
+
+/// Builds a BVH with binned SAH splits (Wald 2007, "On fast construction of SAH-based bounding
+/// volume hierarchies") over primitive boxes and their centres; O(n log n). Depth is bounded by
+/// kBvhMaxDepth (falling back to median splits near the limit).
+Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
+             const BvhBuildOptions& options = {});
+
+}  // namespace uvr

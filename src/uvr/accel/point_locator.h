@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+
+#include "uvr/accel/bvh.h"
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/core/host_device.h"
+#include "uvr/mesh/tet_math.h"
+#include "uvr/mesh/tet_mesh.h"
+
+namespace uvr {
+
+/// Most face-to-face steps a walk takes from the previous sample's tetrahedron before the BVH
+/// takes over.
+inline constexpr int kMaxWalkSteps = 8;
+
+/// Counters of point-location work for statistics.
+struct LocateCounters {
+    std::uint64_t walkSteps = 0;    ///< tetrahedra tested while walking
+    std::uint64_t bvhQueries = 0;   ///< searches that fell back to the BVH
+};
+
+/// Point location in a tetrahedral mesh: first the hint (the previous sample's tetrahedron),
+/// then a walk across faces towards p (ray coherence), then the BVH.
+struct TetLocator {
+    TetMeshView mesh;
+    BvhView bvh;
+    const std::uint32_t* neighbors = nullptr;  ///< 4 per tetrahedron, may be null (no walking)
+
+    /// True when p lies in tetrahedron t (within kBaryEpsilon); fills bary.
+    UVR_HOST_DEVICE bool inside(std::uint32_t t, Vec3f p, float bary[4]) const {
+        const Tet& tet = mesh.tets[t];
+        if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
+                             mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
+            return false;
+        return bary[0] >= -kBaryEpsilon && bary[1] >= -kBaryEpsilon && bary[2] >= -kBaryEpsilon &&
+               bary[3] >= -kBaryEpsilon;
+    }
+
+    /// Index of a tetrahedron containing p, or kNoTet; bary receives p's barycentrics in it.
+    UVR_HOST_DEVICE std::uint32_t locate(Vec3f p, std::uint32_t hint, float bary[4],
+                                         LocateCounters& counters) const {
+        if (hint != kNoTet && neighbors) {
+            std::uint32_t t = hint;
+            for (int step = 0; step < kMaxWalkSteps; ++step) {
+                ++counters.walkSteps;
+                const Tet& tet = mesh.tets[t];
+                if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
+                                     mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
+                    break;
+                int worst = 0;
+                for (int i = 1; i < 4; ++i)
+                    if (bary[i] < bary[worst]) worst = i;
+                if (bary[worst] >= -kBaryEpsilon) return t;
+                const std::uint32_t next = neighbors[4 * t + worst];
+                if (next == kNoTet) break;
+                t = next;
+            }
+        }
+        ++counters.bvhQueries;
+        std::uint32_t found = kNoTet;
+        bvhVisitPoint(bvh, p, [&](std::uint32_t t) {
+            if (inside(t, p, bary)) {
+                found = t;
+                return true;
+            }
+            return false;
+        });
+        return found;
+    }
+};
+
+}  // namespace uvr

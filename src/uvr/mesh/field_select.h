@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "uvr/mesh/mesh.h"
+
+namespace uvr {
+
+/// Which field to render: "NAME[:point|:cell][:magnitude|:x|:y|:z|:N]"; an empty name means the
+/// default (the first field with one component, else the first field's magnitude).
+struct FieldSpec {
+    std::string name;
+    std::optional<Association> association;
+    int component = -1;  ///< -1: magnitude for vectors (the value itself for scalars)
+};
+
+/// Parses a field spec; throws Error(Argument) on an unknown suffix.
+FieldSpec parseFieldSpec(const std::string& text);
+
+/// A scalar field ready for rendering: one value per point or per cell of the mesh.
+struct ScalarField {
+    std::string name;  ///< the field's name plus its component suffix when one was chosen
+    Association association = Association::Point;
+    std::vector<float> values;
+};
+
+/// Resolves a spec against the mesh and extracts the scalar values; throws Error(Argument) naming
+/// the available fields when the name, association or component does not exist, or when a name
+/// exists as both point and cell data and the spec does not say which.
+ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec);
+
+/// Finite minimum and maximum of values (NaN/Inf skipped); {0, 0} when none is finite.
+std::pair<float, float> finiteRange(const std::vector<float>& values);
+
+}  // namespace uvr

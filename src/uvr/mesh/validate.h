@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "uvr/mesh/mesh.h"
+
+namespace uvr {
+
+/// Non-finite values found in one field.
+struct NonFiniteField {
+    std::string name;
+    Association association = Association::Point;
+    std::uint64_t count = 0;
+    std::uint64_t firstTuple = 0;  ///< first point/cell index holding a NaN or Inf
+};
+
+/// What validation found in a mesh; structural errors throw instead.
+struct ValidationReport {
+    std::uint64_t invertedCells = 0;    ///< re-oriented when rendering
+    std::uint64_t zeroVolumeCells = 0;  ///< contribute nothing to images
+    std::uint64_t distortedCells = 0;   ///< tetrahedra of both orientations
+    std::uint64_t coincidentPoints = 0; ///< points at the position of an earlier point
+    std::uint64_t nonFinitePoints = 0;  ///< points with a NaN/Inf coordinate
+    std::uint64_t unusedPoints = 0;     ///< points no cell references
+    std::uint64_t firstInvertedCell = 0, firstZeroVolumeCell = 0, firstDistortedCell = 0;
+    std::vector<NonFiniteField> nonFiniteFields;
+
+    /// Human-readable findings, one per line ("77 zero-volume cells (first: cell 1234)"); empty
+    /// when the mesh is clean.
+    std::vector<std::string> findings() const;
+};
+
+/// Checks the mesh's structure (offsets, corner counts, point indices in range, field sizes) and
+/// throws Error(Validation) naming the first offending cell or field; then classifies every cell's
+/// geometry and scans points and fields, returning the counts.
+ValidationReport validateMesh(const Mesh& mesh, const std::string& file = "");
+
+/// Only the structural checks of validateMesh (cheap; run by every load).
+void validateStructure(const Mesh& mesh, const std::string& file = "");
+
+}  // namespace uvr

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <functional>
+
+#include "uvr/mesh/mesh.h"
+
+namespace uvr::testing {
+
+/// An n x n x n grid of hexahedra over the box [lo, hi]^3 with a point field f(x, y, z) named
+/// "f"; optional point jitter (fraction of the spacing, deterministic).
+inline Mesh makeHexGrid(int n, float lo, float hi,
+                        const std::function<float(Vec3f)>& f = [](Vec3f) { return 1.f; },
+                        float jitter = 0.f) {
+    Mesh mesh;
+    const int np = n + 1;
+    const float h = (hi - lo) / n;
+    Field field{"f", Association::Point, 1, {}};
+    for (int k = 0; k < np; ++k)
+        for (int j = 0; j < np; ++j)
+            for (int i = 0; i < np; ++i) {
+                Vec3f p(lo + i * h, lo + j * h, lo + k * h);
+                const bool interior = i > 0 && j > 0 && k > 0 && i < n && j < n && k < n;
+                if (interior && jitter > 0.f) {
+                    unsigned s = static_cast<unsigned>(i * 73856093 ^ j * 19349663 ^ k * 83492791);
+                    for (int a = 0; a < 3; ++a) {
+                        s = s * 1664525u + 1013904223u;
+                        p[a] += jitter * h * ((s >> 8) * (1.f / 16777216.f) - 0.5f) * 2.f;
+                    }
+                }
+                mesh.points.push_back(p);
+                field.values.push_back(f(p));
+            }
+    auto id = [&](int i, int j, int k) { return static_cast<std::uint32_t>((k * np + j) * np + i); };
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const std::uint32_t c[8] = {id(i, j, k),         id(i + 1, j, k),
+                                            id(i + 1, j + 1, k), id(i, j + 1, k),
+                                            id(i, j, k + 1),     id(i + 1, j, k + 1),
+                                            id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
+                mesh.addCell(CellType::Hexahedron, c);
+            }
+    mesh.fields.push_back(std::move(field));
+    return mesh;
+}
+
+}  // namespace uvr::testing
