@@ -486,8 +486,7 @@ std::vector<T> parseAscii(const XmlDoc& doc, const ArrayDesc& a,
         while (i < s.size() && !isSpace(s[i])) ++i;
     }
     if (expected && count != *expected)
-        throwParseError(doc.file, atLine(a.haveText ? a.textLine : a.line),
-                        sizeMismatch(a, count, *expected));
+        throwParseError(doc.file, atLine(a.line), sizeMismatch(a, count, *expected));
     checkAllocation(doc.file, a.label, count, sizeof(T), options.maxMemoryBytes);
     std::vector<T> out;
     out.reserve(static_cast<std::size_t>(count));
@@ -654,9 +653,6 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         return *a;
     };
     const std::uint64_t pointBase = grid.points.size();
-    if (pointBase + p.points > std::numeric_limits<std::uint32_t>::max())
-        throwError(ErrorKind::Unsupported, doc.file,
-                   label + ": more than 4294967295 points in all are not supported");
 
     // Points.
     if (p.points > 0 || findArray(p, Section::Points, "")) {
@@ -666,6 +662,10 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
                             a.label + ": expected NumberOfComponents=\"3\", got " +
                                 std::to_string(a.components));
         const std::vector<float> xyz = readArray<float>(bytes, doc, a, p.points * 3, options);
+        // Checked after reading, so that counts the file cannot hold are reported as such.
+        if (pointBase + p.points > std::numeric_limits<std::uint32_t>::max())
+            throwError(ErrorKind::Unsupported, doc.file,
+                       label + ": more than 4294967295 points in all are not supported");
         for (std::size_t i = 0; i < p.points; ++i)
             grid.points.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
     }
