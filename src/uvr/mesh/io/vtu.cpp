@@ -753,15 +753,13 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
 
 Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allowParallel);
 
-Mesh readPvtuFile(const std::string& path, const std::vector<char>& bytes, const XmlDoc& doc,
-                  const ReadOptions& options) {
+Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions& options) {
     if (doc.pieces.empty()) throwParseError(path, atByte(0), "expected <Piece Source=...> entries");
     namespace fs = std::filesystem;
     const fs::path folder = fs::path(path).parent_path();
     std::error_code ec;
     const fs::path self = fs::weakly_canonical(fs::path(path), ec);
     Mesh mesh;
-    (void)bytes;
     for (std::size_t k = 0; k < doc.pieces.size(); ++k) {
         const PieceDesc& p = doc.pieces[k];
         const fs::path source = fs::path(p.source);
@@ -822,7 +820,7 @@ Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allow
             throwError(ErrorKind::Unsupported, path,
                        "is a PUnstructuredGrid (.pvtu); a .pvtu piece must be an "
                        "UnstructuredGrid .vtu file");
-        return readPvtuFile(path, bytes, doc, options);
+        return readPvtuFile(path, doc, options);
     }
     if (doc.pieces.empty())
         throwParseError(path, atByte(0),
@@ -849,7 +847,7 @@ Mesh readPvtu(const std::string& path, const ReadOptions& options) {
     if (doc.type != "PUnstructuredGrid")
         throwError(ErrorKind::Unsupported, path,
                    "VTKFile type '" + doc.type + "' is not a PUnstructuredGrid (.pvtu)");
-    return readPvtuFile(path, bytes, doc, options);
+    return readPvtuFile(path, doc, options);
 }
 
 }  // namespace uvr
