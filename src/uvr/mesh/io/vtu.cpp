@@ -1,1 +1,853 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/io/vtu.h"
+
+#include <expat.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+#include "uvr/mesh/io/base64.h"
+#include "uvr/mesh/io/scalar_type.h"
+#include "uvr/mesh/io/vtk_cells.h"
+
+namespace uvr {
+
+namespace {
+
+// Deflate cannot expand data by more than 1032:1 (258-byte matches coded in ~2 bits).
+constexpr std::uint64_t kMaxZlibRatio = 1032;
+constexpr std::uint64_t kMaxComponents = 1u << 20;
+
+enum class Section { None, Points, Cells, PointData, CellData };
+enum class Encoding { Ascii, Binary, Appended };
+
+/// One <DataArray> of a Piece as declared in the XML, with its inline text if any.
+struct ArrayDesc {
+    std::string name;
+    std::optional<ScalarType> type;  // nullopt for String arrays, which are skipped
+    std::uint64_t components = 1;
+    Encoding encoding = Encoding::Ascii;
+    std::uint64_t offset = 0;  // into the appended data
+    std::string text;          // inline content (ascii or base64)
+    std::uint64_t line = 0;    // line of the start tag
+    std::uint64_t textLine = 0;
+    std::uint64_t textByte = 0;
+    bool haveText = false;
+    Section section = Section::None;
+    std::string label;  // "Piece 0: DataArray 'offsets'"
+};
+
+struct PieceDesc {
+    std::uint64_t points = 0;
+    std::uint64_t cells = 0;
+    std::uint64_t line = 0;
+    std::string source;  // .pvtu pieces only
+    std::vector<ArrayDesc> arrays;
+};
+
+/// What the XML part of a VTK XML file declares.
+struct XmlDoc {
+    std::string file;
+    std::string type;
+    bool bigEndian = false;
+    std::size_t headerSize = 4;
+    bool compressed = false;
+    std::vector<PieceDesc> pieces;
+    bool hasAppended = false;
+    bool appendedBase64 = false;
+    std::uint64_t appendedStart = 0;  // file byte offset just after the '_' marker
+    std::uint64_t appendedEnd = 0;    // file byte offset of </AppendedData>
+};
+
+// ---- XML parsing with expat ----
+
+struct ParseState {
+    XmlDoc* doc = nullptr;
+    XML_Parser parser = nullptr;
+    std::vector<std::string> stack;
+    Section section = Section::None;
+    ArrayDesc* array = nullptr;  // the DataArray being collected (innermost element)
+    std::size_t arrayDepth = 0;
+    std::exception_ptr error;
+};
+
+const char* findAttr(const XML_Char** attrs, const char* name) {
+    for (int i = 0; attrs[i]; i += 2)
+        if (std::strcmp(attrs[i], name) == 0) return attrs[i + 1];
+    return nullptr;
+}
+
+std::string trimmed(const char* s) {
+    std::string_view v(s);
+    while (!v.empty() && std::isspace(static_cast<unsigned char>(v.front()))) v.remove_prefix(1);
+    while (!v.empty() && std::isspace(static_cast<unsigned char>(v.back()))) v.remove_suffix(1);
+    return std::string(v);
+}
+
+[[noreturn]] void failAtLine(ParseState& st, const std::string& message) {
+    throwParseError(st.doc->file, atLine(XML_GetCurrentLineNumber(st.parser)), message);
+}
+
+std::uint64_t parseCount(ParseState& st, const XML_Char** attrs, const char* attr,
+                         const std::string& element, bool required, std::uint64_t fallback) {
+    const char* value = findAttr(attrs, attr);
+    if (!value) {
+        if (!required) return fallback;
+        failAtLine(st, element + ": missing attribute " + attr);
+    }
+    const std::string s = trimmed(value);
+    std::uint64_t v = 0;
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || ptr != s.data() + s.size() || s.empty())
+        failAtLine(
+            st, element + ": expected " + attr + " to be a non-negative integer, got '" + s + "'");
+    return v;
+}
+
+void onRootElement(ParseState& st, const XML_Char** attrs) {
+    XmlDoc& doc = *st.doc;
+    const char* type = findAttr(attrs, "type");
+    doc.type = type ? type : "";
+    if (doc.type != "UnstructuredGrid" && doc.type != "PUnstructuredGrid")
+        throwError(ErrorKind::Unsupported, doc.file,
+                   "VTKFile type '" + doc.type +
+                       "' is not supported: expected UnstructuredGrid or PUnstructuredGrid");
+    const char* order = findAttr(attrs, "byte_order");
+    const std::string byteOrder = order ? order : "LittleEndian";
+    if (byteOrder != "LittleEndian" && byteOrder != "BigEndian")
+        failAtLine(
+            st, "VTKFile: expected byte_order LittleEndian or BigEndian, got '" + byteOrder + "'");
+    doc.bigEndian = byteOrder == "BigEndian";
+    const char* header = findAttr(attrs, "header_type");
+    const std::string headerType = header ? header : "UInt32";
+    if (headerType != "UInt32" && headerType != "UInt64")
+        failAtLine(st, "VTKFile: expected header_type UInt32 or UInt64, got '" + headerType + "'");
+    doc.headerSize = headerType == "UInt64" ? 8 : 4;
+    const char* compressor = findAttr(attrs, "compressor");
+    const std::string comp = compressor ? compressor : "";
+    if (!comp.empty() && comp != "vtkZLibDataCompressor")
+        throwError(ErrorKind::Unsupported, doc.file,
+                   atLine(XML_GetCurrentLineNumber(st.parser)) + ": compressor '" + comp +
+                       "' is not supported: expected vtkZLibDataCompressor or none");
+    doc.compressed = !comp.empty();
+}
+
+void onDataArray(ParseState& st, const XML_Char** attrs) {
+    PieceDesc& piece = st.doc->pieces.back();
+    ArrayDesc a;
+    a.section = st.section;
+    a.line = XML_GetCurrentLineNumber(st.parser);
+    const char* name = findAttr(attrs, "Name");
+    a.name = name ? name : "";
+    if (a.section == Section::Points && a.name.empty()) a.name = "Points";
+    a.label = "Piece " + std::to_string(st.doc->pieces.size() - 1) + ": DataArray '" + a.name + "'";
+    const char* type = findAttr(attrs, "type");
+    if (!type) failAtLine(st, a.label + ": missing attribute type");
+    const std::string typeName = type;
+    if (typeName != "String") {
+        a.type = parseXmlTypeName(typeName);
+        if (!a.type)
+            failAtLine(st, a.label +
+                               ": expected type Int8, UInt8, Int16, UInt16, Int32, UInt32, "
+                               "Int64, UInt64, Float32, Float64 or String, got '" +
+                               typeName + "'");
+    }
+    a.components = parseCount(st, attrs, "NumberOfComponents", a.label, false, 1);
+    if (a.components == 0 || a.components > kMaxComponents)
+        failAtLine(st, a.label + ": expected NumberOfComponents in [1, " +
+                           std::to_string(kMaxComponents) + "], got " +
+                           std::to_string(a.components));
+    const char* format = findAttr(attrs, "format");
+    const std::string fmt = format ? format : "";
+    if (fmt == "ascii") {
+        a.encoding = Encoding::Ascii;
+    } else if (fmt == "binary") {
+        a.encoding = Encoding::Binary;
+    } else if (fmt == "appended") {
+        a.encoding = Encoding::Appended;
+        a.offset = parseCount(st, attrs, "offset", a.label, true, 0);
+    } else {
+        failAtLine(st, a.label + ": expected format ascii, binary or appended, got '" + fmt + "'");
+    }
+    piece.arrays.push_back(std::move(a));
+    st.array = &piece.arrays.back();
+    st.arrayDepth = st.stack.size();
+}
+
+void onStart(ParseState& st, const std::string& name, const XML_Char** attrs) {
+    XmlDoc& doc = *st.doc;
+    const std::string parent = st.stack.empty() ? "" : st.stack.back();
+    st.stack.push_back(name);
+    if (st.stack.size() == 1) {
+        if (name != "VTKFile") failAtLine(st, "expected the root element VTKFile, got " + name);
+        onRootElement(st, attrs);
+        return;
+    }
+    if (name == "Piece" && (parent == "UnstructuredGrid" || parent == "PUnstructuredGrid")) {
+        PieceDesc p;
+        p.line = XML_GetCurrentLineNumber(st.parser);
+        const std::string label = "Piece " + std::to_string(doc.pieces.size());
+        if (parent == "UnstructuredGrid") {
+            p.points = parseCount(st, attrs, "NumberOfPoints", label, true, 0);
+            p.cells = parseCount(st, attrs, "NumberOfCells", label, true, 0);
+        } else {
+            const char* source = findAttr(attrs, "Source");
+            if (!source || !*source) failAtLine(st, label + ": missing attribute Source");
+            p.source = source;
+        }
+        doc.pieces.push_back(std::move(p));
+        return;
+    }
+    if (parent == "Piece" && !doc.pieces.empty()) {
+        if (name == "Points") st.section = Section::Points;
+        if (name == "Cells") st.section = Section::Cells;
+        if (name == "PointData") st.section = Section::PointData;
+        if (name == "CellData") st.section = Section::CellData;
+        return;
+    }
+    if (name == "DataArray" && st.section != Section::None && st.stack.size() >= 2 &&
+        (parent == "Points" || parent == "Cells" || parent == "PointData" ||
+         parent == "CellData")) {
+        onDataArray(st, attrs);
+        return;
+    }
+    if (name == "AppendedData" && parent == "VTKFile") {
+        const char* encoding = findAttr(attrs, "encoding");
+        const std::string enc = encoding ? encoding : "";
+        if (enc != "raw" && enc != "base64")
+            failAtLine(st, "AppendedData: expected encoding raw or base64, got '" + enc + "'");
+        doc.hasAppended = true;
+        doc.appendedBase64 = enc == "base64";
+    }
+}
+
+void XMLCALL startHandler(void* data, const XML_Char* name, const XML_Char** attrs) {
+    auto& st = *static_cast<ParseState*>(data);
+    if (st.error) return;
+    try {
+        onStart(st, name, attrs);
+    } catch (...) {
+        st.error = std::current_exception();
+        XML_StopParser(st.parser, XML_FALSE);
+    }
+}
+
+void XMLCALL endHandler(void* data, const XML_Char* name) {
+    auto& st = *static_cast<ParseState*>(data);
+    if (st.error || st.stack.empty()) return;
+    if (st.array && st.stack.size() == st.arrayDepth) st.array = nullptr;
+    const std::string n = name;
+    if (n == "Points" || n == "Cells" || n == "PointData" || n == "CellData" || n == "Piece")
+        st.section = Section::None;
+    st.stack.pop_back();
+}
+
+void XMLCALL textHandler(void* data, const XML_Char* s, int len) {
+    auto& st = *static_cast<ParseState*>(data);
+    if (st.error || !st.array || st.stack.size() != st.arrayDepth) return;
+    try {
+        if (!st.array->haveText) {
+            st.array->haveText = true;
+            st.array->textLine = XML_GetCurrentLineNumber(st.parser);
+            st.array->textByte = static_cast<std::uint64_t>(XML_GetCurrentByteIndex(st.parser));
+        }
+        st.array->text.append(s, static_cast<std::size_t>(len));
+    } catch (...) {
+        st.error = std::current_exception();
+        XML_StopParser(st.parser, XML_FALSE);
+    }
+}
+
+/// Parses the XML of a VTK XML file; raw appended data (not XML) is located but not parsed.
+XmlDoc parseXml(const std::string& path, const std::vector<char>& bytes) {
+    XmlDoc doc;
+    doc.file = path;
+    std::string_view all(bytes.data(), bytes.size());
+    // Step 1: the XML ends at the <AppendedData ...> start tag when there is one.
+    std::size_t xmlEnd = all.size();
+    std::size_t appendedTag = all.find("<AppendedData");
+    std::size_t dataStart = 0;
+    bool selfClosing = false;
+    if (appendedTag != std::string_view::npos) {
+        const std::size_t close = all.find('>', appendedTag);
+        if (close == std::string_view::npos)
+            throwParseError(path, atByte(appendedTag),
+                            "the <AppendedData> start tag is not closed (file truncated?)");
+        xmlEnd = close + 1;
+        selfClosing = all[close - 1] == '/';
+        dataStart = xmlEnd;
+    }
+
+    // Step 2: expat over the XML part, then synthetic end tags for the elements left open.
+    XML_Parser parser = XML_ParserCreate(nullptr);
+    if (!parser) throwError(ErrorKind::Resource, path, "cannot create an XML parser");
+    ParseState st;
+    st.doc = &doc;
+    st.parser = parser;
+    XML_SetUserData(parser, &st);
+    XML_SetElementHandler(parser, startHandler, endHandler);
+    XML_SetCharacterDataHandler(parser, textHandler);
+    auto fail = [&](XML_Status status) {
+        if (st.error) {
+            XML_ParserFree(parser);
+            std::rethrow_exception(st.error);
+        }
+        if (status == XML_STATUS_ERROR) {
+            const std::string where = atLine(XML_GetCurrentLineNumber(parser));
+            const std::string message = "XML syntax error at column " +
+                                        std::to_string(XML_GetCurrentColumnNumber(parser) + 1) +
+                                        ": " + XML_ErrorString(XML_GetErrorCode(parser));
+            XML_ParserFree(parser);
+            throwParseError(path, where, message);
+        }
+    };
+    constexpr std::size_t kChunk = std::size_t(1) << 26;
+    const bool finalInOne = appendedTag == std::string_view::npos;
+    for (std::size_t pos = 0; pos < xmlEnd || pos == 0;) {
+        const std::size_t n = std::min(kChunk, xmlEnd - pos);
+        const bool last = pos + n >= xmlEnd;
+        fail(XML_Parse(parser, bytes.data() + pos, static_cast<int>(n),
+                       (last && finalInOne) ? XML_TRUE : XML_FALSE));
+        pos += n;
+        if (n == 0) break;
+    }
+    if (!finalInOne) {
+        std::string closing;
+        for (auto it = st.stack.rbegin(); it != st.stack.rend(); ++it) closing += "</" + *it + ">";
+        fail(XML_Parse(parser, closing.data(), static_cast<int>(closing.size()), XML_TRUE));
+    }
+    XML_ParserFree(parser);
+
+    // Step 3: the appended data runs from after '_' to </AppendedData>.
+    if (doc.hasAppended && !selfClosing) {
+        std::size_t p = dataStart;
+        while (p < all.size() && std::isspace(static_cast<unsigned char>(all[p]))) ++p;
+        if (p >= all.size() || all[p] != '_')
+            throwParseError(path, atByte(p),
+                            "AppendedData: expected '_' before the appended data, got " +
+                                (p >= all.size() ? std::string("the end of the file")
+                                                 : "'" + std::string(1, all[p]) + "'"));
+        doc.appendedStart = p + 1;
+        const std::size_t end = all.rfind("</AppendedData>");
+        if (end == std::string_view::npos || end < doc.appendedStart)
+            throwParseError(path, atByte(all.size()),
+                            "expected </AppendedData> after the appended data (file truncated?)");
+        doc.appendedEnd = end;
+    }
+    return doc;
+}
+
+// ---- binary payloads ----
+
+/// Sequential bytes of one array's binary payload: raw appended bytes or base64 text.
+class ByteSource {
+public:
+    ByteSource(const char* raw, std::size_t size, std::uint64_t fileOffset)
+        : raw_(raw), size_(size), fileBase_(fileOffset) {}
+    ByteSource(std::string_view text, Base64Origin origin) : b64_(Base64Reader(text, origin)) {}
+
+    void read(std::size_t n, std::vector<unsigned char>& out) {
+        if (b64_) return b64_->read(n, out);
+        out.insert(out.end(), raw_ + pos_, raw_ + pos_ + n);  // n checked against remaining()
+        pos_ += n;
+    }
+    std::uint64_t remaining() const { return b64_ ? b64_->remainingBound() : size_ - pos_; }
+    std::uint64_t fileOffset() const { return b64_ ? b64_->fileOffset() : fileBase_ + pos_; }
+
+private:
+    std::optional<Base64Reader> b64_;
+    const char* raw_ = nullptr;
+    std::size_t size_ = 0, pos_ = 0;
+    std::uint64_t fileBase_ = 0;
+};
+
+std::uint64_t loadHeaderInt(const unsigned char* p, std::size_t size, bool bigEndian) {
+    std::uint64_t v = 0;
+    for (std::size_t k = 0; k < size; ++k) {
+        const std::size_t byte = bigEndian ? k : size - 1 - k;
+        v = (v << 8) | p[byte];
+    }
+    return v;
+}
+
+std::string sizeMismatch(const ArrayDesc& a, std::uint64_t values, std::uint64_t expected) {
+    return a.label + " holds " + std::to_string(values) + " values, expected " +
+           std::to_string(expected);
+}
+
+/// Reads an array's binary payload: [nbytes] + data, or, compressed, [nblocks, blockSize,
+/// lastBlockSize, compressed sizes...] + zlib blocks (VTK's vtkZLibDataCompressor layout).
+std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, ByteSource& src,
+                                       std::optional<std::uint64_t> expected,
+                                       const ReadOptions& options) {
+    const std::size_t hs = doc.headerSize;
+    const std::size_t es = scalarSize(*a.type);
+    auto fail = [&](const std::string& message) {
+        throwParseError(doc.file, atByte(src.fileOffset()), a.label + ": " + message);
+    };
+    auto header = [&](std::uint64_t count, const char* what) {
+        if (count > src.remaining() / hs)
+            fail(std::string("the ") + what + " (" + std::to_string(count) + " x " +
+                 std::to_string(hs) + " bytes) runs past the end of the data");
+        std::vector<unsigned char> raw;
+        src.read(static_cast<std::size_t>(count * hs), raw);
+        std::vector<std::uint64_t> v(static_cast<std::size_t>(count));
+        for (std::size_t i = 0; i < v.size(); ++i)
+            v[i] = loadHeaderInt(raw.data() + i * hs, hs, doc.bigEndian);
+        return v;
+    };
+    auto checkTotal = [&](std::uint64_t totalBytes) {
+        if (totalBytes % es != 0)
+            fail("holds " + std::to_string(totalBytes) + " bytes, not a whole number of " +
+                 xmlTypeName(*a.type) + " values");
+        if (expected && totalBytes / es != *expected)
+            throwParseError(doc.file, atByte(src.fileOffset()),
+                            sizeMismatch(a, totalBytes / es, *expected));
+        checkAllocation(doc.file, a.label, totalBytes / es, es, options.maxMemoryBytes);
+    };
+
+    std::vector<unsigned char> out;
+    if (!doc.compressed) {
+        const std::uint64_t nbytes = header(1, "size header")[0];
+        checkTotal(nbytes);
+        if (nbytes > src.remaining())
+            fail("declares " + std::to_string(nbytes) + " bytes, but only " +
+                 std::to_string(src.remaining()) + " remain");
+        src.read(static_cast<std::size_t>(nbytes), out);
+        return out;
+    }
+    const std::vector<std::uint64_t> h = header(3, "compression header");
+    const std::uint64_t blocks = h[0], blockSize = h[1], lastSize = h[2];
+    const std::vector<std::uint64_t> sizes = header(blocks, "table of compressed block sizes");
+    if (blocks > 0 && (blockSize == 0 || lastSize > blockSize))
+        fail("invalid compression header: block size " + std::to_string(blockSize) +
+             ", last block size " + std::to_string(lastSize));
+    std::uint64_t total = 0, compressedTotal = 0;
+    if (blocks > 0) {
+        if (blocks - 1 > std::numeric_limits<std::uint64_t>::max() / 2 / blockSize)
+            fail("compression header declares an absurd size");
+        total = (blocks - 1) * blockSize + (lastSize == 0 ? blockSize : lastSize);
+    }
+    for (std::uint64_t s : sizes) {
+        compressedTotal += s;
+        if (compressedTotal < s) fail("compressed block sizes overflow");
+    }
+    checkTotal(total);
+    if (compressedTotal > src.remaining())
+        fail("compressed blocks of " + std::to_string(compressedTotal) + " bytes run past the " +
+             "end of the data (" + std::to_string(src.remaining()) + " bytes remain)");
+    if (total / kMaxZlibRatio > compressedTotal + 64 * blocks)
+        fail(std::to_string(compressedTotal) + " compressed bytes cannot inflate to the " +
+             std::to_string(total) + " bytes the header declares");
+    out.resize(static_cast<std::size_t>(total));
+    std::vector<unsigned char> block;
+    for (std::uint64_t b = 0; b < blocks; ++b) {
+        const std::uint64_t expect = (b + 1 == blocks && lastSize != 0) ? lastSize : blockSize;
+        block.clear();
+        src.read(static_cast<std::size_t>(sizes[b]), block);
+        uLongf produced = static_cast<uLongf>(expect);
+        const int rc = uncompress(out.data() + b * blockSize, &produced, block.data(),
+                                  static_cast<uLong>(sizes[b]));
+        if (rc != Z_OK || produced != expect)
+            fail("zlib block " + std::to_string(b) + " of DataArray '" + a.name + "' is corrupt (" +
+                 (rc != Z_OK ? std::string(zError(rc))
+                             : "inflated to " + std::to_string(produced) + " bytes, expected " +
+                                   std::to_string(expect)) +
+                 ")");
+    }
+    return out;
+}
+
+// ---- ascii payloads ----
+
+template <class T>
+std::vector<T> parseAscii(const XmlDoc& doc, const ArrayDesc& a,
+                          std::optional<std::uint64_t> expected, const ReadOptions& options) {
+    const std::string& s = a.text;
+    auto isSpace = [](char c) { return c == ' ' || c == '\n' || c == '\t' || c == '\r'; };
+    // Count first, so a wrong count is refused before allocating.
+    std::uint64_t count = 0;
+    for (std::size_t i = 0; i < s.size();) {
+        while (i < s.size() && isSpace(s[i])) ++i;
+        if (i >= s.size()) break;
+        ++count;
+        while (i < s.size() && !isSpace(s[i])) ++i;
+    }
+    if (expected && count != *expected)
+        throwParseError(doc.file, atLine(a.line), sizeMismatch(a, count, *expected));
+    checkAllocation(doc.file, a.label, count, sizeof(T), options.maxMemoryBytes);
+    std::vector<T> out;
+    out.reserve(static_cast<std::size_t>(count));
+    const bool integer = isIntegerType(*a.type);
+    std::uint64_t line = a.textLine;
+    for (std::size_t i = 0; i < s.size();) {
+        while (i < s.size() && isSpace(s[i])) line += s[i++] == '\n';
+        if (i >= s.size()) break;
+        std::size_t j = i;
+        while (j < s.size() && !isSpace(s[j])) ++j;
+        const char* first = s.data() + i;
+        const char* last = s.data() + j;
+        if (*first == '+' && last - first > 1) ++first;
+        bool ok = false;
+        T value{};
+        if (integer) {
+            std::int64_t v = 0;
+            auto r = std::from_chars(first, last, v);
+            if (r.ec == std::errc() && r.ptr == last) {
+                ok = true;
+                value = static_cast<T>(v);
+            } else {
+                std::uint64_t u = 0;
+                auto ru = std::from_chars(first, last, u);
+                ok = ru.ec == std::errc() && ru.ptr == last;
+                value = static_cast<T>(u);
+            }
+        } else {
+            double d = 0;
+            auto r = std::from_chars(first, last, d);
+            ok = (r.ec == std::errc() || r.ec == std::errc::result_out_of_range) && r.ptr == last;
+            if constexpr (std::is_integral_v<T>) {
+                ok = ok && d >= -9.2e18 && d <= 9.2e18;
+                value = ok ? static_cast<T>(d) : T{};
+            } else {
+                value = static_cast<T>(d);
+            }
+        }
+        if (!ok)
+            throwParseError(doc.file, atLine(line),
+                            a.label + ": expected " +
+                                (integer ? std::string("an integer") : std::string("a number")) +
+                                " (" + xmlTypeName(*a.type) + "), got '" +
+                                std::string(s.data() + i, std::min<std::size_t>(j - i, 40)) + "'");
+        out.push_back(value);
+        i = j;
+    }
+    return out;
+}
+
+// ---- arrays of any encoding ----
+
+/// Converts raw file values of type S (byte-swapped when swap) to T; float -> integer conversions
+/// outside the int64 range become -1, which index checks reject.
+template <class T, class S>
+std::vector<T> convertValues(const std::vector<unsigned char>& raw, bool swap, const XmlDoc& doc,
+                             const ArrayDesc& a, const ReadOptions& options) {
+    const std::size_t count = raw.size() / sizeof(S);
+    checkAllocation(doc.file, a.label, count, sizeof(T), options.maxMemoryBytes);
+    std::vector<T> out(count);
+    unsigned char buf[sizeof(S)];
+    for (std::size_t i = 0; i < count; ++i) {
+        const unsigned char* src = raw.data() + i * sizeof(S);
+        if (swap && sizeof(S) > 1) {
+            for (std::size_t k = 0; k < sizeof(S); ++k) buf[k] = src[sizeof(S) - 1 - k];
+            src = buf;
+        }
+        S v;
+        std::memcpy(&v, src, sizeof(S));
+        if constexpr (std::is_integral_v<T> && std::is_floating_point_v<S>)
+            out[i] = (v >= -9.2e18 && v <= 9.2e18) ? static_cast<T>(v) : T(-1);
+        else
+            out[i] = static_cast<T>(v);
+    }
+    return out;
+}
+
+template <class T>
+std::vector<T> readArray(const std::vector<char>& bytes, const XmlDoc& doc, const ArrayDesc& a,
+                         std::optional<std::uint64_t> expected, const ReadOptions& options) {
+    if (a.encoding == Encoding::Ascii) return parseAscii<T>(doc, a, expected, options);
+    std::vector<unsigned char> raw;
+    if (a.encoding == Encoding::Binary) {
+        ByteSource src(a.text, Base64Origin{doc.file, a.textByte, a.label});
+        raw = readPayload(doc, a, src, expected, options);
+    } else {
+        if (!doc.hasAppended)
+            throwParseError(doc.file, atLine(a.line),
+                            a.label + ": format=\"appended\" but the file has no AppendedData");
+        const std::uint64_t size = doc.appendedEnd - doc.appendedStart;
+        if (a.offset >= size)
+            throwParseError(doc.file, atLine(a.line),
+                            a.label + ": offset " + std::to_string(a.offset) +
+                                " lies beyond the appended data of " + std::to_string(size) +
+                                " bytes");
+        const std::uint64_t start = doc.appendedStart + a.offset;
+        const std::size_t n = static_cast<std::size_t>(doc.appendedEnd - start);
+        const std::string label = a.label + " (appended offset " + std::to_string(a.offset) + ")";
+        if (doc.appendedBase64) {
+            ByteSource src(std::string_view(bytes.data() + start, n),
+                           Base64Origin{doc.file, start, label});
+            raw = readPayload(doc, a, src, expected, options);
+        } else {
+            ByteSource src(bytes.data() + start, n, start);
+            raw = readPayload(doc, a, src, expected, options);
+        }
+    }
+    const bool swap = doc.bigEndian == hostIsLittleEndian();
+    switch (*a.type) {
+        case ScalarType::Int8:
+            return convertValues<T, std::int8_t>(raw, swap, doc, a, options);
+        case ScalarType::UInt8:
+            return convertValues<T, std::uint8_t>(raw, swap, doc, a, options);
+        case ScalarType::Int16:
+            return convertValues<T, std::int16_t>(raw, swap, doc, a, options);
+        case ScalarType::UInt16:
+            return convertValues<T, std::uint16_t>(raw, swap, doc, a, options);
+        case ScalarType::Int32:
+            return convertValues<T, std::int32_t>(raw, swap, doc, a, options);
+        case ScalarType::UInt32:
+            return convertValues<T, std::uint32_t>(raw, swap, doc, a, options);
+        case ScalarType::Int64:
+            return convertValues<T, std::int64_t>(raw, swap, doc, a, options);
+        case ScalarType::UInt64:
+            return convertValues<T, std::uint64_t>(raw, swap, doc, a, options);
+        case ScalarType::Float32:
+            return convertValues<T, float>(raw, swap, doc, a, options);
+        case ScalarType::Float64:
+            return convertValues<T, double>(raw, swap, doc, a, options);
+    }
+    return {};
+}
+
+/// Points, cells (VtkCellArrays convention) and fields of all Pieces, point indices offset.
+struct RawGrid {
+    std::vector<Vec3f> points;
+    VtkCellArrays cells;
+    std::vector<Field> fields;
+};
+
+const ArrayDesc* findArray(const PieceDesc& p, Section section, const std::string& name) {
+    for (const ArrayDesc& a : p.arrays)
+        if (a.section == section && (name.empty() || a.name == name)) return &a;
+    return nullptr;
+}
+
+std::string fieldKey(const Field& f) {
+    return std::string(associationName(f.association)) + " DataArray '" + f.name + "'";
+}
+
+void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t index,
+               const ReadOptions& options, RawGrid& grid) {
+    const PieceDesc& p = doc.pieces[index];
+    const std::string label = "Piece " + std::to_string(index);
+    auto require = [&](Section section, const std::string& name) -> const ArrayDesc& {
+        const ArrayDesc* a = findArray(p, section, name);
+        if (!a)
+            throwParseError(doc.file, atLine(p.line),
+                            label + ": missing " +
+                                (section == Section::Points ? std::string("<Points> DataArray")
+                                                            : "<Cells> DataArray '" + name + "'"));
+        if (!a->type)
+            throwParseError(doc.file, atLine(a->line), a->label + ": expected a numeric type");
+        return *a;
+    };
+    const std::uint64_t pointBase = grid.points.size();
+
+    // Points.
+    if (p.points > 0 || findArray(p, Section::Points, "")) {
+        const ArrayDesc& a = require(Section::Points, "");
+        if (a.components != 3)
+            throwParseError(doc.file, atLine(a.line),
+                            a.label + ": expected NumberOfComponents=\"3\", got " +
+                                std::to_string(a.components));
+        const std::vector<float> xyz = readArray<float>(bytes, doc, a, p.points * 3, options);
+        // Checked after reading, so that counts the file cannot hold are reported as such.
+        if (pointBase + p.points > std::numeric_limits<std::uint32_t>::max())
+            throwError(ErrorKind::Unsupported, doc.file,
+                       label + ": more than 4294967295 points in all are not supported");
+        for (std::size_t i = 0; i < p.points; ++i)
+            grid.points.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    }
+
+    // Cells: VTK XML offsets are END offsets; VtkCellArrays wants n + 1 starting at 0.
+    if (p.cells > 0) {
+        const ArrayDesc& offA = require(Section::Cells, "offsets");
+        const ArrayDesc& typeA = require(Section::Cells, "types");
+        const ArrayDesc& connA = require(Section::Cells, "connectivity");
+        const std::vector<std::int64_t> ends =
+            readArray<std::int64_t>(bytes, doc, offA, p.cells, options);
+        std::int64_t previous = 0;
+        for (std::size_t c = 0; c < ends.size(); ++c) {
+            if (ends[c] < previous)
+                throwParseError(doc.file, atLine(offA.line),
+                                offA.label + ": end offset " + std::to_string(ends[c]) +
+                                    " of cell " + std::to_string(c) +
+                                    " is below the previous offset " + std::to_string(previous));
+            previous = ends[c];
+        }
+        const std::vector<std::int64_t> types =
+            readArray<std::int64_t>(bytes, doc, typeA, p.cells, options);
+        const std::vector<std::int64_t> conn = readArray<std::int64_t>(
+            bytes, doc, connA, static_cast<std::uint64_t>(ends.back()), options);
+        VtkCellArrays& out = grid.cells;
+        const std::int64_t connBase = static_cast<std::int64_t>(out.connectivity.size());
+        if (out.offsets.empty()) out.offsets.push_back(0);
+        for (std::size_t c = 0; c < types.size(); ++c) {
+            if (types[c] < 0 || types[c] > 255)
+                throwParseError(doc.file, atLine(typeA.line),
+                                typeA.label + ": cell " + std::to_string(c) +
+                                    ": expected a VTK cell type in [0, 255], got " +
+                                    std::to_string(types[c]));
+            out.types.push_back(static_cast<std::int32_t>(types[c]));
+            out.offsets.push_back(connBase + ends[c]);
+        }
+        out.connectivity.reserve(out.connectivity.size() + conn.size());
+        for (std::int64_t id : conn)
+            out.connectivity.push_back(id < 0 ? id : id + static_cast<std::int64_t>(pointBase));
+    }
+
+    // Point and cell fields, concatenated across Pieces by name and association.
+    std::vector<Field> fields;
+    for (const ArrayDesc& a : p.arrays) {
+        if (a.section != Section::PointData && a.section != Section::CellData) continue;
+        if (!a.type) continue;  // String arrays
+        if (a.name.empty())
+            throwParseError(doc.file, atLine(a.line), a.label + ": expected a Name attribute");
+        Field f;
+        f.name = a.name;
+        f.association = a.section == Section::PointData ? Association::Point : Association::Cell;
+        f.components = static_cast<int>(a.components);
+        const std::uint64_t tuples = f.association == Association::Point ? p.points : p.cells;
+        if (tuples > std::numeric_limits<std::uint64_t>::max() / a.components)
+            throwParseError(doc.file, atLine(a.line), a.label + ": absurd size");
+        f.values = readArray<float>(bytes, doc, a, tuples * a.components, options);
+        fields.push_back(std::move(f));
+    }
+    if (index == 0) {
+        grid.fields = std::move(fields);
+        return;
+    }
+    for (const Field& f : grid.fields) {
+        auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& g) {
+            return g.name == f.name && g.association == f.association;
+        });
+        if (it == fields.end())
+            throwParseError(doc.file, atLine(p.line),
+                            label + " has no " + fieldKey(f) + ", which Piece 0 has");
+        if (it->components != f.components)
+            throwParseError(doc.file, atLine(p.line),
+                            label + ": " + fieldKey(f) + " has " + std::to_string(it->components) +
+                                " components, Piece 0 has " + std::to_string(f.components));
+    }
+    for (Field& g : fields) {
+        auto it = std::find_if(grid.fields.begin(), grid.fields.end(), [&](const Field& f) {
+            return g.name == f.name && g.association == f.association;
+        });
+        if (it == grid.fields.end())
+            throwParseError(doc.file, atLine(p.line),
+                            label + " has " + fieldKey(g) + ", which Piece 0 lacks");
+        it->values.insert(it->values.end(), g.values.begin(), g.values.end());
+    }
+}
+
+Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allowParallel);
+
+Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions& options) {
+    if (doc.pieces.empty()) throwParseError(path, atByte(0), "expected <Piece Source=...> entries");
+    namespace fs = std::filesystem;
+    const fs::path folder = fs::path(path).parent_path();
+    std::error_code ec;
+    const fs::path self = fs::weakly_canonical(fs::path(path), ec);
+    Mesh mesh;
+    for (std::size_t k = 0; k < doc.pieces.size(); ++k) {
+        const PieceDesc& p = doc.pieces[k];
+        const fs::path source = fs::path(p.source);
+        const std::string piecePath = (source.is_absolute() ? source : folder / source).string();
+        const std::string label = "Piece " + std::to_string(k) + " ('" + p.source + "')";
+        std::error_code ec2;
+        if (fs::weakly_canonical(fs::path(piecePath), ec2) == self && !ec && !ec2)
+            throwParseError(path, atLine(p.line), label + " names the .pvtu file itself");
+        Mesh piece = readVtuFile(piecePath, options, false);
+
+        // Merge: points appended, indices offset, fields concatenated by name and association.
+        const std::uint64_t pointBase = mesh.points.size();
+        if (pointBase + piece.points.size() > std::numeric_limits<std::uint32_t>::max())
+            throwError(ErrorKind::Unsupported, path,
+                       label + ": more than 4294967295 points in all are not supported");
+        const std::uint64_t indexBase = mesh.cellIndices.size();
+        mesh.points.insert(mesh.points.end(), piece.points.begin(), piece.points.end());
+        mesh.cellTypes.insert(mesh.cellTypes.end(), piece.cellTypes.begin(), piece.cellTypes.end());
+        for (std::size_t c = 1; c < piece.cellOffsets.size(); ++c)
+            mesh.cellOffsets.push_back(indexBase + piece.cellOffsets[c]);
+        for (std::uint32_t id : piece.cellIndices)
+            mesh.cellIndices.push_back(id + static_cast<std::uint32_t>(pointBase));
+        for (const std::string& note : piece.notes)
+            mesh.notes.push_back("piece " + std::to_string(k) + ": " + note);
+        if (k == 0) {
+            mesh.fields = std::move(piece.fields);
+            continue;
+        }
+        for (const Field& f : mesh.fields) {
+            const Field* g = piece.findField(f.name, f.association);
+            if (!g)
+                throwParseError(path, atLine(p.line),
+                                label + " has no " + fieldKey(f) + ", which piece 0 has");
+            if (g->components != f.components)
+                throwParseError(path, atLine(p.line),
+                                label + ": " + fieldKey(f) + " has " +
+                                    std::to_string(g->components) + " components, piece 0 has " +
+                                    std::to_string(f.components));
+        }
+        for (const Field& g : piece.fields) {
+            auto it = std::find_if(mesh.fields.begin(), mesh.fields.end(), [&](const Field& f) {
+                return g.name == f.name && g.association == f.association;
+            });
+            if (it == mesh.fields.end())
+                throwParseError(path, atLine(p.line),
+                                label + " has " + fieldKey(g) + ", which piece 0 lacks");
+            it->values.insert(it->values.end(), g.values.begin(), g.values.end());
+        }
+    }
+    return mesh;
+}
+
+Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allowParallel) {
+    const std::vector<char> bytes = readFileBytes(path);
+    const XmlDoc doc = parseXml(path, bytes);
+    if (doc.type == "PUnstructuredGrid") {
+        if (!allowParallel)
+            throwError(ErrorKind::Unsupported, path,
+                       "is a PUnstructuredGrid (.pvtu); a .pvtu piece must be an "
+                       "UnstructuredGrid .vtu file");
+        return readPvtuFile(path, doc, options);
+    }
+    if (doc.pieces.empty())
+        throwParseError(path, atByte(0),
+                        "expected at least one <Piece NumberOfPoints=... NumberOfCells=...>");
+    RawGrid grid;
+    for (std::size_t k = 0; k < doc.pieces.size(); ++k) readPiece(bytes, doc, k, options, grid);
+    Mesh mesh;
+    mesh.points = std::move(grid.points);
+    mesh.fields = std::move(grid.fields);
+    if (grid.cells.offsets.empty()) grid.cells.offsets.push_back(0);
+    appendVtkCells(grid.cells, mesh, path);
+    return mesh;
+}
+
+}  // namespace
+
+Mesh readVtu(const std::string& path, const ReadOptions& options) {
+    return readVtuFile(path, options, true);
+}
+
+Mesh readPvtu(const std::string& path, const ReadOptions& options) {
+    const std::vector<char> bytes = readFileBytes(path);
+    const XmlDoc doc = parseXml(path, bytes);
+    if (doc.type != "PUnstructuredGrid")
+        throwError(ErrorKind::Unsupported, path,
+                   "VTKFile type '" + doc.type + "' is not a PUnstructuredGrid (.pvtu)");
+    return readPvtuFile(path, doc, options);
+}
+
+}  // namespace uvr

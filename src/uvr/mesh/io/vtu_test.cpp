@@ -1,1 +1,552 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/io/vtu.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+using nlohmann::json;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+// ---- helpers ----
+
+/// Folder of the files tests/tools/write_vtu_variants.py writes, generated once per process
+/// ("" when the system Python lacks vtk or meshio).
+const std::string& variantsDir() {
+    static const std::string dir = [] {
+        if (!uvr::testing::pythonHas("vtk") || !uvr::testing::pythonHas("meshio"))
+            return std::string();
+        const fs::path out = fs::temp_directory_path() / "uvr_tests" /
+                             ("vtu_variants_" + std::to_string(::getpid()));
+        fs::remove_all(out);
+        fs::create_directories(out);
+        // UVR_TEST_DATA_DIR is <root>/tests/data, which may not exist: go through its parent.
+        const std::string script =
+            (fs::path(UVR_TEST_DATA_DIR).parent_path() / "tools" / "write_vtu_variants.py")
+                .string();
+        const std::string cmd = std::string(uvr::testing::systemPython()) + " " + script + " " +
+                                out.string() + " >" + (out / "log.txt").string() + " 2>&1";
+        if (uvr::testing::runCommand(cmd) != 0) {
+            ADD_FAILURE() << "write_vtu_variants.py failed; see " << (out / "log.txt");
+            return std::string();
+        }
+        return out.string();
+    }();
+    return dir;
+}
+
+/// Removes the generated folder when the test binary exits.
+struct VariantsCleanup {
+    ~VariantsCleanup() {
+        std::error_code ec;
+        fs::remove_all(fs::temp_directory_path() / "uvr_tests" /
+                           ("vtu_variants_" + std::to_string(::getpid())),
+                       ec);
+    }
+} variantsCleanup;
+
+#define REQUIRE_VARIANTS()                                                               \
+    do {                                                                                 \
+        if (variantsDir().empty()) GTEST_SKIP() << "no vtk/meshio in the system python"; \
+    } while (0)
+
+std::string variant(const std::string& name) {
+    return variantsDir() + "/" + name;
+}
+
+std::string readText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+json loadJson(const std::string& path) {
+    std::ifstream in(path);
+    return json::parse(in);
+}
+
+/// Replaces the first occurrence of from (which must occur) with to.
+std::string replaceOnce(std::string text, const std::string& from, const std::string& to) {
+    const std::size_t pos = text.find(from);
+    EXPECT_NE(pos, std::string::npos) << "'" << from << "' not found";
+    if (pos != std::string::npos) text.replace(pos, from.size(), to);
+    return text;
+}
+
+/// 1-based line number of byte offset pos in text.
+std::uint64_t lineOf(const std::string& text, std::size_t pos) {
+    return 1 + static_cast<std::uint64_t>(std::count(text.begin(), text.begin() + pos, '\n'));
+}
+
+/// Runs f, expecting an uvr::Error of the given kind whose message holds every part.
+void expectError(const std::function<void()>& f, ErrorKind kind,
+                 const std::vector<std::string>& parts) {
+    try {
+        f();
+        ADD_FAILURE() << "no error thrown";
+    } catch (const Error& e) {
+        EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(kind)) << e.what();
+        for (const std::string& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line";
+    }
+}
+
+/// Asserts that mesh equals the expected values (exact float32 equality).
+void expectMatches(const Mesh& mesh, const json& exp) {
+    const auto& pts = exp["points"];
+    ASSERT_EQ(mesh.pointCount(), exp["pointCount"].get<std::uint64_t>());
+    for (std::size_t i = 0; i < mesh.pointCount(); ++i) {
+        EXPECT_EQ(mesh.points[i].x, pts[3 * i].get<float>()) << "point " << i;
+        EXPECT_EQ(mesh.points[i].y, pts[3 * i + 1].get<float>()) << "point " << i;
+        EXPECT_EQ(mesh.points[i].z, pts[3 * i + 2].get<float>()) << "point " << i;
+    }
+    std::vector<int> types;
+    for (CellType t : mesh.cellTypes) types.push_back(static_cast<int>(t));
+    EXPECT_EQ(types, exp["cellTypes"].get<std::vector<int>>());
+    EXPECT_EQ(mesh.cellOffsets, exp["cellOffsets"].get<std::vector<std::uint64_t>>());
+    EXPECT_EQ(mesh.cellIndices, exp["cellIndices"].get<std::vector<std::uint32_t>>());
+    ASSERT_EQ(mesh.fields.size(), exp["fields"].size());
+    for (const auto& f : exp["fields"]) {
+        const Association assoc =
+            f["association"] == "point" ? Association::Point : Association::Cell;
+        const Field* field = mesh.findField(f["name"].get<std::string>(), assoc);
+        ASSERT_NE(field, nullptr) << f["name"];
+        EXPECT_EQ(field->components, f["components"].get<int>()) << f["name"];
+        EXPECT_EQ(field->values, f["values"].get<std::vector<float>>()) << f["name"];
+    }
+}
+
+// ---- real data ----
+
+TEST(VtuSharedData, FireUgMatchesVtk) {
+    if (!uvr::testing::haveSharedData()) GTEST_SKIP() << "no shared data";
+    const Mesh mesh = readVtu(uvr::testing::sharedData("fire_ug.vtu"));
+    // Values from /usr/bin/python3 + vtk 9.1 vtkXMLUnstructuredGridReader.
+    EXPECT_EQ(mesh.pointCount(), 12323u);
+    ASSERT_EQ(mesh.cellCount(), 10462u);
+    EXPECT_TRUE(std::all_of(mesh.cellTypes.begin(), mesh.cellTypes.end(),
+                            [](CellType t) { return t == CellType::Hexahedron; }));
+    const Bounds3f b = mesh.bounds();
+    EXPECT_EQ(b.lo.x, 0.0f);
+    EXPECT_EQ(b.hi.x, 6.0f);
+    EXPECT_EQ(b.lo.y, 0.0f);
+    EXPECT_EQ(b.hi.y, 2.5f);
+    EXPECT_EQ(b.lo.z, 0.0f);
+    EXPECT_EQ(b.hi.z, 2.3999998569488525f);
+    struct Range {
+        const char* name;
+        int component, components;
+        double lo, hi;
+    };
+    const Range ranges[] = {{"t", 0, 1, 298.3812255859375, 692.2396850585938},
+                            {"uvw", 0, 3, -1.1136356592178345, 2.084019184112549},
+                            {"uvw", 1, 3, -1.1742392778396606, 3.8220272064208984},
+                            {"uvw", 2, 3, -1.181658148765564, 2.0478460788726807},
+                            {"u", 0, 1, -1.1136356592178345, 2.084019184112549},
+                            {"v", 0, 1, -1.1742392778396606, 3.8220272064208984},
+                            {"w", 0, 1, -1.181658148765564, 2.0478460788726807},
+                            {"mfrac", 0, 1, 0.0, 0.5155896544456482}};
+    EXPECT_EQ(mesh.fields.size(), 6u);
+    for (const Range& r : ranges) {
+        const Field* f = mesh.findField(r.name, Association::Point);
+        ASSERT_NE(f, nullptr) << r.name;
+        ASSERT_EQ(f->components, r.components);
+        ASSERT_EQ(f->tupleCount(), 12323u);
+        float lo = f->values[r.component], hi = lo;
+        for (std::size_t i = r.component; i < f->values.size(); i += r.components) {
+            lo = std::min(lo, f->values[i]);
+            hi = std::max(hi, f->values[i]);
+        }
+        EXPECT_EQ(lo, static_cast<float>(r.lo)) << r.name << "[" << r.component << "]";
+        EXPECT_EQ(hi, static_cast<float>(r.hi)) << r.name << "[" << r.component << "]";
+    }
+}
+
+TEST(VtuSharedData, FireUgRefusesAnArrayAboveTheMemoryLimit) {
+    if (!uvr::testing::haveSharedData()) GTEST_SKIP() << "no shared data";
+    const std::string path = uvr::testing::sharedData("fire_ug.vtu");
+    ReadOptions options;
+    options.maxMemoryBytes = 100000;  // below the 12323 * 3 * 4 bytes of the points
+    expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
+                {path, "Piece 0: DataArray 'Points'", "36969 entries", "memory limit of 100000"});
+}
+
+// ---- files written by VTK and meshio ----
+
+void checkManifest(const std::string& kind, std::size_t expectedFiles) {
+    const json manifest = loadJson(variant("manifest.json"));
+    std::size_t seen = 0;
+    for (const auto& entry : manifest) {
+        if (entry["kind"] != kind) continue;
+        const std::string path = entry["file"];
+        SCOPED_TRACE(path);
+        ++seen;
+        const Mesh mesh = kind == "pvtu" ? readPvtu(path) : readVtu(path);
+        expectMatches(mesh, loadJson(path + ".json"));
+        EXPECT_TRUE(std::any_of(mesh.notes.begin(), mesh.notes.end(), [](const std::string& n) {
+            return n.find("triangle") != std::string::npos;
+        }));
+    }
+    EXPECT_EQ(seen, expectedFiles);
+}
+
+TEST(VtuVariants, EveryVtkWriterCombinationMatchesVtk) {
+    REQUIRE_VARIANTS();
+    // {ascii, binary, appended} x {base64, raw} x {none, zlib} x {UInt32, UInt64} x {LE, BE}.
+    checkManifest("vtk", 48);
+}
+
+TEST(VtuVariants, MeshioFilesMatchVtk) {
+    REQUIRE_VARIANTS();
+    checkManifest("meshio", 3);
+}
+
+TEST(PvtuVariants, ThreePiecesMatchVtk) {
+    REQUIRE_VARIANTS();
+    checkManifest("pvtu", 1);
+}
+
+TEST(PvtuVariants, ReadVtuForwardsAPvtu) {
+    REQUIRE_VARIANTS();
+    expectMatches(readVtu(variant("three.pvtu")), loadJson(variant("three.pvtu.json")));
+}
+
+TEST(VtuVariants, SeveralPiecesInOneFileAreMerged) {
+    REQUIRE_VARIANTS();
+    const std::string text = readText(variant("vtk_ascii_raw_none_UInt32_le.vtu"));
+    const std::size_t begin = text.find("<Piece"), end = text.find("</Piece>") + 8;
+    const std::string piece = text.substr(begin, end - begin);
+    const std::string dir = uvr::testing::scratchDir();
+    const std::string path = uvr::testing::writeFile(
+        dir + "/two.vtu", text.substr(0, end) + "\n" + piece + text.substr(end));
+    const Mesh mesh = readVtu(path);
+    const json exp = loadJson(variant("vtk_ascii_raw_none_UInt32_le.vtu.json"));
+    const std::uint64_t n = exp["pointCount"].get<std::uint64_t>();
+    const auto indices = exp["cellIndices"].get<std::vector<std::uint32_t>>();
+    ASSERT_EQ(mesh.pointCount(), 2 * n);
+    ASSERT_EQ(mesh.cellIndices.size(), 2 * indices.size());
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+        EXPECT_EQ(mesh.cellIndices[i], indices[i]);
+        EXPECT_EQ(mesh.cellIndices[indices.size() + i], indices[i] + n);
+    }
+    const Field* f = mesh.findField("gradient", Association::Cell);
+    ASSERT_NE(f, nullptr);
+    EXPECT_EQ(f->tupleCount(), 2 * exp["cellTypes"].size());
+
+    // A field missing in the second piece is an error naming that piece.
+    const std::string bad = uvr::testing::writeFile(
+        dir + "/bad.vtu",
+        text.substr(0, end) + "\n" +
+            std::regex_replace(piece,
+                               std::regex("<DataArray type=\"Int8\" Name=\"i8\"[^]*?"
+                                          "</DataArray>"),
+                               "") +
+            text.substr(end));
+    expectError([&] { readVtu(bad); }, ErrorKind::Parse,
+                {bad, "Piece 1 has no point DataArray 'i8', which Piece 0 has"});
+}
+
+// ---- bad inputs (edited copies of generated files) ----
+
+class VtuErrors : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (variantsDir().empty()) GTEST_SKIP() << "no vtk/meshio in the system python";
+        dir_ = uvr::testing::scratchDir();
+    }
+    /// Writes text under the scratch folder and returns its path.
+    std::string write(const std::string& name, const std::string& text) {
+        return uvr::testing::writeFile(dir_ + "/" + name, text);
+    }
+    std::string dir_;
+};
+
+const char* const kAscii = "vtk_ascii_raw_none_UInt32_le.vtu";
+const char* const kBinary = "vtk_binary_b64_none_UInt32_le.vtu";
+const char* const kRaw = "vtk_appended_raw_none_UInt32_le.vtu";
+const char* const kRawZlib = "vtk_appended_raw_zlib_UInt32_le.vtu";
+const char* const kB64Zlib = "vtk_appended_b64_zlib_UInt64_be.vtu";
+
+TEST_F(VtuErrors, MissingFileIsAnIoError) {
+    const std::string path = dir_ + "/absent.vtu";
+    expectError([&] { readVtu(path); }, ErrorKind::Io, {path});
+}
+
+TEST_F(VtuErrors, XmlSyntaxErrorNamesLineAndColumn) {
+    const std::string text = readText(variant(kAscii));
+    const std::size_t pos = text.find("</Points>");
+    const std::string path = write("syntax.vtu", replaceOnce(text, "</Points>", "</Pointz>"));
+    expectError(
+        [&] { readVtu(path); }, ErrorKind::Parse,
+        {path + ": " + "line " + std::to_string(lineOf(text, pos)), "column", "mismatched tag"});
+}
+
+TEST_F(VtuErrors, TruncatedInlineFileIsAnXmlError) {
+    const std::string text = readText(variant(kBinary));
+    const std::string path = write("cut.vtu", text.substr(0, text.size() / 2));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse, {path + ": line ", "XML syntax error"});
+}
+
+TEST_F(VtuErrors, TruncatedAppendedDataIsRefused) {
+    const std::string text = readText(variant(kRaw));
+    const std::string path = write("cut.vtu", text.substr(0, text.size() - 400));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte ", "expected </AppendedData>", "truncated"});
+}
+
+TEST_F(VtuErrors, AppendedDataWithoutUnderscoreIsRefused) {
+    const std::string text = readText(variant(kRaw));
+    const std::size_t tag = text.find("<AppendedData");
+    const std::size_t underscore = text.find('_', tag);
+    std::string edited = text;
+    edited[underscore] = '#';
+    const std::string path = write("underscore.vtu", edited);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte " + std::to_string(underscore), "expected '_'"});
+}
+
+TEST_F(VtuErrors, BadBase64CharacterNamesItsByteOffset) {
+    std::string text = readText(variant(kBinary));
+    const std::size_t tag = text.find("Name=\"u16\"");
+    const std::size_t pos = text.find('>', tag) + 20;  // inside the base64 text
+    text[pos] = '#';
+    const std::string path = write("b64.vtu", text);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte " + std::to_string(pos), "Piece 0: DataArray 'u16'", "got '#'"});
+}
+
+/// File offset of the appended data of the array with this Name attribute, and the data start.
+std::size_t appendedArrayStart(const std::string& text, const std::string& name) {
+    const std::size_t tag = text.find("Name=\"" + name + "\"");
+    const std::size_t off = text.find("offset=\"", tag) + 8;
+    const std::uint64_t offset = std::stoull(text.substr(off, 20));
+    return text.find('_', text.find("<AppendedData")) + 1 + offset;
+}
+
+std::uint32_t loadLe32(const std::string& text, std::size_t pos) {
+    std::uint32_t v;
+    std::memcpy(&v, text.data() + pos, 4);  // the test machine is little-endian, as is the file
+    return v;
+}
+
+TEST_F(VtuErrors, CorruptZlibBlockIsNamed) {
+    std::string text = readText(variant(kRawZlib));
+    // Points: 26 x 3 Float64 = 624 bytes in blocks of 256: 3 blocks; corrupt the third.
+    const std::size_t start = appendedArrayStart(text, "Points");
+    ASSERT_EQ(loadLe32(text, start), 3u);
+    const std::size_t block2 =
+        start + 6 * 4 + loadLe32(text, start + 12) + loadLe32(text, start + 16);
+    for (std::size_t k = 2; k < 8; ++k)
+        text[block2 + k] = static_cast<char>(text[block2 + k] ^ 0x5a);
+    const std::string path = write("zlib.vtu", text);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte ", "Piece 0: DataArray 'Points'",
+                 "zlib block 2 of DataArray 'Points' is corrupt"});
+}
+
+TEST_F(VtuErrors, WrongPointCountIsASizeMismatch) {
+    for (const char* name : {kAscii, kBinary, kRaw, kRawZlib, kB64Zlib}) {
+        SCOPED_TRACE(name);
+        const std::string text = readText(variant(name));
+        const std::string path =
+            write("count.vtu", replaceOnce(text, "NumberOfPoints=\"26\"", "NumberOfPoints=\"27\""));
+        expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                    {path + ": ", "Piece 0: DataArray 'Points' holds 78 values, expected 81"});
+    }
+}
+
+TEST_F(VtuErrors, AbsurdCountsAreRefusedBeforeAllocating) {
+    const std::string huge = "NumberOfPoints=\"900000000000000\"";
+    for (const char* name : {kAscii, kBinary, kRaw, kRawZlib}) {
+        SCOPED_TRACE(name);
+        const std::string path = write(
+            "absurd.vtu", replaceOnce(readText(variant(name)), "NumberOfPoints=\"26\"", huge));
+        expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                    {path + ": ", "DataArray 'Points' holds 78 values, expected 2700000000000000"});
+    }
+    // An uncompressed size header larger than the file.
+    std::string text = readText(variant(kRaw));
+    const std::size_t start = appendedArrayStart(text, "f64");
+    text.replace(start, 4, std::string("\xf8\xff\xff\x7f", 4));
+    const std::string path = write("header.vtu", text);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte ", "DataArray 'f64'", "holds 268435455 values, expected 26"});
+    // A compressed header declaring 2^32 - 1 blocks.
+    text = readText(variant(kRawZlib));
+    text.replace(appendedArrayStart(text, "f64"), 4, std::string("\xff\xff\xff\xff", 4));
+    const std::string path2 = write("blocks.vtu", text);
+    expectError([&] { readVtu(path2); }, ErrorKind::Parse,
+                {path2 + ": byte ", "DataArray 'f64'", "runs past the end of the data"});
+}
+
+TEST_F(VtuErrors, MemoryLimitIsAResourceError) {
+    ReadOptions options;
+    options.maxMemoryBytes = 300;  // 'Points' needs 26 * 3 * 8 raw bytes
+    for (const char* name : {kAscii, kRaw, kB64Zlib}) {
+        SCOPED_TRACE(name);
+        const std::string path = variant(name);
+        expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
+                    {path, "DataArray 'Points'", "memory limit of 300 bytes"});
+    }
+}
+
+TEST_F(VtuErrors, MissingValueInAsciiArrayNamesTheLine) {
+    const std::string text = readText(variant(kAscii));
+    const std::size_t tag = text.find("Name=\"cell_id\"");
+    const std::size_t textStart = text.find('>', tag) + 1;
+    const std::size_t first = text.find_first_not_of(" \n", textStart);
+    const std::size_t firstEnd = text.find_first_of(" \n", first);
+    const std::string path = write("missing.vtu", text.substr(0, first) + text.substr(firstEnd));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line " + std::to_string(lineOf(text, tag)),
+                 "Piece 0: DataArray 'cell_id' holds 7 values, expected 8"});
+}
+
+TEST_F(VtuErrors, BadAsciiTokenNamesTheLine) {
+    const std::string text = readText(variant(kAscii));
+    const std::size_t tag = text.find("Name=\"f64\"");
+    const std::size_t textStart = text.find('>', tag) + 1;
+    const std::size_t secondLine = text.find('\n', text.find_first_not_of(" \n", textStart));
+    const std::size_t token = text.find_first_not_of(" \n", secondLine);
+    const std::size_t tokenEnd = text.find_first_of(" \n", token);
+    const std::string path =
+        write("token.vtu", text.substr(0, token) + "abc" + text.substr(tokenEnd));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line " + std::to_string(lineOf(text, token)),
+                 "Piece 0: DataArray 'f64': expected a number (Float64), got 'abc'"});
+}
+
+TEST_F(VtuErrors, MissingCellArrayIsNamed) {
+    const std::string text = readText(variant(kAscii));
+    const std::string path =
+        write("noconn.vtu",
+              std::regex_replace(text,
+                                 std::regex("<DataArray type=\"Int64\" Name=\"connectivity\"[^]*?"
+                                            "</DataArray>"),
+                                 ""));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line ", "Piece 0: missing <Cells> DataArray 'connectivity'"});
+}
+
+TEST_F(VtuErrors, UnknownTypeNameNamesTheLine) {
+    const std::string text = readText(variant(kRaw));
+    const std::size_t pos = text.find("type=\"Float64\" Name=\"f64\"");
+    const std::string path = write("type.vtu", replaceOnce(text, "type=\"Float64\" Name=\"f64\"",
+                                                           "type=\"Float128\" Name=\"f64\""));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line " + std::to_string(lineOf(text, pos)), "Piece 0: DataArray 'f64'",
+                 "got 'Float128'"});
+}
+
+TEST_F(VtuErrors, AppendedOffsetBeyondTheDataIsRefused) {
+    const std::string text = readText(variant(kRaw));
+    const std::size_t tag = text.find("Name=\"f64\"");
+    const std::size_t off = text.find("offset=\"", tag);
+    const std::size_t close = text.find('"', off + 8);
+    const std::string path =
+        write("offset.vtu", text.substr(0, off) + "offset=\"99999999" + text.substr(close));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line " + std::to_string(lineOf(text, tag)),
+                 "Piece 0: DataArray 'f64': offset 99999999 lies beyond the appended data"});
+}
+
+/// The ascii file with the element text of the DataArray Name=name replaced.
+std::string withAsciiArray(const std::string& text, const std::string& name,
+                           const std::string& values) {
+    const std::size_t tag = text.find("Name=\"" + name + "\"");
+    const std::size_t begin = text.find('>', tag) + 1;
+    const std::size_t end = text.find("</DataArray>", begin);
+    return text.substr(0, begin) + values + text.substr(end);
+}
+
+TEST_F(VtuErrors, UnknownCellTypeIsNamed) {
+    const std::string path =
+        write("celltype.vtu",
+              withAsciiArray(readText(variant(kAscii)), "types", "10 12 13 14 24 5 99 10"));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path, "cell 6: unknown VTK cell type 99"});
+}
+
+TEST_F(VtuErrors, OutOfRangePointIndexIsNamed) {
+    const std::string text = readText(variant(kAscii));
+    const std::size_t tag = text.find("Name=\"connectivity\"");
+    const std::size_t first = text.find_first_not_of(" \n", text.find('>', tag) + 1);
+    std::string edited = text;
+    edited.replace(first, 1, "26");
+    const std::string path = write("index.vtu", edited);
+    expectError([&] { readVtu(path); }, ErrorKind::Validation,
+                {path, "cell 0 (tetra): point index 26 out of range [0, 26)"});
+}
+
+TEST_F(VtuErrors, DecreasingOffsetsAreRefused) {
+    const std::string path =
+        write("offsets.vtu",
+              withAsciiArray(readText(variant(kAscii)), "offsets", "4 12 18 23 33 30 44 48"));
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line ", "Piece 0: DataArray 'offsets'",
+                 "end offset 30 of cell 5 is below the previous offset 33"});
+}
+
+TEST_F(VtuErrors, UnsupportedCompressorAndDatasetTypeAreNamed) {
+    const std::string text = readText(variant(kRawZlib));
+    const std::string lzma =
+        write("lzma.vtu", replaceOnce(text, "vtkZLibDataCompressor", "vtkLZMADataCompressor"));
+    expectError([&] { readVtu(lzma); }, ErrorKind::Unsupported,
+                {lzma + ": line " + std::to_string(lineOf(text, text.find("<VTKFile"))),
+                 "compressor 'vtkLZMADataCompressor'"});
+    const std::string poly = write(
+        "poly.vtu",
+        replaceOnce(readText(variant(kAscii)), "type=\"UnstructuredGrid\"", "type=\"PolyData\""));
+    expectError([&] { readVtu(poly); }, ErrorKind::Unsupported, {poly, "'PolyData'"});
+}
+
+// ---- .pvtu errors ----
+
+TEST_F(VtuErrors, PvtuPieceMissingAFieldIsNamed) {
+    fs::copy_file(variant("three_0.vtu"), dir_ + "/three_0.vtu");
+    fs::copy_file(variant("three_2.vtu"), dir_ + "/three_2.vtu");
+    write("three_1.vtu",
+          std::regex_replace(readText(variant("three_1.vtu")),
+                             std::regex("<DataArray type=\"Int16\" Name=\"i16\"[^>]*/>"), ""));
+    const std::string text = readText(variant("three.pvtu"));
+    const std::string path = write("three.pvtu", text);
+    expectError([&] { readPvtu(path); }, ErrorKind::Parse,
+                {path + ": line " + std::to_string(lineOf(text, text.find("three_1.vtu"))),
+                 "Piece 1 ('three_1.vtu') has no point DataArray 'i16', which piece 0 has"});
+}
+
+TEST_F(VtuErrors, PvtuNamingItselfOrAMissingPieceIsRefused) {
+    const std::string text = readText(variant("three.pvtu"));
+    const std::string self = write("self.pvtu", replaceOnce(text, "three_0.vtu", "self.pvtu"));
+    expectError([&] { readPvtu(self); }, ErrorKind::Parse,
+                {self + ": line ", "Piece 0 ('self.pvtu') names the .pvtu file itself"});
+    const std::string missing = write("missing.pvtu", text);  // pieces not copied here
+    expectError([&] { readPvtu(missing); }, ErrorKind::Io, {dir_ + "/three_0.vtu"});
+    // A piece that is itself a .pvtu (which could recurse) is refused.
+    write("other.pvtu", text);
+    const std::string nested = write("nested.pvtu", replaceOnce(text, "three_0.vtu", "other.pvtu"));
+    expectError([&] { readPvtu(nested); }, ErrorKind::Unsupported,
+                {dir_ + "/other.pvtu", "a .pvtu piece must be an UnstructuredGrid .vtu"});
+}
+
+}  // namespace
+}  // namespace uvr
