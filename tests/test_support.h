@@ -22,6 +22,11 @@ inline bool haveSharedData() {
     return std::filesystem::exists(sharedData("spx.vtk"));
 }
 
+/// Path of a helper script in tests/tools.
+inline std::string testTool(const std::string& name) {
+    return std::string(UVR_TEST_TOOLS_DIR) + "/" + name;
+}
+
 /// A fresh, empty folder for this test's files under the system temp folder.
 inline std::string scratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

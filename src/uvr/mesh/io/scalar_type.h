@@ -59,7 +59,7 @@ const char* xmlTypeName(ScalarType t);
 
 /// Reads element i of raw bytes of type t (swapping bytes when swap) as double.
 inline double loadAsDouble(const unsigned char* data, ScalarType t, std::size_t i, bool swap) {
-    unsigned char buf[8];
+    unsigned char buf[8] = {};
     std::size_t n = scalarSize(t);
     const unsigned char* src = data + i * n;
     if (swap) {
@@ -122,7 +122,7 @@ inline double loadAsDouble(const unsigned char* data, ScalarType t, std::size_t 
 /// Reads element i of raw bytes of integer type t as int64 exactly (UInt64 above INT64_MAX wraps
 /// negative, which range checks then reject).
 inline std::int64_t loadAsInt64(const unsigned char* data, ScalarType t, std::size_t i, bool swap) {
-    unsigned char buf[8];
+    unsigned char buf[8] = {};
     std::size_t n = scalarSize(t);
     const unsigned char* src = data + i * n;
     if (swap) {

@@ -38,10 +38,7 @@ const std::string& variantsDir() {
                              ("vtu_variants_" + std::to_string(::getpid()));
         fs::remove_all(out);
         fs::create_directories(out);
-        // UVR_TEST_DATA_DIR is <root>/tests/data, which may not exist: go through its parent.
-        const std::string script =
-            (fs::path(UVR_TEST_DATA_DIR).parent_path() / "tools" / "write_vtu_variants.py")
-                .string();
+        const std::string script = uvr::testing::testTool("write_vtu_variants.py");
         const std::string cmd = std::string(uvr::testing::systemPython()) + " " + script + " " +
                                 out.string() + " >" + (out / "log.txt").string() + " 2>&1";
         if (uvr::testing::runCommand(cmd) != 0) {
