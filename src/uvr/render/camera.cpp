@@ -185,12 +185,11 @@ Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
     validateCamera(camera);
     Camera out = camera;
     Vec3f offset = camera.position - camera.focalPoint;
-    Vec3f dir = normalize(-offset);
     Vec3f up = normalize(camera.viewUp);
-    up = normalize(up - dir * dot(up, dir));
-    // vtkCamera::Azimuth: rotate the position about view up through the focal point.
+    // vtkCamera::Azimuth: rotate the position about view up (as given) through the focal point.
     offset = rotate(offset, up, azimuthDeg * kDegToRad);
-    dir = normalize(-offset);
+    Vec3f dir = normalize(-offset);
+    up = normalize(up - dir * dot(up, dir));
     // vtkCamera::Elevation: rotate about the negated right axis, so positive angles move the
     // camera towards view up. View up turns with it (the orthogonalised up VTK gives for angles
     // within +-90 degrees, and well defined at the poles).
