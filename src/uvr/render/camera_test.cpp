@@ -242,7 +242,7 @@ std::string pvcc(const std::string& position, const std::string& angle = "30",
       <Element index="0" value=")" +
            angle + R"("/>
     </Property>
-    <Property name="CameraParallelProjection" id="2076.CameraParallelProjection" number_of_elements="1">
+  <Property name="CameraParallelProjection" id="7.CameraParallelProjection" number_of_elements="1">
       <Element index="0" value="0"/>
       <Domain name="bool" id="2076.CameraParallelProjection.bool"/>
     </Property>
