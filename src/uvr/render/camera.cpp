@@ -50,7 +50,7 @@ struct PvccParser {
     std::map<std::string, PvccProperty> properties;
     std::string current;  ///< name of the open <Property>, "" outside one
     bool sawRoot = false;
-    std::string error;  ///< first error, "FILE: line N: message" style parts
+    std::string error;  ///< first error found by a handler (without file and line)
     std::uint64_t errorLine = 0;
 
     void fail(const std::string& message) {

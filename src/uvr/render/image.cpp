@@ -16,7 +16,7 @@ namespace uvr {
 
 namespace {
 
-/// Largest decoded image accepted by readPng, in bytes of float RGBA pixels.
+/// Largest decoded image accepted by readPng, in bytes (float pixels plus decoded rows).
 constexpr std::uint64_t kMaxDecodedBytes = 4ull << 30;
 
 /// libpng error state: the first message, reported after longjmp back to the caller.
@@ -80,7 +80,7 @@ bool encodePng(std::FILE* file, int width, int height, bool alpha, png_bytep* ro
     return true;
 }
 
-/// Decoded PNG header and the transformations that give RGBA at 8 or 16 bits.
+/// Image size and sample depth after the conversion to RGBA.
 struct PngHeader {
     png_uint_32 width = 0, height = 0;
     int bitDepth = 0;
