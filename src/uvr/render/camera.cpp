@@ -1,1 +1,308 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/render/camera.h"
+
+#include <expat.h>
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <vector>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+
+namespace uvr {
+
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+/// Largest camera file read; real .pvcc files are about 2 kilobytes.
+constexpr std::uint64_t kMaxPvccBytes = 16ull << 20;
+
+/// Rotates v about the unit axis by angle radians (Rodrigues' rotation formula, right-handed).
+Vec3f rotate(Vec3f v, Vec3f axis, double angle) {
+    float c = static_cast<float>(std::cos(angle)), s = static_cast<float>(std::sin(angle));
+    return v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1.f - c));
+}
+
+std::string formatVec(Vec3f v) {
+    std::ostringstream os;
+    os << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+    return os.str();
+}
+
+/// One <Property> of a .pvcc file: its element values by index and where it started.
+struct PvccProperty {
+    std::map<int, std::string> elements;
+    long declaredCount = -1;
+    std::uint64_t line = 0;
+};
+
+/// Expat parsing state for a .pvcc file.
+struct PvccParser {
+    XML_Parser parser = nullptr;
+    std::string path;
+    std::map<std::string, PvccProperty> properties;
+    std::string current;  ///< name of the open <Property>, "" outside one
+    bool sawRoot = false;
+    std::string error;  ///< first error found by a handler (without file and line)
+    std::uint64_t errorLine = 0;
+
+    void fail(const std::string& message) {
+        if (error.empty()) {
+            error = message;
+            errorLine = XML_GetCurrentLineNumber(parser);
+        }
+        XML_StopParser(parser, XML_FALSE);
+    }
+};
+
+const char* attribute(const XML_Char** attrs, const char* name) {
+    for (int i = 0; attrs[i]; i += 2) {
+        if (std::string(attrs[i]) == name) return attrs[i + 1];
+    }
+    return nullptr;
+}
+
+void XMLCALL onStart(void* data, const XML_Char* name, const XML_Char** attrs) {
+    auto* p = static_cast<PvccParser*>(data);
+    std::string tag = name;
+    if (tag == "PVCameraConfiguration") p->sawRoot = true;
+    if (tag == "Property") {
+        const char* propName = attribute(attrs, "name");
+        p->current = propName ? propName : "";
+        if (p->current.empty()) return;
+        PvccProperty& prop = p->properties[p->current];
+        prop = PvccProperty{};
+        prop.line = XML_GetCurrentLineNumber(p->parser);
+        if (const char* n = attribute(attrs, "number_of_elements")) {
+            char* end = nullptr;
+            long count = std::strtol(n, &end, 10);
+            if (end == n || *end != '\0' || count < 0) {
+                p->fail("property " + p->current +
+                        ": expected an integer number_of_elements, got \"" + n + "\"");
+                return;
+            }
+            prop.declaredCount = count;
+        }
+    } else if (tag == "Element" && !p->current.empty()) {
+        const char* index = attribute(attrs, "index");
+        const char* value = attribute(attrs, "value");
+        char* end = nullptr;
+        long i = index ? std::strtol(index, &end, 10) : -1;
+        if (!index || end == index || *end != '\0' || i < 0 || i > 1000) {
+            p->fail("property " + p->current + ": expected an Element with an index, got \"" +
+                    (index ? index : "") + "\"");
+            return;
+        }
+        if (!value) {
+            p->fail("property " + p->current + ": Element " + std::to_string(i) + " has no value");
+            return;
+        }
+        p->properties[p->current].elements[static_cast<int>(i)] = value;
+    }
+}
+
+void XMLCALL onEnd(void* data, const XML_Char* name) {
+    auto* p = static_cast<PvccParser*>(data);
+    if (std::string(name) == "Property") p->current.clear();
+}
+
+/// Values of a required property with exactly count numeric elements.
+std::vector<double> propertyValues(const PvccParser& p, const std::string& name, int count) {
+    auto it = p.properties.find(name);
+    if (it == p.properties.end()) {
+        throwParseError(p.path, "property " + name,
+                        "expected a <Property name=\"" + name + "\"> with " +
+                            std::to_string(count) + " element(s), found none");
+    }
+    const PvccProperty& prop = it->second;
+    std::string where = atLine(prop.line) + ": property " + name;
+    if (static_cast<int>(prop.elements.size()) != count ||
+        (prop.declaredCount >= 0 && prop.declaredCount != count)) {
+        throwParseError(p.path, where,
+                        "expected " + std::to_string(count) + " element(s), got " +
+                            std::to_string(prop.elements.size()));
+    }
+    std::vector<double> values;
+    for (int i = 0; i < count; ++i) {
+        auto e = prop.elements.find(i);
+        if (e == prop.elements.end()) {
+            throwParseError(p.path, where,
+                            "expected an Element with index " + std::to_string(i) + ", found none");
+        }
+        const char* text = e->second.c_str();
+        char* end = nullptr;
+        errno = 0;
+        double v = std::strtod(text, &end);
+        if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+            throwParseError(p.path, where,
+                            "element " + std::to_string(i) + ": expected a finite number, got \"" +
+                                e->second + "\"");
+        }
+        values.push_back(v);
+    }
+    return values;
+}
+
+Vec3f toVec3(const std::vector<double>& v) {
+    return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+}
+
+}  // namespace
+
+Camera resetCamera(const Bounds3f& bounds, float aspect) {
+    if (bounds.empty() || !isFinite(bounds.lo) || !isFinite(bounds.hi)) {
+        throwError(ErrorKind::Argument, "",
+                   "cannot reset the camera to empty or non-finite bounds");
+    }
+    if (!(aspect > 0.f) || !std::isfinite(aspect)) {
+        throwError(
+            ErrorKind::Argument, "",
+            "camera aspect (width / height) must be positive, got " + std::to_string(aspect));
+    }
+    // vtkRenderer::ResetCamera: fit the bounding sphere into the view angle (the horizontal one
+    // when the image is taller than wide); a zero radius becomes 0.5 as in VTK.
+    double radius = bounds.diagonal();
+    radius = radius == 0.0 ? 0.5 : 0.5 * radius;
+    Camera cam;
+    cam.viewAngle = 30.f;
+    double angle = cam.viewAngle * kDegToRad;
+    if (aspect < 1.f) angle = 2.0 * std::atan(std::tan(0.5 * angle) * aspect);
+    double distance = radius / std::sin(0.5 * angle);
+    cam.focalPoint = bounds.center();
+    cam.position = cam.focalPoint + Vec3f(0.f, 0.f, static_cast<float>(distance));
+    cam.viewUp = Vec3f(0.f, 1.f, 0.f);
+    return cam;
+}
+
+Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
+    validateCamera(camera);
+    Camera out = camera;
+    Vec3f offset = camera.position - camera.focalPoint;
+    Vec3f up = normalize(camera.viewUp);
+    // vtkCamera::Azimuth: rotate the position about view up (as given) through the focal point.
+    offset = rotate(offset, up, azimuthDeg * kDegToRad);
+    Vec3f dir = normalize(-offset);
+    up = normalize(up - dir * dot(up, dir));
+    // vtkCamera::Elevation: rotate about the negated right axis, so positive angles move the
+    // camera towards view up. View up turns with it (the orthogonalised up VTK gives for angles
+    // within +-90 degrees, and well defined at the poles).
+    Vec3f axis = normalize(cross(up, dir));
+    offset = rotate(offset, axis, elevationDeg * kDegToRad);
+    up = normalize(rotate(up, axis, elevationDeg * kDegToRad));
+    out.position = camera.focalPoint + offset;
+    out.viewUp = up;
+    return out;
+}
+
+Camera loadPvcc(const std::string& path) {
+    std::uint64_t size = fileSize(path);
+    if (size > kMaxPvccBytes) {
+        throwError(ErrorKind::Resource, path,
+                   "camera file of " + std::to_string(size) + " bytes exceeds the limit of " +
+                       std::to_string(kMaxPvccBytes) + " bytes");
+    }
+    std::vector<char> bytes = readFileBytes(path);
+
+    PvccParser state;
+    state.path = path;
+    state.parser = XML_ParserCreate(nullptr);
+    if (!state.parser) throwError(ErrorKind::Resource, path, "cannot create an XML parser");
+    XML_SetUserData(state.parser, &state);
+    XML_SetElementHandler(state.parser, onStart, onEnd);
+    XML_Status status =
+        XML_Parse(state.parser, bytes.data(), static_cast<int>(bytes.size()), XML_TRUE);
+    std::string xmlError;
+    std::uint64_t xmlLine = 0;
+    if (status == XML_STATUS_ERROR && state.error.empty()) {
+        xmlError = XML_ErrorString(XML_GetErrorCode(state.parser));
+        xmlLine = XML_GetCurrentLineNumber(state.parser);
+    }
+    XML_ParserFree(state.parser);
+    state.parser = nullptr;
+    if (!state.error.empty()) throwParseError(path, atLine(state.errorLine), state.error);
+    if (!xmlError.empty()) {
+        throwParseError(path, atLine(xmlLine),
+                        "expected XML (a ParaView camera configuration), got: " + xmlError);
+    }
+    if (!state.sawRoot) {
+        throwParseError(path, atLine(1),
+                        "expected a <PVCameraConfiguration> element (a ParaView .pvcc file)");
+    }
+
+    Camera cam;
+    cam.position = toVec3(propertyValues(state, "CameraPosition", 3));
+    cam.focalPoint = toVec3(propertyValues(state, "CameraFocalPoint", 3));
+    cam.viewUp = toVec3(propertyValues(state, "CameraViewUp", 3));
+    cam.viewAngle = static_cast<float>(propertyValues(state, "CameraViewAngle", 1)[0]);
+    if (state.properties.count("CameraParallelProjection") &&
+        propertyValues(state, "CameraParallelProjection", 1)[0] != 0.0) {
+        throwError(ErrorKind::Unsupported, path,
+                   "property CameraParallelProjection: parallel projection is not supported");
+    }
+    try {
+        validateCamera(cam);
+    } catch (const Error& e) {
+        throwError(ErrorKind::Parse, path, e.what());
+    }
+    return cam;
+}
+
+void validateCamera(const Camera& camera) {
+    if (!isFinite(camera.position) || !isFinite(camera.focalPoint) || !isFinite(camera.viewUp) ||
+        !std::isfinite(camera.viewAngle)) {
+        throwError(ErrorKind::Argument, "",
+                   "camera has non-finite values: position " + formatVec(camera.position) +
+                       ", focal point " + formatVec(camera.focalPoint) + ", view up " +
+                       formatVec(camera.viewUp) + ", angle " + std::to_string(camera.viewAngle));
+    }
+    Vec3f offset = camera.focalPoint - camera.position;
+    float dist = length(offset);
+    float scale = std::max(maxComponent(vmax(camera.position, -camera.position)),
+                           maxComponent(vmax(camera.focalPoint, -camera.focalPoint)));
+    if (!(dist > 0.f) || dist <= 1e-6f * scale) {
+        throwError(ErrorKind::Argument, "",
+                   "camera position " + formatVec(camera.position) +
+                       " equals the focal point; expected distinct points");
+    }
+    float upLen = length(camera.viewUp);
+    if (!(upLen > 0.f) || length(cross(offset / dist, camera.viewUp / upLen)) < 1e-4f) {
+        throwError(ErrorKind::Argument, "",
+                   "camera view up " + formatVec(camera.viewUp) +
+                       " is zero or parallel to the view direction " + formatVec(offset / dist));
+    }
+    if (!(camera.viewAngle > 0.f && camera.viewAngle < 180.f)) {
+        throwError(ErrorKind::Argument, "",
+                   "camera view angle must be in (0, 180) degrees, got " +
+                       std::to_string(camera.viewAngle));
+    }
+}
+
+CameraRays makeCameraRays(const Camera& camera, int width, int height) {
+    validateCamera(camera);
+    if (width <= 0 || height <= 0) {
+        throwError(ErrorKind::Argument, "",
+                   "image size must be positive, got " + std::to_string(width) + " x " +
+                       std::to_string(height));
+    }
+    // Pinhole camera with the image plane at unit distance along the view direction.
+    Vec3f dir = normalize(camera.focalPoint - camera.position);
+    Vec3f right = normalize(cross(dir, camera.viewUp));
+    Vec3f up = cross(right, dir);
+    float halfH = static_cast<float>(std::tan(0.5 * camera.viewAngle * kDegToRad));
+    float halfW = halfH * static_cast<float>(width) / static_cast<float>(height);
+    CameraRays rays;
+    rays.origin = camera.position;
+    rays.topLeft = dir - right * halfW + up * halfH;
+    rays.du = right * (2.f * halfW / static_cast<float>(width));
+    rays.dv = up * (-2.f * halfH / static_cast<float>(height));
+    return rays;
+}
+
+}  // namespace uvr

@@ -1,1 +1,312 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/render/camera.h"
+
+#include <gmock/gmock.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <numbers>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+using uvr::testing::pythonHas;
+using uvr::testing::runCommand;
+using uvr::testing::scratchDir;
+using uvr::testing::systemPython;
+using uvr::testing::writeFile;
+
+/// Relative tolerance for camera positions computed in float.
+constexpr float kTol = 1e-5f;
+
+float degrees(float rad) {
+    return rad * 180.f / std::numbers::pi_v<float>;
+}
+
+float angleBetween(Vec3f a, Vec3f b) {
+    return degrees(std::acos(std::clamp(dot(normalize(a), normalize(b)), -1.f, 1.f)));
+}
+
+void expectVec(Vec3f got, Vec3f want, float tol, const std::string& what = "") {
+    EXPECT_NEAR(got.x, want.x, tol) << what;
+    EXPECT_NEAR(got.y, want.y, tol) << what;
+    EXPECT_NEAR(got.z, want.z, tol) << what;
+}
+
+template <typename F>
+Error catchError(F&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << "expected a uvr::Error";
+    return Error(ErrorKind::Internal, "no error");
+}
+
+std::vector<double> runPython(const std::string& dir, const std::string& script) {
+    std::string py = writeFile(dir + "/oracle.py", script);
+    std::string out = dir + "/oracle.txt";
+    EXPECT_EQ(runCommand(std::string(systemPython()) + " " + py + " > " + out + " 2>/dev/null"), 0);
+    std::ifstream in(out);
+    std::vector<double> values;
+    double v;
+    while (in >> v) values.push_back(v);
+    return values;
+}
+
+Bounds3f box(Vec3f lo, Vec3f hi) {
+    Bounds3f b;
+    b.extend(lo);
+    b.extend(hi);
+    return b;
+}
+
+TEST(Camera, ResetFitsBoundingSphereLookingDownMinusZ) {
+    Camera cam = resetCamera(box({-1, -1, -1}, {1, 1, 1}), 1.5f);
+    float d = std::sqrt(3.f) / std::sin(15.f * std::numbers::pi_v<float> / 180.f);
+    expectVec(cam.position, {0.f, 0.f, d}, kTol * d);
+    expectVec(cam.focalPoint, {0.f, 0.f, 0.f}, 0.f);
+    expectVec(cam.viewUp, {0.f, 1.f, 0.f}, 0.f);
+    EXPECT_FLOAT_EQ(cam.viewAngle, 30.f);
+    EXPECT_NO_THROW(validateCamera(cam));
+}
+
+TEST(Camera, ResetMatchesVtkRendererForWideAndTallImages) {
+    if (!pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk";
+    std::string dir = scratchDir();
+    std::vector<double> v = runPython(dir, R"(
+import vtk
+for w, h in ((400, 200), (200, 400)):
+    r = vtk.vtkRenderer()
+    win = vtk.vtkRenderWindow()
+    win.SetOffScreenRendering(1)
+    win.AddRenderer(r)
+    win.SetSize(w, h)
+    r.ResetCamera(-1, 2, -3, 4, 0, 1)
+    c = r.GetActiveCamera()
+    print(*c.GetPosition(), *c.GetFocalPoint(), *c.GetViewUp(), c.GetViewAngle())
+)");
+    ASSERT_EQ(v.size(), 20u);
+    Bounds3f b = box({-1, -3, 0}, {2, 4, 1});
+    float aspects[2] = {2.f, 0.5f};
+    for (int k = 0; k < 2; ++k) {
+        Camera cam = resetCamera(b, aspects[k]);
+        const double* r = &v[10 * k];
+        expectVec(cam.position, Vec3f(r[0], r[1], r[2]), 1e-4f, "position");
+        expectVec(cam.focalPoint, Vec3f(r[3], r[4], r[5]), 1e-6f, "focal point");
+        expectVec(cam.viewUp, Vec3f(r[6], r[7], r[8]), 1e-6f, "view up");
+        EXPECT_FLOAT_EQ(cam.viewAngle, static_cast<float>(r[9]));
+    }
+    EXPECT_GT(resetCamera(b, 0.5f).position.z, resetCamera(b, 2.f).position.z);
+}
+
+TEST(Camera, ResetRejectsEmptyBoundsAndBadAspect) {
+    EXPECT_EQ(catchError([] { resetCamera(Bounds3f{}, 1.f); }).kind(), ErrorKind::Argument);
+    Bounds3f b = box({0, 0, 0}, {1, 1, 1});
+    EXPECT_EQ(catchError([&] { resetCamera(b, 0.f); }).kind(), ErrorKind::Argument);
+    EXPECT_EQ(catchError([&] { resetCamera(b, std::nanf("")); }).kind(), ErrorKind::Argument);
+}
+
+TEST(Camera, CentreRayHitsFocalPointAndEdgesSpanTheViewAngle) {
+    Camera cam;
+    cam.position = {1.f, 2.f, 3.f};
+    cam.focalPoint = {-2.f, 0.5f, 1.f};
+    cam.viewUp = {0.f, 0.f, 1.f};
+    cam.viewAngle = 40.f;
+    const int w = 64, h = 48;
+    CameraRays rays = makeCameraRays(cam, w, h);
+    Vec3f dir = normalize(cam.focalPoint - cam.position);
+    Ray centre = rays.ray(w / 2.f, h / 2.f);
+    expectVec(centre.org, cam.position, 0.f);
+    expectVec(centre.dir, dir, 1e-6f);
+    // Top and bottom edge midpoints span the vertical view angle; left and right edges the
+    // horizontal angle that the aspect ratio gives.
+    EXPECT_NEAR(angleBetween(rays.ray(w / 2.f, 0.f).dir, rays.ray(w / 2.f, h).dir), 40.f, 1e-3f);
+    float halfH = std::tan(20.f * std::numbers::pi_v<float> / 180.f);
+    float horizontal = 2.f * degrees(std::atan(halfH * w / h));
+    EXPECT_NEAR(angleBetween(rays.ray(0.f, h / 2.f).dir, rays.ray(w, h / 2.f).dir), horizontal,
+                1e-3f);
+    // Pixel (0, 0) is top-left: above the view direction (along view up) and to the left.
+    Vec3f right = normalize(cross(dir, cam.viewUp));
+    Vec3f topLeft = rays.ray(0.5f, 0.5f).dir;
+    EXPECT_GT(dot(topLeft, cam.viewUp), dot(dir, cam.viewUp));
+    EXPECT_LT(dot(topLeft, right), 0.f);
+    EXPECT_NEAR(length(rays.ray(3.5f, 7.5f).dir), 1.f, 1e-6f);
+    EXPECT_EQ(catchError([&] { makeCameraRays(cam, 0, 10); }).kind(), ErrorKind::Argument);
+}
+
+TEST(Camera, OrbitAzimuth90MovesToPlusX) {
+    Camera cam;
+    cam.position = {0.f, 0.f, 10.f};
+    Camera a = orbitCamera(cam, 90.f, 0.f);
+    expectVec(a.position, {10.f, 0.f, 0.f}, 1e-5f);
+    expectVec(a.viewUp, {0.f, 1.f, 0.f}, 1e-6f);
+    Camera e = orbitCamera(cam, 0.f, 90.f);  // over the pole: view up turns with the camera
+    expectVec(e.position, {0.f, 10.f, 0.f}, 1e-5f);
+    expectVec(e.viewUp, {0.f, 0.f, -1.f}, 1e-6f);
+    EXPECT_NO_THROW(validateCamera(e));
+}
+
+TEST(Camera, OrbitMatchesVtkCameraAzimuthElevation) {
+    if (!pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk";
+    std::string dir = scratchDir();
+    std::vector<double> v = runPython(dir, R"(
+import vtk
+for az, el in ((90, 0), (30, 20), (-70, -45), (200, 60)):
+    c = vtk.vtkCamera()
+    c.SetPosition(1, 2, 8)
+    c.SetFocalPoint(0.5, -1, 0)
+    c.SetViewUp(0.1, 1, 0)
+    c.Azimuth(az)
+    c.Elevation(el)
+    c.OrthogonalizeViewUp()
+    print(*c.GetPosition(), *c.GetViewUp())
+)");
+    ASSERT_EQ(v.size(), 24u);
+    Camera cam;
+    cam.position = {1.f, 2.f, 8.f};
+    cam.focalPoint = {0.5f, -1.f, 0.f};
+    cam.viewUp = {0.1f, 1.f, 0.f};
+    float angles[4][2] = {{90, 0}, {30, 20}, {-70, -45}, {200, 60}};
+    for (int k = 0; k < 4; ++k) {
+        Camera o = orbitCamera(cam, angles[k][0], angles[k][1]);
+        const double* r = &v[6 * k];
+        std::string what = "orbit " + std::to_string(k);
+        expectVec(o.position, Vec3f(r[0], r[1], r[2]), 1e-4f, what);
+        expectVec(o.viewUp, Vec3f(r[3], r[4], r[5]), 1e-5f, what);
+        EXPECT_NEAR(length(o.position - o.focalPoint), length(cam.position - cam.focalPoint),
+                    1e-4f);
+    }
+}
+
+TEST(Camera, ValidateRejectsDegenerateCameras) {
+    EXPECT_NO_THROW(validateCamera(Camera{}));
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    struct Case {
+        Camera cam;
+        const char* what;
+    };
+    Camera c;
+    std::vector<Case> cases;
+    c = Camera{}, c.position.x = nan, cases.push_back({c, "non-finite"});
+    c = Camera{}, c.focalPoint.z = inf, cases.push_back({c, "non-finite"});
+    c = Camera{}, c.viewUp.y = nan, cases.push_back({c, "non-finite"});
+    c = Camera{}, c.viewAngle = nan, cases.push_back({c, "non-finite"});
+    c = Camera{}, c.focalPoint = c.position, cases.push_back({c, "equals the focal point"});
+    c = Camera{}, c.viewUp = {0.f, 0.f, 2.f}, cases.push_back({c, "parallel"});
+    c = Camera{}, c.viewUp = {0.f, 0.f, 0.f}, cases.push_back({c, "parallel"});
+    c = Camera{}, c.viewAngle = 0.f, cases.push_back({c, "(0, 180)"});
+    c = Camera{}, c.viewAngle = 180.f, cases.push_back({c, "(0, 180)"});
+    c = Camera{}, c.viewAngle = -10.f, cases.push_back({c, "(0, 180)"});
+    for (const Case& k : cases) {
+        Error e = catchError([&] { validateCamera(k.cam); });
+        EXPECT_EQ(e.kind(), ErrorKind::Argument) << e.what();
+        EXPECT_THAT(e.what(), HasSubstr(k.what));
+    }
+}
+
+/// A .pvcc file as ParaView writes it, with the given camera properties.
+std::string pvcc(const std::string& position, const std::string& angle = "30",
+                 const std::string& up =
+                     "0.0522244587063913\" /><Element index=\"1\" "
+                     "value=\"0.99\"/><Element index=\"2\" value=\"0.1") {
+    return R"(<?xml version="1.0"?>
+<PVCameraConfiguration description="ParaView camera configuration" version="1.0">
+  <Proxy group="views" type="RenderView" id="2076" servers="21">
+    <Property name="CameraPosition" id="2076.CameraPosition" number_of_elements="3">
+)" + position +
+           R"(
+    </Property>
+    <Property name="CameraFocalPoint" id="2076.CameraFocalPoint" number_of_elements="3">
+      <Element index="0" value="-0.445446427868706"/>
+      <Element index="1" value="0.115471756220899"/>
+      <Element index="2" value="-0.440184037664585"/>
+    </Property>
+    <Property name="CameraViewUp" id="2076.CameraViewUp" number_of_elements="3">
+      <Element index="0" value=")" +
+           up + R"("/>
+    </Property>
+    <Property name="CenterOfRotation" id="2076.CenterOfRotation" number_of_elements="3">
+      <Element index="0" value="0"/>
+      <Element index="1" value="0"/>
+      <Element index="2" value="0"/>
+    </Property>
+    <Property name="CameraViewAngle" id="2076.CameraViewAngle" number_of_elements="1">
+      <Element index="0" value=")" +
+           angle + R"("/>
+    </Property>
+  <Property name="CameraParallelProjection" id="7.CameraParallelProjection" number_of_elements="1">
+      <Element index="0" value="0"/>
+      <Domain name="bool" id="2076.CameraParallelProjection.bool"/>
+    </Property>
+  </Proxy>
+</PVCameraConfiguration>
+)";
+}
+
+const char* kPosition = R"(      <Element index="0" value="7.11835691704117"/>
+      <Element index="1" value="56.1347613281343"/>
+      <Element index="2" value="6.60090036368214"/>)";
+
+TEST(Camera, LoadsParaViewCameraFile) {
+    std::string path = writeFile(scratchDir() + "/view.pvcc", pvcc(kPosition, "22.5"));
+    Camera cam = loadPvcc(path);
+    expectVec(cam.position, {7.11835691704117f, 56.1347613281343f, 6.60090036368214f}, 0.f);
+    expectVec(cam.focalPoint, {-0.445446427868706f, 0.115471756220899f, -0.440184037664585f}, 0.f);
+    expectVec(cam.viewUp, {0.0522244587063913f, 0.99f, 0.1f}, 0.f);
+    EXPECT_FLOAT_EQ(cam.viewAngle, 22.5f);
+}
+
+TEST(Camera, BadCameraFilesNameFileAndProperty) {
+    std::string dir = scratchDir();
+    std::string twoElements = R"(<Element index="0" value="1"/><Element index="1" value="2"/>)";
+    std::string word = R"(<Element index="0" value="1"/><Element index="1" value="abc"/>
+      <Element index="2" value="3"/>)";
+    std::string missing = pvcc(kPosition);
+    size_t from = missing.find("    <Property name=\"CameraViewUp\"");
+    size_t to = missing.find("</Property>", from) + 12;
+    missing.erase(from, to - from);
+    std::string parallel = pvcc(kPosition);
+    parallel.replace(parallel.find("value=\"0\"/>\n      <Domain"), 9, "value=\"1\"");
+    struct Case {
+        const char* name;
+        std::string text;
+        ErrorKind kind;
+        const char* where;
+        const char* what;
+    };
+    const Case cases[] = {
+        {"missing", missing, ErrorKind::Parse, "property CameraViewUp", "found none"},
+        {"count", pvcc(twoElements), ErrorKind::Parse, "line 4: property CameraPosition",
+         "expected 3 element(s), got 2"},
+        {"word", pvcc(word), ErrorKind::Parse, "property CameraPosition",
+         "element 1: expected a finite number, got \"abc\""},
+        {"angle", pvcc(kPosition, "180"), ErrorKind::Parse, "view angle", "(0, 180)"},
+        {"notxml", "CameraPosition 1 2 3\n", ErrorKind::Parse, "line 1", "expected XML"},
+        {"unclosed", pvcc(kPosition).substr(0, 300), ErrorKind::Parse, "line ", "expected XML"},
+        {"otherxml", "<?xml version=\"1.0\"?>\n<VTKFile/>\n", ErrorKind::Parse, "line 1",
+         "PVCameraConfiguration"},
+        {"parallel", parallel, ErrorKind::Unsupported, "CameraParallelProjection", "parallel"},
+    };
+    for (const Case& c : cases) {
+        std::string path = writeFile(dir + "/" + c.name + ".pvcc", c.text);
+        Error e = catchError([&] { loadPvcc(path); });
+        EXPECT_EQ(e.kind(), c.kind) << c.name << ": " << e.what();
+        EXPECT_THAT(e.what(), HasSubstr(path + ": ")) << c.name;
+        EXPECT_THAT(e.what(), HasSubstr(c.where)) << c.name;
+        EXPECT_THAT(e.what(), HasSubstr(c.what)) << c.name;
+    }
+    Error e = catchError([&] { loadPvcc(dir + "/absent.pvcc"); });
+    EXPECT_EQ(e.kind(), ErrorKind::Io);
+    EXPECT_THAT(e.what(), HasSubstr("absent.pvcc"));
+}
+
+}  // namespace
+}  // namespace uvr

@@ -1,1 +1,228 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/render/image.h"
+
+#include <png.h>
+
+#include <cerrno>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+
+namespace uvr {
+
+namespace {
+
+/// Largest decoded image accepted by readPng, in bytes (float pixels plus decoded rows).
+constexpr std::uint64_t kMaxDecodedBytes = 4ull << 30;
+
+/// libpng error state: the first message, reported after longjmp back to the caller.
+struct PngErrorState {
+    char message[256] = {0};
+};
+
+void pngError(png_structp png, png_const_charp msg) {
+    auto* state = static_cast<PngErrorState*>(png_get_error_ptr(png));
+    if (state && state->message[0] == '\0') {
+        std::snprintf(state->message, sizeof(state->message), "%s", msg ? msg : "libpng error");
+    }
+    png_longjmp(png, 1);
+}
+
+void pngWarning(png_structp, png_const_charp) {}
+
+/// In-memory source for libpng reads.
+struct PngSource {
+    const unsigned char* data = nullptr;
+    size_t size = 0;
+    size_t pos = 0;
+};
+
+void readFromMemory(png_structp png, png_bytep out, png_size_t count) {
+    auto* src = static_cast<PngSource*>(png_get_io_ptr(png));
+    if (count > src->size - src->pos) png_error(png, "unexpected end of file");
+    std::memcpy(out, src->data + src->pos, count);
+    src->pos += count;
+}
+
+std::uint8_t toByte(float v) {
+    v = v > 0.f ? (v < 1.f ? v : 1.f) : 0.f;  // NaN becomes 0
+    return static_cast<std::uint8_t>(std::lround(v * 255.f));
+}
+
+/// libpng write with setjmp error handling; no C++ objects live in this frame. Returns false
+/// with state.message set on failure.
+bool encodePng(std::FILE* file, int width, int height, bool alpha, png_bytep* rows,
+               PngErrorState& state) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &state, pngError, pngWarning);
+    if (!png) {
+        std::snprintf(state.message, sizeof(state.message), "cannot create a PNG writer");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info || setjmp(png_jmpbuf(png))) {
+        if (state.message[0] == '\0')
+            std::snprintf(state.message, sizeof(state.message), "cannot create PNG info");
+        png_destroy_write_struct(&png, info ? &info : nullptr);
+        return false;
+    }
+    png_init_io(png, file);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+                 alpha ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    png_write_image(png, rows);
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+/// Image size and sample depth after the conversion to RGBA.
+struct PngHeader {
+    png_uint_32 width = 0, height = 0;
+    int bitDepth = 0;
+    size_t rowBytes = 0;
+};
+
+/// Reads the header and sets transformations to RGBA (8 or 16 bits per channel, big-endian).
+bool decodeHeader(png_structp png, png_infop info, PngHeader& header) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_read_info(png, info);
+    int colorType = png_get_color_type(png, info);
+    int bitDepth = png_get_bit_depth(png, info);
+    if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+    if (colorType == PNG_COLOR_TYPE_GRAY && bitDepth < 8) png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+    if (colorType == PNG_COLOR_TYPE_GRAY || colorType == PNG_COLOR_TYPE_GRAY_ALPHA)
+        png_set_gray_to_rgb(png);
+    if (!(colorType & PNG_COLOR_MASK_ALPHA) && !png_get_valid(png, info, PNG_INFO_tRNS))
+        png_set_add_alpha(png, 0xffff, PNG_FILLER_AFTER);
+    png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    header.width = png_get_image_width(png, info);
+    header.height = png_get_image_height(png, info);
+    header.bitDepth = png_get_bit_depth(png, info);
+    header.rowBytes = png_get_rowbytes(png, info);
+    return true;
+}
+
+bool decodeRows(png_structp png, png_infop info, png_bytep* rows) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_read_image(png, rows);
+    png_read_end(png, nullptr);
+    (void)info;
+    return true;
+}
+
+/// Owns a libpng read struct.
+struct PngReader {
+    png_structp png = nullptr;
+    png_infop info = nullptr;
+    ~PngReader() { png_destroy_read_struct(&png, info ? &info : nullptr, nullptr); }
+};
+
+}  // namespace
+
+void writePng(const std::string& path, const Image& image, const std::optional<Vec3f>& background) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
+        throwError(ErrorKind::Argument, path,
+                   "cannot write a " + std::to_string(image.width) + " x " +
+                       std::to_string(image.height) + " image with " +
+                       std::to_string(image.pixels.size()) + " pixels as PNG");
+    }
+    // Convert to 8-bit rows: straight RGBA, or RGB composited over the background.
+    const bool alpha = !background.has_value();
+    const size_t channels = alpha ? 4 : 3;
+    std::vector<std::uint8_t> bytes(image.pixels.size() * channels);
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+        Vec4f p = image.pixels[i];
+        std::uint8_t* out = &bytes[i * channels];
+        if (alpha) {
+            float inv = p.w > 0.f ? 1.f / p.w : 0.f;
+            out[0] = toByte(p.x * inv);
+            out[1] = toByte(p.y * inv);
+            out[2] = toByte(p.z * inv);
+            out[3] = toByte(p.w);
+        } else {
+            float a = p.w > 0.f ? (p.w < 1.f ? p.w : 1.f) : 0.f;
+            Vec3f c = p.xyz() + *background * (1.f - a);
+            out[0] = toByte(c.x);
+            out[1] = toByte(c.y);
+            out[2] = toByte(c.z);
+        }
+    }
+    std::vector<png_bytep> rows(static_cast<size_t>(image.height));
+    for (int y = 0; y < image.height; ++y)
+        rows[y] = &bytes[static_cast<size_t>(y) * image.width * channels];
+
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        std::FILE* file = std::fopen(tmp.c_str(), "wb");
+        if (!file) {
+            throwError(ErrorKind::Io, path, std::string("cannot write: ") + std::strerror(errno));
+        }
+        PngErrorState state;
+        bool ok = encodePng(file, image.width, image.height, alpha, rows.data(), state);
+        bool closed = std::fclose(file) == 0;
+        if (!ok) throwError(ErrorKind::Io, path, std::string("PNG write failed: ") + state.message);
+        if (!closed) {
+            throwError(ErrorKind::Io, path, std::string("cannot write: ") + std::strerror(errno));
+        }
+    });
+}
+
+Image readPng(const std::string& path) {
+    std::vector<char> file = readFileBytes(path);
+    if (file.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(file.data()), 0, 8)) {
+        throwParseError(path, atByte(0), "expected the PNG signature, got something else");
+    }
+    PngSource source{reinterpret_cast<const unsigned char*>(file.data()), file.size(), 0};
+    PngErrorState state;
+    PngReader reader;
+    reader.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &state, pngError, pngWarning);
+    if (reader.png) reader.info = png_create_info_struct(reader.png);
+    if (!reader.png || !reader.info)
+        throwError(ErrorKind::Resource, path, "cannot create a PNG reader");
+    png_set_read_fn(reader.png, &source, readFromMemory);
+
+    // Step 1: header, and a size check before allocating.
+    PngHeader header;
+    if (!decodeHeader(reader.png, reader.info, header)) {
+        throwParseError(path, atByte(source.pos),
+                        std::string("expected a valid PNG header, got: ") + state.message);
+    }
+    std::uint64_t pixelCount = static_cast<std::uint64_t>(header.width) * header.height;
+    checkAllocation(path, "PNG pixels", pixelCount, sizeof(Vec4f) + 8, kMaxDecodedBytes);
+    const int channelBytes = header.bitDepth == 16 ? 2 : 1;
+    if (header.rowBytes != static_cast<size_t>(header.width) * 4 * channelBytes) {
+        throwError(ErrorKind::Internal, path, "unexpected PNG row size after conversion to RGBA");
+    }
+
+    // Step 2: pixel rows.
+    std::vector<std::uint8_t> bytes(header.rowBytes * header.height);
+    std::vector<png_bytep> rows(header.height);
+    for (png_uint_32 y = 0; y < header.height; ++y) rows[y] = &bytes[y * header.rowBytes];
+    if (!decodeRows(reader.png, reader.info, rows.data())) {
+        throwParseError(path, atByte(source.pos),
+                        std::string("truncated or corrupt PNG data: ") + state.message);
+    }
+
+    // Step 3: to premultiplied float RGBA.
+    Image image(static_cast<int>(header.width), static_cast<int>(header.height));
+    const float scale = header.bitDepth == 16 ? 1.f / 65535.f : 1.f / 255.f;
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+        const std::uint8_t* p = &bytes[i * 4 * channelBytes];
+        float c[4];
+        for (int k = 0; k < 4; ++k) {
+            unsigned v = channelBytes == 2 ? (p[2 * k] << 8) | p[2 * k + 1] : p[k];
+            c[k] = static_cast<float>(v) * scale;
+        }
+        image.pixels[i] = Vec4f(c[0] * c[3], c[1] * c[3], c[2] * c[3], c[3]);
+    }
+    return image;
+}
+
+}  // namespace uvr

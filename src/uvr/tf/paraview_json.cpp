@@ -1,1 +1,273 @@
 // SPDX-License-Identifier: MIT
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+#include "uvr/tf/transfer_function.h"
+
+namespace uvr {
+
+namespace {
+
+using Json = nlohmann::json;
+
+/// Largest colour-map file read (ParaView's biggest presets are a few hundred kilobytes).
+constexpr std::uint64_t kMaxJsonBytes = 64ull << 20;
+
+/// Segments each HSV-interpolated colour segment is resampled into for RGB interpolation.
+constexpr int kHsvSubdivisions = 32;
+
+std::string lower(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+/// A short, one-line rendering of a JSON value for error messages.
+std::string describe(const Json& v) {
+    std::string s = v.dump();
+    if (s.size() > 40) s = s.substr(0, 37) + "...";
+    return s;
+}
+
+/// Reads a flat array of numbers whose length is a non-zero multiple of 4.
+std::vector<double> readQuads(const std::string& path, const std::string& where, const Json& v) {
+    if (!v.is_array()) {
+        throwParseError(path, where, "expected an array of numbers, got " + describe(v));
+    }
+    if (v.empty() || v.size() % 4 != 0) {
+        throwParseError(path, where,
+                        "expected a non-empty multiple of 4 numbers (x, then 3 values per "
+                        "point), got " +
+                            std::to_string(v.size()));
+    }
+    std::vector<double> out;
+    out.reserve(v.size());
+    for (size_t i = 0; i < v.size(); ++i) {
+        const Json& e = v[i];
+        if (!e.is_number() || !std::isfinite(e.get<double>())) {
+            throwParseError(path, where + "[" + std::to_string(i) + "]",
+                            "expected a finite number, got " + describe(e));
+        }
+        out.push_back(e.get<double>());
+    }
+    for (size_t i = 4; i < out.size(); i += 4) {
+        if (out[i] < out[i - 4]) {
+            throwParseError(path, where + "[" + std::to_string(i) + "]",
+                            "expected positions that do not decrease, got " +
+                                std::to_string(out[i]) + " after " + std::to_string(out[i - 4]));
+        }
+    }
+    return out;
+}
+
+void checkUnit(const std::string& path, const std::string& where, size_t i, double v,
+               const std::string& what) {
+    if (v < 0.0 || v > 1.0) {
+        throwParseError(path, where + "[" + std::to_string(i) + "]",
+                        "expected " + what + " in [0, 1], got " + std::to_string(v));
+    }
+}
+
+Vec3f hsvToRgb(double h, double s, double v) {
+    h = (h - std::floor(h)) * 6.0;
+    int sector = static_cast<int>(h) % 6;
+    double f = h - std::floor(h);
+    double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+    double r = v, g = t, b = p;
+    switch (sector) {
+        case 1:
+            r = q, g = v, b = p;
+            break;
+        case 2:
+            r = p, g = v, b = t;
+            break;
+        case 3:
+            r = p, g = q, b = v;
+            break;
+        case 4:
+            r = t, g = p, b = v;
+            break;
+        case 5:
+            r = v, g = p, b = q;
+            break;
+        default:
+            break;
+    }
+    return {static_cast<float>(r), static_cast<float>(g), static_cast<float>(b)};
+}
+
+void rgbToHsv(Vec3f c, double& h, double& s, double& v) {
+    double mx = std::max({c.x, c.y, c.z}), mn = std::min({c.x, c.y, c.z});
+    v = mx;
+    double d = mx - mn;
+    s = mx > 0 ? d / mx : 0;
+    if (d <= 0) {
+        h = 0;
+        return;
+    }
+    if (mx == c.x)
+        h = (c.y - c.z) / d;
+    else if (mx == c.y)
+        h = 2.0 + (c.z - c.x) / d;
+    else
+        h = 4.0 + (c.x - c.y) / d;
+    h /= 6.0;
+    if (h < 0) h += 1.0;
+}
+
+/// Resamples HSV interpolation (hue taking the shorter way round, as VTK's HSVWrap default)
+/// into RGB control points.
+std::vector<ColorPoint> expandHsv(const std::vector<ColorPoint>& in) {
+    std::vector<ColorPoint> out;
+    for (size_t i = 0; i + 1 < in.size(); ++i) {
+        double h0, s0, v0, h1, s1, v1;
+        rgbToHsv(in[i].rgb, h0, s0, v0);
+        rgbToHsv(in[i + 1].rgb, h1, s1, v1);
+        if (h1 - h0 > 0.5) h0 += 1.0;
+        if (h0 - h1 > 0.5) h1 += 1.0;
+        for (int k = 0; k < kHsvSubdivisions; ++k) {
+            double f = static_cast<double>(k) / kHsvSubdivisions;
+            float x = in[i].x + static_cast<float>(f) * (in[i + 1].x - in[i].x);
+            out.push_back(
+                {x, k == 0 ? in[i].rgb
+                           : hsvToRgb(h0 + f * (h1 - h0), s0 + f * (s1 - s0), v0 + f * (v1 - v0))});
+        }
+    }
+    out.push_back(in.back());
+    return out;
+}
+
+}  // namespace
+
+TransferFunction loadParaViewColorMap(const std::string& path) {
+    std::uint64_t size = fileSize(path);
+    if (size > kMaxJsonBytes) {
+        throwError(ErrorKind::Resource, path,
+                   "colour-map file of " + std::to_string(size) + " bytes exceeds the limit of " +
+                       std::to_string(kMaxJsonBytes) + " bytes");
+    }
+    std::vector<char> bytes = readFileBytes(path);
+    Json doc;
+    try {
+        doc = Json::parse(bytes.begin(), bytes.end());
+    } catch (const Json::parse_error& e) {
+        std::string msg = e.what();
+        size_t bracket = msg.find("] ");
+        if (bracket != std::string::npos) msg = msg.substr(bracket + 2);
+        throwParseError(path, atByte(e.byte),
+                        "expected JSON (a ParaView colour-map export), got " + msg);
+    }
+
+    // Step 1: the colour-map object (ParaView exports an array of them; the first is used).
+    std::string where = "colour map";
+    const Json* map = &doc;
+    if (doc.is_array()) {
+        if (doc.empty()) {
+            throwParseError(path, "top level",
+                            "expected an array of colour-map objects, got an empty array");
+        }
+        map = &doc[0];
+        where = "colour map 0";
+    }
+    if (!map->is_object()) {
+        throwParseError(path, where, "expected a colour-map object, got " + describe(*map));
+    }
+
+    TransferFunction tf;
+    if (auto it = map->find("Name"); it != map->end() && it->is_string()) {
+        tf.name = it->get<std::string>();
+    }
+
+    // Step 2: the colour space.
+    bool hsv = false;
+    if (auto it = map->find("ColorSpace"); it != map->end()) {
+        std::string space = it->is_string() ? lower(it->get<std::string>()) : "";
+        if (space == "rgb") {
+            tf.colorSpace = ColorSpace::RGB;
+        } else if (space == "lab" || space == "cielab") {
+            tf.colorSpace = ColorSpace::Lab;
+        } else if (space == "diverging") {
+            tf.colorSpace = ColorSpace::Diverging;
+        } else if (space == "hsv") {
+            hsv = true;
+        } else if (space == "step") {
+            throwError(ErrorKind::Unsupported, path,
+                       where + " \"ColorSpace\": \"Step\" colour maps are not supported");
+        } else {
+            throwParseError(
+                path, where + " \"ColorSpace\"",
+                "expected \"RGB\", \"Lab\", \"Diverging\" or \"HSV\", got " + describe(*it));
+        }
+    }
+
+    // Step 3: colour points, normalised over their own range.
+    auto rgbIt = map->find("RGBPoints");
+    if (rgbIt == map->end()) {
+        throwParseError(path, where,
+                        "expected key \"RGBPoints\" (x, r, g, b, ...); indexed (categorical) "
+                        "colour maps are not supported");
+    }
+    const std::string rgbWhere = where + " \"RGBPoints\"";
+    std::vector<double> rgb = readQuads(path, rgbWhere, *rgbIt);
+    for (size_t i = 0; i < rgb.size(); ++i) {
+        if (i % 4 != 0) checkUnit(path, rgbWhere, i, rgb[i], "a colour component");
+    }
+    double lo = rgb.front(), hi = rgb[rgb.size() - 4];
+    auto normalise = [&](double x) {
+        return hi > lo ? static_cast<float>((x - lo) / (hi - lo)) : 0.f;
+    };
+    for (size_t i = 0; i < rgb.size(); i += 4) {
+        tf.colors.push_back({normalise(rgb[i]),
+                             Vec3f(static_cast<float>(rgb[i + 1]), static_cast<float>(rgb[i + 2]),
+                                   static_cast<float>(rgb[i + 3]))});
+    }
+    if (hsv) {
+        tf.colors = expandHsv(tf.colors);
+        tf.colorSpace = ColorSpace::RGB;
+    }
+    tf.sourceRange = std::make_pair(static_cast<float>(lo), static_cast<float>(hi));
+
+    // Step 4: opacity points over the same range; a midpoint other than 0.5 becomes an extra
+    // knot (vtkPiecewiseFunction's linear midpoint shift), sharpness is treated as 0.
+    auto ptsIt = map->find("Points");
+    if (ptsIt == map->end()) {
+        tf.opacities = {{0.f, 0.f}, {1.f, 1.f}};
+        return tf;
+    }
+    const std::string ptsWhere = where + " \"Points\"";
+    std::vector<double> pts = readQuads(path, ptsWhere, *ptsIt);
+    for (size_t i = 0; i < pts.size(); i += 4) {
+        checkUnit(path, ptsWhere, i + 1, pts[i + 1], "an opacity");
+        checkUnit(path, ptsWhere, i + 2, pts[i + 2], "a midpoint");
+        checkUnit(path, ptsWhere, i + 3, pts[i + 3], "a sharpness");
+    }
+    double pLo = lo, pHi = hi;
+    if (!(hi > lo)) pLo = pts.front(), pHi = pts[pts.size() - 4];
+    auto normaliseOpacity = [&](double x) {
+        return pHi > pLo ? static_cast<float>((x - pLo) / (pHi - pLo)) : 0.f;
+    };
+    TransferFunction raw;
+    for (size_t i = 0; i < pts.size(); i += 4) {
+        float x = normaliseOpacity(pts[i]);
+        float a = static_cast<float>(pts[i + 1]);
+        raw.opacities.push_back({x, a});
+        if (i + 4 < pts.size() && pts[i + 2] != 0.5) {
+            float x1 = normaliseOpacity(pts[i + 4]);
+            float a1 = static_cast<float>(pts[i + 5]);
+            raw.opacities.push_back(
+                {x + static_cast<float>(pts[i + 2]) * (x1 - x), 0.5f * (a + a1)});
+        }
+    }
+    // Clip to [0, 1]: the values at the ends plus the knots strictly inside.
+    tf.opacities.push_back({0.f, raw.opacityAt(0.f)});
+    for (const OpacityPoint& p : raw.opacities) {
+        if (p.x > 0.f && p.x < 1.f) tf.opacities.push_back(p);
+    }
+    tf.opacities.push_back({1.f, raw.opacityAt(1.f)});
+    return tf;
+}
+
+}  // namespace uvr

@@ -67,4 +67,14 @@ void applyOpacitySpec(TransferFunction& tf, const std::string& spec);
 /// Loads a preset name or, when the string names an existing .json file, a ParaView export.
 TransferFunction loadTransferFunction(const std::string& presetOrPath);
 
+/// CIE L*a*b* (D65 white, via linear sRGB and XYZ) of an sRGB colour with components in [0, 1].
+Vec3f srgbToLab(Vec3f rgb);
+
+/// sRGB colour, clamped to [0, 1], of a CIE L*a*b* (D65 white) colour; inverse of srgbToLab.
+Vec3f labToSrgb(Vec3f lab);
+
+/// Colour between sRGB colours a (f = 0) and b (f = 1) interpolated in the given colour space;
+/// Diverging follows Moreland 2009's Msh interpolation through an unsaturated midpoint.
+Vec3f interpolateColor(ColorSpace space, Vec3f a, Vec3f b, float f);
+
 }  // namespace uvr

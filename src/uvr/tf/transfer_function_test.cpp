@@ -1,1 +1,341 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/tf/transfer_function.h"
+
+#include <gmock/gmock.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+using uvr::testing::pythonHas;
+using uvr::testing::runCommand;
+using uvr::testing::scratchDir;
+using uvr::testing::systemPython;
+using uvr::testing::writeFile;
+
+/// Tolerance for colours compared against VTK's and matplotlib's own evaluation.
+constexpr float kColorTol = 5e-4f;
+
+void expectColor(Vec3f got, Vec3f want, float tol, const std::string& what) {
+    EXPECT_NEAR(got.x, want.x, tol) << what;
+    EXPECT_NEAR(got.y, want.y, tol) << what;
+    EXPECT_NEAR(got.z, want.z, tol) << what;
+}
+
+/// Runs the function and returns the uvr::Error it throws (fails the test if none).
+template <typename F>
+Error catchError(F&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << "expected a uvr::Error";
+    return Error(ErrorKind::Internal, "no error");
+}
+
+/// Runs a Python script with the system Python and returns its stdout parsed as numbers.
+std::vector<double> runPython(const std::string& dir, const std::string& script) {
+    std::string py = writeFile(dir + "/oracle.py", script);
+    std::string out = dir + "/oracle.txt";
+    EXPECT_EQ(runCommand(std::string(systemPython()) + " " + py + " > " + out + " 2>/dev/null"), 0);
+    std::ifstream in(out);
+    std::vector<double> values;
+    double v;
+    while (in >> v) values.push_back(v);
+    return values;
+}
+
+TransferFunction twoPoint(ColorSpace space, Vec3f a, Vec3f b) {
+    TransferFunction tf;
+    tf.colorSpace = space;
+    tf.colors = {{0.f, a}, {1.f, b}};
+    tf.opacities = {{0.f, 0.f}, {1.f, 1.f}};
+    return tf;
+}
+
+TEST(TransferFunction, RgbInterpolationIsLinearAndClamped) {
+    TransferFunction tf;
+    tf.colors = {{0.f, {0.f, 0.f, 0.f}}, {0.25f, {1.f, 0.f, 0.f}}, {1.f, {1.f, 1.f, 0.5f}}};
+    tf.opacities = {{0.f, 0.f}, {1.f, 1.f}};
+    expectColor(tf.colorAt(0.125f), {0.5f, 0.f, 0.f}, 1e-6f, "middle of first segment");
+    expectColor(tf.colorAt(0.625f), {1.f, 0.5f, 0.25f}, 1e-6f, "middle of second segment");
+    expectColor(tf.colorAt(-3.f), {0.f, 0.f, 0.f}, 0.f, "clamped below");
+    expectColor(tf.colorAt(7.f), {1.f, 1.f, 0.5f}, 0.f, "clamped above");
+    expectColor(tf.colorAt(0.25f), {1.f, 0.f, 0.f}, 0.f, "at a control point");
+}
+
+TEST(TransferFunction, OpacityIsPiecewiseLinearWithJumps) {
+    TransferFunction tf = twoPoint(ColorSpace::RGB, Vec3f(0.f), Vec3f(1.f));
+    tf.opacities = {{0.2f, 0.1f}, {0.6f, 0.5f}, {0.6f, 0.9f}, {1.f, 0.7f}};
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.f), 0.1f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.4f), 0.3f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.5999f), 0.4999f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.6f), 0.9f);  // a jump takes the upper value at its position
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.8f), 0.8f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(2.f), 0.7f);
+}
+
+TEST(TransferFunction, BakeSamplesEvenlyIncludingEnds) {
+    TransferFunction tf = transferFunctionPreset("grayscale");
+    std::vector<Vec4f> table = tf.bake(5);
+    ASSERT_EQ(table.size(), 5u);
+    for (int k = 0; k < 5; ++k) {
+        float t = k / 4.f;
+        EXPECT_FLOAT_EQ(table[k].x, t);
+        EXPECT_FLOAT_EQ(table[k].y, t);
+        EXPECT_FLOAT_EQ(table[k].z, t);
+        EXPECT_FLOAT_EQ(table[k].w, t);
+    }
+    EXPECT_EQ(catchError([&] { tf.bake(1); }).kind(), ErrorKind::Argument);
+}
+
+TEST(TransferFunction, LabConversionMatchesPublishedValues) {
+    // sRGB primaries in CIE L*a*b* (D65), e.g. from Bruce Lindbloom's calculator.
+    Vec3f red = srgbToLab({1.f, 0.f, 0.f});
+    EXPECT_NEAR(red.x, 53.24f, 0.05f);
+    EXPECT_NEAR(red.y, 80.09f, 0.1f);
+    EXPECT_NEAR(red.z, 67.20f, 0.1f);
+    Vec3f white = srgbToLab({1.f, 1.f, 1.f});
+    EXPECT_NEAR(white.x, 100.f, 0.01f);
+    EXPECT_NEAR(white.y, 0.f, 0.05f);
+    EXPECT_NEAR(white.z, 0.f, 0.05f);
+    for (Vec3f c : {Vec3f(0.2f, 0.5f, 0.9f), Vec3f(0.01f, 0.02f, 0.f), Vec3f(0.9f, 0.3f, 0.1f)})
+        expectColor(labToSrgb(srgbToLab(c)), c, 1e-4f, "Lab round trip");
+}
+
+TEST(TransferFunction, DivergingThroughWhiteBetweenSaturatedEnds) {
+    // Moreland 2009: two saturated ends with hues far apart pass through an unsaturated colour
+    // of magnitude max(M1, M2, 88), i.e. a neutral grey with L* = 88 for these two colours.
+    TransferFunction tf =
+        twoPoint(ColorSpace::Diverging, {0.230f, 0.299f, 0.754f}, {0.706f, 0.016f, 0.150f});
+    Vec3f mid = tf.colorAt(0.5f);
+    Vec3f grey = labToSrgb({88.f, 0.f, 0.f});
+    expectColor(mid, grey, 1e-4f, "Msh midpoint");
+    EXPECT_NEAR(mid.x, mid.y, 1e-4f);
+    expectColor(tf.colorAt(0.f), {0.230f, 0.299f, 0.754f}, 1e-6f, "end 0");
+    expectColor(tf.colorAt(1.f), {0.706f, 0.016f, 0.150f}, 1e-6f, "end 1");
+}
+
+TEST(TransferFunction, CoolToWarmAndLabMatchVtkColorTransferFunction) {
+    if (!pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk";
+    std::string dir = scratchDir();
+    std::vector<double> v = runPython(dir, R"(
+import vtk
+def table(space, pts):
+    f = vtk.vtkColorTransferFunction()
+    getattr(f, 'SetColorSpaceTo' + space)()
+    for p in pts: f.AddRGBPoint(*p)
+    for i in range(101): print(*f.GetColor(i / 100.0))
+table('Diverging', [(0, 0.23137254902, 0.298039215686, 0.752941176471), (0.5, 0.865, 0.865, 0.865),
+                    (1, 0.705882352941, 0.0156862745098, 0.149019607843)])
+table('Lab', [(0, 0, 0.6, 0.75), (0.3, 0.1, 0.1, 0.1), (1, 0.77, 0.47, 0.34)])
+)");
+    ASSERT_EQ(v.size(), 2u * 101 * 3);
+    TransferFunction ctw = transferFunctionPreset("Cool to Warm");
+    TransferFunction lab;
+    lab.colorSpace = ColorSpace::Lab;
+    lab.colors = {
+        {0.f, {0.f, 0.6f, 0.75f}}, {0.3f, {0.1f, 0.1f, 0.1f}}, {1.f, {0.77f, 0.47f, 0.34f}}};
+    for (int i = 0; i <= 100; ++i) {
+        const double* d = &v[3 * i];
+        const double* l = &v[3 * (101 + i)];
+        expectColor(ctw.colorAt(i / 100.f), Vec3f(d[0], d[1], d[2]), kColorTol,
+                    "cool-to-warm at " + std::to_string(i));
+        expectColor(lab.colorAt(i / 100.f), Vec3f(l[0], l[1], l[2]), kColorTol,
+                    "Lab at " + std::to_string(i));
+    }
+}
+
+TEST(TransferFunction, ViridisAndInfernoMatchMatplotlib) {
+    if (!pythonHas("matplotlib")) GTEST_SKIP() << "system Python has no matplotlib";
+    std::string dir = scratchDir();
+    std::vector<double> v = runPython(dir, R"(
+from matplotlib import cm
+for name in ('viridis', 'inferno'):
+    for c in cm.get_cmap(name).colors: print(*c)
+)");
+    ASSERT_EQ(v.size(), 2u * 256 * 3);
+    TransferFunction maps[2] = {transferFunctionPreset("viridis"),
+                                transferFunctionPreset("Inferno (matplotlib)")};
+    for (int m = 0; m < 2; ++m) {
+        for (int i = 0; i < 256; ++i) {
+            const double* c = &v[3 * (256 * m + i)];
+            // Every 5th of the 256 entries is embedded; interpolation stays within one 8-bit step.
+            expectColor(maps[m].colorAt(i / 255.f), Vec3f(c[0], c[1], c[2]), 1.f / 255.f,
+                        maps[m].name + " entry " + std::to_string(i));
+        }
+    }
+}
+
+TEST(TransferFunction, PresetsResolveParaViewNames) {
+    for (const char* name : {"Cool to Warm", "cool_to_warm", "COOL-TO-WARM"})
+        EXPECT_EQ(transferFunctionPreset(name).name, "cool-to-warm") << name;
+    EXPECT_EQ(transferFunctionPreset("Black-Body Radiation").name, "black-body");
+    EXPECT_EQ(transferFunctionPreset("Viridis (matplotlib)").name, "viridis");
+    EXPECT_EQ(transferFunctionPreset("Grayscale").name, "grayscale");
+    for (const std::string& name : transferFunctionPresetNames()) {
+        TransferFunction tf = transferFunctionPreset(name);
+        EXPECT_EQ(tf.name, name);
+        EXPECT_FLOAT_EQ(tf.opacityAt(0.f), 0.f);
+        EXPECT_FLOAT_EQ(tf.opacityAt(0.3f), 0.3f);
+        EXPECT_FLOAT_EQ(tf.opacityAt(1.f), 1.f);
+    }
+    Error e = catchError([] { transferFunctionPreset("jet"); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(), HasSubstr("\"jet\""));
+    EXPECT_THAT(e.what(), HasSubstr("cool-to-warm, viridis"));
+}
+
+TEST(TransferFunction, BlackBodyMatchesParaViewPreset) {
+    // ParaView's ColorMaps.json: 0 black, 0.4 (0.902, 0, 0), 0.8 (0.902, 0.902, 0), 1 white.
+    TransferFunction tf = transferFunctionPreset("black-body");
+    expectColor(tf.colorAt(0.2f), {0.45098f, 0.f, 0.f}, 1e-5f, "0.2");
+    expectColor(tf.colorAt(0.6f), {0.901961f, 0.45098f, 0.f}, 1e-5f, "0.6");
+    expectColor(tf.colorAt(0.9f), {0.95098f, 0.95098f, 0.5f}, 1e-5f, "0.9");
+}
+
+TEST(TransferFunction, OpacitySpecs) {
+    TransferFunction tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(tf, "ramp:0.5");
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.5f), 0.25f);
+    applyOpacitySpec(tf, "constant:0.2");
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.f), 0.2f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(1.f), 0.2f);
+    applyOpacitySpec(tf, "step:0.3");
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.29f), 0.f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.3f), 1.f);
+    applyOpacitySpec(tf, "step:0.3:0.4");
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.9f), 0.4f);
+    applyOpacitySpec(tf, "0:0,0.5:1,1:0");
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.25f), 0.5f);
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.75f), 0.5f);
+    applyOpacitySpec(tf, "ramp");
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.7f), 0.7f);
+
+    for (const char* bad :
+         {"ramp:2", "ramp:", "ramp:x", "constant", "constant:0.1:2", "step", "step:0.5:1:1",
+          "step:-1", "foo", "0.5", "0:0,0.5", "0.5:1,0.2:0", "0:nan", "", "1e999:0"}) {
+        Error e = catchError([&] { applyOpacitySpec(tf, bad); });
+        EXPECT_EQ(e.kind(), ErrorKind::Argument) << bad;
+        EXPECT_THAT(e.what(), HasSubstr(std::string(1, '"').append(bad).append(1, '"'))) << bad;
+        EXPECT_THAT(e.what(), HasSubstr("step:T[:A]")) << bad;
+    }
+    EXPECT_FLOAT_EQ(tf.opacityAt(0.7f), 0.7f);  // a bad spec leaves the function unchanged
+}
+
+TEST(TransferFunction, LoadsParaViewExport) {
+    std::string dir = scratchDir();
+    // RGBPoints over data range [-10, 30]; Points with a shifted midpoint and a range beyond it.
+    std::string path = writeFile(dir + "/map.json", R"([
+  {
+    "ColorSpace" : "Lab",
+    "Name" : "My map",
+    "NanColor" : [1, 1, 0],
+    "RGBPoints" : [-10, 0, 0, 1,  10, 1, 1, 1,  30, 1, 0, 0],
+    "Points" : [-20, 0, 0.5, 0,  10, 0.4, 0.25, 0,  30, 1, 0.5, 0]
+  }
+])");
+    TransferFunction tf = loadParaViewColorMap(path);
+    EXPECT_EQ(tf.name, "My map");
+    EXPECT_EQ(tf.colorSpace, ColorSpace::Lab);
+    ASSERT_TRUE(tf.sourceRange.has_value());
+    EXPECT_FLOAT_EQ(tf.sourceRange->first, -10.f);
+    EXPECT_FLOAT_EQ(tf.sourceRange->second, 30.f);
+    ASSERT_EQ(tf.colors.size(), 3u);
+    EXPECT_FLOAT_EQ(tf.colors[1].x, 0.5f);
+    expectColor(tf.colorAt(0.5f), {1.f, 1.f, 1.f}, 1e-6f, "white at data value 10");
+    // Opacity at data value -10 (normalised 0) on the segment from (-20, 0) to (10, 0.4).
+    EXPECT_NEAR(tf.opacityAt(0.f), 0.4f / 3.f, 1e-6f);
+    EXPECT_NEAR(tf.opacityAt(0.5f), 0.4f, 1e-6f);
+    // Midpoint 0.25 between data 10 and 30: value 0.7 at data 15 (normalised 0.625).
+    EXPECT_NEAR(tf.opacityAt(0.625f), 0.7f, 1e-6f);
+    EXPECT_NEAR(tf.opacityAt(0.8125f), 0.85f, 1e-6f);
+    EXPECT_NEAR(tf.opacityAt(1.f), 1.f, 1e-6f);
+}
+
+TEST(TransferFunction, ParaViewCoolToWarmExportEqualsPreset) {
+    std::string dir = scratchDir();
+    std::string path = writeFile(dir + "/ctw.json", R"({"ColorSpace": "Diverging",
+        "Name": "Cool to Warm", "RGBPoints": [0.5, 0.23137254902, 0.298039215686, 0.752941176471,
+        1.5, 0.865, 0.865, 0.865, 2.5, 0.705882352941, 0.0156862745098, 0.149019607843]})");
+    TransferFunction tf = loadTransferFunction(path);
+    TransferFunction preset = loadTransferFunction("cool-to-warm");
+    for (int i = 0; i <= 20; ++i) {
+        expectColor(tf.colorAt(i / 20.f), preset.colorAt(i / 20.f), 1e-6f, std::to_string(i));
+        EXPECT_FLOAT_EQ(tf.opacityAt(i / 20.f), i / 20.f);  // no Points: a linear ramp
+    }
+}
+
+TEST(TransferFunction, HsvExportIsResampledTheShortWayRound) {
+    std::string dir = scratchDir();
+    std::string path = writeFile(dir + "/hsv.json", R"([{"ColorSpace": "HSV",
+        "RGBPoints": [0, 1, 0, 0, 1, 0, 0, 1]}])");
+    TransferFunction tf = loadParaViewColorMap(path);
+    EXPECT_EQ(tf.colorSpace, ColorSpace::RGB);
+    expectColor(tf.colorAt(0.f), {1.f, 0.f, 0.f}, 1e-6f, "red end");
+    expectColor(tf.colorAt(0.5f), {1.f, 0.f, 1.f}, 1e-5f, "magenta, not green, in the middle");
+    expectColor(tf.colorAt(1.f), {0.f, 0.f, 1.f}, 1e-6f, "blue end");
+}
+
+TEST(TransferFunction, MalformedParaViewExportsNameFileAndKey) {
+    std::string dir = scratchDir();
+    struct Case {
+        const char* name;
+        const char* json;
+        ErrorKind kind;
+        const char* where;
+        const char* what;
+    };
+    const Case cases[] = {
+        {"notjson", "[{\"RGBPoints\": [0, 1, 1, 1,]}]", ErrorKind::Parse, "byte 28", "JSON"},
+        {"empty", "[]", ErrorKind::Parse, "top level", "empty array"},
+        {"scalar", "42", ErrorKind::Parse, "colour map", "colour-map object"},
+        {"norgb", "[{\"Name\": \"x\", \"IndexedColors\": [1, 0, 0]}]", ErrorKind::Parse,
+         "colour map 0", "\"RGBPoints\""},
+        {"count", "[{\"RGBPoints\": [0, 1, 1, 1, 1, 0, 0]}]", ErrorKind::Parse,
+         "colour map 0 \"RGBPoints\"", "multiple of 4"},
+        {"token", "[{\"RGBPoints\": [0, 1, \"a\", 1]}]", ErrorKind::Parse, "\"RGBPoints\"[2]",
+         "finite number"},
+        {"order", "[{\"RGBPoints\": [0, 1, 1, 1, 2, 0, 0, 0, 1, 1, 1, 1]}]", ErrorKind::Parse,
+         "\"RGBPoints\"[8]", "do not decrease"},
+        {"colour", "[{\"RGBPoints\": [0, 1, 1, 1, 1, 0, 1.5, 0]}]", ErrorKind::Parse,
+         "\"RGBPoints\"[6]", "colour component in [0, 1]"},
+        {"opacity", "[{\"RGBPoints\": [0, 1, 1, 1], \"Points\": [0, 2, 0.5, 0]}]", ErrorKind::Parse,
+         "\"Points\"[1]", "opacity in [0, 1]"},
+        {"points", "[{\"RGBPoints\": [0, 1, 1, 1], \"Points\": {}}]", ErrorKind::Parse,
+         "\"Points\"", "array of numbers"},
+        {"space", "[{\"ColorSpace\": \"CMYK\", \"RGBPoints\": [0, 1, 1, 1]}]", ErrorKind::Parse,
+         "\"ColorSpace\"", "\"CMYK\""},
+        {"step", "[{\"ColorSpace\": \"Step\", \"RGBPoints\": [0, 1, 1, 1]}]",
+         ErrorKind::Unsupported, "\"ColorSpace\"", "Step"},
+    };
+    for (const Case& c : cases) {
+        std::string path = writeFile(dir + "/" + c.name + ".json", c.json);
+        Error e = catchError([&] { loadParaViewColorMap(path); });
+        EXPECT_EQ(e.kind(), c.kind) << c.name << ": " << e.what();
+        EXPECT_THAT(e.what(), HasSubstr(path + ": ")) << c.name;
+        EXPECT_THAT(e.what(), HasSubstr(c.where)) << c.name;
+        EXPECT_THAT(e.what(), HasSubstr(c.what)) << c.name;
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << c.name;
+    }
+}
+
+TEST(TransferFunction, LoadTransferFunctionChoosesPresetOrFile) {
+    EXPECT_EQ(loadTransferFunction("Viridis").name, "viridis");
+    std::string missing = scratchDir() + "/missing.json";
+    Error e = catchError([&] { loadTransferFunction(missing); });
+    EXPECT_EQ(e.kind(), ErrorKind::Io);
+    EXPECT_THAT(e.what(), HasSubstr(missing));
+    EXPECT_EQ(catchError([] { loadTransferFunction("nope"); }).kind(), ErrorKind::Argument);
+}
+
+}  // namespace
+}  // namespace uvr
