@@ -119,7 +119,7 @@ struct ArrayDesc {
     std::string unit;  ///< plural noun for the tuples, e.g. "point triples"
 };
 
-/// Recursive-descent reader of one legacy VTK file held in memory. Positions are tracked as a
+/// Keyword-driven reader of one legacy VTK file held in memory. Positions are tracked as a
 /// byte offset and, for ASCII files, a line number, so every error can say where it happened.
 class LegacyParser {
 public:
@@ -330,8 +330,8 @@ LegacyParser::Values::Values(LegacyParser& p, ArrayDesc desc, ScalarType type,
                    quote(kw.text()) + " declares more values than any file can hold");
     total_ = desc_.tuples * comps;
     if (p.binary_) {
-        // Binary: exactly total * size bytes must follow. Data larger than the whole file is a
-        // Resource error (an absurd count), data the rest of the file lacks a truncation.
+        // Binary: exactly total * size bytes must follow. Data larger than the whole file is an
+        // absurd count (Resource); data larger than the rest of it, a cut-short file (Parse).
         const std::uint64_t bytes = total_ * esize;
         if (bytes > remaining) {
             const std::string msg =
@@ -688,7 +688,7 @@ void LegacyParser::readAttributes(KeywordLine kw) {
                 const ScalarType type = parseType(kw, 2);
                 const std::int64_t comps =
                     kw.tokens.size() > 3 ? parseComponents(kw, 3, kMaxComponents) : 1;
-                if (nextTokenIs("LOOKUP_TABLE")) readKeywordLine();  // optional before VTK 2
+                if (nextTokenIs("LOOKUP_TABLE")) readKeywordLine();  // optional in older files
                 addField(
                     kw.tokens[1], assoc, comps,
                     readFloats({n, comps, "tuples of SCALARS " + quote(kw.tokens[1])}, type, kw));
@@ -696,10 +696,10 @@ void LegacyParser::readAttributes(KeywordLine kw) {
                        key == "TENSORS6" || key == "GLOBAL_IDS" || key == "PEDIGREE_IDS") {
                 requireTokens(kw, 3, (key + " name type").c_str());
                 const ScalarType type = parseType(kw, 2);
-                const std::int64_t comps = key == "TENSORS"                 ? 9
-                                           : key == "TENSORS6"              ? 6
-                                           : key[0] == 'G' || key[0] == 'P' ? 1
-                                                                            : 3;
+                std::int64_t comps = 3;  // VECTORS, NORMALS
+                if (key == "TENSORS") comps = 9;
+                if (key == "TENSORS6") comps = 6;
+                if (key == "GLOBAL_IDS" || key == "PEDIGREE_IDS") comps = 1;
                 addField(kw.tokens[1], assoc, comps,
                          readFloats({n, comps, "tuples of " + key + " " + quote(kw.tokens[1])},
                                     type, kw));

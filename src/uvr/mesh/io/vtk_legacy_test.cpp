@@ -209,6 +209,11 @@ struct WriterCase {
     const char* mode;
 };
 
+/// Prints a writer case readably in test names and failures.
+void PrintTo(const WriterCase& wc, std::ostream* os) {
+    *os << "version " << wc.version << " " << wc.mode;
+}
+
 class VtkLegacyVtkWritten : public ::testing::TestWithParam<WriterCase> {};
 
 TEST_P(VtkLegacyVtkWritten, ReadsWhatVtkWrote) {
