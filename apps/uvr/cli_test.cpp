@@ -14,15 +14,15 @@
 namespace uvr {
 namespace {
 
-struct Run {
+struct CliRun {
     int code = -1;
     std::string out, err;
 };
 
 /// Runs `uvr ARGS` in dir, capturing stdout and stderr.
-Run uvr(const std::string& args, const std::string& dir) {
+CliRun uvr(const std::string& args, const std::string& dir) {
     const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-    Run r;
+    CliRun r;
     r.code = testing::runCommand(testing::uvrBinary() + " " + args + " >" + out + " 2>" + err);
     auto slurp = [](const std::string& p) {
         std::ifstream in(p);
@@ -39,11 +39,11 @@ int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin
 
 TEST(Cli, HelpListsEverySubcommand) {
     const std::string dir = testing::scratchDir();
-    const Run r = uvr("--help", dir);
+    const CliRun r = uvr("--help", dir);
     EXPECT_EQ(r.code, 0);
     for (const char* cmd : {"info", "render", "demo", "convert", "generate"})
         EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
-    const Run rh = uvr("render --help", dir);
+    const CliRun rh = uvr("render --help", dir);
     EXPECT_EQ(rh.code, 0);
     EXPECT_NE(rh.out.find("--opacity"), std::string::npos);
 }
@@ -53,8 +53,8 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
     const std::string dir = testing::scratchDir();
     const std::string spx = testing::sharedData("spx.vtk");
     const std::string out = dir + "/o.png";
-    for (const std::string& args :
-         {"render " + spx + " -o " + out + " --size 0x10",
+    for (const std::string& args : std::vector<std::string>{
+             "render " + spx + " -o " + out + " --size 0x10",
           "render " + spx + " -o " + out + " --size 100000x100000",
           "render " + spx + " -o " + out + " --step -1",
           "render " + spx + " -o " + out + " --step nan",
@@ -65,7 +65,7 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
           "render " + spx + " -o " + out + " --opacity zigzag",
           "render " + spx + " -o " + dir + "/missing/o.png",
           "render " + spx + " --bogus -o " + out, "render " + spx, "frobnicate"}) {
-        const Run r = uvr("-q " + args, dir);
+        const CliRun r = uvr("-q " + args, dir);
         EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
         EXPECT_EQ(lineCount(r.err), 1) << args << "\n" << r.err;
         EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << r.err;
@@ -81,7 +81,7 @@ TEST(Cli, BadFilesExitWithCode2NamingTheFile) {
     std::string bytes((std::istreambuf_iterator<char>(in)), {});
     testing::writeFile(dir + "/cut.vtk", bytes.substr(0, bytes.size() / 2));
     for (const std::string& file : {dir + "/cut.vtk", dir + "/absent.vtk"}) {
-        const Run r = uvr("-q render " + file + " -o " + dir + "/o.png", dir);
+        const CliRun r = uvr("-q render " + file + " -o " + dir + "/o.png", dir);
         EXPECT_EQ(r.code, 2) << r.err;
         EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
         EXPECT_EQ(lineCount(r.err), 1) << r.err;
@@ -98,13 +98,13 @@ TEST(Cli, InfoOnEveryRealFile) {
         {"post_tets.vtk", {109744, 513375}}, {"cylinder_quadratic_as_tets.vtk", {465, 1522}},
         {"hexa.vtk", {12167, 10648}},        {"fire_ug.vtu", {12323, 10462}}};
     for (const auto& [name, pc] : counts) {
-        const Run r = uvr("-q info --json " + testing::sharedData(name), dir);
+        const CliRun r = uvr("-q info --json " + testing::sharedData(name), dir);
         ASSERT_EQ(r.code, 0) << name << r.err;
         const auto j = nlohmann::json::parse(r.out);
         EXPECT_EQ(j["points"], pc.first) << name;
         EXPECT_EQ(j["cells"], pc.second) << name;
         EXPECT_FALSE(j["fields"].empty()) << name;
-        const Run text = uvr("-q info " + testing::sharedData(name), dir);
+        const CliRun text = uvr("-q info " + testing::sharedData(name), dir);
         EXPECT_EQ(text.code, 0);
         EXPECT_NE(text.out.find("validation:"), std::string::npos);
     }
@@ -113,7 +113,7 @@ TEST(Cli, InfoOnEveryRealFile) {
 TEST(Cli, RenderWritesPngAndStats) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const std::string dir = testing::scratchDir();
-    const Run r = uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
+    const CliRun r = uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
                           "/spx.png --size 64x48 --stats " + dir + "/s.json --tf viridis",
                       dir);
     ASSERT_EQ(r.code, 0) << r.err;
@@ -145,7 +145,7 @@ TEST(Cli, ConvertedMeshRendersIdentically) {
 
 TEST(Cli, GenerateAndDemo) {
     const std::string dir = testing::scratchDir();
-    Run r = uvr("-q generate shell --cells 2000 -o " + dir + "/s.uvrm", dir);
+    CliRun r = uvr("-q generate shell --cells 2000 -o " + dir + "/s.uvrm", dir);
     ASSERT_EQ(r.code, 0) << r.err;
     r = uvr("-q info --json " + dir + "/s.uvrm", dir);
     ASSERT_EQ(r.code, 0) << r.err;

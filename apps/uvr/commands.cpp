@@ -13,7 +13,7 @@ using Clock = std::chrono::steady_clock;
 
 std::string fmt(double v) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.9g", v);
+    std::snprintf(buf, sizeof buf, "%.7g", v);
     return buf;
 }
 

@@ -88,7 +88,8 @@ struct RenderStats {
     std::uint64_t bvhQueries = 0;  ///< point locations that fell back to the BVH
     int width = 0, height = 0;
     double meanSamplesPerPixel() const {
-        return width * height ? static_cast<double>(samples) / (double(width) * height) : 0.0;
+        return width > 0 && height > 0 ? static_cast<double>(samples) / (double(width) * height)
+                                          : 0.0;
     }
 };
 

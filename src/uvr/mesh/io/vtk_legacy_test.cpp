@@ -198,11 +198,7 @@ INSTANTIATE_TEST_SUITE_P(VtkLegacy, VtkLegacyRealData, ::testing::Range<std::siz
 // ---------------------------------------------------------------------------------------------
 // Files written at test time by VTK's own vtkUnstructuredGridWriter (tests/tools script).
 
-std::string writerScript() {
-    return (std::filesystem::path(UVR_TEST_DATA_DIR).parent_path() / "tools" /
-            "write_legacy_vtk.py")
-        .string();
-}
+std::string writerScript() { return testing::testTool("write_legacy_vtk.py"); }
 
 struct WriterCase {
     int version;
