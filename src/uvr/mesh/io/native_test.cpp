@@ -125,7 +125,8 @@ TEST(Native, MixedMeshRoundTripsExactly) {
 }
 
 TEST(Native, HeaderAndArraysFollowTheDocumentedLayout) {
-    const std::string path = testing::scratchDir() + "/mixed.uvrm";
+    const std::string dir = testing::scratchDir();
+    const std::string path = dir + "/mixed.uvrm";
     const Mesh m = mixedMesh();
     writeNative(m, path);
     const std::string bytes = readBytes(path);
@@ -166,6 +167,20 @@ TEST(Native, HeaderAndArraysFollowTheDocumentedLayout) {
     EXPECT_EQ(v, 6.f);
     for (std::uint64_t a : {l.points, l.types, l.offsets, l.indices, l.fields[0], l.fields[3]})
         EXPECT_EQ(a % 8, 0u);
+    // The worked example of docs/NATIVE_FORMAT.md: only the "temperature" field, 416 bytes.
+    Mesh example = m;
+    example.fields.resize(1);
+    const std::string examplePath = dir + "/example.uvrm";
+    writeNative(example, examplePath);
+    const std::string e = readBytes(examplePath);
+    ASSERT_EQ(e.size(), 416u);
+    EXPECT_EQ(e.substr(224, 4), "\x0c\x0a\x0d\x0e");
+    std::uint64_t lastOffset;
+    std::memcpy(&lastOffset, e.data() + 232 + 32, 8);
+    EXPECT_EQ(lastOffset, 23u);
+    float firstValue;
+    std::memcpy(&firstValue, e.data() + 368, 4);
+    EXPECT_EQ(firstValue, m.fields[0].values[0]);
 }
 
 TEST(Native, MillionTetrahedraRoundTrip) {
