@@ -26,9 +26,8 @@ enum class ProceduralField {
     MarschnerLobb,  ///< "marschner_lobb": Marschner & Lobb 1994 test signal over [-1,1]^3
 };
 
-/// Largest allowed ProceduralSpec::jitter: Kuhn tetrahedra stay positively oriented when every
-/// corner moves less than 0.28 of the cell size (worst case found by optimisation), so 0.25 is
-/// safe.
+/// Largest allowed ProceduralSpec::jitter: a Kuhn tetrahedron stays positively oriented while each
+/// corner moves less than 0.28 cell sizes (worst case found by numerical optimisation).
 inline constexpr float kMaxProceduralJitter = 0.25f;
 /// Shell geometry: distance from the torus axis (z) to the centre of its tube.
 inline constexpr float kShellMajorRadius = 0.65f;
@@ -42,8 +41,8 @@ struct ProceduralSpec {
     ProceduralShape shape = ProceduralShape::Box;
     std::uint64_t targetCells = 100000;  ///< approximate tetrahedron count (result within ~2x)
     std::uint64_t seed = 1;              ///< same seed and spec, same mesh, bit for bit
-    /// Interior point jitter radius as a fraction of the local spacing, in [0,
-    /// kMaxProceduralJitter].
+    /// Interior points move inside a ball of this radius times the local spacing (at most
+    /// kMaxProceduralJitter); boundary points move only along the boundary.
     float jitter = 0.2f;
     /// Fields written, in this order (the first is the default render field).
     std::vector<ProceduralField> fields{ProceduralField::Jet, ProceduralField::MarschnerLobb,
