@@ -1,1 +1,363 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/procedural.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <numbers>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr ProceduralShape kShapes[] = {ProceduralShape::Box, ProceduralShape::Shell,
+                                       ProceduralShape::Graded};
+
+ProceduralSpec makeSpec(ProceduralShape shape, std::uint64_t target, std::uint64_t seed = 1) {
+    ProceduralSpec spec;
+    spec.shape = shape;
+    spec.targetCells = target;
+    spec.seed = seed;
+    return spec;
+}
+
+double tetVolume(const Mesh& m, std::uint64_t c) {
+    auto ids = m.cell(c);
+    const Vec3f a = m.points[ids[0]], b = m.points[ids[1]], cc = m.points[ids[2]],
+                d = m.points[ids[3]];
+    const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+    const double vx = cc.x - a.x, vy = cc.y - a.y, vz = cc.z - a.z;
+    const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
+    return (ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx)) / 6.0;
+}
+
+/// True when p lies in tetrahedron c (barycentric coordinates all >= -eps).
+bool insideTet(const Mesh& m, std::uint64_t c, Vec3f p, double eps = 1e-9) {
+    auto ids = m.cell(c);
+    const Vec3f v[4] = {m.points[ids[0]], m.points[ids[1]], m.points[ids[2]], m.points[ids[3]]};
+    auto vol = [](Vec3f a, Vec3f b, Vec3f cc, Vec3f d) {
+        const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+        const double vx = cc.x - a.x, vy = cc.y - a.y, vz = cc.z - a.z;
+        const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
+        return ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx);
+    };
+    const double total = vol(v[0], v[1], v[2], v[3]);
+    const double b0 = vol(p, v[1], v[2], v[3]) / total, b1 = vol(v[0], p, v[2], v[3]) / total,
+                 b2 = vol(v[0], v[1], p, v[3]) / total, b3 = vol(v[0], v[1], v[2], p) / total;
+    return b0 >= -eps && b1 >= -eps && b2 >= -eps && b3 >= -eps;
+}
+
+bool insideAnyTet(const Mesh& m, Vec3f p) {
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c)
+        if (insideTet(m, c, p)) return true;
+    return false;
+}
+
+/// Distance of p from the centre circle of the Shell's tube.
+double tubeDistance(Vec3f p) {
+    const double rho = std::hypot(p.x, p.y) - kShellMajorRadius;
+    return std::hypot(rho, static_cast<double>(p.z));
+}
+
+TEST(Procedural, SameSpecGivesIdenticalMeshDifferentSeedDiffers) {
+    for (ProceduralShape shape : kShapes) {
+        SCOPED_TRACE(proceduralShapeName(shape));
+        const Mesh a = generateMesh(makeSpec(shape, 20000, 7));
+        const Mesh b = generateMesh(makeSpec(shape, 20000, 7));
+        ASSERT_EQ(a.points.size(), b.points.size());
+        EXPECT_EQ(0, std::memcmp(a.points.data(), b.points.data(), a.points.size() * 12));
+        EXPECT_EQ(a.cellIndices, b.cellIndices);
+        EXPECT_EQ(a.cellOffsets, b.cellOffsets);
+        EXPECT_EQ(a.cellTypes, b.cellTypes);
+        ASSERT_EQ(a.fields.size(), b.fields.size());
+        for (size_t f = 0; f < a.fields.size(); ++f) {
+            EXPECT_EQ(a.fields[f].name, b.fields[f].name);
+            EXPECT_EQ(0, std::memcmp(a.fields[f].values.data(), b.fields[f].values.data(),
+                                     a.fields[f].values.size() * 4));
+        }
+        const Mesh c = generateMesh(makeSpec(shape, 20000, 8));
+        ASSERT_EQ(a.points.size(), c.points.size());
+        size_t moved = 0;
+        for (size_t i = 0; i < a.points.size(); ++i) moved += !(a.points[i] == c.points[i]);
+        EXPECT_GT(moved, a.points.size() / 2) << "a different seed must move most points";
+    }
+}
+
+TEST(Procedural, EveryTetrahedronIsPositivelyOriented) {
+    for (ProceduralShape shape : kShapes) {
+        for (std::uint64_t target : {1ull, 500ull, 6000ull, 80000ull}) {
+            for (float jitter : {0.f, 0.2f, kMaxProceduralJitter}) {
+                for (std::uint64_t seed : {1ull, 99ull}) {
+                    ProceduralSpec spec = makeSpec(shape, target, seed);
+                    spec.jitter = jitter;
+                    spec.fields = {};
+                    const Mesh m = generateMesh(spec);
+                    ASSERT_GT(m.cellCount(), 0u);
+                    double minVolume = 1e30;
+                    for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+                        ASSERT_EQ(m.cellTypes[c], CellType::Tetra);
+                        minVolume = std::min(minVolume, tetVolume(m, c));
+                    }
+                    EXPECT_GT(minVolume, 0.0) << proceduralShapeName(shape) << " target " << target
+                                              << " jitter " << jitter << " seed " << seed;
+                }
+            }
+        }
+    }
+}
+
+TEST(Procedural, TotalVolumeMatchesTheDomain) {
+    // The cube shapes partition [-1,1]^3 exactly; the Shell approximates the hollow torus volume
+    // 2 pi^2 R (r1^2 - r0^2) from inside (its faces are chords).
+    for (ProceduralShape shape : {ProceduralShape::Box, ProceduralShape::Graded}) {
+        const Mesh m = generateMesh(makeSpec(shape, 30000));
+        double total = 0;
+        for (std::uint64_t c = 0; c < m.cellCount(); ++c) total += tetVolume(m, c);
+        EXPECT_NEAR(total, 8.0, 1e-4) << proceduralShapeName(shape);
+        const Bounds3f b = m.bounds();
+        EXPECT_EQ(b.lo, Vec3f(-1.f)) << proceduralShapeName(shape);
+        EXPECT_EQ(b.hi, Vec3f(1.f)) << proceduralShapeName(shape);
+    }
+    const Mesh shell = generateMesh(makeSpec(ProceduralShape::Shell, 200000));
+    double total = 0;
+    for (std::uint64_t c = 0; c < shell.cellCount(); ++c) total += tetVolume(shell, c);
+    const double exact =
+        2.0 * std::numbers::pi * std::numbers::pi * kShellMajorRadius *
+        (kShellOuterRadius * kShellOuterRadius - kShellInnerRadius * kShellInnerRadius);
+    EXPECT_LT(total, exact);
+    EXPECT_GT(total, 0.97 * exact);
+    const Bounds3f b = shell.bounds();
+    EXPECT_GE(b.lo.x, -1.f);
+    EXPECT_LE(b.hi.x, 1.f);
+    EXPECT_GE(b.lo.z, -1.f);
+    EXPECT_LE(b.hi.z, 1.f);
+}
+
+TEST(Procedural, InteriorFacesAreSharedByExactlyTwoTetsOthersLieOnTheBoundary) {
+    for (ProceduralShape shape : kShapes) {
+        SCOPED_TRACE(proceduralShapeName(shape));
+        ProceduralSpec spec = makeSpec(shape, 3000, 5);
+        spec.fields = {};
+        const Mesh m = generateMesh(spec);
+        std::map<std::array<std::uint32_t, 3>, int> faces;
+        for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+            auto ids = m.cell(c);
+            for (int skip = 0; skip < 4; ++skip) {
+                std::array<std::uint32_t, 3> f{};
+                int n = 0;
+                for (int v = 0; v < 4; ++v)
+                    if (v != skip) f[n++] = ids[v];
+                std::sort(f.begin(), f.end());
+                ++faces[f];
+            }
+        }
+        size_t interior = 0, boundary = 0;
+        for (const auto& [face, count] : faces) {
+            ASSERT_LE(count, 2) << "face shared by " << count << " tetrahedra";
+            if (count == 2) {
+                ++interior;
+                continue;
+            }
+            ++boundary;
+            const Vec3f a = m.points[face[0]], b = m.points[face[1]], c = m.points[face[2]];
+            if (shape == ProceduralShape::Shell) {
+                // A boundary face lies on the inner or the outer wall of the tube.
+                const double ra = tubeDistance(a), rb = tubeDistance(b), rc = tubeDistance(c);
+                const bool inner = std::abs(ra - kShellInnerRadius) < 1e-5 &&
+                                   std::abs(rb - kShellInnerRadius) < 1e-5 &&
+                                   std::abs(rc - kShellInnerRadius) < 1e-5;
+                const bool outer = std::abs(ra - kShellOuterRadius) < 1e-5 &&
+                                   std::abs(rb - kShellOuterRadius) < 1e-5 &&
+                                   std::abs(rc - kShellOuterRadius) < 1e-5;
+                EXPECT_TRUE(inner || outer)
+                    << "boundary face off the walls: radii " << ra << ", " << rb << ", " << rc;
+            } else {
+                bool onCubeFace = false;
+                for (int axis = 0; axis < 3; ++axis)
+                    for (float side : {-1.f, 1.f})
+                        onCubeFace |= a[axis] == side && b[axis] == side && c[axis] == side;
+                EXPECT_TRUE(onCubeFace) << "boundary face inside the cube";
+            }
+        }
+        EXPECT_GT(interior, boundary);
+        // Euler-style sanity: 4 faces per tet = 2 per interior face + 1 per boundary face.
+        EXPECT_EQ(4 * m.cellCount(), 2 * interior + boundary);
+    }
+}
+
+TEST(Procedural, LinearFieldEqualsTheFormulaAtEveryPoint) {
+    for (ProceduralShape shape : kShapes) {
+        ProceduralSpec spec = makeSpec(shape, 20000);
+        spec.fields = {ProceduralField::Linear, ProceduralField::Constant};
+        const Mesh m = generateMesh(spec);
+        const Field* linear = m.findField("linear", Association::Point);
+        const Field* constant = m.findField("constant", Association::Point);
+        ASSERT_NE(linear, nullptr);
+        ASSERT_NE(constant, nullptr);
+        ASSERT_EQ(linear->values.size(), m.pointCount());
+        for (size_t i = 0; i < m.points.size(); ++i) {
+            const Vec3f p = m.points[i];
+            ASSERT_NEAR(linear->values[i], p.x + 2.0 * p.y - p.z, 1e-5) << "point " << i;
+            ASSERT_EQ(constant->values[i], 1.f) << "point " << i;
+        }
+    }
+}
+
+TEST(Procedural, FieldsFollowTheSpecOrderAndStayInRange) {
+    const ProceduralSpec spec = makeSpec(ProceduralShape::Box, 50000);
+    const Mesh m = generateMesh(spec);
+    ASSERT_EQ(m.fields.size(), spec.fields.size());
+    for (size_t f = 0; f < spec.fields.size(); ++f) {
+        EXPECT_EQ(m.fields[f].name, proceduralFieldName(spec.fields[f]));
+        EXPECT_EQ(m.fields[f].association, Association::Point);
+        EXPECT_EQ(m.fields[f].components, 1);
+    }
+    for (const char* name : {"jet", "marschner_lobb"}) {
+        const Field* field = m.findField(name, Association::Point);
+        ASSERT_NE(field, nullptr);
+        const auto [lo, hi] = std::minmax_element(field->values.begin(), field->values.end());
+        EXPECT_GE(*lo, 0.f) << name;
+        EXPECT_LE(*hi, 1.f) << name;
+        EXPECT_GT(*hi - *lo, 0.5f) << name << " should span most of [0, 1]";
+    }
+    // The jet is strong on its axis near the nozzle and faint far from it.
+    EXPECT_GT(proceduralFieldValue(ProceduralField::Jet, {0.f, -0.95f, 0.f}), 0.6f);
+    EXPECT_LT(proceduralFieldValue(ProceduralField::Jet, {0.9f, -0.95f, 0.9f}), 0.01f);
+    // Marschner-Lobb at the origin: (1 - 0 + 0.25 (1 + cos(12 pi))) / 2.5 = 0.6.
+    EXPECT_NEAR(proceduralFieldValue(ProceduralField::MarschnerLobb, {0.f, 0.f, 0.f}), 0.6f, 1e-6);
+    // At z = 1, r = 1: (1 - 1 + 0.25 (1 + cos(12 pi cos(pi/2)))) / 2.5 = 0.2.
+    EXPECT_NEAR(proceduralFieldValue(ProceduralField::MarschnerLobb, {1.f, 0.f, 1.f}), 0.2f, 1e-6);
+}
+
+TEST(Procedural, CellCountIsWithinTwiceTheTarget) {
+    for (ProceduralShape shape : kShapes) {
+        for (std::uint64_t target : {1000ull, 7777ull, 100000ull, 1000000ull}) {
+            ProceduralSpec spec = makeSpec(shape, target);
+            spec.fields = {};
+            const Mesh m = generateMesh(spec);
+            const double ratio = static_cast<double>(m.cellCount()) / target;
+            EXPECT_GE(ratio, 0.5) << proceduralShapeName(shape) << " target " << target;
+            EXPECT_LE(ratio, 2.0) << proceduralShapeName(shape) << " target " << target;
+            EXPECT_EQ(m.cellOffsets.size(), m.cellCount() + 1);
+            EXPECT_EQ(m.cellOffsets.back(), m.cellIndices.size());
+        }
+    }
+}
+
+TEST(Procedural, ShellIsHollowAndHasAHole) {
+    ProceduralSpec spec = makeSpec(ProceduralShape::Shell, 30000);
+    spec.fields = {};
+    const Mesh m = generateMesh(spec);
+    EXPECT_FALSE(insideAnyTet(m, {0.f, 0.f, 0.f})) << "the centre of the torus hole";
+    EXPECT_FALSE(insideAnyTet(m, {0.2f, -0.1f, 0.05f})) << "elsewhere in the torus hole";
+    EXPECT_FALSE(insideAnyTet(m, {kShellMajorRadius, 0.f, 0.f})) << "the tube's empty core";
+    EXPECT_FALSE(insideAnyTet(m, {0.f, -kShellMajorRadius + 0.05f, 0.03f}))
+        << "the tube's empty core";
+    EXPECT_TRUE(insideAnyTet(m, {kShellMajorRadius + 0.21f, 0.013f, 0.011f})) << "in the wall";
+    EXPECT_TRUE(insideAnyTet(m, {0.017f, -kShellMajorRadius, 0.2f})) << "in the wall";
+    EXPECT_FALSE(insideAnyTet(m, {0.f, 0.f, 0.5f})) << "above the torus";
+}
+
+TEST(Procedural, GradedEdgeRatioIsAboutOneHundred) {
+    ProceduralSpec spec = makeSpec(ProceduralShape::Graded, 50000);
+    spec.jitter = 0.f;  // edge lengths are then exactly those of the graded grid
+    spec.fields = {};
+    const Mesh m = generateMesh(spec);
+    double shortest = 1e30, longest = 0;
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+        auto ids = m.cell(c);
+        for (int a = 0; a < 4; ++a) {
+            for (int b = a + 1; b < 4; ++b) {
+                const Vec3f d = m.points[ids[a]] - m.points[ids[b]];
+                const double len =
+                    std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z);
+                shortest = std::min(shortest, len);
+                longest = std::max(longest, len);
+            }
+        }
+    }
+    EXPECT_GE(longest / shortest, 50.0);
+    EXPECT_LE(longest / shortest, 200.0);
+}
+
+TEST(Procedural, BoxBoundaryPointsStayOnTheBoundary) {
+    const Mesh m = generateMesh(makeSpec(ProceduralShape::Box, 6 * 8 * 8 * 8));
+    // An 8^3 grid: point (i, j, k) has index i + 9 (j + 9 k); grid coordinate -1 + i / 4.
+    ASSERT_EQ(m.pointCount(), 9u * 9u * 9u);
+    size_t jittered = 0;
+    for (std::uint32_t k = 0; k <= 8; ++k) {
+        for (std::uint32_t j = 0; j <= 8; ++j) {
+            for (std::uint32_t i = 0; i <= 8; ++i) {
+                const Vec3f p = m.points[i + 9 * (j + 9 * k)];
+                const std::uint32_t idx[3] = {i, j, k};
+                for (int axis = 0; axis < 3; ++axis) {
+                    const double grid = -1.0 + idx[axis] / 4.0;
+                    if (idx[axis] == 0 || idx[axis] == 8) {
+                        EXPECT_EQ(p[axis], static_cast<float>(grid));
+                    } else {
+                        EXPECT_LE(std::abs(p[axis] - grid), 0.2 * 0.25 + 1e-6);
+                        jittered += p[axis] != static_cast<float>(grid);
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(jittered, 7u * 7u * 7u * 2u);
+}
+
+TEST(Procedural, ProgressIsReportedFromZeroToOneInAboutOnePercentSteps) {
+    std::vector<double> calls;
+    ProceduralSpec spec = makeSpec(ProceduralShape::Box, 300000);
+    generateMesh(spec, [&](double f) { calls.push_back(f); });
+    ASSERT_GE(calls.size(), 50u);
+    EXPECT_LE(calls.size(), 300u);
+    EXPECT_EQ(calls.front(), 0.0);
+    EXPECT_EQ(calls.back(), 1.0);
+    EXPECT_TRUE(std::is_sorted(calls.begin(), calls.end()));
+}
+
+TEST(Procedural, BadSpecsAndNamesAreArgumentErrors) {
+    auto expectArgument = [](auto&& fn, const std::string& text) {
+        try {
+            fn();
+            ADD_FAILURE() << "no error for " << text;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Argument);
+            EXPECT_THAT(e.what(), HasSubstr(text));
+        }
+    };
+    ProceduralSpec spec;
+    spec.targetCells = 0;
+    expectArgument([&] { generateMesh(spec); }, "targetCells");
+    spec = {};
+    spec.jitter = 0.3f;
+    expectArgument([&] { generateMesh(spec); }, "jitter");
+    spec.jitter = -0.1f;
+    expectArgument([&] { generateMesh(spec); }, "jitter");
+    spec.jitter = NAN;
+    expectArgument([&] { generateMesh(spec); }, "jitter");
+    spec = {};
+    spec.fields = {ProceduralField::Linear, ProceduralField::Linear};
+    expectArgument([&] { generateMesh(spec); }, "'linear' is listed twice");
+    spec = {};
+    spec.targetCells = 1ull << 40;
+    expectArgument([&] { generateMesh(spec); }, "32-bit indices");
+    expectArgument([] { parseProceduralShape("sphere"); }, "'sphere': expected box, shell");
+    expectArgument([] { parseProceduralField("Jet"); }, "expected constant, linear, jet");
+    for (ProceduralShape s : kShapes) EXPECT_EQ(parseProceduralShape(proceduralShapeName(s)), s);
+    for (ProceduralField f : {ProceduralField::Constant, ProceduralField::Linear,
+                              ProceduralField::Jet, ProceduralField::MarschnerLobb})
+        EXPECT_EQ(parseProceduralField(proceduralFieldName(f)), f);
+}
+
+}  // namespace
+}  // namespace uvr

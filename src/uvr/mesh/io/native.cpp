@@ -1,1 +1,430 @@
 // SPDX-License-Identifier: MIT
+#include "uvr/mesh/io/native.h"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <climits>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <type_traits>
+#include <vector>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+
+namespace uvr {
+
+namespace {
+
+// Layout of version 1 (docs/NATIVE_FORMAT.md): a 48-byte header, the field descriptors, then the
+// arrays, each starting at a multiple of 8 bytes, all little-endian.
+constexpr std::uint32_t kNativeVersion = 1;
+constexpr std::uint64_t kHeaderBytes = 48;
+constexpr std::uint64_t kMinDescriptorBytes = 4 + 1 + 4 + 8;  // empty name
+constexpr std::uint32_t kMaxNameBytes = 65535;
+
+static_assert(sizeof(Vec3f) == 12 && std::is_trivially_copyable_v<Vec3f>);
+static_assert(sizeof(CellType) == 1);
+
+using FilePtr = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
+
+std::uint64_t align8(std::uint64_t x) {
+    return (x + 7) & ~std::uint64_t{7};
+}
+
+/// a * b, or UINT64_MAX when that overflows.
+std::uint64_t mulSat(std::uint64_t a, std::uint64_t b) {
+    std::uint64_t r;
+    return __builtin_mul_overflow(a, b, &r) ? UINT64_MAX : r;
+}
+
+/// a + b, or UINT64_MAX when that overflows.
+std::uint64_t addSat(std::uint64_t a, std::uint64_t b) {
+    std::uint64_t r;
+    return __builtin_add_overflow(a, b, &r) ? UINT64_MAX : r;
+}
+
+template <typename T>
+T byteSwap(T v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    std::reverse(b, b + sizeof(T));
+    std::memcpy(&v, b, sizeof(T));
+    return v;
+}
+
+/// Converts between little-endian file order and host order (a no-op on little-endian hosts).
+template <typename T>
+T fromLittle(T v) {
+    if constexpr (std::endian::native == std::endian::big && sizeof(T) > 1) return byteSwap(v);
+    return v;
+}
+
+/// Host-order values of `count` elements of `wordBytes` each, swapped in place on big-endian.
+void swapWordsIfBigEndian(void* data, std::uint64_t count, size_t wordBytes) {
+    if constexpr (std::endian::native == std::endian::big) {
+        auto* p = static_cast<unsigned char*>(data);
+        for (std::uint64_t i = 0; i < count; ++i)
+            std::reverse(p + i * wordBytes, p + (i + 1) * wordBytes);
+    } else {
+        (void)data, (void)count, (void)wordBytes;
+    }
+}
+
+template <typename T>
+T loadLe(const unsigned char* p) {
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    return fromLittle(v);
+}
+
+template <typename T>
+void storeLe(std::vector<unsigned char>& out, T v) {
+    v = fromLittle(v);
+    const size_t at = out.size();
+    out.resize(at + sizeof(T));
+    std::memcpy(out.data() + at, &v, sizeof(T));
+}
+
+/// Field descriptor as stored in the file.
+struct FieldDescriptor {
+    std::string name;
+    std::uint8_t association = 0;
+    std::uint32_t components = 0;
+    std::uint64_t valueCount = 0;
+    std::uint64_t offset = 0;  ///< byte offset of the descriptor
+};
+
+/// One array of the file: its name in messages, element count and size, and where it starts.
+struct ArraySpan {
+    std::string what;
+    std::uint64_t count = 0;
+    std::uint64_t elementBytes = 0;
+    std::uint64_t start = 0;
+    std::uint64_t bytes() const { return count * elementBytes; }
+};
+
+/// Sequential reader that turns short reads into Parse errors naming the byte offset.
+class Reader {
+public:
+    Reader(const std::string& path, std::uint64_t size) : path_(path), size_(size) {
+        file_.reset(std::fopen(path.c_str(), "rb"));
+        if (!file_)
+            throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
+    }
+    std::uint64_t offset() const { return offset_; }
+    std::uint64_t remaining() const { return size_ - std::min(size_, offset_); }
+
+    void read(void* dst, std::uint64_t bytes, const std::string& what) {
+        if (bytes == 0) return;
+        const size_t got = std::fread(dst, 1, bytes, file_.get());
+        if (got != bytes) {
+            if (std::ferror(file_.get()))
+                throwError(ErrorKind::Io, path_,
+                           "read failed at " + atByte(offset_ + got) + " in " + what + ": " +
+                               std::strerror(errno));
+            throwParseError(path_, atByte(offset_ + got),
+                            "unexpected end of file in " + what + ": expected " +
+                                std::to_string(bytes) + " bytes from " + atByte(offset_));
+        }
+        offset_ += bytes;
+    }
+    /// Skips zero padding up to the next multiple of 8.
+    void alignTo8(const std::string& what) {
+        unsigned char pad[8];
+        read(pad, align8(offset_) - offset_, "padding before " + what);
+    }
+
+private:
+    std::string path_;
+    std::uint64_t size_;
+    std::uint64_t offset_ = 0;
+    FilePtr file_{nullptr, &std::fclose};
+};
+
+std::string cellTypeList() {
+    return "10 (tetra), 12 (hexahedron), 13 (wedge) or 14 (pyramid)";
+}
+
+/// Checks cell types, offsets and corner indices; errors name the cell (used by reader and
+/// writer, so the writer never writes a file the reader would refuse).
+void checkCells(const Mesh& mesh, const std::string& path) {
+    const std::uint64_t cells = mesh.cellTypes.size();
+    const std::uint64_t points = mesh.points.size();
+    if (mesh.cellOffsets.size() != cells + 1)
+        throwError(ErrorKind::Validation, path,
+                   "cellOffsets has " + std::to_string(mesh.cellOffsets.size()) +
+                       " entries, expected cellCount + 1 = " + std::to_string(cells + 1));
+    if (mesh.cellOffsets[0] != 0)
+        throwError(ErrorKind::Validation, path,
+                   "cell 0: offset " + std::to_string(mesh.cellOffsets[0]) + ", expected 0");
+    for (std::uint64_t c = 0; c < cells; ++c) {
+        const auto raw = static_cast<unsigned>(mesh.cellTypes[c]);
+        if (raw != 10 && raw != 12 && raw != 13 && raw != 14)
+            throwError(ErrorKind::Validation, path,
+                       "cell " + std::to_string(c) + ": type " + std::to_string(raw) +
+                           ", expected " + cellTypeList());
+        const std::uint64_t begin = mesh.cellOffsets[c], end = mesh.cellOffsets[c + 1];
+        const auto corners = static_cast<std::uint64_t>(cornerCount(mesh.cellTypes[c]));
+        if (end < begin || end - begin != corners || end > mesh.cellIndices.size())
+            throwError(ErrorKind::Validation, path,
+                       "cell " + std::to_string(c) + ": offsets " + std::to_string(begin) + ".." +
+                           std::to_string(end) + " do not span the " + std::to_string(corners) +
+                           " corners of a " + cellTypeName(mesh.cellTypes[c]) + " within " +
+                           std::to_string(mesh.cellIndices.size()) + " indices");
+        for (std::uint64_t i = begin; i < end; ++i)
+            if (mesh.cellIndices[i] >= points)
+                throwError(ErrorKind::Validation, path,
+                           "cell " + std::to_string(c) + ": corner " + std::to_string(i - begin) +
+                               " is point " + std::to_string(mesh.cellIndices[i]) +
+                               ", expected below pointCount " + std::to_string(points));
+    }
+    if (mesh.cellOffsets[cells] != mesh.cellIndices.size())
+        throwError(ErrorKind::Validation, path,
+                   "last cell offset " + std::to_string(mesh.cellOffsets[cells]) +
+                       ", expected indexCount " + std::to_string(mesh.cellIndices.size()));
+}
+
+}  // namespace
+
+Mesh readNative(const std::string& path, const ReadOptions& options) {
+    const std::uint64_t size = fileSize(path);
+    Reader in(path, size);
+
+    // Header.
+    if (size < kHeaderBytes)
+        throwParseError(path, atByte(size),
+                        "truncated header: expected at least " + std::to_string(kHeaderBytes) +
+                            " bytes, got " + std::to_string(size));
+    unsigned char header[kHeaderBytes];
+    in.read(header, kHeaderBytes, "the header");
+    if (std::memcmp(header, kNativeMagic, 8) != 0) {
+        std::string got;
+        for (int i = 0; i < 8; ++i) {
+            char hex[4];
+            std::snprintf(hex, sizeof(hex), " %02x", header[i]);
+            got += hex;
+        }
+        throwParseError(path, atByte(0),
+                        "expected the magic bytes 55 56 52 4d 45 53 48 00 (\"UVRMESH\\0\") of a "
+                        ".uvrm file, got" +
+                            got);
+    }
+    const auto version = loadLe<std::uint32_t>(header + 8);
+    const auto flags = loadLe<std::uint32_t>(header + 12);
+    const auto pointCount = loadLe<std::uint64_t>(header + 16);
+    const auto cellCount = loadLe<std::uint64_t>(header + 24);
+    const auto indexCount = loadLe<std::uint64_t>(header + 32);
+    const auto fieldCount = loadLe<std::uint32_t>(header + 40);
+    const auto reserved = loadLe<std::uint32_t>(header + 44);
+    if (version == 0) throwParseError(path, atByte(8), "expected format version 1, got 0");
+    if (version > kNativeVersion)
+        throwError(ErrorKind::Unsupported, path,
+                   "byte 8: format version " + std::to_string(version) +
+                       " is newer than this uvr reads (up to " + std::to_string(kNativeVersion) +
+                       ")");
+    if (flags != 0)
+        throwError(ErrorKind::Unsupported, path,
+                   "byte 12: unknown flags " + std::to_string(flags) + " (version 1 defines none)");
+    if (reserved != 0)
+        throwParseError(path, atByte(44),
+                        "expected reserved word 0, got " + std::to_string(reserved));
+
+    // Header consistency: every cell lists 4 to 8 corners.
+    if (indexCount < mulSat(cellCount, 4) || indexCount > mulSat(cellCount, 8))
+        throwParseError(path, atByte(32),
+                        "indexCount " + std::to_string(indexCount) + " is impossible for " +
+                            std::to_string(cellCount) + " cells (expected 4 to 8 per cell)");
+
+    // Field descriptors, each checked against the bytes left before anything is allocated.
+    if (fieldCount > in.remaining() / kMinDescriptorBytes)
+        throwParseError(path, atByte(40),
+                        "fieldCount " + std::to_string(fieldCount) + " needs at least " +
+                            std::to_string(fieldCount * kMinDescriptorBytes) +
+                            " bytes of descriptors, but only " + std::to_string(in.remaining()) +
+                            " bytes follow the header");
+    std::vector<FieldDescriptor> descriptors(fieldCount);
+    for (std::uint32_t f = 0; f < fieldCount; ++f) {
+        FieldDescriptor& d = descriptors[f];
+        d.offset = in.offset();
+        const std::string what = "field " + std::to_string(f) + " descriptor";
+        unsigned char word[8];
+        in.read(word, 4, what);
+        const auto nameBytes = loadLe<std::uint32_t>(word);
+        if (nameBytes > kMaxNameBytes || nameBytes > in.remaining())
+            throwParseError(
+                path, atByte(d.offset),
+                what + ": name length " + std::to_string(nameBytes) + ", expected at most " +
+                    std::to_string(std::min<std::uint64_t>(kMaxNameBytes, in.remaining())));
+        d.name.resize(nameBytes);
+        in.read(d.name.data(), nameBytes, what);
+        unsigned char rest[13];
+        in.read(rest, 13, what);
+        d.association = rest[0];
+        d.components = loadLe<std::uint32_t>(rest + 1);
+        d.valueCount = loadLe<std::uint64_t>(rest + 5);
+        const std::string named = "field '" + d.name + "'";
+        if (d.association > 1)
+            throwParseError(path, atByte(d.offset + 4 + nameBytes),
+                            named + ": association " + std::to_string(d.association) +
+                                ", expected 0 (point) or 1 (cell)");
+        if (d.components == 0 || d.components > INT_MAX)
+            throwParseError(path, atByte(d.offset + 5 + nameBytes),
+                            named + ": components " + std::to_string(d.components) +
+                                ", expected 1 to " + std::to_string(INT_MAX));
+        const std::uint64_t tuples = d.association == 0 ? pointCount : cellCount;
+        if (mulSat(tuples, d.components) != d.valueCount)
+            throwParseError(path, atByte(d.offset + 9 + nameBytes),
+                            named + ": valueCount " + std::to_string(d.valueCount) + ", expected " +
+                                std::to_string(tuples) + " " +
+                                (d.association == 0 ? "points" : "cells") + " x " +
+                                std::to_string(d.components) + " components");
+    }
+
+    // Array layout: the exact size the counts imply must be the file size.
+    std::vector<ArraySpan> arrays = {{"points", pointCount, 12},
+                                     {"cellTypes", cellCount, 1},
+                                     {"cellOffsets", addSat(cellCount, 1), 8},
+                                     {"cellIndices", indexCount, 4}};
+    for (const FieldDescriptor& d : descriptors)
+        arrays.push_back({"field '" + d.name + "' values", d.valueCount, 4});
+    std::uint64_t cursor = in.offset();
+    for (ArraySpan& a : arrays) {
+        a.start = align8(cursor);
+        const std::uint64_t bytes = mulSat(a.count, a.elementBytes);
+        const std::uint64_t end = addSat(a.start, bytes);
+        if (end > size)
+            throwParseError(
+                path, atByte(a.start),
+                a.what + ": " + std::to_string(a.count) + " x " + std::to_string(a.elementBytes) +
+                    " bytes need the file to hold " +
+                    (end == UINT64_MAX ? std::string("more than 2^64") : std::to_string(end)) +
+                    " bytes, but it has " + std::to_string(size) +
+                    " (truncated or corrupt header)");
+        cursor = end;
+    }
+    if (cursor != size)
+        throwParseError(path, atByte(cursor),
+                        "expected the file to end after the last array at " + atByte(cursor) +
+                            ", but it has " + std::to_string(size) + " bytes");
+    for (const ArraySpan& a : arrays)
+        checkAllocation(path, a.what, a.count, a.elementBytes, options.maxMemoryBytes);
+
+    // Arrays: one bulk read each, straight into the mesh's vectors.
+    Mesh mesh;
+    auto readArray = [&](const ArraySpan& a, void* dst, size_t wordBytes) {
+        in.alignTo8(a.what);
+        in.read(dst, a.bytes(), a.what);
+        swapWordsIfBigEndian(dst, a.bytes() / wordBytes, wordBytes);
+    };
+    mesh.points.resize(pointCount);
+    readArray(arrays[0], mesh.points.data(), 4);
+    mesh.cellTypes.resize(cellCount);
+    readArray(arrays[1], mesh.cellTypes.data(), 1);
+    mesh.cellOffsets.resize(cellCount + 1);
+    readArray(arrays[2], mesh.cellOffsets.data(), 8);
+    mesh.cellIndices.resize(indexCount);
+    readArray(arrays[3], mesh.cellIndices.data(), 4);
+    mesh.fields.resize(fieldCount);
+    for (std::uint32_t f = 0; f < fieldCount; ++f) {
+        Field& field = mesh.fields[f];
+        field.name = std::move(descriptors[f].name);
+        field.association =
+            descriptors[f].association == 0 ? Association::Point : Association::Cell;
+        field.components = static_cast<int>(descriptors[f].components);
+        field.values.resize(descriptors[f].valueCount);
+        readArray(arrays[4 + f], field.values.data(), 4);
+    }
+
+    checkCells(mesh, path);
+    return mesh;
+}
+
+void writeNative(const Mesh& mesh, const std::string& path) {
+    // Refuse meshes the reader would refuse, before creating any file.
+    checkCells(mesh, path);
+    for (const Field& f : mesh.fields) {
+        const std::uint64_t tuples =
+            f.association == Association::Point ? mesh.pointCount() : mesh.cellCount();
+        if (f.components < 1 ||
+            f.values.size() != tuples * static_cast<std::uint64_t>(f.components))
+            throwError(ErrorKind::Validation, path,
+                       "field '" + f.name + "': " + std::to_string(f.values.size()) +
+                           " values, expected " + std::to_string(tuples) + " " +
+                           associationName(f.association) + " tuples x " +
+                           std::to_string(f.components) + " components");
+        if (f.name.size() > kMaxNameBytes)
+            throwError(ErrorKind::Argument, path,
+                       "field name of " + std::to_string(f.name.size()) +
+                           " bytes, expected at most " + std::to_string(kMaxNameBytes));
+    }
+    if (mesh.fields.size() > UINT32_MAX)
+        throwError(ErrorKind::Argument, path, "more than 2^32 - 1 fields");
+
+    // Header and descriptors.
+    std::vector<unsigned char> head(8);
+    std::memcpy(head.data(), kNativeMagic, 8);
+    storeLe<std::uint32_t>(head, kNativeVersion);
+    storeLe<std::uint32_t>(head, 0);  // flags
+    storeLe<std::uint64_t>(head, mesh.pointCount());
+    storeLe<std::uint64_t>(head, mesh.cellCount());
+    storeLe<std::uint64_t>(head, mesh.cellIndices.size());
+    storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(mesh.fields.size()));
+    storeLe<std::uint32_t>(head, 0);  // reserved
+    for (const Field& f : mesh.fields) {
+        storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(f.name.size()));
+        head.insert(head.end(), f.name.begin(), f.name.end());
+        head.push_back(static_cast<unsigned char>(f.association));
+        storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(f.components));
+        storeLe<std::uint64_t>(head, f.values.size());
+    }
+
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        FilePtr file(std::fopen(tmp.c_str(), "wb"), &std::fclose);
+        if (!file)
+            throwError(ErrorKind::Io, path,
+                       "cannot create " + tmp + ": " + std::string(std::strerror(errno)));
+        std::uint64_t offset = 0;
+        auto put = [&](const void* data, std::uint64_t bytes) {
+            if (bytes != 0 && std::fwrite(data, 1, bytes, file.get()) != bytes)
+                throwError(ErrorKind::Io, path,
+                           "write failed at " + atByte(offset) + ": " + std::strerror(errno));
+            offset += bytes;
+        };
+        // Arrays in file order, each after zero padding to a multiple of 8; on big-endian hosts
+        // they are swapped chunk by chunk into a scratch buffer.
+        auto putArray = [&](const void* data, std::uint64_t count, size_t wordBytes) {
+            static constexpr unsigned char kZeros[8] = {};
+            put(kZeros, align8(offset) - offset);
+            if constexpr (std::endian::native == std::endian::little) {
+                put(data, count * wordBytes);
+            } else {
+                std::vector<unsigned char> chunk;
+                const auto* p = static_cast<const unsigned char*>(data);
+                constexpr std::uint64_t kWords = 1 << 20;
+                for (std::uint64_t i = 0; i < count; i += kWords) {
+                    const std::uint64_t n = std::min(kWords, count - i);
+                    chunk.assign(p + i * wordBytes, p + (i + n) * wordBytes);
+                    swapWordsIfBigEndian(chunk.data(), n, wordBytes);
+                    put(chunk.data(), chunk.size());
+                }
+            }
+        };
+        put(head.data(), head.size());
+        putArray(mesh.points.data(), mesh.points.size() * 3, 4);
+        putArray(mesh.cellTypes.data(), mesh.cellTypes.size(), 1);
+        putArray(mesh.cellOffsets.data(), mesh.cellOffsets.size(), 8);
+        putArray(mesh.cellIndices.data(), mesh.cellIndices.size(), 4);
+        for (const Field& f : mesh.fields) putArray(f.values.data(), f.values.size(), 4);
+        if (std::fflush(file.get()) != 0)
+            throwError(ErrorKind::Io, path, std::string("write failed: ") + std::strerror(errno));
+        std::FILE* raw = file.release();
+        if (std::fclose(raw) != 0)
+            throwError(ErrorKind::Io, path, std::string("write failed: ") + std::strerror(errno));
+    });
+}
+
+}  // namespace uvr

@@ -11,8 +11,8 @@ namespace uvr {
 /// First 8 bytes of a native uvr mesh file (.uvrm).
 inline constexpr char kNativeMagic[8] = {'U', 'V', 'R', 'M', 'E', 'S', 'H', '\0'};
 
-/// Reads a native uvr mesh (.uvrm, documented in docs/FORMATS.md); all counts are checked against
-/// the file size before anything is allocated.
+/// Reads a native uvr mesh (.uvrm, documented in docs/NATIVE_FORMAT.md); all counts are checked
+/// against the file size before anything is allocated.
 Mesh readNative(const std::string& path, const ReadOptions& options = {});
 
 /// Writes a mesh in the native format, atomically (temporary file, then rename).
