@@ -92,7 +92,8 @@ void RenderFlags::registerOn(CLI::App& app) {
         ->capture_default_str();
     app.add_option("--opacity", opacity,
                    "Opacity: ramp, ramp:A, constant:A, step:T[:A] (binary) or x0:a0,x1:a1,... "
-                   "over the normalised range (default: the JSON's Points, else ramp)");
+                   "over the normalised range (default: the JSON's Points, else ramp)")
+        ->capture_default_str();
     app.add_option("--range", range, "Value range lo,hi the transfer function spans "
                                      "(default: the field's range)");
     app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
@@ -101,15 +102,18 @@ void RenderFlags::registerOn(CLI::App& app) {
     app.add_option("--camera-focal", cameraFocal, "Camera focal point x,y,z");
     app.add_option("--camera-up", cameraUp, "Camera view up x,y,z");
     app.add_option("--view-angle", viewAngle, "Vertical view angle in degrees (default 30)");
-    app.add_option("--azimuth", azimuth, "Rotate the camera about view up, degrees");
-    app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees");
+    app.add_option("--azimuth", azimuth, "Rotate the camera about view up, degrees")
+        ->capture_default_str();
+    app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees")
+        ->capture_default_str();
     app.add_option("--step", step,
                    "Sample spacing s1 (default: 0.5 * cube root of the mean tetrahedron volume)");
     app.add_option("--opacity-unit", opacityUnit,
                    "Distance over which a TF opacity applies (default: ParaView's "
                    "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))");
     app.add_option("--background", background,
-                   "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)");
+                   "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
+        ->capture_default_str();
     app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
     app.add_option("--threads", threads, "CPU threads (default: all cores)")
         ->check(CLI::Range(0, 4096));

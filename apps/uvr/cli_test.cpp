@@ -89,7 +89,7 @@ TEST(Cli, BadFilesExitWithCode2NamingTheFile) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/o.png"));
 }
 
-TEST(Cli, InfoOnEveryRealFile) {
+TEST(Cli, InfoAndRenderOnEveryRealFile) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const std::string dir = testing::scratchDir();
     const std::map<std::string, std::pair<int, int>> counts = {
@@ -107,6 +107,17 @@ TEST(Cli, InfoOnEveryRealFile) {
         const CliRun text = uvr("-q info " + testing::sharedData(name), dir);
         EXPECT_EQ(text.code, 0);
         EXPECT_NE(text.out.find("validation:"), std::string::npos);
+        // Every real file renders, and covers part (not all) of the image.
+        const std::string png = dir + "/" + name + ".png";
+        const CliRun render = uvr("-q render " + testing::sharedData(name) + " -o " + png +
+                                      " --size 24x24 --opacity constant:0.5",
+                                  dir);
+        ASSERT_EQ(render.code, 0) << name << render.err;
+        const Image img = readPng(png);
+        const auto covered = std::count_if(img.pixels.begin(), img.pixels.end(),
+                                           [](const Vec4f& p) { return p.w > 0.f; });
+        EXPECT_GT(covered, 8) << name;
+        EXPECT_LT(covered, 24 * 24) << name;
     }
 }
 

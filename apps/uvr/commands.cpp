@@ -106,6 +106,8 @@ void addDemoCommand(CLI::App& app, Log& log) {
     flags->tf = "black-body";
     flags->opacity = "0:0,0.25:0.05,0.6:0.6,1:1";
     flags->background = "0.1,0.1,0.12";
+    flags->azimuth = 30.f;
+    flags->elevation = 15.f;
     flags->registerOn(*cmd);
     cmd->get_option("--output")->required(false)->capture_default_str();
     cmd->add_option("--cells", *cells, "Approximate tetrahedron count")
@@ -154,7 +156,7 @@ void addGenerateCommand(CLI::App& app, Log& log) {
     cmd->add_option("--seed", spec->seed, "Random seed (same seed, same mesh)")->capture_default_str();
     cmd->add_option("--jitter", spec->jitter, "Interior point jitter, fraction of the spacing")
         ->capture_default_str()
-        ->check(CLI::Range(0.f, 0.3f));
+        ->check(CLI::Range(0.f, kMaxProceduralJitter));
     cmd->add_option("--fields", *fields,
                     "Fields to write, first is the default: jet, marschner_lobb, linear, constant")
         ->delimiter(',');

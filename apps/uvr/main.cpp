@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
                  "native .uvrm)",
                  "uvr"};
     app.require_subcommand(1);
+    app.fallthrough();  // -q works after the subcommand too
     app.set_version_flag("--version", "uvr 0.1.0");
     cli::Log log;
     app.add_flag("-q,--quiet", log.quiet, "No progress messages on stderr");
