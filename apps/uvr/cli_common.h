@@ -64,5 +64,6 @@ void addRenderCommand(CLI::App& app, Log& log);
 void addDemoCommand(CLI::App& app, Log& log);
 void addConvertCommand(CLI::App& app, Log& log);
 void addGenerateCommand(CLI::App& app, Log& log);
+void addCompareCommand(CLI::App& app, Log& log);
 
 }  // namespace uvr::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     cli::addDemoCommand(app, log);
     cli::addConvertCommand(app, log);
     cli::addGenerateCommand(app, log);
+    cli::addCompareCommand(app, log);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
