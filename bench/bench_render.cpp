@@ -43,7 +43,7 @@ void BM_RenderReference(benchmark::State& state) {
     settings.tf = uvr::transferFunctionPreset("cool-to-warm");
     std::uint64_t samples = 0;
     for (auto _ : state) {
-        const uvr::RenderResult r = uvr::renderReferenceCpu(prepared, settings);
+        const uvr::RenderResult r = uvr::renderCpu(prepared, settings);
         samples += r.stats.samples;
         state.SetIterationTime(r.stats.seconds);
     }

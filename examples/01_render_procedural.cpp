@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
         settings.height = 256;
         settings.tf = uvr::transferFunctionPreset("black-body");
         uvr::applyOpacitySpec(settings.tf, "0:0,0.3:0.05,1:1");
-        const uvr::RenderResult result = uvr::renderReferenceCpu(prepared, settings);
+        const uvr::RenderResult result = uvr::renderCpu(prepared, settings);
         uvr::writePng(out, result.image, uvr::Vec3f(0.1f, 0.1f, 0.12f));
         std::printf("%s: %llu samples, %.1f per pixel, %.3f s\n", out,
                     static_cast<unsigned long long>(result.stats.samples),

@@ -3,6 +3,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -111,6 +112,28 @@ void RenderFlags::registerOn(CLI::App& app) {
     app.add_option("--opacity-unit", opacityUnit,
                    "Distance over which a TF opacity applies (default: ParaView's "
                    "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))");
+    app.add_option("--method", method,
+                   "Integrator: reference (fixed step s1 everywhere) or adaptive (k-d partitions, "
+                   "space skipping, adaptive steps; Morrical et al. 2019)")
+        ->check(CLI::IsMember({"reference", "adaptive"}))
+        ->capture_default_str();
+    app.add_option("--max-step", maxStep,
+                   "Adaptive: largest step s2 (default: " +
+                       std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)");
+    app.add_option("--power", power, "Adaptive: power p >= 1 of the step formula")
+        ->capture_default_str();
+    app.add_flag("--no-skip", noSkip,
+                 "Adaptive: also march partitions of zero opacity (\"adaptive only\")");
+    app.add_flag("--no-adaptive", noAdaptive,
+                 "Adaptive: every partition at s1 (\"skipping only\")");
+    app.add_option("--leaf-cells", leafCells,
+                   "Adaptive: cells per k-d partition at most (default " +
+                       std::to_string(KdBuildOptions{}.leafCells) + ")")
+        ->check(CLI::Range(1u, 1u << 30));
+    app.add_option("--heatmap", heatmapFile,
+                   "Also write the per-pixel sample counts as a heat map PNG");
+    app.add_option("--heatmap-max", heatmapMax,
+                   "Sample count at the top of the heat map scale (default: the frame's maximum)");
     app.add_option("--background", background,
                    "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
         ->capture_default_str();
@@ -127,6 +150,14 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
+    s.method = method == "adaptive" ? RenderMethod::Partitions : RenderMethod::Reference;
+    s.maxStep = maxStep;
+    s.power = power;
+    s.skip = !noSkip;
+    s.adaptive = !noAdaptive;
+    if (s.method == RenderMethod::Reference && (noSkip || noAdaptive || maxStep > 0.f || leafCells))
+        throwError(ErrorKind::Argument, "",
+                   "--no-skip, --no-adaptive, --max-step and --leaf-cells need --method adaptive");
     if (!(std::isfinite(step) && step >= 0.f))
         throwError(ErrorKind::Argument, "", "--step must be a positive finite distance");
     if (!(std::isfinite(opacityUnit) && opacityUnit >= 0.f))
@@ -144,6 +175,13 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
     if (azimuth != 0.f || elevation != 0.f) cam = orbitCamera(cam, azimuth, elevation), custom = true;
     if (custom) s.camera = cam;
     return s;
+}
+
+PrepareOptions RenderFlags::prepareOptions() const {
+    PrepareOptions o;
+    o.partitions = method == "adaptive";
+    if (leafCells) o.kd.leafCells = leafCells;
+    return o;
 }
 
 Mesh loadMesh(const std::string& path, const Log& log) {
@@ -171,6 +209,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     }
     checkOutputPath(flags.output);
     if (!flags.statsFile.empty()) checkOutputPath(flags.statsFile);
+    if (!flags.heatmapFile.empty()) checkOutputPath(flags.heatmapFile);
     const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
     auto start = Clock::now();
     const ValidationReport report = validateMesh(mesh, source);
@@ -178,25 +217,62 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
     const RenderSettings settings = flags.settings(mesh.bounds());
     validateSettings(settings);
-    PreparedMesh prepared = prepareMesh(mesh, field, [&](const std::string& s) { log.step(s); });
+    PreparedMesh prepared = prepareMesh(mesh, field, flags.prepareOptions(),
+                                        [&](const std::string& s) { log.step(s); });
     log.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
     log.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
              std::to_string(settings.height));
-    RenderResult result = renderReferenceCpu(prepared, settings);
+    RenderResult result = renderCpu(prepared, settings);
     char line[200];
     std::snprintf(line, sizeof line, "rendered in %.3f s: %llu samples, %.1f per pixel, step %g",
                   result.stats.seconds, static_cast<unsigned long long>(result.stats.samples),
                   result.stats.meanSamplesPerPixel(), result.setup.params.step);
     log.step(line);
+    if (settings.method == RenderMethod::Partitions) {
+        std::snprintf(line, sizeof line,
+                      "%zu partitions (built in %.3f s); transfer-function update %.3f ms; "
+                      "%.1f partitions visited and %.1f skipped per pixel",
+                      prepared.kd->partitions.size(), prepared.kd->buildSeconds,
+                      result.setup.tfUpdateSeconds * 1e3,
+                      double(result.stats.partitionsVisited) / (settings.width * settings.height),
+                      double(result.stats.partitionsSkipped) / (settings.width * settings.height));
+        log.step(line);
+    }
     writePng(flags.output, result.image, background);
     log.step("wrote " + flags.output);
+    if (!flags.heatmapFile.empty()) {
+        writePng(flags.heatmapFile, sampleHeatmap(result.sampleCounts, settings.width,
+                                                  settings.height, flags.heatmapMax));
+        log.step("wrote " + flags.heatmapFile);
+    }
     if (!flags.statsFile.empty()) {
         nlohmann::json j;
         j["source"] = source;
         j["field"] = field.name;
         j["device"] = "cpu";
         j["threads"] = omp_get_max_threads();
-        j["method"] = "reference";
+        j["method"] = flags.method;
+        if (prepared.kd) {
+            const KdPartitions& kd = *prepared.kd;
+            std::vector<std::uint32_t> sizes;
+            for (const KdPartition& p : kd.partitions) sizes.push_back(p.cellCount);
+            std::sort(sizes.begin(), sizes.end());
+            j["partitions"] = {
+                {"count", kd.partitions.size()},
+                {"build_seconds", kd.buildSeconds},
+                {"cells_min", sizes.empty() ? 0 : sizes.front()},
+                {"cells_median", sizes.empty() ? 0 : sizes[sizes.size() / 2]},
+                {"cells_max", sizes.empty() ? 0 : sizes.back()},
+                {"duplication_factor", kd.duplicationFactor(prepared.tets.tets.size())},
+                {"leaf_cells", flags.prepareOptions().kd.leafCells}};
+            j["tf_update_seconds"] = result.setup.tfUpdateSeconds;
+            j["max_step"] = result.setup.maxStep;
+            j["power"] = settings.power;
+            j["skip"] = settings.skip;
+            j["adaptive"] = settings.adaptive;
+            j["partitions_visited"] = result.stats.partitionsVisited;
+            j["partitions_skipped"] = result.stats.partitionsSkipped;
+        }
         j["image"] = {{"width", settings.width}, {"height", settings.height}};
         j["mesh"] = {{"points", mesh.pointCount()},
                      {"cells", mesh.cellCount()},

@@ -41,6 +41,13 @@ struct RenderFlags {
     float azimuth = 0.f, elevation = 0.f;
     float step = 0.f;
     float opacityUnit = 0.f;
+    std::string method = "reference";
+    float maxStep = 0.f;
+    float power = 2.f;
+    bool noSkip = false, noAdaptive = false;
+    std::uint32_t leafCells = 0;
+    std::string heatmapFile;
+    std::uint32_t heatmapMax = 0;
     std::string background;
     std::string statsFile;
     int threads = 0;
@@ -49,6 +56,8 @@ struct RenderFlags {
     void registerOn(CLI::App& app);
     /// Parses the flags into render settings; the default camera fits the bounds.
     RenderSettings settings(const Bounds3f& bounds) const;
+    /// What mesh preparation the flags need (partitions only for the adaptive method).
+    PrepareOptions prepareOptions() const;
 };
 
 /// Loads a mesh with progress messages and validation; prints findings.

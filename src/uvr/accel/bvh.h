@@ -28,14 +28,15 @@ struct BvhView {
 /// Deepest stack a BVH traversal needs; the builder guarantees the tree is no deeper.
 inline constexpr int kBvhMaxDepth = 64;
 
-/// Calls visit(primId) for every primitive whose leaf box contains p, until visit returns true;
-/// returns whether it did.
+/// Calls visit(primId) for every primitive whose leaf box contains p, in the tree rooted at
+/// `root`, until visit returns true; returns whether it did.
 template <class Visit>
-UVR_HOST_DEVICE bool bvhVisitPoint(const BvhView& bvh, Vec3f p, Visit&& visit) {
+UVR_HOST_DEVICE bool bvhVisitPoint(const BvhView& bvh, Vec3f p, Visit&& visit,
+                                   std::uint32_t root = 0) {
     if (bvh.nodeCount == 0) return false;
     std::uint32_t stack[kBvhMaxDepth];
     int top = 0;
-    std::uint32_t node = 0;
+    std::uint32_t node = root;
     while (true) {
         const BvhNode& n = bvh.nodes[node];
         if (n.box.contains(p)) {

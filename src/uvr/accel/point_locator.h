@@ -41,6 +41,14 @@ struct TetLocator {
     /// Index of a tetrahedron containing p, or kNoTet; bary receives p's barycentrics in it.
     UVR_HOST_DEVICE std::uint32_t locate(Vec3f p, std::uint32_t hint, float bary[4],
                                          LocateCounters& counters) const {
+        return locateIn(bvh, 0, p, hint, bary, counters);
+    }
+
+    /// As locate, but the BVH fallback searches only the tree at `root` of `tree` (e.g. one
+    /// k-d partition's cells).
+    UVR_HOST_DEVICE std::uint32_t locateIn(const BvhView& tree, std::uint32_t root, Vec3f p,
+                                           std::uint32_t hint, float bary[4],
+                                           LocateCounters& counters) const {
         if (hint != kNoTet && neighbors) {
             std::uint32_t t = hint;
             for (int step = 0; step < kMaxWalkSteps; ++step) {
@@ -60,13 +68,16 @@ struct TetLocator {
         }
         ++counters.bvhQueries;
         std::uint32_t found = kNoTet;
-        bvhVisitPoint(bvh, p, [&](std::uint32_t t) {
-            if (inside(t, p, bary)) {
-                found = t;
-                return true;
-            }
-            return false;
-        });
+        bvhVisitPoint(
+            tree, p,
+            [&](std::uint32_t t) {
+                if (inside(t, p, bary)) {
+                    found = t;
+                    return true;
+                }
+                return false;
+            },
+            root);
         return found;
     }
 };

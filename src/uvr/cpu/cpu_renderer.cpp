@@ -16,37 +16,52 @@ int threadCount() { return omp_get_max_threads(); }
 int currentThread() { return omp_get_thread_num(); }
 }  // namespace cpu
 
-RenderResult renderReferenceCpu(const PreparedMesh& mesh, const RenderSettings& settings) {
-    RenderResult result;
-    result.setup = makeFrameSetup(mesh, settings);
-    const SceneView scene = result.setup.scene(mesh);
-    result.image = Image(settings.width, settings.height);
-    result.sampleCounts.assign(result.image.pixels.size(), 0);
-    FrameView frame{result.image.pixels.data(), result.sampleCounts.data(), settings.width,
-                    settings.height, result.setup.rays};
-    std::vector<RayCounters> perThread(cpu::threadCount());
-    const auto start = std::chrono::steady_clock::now();
-    // Tiles of 8x8 pixels keep neighbouring rays (and their tetrahedra) on one core.
+namespace {
+
+/// Runs the pixel kernel over the frame in 8x8 tiles (neighbouring rays, and their
+/// tetrahedra, stay on one core) and sums the counters.
+template <class March>
+void launchFrame(const FrameView& frame, RenderStats& stats, March&& march) {
+    std::vector<RenderStats> perThread(cpu::threadCount());
     constexpr int kTile = 8;
-    const int tilesX = (settings.width + kTile - 1) / kTile;
-    const int tilesY = (settings.height + kTile - 1) / kTile;
+    const int tilesX = (frame.width + kTile - 1) / kTile;
+    const int tilesY = (frame.height + kTile - 1) / kTile;
     cpu::parallelFor(std::int64_t(tilesX) * tilesY, 1, [&](std::int64_t tile, int thread) {
         const int x0 = static_cast<int>(tile % tilesX) * kTile;
         const int y0 = static_cast<int>(tile / tilesX) * kTile;
-        RayCounters& counters = perThread[thread];
+        RenderStats& s = perThread[thread];
         for (int y = y0; y < y0 + kTile && y < frame.height; ++y)
             for (int x = x0; x < x0 + kTile && x < frame.width; ++x)
-                referencePixel(scene, frame, x, y, counters);
+                s.add(shadePixel(frame, x, y, march));
     });
+    for (const RenderStats& s : perThread) stats.merge(s);
+}
+
+}  // namespace
+
+RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings) {
+    RenderResult result;
+    result.setup = makeFrameSetup(mesh, settings);
+    result.image = Image(settings.width, settings.height);
+    result.sampleCounts.assign(result.image.pixels.size(), 0);
+    const FrameView frame{result.image.pixels.data(), result.sampleCounts.data(), settings.width,
+                          settings.height, result.setup.rays};
+    const auto start = std::chrono::steady_clock::now();
+    if (settings.method == RenderMethod::Reference) {
+        const SceneView scene = result.setup.scene(mesh);
+        launchFrame(frame, result.stats, [&](const Ray& ray, RayCounters& c) {
+            return marchReference(scene, ray, c);
+        });
+    } else {
+        const PartitionSceneView scene = result.setup.partitionScene(mesh, settings.skip);
+        launchFrame(frame, result.stats, [&](const Ray& ray, RayCounters& c) {
+            return marchPartitions(scene, ray, c);
+        });
+    }
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;
     result.stats.height = settings.height;
-    for (std::uint32_t s : result.sampleCounts) result.stats.samples += s;
-    for (const RayCounters& c : perThread) {
-        result.stats.walkSteps += c.locate.walkSteps;
-        result.stats.bvhQueries += c.locate.bvhQueries;
-    }
     return result;
 }
 

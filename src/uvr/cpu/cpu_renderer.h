@@ -5,7 +5,7 @@
 
 namespace uvr {
 
-/// Renders a frame with the reference marcher on all CPU cores.
-RenderResult renderReferenceCpu(const PreparedMesh& mesh, const RenderSettings& settings);
+/// Renders a frame on all CPU cores with the integrator settings.method names.
+RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings);
 
 }  // namespace uvr

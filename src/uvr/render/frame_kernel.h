@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "uvr/core/host_device.h"
+#include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/reference_marcher.h"
 
@@ -11,22 +12,24 @@ namespace uvr {
 
 /// Output buffers of one frame, as plain data.
 struct FrameView {
-    Vec4f* pixels = nullptr;            ///< width * height, premultiplied RGBA
+    Vec4f* pixels = nullptr;                ///< width * height, premultiplied RGBA
     std::uint32_t* sampleCounts = nullptr;  ///< width * height samples per pixel
     int width = 0;
     int height = 0;
     CameraRays rays;
 };
 
-/// Kernel body for one pixel of the reference integrator; the CPU and CUDA backends launch it.
-UVR_HOST_DEVICE inline void referencePixel(const SceneView& scene, const FrameView& frame, int x,
-                                           int y, RayCounters& counters) {
+/// Kernel body for one pixel: traces the pixel's centre ray with `march(ray, counters)`, stores
+/// colour and sample count, returns the ray's counters. CPU and CUDA backends launch it.
+template <class March>
+UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int y, March&& march) {
     const Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
-    const std::uint32_t before = counters.samples;
-    const Vec4f c = marchReference(scene, ray, counters);
+    RayCounters counters;
+    const Vec4f c = march(ray, counters);
     const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
     frame.pixels[i] = c;
-    frame.sampleCounts[i] = counters.samples - before;
+    frame.sampleCounts[i] = counters.samples;
+    return counters;
 }
 
 }  // namespace uvr

@@ -29,7 +29,9 @@ struct SceneView {
 
 /// Per-ray counters.
 struct RayCounters {
-    std::uint32_t samples = 0;   ///< samples taken (point locations)
+    std::uint32_t samples = 0;            ///< samples taken (point locations)
+    std::uint32_t partitionsVisited = 0;  ///< k-d partitions the ray entered
+    std::uint32_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
     LocateCounters locate;
 };
 

@@ -99,7 +99,7 @@ TEST(ReferenceMarcher, CpuFrameMatchesPerRayMarching) {
     s.height = 30;
     s.tf.colors = {{0.f, {0, 0, 1}}, {1.f, {1, 0, 0}}};
     s.tf.opacities = {{0.f, 0.f}, {1.f, 0.8f}};
-    const RenderResult r = renderReferenceCpu(pm, s);
+    const RenderResult r = renderCpu(pm, s);
     ASSERT_EQ(r.image.pixels.size(), 1200u);
     const SceneView scene = r.setup.scene(pm);
     std::uint64_t total = 0;

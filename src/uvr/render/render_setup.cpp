@@ -17,7 +17,8 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const ProgressFn& progress) {
+PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field,
+                         const PrepareOptions& options, const ProgressFn& progress) {
     PreparedMesh out;
     out.sourceCells = mesh.cellCount();
     auto start = std::chrono::steady_clock::now();
@@ -40,6 +41,13 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Progr
     if (progress) progress("finding face neighbours");
     out.neighbors = buildTetNeighbors(out.tets);
     out.adjacencySeconds = secondsSince(start);
+
+    if (options.partitions) {
+        if (progress)
+            progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
+                     " cells each)");
+        out.kd = buildKdPartitions(out.tets, options.kd);
+    }
     return out;
 }
 
@@ -71,10 +79,35 @@ void validateSettings(const RenderSettings& s) {
                      s.range->first <= s.range->second))
         bad("--range " + std::to_string(s.range->first) + "," + std::to_string(s.range->second) +
             ": expected finite lo <= hi");
+    if (!std::isfinite(s.maxStep) || s.maxStep < 0.f)
+        bad("--max-step " + std::to_string(s.maxStep) + ": expected a positive finite distance");
+    if (!(s.power >= 1.f && s.power <= 64.f))
+        bad("--power " + std::to_string(s.power) + ": expected a number in [1, 64]");
     if (s.tfTableSize < 2 || s.tfTableSize > (1 << 20)) bad("transfer function table size out of range");
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
+}
+
+std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
+                                                      const TfRangeView& range, float s1,
+                                                      float s2, float power, bool adaptive) {
+    const std::size_t n = kd.partitions.size();
+    std::vector<PartitionShading> out(n);
+    std::vector<float> variance(n);
+    float lo = INFINITY, hi = -INFINITY;
+    for (std::size_t p = 0; p < n; ++p) {
+        const RangeStats st = range.query(kd.partitions[p].valueMin, kd.partitions[p].valueMax);
+        out[p].maxOpacity = st.maxOpacity;
+        variance[p] = st.variance;
+        if (st.maxOpacity > 0.f) lo = std::fmin(lo, st.variance), hi = std::fmax(hi, st.variance);
+    }
+    for (std::size_t p = 0; p < n; ++p) {
+        float v = 0.f;  // invisible partitions: the coarsest step
+        if (out[p].maxOpacity > 0.f) v = hi > lo ? (variance[p] - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
+        out[p].step = adaptive ? adaptiveStep(v, s1, s2, power) : s1;
+    }
+    return out;
 }
 
 SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
@@ -83,6 +116,17 @@ SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi};
     v.bounds = mesh.tets.bounds;
     v.params = params;
+    return v;
+}
+
+PartitionSceneView FrameSetup::partitionScene(const PreparedMesh& mesh, bool skip) const {
+    UVR_CHECK(mesh.kd && shading.size() == mesh.kd->partitions.size(),
+              "partition scene without partitions or shading");
+    PartitionSceneView v;
+    v.base = scene(mesh);
+    v.kd = mesh.kd->view();
+    v.shading = shading.data();
+    v.skipTransparent = skip;
     return v;
 }
 
@@ -102,6 +146,22 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                : defaultOpacityUnit(mesh.tets.bounds, mesh.sourceCells);
     f.params.terminationAlpha = settings.terminationAlpha;
     // A ray of the bounds' diagonal must not need more samples than a float counts exactly.
+    f.maxStep = settings.maxStep > 0.f ? settings.maxStep : kDefaultMaxStepFactor * f.params.step;
+    if (f.maxStep < f.params.step)
+        throwError(ErrorKind::Argument, "",
+                   "--max-step " + std::to_string(f.maxStep) + " is below --step " +
+                       std::to_string(f.params.step) + " (s2 must be >= s1)");
+    if (settings.method == RenderMethod::Partitions) {
+        if (!mesh.kd)
+            throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
+        const auto start = std::chrono::steady_clock::now();
+        const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
+                                f.rangeHi};
+        const TfRangeTables ranges(table);
+        f.shading = computePartitionShading(*mesh.kd, ranges.view(table), f.params.step,
+                                            f.maxStep, settings.power, settings.adaptive);
+        f.tfUpdateSeconds = secondsSince(start);
+    }
     const double samplesPerRay = mesh.tets.bounds.diagonal() / f.params.step;
     if (samplesPerRay > 1e7)
         throwError(ErrorKind::Argument, "",

@@ -9,22 +9,31 @@
 #include <vector>
 
 #include "uvr/accel/bvh.h"
+#include "uvr/accel/kd_partitions.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/image.h"
+#include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {
 
-/// A mesh made ready for rendering one field: tetrahedra, BVH and face neighbours, built once and
-/// reused by every frame and transfer-function change.
+/// What prepareMesh builds besides tetrahedra, BVH and neighbours.
+struct PrepareOptions {
+    bool partitions = true;  ///< build the k-d partitions the partition integrator needs
+    KdBuildOptions kd;
+};
+
+/// A mesh made ready for rendering one field: tetrahedra, BVH, face neighbours and (optionally)
+/// k-d partitions, built once and reused by every frame and transfer-function change.
 struct PreparedMesh {
     TetMesh tets;
     Bvh bvh;
     std::vector<std::uint32_t> neighbors;
+    std::optional<KdPartitions> kd;
     std::uint64_t sourceCells = 0;  ///< cells of the mesh before splitting
     double splitSeconds = 0.0;      ///< time to split cells into tetrahedra
     double bvhSeconds = 0.0;        ///< time to build the BVH
@@ -39,7 +48,7 @@ using ProgressFn = std::function<void(const std::string&)>;
 
 /// Splits cells, builds the BVH over the tetrahedra and the face-neighbour table.
 PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field,
-                         const ProgressFn& progress = {});
+                         const PrepareOptions& options = {}, const ProgressFn& progress = {});
 
 /// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume,
 /// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray.
@@ -48,8 +57,19 @@ float defaultStep(const TetMesh& mesh);
 /// ParaView's default ScalarOpacityUnitDistance: bounds diagonal / cbrt(cell count).
 float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount);
 
+/// Which integrator renders a frame.
+enum class RenderMethod {
+    Reference,   ///< fixed step s1 through the whole volume (the yardstick)
+    Partitions,  ///< k-d partitions with space skipping and adaptive steps (Morrical et al. 2019)
+};
+
 /// What to render and how.
 struct RenderSettings {
+    RenderMethod method = RenderMethod::Reference;
+    float maxStep = 0.f;  ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1
+    float power = 2.f;    ///< adaptive power p >= 1
+    bool skip = true;     ///< skip partitions of zero maximum opacity
+    bool adaptive = true; ///< adaptive steps (false: every partition at s1)
     int width = 1024;
     int height = 1024;
     std::optional<Camera> camera;  ///< default: resetCamera on the mesh bounds
@@ -65,9 +85,24 @@ struct RenderSettings {
 /// side, non-finite or non-positive step or opacity unit, bad range, bad camera.
 void validateSettings(const RenderSettings& settings);
 
+/// Default s2 / s1 of the adaptive step.
+inline constexpr float kDefaultMaxStepFactor = 8.f;
+
+/// Per-partition shading for a transfer function (Morrical et al. 2019, Sec. 2.1): each
+/// partition's maximum opacity and colour variance over its value range (O(1) per partition from
+/// the table's range statistics, independent of cell count), variances normalised to [0, 1] by
+/// the minimum and maximum over the visible partitions, and the adaptive step from it (s1 for
+/// every partition when adaptive is false; s2 for invisible partitions).
+std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
+                                                      const TfRangeView& range, float s1,
+                                                      float s2, float power, bool adaptive);
+
 /// Host-side frame state built from settings: the baked table, the camera and the parameters.
 struct FrameSetup {
     std::vector<Vec4f> tfTable;
+    std::vector<PartitionShading> shading;  ///< per partition (partition method only)
+    double tfUpdateSeconds = 0.0;           ///< range tables + shading of all partitions
+    float maxStep = 0.f;                    ///< s2 in effect
     Camera camera;
     CameraRays rays;
     MarchParams params;
@@ -75,6 +110,8 @@ struct FrameSetup {
 
     /// Scene view over a prepared mesh; both must outlive it.
     SceneView scene(const PreparedMesh& mesh) const;
+    /// Partition scene view (the mesh must have partitions); both must outlive it.
+    PartitionSceneView partitionScene(const PreparedMesh& mesh, bool skip) const;
 };
 
 /// Resolves defaults and validates; throws Error(Argument) on bad settings.
@@ -86,7 +123,26 @@ struct RenderStats {
     std::uint64_t samples = 0;     ///< samples taken
     std::uint64_t walkSteps = 0;   ///< tetrahedra tested while walking
     std::uint64_t bvhQueries = 0;  ///< point locations that fell back to the BVH
+    std::uint64_t partitionsVisited = 0;  ///< partitions entered by rays (partition method)
+    std::uint64_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
     int width = 0, height = 0;
+
+    /// Adds another frame part's counters.
+    void merge(const RenderStats& o) {
+        samples += o.samples;
+        walkSteps += o.walkSteps;
+        bvhQueries += o.bvhQueries;
+        partitionsVisited += o.partitionsVisited;
+        partitionsSkipped += o.partitionsSkipped;
+    }
+    /// Adds one ray's counters.
+    void add(const RayCounters& c) {
+        samples += c.samples;
+        walkSteps += c.locate.walkSteps;
+        bvhQueries += c.locate.bvhQueries;
+        partitionsVisited += c.partitionsVisited;
+        partitionsSkipped += c.partitionsSkipped;
+    }
     double meanSamplesPerPixel() const {
         return width > 0 && height > 0 ? static_cast<double>(samples) / (double(width) * height)
                                           : 0.0;

@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "uvr/accel/bvh.h"
+#include "uvr/core/bounds.h"
+#include "uvr/core/host_device.h"
+#include "uvr/core/ray.h"
+#include "uvr/mesh/tet_mesh.h"
+
+namespace uvr {
+
+/// A k-d tree node (8 bytes): an inner node splits `axis` at `split`, its children are
+/// nodes[child] (below the plane) and nodes[child + 1] (above); a leaf names partition `child`.
+struct KdNode {
+    float split = 0.f;
+    std::uint32_t bits = 0;  ///< (child << 2) | axis, axis 3 marks a leaf
+
+    UVR_HOST_DEVICE bool isLeaf() const { return (bits & 3u) == 3u; }
+    UVR_HOST_DEVICE int axis() const { return static_cast<int>(bits & 3u); }
+    UVR_HOST_DEVICE std::uint32_t child() const { return bits >> 2; }
+};
+
+/// One partition (Morrical et al. 2019, Sec. 2.1-2.2): a k-d leaf's cells, the leaf region shrunk
+/// to the bounds of those cells, and their whole-cell scalar range.
+struct KdPartition {
+    Bounds3f box;                ///< shrunk: leaf region intersected with the cells' bounds
+    float valueMin = 0.f;        ///< finite scalar range over the cells (whole cells)
+    float valueMax = 0.f;
+    std::uint32_t firstCell = 0; ///< into KdPartitions::cells
+    std::uint32_t cellCount = 0;
+    std::uint32_t bvhRoot = 0;   ///< root of this partition's BVH in KdPartitions::bvhNodes
+};
+
+/// Plain-data view of the partitions for CPU and GPU kernels.
+struct KdView {
+    const KdNode* nodes = nullptr;
+    const KdPartition* partitions = nullptr;
+    std::uint32_t partitionCount = 0;
+    Bounds3f bounds;                      ///< region of the root node
+    BvhView bvh;                          ///< all partitions' BVHs; primIds are tetrahedron ids
+};
+
+/// Deepest k-d tree the builder makes (and the traversal stack holds).
+inline constexpr int kKdMaxDepth = 40;
+
+/// Ordered front-to-back traversal of the k-d tree along a ray (exact: the interval [tMin, tMax]
+/// is cut at each split plane's t, and the pieces are handed out in order, so no partition is
+/// skipped or visited twice whatever the precision). Calls leaf(partition, t0, t1) for each leaf
+/// region the ray crosses, with consecutive, non-overlapping [t0, t1) pieces, until leaf returns
+/// true (e.g. once the ray is opaque).
+template <class Leaf>
+UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, float tMin,
+                                float tMax, Leaf&& leaf) {
+    struct Entry {
+        std::uint32_t node;
+        float t0, t1;
+    };
+    Entry stack[kKdMaxDepth + 1];
+    int top = 0;
+    std::uint32_t node = 0;
+    float t0 = tMin, t1 = tMax;
+    while (true) {
+        const KdNode n = kd.nodes[node];
+        if (!n.isLeaf()) {
+            const int a = n.axis();
+            const float o = ray.org[a], d = ray.dir[a];
+            // Near side: where the ray starts; on the plane, the side it heads to.
+            const bool belowFirst = o < n.split || (o == n.split && d <= 0.f);
+            const std::uint32_t nearNode = n.child() + (belowFirst ? 0u : 1u);
+            const std::uint32_t farNode = n.child() + (belowFirst ? 1u : 0u);
+            const float tSplit = (n.split - o) * invDir[a];
+            if (d == 0.f || o == n.split || !(tSplit > 0.f) || tSplit >= t1) {
+                node = nearNode;  // never crossing the plane inside the interval
+            } else if (tSplit <= t0) {
+                node = farNode;  // crossed before the interval starts
+            } else {
+                stack[top++] = {farNode, tSplit, t1};
+                node = nearNode;
+                t1 = tSplit;
+            }
+            continue;
+        }
+        if (leaf(n.child(), t0, t1)) return;
+        if (top == 0) return;
+        --top;
+        node = stack[top].node;
+        t0 = stack[top].t0;
+        t1 = stack[top].t1;
+    }
+}
+
+/// Build parameters.
+struct KdBuildOptions {
+    std::uint32_t leafCells = 4096;  ///< split nodes holding more cells than this
+    int maxDepth = kKdMaxDepth;      ///< never deeper than this (at most kKdMaxDepth)
+};
+
+/// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its
+/// cells (a cell straddling a split goes to both sides), shrunk box, value range and a BVH over
+/// its cells for point location restricted to the partition.
+struct KdPartitions {
+    std::vector<KdNode> nodes;
+    std::vector<KdPartition> partitions;
+    std::vector<std::uint32_t> cells;  ///< tetrahedron ids of every partition, in BVH order
+    std::vector<BvhNode> bvhNodes;
+    Bounds3f bounds;
+    double buildSeconds = 0.0;
+
+    /// View for kernels; this object must outlive it.
+    KdView view() const {
+        return {nodes.data(), partitions.data(), static_cast<std::uint32_t>(partitions.size()),
+                bounds, {bvhNodes.data(), cells.data(), static_cast<std::uint32_t>(bvhNodes.size())}};
+    }
+    /// Sum of cells over partitions divided by the mesh's cell count (>= 1).
+    double duplicationFactor(std::uint64_t tetCount) const {
+        return tetCount ? double(cells.size()) / double(tetCount) : 0.0;
+    }
+};
+
+/// Builds the partitions with median splits of cell centres along the longest axis of each node
+/// (Morrical et al. 2019, Sec. 2.1); O(n log n) for well-shaped meshes. A node whose split would
+/// not reduce the larger side below 90% of its cells becomes a leaf, which bounds duplication.
+KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options = {});
+
+}  // namespace uvr

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "uvr/accel/kd_partitions.h"
+#include "uvr/render/reference_marcher.h"
+#include "uvr/tf/range_stats.h"
+
+namespace uvr {
+
+/// What a ray needs to know about a partition under the current transfer function.
+struct PartitionShading {
+    float maxOpacity = 0.f;  ///< 0: the partition is invisible and can be skipped
+    float step = 0.f;        ///< sample spacing inside the partition
+};
+
+/// Adaptive step (Morrical et al. 2019, Sec. 2.4): s = max(s1 + (s2 - s1) |min(v, 1) - 1|^p, s1)
+/// for normalised colour variance v (v >= 1 gives s1, v = 0 gives s2).
+UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) {
+    const float x = fabsf((v < 1.f ? v : 1.f) - 1.f);
+    const float s = s1 + (s2 - s1) * powf(x, p);
+    return s > s1 ? s : s1;
+}
+
+/// Scene for the partition integrator: the reference scene plus the partitions and their
+/// per-transfer-function shading.
+struct PartitionSceneView {
+    SceneView base;
+    KdView kd;
+    const PartitionShading* shading = nullptr;
+    bool skipTransparent = true;  ///< skip partitions whose maximum opacity is 0
+};
+
+/// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
+/// back in exact order; skips unoccupied space (outside the shrunk boxes) and, when asked,
+/// partitions with zero maximum opacity; marches each visited partition with its own step s and
+/// opacity correction, locating samples among the partition's cells; stops early once opaque.
+///
+/// Sample placement: a partition's piece of the ray owns the reference grid points
+/// t = k * s1 for k in [K0, K1); its samples sit at (K0 + j * s / s1) * s1 and each one stands
+/// for the distance to the next (the last one only up to K1 * s1). So with s == s1 the samples
+/// are exactly the reference marcher's, and with larger steps the distances still add up to the
+/// piece's length: no partition crossing gains or loses optical depth.
+UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
+                                             RayCounters& counters) {
+    Vec4f acc(0.f, 0.f, 0.f, 0.f);
+    const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
+    float tEnter = 0.f, tExit = INFINITY;
+    if (scene.kd.partitionCount == 0 ||
+        !intersectBox(scene.kd.bounds, ray.org, inv, tEnter, tExit))
+        return acc;
+    const TetLocator& locator = scene.base.locator;
+    const float s1 = scene.base.params.step;
+    const float unit = scene.base.params.opacityUnit;
+    const float stopAlpha = scene.base.params.terminationAlpha;
+    std::uint32_t tet = kNoTet;
+    float bary[4];
+    kdTraverse(scene.kd, ray, inv, tEnter, tExit, [&](std::uint32_t p, float t0, float t1) {
+        const KdPartition& part = scene.kd.partitions[p];
+        const PartitionShading shade = scene.shading[p];
+        ++counters.partitionsVisited;
+        if (part.cellCount == 0) return false;
+        if (scene.skipTransparent && !(shade.maxOpacity > 0.f)) {
+            ++counters.partitionsSkipped;
+            return false;
+        }
+        // Only the part of [t0, t1) inside the shrunk box can hold cells.
+        float c0 = t0, c1 = t1;
+        if (!intersectBox(part.box, ray.org, inv, c0, c1)) return false;
+        // Reference grid points owned: [K0, K1); the ray's end point belongs to the last piece.
+        const float k0 = ceilf(c0 / s1);
+        const float k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
+        const float m = shade.step / s1;  // step in grid units (1 for s1)
+        for (float k = k0; k < k1; k += m) {
+            const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
+            ++counters.samples;
+            tet = locator.locateIn(scene.kd.bvh, part.bvhRoot, ray.at(k * s1), tet, bary,
+                                   counters.locate);
+            if (tet == kNoTet) continue;
+            const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
+            const float a = correctOpacity(c.w, length, unit);
+            if (a <= 0.f) continue;
+            compositeFrontToBack(acc, c.xyz(), a);
+            if (acc.w >= stopAlpha) return true;
+        }
+        return false;
+    });
+    return acc;
+}
+
+}  // namespace uvr

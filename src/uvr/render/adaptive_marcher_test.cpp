@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/render/adaptive_marcher.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "test_meshes.h"
+#include "uvr/cpu/cpu_renderer.h"
+
+namespace uvr {
+namespace {
+
+PreparedMesh jitteredGrid(std::uint32_t leafCells = 64) {
+    Mesh m = testing::makeHexGrid(10, -1.f, 1.f,
+                                  [](Vec3f p) { return std::sin(3 * p.x) * std::cos(2 * p.y) + p.z; },
+                                  0.3f);
+    PrepareOptions o;
+    o.kd.leafCells = leafCells;
+    return prepareMesh(m, selectScalarField(m, {}), o);
+}
+
+RenderSettings baseSettings() {
+    RenderSettings s;
+    s.width = 64;
+    s.height = 48;
+    s.tf.colors = {{0.f, {0, 0, 1}}, {0.5f, {1, 1, 1}}, {1.f, {1, 0, 0}}};
+    s.tf.opacities = {{0.f, 0.f}, {0.45f, 0.f}, {1.f, 0.9f}};
+    s.camera = orbitCamera(resetCamera(Bounds3f{{-1, -1, -1}, {1, 1, 1}}, 64.f / 48.f), 25, 20);
+    return s;
+}
+
+float meanDifference(const Image& a, const Image& b) {
+    double d = 0.0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        const Vec4f x = a.pixels[i], y = b.pixels[i];
+        d += std::fabs(x.x - y.x) + std::fabs(x.y - y.y) + std::fabs(x.z - y.z) +
+             std::fabs(x.w - y.w);
+    }
+    return static_cast<float>(d / (4.0 * a.pixels.size()));
+}
+
+float maxDifference(const Image& a, const Image& b) {
+    float d = 0.f;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        const Vec4f x = a.pixels[i], y = b.pixels[i];
+        d = std::max({d, std::fabs(x.x - y.x), std::fabs(x.y - y.y), std::fabs(x.z - y.z),
+                      std::fabs(x.w - y.w)});
+    }
+    return d;
+}
+
+TEST(AdaptiveStep, FormulaEnds) {
+    EXPECT_FLOAT_EQ(adaptiveStep(1.f, 0.1f, 0.8f, 2.f), 0.1f);
+    EXPECT_FLOAT_EQ(adaptiveStep(0.f, 0.1f, 0.8f, 2.f), 0.8f);
+    EXPECT_FLOAT_EQ(adaptiveStep(0.5f, 0.1f, 0.8f, 2.f), 0.1f + 0.7f * 0.25f);
+    EXPECT_FLOAT_EQ(adaptiveStep(3.f, 0.1f, 0.8f, 2.f), 0.1f);  // v clamped to 1
+    EXPECT_GT(adaptiveStep(0.5f, 0.1f, 0.8f, 1.f), adaptiveStep(0.5f, 0.1f, 0.8f, 4.f));
+}
+
+TEST(PartitionIntegrator, EqualStepsReproduceTheReference) {
+    const PreparedMesh pm = jitteredGrid();
+    RenderSettings ref = baseSettings();
+    const RenderResult r = renderCpu(pm, ref);
+    for (bool skip : {true, false}) {
+        RenderSettings s = ref;
+        s.method = RenderMethod::Partitions;
+        s.skip = skip;
+        s.adaptive = false;  // every partition at s1: the reference's samples
+        const RenderResult p = renderCpu(pm, s);
+        EXPECT_LT(maxDifference(r.image, p.image), 1e-4f) << "skip " << skip;
+        if (skip) {
+            EXPECT_LT(p.stats.samples, r.stats.samples);  // transparent partitions skipped
+            EXPECT_GT(p.stats.partitionsSkipped, 0u);
+        } else {
+            EXPECT_EQ(p.stats.samples, r.stats.samples);  // a convex mesh: nothing to skip
+            EXPECT_EQ(p.stats.partitionsSkipped, 0u);
+        }
+        // Also with s2 == s1 and adaptivity on.
+        s.adaptive = true;
+        s.maxStep = r.setup.params.step;
+        EXPECT_LT(maxDifference(r.image, renderCpu(pm, s).image), 1e-4f);
+    }
+}
+
+TEST(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
+    const PreparedMesh pm = jitteredGrid();
+    RenderSettings s = baseSettings();
+    const RenderResult r = renderCpu(pm, s);
+    s.method = RenderMethod::Partitions;
+    s.maxStep = 4.f * r.setup.params.step;
+    const RenderResult a = renderCpu(pm, s);
+    EXPECT_LT(a.stats.samples, r.stats.samples);
+    EXPECT_LT(meanDifference(r.image, a.image), 0.01f);
+    for (const PartitionShading& sh : a.setup.shading) {
+        EXPECT_GE(sh.step, r.setup.params.step * 0.999f);
+        EXPECT_LE(sh.step, s.maxStep * 1.001f);
+    }
+}
+
+TEST(PartitionShading, NormalisedVarianceMapsToTheStepRange) {
+    const PreparedMesh pm = jitteredGrid(32);
+    RenderSettings s = baseSettings();
+    s.method = RenderMethod::Partitions;
+    s.maxStep = 1.f;
+    s.step = 0.05f;
+    const FrameSetup f = makeFrameSetup(pm, s);
+    float lo = INFINITY, hi = -INFINITY;
+    int invisible = 0;
+    for (const PartitionShading& sh : f.shading) {
+        if (sh.maxOpacity > 0.f) {
+            lo = std::min(lo, sh.step);
+            hi = std::max(hi, sh.step);
+        } else {
+            ++invisible;
+            EXPECT_FLOAT_EQ(sh.step, 1.f);
+        }
+    }
+    EXPECT_GT(invisible, 0);
+    EXPECT_FLOAT_EQ(lo, 0.05f);  // the most varied visible partition gets s1
+    EXPECT_FLOAT_EQ(hi, 1.f);    // the least varied gets s2
+    EXPECT_LT(f.tfUpdateSeconds, 1.0);
+}
+
+}  // namespace
+}  // namespace uvr

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/tf/range_stats.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace uvr {
+namespace {
+
+/// Brute force over the same points query() uses: the two interpolated ends and the entries
+/// strictly between them.
+RangeStats bruteForce(const TfTableView& t, float lo, float hi) {
+    std::vector<Vec4f> pts{t.sample(lo), t.sample(hi)};
+    const float scale = float(t.count - 1) / (t.hi - t.lo);
+    const float f0 = std::clamp((lo - t.lo) * scale, 0.f, float(t.count - 1));
+    const float f1 = std::clamp((hi - t.lo) * scale, 0.f, float(t.count - 1));
+    for (int i = 0; i < t.count; ++i)
+        if (float(i) > f0 && float(i) < f1) pts.push_back(t.entries[i]);
+    RangeStats s;
+    double mean[4] = {}, sq = 0;
+    for (const Vec4f& p : pts) {
+        s.maxOpacity = std::max(s.maxOpacity, p.w);
+        mean[0] += p.x, mean[1] += p.y, mean[2] += p.z, mean[3] += p.w;
+        sq += double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z + double(p.w) * p.w;
+    }
+    const double n = pts.size();
+    s.variance = static_cast<float>(
+        sq / n - (mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2] + mean[3] * mean[3]) /
+                     (n * n));
+    return s;
+}
+
+TEST(RangeStats, MatchBruteForceOnRandomTablesAndRanges) {
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (int count : {2, 3, 17, 256, 1000}) {
+        std::vector<Vec4f> e(count);
+        for (auto& v : e) v = Vec4f(u(rng), u(rng), u(rng), u(rng) < 0.3f ? 0.f : u(rng));
+        const TfTableView table{e.data(), count, -2.f, 5.f};
+        const TfRangeTables tables(table);
+        const TfRangeView view = tables.view(table);
+        for (int i = 0; i < 2000; ++i) {
+            float a = -3.f + 9.f * u(rng), b = -3.f + 9.f * u(rng);
+            if (a > b) std::swap(a, b);
+            const RangeStats got = view.query(a, b), want = bruteForce(table, a, b);
+            ASSERT_FLOAT_EQ(got.maxOpacity, want.maxOpacity) << count << " " << a << " " << b;
+            ASSERT_NEAR(got.variance, std::max(want.variance, 0.f), 1e-5f);
+        }
+    }
+}
+
+TEST(RangeStats, ConstantTableHasZeroVarianceAndRampMaxIsTheUpperEnd) {
+    std::vector<Vec4f> flat(64, Vec4f(0.2f, 0.4f, 0.6f, 0.5f));
+    const TfTableView t{flat.data(), 64, 0.f, 1.f};
+    const TfRangeTables tables(t);
+    EXPECT_NEAR(tables.view(t).query(0.1f, 0.9f).variance, 0.f, 1e-7f);
+    std::vector<Vec4f> ramp(101);
+    for (int i = 0; i <= 100; ++i) ramp[i] = Vec4f(0, 0, 0, i / 100.f);
+    const TfTableView r{ramp.data(), 101, 0.f, 1.f};
+    const TfRangeTables rt(r);
+    EXPECT_NEAR(rt.view(r).query(0.2f, 0.355f).maxOpacity, 0.355f, 1e-6f);
+    EXPECT_EQ(rt.view(r).query(-1.f, -0.5f).maxOpacity, 0.f);  // below the range: first entry
+}
+
+}  // namespace
+}  // namespace uvr
