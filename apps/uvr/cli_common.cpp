@@ -82,8 +82,8 @@ std::pair<int, int> parseSize(const std::string& flag, const std::string& text) 
     return {w, h};
 }
 
-void RenderFlags::registerOn(CLI::App& app) {
-    app.add_option("-o,--output", output, "Output PNG file")->required();
+void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
+    if (oneFrame) app.add_option("-o,--output", output, "Output PNG file")->required();
     app.add_option("--field", field,
                    "Field to render: NAME[:point|:cell][:magnitude|:x|:y|:z|:N] "
                    "(default: the first scalar field)");
@@ -112,32 +112,38 @@ void RenderFlags::registerOn(CLI::App& app) {
     app.add_option("--opacity-unit", opacityUnit,
                    "Distance over which a TF opacity applies (default: ParaView's "
                    "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))");
-    app.add_option("--method", method,
-                   "Integrator: reference (fixed step s1 everywhere) or adaptive (k-d partitions, "
-                   "space skipping, adaptive steps; Morrical et al. 2019)")
-        ->check(CLI::IsMember({"reference", "adaptive"}))
-        ->capture_default_str();
+    if (oneFrame)
+        app.add_option("--method", method,
+                       "Integrator: reference (fixed step s1 everywhere) or adaptive (k-d "
+                       "partitions, space skipping, adaptive steps; Morrical et al. 2019)")
+            ->check(CLI::IsMember({"reference", "adaptive"}))
+            ->capture_default_str();
     app.add_option("--max-step", maxStep,
                    "Adaptive: largest step s2 (default: " +
                        std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)");
     app.add_option("--power", power, "Adaptive: power p >= 1 of the step formula")
         ->capture_default_str();
-    app.add_flag("--no-skip", noSkip,
-                 "Adaptive: also march partitions of zero opacity (\"adaptive only\")");
-    app.add_flag("--no-adaptive", noAdaptive,
-                 "Adaptive: every partition at s1 (\"skipping only\")");
+    if (oneFrame) {
+        app.add_flag("--no-skip", noSkip,
+                     "Adaptive: also march partitions of zero opacity (\"adaptive only\")");
+        app.add_flag("--no-adaptive", noAdaptive,
+                     "Adaptive: every partition at s1 (\"skipping only\")");
+    }
     app.add_option("--leaf-cells", leafCells,
                    "Adaptive: cells per k-d partition at most (default " +
                        std::to_string(KdBuildOptions{}.leafCells) + ")")
         ->check(CLI::Range(1u, 1u << 30));
-    app.add_option("--heatmap", heatmapFile,
-                   "Also write the per-pixel sample counts as a heat map PNG");
-    app.add_option("--heatmap-max", heatmapMax,
-                   "Sample count at the top of the heat map scale (default: the frame's maximum)");
+    if (oneFrame) {
+        app.add_option("--heatmap", heatmapFile,
+                       "Also write the per-pixel sample counts as a heat map PNG");
+        app.add_option("--heatmap-max", heatmapMax,
+                       "Sample count at the top of the heat map scale (default: the frame's "
+                       "maximum)");
+    }
     app.add_option("--background", background,
                    "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
         ->capture_default_str();
-    app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
+    if (oneFrame) app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
     app.add_option("--threads", threads, "CPU threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
 }
@@ -177,6 +183,16 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
     return s;
 }
 
+std::optional<Vec3f> RenderFlags::backgroundColor() const {
+    if (background.empty()) return std::nullopt;
+    const Vec3f c = parseVec3("--background", background);
+    for (int i = 0; i < 3; ++i)
+        if (c[i] < 0.f || c[i] > 1.f)
+            throwError(ErrorKind::Argument, "",
+                       "--background '" + background + "': components must lie in [0,1]");
+    return c;
+}
+
 PrepareOptions RenderFlags::prepareOptions() const {
     PrepareOptions o;
     o.partitions = method == "adaptive";
@@ -199,14 +215,7 @@ Mesh loadMesh(const std::string& path, const Log& log) {
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
                             const Log& log) {
     if (flags.threads > 0) omp_set_num_threads(flags.threads);
-    std::optional<Vec3f> background;
-    if (!flags.background.empty()) {
-        background = parseVec3("--background", flags.background);
-        for (int i = 0; i < 3; ++i)
-            if ((*background)[i] < 0.f || (*background)[i] > 1.f)
-                throwError(ErrorKind::Argument, "",
-                           "--background '" + flags.background + "': components must lie in [0,1]");
-    }
+    const std::optional<Vec3f> background = flags.backgroundColor();
     checkOutputPath(flags.output);
     if (!flags.statsFile.empty()) checkOutputPath(flags.statsFile);
     if (!flags.heatmapFile.empty()) checkOutputPath(flags.heatmapFile);

@@ -52,10 +52,13 @@ struct RenderFlags {
     std::string statsFile;
     int threads = 0;
 
-    /// Adds the flags to a subcommand.
-    void registerOn(CLI::App& app);
+    /// Adds the flags to a subcommand; oneFrame adds those of a single render (output, method,
+    /// heat map, stats), which `bench` chooses itself.
+    void registerOn(CLI::App& app, bool oneFrame = true);
     /// Parses the flags into render settings; the default camera fits the bounds.
     RenderSettings settings(const Bounds3f& bounds) const;
+    /// The --background colour, if given (checked to lie in [0, 1]).
+    std::optional<Vec3f> backgroundColor() const;
     /// What mesh preparation the flags need (partitions only for the adaptive method).
     PrepareOptions prepareOptions() const;
 };
@@ -74,5 +77,6 @@ void addDemoCommand(CLI::App& app, Log& log);
 void addConvertCommand(CLI::App& app, Log& log);
 void addGenerateCommand(CLI::App& app, Log& log);
 void addCompareCommand(CLI::App& app, Log& log);
+void addBenchCommand(CLI::App& app, Log& log);
 
 }  // namespace uvr::cli

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     cli::addConvertCommand(app, log);
     cli::addGenerateCommand(app, log);
     cli::addCompareCommand(app, log);
+    cli::addBenchCommand(app, log);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,219 @@
+// SPDX-License-Identifier: MIT
+// `uvr bench`: the paper's evaluation (Morrical et al. 2019, Figs. 4-6) for one mesh, camera and
+// transfer function: reference, skipping only, adaptive only, both, and a sweep over s2.
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+
+namespace uvr::cli {
+
+namespace {
+
+/// One benchmarked configuration.
+struct Variant {
+    std::string name;
+    RenderSettings settings;
+    double s2Factor = 0.0;  ///< s2 / s1 (0 when not adaptive)
+    // Results.
+    double medianSeconds = 0.0;
+    std::uint64_t samples = 0;
+    double ssim = 1.0, psnr = 0.0;
+    RenderResult last;
+};
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string fileName(const std::string& name) {
+    std::string s = name;
+    for (char& c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    return s;
+}
+
+}  // namespace
+
+void addBenchCommand(CLI::App& app, Log& log) {
+    auto* cmd = app.add_subcommand(
+        "bench",
+        "Time reference, skipping only, adaptive only, both, and an s2 sweep on one mesh; "
+        "print time per frame, samples, speed-up and SSIM against the reference");
+    auto file = std::make_shared<std::string>();
+    auto flags = std::make_shared<RenderFlags>();
+    auto repeat = std::make_shared<int>(5);
+    auto sweep = std::make_shared<std::vector<double>>(std::vector<double>{2, 4, 8, 16, 32});
+    auto csv = std::make_shared<std::string>();
+    auto json = std::make_shared<std::string>();
+    auto plot = std::make_shared<std::string>();
+    auto images = std::make_shared<std::string>();
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    flags->registerOn(*cmd, false);
+    cmd->add_option("--repeat", *repeat, "Timed frames per configuration (median reported)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
+    cmd->add_option("--sweep", *sweep, "s2 / s1 factors of the sweep")
+        ->delimiter(',')
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 1e4));
+    cmd->add_option("--csv", *csv, "Write the table as CSV");
+    cmd->add_option("--json", *json, "Write the table and settings as JSON");
+    cmd->add_option("--plot", *plot, "Write a PNG plot of time and SSIM against s2 / s1");
+    cmd->add_option("--images", *images,
+                    "Write each configuration's image and sample heat map into this folder");
+    cmd->callback([=, &log] {
+        for (const std::string* out : {csv.get(), json.get(), plot.get()})
+            if (!out->empty()) checkOutputPath(*out);
+        if (!images->empty() && !std::filesystem::is_directory(*images))
+            throwError(ErrorKind::Io, *images, "not a folder");
+        flags->method = "adaptive";  // partitions are needed; variants pick their integrator
+        const Mesh mesh = loadMesh(*file, log);
+        const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
+        const RenderSettings base = flags->settings(mesh.bounds());
+        const std::optional<Vec3f> background = flags->backgroundColor();
+        const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
+        if (flags->threads > 0) omp_set_num_threads(flags->threads);
+        const PreparedMesh prepared = prepareMesh(mesh, field, flags->prepareOptions(),
+                                                  [&](const std::string& s) { log.step(s); });
+        const float s1 = makeFrameSetup(prepared, base).params.step;
+        const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;
+
+        std::vector<Variant> variants;
+        auto add = [&](const std::string& name, RenderMethod method, bool skip, bool adaptive,
+                       float s2) {
+            Variant v;
+            v.name = name;
+            v.settings = base;
+            v.settings.method = method;
+            v.settings.skip = skip;
+            v.settings.adaptive = adaptive;
+            v.settings.maxStep = s2;
+            v.s2Factor = adaptive ? s2 / s1 : 0.0;
+            variants.push_back(v);
+        };
+        add("reference", RenderMethod::Reference, false, false, defaultS2);
+        add("skipping only", RenderMethod::Partitions, true, false, defaultS2);
+        add("adaptive only", RenderMethod::Partitions, false, true, defaultS2);
+        add("skipping + adaptive", RenderMethod::Partitions, true, true, defaultS2);
+        for (double f : *sweep) {
+            char name[64];
+            std::snprintf(name, sizeof name, "both, s2 = %g s1", f);
+            add(name, RenderMethod::Partitions, true, true, static_cast<float>(f * s1));
+        }
+        // Render: one warm-up frame, then `repeat` timed frames per variant.
+        Rgb8Image reference;
+        for (Variant& v : variants) {
+            log.step("timing " + v.name);
+            std::vector<double> times;
+            v.last = renderCpu(prepared, v.settings);
+            for (int r = 0; r < *repeat; ++r) {
+                v.last = renderCpu(prepared, v.settings);
+                times.push_back(v.last.stats.seconds);
+            }
+            v.medianSeconds = median(times);
+            v.samples = v.last.stats.samples;
+            const Rgb8Image img = toRgb8(v.last.image, bg);
+            if (reference.rgb.empty()) reference = img;
+            const ImageComparison cmp = compareImages(reference, img);
+            v.ssim = cmp.ssim;
+            v.psnr = cmp.psnr;
+            if (!images->empty()) {
+                const std::string stem = *images + "/" + fileName(v.name);
+                writePng(stem + ".png", v.last.image, background);
+                writePng(stem + "_samples.png",
+                         sampleHeatmap(v.last.sampleCounts, v.settings.width, v.settings.height,
+                                       flags->heatmapMax));
+            }
+        }
+        // Table.
+        const int threads = omp_get_max_threads();
+        const double refTime = variants.front().medianSeconds;
+        std::printf("%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
+                    "p = %g, %d thread(s), median of %d frames\n",
+                    file->c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
+                    prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width,
+                    base.height, s1, base.power, threads, *repeat);
+        std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
+                    "samples", "spp", "Msps/core", "speed-up", "SSIM");
+        for (const Variant& v : variants) {
+            const double pixels = double(base.width) * base.height;
+            std::printf("%-22s %8s %10.1f %12llu %9.2f %9.2f %7.2fx %8.4f\n", v.name.c_str(),
+                        v.s2Factor > 0 ? std::to_string(v.s2Factor).substr(0, 5).c_str() : "-",
+                        v.medianSeconds * 1e3, static_cast<unsigned long long>(v.samples),
+                        v.samples / pixels, v.samples / v.medianSeconds / threads / 1e6,
+                        refTime / v.medianSeconds, v.ssim);
+        }
+        std::printf("transfer-function update: %.3f ms for %zu partitions\n",
+                    variants.back().last.setup.tfUpdateSeconds * 1e3,
+                    prepared.kd->partitions.size());
+        // Files.
+        if (!csv->empty())
+            writeFileAtomically(*csv, [&](const std::string& tmp) {
+                std::ofstream out(tmp);
+                out << "configuration,s2_over_s1,seconds_per_frame,samples,samples_per_pixel,"
+                       "speedup,ssim,psnr\n";
+                for (const Variant& v : variants)
+                    out << '"' << v.name << "\"," << v.s2Factor << ',' << v.medianSeconds << ','
+                        << v.samples << ',' << v.samples / (double(base.width) * base.height)
+                        << ',' << refTime / v.medianSeconds << ',' << v.ssim << ',' << v.psnr
+                        << '\n';
+                if (!out) throwError(ErrorKind::Io, *csv, "cannot write");
+            });
+        if (!json->empty())
+            writeFileAtomically(*json, [&](const std::string& tmp) {
+                nlohmann::json j;
+                j["file"] = *file;
+                j["field"] = field.name;
+                j["tetrahedra"] = prepared.tets.tets.size();
+                j["partitions"] = prepared.kd->partitions.size();
+                j["partition_build_seconds"] = prepared.kd->buildSeconds;
+                j["image"] = {base.width, base.height};
+                j["s1"] = s1;
+                j["power"] = base.power;
+                j["threads"] = threads;
+                j["repeat"] = *repeat;
+                j["tf_update_seconds"] = variants.back().last.setup.tfUpdateSeconds;
+                for (const Variant& v : variants)
+                    j["rows"].push_back({{"configuration", v.name},
+                                         {"s2_over_s1", v.s2Factor},
+                                         {"seconds_per_frame", v.medianSeconds},
+                                         {"samples", v.samples},
+                                         {"speedup", refTime / v.medianSeconds},
+                                         {"ssim", v.ssim},
+                                         {"psnr", v.psnr}});
+                std::ofstream(tmp) << j.dump(2) << "\n";
+            });
+        if (!plot->empty()) {
+            PlotSpec spec;
+            spec.title = std::filesystem::path(*file).filename().string() +
+                         ": time and SSIM against s2 (skipping + adaptive)";
+            spec.xLabel = "s2 / s1";
+            spec.yLabel = "ms per frame";
+            spec.yRightLabel = "SSIM vs reference";
+            PlotSeries time{"ms per frame", {}, {}, Vec3f(0.1f, 0.3f, 0.8f), false};
+            PlotSeries ssim{"SSIM", {}, {}, Vec3f(0.8f, 0.2f, 0.1f), true};
+            time.x.push_back(1.0);  // s2 = s1: skipping only
+            time.y.push_back(variants[1].medianSeconds * 1e3);
+            ssim.x.push_back(1.0);
+            ssim.y.push_back(variants[1].ssim);
+            for (std::size_t i = 4; i < variants.size(); ++i) {
+                time.x.push_back(variants[i].s2Factor);
+                time.y.push_back(variants[i].medianSeconds * 1e3);
+                ssim.x.push_back(variants[i].s2Factor);
+                ssim.y.push_back(variants[i].ssim);
+            }
+            spec.series = {time, ssim};
+            writePng(*plot, renderPlot(spec));
+        }
+    });
+}
+
+}  // namespace uvr::cli
