@@ -55,21 +55,26 @@ std::array<double, kSsimWindow> gaussianWeights() {
 /// kept pixels' windows lie entirely inside the image and no border handling is needed here.
 double channelSsim(const Rgb8Image& a, const Rgb8Image& b, int channel) {
     const auto w = gaussianWeights();
-    const int width = a.width, height = a.height;
+    const int width = a.width;
     const int innerW = width - 2 * kSsimRadius;
-    const int innerH = height - 2 * kSsimRadius;
-    const size_t n = static_cast<size_t>(innerW) * height;
+    const int innerH = a.height - 2 * kSsimRadius;
 
-    // Step 1: horizontal pass of the separable Gaussian over x, y, x^2, y^2 and xy, for the
-    // kept columns of every row.
-    std::vector<double> hx(n), hy(n), hxx(n), hyy(n), hxy(n);
+    // The separable Gaussian's horizontal pass of x, y, x^2, y^2 and xy for the kept columns,
+    // kept for the last kSsimWindow image rows in a ring buffer.
+    constexpr int kMoments = 5;
+    std::vector<double> ring(static_cast<size_t>(kMoments) * kSsimWindow * innerW);
     std::vector<double> rowA(width), rowB(width);
-    for (int y = 0; y < height; ++y) {
+    auto ringRow = [&](int moment, int imageRow) {
+        return &ring[(static_cast<size_t>(moment) * kSsimWindow + imageRow % kSsimWindow) * innerW];
+    };
+    auto filterRow = [&](int y) {
         for (int x = 0; x < width; ++x) {
             const size_t i = (static_cast<size_t>(y) * width + x) * 3 + channel;
             rowA[x] = a.rgb[i];
             rowB[x] = b.rgb[i];
         }
+        double* out[kMoments];
+        for (int m = 0; m < kMoments; ++m) out[m] = ringRow(m, y);
         for (int x = 0; x < innerW; ++x) {
             double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
             for (int k = 0; k < kSsimWindow; ++k) {
@@ -80,37 +85,35 @@ double channelSsim(const Rgb8Image& a, const Rgb8Image& b, int channel) {
                 syy += wk * vb * vb;
                 sxy += wk * va * vb;
             }
-            const size_t o = static_cast<size_t>(y) * innerW + x;
-            hx[o] = sx;
-            hy[o] = sy;
-            hxx[o] = sxx;
-            hyy[o] = syy;
-            hxy[o] = sxy;
+            out[0][x] = sx;
+            out[1][x] = sy;
+            out[2][x] = sxx;
+            out[3][x] = syy;
+            out[4][x] = sxy;
         }
-    }
+    };
 
-    // Step 2: vertical pass for the kept rows, then the SSIM map and its mean.
+    // Vertical pass for each kept row, then the SSIM map and its mean.
     const double c1 = (kSsimK1 * kDataRange) * (kSsimK1 * kDataRange);
     const double c2 = (kSsimK2 * kDataRange) * (kSsimK2 * kDataRange);
-    std::vector<double> ux(innerW), uy(innerW), uxx(innerW), uyy(innerW), uxy(innerW);
+    std::vector<double> sums(static_cast<size_t>(kMoments) * innerW);
+    for (int y = 0; y < kSsimWindow - 1; ++y) filterRow(y);
     double total = 0.0;
     for (int y = 0; y < innerH; ++y) {
-        std::fill(ux.begin(), ux.end(), 0.0);
-        std::fill(uy.begin(), uy.end(), 0.0);
-        std::fill(uxx.begin(), uxx.end(), 0.0);
-        std::fill(uyy.begin(), uyy.end(), 0.0);
-        std::fill(uxy.begin(), uxy.end(), 0.0);
-        for (int k = 0; k < kSsimWindow; ++k) {
-            const double wk = w[k];
-            const size_t row = static_cast<size_t>(y + k) * innerW;
-            for (int x = 0; x < innerW; ++x) {
-                ux[x] += wk * hx[row + x];
-                uy[x] += wk * hy[row + x];
-                uxx[x] += wk * hxx[row + x];
-                uyy[x] += wk * hyy[row + x];
-                uxy[x] += wk * hxy[row + x];
+        filterRow(y + kSsimWindow - 1);
+        std::fill(sums.begin(), sums.end(), 0.0);
+        for (int m = 0; m < kMoments; ++m) {
+            double* sum = &sums[static_cast<size_t>(m) * innerW];
+            for (int k = 0; k < kSsimWindow; ++k) {
+                const double* row = ringRow(m, y + k);
+                for (int x = 0; x < innerW; ++x) sum[x] += w[k] * row[x];
             }
         }
+        const double* ux = &sums[0];
+        const double* uy = &sums[static_cast<size_t>(innerW)];
+        const double* uxx = &sums[2 * static_cast<size_t>(innerW)];
+        const double* uyy = &sums[3 * static_cast<size_t>(innerW)];
+        const double* uxy = &sums[4 * static_cast<size_t>(innerW)];
         double rowSum = 0.0;
         for (int x = 0; x < innerW; ++x) {
             const double vx = uxx[x] - ux[x] * ux[x];

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -126,6 +127,20 @@ TEST(ImageMetrics, MatchesScikitImage) {
                      })});
     pairs.push_back({"unrelated", makeImage(w, h, [&](int, int, int) { return any(rng); }),
                      makeImage(w, h, [&](int, int, int) { return any(rng); })});
+
+    // A real uvr render from the docs, against itself with sampling-like noise and shifted.
+    const std::string demo = testing::testTool("../../docs/images/demo.png");
+    if (std::filesystem::exists(demo)) {
+        const Rgb8Image r = toRgb8(readPng(demo));
+        pairs.push_back({"demo_noise", r, makeImage(r.width, r.height, [&](int x, int y, int c) {
+                             return value(r, x, y, c) + small(rng) * 2;
+                         })});
+        pairs.push_back({"demo_shift", r, makeImage(r.width, r.height, [&](int x, int y, int c) {
+                             return value(r, x + 1, y, c);
+                         })});
+    } else {
+        ADD_FAILURE() << "missing " << demo;
+    }
 
     std::vector<std::string> files;
     for (const Pair& p : pairs) {

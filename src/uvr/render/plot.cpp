@@ -265,6 +265,11 @@ AxisTicks niceTicks(double dataMin, double dataMax, int targetCount) {
     t.step = niceNumber(range / (targetCount - 1), true);
     t.lo = std::floor(dataMin / t.step) * t.step;
     t.hi = std::ceil(dataMax / t.step) * t.step;
+    // Ranges at the ends of double precision (overflowing widths, denormals) get [0, 1].
+    const double ticks = (t.hi - t.lo) / t.step;
+    if (!(t.step > 0.0) || !std::isfinite(t.lo) || !std::isfinite(t.hi) || !(ticks >= 1.0) ||
+        ticks > 100.0)
+        return AxisTicks{};
     return t;
 }
 

@@ -39,7 +39,7 @@ int textWidth(const std::string& text, int scale = 1);
 
 /// Tick marks of one axis: lo, lo + step, ..., hi, with step 1, 2 or 5 times a power of ten.
 struct AxisTicks {
-    double lo = 0.0, hi = 1.0, step = 0.2;
+    double lo = 0.0, hi = 1.0, step = 0.2;  ///< first tick, last tick, spacing
     /// Number of ticks from lo to hi inclusive.
     int count() const;
     /// The i-th tick value (exactly 0 where rounding would give a tiny residue).
@@ -47,8 +47,8 @@ struct AxisTicks {
 };
 
 /// "Nice" ticks covering [dataMin, dataMax] with about targetCount ticks (Heckbert, "Nice
-/// Numbers for Graph Labels", Graphics Gems 1990); an empty or non-finite range gets [0, 1],
-/// a single value a range around it.
+/// Numbers for Graph Labels", Graphics Gems 1990); an empty or non-finite range, or one beyond
+/// double precision, gets [0, 1], a single value a range around it.
 AxisTicks niceTicks(double dataMin, double dataMax, int targetCount = 6);
 
 /// Formats a tick value with as many decimals as the step needs.
@@ -58,9 +58,9 @@ std::string formatTick(double value, double step);
 /// the ticks of each axis; data (x, y) maps linearly onto pixel centres, x.lo to column left and
 /// y.lo to row bottom.
 struct PlotFrame {
-    int left = 0, top = 0, right = 0, bottom = 0;
-    AxisTicks x, y, yRight;
-    bool hasRightAxis = false;  ///< true when some series has rightAxis set
+    int left = 0, top = 0, right = 0, bottom = 0;  ///< plot area, inclusive pixel bounds
+    AxisTicks x, y, yRight;                        ///< bottom, left and right axes
+    bool hasRightAxis = false;                     ///< true when some series has rightAxis set
 };
 
 /// Computes the layout of a plot; throws Error(Argument) for a size below 160x120, series whose

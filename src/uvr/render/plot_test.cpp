@@ -55,9 +55,12 @@ TEST(Plot, NiceTicks) {
     t = niceTicks(5.0, 5.0);
     EXPECT_LT(t.lo, 5.0);
     EXPECT_GT(t.hi, 5.0);
-    t = niceTicks(NAN, 1.0);
-    EXPECT_DOUBLE_EQ(t.lo, 0.0);
-    EXPECT_DOUBLE_EQ(t.hi, 1.0);
+    for (auto [lo, hi] : {std::pair{std::nan(""), 1.0}, std::pair{1.0, -1.0},
+                          std::pair{-1e308, 1e308}, std::pair{0.0, 5e-324}}) {
+        t = niceTicks(lo, hi);
+        EXPECT_DOUBLE_EQ(t.lo, 0.0) << lo << " " << hi;
+        EXPECT_DOUBLE_EQ(t.hi, 1.0) << lo << " " << hi;
+    }
     // Every step is 1, 2 or 5 times a power of ten and the ticks cover the data.
     for (double hi : {0.017, 3.3, 77.0, 1234.5, 9.9e7}) {
         t = niceTicks(-hi / 3, hi);
