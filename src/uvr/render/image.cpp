@@ -126,6 +126,14 @@ struct PngReader {
 
 }  // namespace
 
+void compositeToRgb8(const Vec4f& pixel, const Vec3f& background, std::uint8_t out[3]) {
+    const float a = pixel.w > 0.f ? (pixel.w < 1.f ? pixel.w : 1.f) : 0.f;
+    const Vec3f c = pixel.xyz() + background * (1.f - a);
+    out[0] = toByte(c.x);
+    out[1] = toByte(c.y);
+    out[2] = toByte(c.z);
+}
+
 void writePng(const std::string& path, const Image& image, const std::optional<Vec3f>& background) {
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
@@ -148,11 +156,7 @@ void writePng(const std::string& path, const Image& image, const std::optional<V
             out[2] = toByte(p.z * inv);
             out[3] = toByte(p.w);
         } else {
-            float a = p.w > 0.f ? (p.w < 1.f ? p.w : 1.f) : 0.f;
-            Vec3f c = p.xyz() + *background * (1.f - a);
-            out[0] = toByte(c.x);
-            out[1] = toByte(c.y);
-            out[2] = toByte(c.z);
+            compositeToRgb8(p, *background, out);
         }
     }
     std::vector<png_bytep> rows(static_cast<size_t>(image.height));

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,10 @@ struct Image {
     Vec4f& at(int x, int y) { return pixels[static_cast<size_t>(y) * width + x]; }
     const Vec4f& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
 };
+
+/// Composites one premultiplied pixel over an opaque background and quantises it to 8-bit RGB
+/// (each value clamped to [0, 1], NaN to 0, rounded to nearest), exactly as writePng does.
+void compositeToRgb8(const Vec4f& pixel, const Vec3f& background, std::uint8_t out[3]);
 
 /// Writes an 8-bit PNG atomically (temporary file, then rename): RGBA with straight (un-
 /// premultiplied) colour when background is empty, else RGB composited over the background.

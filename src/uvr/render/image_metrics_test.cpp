@@ -1,1 +1,344 @@
 // SPDX-License-Identifier: MIT
+// SSIM/PSNR against scikit-image 0.19 (tests/tools/ssim_reference.py) and analytic values; toRgb8
+// against writePng; the `uvr compare` command.
+#include "uvr/render/image_metrics.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// An 8-bit RGB image whose values are fn(x, y, channel) clamped to 0..255.
+Rgb8Image makeImage(int w, int h, const std::function<double(int, int, int)>& fn) {
+    Rgb8Image img;
+    img.width = w;
+    img.height = h;
+    img.rgb.resize(static_cast<size_t>(w) * h * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double v = std::clamp(std::round(fn(x, y, c)), 0.0, 255.0);
+                img.rgb[(static_cast<size_t>(y) * w + x) * 3 + c] = static_cast<std::uint8_t>(v);
+            }
+    return img;
+}
+
+std::uint8_t value(const Rgb8Image& img, int x, int y, int c) {
+    x = std::clamp(x, 0, img.width - 1);
+    y = std::clamp(y, 0, img.height - 1);
+    return img.rgb[(static_cast<size_t>(y) * img.width + x) * 3 + c];
+}
+
+/// Writes an Rgb8Image as an opaque RGB PNG through writePng.
+void writeRgb8(const std::string& path, const Rgb8Image& img) {
+    Image out(img.width, img.height);
+    for (size_t i = 0; i < out.pixels.size(); ++i)
+        out.pixels[i] = Vec4f(img.rgb[i * 3] / 255.f, img.rgb[i * 3 + 1] / 255.f,
+                              img.rgb[i * 3 + 2] / 255.f, 1.f);
+    writePng(path, out, Vec3f(0.f, 0.f, 0.f));
+}
+
+/// A textured test image: smooth colour gradients plus a checker pattern and a disc.
+Rgb8Image texture(int w, int h) {
+    return makeImage(w, h, [&](int x, int y, int c) {
+        const double gx = static_cast<double>(x) / w, gy = static_cast<double>(y) / h;
+        const double checker = ((x / 6 + y / 6) % 2) * 40.0;
+        const double disc = std::hypot(x - w * 0.6, y - h * 0.4) < h * 0.25 ? 60.0 : 0.0;
+        return 30 + 150 * (c == 0 ? gx : c == 1 ? gy : 1 - gx * gy) + checker + disc;
+    });
+}
+
+/// Runs the skimage oracle on pairs of PNG files; one JSON object per pair.
+std::vector<nlohmann::json> skimageReference(const std::vector<std::string>& files,
+                                             const std::string& dir) {
+    const std::string out = dir + "/reference.json";
+    std::string cmd =
+        std::string(testing::systemPython()) + " " + testing::testTool("ssim_reference.py");
+    for (const std::string& f : files) cmd += " " + f;
+    EXPECT_EQ(testing::runCommand(cmd + " >" + out), 0) << cmd;
+    std::vector<nlohmann::json> results;
+    std::ifstream in(out);
+    for (std::string line; std::getline(in, line);) results.push_back(nlohmann::json::parse(line));
+    return results;
+}
+
+TEST(ImageMetrics, MatchesScikitImage) {
+    if (!testing::pythonHas("skimage") || !testing::pythonHas("PIL"))
+        GTEST_SKIP() << "system Python lacks scikit-image or Pillow";
+    const std::string dir = testing::scratchDir();
+    const int w = 97, h = 64;  // odd, non-square: catches transposed or off-by-one windows
+    const Rgb8Image base = texture(w, h);
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> noise(-25, 25), small(-2, 2), any(0, 255);
+
+    struct Pair {
+        std::string name;
+        Rgb8Image a, b;
+    };
+    std::vector<Pair> pairs;
+    pairs.push_back({"noise", base, makeImage(w, h, [&](int x, int y, int c) {
+                         return value(base, x, y, c) + noise(rng);
+                     })});
+    pairs.push_back({"blur", base, makeImage(w, h, [&](int x, int y, int c) {
+                         int sum = 0;
+                         for (int dy = -1; dy <= 1; ++dy)
+                             for (int dx = -1; dx <= 1; ++dx) sum += value(base, x + dx, y + dy, c);
+                         return sum / 9.0;
+                     })});
+    pairs.push_back({"shift", base, makeImage(w, h, [&](int x, int y, int c) {
+                         return value(base, x - 2, y + 1, c);
+                     })});
+    pairs.push_back({"brightness", base, makeImage(w, h, [&](int x, int y, int c) {
+                         return value(base, x, y, c) + 30;
+                     })});
+    pairs.push_back({"identical", base, base});
+    // A render-like image: a dark background with a soft glowing blob, and the same with
+    // low-amplitude sampling noise inside the blob.
+    const Rgb8Image render = makeImage(w, h, [&](int x, int y, int c) {
+        const double r = std::hypot(x - w * 0.45, y - h * 0.55) / (h * 0.4);
+        const double glow = std::exp(-3 * r * r);
+        return 20 + glow * (c == 0 ? 230 : c == 1 ? 160 * glow : 60 * glow * glow);
+    });
+    pairs.push_back({"render", render, makeImage(w, h, [&](int x, int y, int c) {
+                         const int v = value(render, x, y, c);
+                         return v > 25 ? v + small(rng) : v;
+                     })});
+    pairs.push_back({"unrelated", makeImage(w, h, [&](int, int, int) { return any(rng); }),
+                     makeImage(w, h, [&](int, int, int) { return any(rng); })});
+
+    // A real uvr render from the docs, against itself with sampling-like noise and shifted.
+    const std::string demo = testing::testTool("../../docs/images/demo.png");
+    if (std::filesystem::exists(demo)) {
+        const Rgb8Image r = toRgb8(readPng(demo));
+        pairs.push_back({"demo_noise", r, makeImage(r.width, r.height, [&](int x, int y, int c) {
+                             return value(r, x, y, c) + small(rng) * 2;
+                         })});
+        pairs.push_back({"demo_shift", r, makeImage(r.width, r.height, [&](int x, int y, int c) {
+                             return value(r, x + 1, y, c);
+                         })});
+    } else {
+        ADD_FAILURE() << "missing " << demo;
+    }
+
+    std::vector<std::string> files;
+    for (const Pair& p : pairs) {
+        files.push_back(dir + "/" + p.name + "_a.png");
+        files.push_back(dir + "/" + p.name + "_b.png");
+        writeRgb8(files[files.size() - 2], p.a);
+        writeRgb8(files.back(), p.b);
+    }
+    const std::vector<nlohmann::json> refs = skimageReference(files, dir);
+    ASSERT_EQ(refs.size(), pairs.size());
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        SCOPED_TRACE(pairs[i].name);
+        const nlohmann::json& ref = refs[i];
+        // Compare what uvr reads from the same files that skimage reads.
+        const ImageComparison ours =
+            compareImages(toRgb8(readPng(files[2 * i])), toRgb8(readPng(files[2 * i + 1])));
+        EXPECT_NEAR(ours.ssim, ref["ssim"].get<double>(), 1e-4);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(ours.ssimChannel[c], ref["ssim_channels"][c].get<double>(), 1e-4) << c;
+        if (ref["psnr"].is_null()) {
+            EXPECT_TRUE(std::isinf(ours.psnr));
+        } else {
+            EXPECT_NEAR(ours.psnr, ref["psnr"].get<double>(), 1e-4);
+        }
+    }
+}
+
+TEST(ImageMetrics, AnalyticValues) {
+    // Identical images: SSIM 1, PSNR infinite.
+    const Rgb8Image t = texture(40, 30);
+    const ImageComparison same = compareImages(t, t);
+    EXPECT_DOUBLE_EQ(same.ssim, 1.0);
+    EXPECT_TRUE(std::isinf(same.psnr));
+    EXPECT_EQ(same.maxAbsDifference, 0.0);
+
+    // Constant images 100 and 110: zero variances, so SSIM is the luminance term alone,
+    // (2 mu_a mu_b + C1) / (mu_a^2 + mu_b^2 + C1), and MSE is 100.
+    const Rgb8Image a = makeImage(20, 20, [](int, int, int) { return 100; });
+    const Rgb8Image b = makeImage(20, 20, [](int, int, int) { return 110; });
+    const ImageComparison r = compareImages(a, b);
+    const double c1 = (0.01 * 255) * (0.01 * 255);
+    const double expected = (2 * 100.0 * 110.0 + c1) / (100.0 * 100.0 + 110.0 * 110.0 + c1);
+    EXPECT_NEAR(r.ssim, expected, 1e-12);
+    for (double s : r.ssimChannel) EXPECT_NEAR(s, expected, 1e-12);
+    EXPECT_NEAR(r.psnr, 10 * std::log10(255.0 * 255.0 / 100.0), 1e-12);
+    EXPECT_EQ(r.maxAbsDifference, 10.0);
+
+    // Only the green channel differs: R and B SSIM stay 1.
+    const Rgb8Image g = makeImage(20, 20, [](int, int, int c) { return c == 1 ? 110 : 100; });
+    const ImageComparison rg = compareImages(a, g);
+    EXPECT_DOUBLE_EQ(rg.ssimChannel[0], 1.0);
+    EXPECT_NEAR(rg.ssimChannel[1], expected, 1e-12);
+    EXPECT_DOUBLE_EQ(rg.ssimChannel[2], 1.0);
+}
+
+TEST(ImageMetrics, BadSizesAreArgumentErrors) {
+    auto expectArgumentError = [](const Rgb8Image& a, const Rgb8Image& b, const char* text) {
+        try {
+            compareImages(a, b);
+            ADD_FAILURE() << "no error for " << text;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Argument);
+            EXPECT_THAT(e.what(), HasSubstr(text));
+        }
+    };
+    const auto flat = [](int, int, int) { return 50; };
+    expectArgumentError(makeImage(20, 20, flat), makeImage(21, 20, flat),
+                        "20x20 image with a 21x20");
+    expectArgumentError(makeImage(10, 30, flat), makeImage(10, 30, flat), "10x30");
+    expectArgumentError(makeImage(30, 10, flat), makeImage(30, 10, flat), "at least 11x11");
+    Rgb8Image broken = makeImage(20, 20, flat);
+    broken.rgb.pop_back();
+    expectArgumentError(broken, makeImage(20, 20, flat), "1199 RGB values");
+    // The smallest valid size works.
+    EXPECT_NO_THROW(compareImages(makeImage(11, 11, flat), makeImage(11, 11, flat)));
+}
+
+TEST(ImageMetrics, ToRgb8QuantisesLikeWritePng) {
+    const std::string dir = testing::scratchDir();
+    Image img(37, 23);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-0.2f, 1.3f);
+    for (Vec4f& p : img.pixels) {
+        const float a = std::clamp(u(rng), 0.f, 1.f);
+        p = Vec4f(u(rng) * a, u(rng) * a, u(rng) * a, a);  // premultiplied, some out of range
+    }
+    img.pixels[0] = Vec4f(NAN, 0.5f, 2.f, 0.5f);
+    img.pixels[1] = Vec4f(0.2f, 0.2f, 0.2f, NAN);
+    const Vec3f bg(0.1f, 0.5f, 0.9f);
+    const std::string path = dir + "/over.png";
+    writePng(path, img, bg);
+    const Rgb8Image ours = toRgb8(img, bg);
+    const Rgb8Image fromFile = toRgb8(readPng(path));
+    ASSERT_EQ(ours.width, 37);
+    ASSERT_EQ(ours.height, 23);
+    EXPECT_EQ(ours.rgb, fromFile.rgb);
+    // Fully transparent pixels become the background, quantised.
+    Image clear(1, 1);
+    const Rgb8Image c = toRgb8(clear, bg);
+    EXPECT_EQ(c.rgb, (std::vector<std::uint8_t>{26, 128, 230}));
+
+    Image bad(4, 4);
+    bad.pixels.pop_back();
+    EXPECT_THROW(toRgb8(bad), Error);
+}
+
+// ---- `uvr compare` ----
+
+struct CliRun {
+    int code = -1;
+    std::string out, err;
+};
+
+CliRun runUvr(const std::string& args, const std::string& dir) {
+    CliRun r;
+    r.code = testing::runCommand(testing::uvrBinary() + " " + args + " >" + dir + "/out.txt 2>" +
+                                 dir + "/err.txt");
+    r.out = slurp(dir + "/out.txt");
+    r.err = slurp(dir + "/err.txt");
+    return r;
+}
+
+int lineCount(const std::string& s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
+
+TEST(ImageMetrics, CompareCommandPrintsTheMetrics) {
+    const std::string dir = testing::scratchDir();
+    const Rgb8Image a = texture(64, 48);
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<int> noise(-15, 15);
+    const Rgb8Image b =
+        makeImage(64, 48, [&](int x, int y, int c) { return value(a, x, y, c) + noise(rng); });
+    const std::string fa = dir + "/a.png", fb = dir + "/b.png";
+    writeRgb8(fa, a);
+    writeRgb8(fb, b);
+    const ImageComparison expected = compareImages(a, b);
+    ASSERT_LT(expected.ssim, 0.99);
+    ASSERT_GT(expected.ssim, 0.3);
+
+    // Text output: the SSIM line, rounded to 6 decimals.
+    const CliRun text = runUvr("compare -q " + fa + " " + fb, dir);
+    ASSERT_EQ(text.code, 0) << text.err;
+    double ssim = -2, psnr = -1;
+    ASSERT_EQ(std::sscanf(text.out.c_str(), "SSIM %lf  PSNR %lf dB", &ssim, &psnr), 2) << text.out;
+    EXPECT_NEAR(ssim, expected.ssim, 5e-7);
+    EXPECT_NEAR(psnr, expected.psnr, 5e-3);
+    EXPECT_THAT(text.out, HasSubstr("SSIM per channel  R "));
+
+    // JSON output: full precision.
+    const CliRun json = runUvr("compare -q --json " + fa + " " + fb, dir);
+    ASSERT_EQ(json.code, 0) << json.err;
+    const nlohmann::json j = nlohmann::json::parse(json.out);
+    EXPECT_NEAR(j["ssim"].get<double>(), expected.ssim, 1e-12);
+    EXPECT_NEAR(j["ssim_channels"][1].get<double>(), expected.ssimChannel[1], 1e-12);
+    EXPECT_NEAR(j["psnr"].get<double>(), expected.psnr, 1e-9);
+    EXPECT_FALSE(j["identical"].get<bool>());
+
+    // Identical files: PSNR is null in JSON, "inf" in text.
+    const CliRun same = runUvr("compare -q --json " + fa + " " + fa, dir);
+    ASSERT_EQ(same.code, 0) << same.err;
+    EXPECT_TRUE(nlohmann::json::parse(same.out)["psnr"].is_null());
+    EXPECT_THAT(runUvr("compare " + fa + " " + fa, dir).out, HasSubstr("PSNR inf dB"));
+
+    // --min-ssim: 1 below the threshold, 0 at or above it.
+    const CliRun below = runUvr("compare -q --min-ssim 0.99 " + fa + " " + fb, dir);
+    EXPECT_EQ(below.code, 1) << below.out << below.err;
+    EXPECT_THAT(below.out, HasSubstr("FAIL"));
+    EXPECT_EQ(runUvr("compare -q --min-ssim 0.2 " + fa + " " + fb, dir).code, 0);
+    const CliRun jsonBelow = runUvr("compare -q --json --min-ssim 0.99 " + fa + " " + fb, dir);
+    EXPECT_EQ(jsonBelow.code, 1);
+    EXPECT_FALSE(nlohmann::json::parse(jsonBelow.out)["pass"].get<bool>());
+}
+
+TEST(ImageMetrics, CompareCommandRejectsBadInputWithCode2) {
+    const std::string dir = testing::scratchDir();
+    const std::string fa = dir + "/a.png", fsmall = dir + "/small.png", ftiny = dir + "/tiny.png";
+    writeRgb8(fa, texture(64, 48));
+    writeRgb8(fsmall, texture(48, 64));
+    writeRgb8(ftiny, texture(8, 8));
+    const std::string notPng = testing::writeFile(dir + "/text.png", "hello");
+    struct Case {
+        std::string args, needle;
+    };
+    for (const Case& c : std::vector<Case>{{fa + " " + dir + "/missing.png", "missing.png"},
+                                           {fa + " " + fsmall, "48x64 but " + fa + " is 64x48"},
+                                           {ftiny + " " + ftiny, "tiny.png: is 8x8"},
+                                           {fa + " " + notPng, "text.png"},
+                                           {fa + " " + fa + " --min-ssim nan", "--min-ssim"},
+                                           {fa + " " + fa + " --background 2,0,0", "--background"},
+                                           {fa, "B"}}) {
+        const CliRun r = runUvr("compare -q " + c.args, dir);
+        EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+        EXPECT_EQ(lineCount(r.err), 1) << c.args << "\n" << r.err;
+        EXPECT_THAT(r.err, HasSubstr(c.needle)) << c.args;
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+}
+
+}  // namespace
+}  // namespace uvr
