@@ -41,7 +41,7 @@ TEST(Cli, HelpListsEverySubcommand) {
     const std::string dir = testing::scratchDir();
     const CliRun r = uvr("--help", dir);
     EXPECT_EQ(r.code, 0);
-    for (const char* cmd : {"info", "render", "demo", "convert", "generate"})
+    for (const char* cmd : {"info", "render", "demo", "convert", "generate", "compare", "bench"})
         EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
     const CliRun rh = uvr("render --help", dir);
     EXPECT_EQ(rh.code, 0);

@@ -101,12 +101,7 @@ void addCompareCommand(CLI::App& app, Log& log) {
                             pass ? ">=" : "<", **minSsim);
             }
         }
-        if (!pass) {
-            // main() maps only errors to exit codes, so a completed comparison that misses the
-            // threshold ends here, after flushing what was printed.
-            std::fflush(stdout);
-            std::exit(kBelowThreshold);
-        }
+        if (!pass) throw CLI::RuntimeError(kBelowThreshold);  // main() returns the code
     });
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The uvr command-line tool: info, render, demo, convert, generate.
+// The uvr command-line tool: info, render, demo, convert, generate, compare, bench.
 #include <cstdio>
 #include <new>
 
@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
+    } catch (const CLI::RuntimeError& e) {
+        return e.get_exit_code();  // a completed command's own exit status (compare --min-ssim)
     } catch (const CLI::ParseError& e) {
         std::fprintf(stderr, "uvr: error: %s (see uvr --help)\n", e.what());
         return 2;
