@@ -51,8 +51,43 @@ void BM_RenderReference(benchmark::State& state) {
         benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
 }
 
+void BM_KdBuild(benchmark::State& state) {
+    const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
+    uvr::PrepareOptions options;
+    options.partitions = false;
+    const uvr::PreparedMesh prepared =
+        uvr::prepareMesh(mesh, uvr::selectScalarField(mesh, {}), options);
+    std::size_t partitions = 0;
+    for (auto _ : state) partitions = uvr::buildKdPartitions(prepared.tets).partitions.size();
+    state.counters["partitions"] = static_cast<double>(partitions);
+    state.counters["tets/s"] = benchmark::Counter(static_cast<double>(mesh.cellCount()),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+/// Transfer-function update (Morrical et al. 2019, Sec. 2.1): range tables of the baked table,
+/// then maximum opacity, variance and step of every partition; one thread.
+void BM_TfUpdate(benchmark::State& state) {
+    const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
+    uvr::PrepareOptions options;
+    options.kd.leafCells = static_cast<std::uint32_t>(state.range(1));
+    const uvr::PreparedMesh prepared =
+        uvr::prepareMesh(mesh, uvr::selectScalarField(mesh, {}), options);
+    uvr::TransferFunction tf = uvr::transferFunctionPreset("cool-to-warm");
+    const std::vector<uvr::Vec4f> baked = tf.bake(1024);
+    const uvr::TfTableView table{baked.data(), 1024, prepared.tets.valueMin,
+                                 prepared.tets.valueMax};
+    for (auto _ : state) {
+        const uvr::TfRangeTables ranges(table);
+        benchmark::DoNotOptimize(
+            uvr::computePartitionShading(*prepared.kd, ranges.view(table), 0.01f, 0.16f, 2.f, true));
+    }
+    state.counters["partitions"] = static_cast<double>(prepared.kd->partitions.size());
+}
+
 }  // namespace
 
+BENCHMARK(BM_KdBuild)->Arg(1000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TfUpdate)->Args({1000, 64})->Args({1000000, 200})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Generate)->Arg(1000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Prepare)->Arg(1000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RenderReference)

@@ -167,5 +167,54 @@ TEST(Cli, GenerateAndDemo) {
     EXPECT_EQ(readPng(dir + "/demo.png").width, 32);
 }
 
+TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const CliRun r = uvr("-q render " + testing::sharedData("bluntfin_tets.vtk") + " -o " + dir +
+                             "/a.png --size 64x48 --method adaptive --opacity step:0.5 "
+                             "--leaf-cells 512 --heatmap " + dir + "/h.png --stats " + dir +
+                             "/s.json",
+                         dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream in(dir + "/s.json");
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["method"], "adaptive");
+    EXPECT_GT(j["partitions"]["count"].get<int>(), 100);
+    EXPECT_GE(j["partitions"]["duplication_factor"].get<double>(), 1.0);
+    EXPECT_LE(j["partitions"]["cells_median"].get<int>(), 512);
+    EXPECT_GT(j["partitions_skipped"].get<double>(), 0);  // the step TF hides half the range
+    EXPECT_GE(j["tf_update_seconds"].get<double>(), 0);
+    const Image h = readPng(dir + "/h.png");
+    EXPECT_EQ(h.height, 48);
+    EXPECT_GT(h.width, 64);  // the colour bar and its scale
+    // Method-only flags without --method adaptive are refused.
+    EXPECT_EQ(uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
+                      "/b.png --no-skip",
+                  dir)
+                  .code,
+              2);
+}
+
+TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const CliRun r = uvr("-q bench " + testing::sharedData("spx.vtk") +
+                             " --size 48x48 --repeat 1 --sweep 2,4 --csv " + dir + "/b.csv --json " +
+                             dir + "/b.json --plot " + dir + "/p.png --images " + dir,
+                         dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char* row : {"reference", "skipping only", "adaptive only", "skipping + adaptive",
+                            "both, s2 = 2 s1", "both, s2 = 4 s1"})
+        EXPECT_NE(r.out.find(row), std::string::npos) << row;
+    std::ifstream in(dir + "/b.json");
+    const auto j = nlohmann::json::parse(in);
+    ASSERT_EQ(j["rows"].size(), 6u);
+    EXPECT_EQ(j["rows"][0]["ssim"].get<double>(), 1.0);  // the reference against itself
+    EXPECT_GE(j["rows"][1]["ssim"].get<double>(), 0.995);  // skipping only: same samples
+    EXPECT_EQ(readPng(dir + "/p.png").width, 800);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/reference_samples.png"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/b.csv"));
+}
+
 }  // namespace
 }  // namespace uvr

@@ -94,7 +94,7 @@ UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, 
 
 /// Build parameters.
 struct KdBuildOptions {
-    std::uint32_t leafCells = 4096;  ///< split nodes holding more cells than this
+    std::uint32_t leafCells = 1024;  ///< split nodes holding more cells (PERFORMANCE.md)
     int maxDepth = kKdMaxDepth;      ///< never deeper than this (at most kKdMaxDepth)
 };
 

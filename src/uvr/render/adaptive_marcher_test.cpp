@@ -6,7 +6,10 @@
 #include <cmath>
 
 #include "test_meshes.h"
+#include "test_support.h"
 #include "uvr/cpu/cpu_renderer.h"
+#include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/render/image_metrics.h"
 
 namespace uvr {
 namespace {
@@ -95,6 +98,36 @@ TEST(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
     for (const PartitionShading& sh : a.setup.shading) {
         EXPECT_GE(sh.step, r.setup.params.step * 0.999f);
         EXPECT_LE(sh.step, s.maxStep * 1.001f);
+    }
+}
+
+// The correctness bar of the method: with s1 == s2 the partition integrator reproduces the
+// reference (any loss comes from the adaptive step only), on every real mesh.
+TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    for (const char* name : {"spx.vtk", "post.vtk", "tetraMesh.vtk", "bluntfin_tets.vtk",
+                             "post_tets.vtk", "cylinder_quadratic_as_tets.vtk", "hexa.vtk",
+                             "fire_ug.vtu"}) {
+        const Mesh mesh = readMesh(testing::sharedData(name));
+        const ScalarField field = selectScalarField(mesh, parseFieldSpec(
+            std::string(name) == "cylinder_quadratic_as_tets.vtk" ? "pressure:point" : ""));
+        const PreparedMesh pm = prepareMesh(mesh, field);
+        RenderSettings s;
+        s.width = s.height = 96;
+        s.tf = transferFunctionPreset("viridis");
+        applyOpacitySpec(s.tf, "0:0,1:0.5");
+        s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), 30.f, 20.f);
+        const RenderResult ref = renderCpu(pm, s);
+        s.method = RenderMethod::Partitions;
+        for (bool adaptive : {false, true}) {
+            s.adaptive = adaptive;
+            s.maxStep = ref.setup.params.step;  // s2 == s1
+            const RenderResult p = renderCpu(pm, s);
+            const double ssim = compareImages(toRgb8(ref.image), toRgb8(p.image)).ssim;
+            EXPECT_GE(ssim, 0.995) << name << (adaptive ? " adaptive" : " skipping only");
+            EXPECT_LT(maxDifference(ref.image, p.image), 2e-3f) << name;
+            EXPECT_LE(p.stats.samples, ref.stats.samples) << name;
+        }
     }
 }
 

@@ -86,7 +86,7 @@ struct RenderSettings {
 void validateSettings(const RenderSettings& settings);
 
 /// Default s2 / s1 of the adaptive step.
-inline constexpr float kDefaultMaxStepFactor = 8.f;
+inline constexpr float kDefaultMaxStepFactor = 16.f;
 
 /// Per-partition shading for a transfer function (Morrical et al. 2019, Sec. 2.1): each
 /// partition's maximum opacity and colour variance over its value range (O(1) per partition from
