@@ -1,0 +1,25 @@
+#!/bin/sh
+# SPDX-License-Identifier: MIT
+# The paper's evaluation (Morrical et al. 2019, Figs. 4-6) on the real meshes: for Blunt Fin and
+# the Oxygen Post, a semi-transparent and a "binary" transfer function, run `uvr bench` at
+# 1024x1024 and keep its table (CSV, JSON), plot and images under OUT (default: eval/).
+# Usage: bench/paper_eval.sh [BUILD_DIR] [OUT] [DATA_DIR]
+set -eu
+build=${1:-build/release}
+out=${2:-eval}
+data=${3:-../shared/data}
+mkdir -p "$out"
+semi="0:0,1:0.1"      # opacity rising linearly to 0.1 per unit distance: see-through
+binary="step:0.5:0.5" # transparent below the middle of the range, 0.5 above
+for mesh in bluntfin_tets post_tets; do
+  for tf in semi binary; do
+    eval spec=\$$tf
+    name="$mesh-$tf"
+    mkdir -p "$out/$name"
+    echo "== $name (opacity $spec)"
+    "$build/uvr" -q bench "$data/$mesh.vtk" --size 1024x1024 --opacity "$spec" \
+      --azimuth -30 --elevation 25 --background 1,1,1 --repeat 5 --sweep 2,4,8,16,32,64 \
+      --csv "$out/$name.csv" --json "$out/$name.json" --plot "$out/$name.png" \
+      --images "$out/$name" | tee "$out/$name.txt"
+  done
+done
