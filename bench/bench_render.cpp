@@ -78,8 +78,8 @@ void BM_TfUpdate(benchmark::State& state) {
                                  prepared.tets.valueMax};
     for (auto _ : state) {
         const uvr::TfRangeTables ranges(table);
-        benchmark::DoNotOptimize(
-            uvr::computePartitionShading(*prepared.kd, ranges.view(table), 0.01f, 0.16f, 2.f, true));
+        benchmark::DoNotOptimize(uvr::computePartitionShading(*prepared.kd, ranges.view(table),
+                                                              0.01f, 0.16f, 2.f, true));
     }
     state.counters["partitions"] = static_cast<double>(prepared.kd->partitions.size());
 }

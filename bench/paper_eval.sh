@@ -9,9 +9,15 @@ build=${1:-build/release}
 out=${2:-eval}
 data=${3:-../shared/data}
 mkdir -p "$out"
-semi="0:0,1:0.1"      # opacity rising linearly to 0.1 per unit distance: see-through
-binary="step:0.5:0.5" # transparent below the middle of the range, 0.5 above
+# semi-transparent: opacity rising linearly to 0.1 per unit distance (see-through);
+# binary: transparent below a threshold, 0.5 above it (the middle of Blunt Fin's density range;
+# the top 15% of the Oxygen Post's, whose high speeds fill most of its volume).
+semi="0:0,1:0.1"
 for mesh in bluntfin_tets post_tets; do
+  case $mesh in
+    bluntfin_tets) binary="step:0.5:0.5" ;;
+    *) binary="step:0.85:0.5" ;;
+  esac
   for tf in semi binary; do
     eval spec=\$$tf
     name="$mesh-$tf"

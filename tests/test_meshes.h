@@ -9,9 +9,9 @@ namespace uvr::testing {
 
 /// An n x n x n grid of hexahedra over the box [lo, hi]^3 with a point field f(x, y, z) named
 /// "f"; optional point jitter (fraction of the spacing, deterministic).
-inline Mesh makeHexGrid(int n, float lo, float hi,
-                        const std::function<float(Vec3f)>& f = [](Vec3f) { return 1.f; },
-                        float jitter = 0.f) {
+inline Mesh makeHexGrid(
+    int n, float lo, float hi, const std::function<float(Vec3f)>& f = [](Vec3f) { return 1.f; },
+    float jitter = 0.f) {
     Mesh mesh;
     const int np = n + 1;
     const float h = (hi - lo) / n;
@@ -31,14 +31,20 @@ inline Mesh makeHexGrid(int n, float lo, float hi,
                 mesh.points.push_back(p);
                 field.values.push_back(f(p));
             }
-    auto id = [&](int i, int j, int k) { return static_cast<std::uint32_t>((k * np + j) * np + i); };
+    auto id = [&](int i, int j, int k) {
+        return static_cast<std::uint32_t>((k * np + j) * np + i);
+    };
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
-                const std::uint32_t c[8] = {id(i, j, k),         id(i + 1, j, k),
-                                            id(i + 1, j + 1, k), id(i, j + 1, k),
-                                            id(i, j, k + 1),     id(i + 1, j, k + 1),
-                                            id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
+                const std::uint32_t c[8] = {id(i, j, k),
+                                            id(i + 1, j, k),
+                                            id(i + 1, j + 1, k),
+                                            id(i, j + 1, k),
+                                            id(i, j, k + 1),
+                                            id(i + 1, j, k + 1),
+                                            id(i + 1, j + 1, k + 1),
+                                            id(i, j + 1, k + 1)};
                 mesh.addCell(CellType::Hexahedron, c);
             }
     mesh.fields.push_back(std::move(field));

@@ -136,11 +136,12 @@ void addBenchCommand(CLI::App& app, Log& log) {
         // Table.
         const int threads = omp_get_max_threads();
         const double refTime = variants.front().medianSeconds;
-        std::printf("%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
-                    "p = %g, %d thread(s), median of %d frames\n",
-                    file->c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
-                    prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width,
-                    base.height, s1, base.power, threads, *repeat);
+        std::printf(
+            "%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
+            "p = %g, %d thread(s), median of %d frames\n",
+            file->c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
+            prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
+            base.power, threads, *repeat);
         std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
                     "samples", "spp", "Msps/core", "speed-up", "SSIM");
         for (const Variant& v : variants) {
@@ -162,9 +163,8 @@ void addBenchCommand(CLI::App& app, Log& log) {
                        "speedup,ssim,psnr\n";
                 for (const Variant& v : variants)
                     out << '"' << v.name << "\"," << v.s2Factor << ',' << v.medianSeconds << ','
-                        << v.samples << ',' << v.samples / (double(base.width) * base.height)
-                        << ',' << refTime / v.medianSeconds << ',' << v.ssim << ',' << v.psnr
-                        << '\n';
+                        << v.samples << ',' << v.samples / (double(base.width) * base.height) << ','
+                        << refTime / v.medianSeconds << ',' << v.ssim << ',' << v.psnr << '\n';
                 if (!out) throwError(ErrorKind::Io, *csv, "cannot write");
             });
         if (!json->empty())

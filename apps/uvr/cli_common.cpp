@@ -15,7 +15,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-[[noreturn]] void badFlag(const std::string& flag, const std::string& text, const std::string& what) {
+[[noreturn]] void badFlag(const std::string& flag, const std::string& text,
+                          const std::string& what) {
     throwError(ErrorKind::Argument, "", flag + " '" + text + "': expected " + what);
 }
 
@@ -35,7 +36,9 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
     while (true) {
         size_t comma = text.find(',', pos);
         float v;
-        if (!parseFloat(std::string_view(text).substr(pos, comma == std::string::npos ? std::string::npos : comma - pos), v))
+        if (!parseFloat(std::string_view(text).substr(
+                            pos, comma == std::string::npos ? std::string::npos : comma - pos),
+                        v))
             badFlag(flag, text, what);
         out.push_back(v);
         if (comma == std::string::npos) break;
@@ -95,8 +98,9 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Opacity: ramp, ramp:A, constant:A, step:T[:A] (binary) or x0:a0,x1:a1,... "
                    "over the normalised range (default: the JSON's Points, else ramp)")
         ->capture_default_str();
-    app.add_option("--range", range, "Value range lo,hi the transfer function spans "
-                                     "(default: the field's range)");
+    app.add_option("--range", range,
+                   "Value range lo,hi the transfer function spans "
+                   "(default: the field's range)");
     app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
     app.add_option("--camera", cameraFile, "ParaView camera file (.pvcc)");
     app.add_option("--camera-position", cameraPosition, "Camera position x,y,z");
@@ -171,14 +175,17 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
     Camera cam = resetCamera(bounds, float(s.width) / float(s.height));
     bool custom = false;
     if (!cameraFile.empty()) cam = loadPvcc(cameraFile), custom = true;
-    if (!cameraPosition.empty()) cam.position = parseVec3("--camera-position", cameraPosition), custom = true;
-    if (!cameraFocal.empty()) cam.focalPoint = parseVec3("--camera-focal", cameraFocal), custom = true;
+    if (!cameraPosition.empty())
+        cam.position = parseVec3("--camera-position", cameraPosition), custom = true;
+    if (!cameraFocal.empty())
+        cam.focalPoint = parseVec3("--camera-focal", cameraFocal), custom = true;
     if (!cameraUp.empty()) cam.viewUp = parseVec3("--camera-up", cameraUp), custom = true;
     if (viewAngle) cam.viewAngle = *viewAngle, custom = true;
     if (!std::isfinite(azimuth) || !std::isfinite(elevation))
         throwError(ErrorKind::Argument, "", "--azimuth/--elevation must be finite");
     validateCamera(cam);
-    if (azimuth != 0.f || elevation != 0.f) cam = orbitCamera(cam, azimuth, elevation), custom = true;
+    if (azimuth != 0.f || elevation != 0.f)
+        cam = orbitCamera(cam, azimuth, elevation), custom = true;
     if (custom) s.camera = cam;
     return s;
 }

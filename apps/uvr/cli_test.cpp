@@ -35,7 +35,9 @@ CliRun uvr(const std::string& args, const std::string& dir) {
     return r;
 }
 
-int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+int lineCount(const std::string& s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
 
 TEST(Cli, HelpListsEverySubcommand) {
     const std::string dir = testing::scratchDir();
@@ -55,16 +57,16 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
     const std::string out = dir + "/o.png";
     for (const std::string& args : std::vector<std::string>{
              "render " + spx + " -o " + out + " --size 0x10",
-          "render " + spx + " -o " + out + " --size 100000x100000",
-          "render " + spx + " -o " + out + " --step -1",
-          "render " + spx + " -o " + out + " --step nan",
-          "render " + spx + " -o " + out + " --range 5,1",
-          "render " + spx + " -o " + out + " --camera-position nan,0,0",
-          "render " + spx + " -o " + out + " --field nosuch",
-          "render " + spx + " -o " + out + " --tf nosuch",
-          "render " + spx + " -o " + out + " --opacity zigzag",
-          "render " + spx + " -o " + dir + "/missing/o.png",
-          "render " + spx + " --bogus -o " + out, "render " + spx, "frobnicate"}) {
+             "render " + spx + " -o " + out + " --size 100000x100000",
+             "render " + spx + " -o " + out + " --step -1",
+             "render " + spx + " -o " + out + " --step nan",
+             "render " + spx + " -o " + out + " --range 5,1",
+             "render " + spx + " -o " + out + " --camera-position nan,0,0",
+             "render " + spx + " -o " + out + " --field nosuch",
+             "render " + spx + " -o " + out + " --tf nosuch",
+             "render " + spx + " -o " + out + " --opacity zigzag",
+             "render " + spx + " -o " + dir + "/missing/o.png",
+             "render " + spx + " --bogus -o " + out, "render " + spx, "frobnicate"}) {
         const CliRun r = uvr("-q " + args, dir);
         EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
         EXPECT_EQ(lineCount(r.err), 1) << args << "\n" << r.err;
@@ -125,8 +127,8 @@ TEST(Cli, RenderWritesPngAndStats) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const std::string dir = testing::scratchDir();
     const CliRun r = uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
-                          "/spx.png --size 64x48 --stats " + dir + "/s.json --tf viridis",
-                      dir);
+                             "/spx.png --size 64x48 --stats " + dir + "/s.json --tf viridis",
+                         dir);
     ASSERT_EQ(r.code, 0) << r.err;
     const Image img = readPng(dir + "/spx.png");
     EXPECT_EQ(img.width, 64);
@@ -172,8 +174,8 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
     const std::string dir = testing::scratchDir();
     const CliRun r = uvr("-q render " + testing::sharedData("bluntfin_tets.vtk") + " -o " + dir +
                              "/a.png --size 64x48 --method adaptive --opacity step:0.5 "
-                             "--leaf-cells 512 --heatmap " + dir + "/h.png --stats " + dir +
-                             "/s.json",
+                             "--leaf-cells 512 --heatmap " +
+                             dir + "/h.png --stats " + dir + "/s.json",
                          dir);
     ASSERT_EQ(r.code, 0) << r.err;
     std::ifstream in(dir + "/s.json");
@@ -188,20 +190,20 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
     EXPECT_EQ(h.height, 48);
     EXPECT_GT(h.width, 64);  // the colour bar and its scale
     // Method-only flags without --method adaptive are refused.
-    EXPECT_EQ(uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
-                      "/b.png --no-skip",
-                  dir)
-                  .code,
-              2);
+    EXPECT_EQ(
+        uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir + "/b.png --no-skip", dir)
+            .code,
+        2);
 }
 
 TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const std::string dir = testing::scratchDir();
-    const CliRun r = uvr("-q bench " + testing::sharedData("spx.vtk") +
-                             " --size 48x48 --repeat 1 --sweep 2,4 --csv " + dir + "/b.csv --json " +
-                             dir + "/b.json --plot " + dir + "/p.png --images " + dir,
-                         dir);
+    const CliRun r =
+        uvr("-q bench " + testing::sharedData("spx.vtk") +
+                " --size 48x48 --repeat 1 --sweep 2,4 --csv " + dir + "/b.csv --json " + dir +
+                "/b.json --plot " + dir + "/p.png --images " + dir,
+            dir);
     ASSERT_EQ(r.code, 0) << r.err;
     for (const char* row : {"reference", "skipping only", "adaptive only", "skipping + adaptive",
                             "both, s2 = 2 s1", "both, s2 = 4 s1"})
@@ -209,7 +211,7 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     std::ifstream in(dir + "/b.json");
     const auto j = nlohmann::json::parse(in);
     ASSERT_EQ(j["rows"].size(), 6u);
-    EXPECT_EQ(j["rows"][0]["ssim"].get<double>(), 1.0);  // the reference against itself
+    EXPECT_EQ(j["rows"][0]["ssim"].get<double>(), 1.0);    // the reference against itself
     EXPECT_GE(j["rows"][1]["ssim"].get<double>(), 0.995);  // skipping only: same samples
     EXPECT_EQ(readPng(dir + "/p.png").width, 800);
     EXPECT_TRUE(std::filesystem::exists(dir + "/reference_samples.png"));

@@ -36,12 +36,10 @@ void addInfoCommand(CLI::App& app, Log& log) {
         j["points"] = mesh.pointCount();
         j["cells"] = mesh.cellCount();
         j["cell_types"] = byType;
-        if (!b.empty())
-            j["bounds"] = {{b.lo.x, b.hi.x}, {b.lo.y, b.hi.y}, {b.lo.z, b.hi.z}};
+        if (!b.empty()) j["bounds"] = {{b.lo.x, b.hi.x}, {b.lo.y, b.hi.y}, {b.lo.z, b.hi.z}};
         j["fields"] = nlohmann::json::array();
         for (const Field& f : mesh.fields) {
-            const ScalarField s = selectScalarField(
-                mesh, FieldSpec{f.name, f.association, -1});
+            const ScalarField s = selectScalarField(mesh, FieldSpec{f.name, f.association, -1});
             const auto [lo, hi] = finiteRange(s.values);
             j["fields"].push_back({{"name", f.name},
                                    {"association", associationName(f.association)},
@@ -98,8 +96,9 @@ void addRenderCommand(CLI::App& app, Log& log) {
 
 void addDemoCommand(CLI::App& app, Log& log) {
     auto* cmd = app.add_subcommand(
-        "demo", "Generate the built-in procedural data set (a turbulent jet in a jittered "
-                "tetrahedral box) and render it to a PNG");
+        "demo",
+        "Generate the built-in procedural data set (a turbulent jet in a jittered "
+        "tetrahedral box) and render it to a PNG");
     auto flags = std::make_shared<RenderFlags>();
     auto cells = std::make_shared<std::uint64_t>(400000);
     flags->output = "uvr-demo.png";
@@ -153,7 +152,8 @@ void addGenerateCommand(CLI::App& app, Log& log) {
     cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
-    cmd->add_option("--seed", spec->seed, "Random seed (same seed, same mesh)")->capture_default_str();
+    cmd->add_option("--seed", spec->seed, "Random seed (same seed, same mesh)")
+        ->capture_default_str();
     cmd->add_option("--jitter", spec->jitter, "Interior point jitter, fraction of the spacing")
         ->capture_default_str()
         ->check(CLI::Range(0.f, kMaxProceduralJitter));

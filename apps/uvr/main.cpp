@@ -7,9 +7,10 @@
 
 int main(int argc, char** argv) {
     using namespace uvr;
-    CLI::App app{"uvr: GPU-ready renderer for unstructured volume meshes (VTK .vtk/.vtu/.pvtu, "
-                 "native .uvrm)",
-                 "uvr"};
+    CLI::App app{
+        "uvr: GPU-ready renderer for unstructured volume meshes (VTK .vtk/.vtu/.pvtu, "
+        "native .uvrm)",
+        "uvr"};
     app.require_subcommand(1);
     app.fallthrough();  // -q works after the subcommand too
     app.set_version_flag("--version", "uvr 0.1.0");

@@ -89,8 +89,8 @@ Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
                     acc.extend(binBox[b]);
                     accCount += binCount[b];
                     if (accCount == 0 || rightCount[b + 1] == 0) continue;
-                    const float cost = halfArea(acc) * accCount +
-                                       halfArea(rightBox[b + 1]) * rightCount[b + 1];
+                    const float cost =
+                        halfArea(acc) * accCount + halfArea(rightBox[b + 1]) * rightCount[b + 1];
                     if (cost < bestCost) {
                         bestCost = cost;
                         bestAxis = axis;

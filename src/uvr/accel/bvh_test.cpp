@@ -15,7 +15,8 @@ namespace {
 
 /// A jittered 6^3 hex grid over [-1, 1]^3 split into tetrahedra, with f = x + 2y - z.
 PreparedMesh jitteredGrid() {
-    Mesh m = testing::makeHexGrid(6, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.3f);
+    Mesh m = testing::makeHexGrid(
+        6, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.3f);
     return prepareMesh(m, selectScalarField(m, {}));
 }
 
@@ -43,7 +44,8 @@ TEST(Bvh, EveryPrimitiveInExactlyOneLeafAndBoxesNest) {
             for (std::uint32_t i = 0; i < node.count; ++i) {
                 const std::uint32_t t = bvh.primIds[node.first + i];
                 ++seen[t];
-                for (std::uint32_t v : pm.tets.tets[t].v) ASSERT_TRUE(node.box.contains(pm.tets.points[v]));
+                for (std::uint32_t v : pm.tets.tets[t].v)
+                    ASSERT_TRUE(node.box.contains(pm.tets.points[v]));
             }
         } else {
             for (std::uint32_t c : {node.first, node.first + 1}) {

@@ -132,8 +132,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
             kd.bvhNodes.push_back(node);
         }
         for (std::uint32_t local : bvh.primIds) kd.cells.push_back(task.cells[local]);
-        kd.nodes[task.node].bits =
-            (static_cast<std::uint32_t>(kd.partitions.size()) << 2) | 3u;
+        kd.nodes[task.node].bits = (static_cast<std::uint32_t>(kd.partitions.size()) << 2) | 3u;
         kd.partitions.push_back(part);
     }
     UVR_CHECK(kd.cells.size() < 0xffffffffull, "partition cell lists exceed 32-bit indices");

@@ -26,12 +26,12 @@ struct KdNode {
 /// One partition (Morrical et al. 2019, Sec. 2.1-2.2): a k-d leaf's cells, the leaf region shrunk
 /// to the bounds of those cells, and their whole-cell scalar range.
 struct KdPartition {
-    Bounds3f box;                ///< shrunk: leaf region intersected with the cells' bounds
-    float valueMin = 0.f;        ///< finite scalar range over the cells (whole cells)
+    Bounds3f box;          ///< shrunk: leaf region intersected with the cells' bounds
+    float valueMin = 0.f;  ///< finite scalar range over the cells (whole cells)
     float valueMax = 0.f;
-    std::uint32_t firstCell = 0; ///< into KdPartitions::cells
+    std::uint32_t firstCell = 0;  ///< into KdPartitions::cells
     std::uint32_t cellCount = 0;
-    std::uint32_t bvhRoot = 0;   ///< root of this partition's BVH in KdPartitions::bvhNodes
+    std::uint32_t bvhRoot = 0;  ///< root of this partition's BVH in KdPartitions::bvhNodes
 };
 
 /// Plain-data view of the partitions for CPU and GPU kernels.
@@ -39,8 +39,8 @@ struct KdView {
     const KdNode* nodes = nullptr;
     const KdPartition* partitions = nullptr;
     std::uint32_t partitionCount = 0;
-    Bounds3f bounds;                      ///< region of the root node
-    BvhView bvh;                          ///< all partitions' BVHs; primIds are tetrahedron ids
+    Bounds3f bounds;  ///< region of the root node
+    BvhView bvh;      ///< all partitions' BVHs; primIds are tetrahedron ids
 };
 
 /// Deepest k-d tree the builder makes (and the traversal stack holds).
@@ -111,8 +111,11 @@ struct KdPartitions {
 
     /// View for kernels; this object must outlive it.
     KdView view() const {
-        return {nodes.data(), partitions.data(), static_cast<std::uint32_t>(partitions.size()),
-                bounds, {bvhNodes.data(), cells.data(), static_cast<std::uint32_t>(bvhNodes.size())}};
+        return {nodes.data(),
+                partitions.data(),
+                static_cast<std::uint32_t>(partitions.size()),
+                bounds,
+                {bvhNodes.data(), cells.data(), static_cast<std::uint32_t>(bvhNodes.size())}};
     }
     /// Sum of cells over partitions divided by the mesh's cell count (>= 1).
     double duplicationFactor(std::uint64_t tetCount) const {

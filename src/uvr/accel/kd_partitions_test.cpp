@@ -13,7 +13,8 @@ namespace uvr {
 namespace {
 
 PreparedMesh grid(std::uint32_t leafCells) {
-    Mesh m = testing::makeHexGrid(8, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+    Mesh m = testing::makeHexGrid(
+        8, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
     PrepareOptions o;
     o.kd.leafCells = leafCells;
     return prepareMesh(m, selectScalarField(m, {}), o);
@@ -39,7 +40,6 @@ TEST(KdPartitions, EveryCellInAPartitionWithItsValuesInRange) {
     ASSERT_GT(kd.partitions.size(), 20u);
     std::vector<int> seen(pm.tets.tets.size(), 0);
     for (const KdPartition& p : kd.partitions) {
-
         for (std::uint32_t i = 0; i < p.cellCount; ++i) {
             const std::uint32_t t = kd.cells[p.firstCell + i];
             ++seen[t];
@@ -71,8 +71,7 @@ TEST(KdPartitions, APointsCellIsInThePartitionWhoseRegionHoldsIt) {
         const KdPartition& part = kd.partitions[leafOf(kd, p)];
         ASSERT_TRUE(part.box.contains(p));
         // Located with the partition's own BVH only.
-        const std::uint32_t t2 =
-            loc.locateIn(kd.view().bvh, part.bvhRoot, p, kNoTet, bary, c);
+        const std::uint32_t t2 = loc.locateIn(kd.view().bvh, part.bvhRoot, p, kNoTet, bary, c);
         ASSERT_NE(t2, kNoTet);
         ASSERT_TRUE(loc.inside(t2, p, bary));
     }

@@ -17,8 +17,8 @@ inline constexpr int kMaxWalkSteps = 8;
 
 /// Counters of point-location work for statistics.
 struct LocateCounters {
-    std::uint64_t walkSteps = 0;    ///< tetrahedra tested while walking
-    std::uint64_t bvhQueries = 0;   ///< searches that fell back to the BVH
+    std::uint64_t walkSteps = 0;   ///< tetrahedra tested while walking
+    std::uint64_t bvhQueries = 0;  ///< searches that fell back to the BVH
 };
 
 /// Point location in a tetrahedral mesh: first the hint (the previous sample's tetrahedron),
@@ -31,8 +31,8 @@ struct TetLocator {
     /// True when p lies in tetrahedron t (within kBaryEpsilon); fills bary.
     UVR_HOST_DEVICE bool inside(std::uint32_t t, Vec3f p, float bary[4]) const {
         const Tet& tet = mesh.tets[t];
-        if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
-                             mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
+        if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]], mesh.points[tet.v[2]],
+                             mesh.points[tet.v[3]], bary))
             return false;
         return bary[0] >= -kBaryEpsilon && bary[1] >= -kBaryEpsilon && bary[2] >= -kBaryEpsilon &&
                bary[3] >= -kBaryEpsilon;

@@ -74,9 +74,13 @@ UVR_HOST_DEVICE inline Vec3f normalize(Vec3f a) {
     return a * (1.f / length(a));
 }
 /// Minimum as one instruction (b when either is NaN); fminf is a libm call on the host.
-UVR_HOST_DEVICE inline float minf(float a, float b) { return a < b ? a : b; }
+UVR_HOST_DEVICE inline float minf(float a, float b) {
+    return a < b ? a : b;
+}
 /// Maximum as one instruction (b when either is NaN).
-UVR_HOST_DEVICE inline float maxf(float a, float b) { return a > b ? a : b; }
+UVR_HOST_DEVICE inline float maxf(float a, float b) {
+    return a > b ? a : b;
+}
 /// Component-wise minimum.
 UVR_HOST_DEVICE inline Vec3f vmin(Vec3f a, Vec3f b) {
     return {minf(a.x, b.x), minf(a.y, b.y), minf(a.z, b.z)};
@@ -86,7 +90,9 @@ UVR_HOST_DEVICE inline Vec3f vmax(Vec3f a, Vec3f b) {
     return {maxf(a.x, b.x), maxf(a.y, b.y), maxf(a.z, b.z)};
 }
 /// Largest component.
-UVR_HOST_DEVICE inline float maxComponent(Vec3f a) { return maxf(a.x, maxf(a.y, a.z)); }
+UVR_HOST_DEVICE inline float maxComponent(Vec3f a) {
+    return maxf(a.x, maxf(a.y, a.z));
+}
 /// True when every component is finite.
 UVR_HOST_DEVICE inline bool isFinite(Vec3f a) {
 #if defined(__CUDA_ARCH__)

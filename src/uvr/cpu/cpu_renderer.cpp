@@ -12,8 +12,12 @@
 namespace uvr {
 
 namespace cpu {
-int threadCount() { return omp_get_max_threads(); }
-int currentThread() { return omp_get_thread_num(); }
+int threadCount() {
+    return omp_get_max_threads();
+}
+int currentThread() {
+    return omp_get_thread_num();
+}
 }  // namespace cpu
 
 namespace {
@@ -49,14 +53,12 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     const auto start = std::chrono::steady_clock::now();
     if (settings.method == RenderMethod::Reference) {
         const SceneView scene = result.setup.scene(mesh);
-        launchFrame(frame, result.stats, [&](const Ray& ray, RayCounters& c) {
-            return marchReference(scene, ray, c);
-        });
+        launchFrame(frame, result.stats,
+                    [&](const Ray& ray, RayCounters& c) { return marchReference(scene, ray, c); });
     } else {
         const PartitionSceneView scene = result.setup.partitionScene(mesh, settings.skip);
-        launchFrame(frame, result.stats, [&](const Ray& ray, RayCounters& c) {
-            return marchPartitions(scene, ray, c);
-        });
+        launchFrame(frame, result.stats,
+                    [&](const Ray& ray, RayCounters& c) { return marchPartitions(scene, ray, c); });
     }
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

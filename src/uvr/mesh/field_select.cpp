@@ -27,8 +27,8 @@ FieldSpec parseFieldSpec(const std::string& text) {
     spec.name = text.substr(0, pos);
     while (pos != std::string::npos) {
         size_t next = text.find(':', pos + 1);
-        std::string part = text.substr(pos + 1, next == std::string::npos ? std::string::npos
-                                                                           : next - pos - 1);
+        std::string part =
+            text.substr(pos + 1, next == std::string::npos ? std::string::npos : next - pos - 1);
         if (part == "point") {
             spec.association = Association::Point;
         } else if (part == "cell") {
@@ -85,16 +85,15 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
                        "--field '" + spec.name +
                            "' exists as point and cell data: add ':point' or ':cell'");
     }
-    const std::uint64_t tuples = field->association == Association::Point ? mesh.pointCount()
-                                                                           : mesh.cellCount();
+    const std::uint64_t tuples =
+        field->association == Association::Point ? mesh.pointCount() : mesh.cellCount();
     UVR_CHECK(field->tupleCount() == tuples && field->values.size() == tuples * field->components,
               "field '" << field->name << "' holds " << field->values.size() << " values for "
                         << tuples << " tuples");
     if (spec.component >= field->components)
         throwError(ErrorKind::Argument, "",
                    "--field '" + field->name + "': component " + std::to_string(spec.component) +
-                       " does not exist (the field has " + std::to_string(field->components) +
-                       ")");
+                       " does not exist (the field has " + std::to_string(field->components) + ")");
     ScalarField out;
     out.name = field->name;
     out.association = field->association;

@@ -25,7 +25,8 @@ struct TetMeshView {
     std::uint64_t tetCount = 0;
     bool cellCentered = false;
 
-    /// Interpolated field value at p given barycentrics in tet t (piecewise constant for cell data).
+    /// Interpolated field value at p given barycentrics in tet t (piecewise constant for cell
+    /// data).
     UVR_HOST_DEVICE float interpolate(std::uint64_t t, const float bary[4]) const {
         if (cellCentered) return values[t];
         const Tet& tet = tets[t];
@@ -42,8 +43,8 @@ struct TetMesh {
     std::vector<float> values;
     Association association = Association::Point;
     std::string fieldName;
-    Bounds3f bounds;        ///< bounds of the points used by tets
-    float valueMin = 0.f;   ///< finite range of the field over the tets' values
+    Bounds3f bounds;       ///< bounds of the points used by tets
+    float valueMin = 0.f;  ///< finite range of the field over the tets' values
     float valueMax = 0.f;
     double totalVolume = 0.0;  ///< sum of tetrahedron volumes
 

@@ -18,18 +18,21 @@ struct FaceList {
 
 const FaceList& cellFaces(CellType type) {
     static const FaceList kTet{4, {{0, 2, 1, -1}, {0, 1, 3, -1}, {1, 2, 3, -1}, {0, 3, 2, -1}}};
-    static const FaceList kHex{6,
-                               {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1},
-                                {4, 5, 6, 7}}};
+    static const FaceList kHex{
+        6, {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}}};
     static const FaceList kWedge{
         5, {{0, 1, 2, -1}, {3, 5, 4, -1}, {0, 3, 4, 1}, {1, 4, 5, 2}, {2, 5, 3, 0}}};
     static const FaceList kPyramid{
         5, {{0, 3, 2, 1}, {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {3, 0, 4, -1}}};
     switch (type) {
-        case CellType::Tetra: return kTet;
-        case CellType::Hexahedron: return kHex;
-        case CellType::Wedge: return kWedge;
-        case CellType::Pyramid: return kPyramid;
+        case CellType::Tetra:
+            return kTet;
+        case CellType::Hexahedron:
+            return kHex;
+        case CellType::Wedge:
+            return kWedge;
+        case CellType::Pyramid:
+            return kPyramid;
     }
     return kTet;
 }
@@ -142,7 +145,8 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
     UVR_CHECK(field.values.size() == (cellData ? mesh.cellCount() : mesh.pointCount()),
               "field '" << field.name << "' has " << field.values.size() << " values");
     std::uint64_t estimate = 0;
-    for (CellType t : mesh.cellTypes) estimate += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
+    for (CellType t : mesh.cellTypes)
+        estimate += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
     out.tets.reserve(estimate);
     if (cellData) out.values.reserve(estimate);
     for (std::uint64_t c = 0; c < mesh.cellCount(); ++c) {

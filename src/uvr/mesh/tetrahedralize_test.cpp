@@ -18,7 +18,8 @@ namespace {
 constexpr double kVolumeTolerance = 1e-5;
 
 /// Mesh of one cell of the given type over unit-cube corners, with global ids permuted.
-Mesh oneCell(CellType type, const std::vector<Vec3f>& corners, const std::vector<std::uint32_t>& perm) {
+Mesh oneCell(CellType type, const std::vector<Vec3f>& corners,
+             const std::vector<std::uint32_t>& perm) {
     Mesh m;
     m.points.resize(corners.size());
     std::vector<std::uint32_t> ids(corners.size());
@@ -65,9 +66,11 @@ TEST(Tetrahedralize, EveryHexNumberingGivesSixPositiveTetsFillingTheCube) {
 }
 
 TEST(Tetrahedralize, EveryWedgeAndPyramidNumberingFillsTheCell) {
-    const std::vector<Vec3f> wedge = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
+    const std::vector<Vec3f> wedge = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0},
+                                      {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
     // VTK's wedge: (0,1,2) has its normal pointing away from (3,4,5).
-    const std::vector<Vec3f> vtkWedge = {wedge[0], wedge[2], wedge[1], wedge[3], wedge[5], wedge[4]};
+    const std::vector<Vec3f> vtkWedge = {wedge[0], wedge[2], wedge[1],
+                                         wedge[3], wedge[5], wedge[4]};
     std::vector<std::uint32_t> perm(6);
     std::iota(perm.begin(), perm.end(), 0u);
     do {
@@ -78,7 +81,8 @@ TEST(Tetrahedralize, EveryWedgeAndPyramidNumberingFillsTheCell) {
         ASSERT_EQ(count, 3);
         ASSERT_EQ(shape, CellShape::Valid);
     } while (std::next_permutation(perm.begin(), perm.end()));
-    const std::vector<Vec3f> pyramid = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5f, 0.5f, 1}};
+    const std::vector<Vec3f> pyramid = {
+        {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5f, 0.5f, 1}};
     perm.resize(5);
     std::iota(perm.begin(), perm.end(), 0u);
     do {
@@ -102,7 +106,8 @@ TEST(Tetrahedralize, NeighbouringHexesSplitSharedFacesTheSameWay) {
     for (size_t i = 0; i < perm.size(); ++i) m.points[perm[i]] = grid.points[i];
     for (auto& id : m.cellIndices) id = perm[id];
     m.fields.clear();
-    const TetMesh tets = tetrahedralize(m, ScalarField{"c", Association::Cell, std::vector<float>(m.cellCount(), 1.f)});
+    const TetMesh tets = tetrahedralize(
+        m, ScalarField{"c", Association::Cell, std::vector<float>(m.cellCount(), 1.f)});
     ASSERT_EQ(tets.tets.size(), 6u * 64u);
     std::map<std::array<std::uint32_t, 3>, int> faces;
     for (const Tet& t : tets.tets)

@@ -61,7 +61,8 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
     for (std::uint64_t c = 0; c < mesh.cellCount(); ++c) {
         for (std::uint32_t id : mesh.cell(c)) used[id] = true;
         switch (splitCell(mesh, c).shape) {
-            case CellShape::Valid: break;
+            case CellShape::Valid:
+                break;
             case CellShape::Inverted:
                 if (r.invertedCells++ == 0) r.firstInvertedCell = c;
                 break;
@@ -121,8 +122,8 @@ std::vector<std::string> ValidationReport::findings() const {
                       " point(s) with NaN/Inf coordinates: cells using them are dropped");
     if (unusedPoints) out.push_back(std::to_string(unusedPoints) + " point(s) used by no cell");
     for (const NonFiniteField& f : nonFiniteFields)
-        out.push_back(std::string(associationName(f.association)) + " field '" + f.name + "': " +
-                      std::to_string(f.count) + " NaN/Inf value(s) (first at " +
+        out.push_back(std::string(associationName(f.association)) + " field '" + f.name +
+                      "': " + std::to_string(f.count) + " NaN/Inf value(s) (first at " +
                       associationName(f.association) + " " + std::to_string(f.firstTuple) +
                       "): rendered transparent");
     return out;

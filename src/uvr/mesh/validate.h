@@ -19,12 +19,12 @@ struct NonFiniteField {
 
 /// What validation found in a mesh; structural errors throw instead.
 struct ValidationReport {
-    std::uint64_t invertedCells = 0;    ///< re-oriented when rendering
-    std::uint64_t zeroVolumeCells = 0;  ///< contribute nothing to images
-    std::uint64_t distortedCells = 0;   ///< tetrahedra of both orientations
-    std::uint64_t coincidentPoints = 0; ///< points at the position of an earlier point
-    std::uint64_t nonFinitePoints = 0;  ///< points with a NaN/Inf coordinate
-    std::uint64_t unusedPoints = 0;     ///< points no cell references
+    std::uint64_t invertedCells = 0;     ///< re-oriented when rendering
+    std::uint64_t zeroVolumeCells = 0;   ///< contribute nothing to images
+    std::uint64_t distortedCells = 0;    ///< tetrahedra of both orientations
+    std::uint64_t coincidentPoints = 0;  ///< points at the position of an earlier point
+    std::uint64_t nonFinitePoints = 0;   ///< points with a NaN/Inf coordinate
+    std::uint64_t unusedPoints = 0;      ///< points no cell references
     std::uint64_t firstInvertedCell = 0, firstZeroVolumeCell = 0, firstDistortedCell = 0;
     std::vector<NonFiniteField> nonFiniteFields;
 

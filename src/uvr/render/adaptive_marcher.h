@@ -53,8 +53,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
     const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
     float tEnter = 0.f, tExit = INFINITY;
-    if (scene.kd.partitionCount == 0 ||
-        !intersectBox(scene.kd.bounds, ray.org, inv, tEnter, tExit))
+    if (scene.kd.partitionCount == 0 || !intersectBox(scene.kd.bounds, ray.org, inv, tEnter, tExit))
         return acc;
     const TetLocator& locator = scene.base.locator;
     const float s1 = scene.base.params.step;
@@ -83,8 +82,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         for (float k = k0; k < k1; k += m) {
             const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
             ++counters.samples;
-            tet = locator.locateIn(scene.kd.bvh, part.bvhRoot, ray.at(k * s1),
-                                   walk ? tet : kNoTet, bary, counters.locate);
+            tet = locator.locateIn(scene.kd.bvh, part.bvhRoot, ray.at(k * s1), walk ? tet : kNoTet,
+                                   bary, counters.locate);
             if (tet == kNoTet) continue;
             const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
             const float a = correctOpacity(c.w, length, unit);

@@ -15,9 +15,8 @@ namespace uvr {
 namespace {
 
 PreparedMesh jitteredGrid(std::uint32_t leafCells = 64) {
-    Mesh m = testing::makeHexGrid(10, -1.f, 1.f,
-                                  [](Vec3f p) { return std::sin(3 * p.x) * std::cos(2 * p.y) + p.z; },
-                                  0.3f);
+    Mesh m = testing::makeHexGrid(
+        10, -1.f, 1.f, [](Vec3f p) { return std::sin(3 * p.x) * std::cos(2 * p.y) + p.z; }, 0.3f);
     PrepareOptions o;
     o.kd.leafCells = leafCells;
     return prepareMesh(m, selectScalarField(m, {}), o);
@@ -105,12 +104,14 @@ TEST(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
 // reference (any loss comes from the adaptive step only), on every real mesh.
 TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
-    for (const char* name : {"spx.vtk", "post.vtk", "tetraMesh.vtk", "bluntfin_tets.vtk",
-                             "post_tets.vtk", "cylinder_quadratic_as_tets.vtk", "hexa.vtk",
-                             "fire_ug.vtu"}) {
+    for (const char* name :
+         {"spx.vtk", "post.vtk", "tetraMesh.vtk", "bluntfin_tets.vtk", "post_tets.vtk",
+          "cylinder_quadratic_as_tets.vtk", "hexa.vtk", "fire_ug.vtu"}) {
         const Mesh mesh = readMesh(testing::sharedData(name));
-        const ScalarField field = selectScalarField(mesh, parseFieldSpec(
-            std::string(name) == "cylinder_quadratic_as_tets.vtk" ? "pressure:point" : ""));
+        const ScalarField field = selectScalarField(
+            mesh,
+            parseFieldSpec(std::string(name) == "cylinder_quadratic_as_tets.vtk" ? "pressure:point"
+                                                                                 : ""));
         const PreparedMesh pm = prepareMesh(mesh, field);
         RenderSettings s;
         s.width = s.height = 96;

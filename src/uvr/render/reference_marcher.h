@@ -14,9 +14,9 @@ namespace uvr {
 
 /// Compositing parameters shared by every integrator.
 struct MarchParams {
-    float step = 0.f;                 ///< sample spacing s1 along the ray (world units)
-    float opacityUnit = 1.f;          ///< distance over which a TF opacity applies (ParaView's unit)
-    float terminationAlpha = 0.99f;   ///< early ray termination threshold on accumulated opacity
+    float step = 0.f;                ///< sample spacing s1 along the ray (world units)
+    float opacityUnit = 1.f;         ///< distance over which a TF opacity applies (ParaView's unit)
+    float terminationAlpha = 0.99f;  ///< early ray termination threshold on accumulated opacity
 };
 
 /// Everything a ray needs, as plain data for CPU and GPU.

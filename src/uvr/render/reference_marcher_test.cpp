@@ -92,7 +92,8 @@ TEST(ReferenceMarcher, NanValuesAreTransparent) {
 }
 
 TEST(ReferenceMarcher, CpuFrameMatchesPerRayMarching) {
-    Mesh m = testing::makeHexGrid(4, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.2f);
+    Mesh m = testing::makeHexGrid(
+        4, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.2f);
     const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}));
     RenderSettings s;
     s.width = 40;

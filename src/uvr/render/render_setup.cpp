@@ -17,17 +17,19 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field,
-                         const PrepareOptions& options, const ProgressFn& progress) {
+PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const PrepareOptions& options,
+                         const ProgressFn& progress) {
     PreparedMesh out;
     out.sourceCells = mesh.cellCount();
     auto start = std::chrono::steady_clock::now();
-    if (progress) progress("splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra");
+    if (progress)
+        progress("splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra");
     out.tets = tetrahedralize(mesh, field);
     out.splitSeconds = secondsSince(start);
 
     start = std::chrono::steady_clock::now();
-    if (progress) progress("building the BVH over " + std::to_string(out.tets.tets.size()) + " tetrahedra");
+    if (progress)
+        progress("building the BVH over " + std::to_string(out.tets.tets.size()) + " tetrahedra");
     std::vector<Bounds3f> boxes(out.tets.tets.size());
     std::vector<Vec3f> centers(out.tets.tets.size());
     for (std::size_t t = 0; t < boxes.size(); ++t) {
@@ -52,7 +54,8 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field,
 }
 
 float defaultStep(const TetMesh& mesh) {
-    if (mesh.tets.empty() || !(mesh.totalVolume > 0.0)) return 0.01f * std::fmax(mesh.bounds.diagonal(), 1e-30f);
+    if (mesh.tets.empty() || !(mesh.totalVolume > 0.0))
+        return 0.01f * std::fmax(mesh.bounds.diagonal(), 1e-30f);
     return static_cast<float>(0.5 * std::cbrt(mesh.totalVolume / double(mesh.tets.size())));
 }
 
@@ -83,15 +86,16 @@ void validateSettings(const RenderSettings& s) {
         bad("--max-step " + std::to_string(s.maxStep) + ": expected a positive finite distance");
     if (!(s.power >= 1.f && s.power <= 64.f))
         bad("--power " + std::to_string(s.power) + ": expected a number in [1, 64]");
-    if (s.tfTableSize < 2 || s.tfTableSize > (1 << 20)) bad("transfer function table size out of range");
+    if (s.tfTableSize < 2 || s.tfTableSize > (1 << 20))
+        bad("transfer function table size out of range");
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
 }
 
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
-                                                      const TfRangeView& range, float s1,
-                                                      float s2, float power, bool adaptive) {
+                                                      const TfRangeView& range, float s1, float s2,
+                                                      float power, bool adaptive) {
     const std::size_t n = kd.partitions.size();
     std::vector<PartitionShading> out(n);
     std::vector<float> variance(n);
@@ -104,7 +108,8 @@ std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
     }
     for (std::size_t p = 0; p < n; ++p) {
         float v = 0.f;  // invisible partitions: the coarsest step
-        if (out[p].maxOpacity > 0.f) v = hi > lo ? (variance[p] - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
+        if (out[p].maxOpacity > 0.f)
+            v = hi > lo ? (variance[p] - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
         out[p].step = adaptive ? adaptiveStep(v, s1, s2, power) : s1;
     }
     return out;
@@ -158,8 +163,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
                                 f.rangeHi};
         const TfRangeTables ranges(table);
-        f.shading = computePartitionShading(*mesh.kd, ranges.view(table), f.params.step,
-                                            f.maxStep, settings.power, settings.adaptive);
+        f.shading = computePartitionShading(*mesh.kd, ranges.view(table), f.params.step, f.maxStep,
+                                            settings.power, settings.adaptive);
         f.tfUpdateSeconds = secondsSince(start);
     }
     const double samplesPerRay = mesh.tets.bounds.diagonal() / f.params.step;

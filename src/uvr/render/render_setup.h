@@ -13,9 +13,9 @@
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/tet_mesh.h"
+#include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/image.h"
-#include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/transfer_function.h"
 
@@ -66,19 +66,19 @@ enum class RenderMethod {
 /// What to render and how.
 struct RenderSettings {
     RenderMethod method = RenderMethod::Reference;
-    float maxStep = 0.f;  ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1
-    float power = 2.f;    ///< adaptive power p >= 1
-    bool skip = true;     ///< skip partitions of zero maximum opacity
-    bool adaptive = true; ///< adaptive steps (false: every partition at s1)
+    float maxStep = 0.f;   ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1
+    float power = 2.f;     ///< adaptive power p >= 1
+    bool skip = true;      ///< skip partitions of zero maximum opacity
+    bool adaptive = true;  ///< adaptive steps (false: every partition at s1)
     int width = 1024;
     int height = 1024;
     std::optional<Camera> camera;  ///< default: resetCamera on the mesh bounds
     TransferFunction tf;
     std::optional<std::pair<float, float>> range;  ///< default: the field's finite range
-    float step = 0.f;         ///< s1; 0 = defaultStep
-    float opacityUnit = 0.f;  ///< 0 = defaultOpacityUnit
+    float step = 0.f;                              ///< s1; 0 = defaultStep
+    float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
     float terminationAlpha = 0.99f;
-    int tfTableSize = 1024;   ///< entries of the baked transfer function
+    int tfTableSize = 1024;  ///< entries of the baked transfer function
 };
 
 /// Throws Error(Argument) for settings that cannot render: image size outside [1, 16384] per
@@ -94,8 +94,8 @@ inline constexpr float kDefaultMaxStepFactor = 16.f;
 /// the minimum and maximum over the visible partitions, and the adaptive step from it (s1 for
 /// every partition when adaptive is false; s2 for invisible partitions).
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
-                                                      const TfRangeView& range, float s1,
-                                                      float s2, float power, bool adaptive);
+                                                      const TfRangeView& range, float s1, float s2,
+                                                      float power, bool adaptive);
 
 /// Host-side frame state built from settings: the baked table, the camera and the parameters.
 struct FrameSetup {
@@ -119,10 +119,10 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
 
 /// Statistics of one rendered frame.
 struct RenderStats {
-    double seconds = 0.0;          ///< wall time of the frame (rendering only)
-    std::uint64_t samples = 0;     ///< samples taken
-    std::uint64_t walkSteps = 0;   ///< tetrahedra tested while walking
-    std::uint64_t bvhQueries = 0;  ///< point locations that fell back to the BVH
+    double seconds = 0.0;                 ///< wall time of the frame (rendering only)
+    std::uint64_t samples = 0;            ///< samples taken
+    std::uint64_t walkSteps = 0;          ///< tetrahedra tested while walking
+    std::uint64_t bvhQueries = 0;         ///< point locations that fell back to the BVH
     std::uint64_t partitionsVisited = 0;  ///< partitions entered by rays (partition method)
     std::uint64_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
     int width = 0, height = 0;
@@ -145,7 +145,7 @@ struct RenderStats {
     }
     double meanSamplesPerPixel() const {
         return width > 0 && height > 0 ? static_cast<double>(samples) / (double(width) * height)
-                                          : 0.0;
+                                       : 0.0;
     }
 };
 

@@ -8,9 +8,9 @@ TfRangeTables::TfRangeTables(const TfTableView& table) {
     prefix.assign(5 * static_cast<std::size_t>(n + 1), 0.0);
     for (int i = 0; i < n; ++i) {
         const Vec4f e = table.entries[i];
-        const double v[5] = {e.x, e.y, e.z, e.w,
-                             double(e.x) * e.x + double(e.y) * e.y + double(e.z) * e.z +
-                                 double(e.w) * e.w};
+        const double v[5] = {
+            e.x, e.y, e.z, e.w,
+            double(e.x) * e.x + double(e.y) * e.y + double(e.z) * e.z + double(e.w) * e.w};
         for (int c = 0; c < 5; ++c) prefix[5 * (i + 1) + c] = prefix[5 * i + c] + v[c];
     }
     levels = 1;

@@ -43,10 +43,9 @@ struct TfRangeView {
         if (i1 < i0) i1 = i0;
         RangeStats out;
         out.maxOpacity = e0.w > e1.w ? e0.w : e1.w;
-        double sum[5] = {double(e0.x) + e1.x, double(e0.y) + e1.y, double(e0.z) + e1.z,
-                         double(e0.w) + e1.w,
-                         double(dot(e0.xyz(), e0.xyz())) + e0.w * e0.w +
-                             dot(e1.xyz(), e1.xyz()) + e1.w * e1.w};
+        double sum[5] = {
+            double(e0.x) + e1.x, double(e0.y) + e1.y, double(e0.z) + e1.z, double(e0.w) + e1.w,
+            double(dot(e0.xyz(), e0.xyz())) + e0.w * e0.w + dot(e1.xyz(), e1.xyz()) + e1.w * e1.w};
         double count = 2.0;
         if (i1 > i0) {
             for (int c = 0; c < 5; ++c) sum[c] += prefix[5 * i1 + c] - prefix[5 * i0 + c];
@@ -58,8 +57,9 @@ struct TfRangeView {
             const float m = m0 > m1 ? m0 : m1;
             out.maxOpacity = out.maxOpacity > m ? out.maxOpacity : m;
         }
-        const double mean2 = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2] +
-                              sum[3] * sum[3]) / (count * count);
+        const double mean2 =
+            (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2] + sum[3] * sum[3]) /
+            (count * count);
         const double var = sum[4] / count - mean2;
         out.variance = var > 0.0 ? static_cast<float>(var) : 0.f;
         return out;

@@ -26,8 +26,8 @@ RangeStats bruteForce(const TfTableView& t, float lo, float hi) {
     }
     const double n = pts.size();
     s.variance = static_cast<float>(
-        sq / n - (mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2] + mean[3] * mean[3]) /
-                     (n * n));
+        sq / n -
+        (mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2] + mean[3] * mean[3]) / (n * n));
     return s;
 }
 

@@ -198,7 +198,9 @@ INSTANTIATE_TEST_SUITE_P(VtkLegacy, VtkLegacyRealData, ::testing::Range<std::siz
 // ---------------------------------------------------------------------------------------------
 // Files written at test time by VTK's own vtkUnstructuredGridWriter (tests/tools script).
 
-std::string writerScript() { return testing::testTool("write_legacy_vtk.py"); }
+std::string writerScript() {
+    return testing::testTool("write_legacy_vtk.py");
+}
 
 struct WriterCase {
     int version;
