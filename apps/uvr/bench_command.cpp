@@ -68,7 +68,8 @@ void addBenchCommand(CLI::App& app, Log& log) {
     cmd->add_option("--json", *json, "Write the table and settings as JSON");
     cmd->add_option("--plot", *plot, "Write a PNG plot of time and SSIM against s2 / s1");
     cmd->add_option("--images", *images,
-                    "Write each configuration's image and sample heat map into this folder");
+                    "Write each configuration's image and sample heat map (all on the reference's "
+                    "scale) into this folder");
     cmd->callback([=, &log] {
         for (const std::string* out : {csv.get(), json.get(), plot.get()})
             if (!out->empty()) checkOutputPath(*out);
@@ -110,6 +111,7 @@ void addBenchCommand(CLI::App& app, Log& log) {
         }
         // Render: one warm-up frame, then `repeat` timed frames per variant.
         Rgb8Image reference;
+        std::uint32_t heatmapMax = 0;  // the reference's largest count: one scale for all
         for (Variant& v : variants) {
             log.step("timing " + v.name);
             std::vector<double> times;
@@ -121,7 +123,10 @@ void addBenchCommand(CLI::App& app, Log& log) {
             v.medianSeconds = median(times);
             v.samples = v.last.stats.samples;
             const Rgb8Image img = toRgb8(v.last.image, bg);
-            if (reference.rgb.empty()) reference = img;
+            if (reference.rgb.empty()) {
+                reference = img;
+                for (std::uint32_t c : v.last.sampleCounts) heatmapMax = std::max(heatmapMax, c);
+            }
             const ImageComparison cmp = compareImages(reference, img);
             v.ssim = cmp.ssim;
             v.psnr = cmp.psnr;
@@ -130,7 +135,7 @@ void addBenchCommand(CLI::App& app, Log& log) {
                 writePng(stem + ".png", v.last.image, background);
                 writePng(stem + "_samples.png",
                          sampleHeatmap(v.last.sampleCounts, v.settings.width, v.settings.height,
-                                       flags->heatmapMax));
+                                       heatmapMax));
             }
         }
         // Table.

@@ -299,6 +299,8 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["render_seconds"] = result.stats.seconds;
         j["samples"] = result.stats.samples;
         j["mean_samples_per_pixel"] = result.stats.meanSamplesPerPixel();
+        j["max_samples_per_pixel"] =
+            *std::max_element(result.sampleCounts.begin(), result.sampleCounts.end());
         j["samples_per_second"] =
             result.stats.seconds > 0 ? double(result.stats.samples) / result.stats.seconds : 0.0;
         j["walk_steps"] = result.stats.walkSteps;
