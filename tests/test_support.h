@@ -3,10 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include "uvr/core/error.h"
+#include "uvr/core/vec.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <sys/wait.h>
 
@@ -64,6 +68,37 @@ inline std::string uvrBinary() {
 inline int runCommand(const std::string& cmd) {
     int status = std::system(cmd.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : 255;
+}
+
+/// Runs f and returns the uvr::Error it throws (the test fails when it throws none).
+template <typename F>
+Error catchError(F&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << "expected a uvr::Error";
+    return Error(ErrorKind::Internal, "no error");
+}
+
+/// Runs a Python script with the system Python in dir and returns its stdout parsed as numbers.
+inline std::vector<double> runPython(const std::string& dir, const std::string& script) {
+    const std::string py = writeFile(dir + "/oracle.py", script);
+    const std::string out = dir + "/oracle.txt";
+    EXPECT_EQ(runCommand(std::string(systemPython()) + " " + py + " > " + out + " 2>/dev/null"), 0);
+    std::ifstream in(out);
+    std::vector<double> values;
+    double v;
+    while (in >> v) values.push_back(v);
+    return values;
+}
+
+/// Expects two vectors to agree component-wise within tol.
+inline void expectVec(Vec3f got, Vec3f want, float tol, const std::string& what = "") {
+    EXPECT_NEAR(got.x, want.x, tol) << what;
+    EXPECT_NEAR(got.y, want.y, tol) << what;
+    EXPECT_NEAR(got.z, want.z, tol) << what;
 }
 
 }  // namespace uvr::testing

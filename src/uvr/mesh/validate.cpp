@@ -13,43 +13,47 @@
 namespace uvr {
 
 void validateStructure(const Mesh& mesh, const std::string& file) {
-    const std::uint64_t n = mesh.cellCount();
-    if (mesh.cellOffsets.size() != n + 1 || mesh.cellOffsets.front() != 0 ||
-        mesh.cellOffsets.back() != mesh.cellIndices.size())
-        throwError(ErrorKind::Validation, file,
-                   "cell offsets are inconsistent: " + std::to_string(mesh.cellOffsets.size()) +
-                       " offsets for " + std::to_string(n) + " cells and " +
-                       std::to_string(mesh.cellIndices.size()) + " indices");
-    const std::uint64_t np = mesh.pointCount();
-    if (np > 0xffffffffull)
+    const std::uint64_t cells = mesh.cellCount();
+    const std::uint64_t points = mesh.pointCount();
+    const std::uint64_t indices = mesh.cellIndices.size();
+    auto fail = [&](const std::string& message) { throwError(ErrorKind::Validation, file, message); };
+    if (points > 0xffffffffull)
         throwError(ErrorKind::Unsupported, file,
-                   std::to_string(np) + " points: at most 2^32 - 1 are supported");
-    for (std::uint64_t c = 0; c < n; ++c) {
+                   std::to_string(points) + " points: at most 2^32 - 1 are supported");
+    if (mesh.cellOffsets.size() != cells + 1)
+        fail("cellOffsets has " + std::to_string(mesh.cellOffsets.size()) +
+             " entries, expected cellCount + 1 = " + std::to_string(cells + 1));
+    if (mesh.cellOffsets[0] != 0)
+        fail("cell 0: offset " + std::to_string(mesh.cellOffsets[0]) + ", expected 0");
+    for (std::uint64_t c = 0; c < cells; ++c) {
         const int corners = cornerCount(mesh.cellTypes[c]);
         if (corners == 0)
-            throwError(ErrorKind::Validation, file,
-                       "cell " + std::to_string(c) + ": unsupported cell type " +
-                           std::to_string(static_cast<int>(mesh.cellTypes[c])));
-        if (mesh.cellOffsets[c + 1] - mesh.cellOffsets[c] != static_cast<std::uint64_t>(corners))
-            throwError(ErrorKind::Validation, file,
-                       "cell " + std::to_string(c) + " (" + cellTypeName(mesh.cellTypes[c]) +
-                           ") lists " +
-                           std::to_string(mesh.cellOffsets[c + 1] - mesh.cellOffsets[c]) +
-                           " points, expected " + std::to_string(corners));
-        for (std::uint32_t id : mesh.cell(c))
-            if (id >= np)
-                throwError(ErrorKind::Validation, file,
-                           "cell " + std::to_string(c) + " (" + cellTypeName(mesh.cellTypes[c]) +
-                               "): point index " + std::to_string(id) + " out of range [0, " +
-                               std::to_string(np) + ")");
+            fail("cell " + std::to_string(c) + ": type " +
+                 std::to_string(static_cast<unsigned>(mesh.cellTypes[c])) +
+                 ", expected 10 (tetra), 12 (hexahedron), 13 (wedge) or 14 (pyramid)");
+        const std::uint64_t begin = mesh.cellOffsets[c], end = mesh.cellOffsets[c + 1];
+        if (end < begin || end - begin != static_cast<std::uint64_t>(corners) || end > indices)
+            fail("cell " + std::to_string(c) + ": offsets " + std::to_string(begin) + ".." +
+                 std::to_string(end) + " do not span the " + std::to_string(corners) +
+                 " corners of a " + cellTypeName(mesh.cellTypes[c]) + " within " +
+                 std::to_string(indices) + " indices");
+        for (std::uint64_t i = begin; i < end; ++i)
+            if (mesh.cellIndices[i] >= points)
+                fail("cell " + std::to_string(c) + " (" + cellTypeName(mesh.cellTypes[c]) +
+                     "): corner " + std::to_string(i - begin) + " is point " +
+                     std::to_string(mesh.cellIndices[i]) + ", expected below pointCount " +
+                     std::to_string(points));
     }
+    if (mesh.cellOffsets[cells] != indices)
+        fail("last cell offset " + std::to_string(mesh.cellOffsets[cells]) +
+             ", expected indexCount " + std::to_string(indices));
     for (const Field& f : mesh.fields) {
-        const std::uint64_t tuples = f.association == Association::Point ? np : n;
-        if (f.components < 1 || f.values.size() != tuples * f.components)
-            throwError(ErrorKind::Validation, file,
-                       std::string(associationName(f.association)) + " field '" + f.name +
-                           "' holds " + std::to_string(f.values.size()) + " values, expected " +
-                           std::to_string(tuples) + " x " + std::to_string(f.components));
+        const std::uint64_t tuples = f.association == Association::Point ? points : cells;
+        if (f.components < 1 || f.values.size() != tuples * static_cast<std::uint64_t>(f.components))
+            fail("field '" + f.name + "': " + std::to_string(f.values.size()) +
+                 " values, expected " + std::to_string(tuples) + " " +
+                 associationName(f.association) + " tuples x " + std::to_string(f.components) +
+                 " components");
     }
 }
 

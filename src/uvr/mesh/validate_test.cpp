@@ -33,7 +33,8 @@ TEST(Validate, OutOfRangeIndexNamesTheCell) {
         FAIL();
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Validation);
-        EXPECT_STREQ(e.what(), "m.vtk: cell 1 (tetra): point index 9 out of range [0, 4)");
+        EXPECT_STREQ(e.what(),
+                     "m.vtk: cell 1 (tetra): corner 3 is point 9, expected below pointCount 4");
     }
 }
 

@@ -15,8 +15,11 @@ namespace uvr {
 namespace {
 
 using ::testing::HasSubstr;
+using uvr::testing::catchError;
+using uvr::testing::expectVec;
 using uvr::testing::pythonHas;
 using uvr::testing::runCommand;
+using uvr::testing::runPython;
 using uvr::testing::scratchDir;
 using uvr::testing::systemPython;
 using uvr::testing::writeFile;
@@ -30,34 +33,6 @@ float degrees(float rad) {
 
 float angleBetween(Vec3f a, Vec3f b) {
     return degrees(std::acos(std::clamp(dot(normalize(a), normalize(b)), -1.f, 1.f)));
-}
-
-void expectVec(Vec3f got, Vec3f want, float tol, const std::string& what = "") {
-    EXPECT_NEAR(got.x, want.x, tol) << what;
-    EXPECT_NEAR(got.y, want.y, tol) << what;
-    EXPECT_NEAR(got.z, want.z, tol) << what;
-}
-
-template <typename F>
-Error catchError(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e;
-    }
-    ADD_FAILURE() << "expected a uvr::Error";
-    return Error(ErrorKind::Internal, "no error");
-}
-
-std::vector<double> runPython(const std::string& dir, const std::string& script) {
-    std::string py = writeFile(dir + "/oracle.py", script);
-    std::string out = dir + "/oracle.txt";
-    EXPECT_EQ(runCommand(std::string(systemPython()) + " " + py + " > " + out + " 2>/dev/null"), 0);
-    std::ifstream in(out);
-    std::vector<double> values;
-    double v;
-    while (in >> v) values.push_back(v);
-    return values;
 }
 
 Bounds3f box(Vec3f lo, Vec3f hi) {

@@ -18,6 +18,7 @@ namespace uvr {
 namespace {
 
 using ::testing::HasSubstr;
+using uvr::testing::catchError;
 using uvr::testing::pythonHas;
 using uvr::testing::runCommand;
 using uvr::testing::scratchDir;
@@ -26,17 +27,6 @@ using uvr::testing::writeFile;
 
 /// One 8-bit quantisation step.
 constexpr float kStep = 1.f / 255.f;
-
-template <typename F>
-Error catchError(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e;
-    }
-    ADD_FAILURE() << "expected a uvr::Error";
-    return Error(ErrorKind::Internal, "no error");
-}
 
 void expectPixel(Vec4f got, Vec4f want, float tol, const std::string& what) {
     EXPECT_NEAR(got.x, want.x, tol) << what;

@@ -14,8 +14,11 @@ namespace uvr {
 namespace {
 
 using ::testing::HasSubstr;
+using uvr::testing::catchError;
+using uvr::testing::expectVec;
 using uvr::testing::pythonHas;
 using uvr::testing::runCommand;
+using uvr::testing::runPython;
 using uvr::testing::scratchDir;
 using uvr::testing::systemPython;
 using uvr::testing::writeFile;
@@ -23,35 +26,9 @@ using uvr::testing::writeFile;
 /// Tolerance for colours compared against VTK's and matplotlib's own evaluation.
 constexpr float kColorTol = 5e-4f;
 
-void expectColor(Vec3f got, Vec3f want, float tol, const std::string& what) {
-    EXPECT_NEAR(got.x, want.x, tol) << what;
-    EXPECT_NEAR(got.y, want.y, tol) << what;
-    EXPECT_NEAR(got.z, want.z, tol) << what;
-}
-
 /// Runs the function and returns the uvr::Error it throws (fails the test if none).
-template <typename F>
-Error catchError(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e;
-    }
-    ADD_FAILURE() << "expected a uvr::Error";
-    return Error(ErrorKind::Internal, "no error");
-}
 
 /// Runs a Python script with the system Python and returns its stdout parsed as numbers.
-std::vector<double> runPython(const std::string& dir, const std::string& script) {
-    std::string py = writeFile(dir + "/oracle.py", script);
-    std::string out = dir + "/oracle.txt";
-    EXPECT_EQ(runCommand(std::string(systemPython()) + " " + py + " > " + out + " 2>/dev/null"), 0);
-    std::ifstream in(out);
-    std::vector<double> values;
-    double v;
-    while (in >> v) values.push_back(v);
-    return values;
-}
 
 TransferFunction twoPoint(ColorSpace space, Vec3f a, Vec3f b) {
     TransferFunction tf;
@@ -65,11 +42,11 @@ TEST(TransferFunction, RgbInterpolationIsLinearAndClamped) {
     TransferFunction tf;
     tf.colors = {{0.f, {0.f, 0.f, 0.f}}, {0.25f, {1.f, 0.f, 0.f}}, {1.f, {1.f, 1.f, 0.5f}}};
     tf.opacities = {{0.f, 0.f}, {1.f, 1.f}};
-    expectColor(tf.colorAt(0.125f), {0.5f, 0.f, 0.f}, 1e-6f, "middle of first segment");
-    expectColor(tf.colorAt(0.625f), {1.f, 0.5f, 0.25f}, 1e-6f, "middle of second segment");
-    expectColor(tf.colorAt(-3.f), {0.f, 0.f, 0.f}, 0.f, "clamped below");
-    expectColor(tf.colorAt(7.f), {1.f, 1.f, 0.5f}, 0.f, "clamped above");
-    expectColor(tf.colorAt(0.25f), {1.f, 0.f, 0.f}, 0.f, "at a control point");
+    expectVec(tf.colorAt(0.125f), {0.5f, 0.f, 0.f}, 1e-6f, "middle of first segment");
+    expectVec(tf.colorAt(0.625f), {1.f, 0.5f, 0.25f}, 1e-6f, "middle of second segment");
+    expectVec(tf.colorAt(-3.f), {0.f, 0.f, 0.f}, 0.f, "clamped below");
+    expectVec(tf.colorAt(7.f), {1.f, 1.f, 0.5f}, 0.f, "clamped above");
+    expectVec(tf.colorAt(0.25f), {1.f, 0.f, 0.f}, 0.f, "at a control point");
 }
 
 TEST(TransferFunction, OpacityIsPiecewiseLinearWithJumps) {
@@ -108,7 +85,7 @@ TEST(TransferFunction, LabConversionMatchesPublishedValues) {
     EXPECT_NEAR(white.y, 0.f, 0.05f);
     EXPECT_NEAR(white.z, 0.f, 0.05f);
     for (Vec3f c : {Vec3f(0.2f, 0.5f, 0.9f), Vec3f(0.01f, 0.02f, 0.f), Vec3f(0.9f, 0.3f, 0.1f)})
-        expectColor(labToSrgb(srgbToLab(c)), c, 1e-4f, "Lab round trip");
+        expectVec(labToSrgb(srgbToLab(c)), c, 1e-4f, "Lab round trip");
 }
 
 TEST(TransferFunction, DivergingThroughWhiteBetweenSaturatedEnds) {
@@ -118,10 +95,10 @@ TEST(TransferFunction, DivergingThroughWhiteBetweenSaturatedEnds) {
         twoPoint(ColorSpace::Diverging, {0.230f, 0.299f, 0.754f}, {0.706f, 0.016f, 0.150f});
     Vec3f mid = tf.colorAt(0.5f);
     Vec3f grey = labToSrgb({88.f, 0.f, 0.f});
-    expectColor(mid, grey, 1e-4f, "Msh midpoint");
+    expectVec(mid, grey, 1e-4f, "Msh midpoint");
     EXPECT_NEAR(mid.x, mid.y, 1e-4f);
-    expectColor(tf.colorAt(0.f), {0.230f, 0.299f, 0.754f}, 1e-6f, "end 0");
-    expectColor(tf.colorAt(1.f), {0.706f, 0.016f, 0.150f}, 1e-6f, "end 1");
+    expectVec(tf.colorAt(0.f), {0.230f, 0.299f, 0.754f}, 1e-6f, "end 0");
+    expectVec(tf.colorAt(1.f), {0.706f, 0.016f, 0.150f}, 1e-6f, "end 1");
 }
 
 TEST(TransferFunction, CoolToWarmAndLabMatchVtkColorTransferFunction) {
@@ -147,10 +124,10 @@ table('Lab', [(0, 0, 0.6, 0.75), (0.3, 0.1, 0.1, 0.1), (1, 0.77, 0.47, 0.34)])
     for (int i = 0; i <= 100; ++i) {
         const double* d = &v[3 * i];
         const double* l = &v[3 * (101 + i)];
-        expectColor(ctw.colorAt(i / 100.f), Vec3f(d[0], d[1], d[2]), kColorTol,
-                    "cool-to-warm at " + std::to_string(i));
-        expectColor(lab.colorAt(i / 100.f), Vec3f(l[0], l[1], l[2]), kColorTol,
-                    "Lab at " + std::to_string(i));
+        expectVec(ctw.colorAt(i / 100.f), Vec3f(d[0], d[1], d[2]), kColorTol,
+                  "cool-to-warm at " + std::to_string(i));
+        expectVec(lab.colorAt(i / 100.f), Vec3f(l[0], l[1], l[2]), kColorTol,
+                  "Lab at " + std::to_string(i));
     }
 }
 
@@ -169,8 +146,8 @@ for name in ('viridis', 'inferno'):
         for (int i = 0; i < 256; ++i) {
             const double* c = &v[3 * (256 * m + i)];
             // Every 5th of the 256 entries is embedded; interpolation stays within one 8-bit step.
-            expectColor(maps[m].colorAt(i / 255.f), Vec3f(c[0], c[1], c[2]), 1.f / 255.f,
-                        maps[m].name + " entry " + std::to_string(i));
+            expectVec(maps[m].colorAt(i / 255.f), Vec3f(c[0], c[1], c[2]), 1.f / 255.f,
+                      maps[m].name + " entry " + std::to_string(i));
         }
     }
 }
@@ -197,9 +174,9 @@ TEST(TransferFunction, PresetsResolveParaViewNames) {
 TEST(TransferFunction, BlackBodyMatchesParaViewPreset) {
     // ParaView's ColorMaps.json: 0 black, 0.4 (0.902, 0, 0), 0.8 (0.902, 0.902, 0), 1 white.
     TransferFunction tf = transferFunctionPreset("black-body");
-    expectColor(tf.colorAt(0.2f), {0.45098f, 0.f, 0.f}, 1e-5f, "0.2");
-    expectColor(tf.colorAt(0.6f), {0.901961f, 0.45098f, 0.f}, 1e-5f, "0.6");
-    expectColor(tf.colorAt(0.9f), {0.95098f, 0.95098f, 0.5f}, 1e-5f, "0.9");
+    expectVec(tf.colorAt(0.2f), {0.45098f, 0.f, 0.f}, 1e-5f, "0.2");
+    expectVec(tf.colorAt(0.6f), {0.901961f, 0.45098f, 0.f}, 1e-5f, "0.6");
+    expectVec(tf.colorAt(0.9f), {0.95098f, 0.95098f, 0.5f}, 1e-5f, "0.9");
 }
 
 TEST(TransferFunction, OpacitySpecs) {
@@ -251,7 +228,7 @@ TEST(TransferFunction, LoadsParaViewExport) {
     EXPECT_FLOAT_EQ(tf.sourceRange->second, 30.f);
     ASSERT_EQ(tf.colors.size(), 3u);
     EXPECT_FLOAT_EQ(tf.colors[1].x, 0.5f);
-    expectColor(tf.colorAt(0.5f), {1.f, 1.f, 1.f}, 1e-6f, "white at data value 10");
+    expectVec(tf.colorAt(0.5f), {1.f, 1.f, 1.f}, 1e-6f, "white at data value 10");
     // Opacity at data value -10 (normalised 0) on the segment from (-20, 0) to (10, 0.4).
     EXPECT_NEAR(tf.opacityAt(0.f), 0.4f / 3.f, 1e-6f);
     EXPECT_NEAR(tf.opacityAt(0.5f), 0.4f, 1e-6f);
@@ -269,7 +246,7 @@ TEST(TransferFunction, ParaViewCoolToWarmExportEqualsPreset) {
     TransferFunction tf = loadTransferFunction(path);
     TransferFunction preset = loadTransferFunction("cool-to-warm");
     for (int i = 0; i <= 20; ++i) {
-        expectColor(tf.colorAt(i / 20.f), preset.colorAt(i / 20.f), 1e-6f, std::to_string(i));
+        expectVec(tf.colorAt(i / 20.f), preset.colorAt(i / 20.f), 1e-6f, std::to_string(i));
         EXPECT_FLOAT_EQ(tf.opacityAt(i / 20.f), i / 20.f);  // no Points: a linear ramp
     }
 }
@@ -280,9 +257,9 @@ TEST(TransferFunction, HsvExportIsResampledTheShortWayRound) {
         "RGBPoints": [0, 1, 0, 0, 1, 0, 0, 1]}])");
     TransferFunction tf = loadParaViewColorMap(path);
     EXPECT_EQ(tf.colorSpace, ColorSpace::RGB);
-    expectColor(tf.colorAt(0.f), {1.f, 0.f, 0.f}, 1e-6f, "red end");
-    expectColor(tf.colorAt(0.5f), {1.f, 0.f, 1.f}, 1e-5f, "magenta, not green, in the middle");
-    expectColor(tf.colorAt(1.f), {0.f, 0.f, 1.f}, 1e-6f, "blue end");
+    expectVec(tf.colorAt(0.f), {1.f, 0.f, 0.f}, 1e-6f, "red end");
+    expectVec(tf.colorAt(0.5f), {1.f, 0.f, 1.f}, 1e-5f, "magenta, not green, in the middle");
+    expectVec(tf.colorAt(1.f), {0.f, 0.f, 1.f}, 1e-6f, "blue end");
 }
 
 TEST(TransferFunction, MalformedParaViewExportsNameFileAndKey) {

@@ -13,6 +13,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/validate.h"
 
 namespace uvr {
 
@@ -144,49 +145,6 @@ private:
     std::uint64_t offset_ = 0;
     FilePtr file_{nullptr, &std::fclose};
 };
-
-std::string cellTypeList() {
-    return "10 (tetra), 12 (hexahedron), 13 (wedge) or 14 (pyramid)";
-}
-
-/// Checks cell types, offsets and corner indices; errors name the cell (used by reader and
-/// writer, so the writer never writes a file the reader would refuse).
-void checkCells(const Mesh& mesh, const std::string& path) {
-    const std::uint64_t cells = mesh.cellTypes.size();
-    const std::uint64_t points = mesh.points.size();
-    if (mesh.cellOffsets.size() != cells + 1)
-        throwError(ErrorKind::Validation, path,
-                   "cellOffsets has " + std::to_string(mesh.cellOffsets.size()) +
-                       " entries, expected cellCount + 1 = " + std::to_string(cells + 1));
-    if (mesh.cellOffsets[0] != 0)
-        throwError(ErrorKind::Validation, path,
-                   "cell 0: offset " + std::to_string(mesh.cellOffsets[0]) + ", expected 0");
-    for (std::uint64_t c = 0; c < cells; ++c) {
-        const auto raw = static_cast<unsigned>(mesh.cellTypes[c]);
-        if (raw != 10 && raw != 12 && raw != 13 && raw != 14)
-            throwError(ErrorKind::Validation, path,
-                       "cell " + std::to_string(c) + ": type " + std::to_string(raw) +
-                           ", expected " + cellTypeList());
-        const std::uint64_t begin = mesh.cellOffsets[c], end = mesh.cellOffsets[c + 1];
-        const auto corners = static_cast<std::uint64_t>(cornerCount(mesh.cellTypes[c]));
-        if (end < begin || end - begin != corners || end > mesh.cellIndices.size())
-            throwError(ErrorKind::Validation, path,
-                       "cell " + std::to_string(c) + ": offsets " + std::to_string(begin) + ".." +
-                           std::to_string(end) + " do not span the " + std::to_string(corners) +
-                           " corners of a " + cellTypeName(mesh.cellTypes[c]) + " within " +
-                           std::to_string(mesh.cellIndices.size()) + " indices");
-        for (std::uint64_t i = begin; i < end; ++i)
-            if (mesh.cellIndices[i] >= points)
-                throwError(ErrorKind::Validation, path,
-                           "cell " + std::to_string(c) + ": corner " + std::to_string(i - begin) +
-                               " is point " + std::to_string(mesh.cellIndices[i]) +
-                               ", expected below pointCount " + std::to_string(points));
-    }
-    if (mesh.cellOffsets[cells] != mesh.cellIndices.size())
-        throwError(ErrorKind::Validation, path,
-                   "last cell offset " + std::to_string(mesh.cellOffsets[cells]) +
-                       ", expected indexCount " + std::to_string(mesh.cellIndices.size()));
-}
 
 }  // namespace
 
@@ -339,23 +297,14 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
         readArray(arrays[4 + f], field.values.data(), 4);
     }
 
-    checkCells(mesh, path);
+    validateStructure(mesh, path);
     return mesh;
 }
 
 void writeNative(const Mesh& mesh, const std::string& path) {
     // Refuse meshes the reader would refuse, before creating any file.
-    checkCells(mesh, path);
+    validateStructure(mesh, path);
     for (const Field& f : mesh.fields) {
-        const std::uint64_t tuples =
-            f.association == Association::Point ? mesh.pointCount() : mesh.cellCount();
-        if (f.components < 1 ||
-            f.values.size() != tuples * static_cast<std::uint64_t>(f.components))
-            throwError(ErrorKind::Validation, path,
-                       "field '" + f.name + "': " + std::to_string(f.values.size()) +
-                           " values, expected " + std::to_string(tuples) + " " +
-                           associationName(f.association) + " tuples x " +
-                           std::to_string(f.components) + " components");
         if (f.name.size() > kMaxNameBytes)
             throwError(ErrorKind::Argument, path,
                        "field name of " + std::to_string(f.name.size()) +

@@ -321,7 +321,7 @@ TEST(Native, BadCellsAreValidationErrorsNamingTheCell) {
     };
     // Cell 2 (the wedge), corner 4 -> point 12 of 12.
     expectInvalid([&](std::string& b) { patch<std::uint32_t>(b, l.indices + 4 * (12 + 4), 12); },
-                  {"cell 2: corner 4 is point 12", "pointCount 12"});
+                  {"cell 2 (wedge): corner 4 is point 12", "pointCount 12"});
     expectInvalid([&](std::string& b) { patch<std::uint8_t>(b, l.types + 1, 11); },
                   {"cell 1: type 11"});
     expectInvalid([&](std::string& b) { patch<std::uint8_t>(b, l.types + 3, 0); },
@@ -357,7 +357,7 @@ TEST(Native, FailedWritesLeaveNoFile) {
                 {out, "field 'velocity vector'", "35 values, expected 12 point tuples x 3"});
     bad = mixedMesh();
     bad.cellIndices[3] = 99;
-    expectError([&] { writeNative(bad, out); }, ErrorKind::Validation, {out, "cell 0: corner 3"});
+    expectError([&] { writeNative(bad, out); }, ErrorKind::Validation, {out, "cell 0", "corner 3"});
     EXPECT_TRUE(std::filesystem::is_empty(dir)) << "nothing, not even a temporary, is left";
 
     // An existing file is replaced only by a complete new one.

@@ -57,16 +57,23 @@ std::optional<ScalarType> parseXmlTypeName(const std::string& name);
 /// The VTK XML name of a type ("Float32").
 const char* xmlTypeName(ScalarType t);
 
-/// Reads element i of raw bytes of type t (swapping bytes when swap) as double.
-inline double loadAsDouble(const unsigned char* data, ScalarType t, std::size_t i, bool swap) {
-    unsigned char buf[8] = {};
-    std::size_t n = scalarSize(t);
+/// Copies element i of raw bytes of type t into buf in host order (reversing the bytes when
+/// swap).
+inline void loadElementBytes(const unsigned char* data, ScalarType t, std::size_t i, bool swap,
+                             unsigned char buf[8]) {
+    const std::size_t n = scalarSize(t);
     const unsigned char* src = data + i * n;
     if (swap) {
         for (std::size_t k = 0; k < n; ++k) buf[k] = src[n - 1 - k];
     } else {
         std::memcpy(buf, src, n);
     }
+}
+
+/// Reads element i of raw bytes of type t (swapping bytes when swap) as double.
+inline double loadAsDouble(const unsigned char* data, ScalarType t, std::size_t i, bool swap) {
+    unsigned char buf[8] = {};
+    loadElementBytes(data, t, i, swap, buf);
     switch (t) {
         case ScalarType::Int8: {
             std::int8_t v;
@@ -123,13 +130,7 @@ inline double loadAsDouble(const unsigned char* data, ScalarType t, std::size_t 
 /// negative, which range checks then reject).
 inline std::int64_t loadAsInt64(const unsigned char* data, ScalarType t, std::size_t i, bool swap) {
     unsigned char buf[8] = {};
-    std::size_t n = scalarSize(t);
-    const unsigned char* src = data + i * n;
-    if (swap) {
-        for (std::size_t k = 0; k < n; ++k) buf[k] = src[n - 1 - k];
-    } else {
-        std::memcpy(buf, src, n);
-    }
+    loadElementBytes(data, t, i, swap, buf);
     switch (t) {
         case ScalarType::Int64: {
             std::int64_t v;

@@ -12,6 +12,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/validate.h"
 
 namespace uvr {
 
@@ -83,27 +84,8 @@ private:
 
 void writeVtu(const Mesh& mesh, const std::string& path) {
     // Structure checks, so that VTK never reads past an array.
+    validateStructure(mesh, path);
     const std::uint64_t cells = mesh.cellCount();
-    if (mesh.cellOffsets.size() != cells + 1 || mesh.cellOffsets.back() != mesh.cellIndices.size())
-        throwError(ErrorKind::Validation, path,
-                   "cell offsets (" + std::to_string(mesh.cellOffsets.size()) +
-                       " entries) do not match " + std::to_string(cells) + " cells and " +
-                       std::to_string(mesh.cellIndices.size()) + " indices");
-    for (std::uint64_t c = 0; c < cells; ++c)
-        if (mesh.cellOffsets[c + 1] < mesh.cellOffsets[c])
-            throwError(ErrorKind::Validation, path,
-                       "cell " + std::to_string(c) + ": offsets run backwards");
-    for (const Field& f : mesh.fields) {
-        const std::uint64_t tuples =
-            f.association == Association::Point ? mesh.pointCount() : mesh.cellCount();
-        if (f.components < 1 ||
-            f.values.size() != tuples * static_cast<std::uint64_t>(f.components))
-            throwError(ErrorKind::Validation, path,
-                       "field '" + f.name + "': " + std::to_string(f.values.size()) +
-                           " values, expected " + std::to_string(tuples) + " " +
-                           associationName(f.association) + " tuples x " +
-                           std::to_string(f.components) + " components");
-    }
 
     // XML header: the appended blocks follow in the order their DataArrays are listed, each a
     // UInt64 byte count and the data; offsets count from the byte after the '_' marker.
