@@ -62,6 +62,7 @@ const char* xmlTypeName(ScalarType t);
 inline void loadElementBytes(const unsigned char* data, ScalarType t, std::size_t i, bool swap,
                              unsigned char buf[8]) {
     const std::size_t n = scalarSize(t);
+    if (n > 8) return;  // never: tells the compiler buf cannot overflow
     const unsigned char* src = data + i * n;
     if (swap) {
         for (std::size_t k = 0; k < n; ++k) buf[k] = src[n - 1 - k];
