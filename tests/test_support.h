@@ -17,8 +17,11 @@
 namespace uvr::testing {
 
 /// Path of a real mesh in ../shared/data; the test is skipped when the folder is absent.
+/// The folder is UVR_SHARED_DATA_DIR, or the environment variable UVR_SHARED_DATA when set (for
+/// running a carried test binary on another machine).
 inline std::string sharedData(const std::string& name) {
-    return std::string(UVR_SHARED_DATA_DIR) + "/" + name;
+    const char* env = std::getenv("UVR_SHARED_DATA");
+    return std::string(env ? env : UVR_SHARED_DATA_DIR) + "/" + name;
 }
 
 /// True when the shared data folder is present (tests that need it GTEST_SKIP otherwise).
@@ -61,7 +64,8 @@ inline bool pythonHas(const std::string& module) {
 
 /// Path of the uvr command-line binary built beside the tests.
 inline std::string uvrBinary() {
-    return UVR_BIN_PATH;
+    const char* env = std::getenv("UVR_BIN");  // a carried binary on another machine
+    return env ? env : UVR_BIN_PATH;
 }
 
 /// Runs a shell command, returning its exit status (the shell's, 0..255).

@@ -84,6 +84,7 @@ void addBenchCommand(CLI::App& app, Log& log) {
         if (flags->threads > 0) omp_set_num_threads(flags->threads);
         const PreparedMesh prepared = prepareMesh(mesh, field, flags->prepareOptions(),
                                                   [&](const std::string& s) { log.step(s); });
+        FrameRenderer renderer(prepared, flags->device, log);
         const float s1 = makeFrameSetup(prepared, base).params.step;
         const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;
 
@@ -115,9 +116,9 @@ void addBenchCommand(CLI::App& app, Log& log) {
         for (Variant& v : variants) {
             log.step("timing " + v.name);
             std::vector<double> times;
-            v.last = renderCpu(prepared, v.settings);
+            v.last = renderer.render(v.settings);
             for (int r = 0; r < *repeat; ++r) {
-                v.last = renderCpu(prepared, v.settings);
+                v.last = renderer.render(v.settings);
                 times.push_back(v.last.stats.seconds);
             }
             v.medianSeconds = median(times);
@@ -141,20 +142,25 @@ void addBenchCommand(CLI::App& app, Log& log) {
         // Table.
         const int threads = omp_get_max_threads();
         const double refTime = variants.front().medianSeconds;
+        // Samples per second per CPU core, or for the whole GPU.
+        const std::string where = renderer.gpu()
+                                      ? cudaDeviceDescription()
+                                      : std::to_string(threads) + " CPU thread(s)";
+        const int units = renderer.gpu() ? 1 : threads;
         std::printf(
             "%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
-            "p = %g, %d thread(s), median of %d frames\n",
+            "p = %g, %s, median of %d frames\n",
             file->c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
             prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
-            base.power, threads, *repeat);
+            base.power, where.c_str(), *repeat);
         std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
-                    "samples", "spp", "Msps/core", "speed-up", "SSIM");
+                    "samples", "spp", renderer.gpu() ? "Msps" : "Msps/core", "speed-up", "SSIM");
         for (const Variant& v : variants) {
             const double pixels = double(base.width) * base.height;
-            std::printf("%-22s %8s %10.1f %12llu %9.2f %9.2f %7.2fx %8.4f\n", v.name.c_str(),
+            std::printf("%-22s %8s %10.2f %12llu %9.2f %9.1f %7.2fx %8.4f\n", v.name.c_str(),
                         v.s2Factor > 0 ? std::to_string(v.s2Factor).substr(0, 5).c_str() : "-",
                         v.medianSeconds * 1e3, static_cast<unsigned long long>(v.samples),
-                        v.samples / pixels, v.samples / v.medianSeconds / threads / 1e6,
+                        v.samples / pixels, v.samples / v.medianSeconds / units / 1e6,
                         refTime / v.medianSeconds, v.ssim);
         }
         std::printf("transfer-function update: %.3f ms for %zu partitions\n",
@@ -184,6 +190,7 @@ void addBenchCommand(CLI::App& app, Log& log) {
                 j["s1"] = s1;
                 j["power"] = base.power;
                 j["threads"] = threads;
+                j["device"] = where;
                 j["repeat"] = *repeat;
                 j["tf_update_seconds"] = variants.back().last.setup.tfUpdateSeconds;
                 for (const Variant& v : variants)

@@ -148,6 +148,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
         ->capture_default_str();
     if (oneFrame) app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
+    app.add_option("--device", device,
+                   "Where to render: cpu, cuda, or auto (CUDA when a device is present)")
+        ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
+        ->capture_default_str();
     app.add_option("--threads", threads, "CPU threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
 }
@@ -207,6 +211,27 @@ PrepareOptions RenderFlags::prepareOptions() const {
     return o;
 }
 
+FrameRenderer::FrameRenderer(const PreparedMesh& mesh, const std::string& device, const Log& log)
+    : mesh_(mesh) {
+    if (device == "cuda" || (device == "auto" && cudaDeviceAvailable())) {
+        log.step("GPU: " + cudaDeviceDescription());
+        gpu_ = std::make_unique<CudaScene>(mesh);
+        char line[160];
+        std::snprintf(line, sizeof line,
+                      "uploaded %.1f MiB to the GPU (%.1f bytes per tetrahedron) in %.3f s",
+                      gpu_->geometryBytes() / 1048576.0,
+                      double(gpu_->geometryBytes()) / std::max<std::size_t>(1, mesh.tets.tets.size()),
+                      gpu_->uploadSeconds());
+        log.step(line);
+    }
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+RenderResult FrameRenderer::render(const RenderSettings& settings) {
+    return gpu_ ? gpu_->render(settings) : renderCpu(mesh_, settings);
+}
+
 Mesh loadMesh(const std::string& path, const Log& log) {
     auto start = Clock::now();
     log.step("reading " + path);
@@ -238,10 +263,11 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     log.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
     log.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
              std::to_string(settings.height));
-    RenderResult result = renderCpu(prepared, settings);
+    FrameRenderer renderer(prepared, flags.device, log);
+    RenderResult result = renderer.render(settings);
     char line[200];
-    std::snprintf(line, sizeof line, "rendered in %.3f s: %llu samples, %.1f per pixel, step %g",
-                  result.stats.seconds, static_cast<unsigned long long>(result.stats.samples),
+    std::snprintf(line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
+                  renderer.deviceName(), result.stats.seconds, static_cast<unsigned long long>(result.stats.samples),
                   result.stats.meanSamplesPerPixel(), result.setup.params.step);
     log.step(line);
     if (settings.method == RenderMethod::Partitions) {
@@ -265,7 +291,14 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         nlohmann::json j;
         j["source"] = source;
         j["field"] = field.name;
-        j["device"] = "cpu";
+        j["device"] = renderer.deviceName();
+        if (renderer.gpu()) {
+            j["gpu"] = {{"description", cudaDeviceDescription()},
+                        {"geometry_bytes", renderer.gpu()->geometryBytes()},
+                        {"bytes_per_tetrahedron", double(renderer.gpu()->geometryBytes()) /
+                                                      std::max<std::size_t>(1, prepared.tets.tets.size())},
+                        {"upload_seconds", renderer.gpu()->uploadSeconds()}};
+        }
         j["threads"] = omp_get_max_threads();
         j["method"] = flags.method;
         if (prepared.kd) {

@@ -46,6 +46,7 @@ struct RenderFlags {
     float power = 2.f;
     bool noSkip = false, noAdaptive = false;
     std::uint32_t leafCells = 0;
+    std::string device = "auto";
     std::string heatmapFile;
     std::uint32_t heatmapMax = 0;
     std::string background;
@@ -61,6 +62,25 @@ struct RenderFlags {
     std::optional<Vec3f> backgroundColor() const;
     /// What mesh preparation the flags need (partitions only for the adaptive method).
     PrepareOptions prepareOptions() const;
+};
+
+/// Renders frames of one prepared mesh on the device the flags chose (auto: CUDA when a device
+/// is present), keeping the GPU copy of the mesh across frames.
+class FrameRenderer {
+public:
+    /// Picks the device ("cpu", "cuda" or "auto") and uploads the mesh for CUDA.
+    FrameRenderer(const PreparedMesh& mesh, const std::string& device, const Log& log);
+    ~FrameRenderer();
+    /// Renders one frame.
+    RenderResult render(const RenderSettings& settings);
+    /// "cpu" or "cuda".
+    const char* deviceName() const { return gpu_ ? "cuda" : "cpu"; }
+    /// The GPU copy, when rendering on CUDA.
+    const CudaScene* gpu() const { return gpu_.get(); }
+
+private:
+    const PreparedMesh& mesh_;
+    std::unique_ptr<CudaScene> gpu_;
 };
 
 /// Loads a mesh with progress messages and validation; prints findings.

@@ -25,7 +25,7 @@ namespace {
 /// Runs the pixel kernel over the frame in 8x8 tiles (neighbouring rays, and their
 /// tetrahedra, stay on one core) and sums the counters.
 template <class March>
-void launchFrame(const FrameView& frame, RenderStats& stats, March&& march) {
+void launchFrame(const FrameView& frame, RenderStats& stats, const March& march) {
     std::vector<RenderStats> perThread(cpu::threadCount());
     constexpr int kTile = 8;
     const int tilesX = (frame.width + kTile - 1) / kTile;
@@ -51,15 +51,11 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     const FrameView frame{result.image.pixels.data(), result.sampleCounts.data(), settings.width,
                           settings.height, result.setup.rays};
     const auto start = std::chrono::steady_clock::now();
-    if (settings.method == RenderMethod::Reference) {
-        const SceneView scene = result.setup.scene(mesh);
+    if (settings.method == RenderMethod::Reference)
+        launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)});
+    else
         launchFrame(frame, result.stats,
-                    [&](const Ray& ray, RayCounters& c) { return marchReference(scene, ray, c); });
-    } else {
-        const PartitionSceneView scene = result.setup.partitionScene(mesh, settings.skip);
-        launchFrame(frame, result.stats,
-                    [&](const Ray& ray, RayCounters& c) { return marchPartitions(scene, ray, c); });
-    }
+                    PartitionMarch{result.setup.partitionScene(mesh, settings.skip)});
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;

@@ -32,4 +32,20 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
     return counters;
 }
 
+/// The reference marcher as a functor for shadePixel (lambdas do not cross to CUDA kernels).
+struct ReferenceMarch {
+    SceneView scene;
+    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
+        return marchReference(scene, ray, counters);
+    }
+};
+
+/// The partition integrator as a functor for shadePixel.
+struct PartitionMarch {
+    PartitionSceneView scene;
+    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
+        return marchPartitions(scene, ray, counters);
+    }
+};
+
 }  // namespace uvr

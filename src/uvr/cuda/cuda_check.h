@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace uvr::cuda {
+
+/// Throws uvr::Error for a failed CUDA call: Error(Resource) with the free and total device
+/// memory for out-of-memory, Error(Internal) with the call text, file and line otherwise.
+void check(cudaError_t status, const char* call, const char* file, int line);
+
+/// Throws Error(Resource) naming what could not be allocated, its size and the free memory.
+[[noreturn]] void outOfMemory(const std::string& what, std::size_t bytes);
+
+/// A device array owned by RAII; upload() allocates and copies, naming `what` on failure.
+template <class T>
+class DeviceArray {
+public:
+    DeviceArray() = default;
+    DeviceArray(const DeviceArray&) = delete;
+    DeviceArray& operator=(const DeviceArray&) = delete;
+    ~DeviceArray() { release(); }
+
+    /// Makes room for n elements (keeps the allocation when it is large enough).
+    void reserve(std::size_t n, const char* what) {
+        if (n <= capacity_) {
+            size_ = n;
+            return;
+        }
+        release();
+        if (n > 0 && cudaMalloc(reinterpret_cast<void**>(&ptr_), n * sizeof(T)) != cudaSuccess) {
+            cudaGetLastError();  // clear the sticky-free allocation error
+            ptr_ = nullptr;
+            outOfMemory(what, n * sizeof(T));
+        }
+        capacity_ = size_ = n;
+    }
+    /// Allocates and copies a host vector.
+    void upload(const std::vector<T>& host, const char* what) {
+        reserve(host.size(), what);
+        if (!host.empty())
+            check(cudaMemcpy(ptr_, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice),
+                  "cudaMemcpy(upload)", __FILE__, __LINE__);
+    }
+    T* data() const { return ptr_; }
+    std::size_t size() const { return size_; }
+    std::size_t bytes() const { return size_ * sizeof(T); }
+
+private:
+    void release() {
+        if (ptr_) cudaFree(ptr_);
+        ptr_ = nullptr;
+        capacity_ = size_ = 0;
+    }
+    T* ptr_ = nullptr;
+    std::size_t size_ = 0, capacity_ = 0;
+};
+
+}  // namespace uvr::cuda
+
+/// Checks a CUDA runtime call (GUIDE.md §5): the call text, file and line go into the error.
+#define UVR_CUDA_CHECK(call) ::uvr::cuda::check((call), #call, __FILE__, __LINE__)

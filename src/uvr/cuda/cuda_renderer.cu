@@ -1,0 +1,212 @@
+// SPDX-License-Identifier: MIT
+// The CUDA backend: device memory, uploads and launches only; every ray's math is the shared
+// UVR_HOST_DEVICE code of render/ (GUIDE.md §2).
+#include "uvr/cuda/cuda_renderer.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "uvr/core/error.h"
+#include "uvr/cuda/cuda_check.h"
+#include "uvr/render/frame_kernel.h"
+
+namespace uvr {
+
+namespace cuda {
+
+void check(cudaError_t status, const char* call, const char* file, int line) {
+    if (status == cudaSuccess) return;
+    if (status == cudaErrorMemoryAllocation) outOfMemory(call, 0);
+    throw Error(ErrorKind::Internal, std::string("CUDA error in ") + call + " at " + file + ":" +
+                                         std::to_string(line) + ": " + cudaGetErrorString(status));
+}
+
+void outOfMemory(const std::string& what, std::size_t bytes) {
+    std::size_t freeBytes = 0, totalBytes = 0;
+    cudaMemGetInfo(&freeBytes, &totalBytes);
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "out of GPU memory allocating %s: need %.2f GiB more, %.2f GiB free of %.2f GiB",
+                  what.c_str(), bytes / 1073741824.0, freeBytes / 1073741824.0,
+                  totalBytes / 1073741824.0);
+    throw Error(ErrorKind::Resource, buf);
+}
+
+namespace {
+
+/// Counters summed over a frame: samples, walk steps, BVH queries, partitions visited, skipped.
+constexpr int kCounters = 5;
+
+/// Kernel: one thread per pixel runs the shared pixel body, then the warp sums its counters.
+template <class March>
+__global__ void frameKernel(FrameView frame, March march, unsigned long long* totals) {
+    const int x = blockIdx.x * blockDim.x + threadIdx.x;
+    const int y = blockIdx.y * blockDim.y + threadIdx.y;
+    RayCounters c;
+    if (x < frame.width && y < frame.height) c = shadePixel(frame, x, y, march);
+    unsigned long long v[kCounters] = {c.samples, c.locate.walkSteps, c.locate.bvhQueries,
+                                       c.partitionsVisited, c.partitionsSkipped};
+    const unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) % 32u;
+    for (int k = 0; k < kCounters; ++k) {
+        for (int offset = 16; offset > 0; offset /= 2)
+            v[k] += __shfl_down_sync(0xffffffffu, v[k], offset);
+        if (lane == 0 && v[k]) atomicAdd(&totals[k], v[k]);
+    }
+}
+
+}  // namespace
+}  // namespace cuda
+
+bool cudaDeviceAvailable() {
+    int count = 0;
+    return cudaGetDeviceCount(&count) == cudaSuccess && count > 0;
+}
+
+std::string cudaDeviceDescription() {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) {
+        cudaGetLastError();
+        return "none: no CUDA device found";
+    }
+    cudaDeviceProp prop{};
+    UVR_CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s, %.1f GiB, compute capability %d.%d, %d SMs", prop.name,
+                  prop.totalGlobalMem / 1073741824.0, prop.major, prop.minor,
+                  prop.multiProcessorCount);
+    return buf;
+}
+
+struct CudaScene::Impl {
+    const PreparedMesh& mesh;
+    cuda::DeviceArray<Vec3f> points;
+    cuda::DeviceArray<Tet> tets;
+    cuda::DeviceArray<float> values;
+    cuda::DeviceArray<std::uint32_t> neighbors;
+    cuda::DeviceArray<BvhNode> bvhNodes;
+    cuda::DeviceArray<std::uint32_t> bvhPrims;
+    cuda::DeviceArray<KdNode> kdNodes;
+    cuda::DeviceArray<KdPartition> partitions;
+    cuda::DeviceArray<BvhNode> partitionBvhNodes;
+    cuda::DeviceArray<std::uint32_t> partitionCells;
+    // Per frame / transfer function.
+    cuda::DeviceArray<Vec4f> tfTable;
+    cuda::DeviceArray<PartitionShading> shading;
+    cuda::DeviceArray<Vec4f> pixels;
+    cuda::DeviceArray<std::uint32_t> sampleCounts;
+    cuda::DeviceArray<unsigned long long> totals;
+    double uploadSeconds = 0.0;
+
+    explicit Impl(const PreparedMesh& m) : mesh(m) {}
+
+    /// The host scene view with every pointer replaced by its device copy.
+    SceneView deviceScene(const FrameSetup& setup) const {
+        SceneView v = setup.scene(mesh);
+        v.locator.mesh.points = points.data();
+        v.locator.mesh.tets = tets.data();
+        v.locator.mesh.values = values.data();
+        v.locator.bvh.nodes = bvhNodes.data();
+        v.locator.bvh.primIds = bvhPrims.data();
+        v.locator.neighbors = neighbors.data();
+        v.tf.entries = tfTable.data();
+        return v;
+    }
+};
+
+CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(mesh)) {
+    if (!cudaDeviceAvailable())
+        throwError(ErrorKind::Unsupported, "", "--device cuda: no CUDA device found");
+    const auto start = std::chrono::steady_clock::now();
+    Impl& d = *impl_;
+    d.points.upload(mesh.tets.points, "the mesh points");
+    d.tets.upload(mesh.tets.tets, "the tetrahedra");
+    d.values.upload(mesh.tets.values, "the field values");
+    d.neighbors.upload(mesh.neighbors, "the face neighbours");
+    d.bvhNodes.upload(mesh.bvh.nodes, "the BVH nodes");
+    d.bvhPrims.upload(mesh.bvh.primIds, "the BVH primitive ids");
+    if (mesh.kd) {
+        d.kdNodes.upload(mesh.kd->nodes, "the k-d nodes");
+        d.partitions.upload(mesh.kd->partitions, "the partitions");
+        d.partitionBvhNodes.upload(mesh.kd->bvhNodes, "the partition BVH nodes");
+        d.partitionCells.upload(mesh.kd->cells, "the partition cell lists");
+    }
+    d.totals.reserve(cuda::kCounters, "the frame counters");
+    UVR_CUDA_CHECK(cudaDeviceSynchronize());
+    d.uploadSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+CudaScene::~CudaScene() = default;
+
+std::uint64_t CudaScene::geometryBytes() const {
+    const Impl& d = *impl_;
+    return d.points.bytes() + d.tets.bytes() + d.values.bytes() + d.neighbors.bytes() +
+           d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
+           d.partitionBvhNodes.bytes() + d.partitionCells.bytes();
+}
+
+double CudaScene::uploadSeconds() const { return impl_->uploadSeconds; }
+
+RenderResult CudaScene::render(const RenderSettings& settings) {
+    Impl& d = *impl_;
+    RenderResult result;
+    result.setup = makeFrameSetup(d.mesh, settings);
+    // Transfer-function state: the only per-change upload (a few kilobytes).
+    d.tfTable.upload(result.setup.tfTable, "the transfer function");
+    const std::size_t pixelCount = static_cast<std::size_t>(settings.width) * settings.height;
+    d.pixels.reserve(pixelCount, "the image");
+    d.sampleCounts.reserve(pixelCount, "the sample counts");
+    UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
+    const FrameView frame{d.pixels.data(), d.sampleCounts.data(), settings.width, settings.height,
+                          result.setup.rays};
+    const dim3 block(16, 8);
+    const dim3 grid((settings.width + block.x - 1) / block.x,
+                    (settings.height + block.y - 1) / block.y);
+    cudaEvent_t begin, end;
+    UVR_CUDA_CHECK(cudaEventCreate(&begin));
+    UVR_CUDA_CHECK(cudaEventCreate(&end));
+    UVR_CUDA_CHECK(cudaEventRecord(begin));
+    if (settings.method == RenderMethod::Reference) {
+        cuda::frameKernel<<<grid, block>>>(frame, ReferenceMarch{d.deviceScene(result.setup)},
+                                           d.totals.data());
+    } else {
+        if (!d.mesh.kd)
+            throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
+        d.shading.upload(result.setup.shading, "the partition shading");
+        PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
+        scene.base = d.deviceScene(result.setup);
+        scene.kd.nodes = d.kdNodes.data();
+        scene.kd.partitions = d.partitions.data();
+        scene.kd.bvh.nodes = d.partitionBvhNodes.data();
+        scene.kd.bvh.primIds = d.partitionCells.data();
+        scene.shading = d.shading.data();
+        cuda::frameKernel<<<grid, block>>>(frame, PartitionMarch{scene}, d.totals.data());
+    }
+    UVR_CUDA_CHECK(cudaGetLastError());
+    UVR_CUDA_CHECK(cudaEventRecord(end));
+    UVR_CUDA_CHECK(cudaEventSynchronize(end));
+    float ms = 0.f;
+    UVR_CUDA_CHECK(cudaEventElapsedTime(&ms, begin, end));
+    UVR_CUDA_CHECK(cudaEventDestroy(begin));
+    UVR_CUDA_CHECK(cudaEventDestroy(end));
+    // Results back to the host.
+    result.image = Image(settings.width, settings.height);
+    result.sampleCounts.resize(pixelCount);
+    UVR_CUDA_CHECK(cudaMemcpy(result.image.pixels.data(), d.pixels.data(),
+                              pixelCount * sizeof(Vec4f), cudaMemcpyDeviceToHost));
+    UVR_CUDA_CHECK(cudaMemcpy(result.sampleCounts.data(), d.sampleCounts.data(),
+                              pixelCount * sizeof(std::uint32_t), cudaMemcpyDeviceToHost));
+    unsigned long long totals[cuda::kCounters];
+    UVR_CUDA_CHECK(cudaMemcpy(totals, d.totals.data(), sizeof totals, cudaMemcpyDeviceToHost));
+    result.stats.seconds = ms * 1e-3;
+    result.stats.width = settings.width;
+    result.stats.height = settings.height;
+    result.stats.samples = totals[0];
+    result.stats.walkSteps = totals[1];
+    result.stats.bvhQueries = totals[2];
+    result.stats.partitionsVisited = totals[3];
+    result.stats.partitionsSkipped = totals[4];
+    return result;
+}
+
+}  // namespace uvr

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "uvr/render/render_setup.h"
+
+namespace uvr {
+
+/// True when this uvr was built with CUDA and a CUDA device can be used.
+bool cudaDeviceAvailable();
+
+/// One line naming the CUDA device and its memory, or why there is none.
+std::string cudaDeviceDescription();
+
+/// A prepared mesh resident on the GPU: geometry, BVH, neighbours and partitions are uploaded
+/// once; each render uploads only the baked transfer function and per-partition shading, so
+/// transfer-function changes never touch geometry. The PreparedMesh must outlive it.
+class CudaScene {
+public:
+    /// Uploads the mesh; throws Error(Resource) naming the need and the free memory when it does
+    /// not fit, Error(Unsupported) when uvr was built without CUDA or no device is present.
+    explicit CudaScene(const PreparedMesh& mesh);
+    ~CudaScene();
+    CudaScene(const CudaScene&) = delete;
+    CudaScene& operator=(const CudaScene&) = delete;
+
+    /// Renders a frame on the GPU with the integrator settings.method names (same results as
+    /// renderCpu up to floating-point rounding).
+    RenderResult render(const RenderSettings& settings);
+
+    /// Bytes of device memory holding the mesh, BVH, neighbours and partitions.
+    std::uint64_t geometryBytes() const;
+    /// Seconds the upload took.
+    double uploadSeconds() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uvr

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+// GPU tests: skipped without a CUDA device; run on the GPU machine before GPU work is resolved.
+#include "uvr/cuda/cuda_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include "test_meshes.h"
+#include "test_support.h"
+#include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/render/image_metrics.h"
+
+namespace uvr {
+namespace {
+
+#define UVR_REQUIRE_GPU() \
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription()
+
+RenderSettings settingsFor(const PreparedMesh& pm, RenderMethod method) {
+    RenderSettings s;
+    s.width = 160;
+    s.height = 120;
+    s.method = method;
+    s.tf = transferFunctionPreset("cool-to-warm");
+    applyOpacitySpec(s.tf, "0:0,1:0.4");
+    s.camera = orbitCamera(resetCamera(pm.tets.bounds, 160.f / 120.f), 30.f, 20.f);
+    return s;
+}
+
+/// CPU and GPU run the same code on the same data: images agree to rounding, counts exactly or
+/// nearly (a sample on a shared face may resolve to either tetrahedron).
+void expectSameAsCpu(const PreparedMesh& pm, const RenderSettings& s, const std::string& what) {
+    CudaScene gpu(pm);
+    const RenderResult c = renderCpu(pm, s);
+    const RenderResult g = gpu.render(s);
+    const double ssim = compareImages(toRgb8(c.image), toRgb8(g.image)).ssim;
+    EXPECT_GE(ssim, 0.99) << what;
+    EXPECT_NEAR(double(g.stats.samples), double(c.stats.samples), 0.001 * c.stats.samples) << what;
+    EXPECT_EQ(g.stats.partitionsVisited, c.stats.partitionsVisited) << what;
+    EXPECT_GT(gpu.geometryBytes(), 0u);
+}
+
+TEST(Cuda, DescriptionIsOneLine) {
+    const std::string d = cudaDeviceDescription();
+    EXPECT_FALSE(d.empty());
+    EXPECT_EQ(d.find('\n'), std::string::npos);
+}
+
+TEST(Cuda, WithoutADeviceTheSceneIsRefusedClearly) {
+    if (cudaDeviceAvailable()) GTEST_SKIP() << "a CUDA device is present";
+    Mesh m = testing::makeHexGrid(2, 0.f, 1.f);
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}));
+    try {
+        CudaScene scene(pm);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    }
+}
+
+TEST(Cuda, ProceduralMeshMatchesCpuForEveryMethod) {
+    UVR_REQUIRE_GPU();
+    Mesh m = testing::makeHexGrid(12, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+    PrepareOptions o;
+    o.kd.leafCells = 128;
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
+    expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Reference), "reference");
+    RenderSettings s = settingsFor(pm, RenderMethod::Partitions);
+    expectSameAsCpu(pm, s, "skipping + adaptive");
+    s.skip = false;
+    expectSameAsCpu(pm, s, "adaptive only");
+    s.skip = true;
+    s.adaptive = false;
+    expectSameAsCpu(pm, s, "skipping only");
+}
+
+TEST(Cuda, RealMeshesMatchCpu) {
+    UVR_REQUIRE_GPU();
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    for (const char* name : {"bluntfin_tets.vtk", "fire_ug.vtu", "spx.vtk"}) {
+        const Mesh mesh = readMesh(testing::sharedData(name));
+        const PreparedMesh pm = prepareMesh(mesh, selectScalarField(mesh, {}));
+        expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Reference), std::string(name) + " ref");
+        expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Partitions),
+                        std::string(name) + " adaptive");
+    }
+}
+
+TEST(Cuda, TransferFunctionChangesReuseTheUploadedGeometry) {
+    UVR_REQUIRE_GPU();
+    Mesh m = testing::makeHexGrid(8, -1.f, 1.f, [](Vec3f p) { return p.x; });
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}));
+    CudaScene gpu(pm);
+    const std::uint64_t bytes = gpu.geometryBytes();
+    RenderSettings s = settingsFor(pm, RenderMethod::Partitions);
+    const RenderResult a = gpu.render(s);
+    applyOpacitySpec(s.tf, "step:0.5");
+    const RenderResult b = gpu.render(s);
+    EXPECT_EQ(gpu.geometryBytes(), bytes);
+    EXPECT_GT(b.stats.partitionsSkipped, a.stats.partitionsSkipped);
+    EXPECT_LT(compareImages(toRgb8(a.image), toRgb8(b.image)).ssim, 0.999);
+}
+
+}  // namespace
+}  // namespace uvr

@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: MIT
+// The CUDA entry points of a build without CUDA (UVR_ENABLE_CUDA=OFF): no device, clear errors.
+#include "uvr/core/error.h"
+#include "uvr/cuda/cuda_renderer.h"
+
+namespace uvr {
+
+struct CudaScene::Impl {};
+
+bool cudaDeviceAvailable() { return false; }
+
+std::string cudaDeviceDescription() { return "none: this uvr was built without CUDA"; }
+
+CudaScene::CudaScene(const PreparedMesh&) {
+    throwError(ErrorKind::Unsupported, "",
+               "--device cuda: this uvr was built without CUDA (configure with a CUDA compiler "
+               "and UVR_ENABLE_CUDA=ON)");
+}
+
+CudaScene::~CudaScene() = default;
+
+RenderResult CudaScene::render(const RenderSettings&) { return {}; }
+
+std::uint64_t CudaScene::geometryBytes() const { return 0; }
+
+double CudaScene::uploadSeconds() const { return 0.0; }
+
+}  // namespace uvr
