@@ -27,6 +27,7 @@ struct TetLocator {
     TetMeshView mesh;
     BvhView bvh;
     const std::uint32_t* neighbors = nullptr;  ///< 4 per tetrahedron, may be null (no walking)
+    int maxWalkSteps = kMaxWalkSteps;          ///< walk length before the BVH takes over
 
     /// True when p lies in tetrahedron t (within kBaryEpsilon); fills bary.
     UVR_HOST_DEVICE bool inside(std::uint32_t t, Vec3f p, float bary[4]) const {
@@ -51,7 +52,7 @@ struct TetLocator {
                                            LocateCounters& counters) const {
         if (hint != kNoTet && neighbors) {
             std::uint32_t t = hint;
-            for (int step = 0; step < kMaxWalkSteps; ++step) {
+            for (int step = 0; step < maxWalkSteps; ++step) {
                 ++counters.walkSteps;
                 const Tet& tet = mesh.tets[t];
                 if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],

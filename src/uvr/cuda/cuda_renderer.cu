@@ -34,6 +34,9 @@ void outOfMemory(const std::string& what, std::size_t bytes) {
 
 namespace {
 
+/// Walk length on the GPU before the BVH takes over.
+constexpr int kGpuMaxWalkSteps = 64;
+
 /// Counters summed over a frame: samples, walk steps, BVH queries, partitions visited, skipped.
 constexpr int kCounters = 5;
 
@@ -180,6 +183,10 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         scene.kd.bvh.nodes = d.partitionBvhNodes.data();
         scene.kd.bvh.primIds = d.partitionCells.data();
         scene.shading = d.shading.data();
+        // GPU: walking stays coherent across a warp where divergent BVH searches do not, so
+        // samples always walk from the previous one, for longer.
+        scene.longStep = INFINITY;
+        scene.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;
         cuda::frameKernel<<<grid, block>>>(frame, PartitionMarch{scene}, d.totals.data());
     }
     UVR_CUDA_CHECK(cudaGetLastError());

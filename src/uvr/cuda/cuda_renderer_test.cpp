@@ -90,12 +90,14 @@ TEST(Cuda, RealMeshesMatchCpu) {
 TEST(Cuda, TransferFunctionChangesReuseTheUploadedGeometry) {
     UVR_REQUIRE_GPU();
     Mesh m = testing::makeHexGrid(8, -1.f, 1.f, [](Vec3f p) { return p.x; });
-    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}));
+    PrepareOptions o;
+    o.kd.leafCells = 64;
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
     CudaScene gpu(pm);
     const std::uint64_t bytes = gpu.geometryBytes();
     RenderSettings s = settingsFor(pm, RenderMethod::Partitions);
     const RenderResult a = gpu.render(s);
-    applyOpacitySpec(s.tf, "step:0.5");
+    applyOpacitySpec(s.tf, "step:0.75");  // partitions with x < 0.5 become transparent
     const RenderResult b = gpu.render(s);
     EXPECT_EQ(gpu.geometryBytes(), bytes);
     EXPECT_GT(b.stats.partitionsSkipped, a.stats.partitionsSkipped);

@@ -24,10 +24,10 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
     return s > s1 ? s : s1;
 }
 
-/// Steps longer than this many s1 locate samples with the partition's BVH instead of walking
-/// from the previous sample's tetrahedron (measured on Blunt Fin: a walk crosses about three
-/// tetrahedra per s1, and a BVH search costs about as much as ten walk steps).
-inline constexpr float kLongStep = 3.f;
+/// On the CPU, steps longer than this many s1 locate samples with the partition's BVH instead
+/// of walking from the previous sample's tetrahedron (measured on Blunt Fin: a walk crosses about
+/// three tetrahedra per s1, and a BVH search costs about as much as ten walk steps).
+inline constexpr float kCpuLongStep = 3.f;
 
 /// Scene for the partition integrator: the reference scene plus the partitions and their
 /// per-transfer-function shading.
@@ -36,6 +36,7 @@ struct PartitionSceneView {
     KdView kd;
     const PartitionShading* shading = nullptr;
     bool skipTransparent = true;  ///< skip partitions whose maximum opacity is 0
+    float longStep = kCpuLongStep;  ///< steps above this many s1 search the BVH, not walk
 };
 
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
@@ -78,7 +79,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const float k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
         const float m = shade.step / s1;  // step in grid units (1 for s1)
         // Long steps cross more tetrahedra than a walk takes: search the partition's BVH.
-        const bool walk = m <= kLongStep;
+        const bool walk = m <= scene.longStep;
         for (float k = k0; k < k1; k += m) {
             const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
             ++counters.samples;
