@@ -84,7 +84,7 @@ void addBenchCommand(CLI::App& app, Log& log) {
         if (flags->threads > 0) omp_set_num_threads(flags->threads);
         const PreparedMesh prepared = prepareMesh(mesh, field, flags->prepareOptions(),
                                                   [&](const std::string& s) { log.step(s); });
-        FrameRenderer renderer(prepared, flags->device, log);
+        FrameRenderer renderer(prepared, flags->useCuda(), log);
         const float s1 = makeFrameSetup(prepared, base).params.step;
         const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;
 

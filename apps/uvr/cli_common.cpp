@@ -135,7 +135,8 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     }
     app.add_option("--leaf-cells", leafCells,
                    "Adaptive: cells per k-d partition at most (default " +
-                       std::to_string(KdBuildOptions{}.leafCells) + ")")
+                       std::to_string(KdBuildOptions{}.leafCells) + " on the CPU, " +
+                       std::to_string(kCudaDefaultLeafCells) + " with CUDA)")
         ->check(CLI::Range(1u, 1u << 30));
     if (oneFrame) {
         app.add_option("--heatmap", heatmapFile,
@@ -204,16 +205,22 @@ std::optional<Vec3f> RenderFlags::backgroundColor() const {
     return c;
 }
 
+bool RenderFlags::useCuda() const {
+    return device == "cuda" || (device == "auto" && cudaDeviceAvailable());
+}
+
 PrepareOptions RenderFlags::prepareOptions() const {
     PrepareOptions o;
     o.partitions = method == "adaptive";
-    if (leafCells) o.kd.leafCells = leafCells;
+    if (leafCells)
+        o.kd.leafCells = leafCells;
+    else if (useCuda())
+        o.kd.leafCells = kCudaDefaultLeafCells;
     return o;
 }
 
-FrameRenderer::FrameRenderer(const PreparedMesh& mesh, const std::string& device, const Log& log)
-    : mesh_(mesh) {
-    if (device == "cuda" || (device == "auto" && cudaDeviceAvailable())) {
+FrameRenderer::FrameRenderer(const PreparedMesh& mesh, bool cuda, const Log& log) : mesh_(mesh) {
+    if (cuda) {
         log.step("GPU: " + cudaDeviceDescription());
         gpu_ = std::make_unique<CudaScene>(mesh);
         char line[160];
@@ -263,7 +270,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     log.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
     log.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
              std::to_string(settings.height));
-    FrameRenderer renderer(prepared, flags.device, log);
+    FrameRenderer renderer(prepared, flags.useCuda(), log);
     RenderResult result = renderer.render(settings);
     char line[200];
     std::snprintf(line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
@@ -313,7 +320,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                 {"cells_median", sizes.empty() ? 0 : sizes[sizes.size() / 2]},
                 {"cells_max", sizes.empty() ? 0 : sizes.back()},
                 {"duplication_factor", kd.duplicationFactor(prepared.tets.tets.size())},
-                {"leaf_cells", flags.prepareOptions().kd.leafCells}};
+                {"leaf_cells", prepared.kd->leafCells}};
             j["tf_update_seconds"] = result.setup.tfUpdateSeconds;
             j["max_step"] = result.setup.maxStep;
             j["power"] = settings.power;

@@ -60,7 +60,10 @@ struct RenderFlags {
     RenderSettings settings(const Bounds3f& bounds) const;
     /// The --background colour, if given (checked to lie in [0, 1]).
     std::optional<Vec3f> backgroundColor() const;
-    /// What mesh preparation the flags need (partitions only for the adaptive method).
+    /// True when --device asks for CUDA, or is auto and a CUDA device is present.
+    bool useCuda() const;
+    /// What mesh preparation the flags need (partitions only for the adaptive method; the
+    /// device's default leaf size unless --leaf-cells is given).
     PrepareOptions prepareOptions() const;
 };
 
@@ -68,8 +71,8 @@ struct RenderFlags {
 /// is present), keeping the GPU copy of the mesh across frames.
 class FrameRenderer {
 public:
-    /// Picks the device ("cpu", "cuda" or "auto") and uploads the mesh for CUDA.
-    FrameRenderer(const PreparedMesh& mesh, const std::string& device, const Log& log);
+    /// Renders on the CPU, or uploads the mesh and renders with CUDA.
+    FrameRenderer(const PreparedMesh& mesh, bool cuda, const Log& log);
     ~FrameRenderer();
     /// Renders one frame.
     RenderResult render(const RenderSettings& settings);

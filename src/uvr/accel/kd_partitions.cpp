@@ -37,6 +37,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     UVR_CHECK(n < (1ull << 30), "too many tetrahedra for k-d partitions");
     KdPartitions kd;
     kd.bounds = mesh.bounds;
+    kd.leafCells = options.leafCells;
     // Per-cell boxes, centres and finite value ranges.
     std::vector<Bounds3f> boxes(n);
     std::vector<Vec3f> centers(n);

@@ -107,6 +107,7 @@ struct KdPartitions {
     std::vector<std::uint32_t> cells;  ///< tetrahedron ids of every partition, in BVH order
     std::vector<BvhNode> bvhNodes;
     Bounds3f bounds;
+    std::uint32_t leafCells = 0;  ///< the build's leaf size
     double buildSeconds = 0.0;
 
     /// View for kernels; this object must outlive it.
