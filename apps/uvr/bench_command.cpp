@@ -134,18 +134,16 @@ void addBenchCommand(CLI::App& app, Log& log) {
             if (!images->empty()) {
                 const std::string stem = *images + "/" + fileName(v.name);
                 writePng(stem + ".png", v.last.image, background);
-                writePng(stem + "_samples.png",
-                         sampleHeatmap(v.last.sampleCounts, v.settings.width, v.settings.height,
-                                       heatmapMax));
+                writePng(stem + "_samples.png", sampleHeatmap(v.last.sampleCounts, v.settings.width,
+                                                              v.settings.height, heatmapMax));
             }
         }
         // Table.
         const int threads = omp_get_max_threads();
         const double refTime = variants.front().medianSeconds;
         // Samples per second per CPU core, or for the whole GPU.
-        const std::string where = renderer.gpu()
-                                      ? cudaDeviceDescription()
-                                      : std::to_string(threads) + " CPU thread(s)";
+        const std::string where =
+            renderer.gpu() ? cudaDeviceDescription() : std::to_string(threads) + " CPU thread(s)";
         const int units = renderer.gpu() ? 1 : threads;
         std::printf(
             "%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "

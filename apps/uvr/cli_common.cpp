@@ -224,11 +224,12 @@ FrameRenderer::FrameRenderer(const PreparedMesh& mesh, bool cuda, const Log& log
         log.step("GPU: " + cudaDeviceDescription());
         gpu_ = std::make_unique<CudaScene>(mesh);
         char line[160];
-        std::snprintf(line, sizeof line,
-                      "uploaded %.1f MiB to the GPU (%.1f bytes per tetrahedron) in %.3f s",
-                      gpu_->geometryBytes() / 1048576.0,
-                      double(gpu_->geometryBytes()) / std::max<std::size_t>(1, mesh.tets.tets.size()),
-                      gpu_->uploadSeconds());
+        std::snprintf(
+            line, sizeof line,
+            "uploaded %.1f MiB to the GPU (%.1f bytes per tetrahedron) in %.3f s",
+            gpu_->geometryBytes() / 1048576.0,
+            double(gpu_->geometryBytes()) / std::max<std::size_t>(1, mesh.tets.tets.size()),
+            gpu_->uploadSeconds());
         log.step(line);
     }
 }
@@ -273,8 +274,10 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     FrameRenderer renderer(prepared, flags.useCuda(), log);
     RenderResult result = renderer.render(settings);
     char line[200];
-    std::snprintf(line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
-                  renderer.deviceName(), result.stats.seconds, static_cast<unsigned long long>(result.stats.samples),
+    std::snprintf(line, sizeof line,
+                  "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
+                  renderer.deviceName(), result.stats.seconds,
+                  static_cast<unsigned long long>(result.stats.samples),
                   result.stats.meanSamplesPerPixel(), result.setup.params.step);
     log.step(line);
     if (settings.method == RenderMethod::Partitions) {
@@ -300,11 +303,12 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["field"] = field.name;
         j["device"] = renderer.deviceName();
         if (renderer.gpu()) {
-            j["gpu"] = {{"description", cudaDeviceDescription()},
-                        {"geometry_bytes", renderer.gpu()->geometryBytes()},
-                        {"bytes_per_tetrahedron", double(renderer.gpu()->geometryBytes()) /
-                                                      std::max<std::size_t>(1, prepared.tets.tets.size())},
-                        {"upload_seconds", renderer.gpu()->uploadSeconds()}};
+            j["gpu"] = {
+                {"description", cudaDeviceDescription()},
+                {"geometry_bytes", renderer.gpu()->geometryBytes()},
+                {"bytes_per_tetrahedron", double(renderer.gpu()->geometryBytes()) /
+                                              std::max<std::size_t>(1, prepared.tets.tets.size())},
+                {"upload_seconds", renderer.gpu()->uploadSeconds()}};
         }
         j["threads"] = omp_get_max_threads();
         j["method"] = flags.method;

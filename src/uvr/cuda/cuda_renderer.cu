@@ -148,7 +148,9 @@ std::uint64_t CudaScene::geometryBytes() const {
            d.partitionBvhNodes.bytes() + d.partitionCells.bytes();
 }
 
-double CudaScene::uploadSeconds() const { return impl_->uploadSeconds; }
+double CudaScene::uploadSeconds() const {
+    return impl_->uploadSeconds;
+}
 
 RenderResult CudaScene::render(const RenderSettings& settings) {
     Impl& d = *impl_;

@@ -61,7 +61,8 @@ TEST(Cuda, WithoutADeviceTheSceneIsRefusedClearly) {
 
 TEST(Cuda, ProceduralMeshMatchesCpuForEveryMethod) {
     UVR_REQUIRE_GPU();
-    Mesh m = testing::makeHexGrid(12, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+    Mesh m = testing::makeHexGrid(
+        12, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
     PrepareOptions o;
     o.kd.leafCells = 128;
     const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);

@@ -7,9 +7,13 @@ namespace uvr {
 
 struct CudaScene::Impl {};
 
-bool cudaDeviceAvailable() { return false; }
+bool cudaDeviceAvailable() {
+    return false;
+}
 
-std::string cudaDeviceDescription() { return "none: this uvr was built without CUDA"; }
+std::string cudaDeviceDescription() {
+    return "none: this uvr was built without CUDA";
+}
 
 CudaScene::CudaScene(const PreparedMesh&) {
     throwError(ErrorKind::Unsupported, "",
@@ -19,10 +23,16 @@ CudaScene::CudaScene(const PreparedMesh&) {
 
 CudaScene::~CudaScene() = default;
 
-RenderResult CudaScene::render(const RenderSettings&) { return {}; }
+RenderResult CudaScene::render(const RenderSettings&) {
+    return {};
+}
 
-std::uint64_t CudaScene::geometryBytes() const { return 0; }
+std::uint64_t CudaScene::geometryBytes() const {
+    return 0;
+}
 
-double CudaScene::uploadSeconds() const { return 0.0; }
+double CudaScene::uploadSeconds() const {
+    return 0.0;
+}
 
 }  // namespace uvr

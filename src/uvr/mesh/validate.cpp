@@ -16,7 +16,9 @@ void validateStructure(const Mesh& mesh, const std::string& file) {
     const std::uint64_t cells = mesh.cellCount();
     const std::uint64_t points = mesh.pointCount();
     const std::uint64_t indices = mesh.cellIndices.size();
-    auto fail = [&](const std::string& message) { throwError(ErrorKind::Validation, file, message); };
+    auto fail = [&](const std::string& message) {
+        throwError(ErrorKind::Validation, file, message);
+    };
     if (points > 0xffffffffull)
         throwError(ErrorKind::Unsupported, file,
                    std::to_string(points) + " points: at most 2^32 - 1 are supported");
@@ -49,7 +51,8 @@ void validateStructure(const Mesh& mesh, const std::string& file) {
              ", expected indexCount " + std::to_string(indices));
     for (const Field& f : mesh.fields) {
         const std::uint64_t tuples = f.association == Association::Point ? points : cells;
-        if (f.components < 1 || f.values.size() != tuples * static_cast<std::uint64_t>(f.components))
+        if (f.components < 1 ||
+            f.values.size() != tuples * static_cast<std::uint64_t>(f.components))
             fail("field '" + f.name + "': " + std::to_string(f.values.size()) +
                  " values, expected " + std::to_string(tuples) + " " +
                  associationName(f.association) + " tuples x " + std::to_string(f.components) +
