@@ -57,6 +57,32 @@ __global__ void frameKernel(FrameView frame, March march, unsigned long long* to
     }
 }
 
+/// Transfer-function update, pass 1 (one thread per partition): range statistics, and the
+/// minimum and maximum variance over the visible partitions (as ordered bit patterns: variances
+/// are non-negative, so their float bits order like unsigned integers).
+__global__ void partitionStatsKernel(TfRangeView range, const KdPartition* partitions,
+                                     std::uint32_t count, RangeStats* stats,
+                                     unsigned* varianceBounds) {
+    const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
+    if (p >= count) return;
+    const RangeStats st = range.query(partitions[p].valueMin, partitions[p].valueMax);
+    stats[p] = st;
+    if (st.maxOpacity > 0.f) {
+        atomicMin(&varianceBounds[0], __float_as_uint(st.variance));
+        atomicMax(&varianceBounds[1], __float_as_uint(st.variance));
+    }
+}
+
+/// Transfer-function update, pass 2: the shared per-partition shading.
+__global__ void partitionShadeKernel(const RangeStats* stats, std::uint32_t count,
+                                     const unsigned* varianceBounds, float s1, float s2,
+                                     float power, bool adaptive, PartitionShading* shading) {
+    const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
+    if (p >= count) return;
+    const float lo = __uint_as_float(varianceBounds[0]), hi = __uint_as_float(varianceBounds[1]);
+    shading[p] = shadePartition(stats[p], lo, hi, s1, s2, power, adaptive);
+}
+
 }  // namespace
 }  // namespace cuda
 
@@ -94,6 +120,10 @@ struct CudaScene::Impl {
     cuda::DeviceArray<std::uint32_t> partitionCells;
     // Per frame / transfer function.
     cuda::DeviceArray<Vec4f> tfTable;
+    cuda::DeviceArray<double> tfPrefix;
+    cuda::DeviceArray<float> tfMaxLevels;
+    cuda::DeviceArray<RangeStats> partitionStats;
+    cuda::DeviceArray<unsigned> varianceBounds;
     cuda::DeviceArray<PartitionShading> shading;
     cuda::DeviceArray<Vec4f> pixels;
     cuda::DeviceArray<std::uint32_t> sampleCounts;
@@ -152,10 +182,44 @@ double CudaScene::uploadSeconds() const {
     return impl_->uploadSeconds;
 }
 
+void CudaScene::updateShading(RenderResult& result, const RenderSettings& settings) {
+    Impl& d = *impl_;
+    const auto start = std::chrono::steady_clock::now();
+    FrameSetup& f = result.setup;
+    const std::uint32_t n = static_cast<std::uint32_t>(d.mesh.kd->partitions.size());
+    // Range tables of the baked table (O(entries log entries) on the host, ~100 KB up).
+    const TfTableView hostTable{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
+                                f.rangeHi};
+    const TfRangeTables tables(hostTable);
+    d.tfPrefix.upload(tables.prefix, "the transfer-function prefix sums");
+    d.tfMaxLevels.upload(tables.maxLevels, "the transfer-function maxima");
+    TfRangeView range = tables.view(hostTable);
+    range.table.entries = d.tfTable.data();
+    range.prefix = d.tfPrefix.data();
+    range.maxLevels = d.tfMaxLevels.data();
+    d.partitionStats.reserve(n, "the partition statistics");
+    d.varianceBounds.upload(std::vector<unsigned>{0x7f800000u, 0u}, "the variance bounds");
+    d.shading.reserve(n, "the partition shading");
+    const int block = 256;
+    const int grid = static_cast<int>((n + block - 1) / block);
+    cuda::partitionStatsKernel<<<grid, block>>>(range, d.partitions.data(), n,
+                                                d.partitionStats.data(), d.varianceBounds.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    cuda::partitionShadeKernel<<<grid, block>>>(d.partitionStats.data(), n, d.varianceBounds.data(),
+                                                f.params.step, f.maxStep, settings.power,
+                                                settings.adaptive, d.shading.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    f.shading.resize(n);
+    UVR_CUDA_CHECK(cudaMemcpy(f.shading.data(), d.shading.data(), n * sizeof(PartitionShading),
+                              cudaMemcpyDeviceToHost));
+    f.tfUpdateSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 RenderResult CudaScene::render(const RenderSettings& settings) {
     Impl& d = *impl_;
     RenderResult result;
-    result.setup = makeFrameSetup(d.mesh, settings);
+    result.setup = makeFrameSetup(d.mesh, settings, /*shadePartitions=*/false);
     // Transfer-function state: the only per-change upload (a few kilobytes).
     d.tfTable.upload(result.setup.tfTable, "the transfer function");
     const std::size_t pixelCount = static_cast<std::size_t>(settings.width) * settings.height;
@@ -177,7 +241,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     } else {
         if (!d.mesh.kd)
             throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
-        d.shading.upload(result.setup.shading, "the partition shading");
+        updateShading(result, settings);
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
         scene.base = d.deviceScene(result.setup);
         scene.kd.nodes = d.kdNodes.data();

@@ -88,6 +88,30 @@ TEST(Cuda, RealMeshesMatchCpu) {
     }
 }
 
+TEST(Cuda, PartitionShadingOnTheGpuEqualsTheCpus) {
+    UVR_REQUIRE_GPU();
+    Mesh m = testing::makeHexGrid(
+        12, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+    PrepareOptions o;
+    o.kd.leafCells = 64;
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
+    CudaScene gpu(pm);
+    for (const char* opacity : {"0:0,1:0.4", "step:0.6", "constant:0.2"}) {
+        RenderSettings s = settingsFor(pm, RenderMethod::Partitions);
+        applyOpacitySpec(s.tf, opacity);
+        const FrameSetup cpu = makeFrameSetup(pm, s);
+        const RenderResult g = gpu.render(s);
+        ASSERT_EQ(g.setup.shading.size(), cpu.shading.size());
+        for (size_t p = 0; p < cpu.shading.size(); ++p) {
+            // Same code; only fused multiply-adds may round differently on the GPU.
+            EXPECT_NEAR(g.setup.shading[p].maxOpacity, cpu.shading[p].maxOpacity, 1e-6f) << opacity;
+            EXPECT_EQ(g.setup.shading[p].maxOpacity > 0.f, cpu.shading[p].maxOpacity > 0.f);
+            EXPECT_NEAR(g.setup.shading[p].step, cpu.shading[p].step, 1e-5f * cpu.shading[p].step)
+                << opacity;
+        }
+    }
+}
+
 TEST(Cuda, TransferFunctionChangesReuseTheUploadedGeometry) {
     UVR_REQUIRE_GPU();
     Mesh m = testing::makeHexGrid(8, -1.f, 1.f, [](Vec3f p) { return p.x; });

@@ -24,6 +24,18 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
     return s > s1 ? s : s1;
 }
 
+/// Shading of one partition from its range statistics (Morrical et al. 2019, Sec. 2.1, 2.4): the
+/// variance normalised by the minimum lo and maximum hi over the visible partitions (1 when they
+/// are all equal and positive), invisible partitions at v = 0 (s2), and the adaptive step; every
+/// step is s1 when adaptive is false. Shared by the CPU loop and the CUDA kernel.
+UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, float lo, float hi,
+                                                       float s1, float s2, float power,
+                                                       bool adaptive) {
+    float v = 0.f;
+    if (st.maxOpacity > 0.f) v = hi > lo ? (st.variance - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
+    return {st.maxOpacity, adaptive ? adaptiveStep(v, s1, s2, power) : s1};
+}
+
 /// On the CPU, steps longer than this many s1 locate samples with the partition's BVH instead
 /// of walking from the previous sample's tetrahedron (measured on Blunt Fin: a walk crosses about
 /// three tetrahedra per s1, and a BVH search costs about as much as ten walk steps).
@@ -35,7 +47,7 @@ struct PartitionSceneView {
     SceneView base;
     KdView kd;
     const PartitionShading* shading = nullptr;
-    bool skipTransparent = true;  ///< skip partitions whose maximum opacity is 0
+    bool skipTransparent = true;    ///< skip partitions whose maximum opacity is 0
     float longStep = kCpuLongStep;  ///< steps above this many s1 search the BVH, not walk
 };
 

@@ -97,21 +97,16 @@ std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
                                                       const TfRangeView& range, float s1, float s2,
                                                       float power, bool adaptive) {
     const std::size_t n = kd.partitions.size();
-    std::vector<PartitionShading> out(n);
-    std::vector<float> variance(n);
+    std::vector<RangeStats> stats(n);
     float lo = INFINITY, hi = -INFINITY;
     for (std::size_t p = 0; p < n; ++p) {
-        const RangeStats st = range.query(kd.partitions[p].valueMin, kd.partitions[p].valueMax);
-        out[p].maxOpacity = st.maxOpacity;
-        variance[p] = st.variance;
-        if (st.maxOpacity > 0.f) lo = std::fmin(lo, st.variance), hi = std::fmax(hi, st.variance);
+        stats[p] = range.query(kd.partitions[p].valueMin, kd.partitions[p].valueMax);
+        if (stats[p].maxOpacity > 0.f)
+            lo = std::fmin(lo, stats[p].variance), hi = std::fmax(hi, stats[p].variance);
     }
-    for (std::size_t p = 0; p < n; ++p) {
-        float v = 0.f;  // invisible partitions: the coarsest step
-        if (out[p].maxOpacity > 0.f)
-            v = hi > lo ? (variance[p] - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
-        out[p].step = adaptive ? adaptiveStep(v, s1, s2, power) : s1;
-    }
+    std::vector<PartitionShading> out(n);
+    for (std::size_t p = 0; p < n; ++p)
+        out[p] = shadePartition(stats[p], lo, hi, s1, s2, power, adaptive);
     return out;
 }
 
@@ -135,7 +130,8 @@ PartitionSceneView FrameSetup::partitionScene(const PreparedMesh& mesh, bool ski
     return v;
 }
 
-FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings) {
+FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
+                          bool shadePartitions) {
     validateSettings(settings);
     FrameSetup f;
     f.tfTable = settings.tf.bake(settings.tfTableSize);
@@ -156,9 +152,9 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         throwError(ErrorKind::Argument, "",
                    "--max-step " + std::to_string(f.maxStep) + " is below --step " +
                        std::to_string(f.params.step) + " (s2 must be >= s1)");
-    if (settings.method == RenderMethod::Partitions) {
-        if (!mesh.kd)
-            throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
+    if (settings.method == RenderMethod::Partitions && !mesh.kd)
+        throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
+    if (settings.method == RenderMethod::Partitions && shadePartitions) {
         const auto start = std::chrono::steady_clock::now();
         const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
                                 f.rangeHi};

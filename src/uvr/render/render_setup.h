@@ -114,8 +114,11 @@ struct FrameSetup {
     PartitionSceneView partitionScene(const PreparedMesh& mesh, bool skip) const;
 };
 
-/// Resolves defaults and validates; throws Error(Argument) on bad settings.
-FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings);
+/// Resolves defaults and validates; throws Error(Argument) on bad settings. For the partition
+/// method it also computes the per-partition shading on the host unless shadePartitions is false
+/// (the CUDA backend computes it on the GPU).
+FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
+                          bool shadePartitions = true);
 
 /// Statistics of one rendered frame.
 struct RenderStats {
