@@ -173,10 +173,6 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
     if (s.method == RenderMethod::Reference && (noSkip || noAdaptive || maxStep > 0.f || leafCells))
         throwError(ErrorKind::Argument, "",
                    "--no-skip, --no-adaptive, --max-step and --leaf-cells need --method adaptive");
-    if (!(std::isfinite(step) && step >= 0.f))
-        throwError(ErrorKind::Argument, "", "--step must be a positive finite distance");
-    if (!(std::isfinite(opacityUnit) && opacityUnit >= 0.f))
-        throwError(ErrorKind::Argument, "", "--opacity-unit must be a positive finite distance");
     Camera cam = resetCamera(bounds, float(s.width) / float(s.height));
     bool custom = false;
     if (!cameraFile.empty()) cam = loadPvcc(cameraFile), custom = true;
@@ -243,8 +239,7 @@ RenderResult FrameRenderer::render(const RenderSettings& settings) {
 Mesh loadMesh(const std::string& path, const Log& log) {
     auto start = Clock::now();
     log.step("reading " + path);
-    Mesh mesh = readMesh(path);
-    validateStructure(mesh, path);
+    Mesh mesh = readMesh(path);  // every reader checks the structure it returns
     log.done("read " + std::to_string(mesh.pointCount()) + " points, " +
                  std::to_string(mesh.cellCount()) + " cells",
              start);
