@@ -42,7 +42,7 @@ std::string fileName(const std::string& name) {
 
 }  // namespace
 
-void addBenchCommand(CLI::App& app, Log& log) {
+void addBenchCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "bench",
         "Time reference, skipping only, adaptive only, both, and an s2 sweep on one mesh; "
@@ -70,21 +70,21 @@ void addBenchCommand(CLI::App& app, Log& log) {
     cmd->add_option("--images", *images,
                     "Write each configuration's image and sample heat map (all on the reference's "
                     "scale) into this folder");
-    cmd->callback([=, &log] {
+    cmd->callback([=, &ctx] {
         for (const std::string* out : {csv.get(), json.get(), plot.get()})
             if (!out->empty()) checkOutputPath(*out);
         if (!images->empty() && !std::filesystem::is_directory(*images))
             throwError(ErrorKind::Io, *images, "not a folder");
         flags->method = "adaptive";  // partitions are needed; variants pick their integrator
-        const Mesh mesh = loadMesh(*file, log);
+        const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
         const RenderSettings base = flags->settings(mesh.bounds());
         const std::optional<Vec3f> background = flags->backgroundColor();
         const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
         if (flags->threads > 0) omp_set_num_threads(flags->threads);
         const PreparedMesh prepared = prepareMesh(mesh, field, flags->prepareOptions(),
-                                                  [&](const std::string& s) { log.step(s); });
-        FrameRenderer renderer(prepared, flags->useCuda(), log);
+                                                  [&](const std::string& s) { ctx.step(s); });
+        FrameRenderer renderer(prepared, flags->useCuda(), ctx);
         const float s1 = makeFrameSetup(prepared, base).params.step;
         const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;
 
@@ -114,7 +114,7 @@ void addBenchCommand(CLI::App& app, Log& log) {
         Rgb8Image reference;
         std::uint32_t heatmapMax = 0;  // the reference's largest count: one scale for all
         for (Variant& v : variants) {
-            log.step("timing " + v.name);
+            ctx.step("timing " + v.name);
             std::vector<double> times;
             v.last = renderer.render(v.settings);
             for (int r = 0; r < *repeat; ++r) {

@@ -2,6 +2,7 @@
 #include "cli_common.h"
 
 #include <omp.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
@@ -50,14 +51,53 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
 
 }  // namespace
 
-void Log::step(const std::string& message) const {
+void Context::step(const std::string& message) const {
     if (!quiet) std::fprintf(stderr, "uvr: %s\n", message.c_str());
 }
 
-void Log::done(const std::string& message, Clock::time_point start) const {
+void Context::done(const std::string& message, Clock::time_point start) const {
     if (!quiet)
         std::fprintf(stderr, "uvr: %s (%.2f s)\n", message.c_str(),
                      std::chrono::duration<double>(Clock::now() - start).count());
+}
+
+std::uint64_t parseBytes(const std::string& flag, const std::string& text) {
+    std::uint64_t value = 0;
+    const char* end = text.data() + text.size();
+    auto [ptr, ec] = std::from_chars(text.data(), end, value);
+    std::uint64_t scale = 1;
+    if (ec == std::errc() && ptr + 1 == end) {
+        switch (*ptr) {
+            case 'K':
+            case 'k':
+                scale = 1ull << 10;
+                break;
+            case 'M':
+            case 'm':
+                scale = 1ull << 20;
+                break;
+            case 'G':
+            case 'g':
+                scale = 1ull << 30;
+                break;
+            case 'T':
+            case 't':
+                scale = 1ull << 40;
+                break;
+            default:
+                scale = 0;
+        }
+        ++ptr;
+    }
+    if (ec != std::errc() || ptr != end || scale == 0 || value == 0 || value > (~0ull) / scale)
+        badFlag(flag, text, "a positive byte count such as 500M or 16G");
+    return value * scale;
+}
+
+std::uint64_t defaultMaxMemory() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGESIZE);
+    if (pages <= 0 || pageSize <= 0) return 0;
+    return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 10 * 8;
 }
 
 Vec3f parseVec3(const std::string& flag, const std::string& text) {
@@ -215,9 +255,10 @@ PrepareOptions RenderFlags::prepareOptions() const {
     return o;
 }
 
-FrameRenderer::FrameRenderer(const PreparedMesh& mesh, bool cuda, const Log& log) : mesh_(mesh) {
+FrameRenderer::FrameRenderer(const PreparedMesh& mesh, bool cuda, const Context& ctx)
+    : mesh_(mesh) {
     if (cuda) {
-        log.step("GPU: " + cudaDeviceDescription());
+        ctx.step("GPU: " + cudaDeviceDescription());
         gpu_ = std::make_unique<CudaScene>(mesh);
         char line[160];
         std::snprintf(
@@ -226,7 +267,7 @@ FrameRenderer::FrameRenderer(const PreparedMesh& mesh, bool cuda, const Log& log
             gpu_->geometryBytes() / 1048576.0,
             double(gpu_->geometryBytes()) / std::max<std::size_t>(1, mesh.tets.tets.size()),
             gpu_->uploadSeconds());
-        log.step(line);
+        ctx.step(line);
     }
 }
 
@@ -236,19 +277,21 @@ RenderResult FrameRenderer::render(const RenderSettings& settings) {
     return gpu_ ? gpu_->render(settings) : renderCpu(mesh_, settings);
 }
 
-Mesh loadMesh(const std::string& path, const Log& log) {
+Mesh loadMesh(const std::string& path, const Context& ctx) {
     auto start = Clock::now();
-    log.step("reading " + path);
-    Mesh mesh = readMesh(path);  // every reader checks the structure it returns
-    log.done("read " + std::to_string(mesh.pointCount()) + " points, " +
+    ctx.step("reading " + path);
+    ReadOptions options;
+    options.maxMemoryBytes = ctx.maxMemoryBytes;
+    Mesh mesh = readMesh(path, options);  // every reader checks the structure it returns
+    ctx.done("read " + std::to_string(mesh.pointCount()) + " points, " +
                  std::to_string(mesh.cellCount()) + " cells",
              start);
-    for (const std::string& note : mesh.notes) log.step("note: " + note);
+    for (const std::string& note : mesh.notes) ctx.step("note: " + note);
     return mesh;
 }
 
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
-                            const Log& log) {
+                            const Context& ctx) {
     if (flags.threads > 0) omp_set_num_threads(flags.threads);
     const std::optional<Vec3f> background = flags.backgroundColor();
     checkOutputPath(flags.output);
@@ -257,16 +300,16 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
     auto start = Clock::now();
     const ValidationReport report = validateMesh(mesh, source);
-    for (const std::string& f : report.findings()) log.step("validation: " + f);
+    for (const std::string& f : report.findings()) ctx.step("validation: " + f);
     // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
     const RenderSettings settings = flags.settings(mesh.bounds());
     validateSettings(settings);
     PreparedMesh prepared = prepareMesh(mesh, field, flags.prepareOptions(),
-                                        [&](const std::string& s) { log.step(s); });
-    log.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
-    log.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
+                                        [&](const std::string& s) { ctx.step(s); });
+    ctx.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
+    ctx.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
              std::to_string(settings.height));
-    FrameRenderer renderer(prepared, flags.useCuda(), log);
+    FrameRenderer renderer(prepared, flags.useCuda(), ctx);
     RenderResult result = renderer.render(settings);
     char line[200];
     std::snprintf(line, sizeof line,
@@ -274,7 +317,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                   renderer.deviceName(), result.stats.seconds,
                   static_cast<unsigned long long>(result.stats.samples),
                   result.stats.meanSamplesPerPixel(), result.setup.params.step);
-    log.step(line);
+    ctx.step(line);
     if (settings.method == RenderMethod::Partitions) {
         std::snprintf(line, sizeof line,
                       "%zu partitions (built in %.3f s); transfer-function update %.3f ms; "
@@ -283,14 +326,14 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                       result.setup.tfUpdateSeconds * 1e3,
                       double(result.stats.partitionsVisited) / (settings.width * settings.height),
                       double(result.stats.partitionsSkipped) / (settings.width * settings.height));
-        log.step(line);
+        ctx.step(line);
     }
     writePng(flags.output, result.image, background);
-    log.step("wrote " + flags.output);
+    ctx.step("wrote " + flags.output);
     if (!flags.heatmapFile.empty()) {
         writePng(flags.heatmapFile, sampleHeatmap(result.sampleCounts, settings.width,
                                                   settings.height, flags.heatmapMax));
-        log.step("wrote " + flags.heatmapFile);
+        ctx.step("wrote " + flags.heatmapFile);
     }
     if (!flags.statsFile.empty()) {
         nlohmann::json j;
@@ -357,7 +400,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
             out << j.dump(2) << "\n";
             if (!out) throwError(ErrorKind::Io, flags.statsFile, "cannot write");
         });
-        log.step("wrote " + flags.statsFile);
+        ctx.step("wrote " + flags.statsFile);
     }
     return result;
 }

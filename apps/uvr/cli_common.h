@@ -11,15 +11,23 @@
 
 namespace uvr::cli {
 
-/// Progress messages on stderr ("uvr: reading x.vtk"), silenced by --quiet.
-class Log {
+/// What every subcommand shares: progress messages on stderr ("uvr: reading x.vtk", silenced by
+/// --quiet) and the memory limit of loads (--max-memory).
+class Context {
 public:
     bool quiet = false;
+    std::uint64_t maxMemoryBytes = 0;  ///< per array a reader allocates; 0 = no limit
     /// Prints a step message.
     void step(const std::string& message) const;
     /// Prints a message with the seconds since `start`.
     void done(const std::string& message, std::chrono::steady_clock::time_point start) const;
 };
+
+/// Parses a byte count with an optional K, M, G or T suffix (powers of 1024) for a flag.
+std::uint64_t parseBytes(const std::string& flag, const std::string& text);
+
+/// The default --max-memory: 80% of the machine's physical memory.
+std::uint64_t defaultMaxMemory();
 
 /// Parses "x,y,z" for a flag; throws Error(Argument) naming the flag.
 Vec3f parseVec3(const std::string& flag, const std::string& text);
@@ -72,7 +80,7 @@ struct RenderFlags {
 class FrameRenderer {
 public:
     /// Renders on the CPU, or uploads the mesh and renders with CUDA.
-    FrameRenderer(const PreparedMesh& mesh, bool cuda, const Log& log);
+    FrameRenderer(const PreparedMesh& mesh, bool cuda, const Context& ctx);
     ~FrameRenderer();
     /// Renders one frame.
     RenderResult render(const RenderSettings& settings);
@@ -87,19 +95,19 @@ private:
 };
 
 /// Loads a mesh with progress messages and validation; prints findings.
-Mesh loadMesh(const std::string& path, const Log& log);
+Mesh loadMesh(const std::string& path, const Context& ctx);
 
 /// Prepares, renders and writes the PNG (and stats JSON); returns the result.
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
-                            const Log& log);
+                            const Context& ctx);
 
 /// Registers the subcommands.
-void addInfoCommand(CLI::App& app, Log& log);
-void addRenderCommand(CLI::App& app, Log& log);
-void addDemoCommand(CLI::App& app, Log& log);
-void addConvertCommand(CLI::App& app, Log& log);
-void addGenerateCommand(CLI::App& app, Log& log);
-void addCompareCommand(CLI::App& app, Log& log);
-void addBenchCommand(CLI::App& app, Log& log);
+void addInfoCommand(CLI::App& app, Context& ctx);
+void addRenderCommand(CLI::App& app, Context& ctx);
+void addDemoCommand(CLI::App& app, Context& ctx);
+void addConvertCommand(CLI::App& app, Context& ctx);
+void addGenerateCommand(CLI::App& app, Context& ctx);
+void addCompareCommand(CLI::App& app, Context& ctx);
+void addBenchCommand(CLI::App& app, Context& ctx);
 
 }  // namespace uvr::cli

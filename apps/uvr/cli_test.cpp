@@ -91,6 +91,20 @@ TEST(Cli, BadFilesExitWithCode2NamingTheFile) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/o.png"));
 }
 
+TEST(Cli, MaxMemoryRefusesLargerArraysBeforeAllocating) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string post = testing::sharedData("post_tets.vtk");
+    CliRun r = uvr("-q info " + post + " --max-memory 1M", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("exceed the memory limit of 1048576 bytes"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(post), std::string::npos);
+    EXPECT_EQ(uvr("-q info " + post + " --max-memory 1G", dir).code, 0);
+    r = uvr("-q info " + post + " --max-memory 12Q", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(lineCount(r.err), 1) << r.err;
+}
+
 TEST(Cli, InfoAndRenderOnEveryRealFile) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const std::string dir = testing::scratchDir();

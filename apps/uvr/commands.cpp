@@ -19,14 +19,14 @@ std::string fmt(double v) {
 
 }  // namespace
 
-void addInfoCommand(CLI::App& app, Log& log) {
+void addInfoCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand("info", "Print counts, fields, bounds and validation findings");
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
     cmd->add_flag("--json", *json, "Print JSON instead of text");
-    cmd->callback([file, json, &log] {
-        const Mesh mesh = loadMesh(*file, log);
+    cmd->callback([file, json, &ctx] {
+        const Mesh mesh = loadMesh(*file, ctx);
         const ValidationReport report = validateMesh(mesh, *file);
         std::map<std::string, std::uint64_t> byType;
         for (CellType t : mesh.cellTypes) ++byType[cellTypeName(t)];
@@ -82,19 +82,19 @@ void addInfoCommand(CLI::App& app, Log& log) {
     });
 }
 
-void addRenderCommand(CLI::App& app, Log& log) {
+void addRenderCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand("render", "Render a mesh file to a PNG (CPU reference marcher)");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
     flags->registerOn(*cmd);
-    cmd->callback([file, flags, &log] {
-        const Mesh mesh = loadMesh(*file, log);
-        renderAndWrite(mesh, *file, *flags, log);
+    cmd->callback([file, flags, &ctx] {
+        const Mesh mesh = loadMesh(*file, ctx);
+        renderAndWrite(mesh, *file, *flags, ctx);
     });
 }
 
-void addDemoCommand(CLI::App& app, Log& log) {
+void addDemoCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "demo",
         "Generate the built-in procedural data set (a turbulent jet in a jittered "
@@ -112,35 +112,35 @@ void addDemoCommand(CLI::App& app, Log& log) {
     cmd->add_option("--cells", *cells, "Approximate tetrahedron count")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(2000000000)));
-    cmd->callback([flags, cells, &log] {
+    cmd->callback([flags, cells, &ctx] {
         ProceduralSpec spec;
         spec.shape = ProceduralShape::Box;
         spec.targetCells = *cells;
         auto start = Clock::now();
-        log.step("generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)");
+        ctx.step("generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)");
         const Mesh mesh = generateMesh(spec);
-        log.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra", start);
-        renderAndWrite(mesh, "demo", *flags, log);
+        ctx.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra", start);
+        renderAndWrite(mesh, "demo", *flags, ctx);
     });
 }
 
-void addConvertCommand(CLI::App& app, Log& log) {
+void addConvertCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "convert", "Convert a mesh between formats (any readable format to .uvrm or .vtu)");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     cmd->add_option("IN", *in, "Input mesh")->required();
     cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
-    cmd->callback([in, out, &log] {
+    cmd->callback([in, out, &ctx] {
         checkOutputPath(*out);
-        const Mesh mesh = loadMesh(*in, log);
+        const Mesh mesh = loadMesh(*in, ctx);
         auto start = Clock::now();
         writeMesh(mesh, *out);
-        log.done("wrote " + *out, start);
+        ctx.done("wrote " + *out, start);
     });
 }
 
-void addGenerateCommand(CLI::App& app, Log& log) {
+void addGenerateCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand("generate", "Write a procedural tetrahedral mesh");
     auto shape = std::make_shared<std::string>("box");
     auto out = std::make_shared<std::string>();
@@ -160,7 +160,7 @@ void addGenerateCommand(CLI::App& app, Log& log) {
     cmd->add_option("--fields", *fields,
                     "Fields to write, first is the default: jet, marschner_lobb, linear, constant")
         ->delimiter(',');
-    cmd->callback([shape, out, spec, fields, &log] {
+    cmd->callback([shape, out, spec, fields, &ctx] {
         checkOutputPath(*out);
         spec->shape = parseProceduralShape(*shape);
         if (!fields->empty()) {
@@ -168,22 +168,22 @@ void addGenerateCommand(CLI::App& app, Log& log) {
             for (const std::string& f : *fields) spec->fields.push_back(parseProceduralField(f));
         }
         auto start = Clock::now();
-        log.step("generating " + std::string(proceduralShapeName(spec->shape)) + " with about " +
+        ctx.step("generating " + std::string(proceduralShapeName(spec->shape)) + " with about " +
                  std::to_string(spec->targetCells) + " tetrahedra");
         int lastPercent = -10;
         const Mesh mesh = generateMesh(*spec, [&](double f) {
             const int percent = static_cast<int>(f * 100);
             if (percent >= lastPercent + 10) {
                 lastPercent = percent;
-                log.step("  " + std::to_string(percent) + "%");
+                ctx.step("  " + std::to_string(percent) + "%");
             }
         });
-        log.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
+        ctx.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
                      std::to_string(mesh.cellCount()) + " tetrahedra",
                  start);
         start = Clock::now();
         writeMesh(mesh, *out);
-        log.done("wrote " + *out, start);
+        ctx.done("wrote " + *out, start);
     });
 }
 

@@ -24,7 +24,7 @@ std::string sizeText(const Image& image) {
 
 }  // namespace
 
-void addCompareCommand(CLI::App& app, Log& log) {
+void addCompareCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "compare",
         "Compare two PNG images: SSIM (Wang et al. 2004, as scikit-image computes it) and PSNR. "
@@ -42,7 +42,7 @@ void addCompareCommand(CLI::App& app, Log& log) {
     cmd->add_flag("--json", *json, "Print JSON instead of text");
     cmd->add_option("--min-ssim", *minSsim,
                     "Exit with status 1 when the mean SSIM is below this value (-1..1)");
-    cmd->callback([fileA, fileB, background, json, minSsim, &log] {
+    cmd->callback([fileA, fileB, background, json, minSsim, &ctx] {
         const Vec3f bg = parseVec3("--background", *background);
         if (!(bg.x >= 0.f && bg.x <= 1.f && bg.y >= 0.f && bg.y <= 1.f && bg.z >= 0.f &&
               bg.z <= 1.f)) {
@@ -55,7 +55,7 @@ void addCompareCommand(CLI::App& app, Log& log) {
             throwError(ErrorKind::Argument, "",
                        std::string("--min-ssim ") + text + ": expected a number in -1..1");
         }
-        log.step("reading " + *fileA + " and " + *fileB);
+        ctx.step("reading " + *fileA + " and " + *fileB);
         const Image a = readPng(*fileA);
         const Image b = readPng(*fileB);
         if (a.width != b.width || a.height != b.height) {

@@ -14,15 +14,23 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.fallthrough();  // -q works after the subcommand too
     app.set_version_flag("--version", "uvr 0.1.0");
-    cli::Log log;
-    app.add_flag("-q,--quiet", log.quiet, "No progress messages on stderr");
-    cli::addInfoCommand(app, log);
-    cli::addRenderCommand(app, log);
-    cli::addDemoCommand(app, log);
-    cli::addConvertCommand(app, log);
-    cli::addGenerateCommand(app, log);
-    cli::addCompareCommand(app, log);
-    cli::addBenchCommand(app, log);
+    cli::Context ctx;
+    app.add_flag("-q,--quiet", ctx.quiet, "No progress messages on stderr");
+    std::string maxMemory;
+    app.add_option("--max-memory", maxMemory,
+                   "Largest array a file load may allocate, e.g. 16G (default: 80% of physical "
+                   "memory); larger declared sizes are refused before allocating");
+    app.parse_complete_callback([&] {
+        ctx.maxMemoryBytes = maxMemory.empty() ? cli::defaultMaxMemory()
+                                               : cli::parseBytes("--max-memory", maxMemory);
+    });
+    cli::addInfoCommand(app, ctx);
+    cli::addRenderCommand(app, ctx);
+    cli::addDemoCommand(app, ctx);
+    cli::addConvertCommand(app, ctx);
+    cli::addGenerateCommand(app, ctx);
+    cli::addCompareCommand(app, ctx);
+    cli::addBenchCommand(app, ctx);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
