@@ -14,7 +14,15 @@
 
 namespace uvr {
 
-std::vector<char> readFileBytes(const std::string& path) {
+std::vector<char> readFileBytes(const std::string& path, std::uint64_t maxBytes,
+                                const std::string& what) {
+    if (maxBytes) {
+        const std::uint64_t size = fileSize(path);
+        if (size > maxBytes)
+            throwError(ErrorKind::Resource, path,
+                       what + " of " + std::to_string(size) + " bytes exceeds the limit of " +
+                           std::to_string(maxBytes) + " bytes");
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
     std::error_code ec;

@@ -8,8 +8,11 @@
 
 namespace uvr {
 
-/// Reads a whole file into memory; throws Error(Io) naming the file on failure.
-std::vector<char> readFileBytes(const std::string& path);
+/// Reads a whole file into memory; throws Error(Io) naming the file on failure, and
+/// Error(Resource) "WHAT of N bytes exceeds the limit of M bytes" before reading when maxBytes is
+/// non-zero and the file is larger.
+std::vector<char> readFileBytes(const std::string& path, std::uint64_t maxBytes = 0,
+                                const std::string& what = "file");
 
 /// Size of a file in bytes; throws Error(Io) when it cannot be opened.
 std::uint64_t fileSize(const std::string& path);

@@ -43,6 +43,20 @@ TEST(FileUtil, OutputPathChecksNameTheFolder) {
     EXPECT_THROW(checkOutputPath(dir), Error);
 }
 
+TEST(FileUtil, ReadRefusesFilesAboveTheLimitBeforeReading) {
+    const std::string path =
+        testing::writeFile(testing::scratchDir() + "/big.json", std::string(100, 'x'));
+    EXPECT_EQ(readFileBytes(path, 100).size(), 100u);
+    try {
+        readFileBytes(path, 99, "colour-map file");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Resource);
+        EXPECT_EQ(std::string(e.what()),
+                  path + ": colour-map file of 100 bytes exceeds the limit of 99 bytes");
+    }
+}
+
 TEST(FileUtil, ReadErrorsNameTheFile) {
     try {
         readFileBytes("/nonexistent/x.vtk");

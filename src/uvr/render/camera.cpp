@@ -202,13 +202,7 @@ Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
 }
 
 Camera loadPvcc(const std::string& path) {
-    std::uint64_t size = fileSize(path);
-    if (size > kMaxPvccBytes) {
-        throwError(ErrorKind::Resource, path,
-                   "camera file of " + std::to_string(size) + " bytes exceeds the limit of " +
-                       std::to_string(kMaxPvccBytes) + " bytes");
-    }
-    std::vector<char> bytes = readFileBytes(path);
+    std::vector<char> bytes = readFileBytes(path, kMaxPvccBytes, "camera file");
 
     PvccParser state;
     state.path = path;

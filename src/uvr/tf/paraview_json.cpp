@@ -143,13 +143,7 @@ std::vector<ColorPoint> expandHsv(const std::vector<ColorPoint>& in) {
 }  // namespace
 
 TransferFunction loadParaViewColorMap(const std::string& path) {
-    std::uint64_t size = fileSize(path);
-    if (size > kMaxJsonBytes) {
-        throwError(ErrorKind::Resource, path,
-                   "colour-map file of " + std::to_string(size) + " bytes exceeds the limit of " +
-                       std::to_string(kMaxJsonBytes) + " bytes");
-    }
-    std::vector<char> bytes = readFileBytes(path);
+    std::vector<char> bytes = readFileBytes(path, kMaxJsonBytes, "colour-map file");
     Json doc;
     try {
         doc = Json::parse(bytes.begin(), bytes.end());
