@@ -178,6 +178,9 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                        std::to_string(KdBuildOptions{}.leafCells) + " on the CPU, " +
                        std::to_string(kCudaDefaultLeafCells) + " with CUDA)")
         ->check(CLI::Range(1u, 1u << 30));
+    app.add_flag("--no-seed-grid", noSeedGrid,
+                 "Adaptive: locate long steps with the partition BVH instead of the seed grid "
+                 "(for comparisons)");
     if (oneFrame) {
         app.add_option("--heatmap", heatmapFile,
                        "Also write the per-pixel sample counts as a heat map PNG");
@@ -210,9 +213,11 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
     s.power = power;
     s.skip = !noSkip;
     s.adaptive = !noAdaptive;
-    if (s.method == RenderMethod::Reference && (noSkip || noAdaptive || maxStep > 0.f || leafCells))
+    if (s.method == RenderMethod::Reference &&
+        (noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid))
         throwError(ErrorKind::Argument, "",
-                   "--no-skip, --no-adaptive, --max-step and --leaf-cells need --method adaptive");
+                   "--no-skip, --no-adaptive, --max-step, --leaf-cells and --no-seed-grid need "
+                   "--method adaptive");
     Camera cam = resetCamera(bounds, float(s.width) / float(s.height));
     bool custom = false;
     if (!cameraFile.empty()) cam = loadPvcc(cameraFile), custom = true;
@@ -248,6 +253,7 @@ bool RenderFlags::useCuda() const {
 PrepareOptions RenderFlags::prepareOptions() const {
     PrepareOptions o;
     o.partitions = method == "adaptive";
+    o.seedGrids = !noSeedGrid;
     if (leafCells)
         o.kd.leafCells = leafCells;
     else if (useCuda())
@@ -363,6 +369,10 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                 {"cells_max", sizes.empty() ? 0 : sizes.back()},
                 {"duplication_factor", kd.duplicationFactor(prepared.tets.tets.size())},
                 {"leaf_cells", prepared.kd->leafCells}};
+            if (prepared.seeds)
+                j["seed_grids"] = {{"cells", prepared.seeds->seeds.size()},
+                                   {"bytes", prepared.seeds->bytes()},
+                                   {"build_seconds", prepared.seeds->buildSeconds}};
             j["tf_update_seconds"] = result.setup.tfUpdateSeconds;
             j["max_step"] = result.setup.maxStep;
             j["power"] = settings.power;

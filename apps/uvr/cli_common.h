@@ -54,6 +54,7 @@ struct RenderFlags {
     float power = 2.f;
     bool noSkip = false, noAdaptive = false;
     std::uint32_t leafCells = 0;
+    bool noSeedGrid = false;
     std::string device = "auto";
     std::string heatmapFile;
     std::uint32_t heatmapMax = 0;

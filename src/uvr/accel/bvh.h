@@ -28,8 +28,23 @@ struct BvhView {
 /// Deepest stack a BVH traversal needs; the builder guarantees the tree is no deeper.
 inline constexpr int kBvhMaxDepth = 64;
 
-/// Calls visit(primId) for every primitive whose leaf box contains p, in the tree rooted at
-/// `root`, until visit returns true; returns whether it did.
+/// Relative tolerance of point queries: a box counts as containing points up to this fraction of
+/// its largest extent outside it, so a point that a containment test with a relative tolerance
+/// accepts (TetLocator::inside) is never lost to rounding at a box face. Child boxes lie inside
+/// their parent's and are no larger, so the grown boxes nest as the boxes do.
+inline constexpr float kBoxPointTolerance = 4e-5f;
+
+/// True when p lies in b grown by kBoxPointTolerance times b's largest extent.
+UVR_HOST_DEVICE inline bool boxHoldsPoint(const Bounds3f& b, Vec3f p) {
+    const Vec3f e = b.extent();
+    const float m = e.x > e.y ? (e.x > e.z ? e.x : e.z) : (e.y > e.z ? e.y : e.z);
+    const float pad = kBoxPointTolerance * m;
+    return p.x >= b.lo.x - pad && p.x <= b.hi.x + pad && p.y >= b.lo.y - pad &&
+           p.y <= b.hi.y + pad && p.z >= b.lo.z - pad && p.z <= b.hi.z + pad;
+}
+
+/// Calls visit(primId) for every primitive whose leaf box holds p (boxHoldsPoint), in the tree
+/// rooted at `root`, until visit returns true; returns whether it did.
 template <class Visit>
 UVR_HOST_DEVICE bool bvhVisitPoint(const BvhView& bvh, Vec3f p, Visit&& visit,
                                    std::uint32_t root = 0) {
@@ -39,7 +54,7 @@ UVR_HOST_DEVICE bool bvhVisitPoint(const BvhView& bvh, Vec3f p, Visit&& visit,
     std::uint32_t node = root;
     while (true) {
         const BvhNode& n = bvh.nodes[node];
-        if (n.box.contains(p)) {
+        if (boxHoldsPoint(n.box, p)) {
             if (n.count > 0) {
                 for (std::uint32_t i = 0; i < n.count; ++i)
                     if (visit(bvh.primIds[n.first + i])) return true;

@@ -15,6 +15,11 @@ namespace uvr {
 /// takes over.
 inline constexpr int kMaxWalkSteps = 8;
 
+// The points with every barycentric >= -e form the tetrahedron scaled by 1 + 4e about its
+// centroid, which reaches at most 3e times the largest extent of the tetrahedron's box beyond it.
+static_assert(kBoxPointTolerance >= 3.f * kBaryEpsilon,
+              "BVH point queries must hold every point TetLocator::inside accepts");
+
 /// Counters of point-location work for statistics.
 struct LocateCounters {
     std::uint64_t walkSteps = 0;   ///< tetrahedra tested while walking

@@ -118,6 +118,8 @@ struct CudaScene::Impl {
     cuda::DeviceArray<KdPartition> partitions;
     cuda::DeviceArray<BvhNode> partitionBvhNodes;
     cuda::DeviceArray<std::uint32_t> partitionCells;
+    cuda::DeviceArray<PartitionGrid> seedGrids;
+    cuda::DeviceArray<std::uint32_t> seeds;
     // Per frame / transfer function.
     cuda::DeviceArray<Vec4f> tfTable;
     cuda::DeviceArray<double> tfPrefix;
@@ -163,6 +165,10 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
         d.partitionBvhNodes.upload(mesh.kd->bvhNodes, "the partition BVH nodes");
         d.partitionCells.upload(mesh.kd->cells, "the partition cell lists");
     }
+    if (mesh.seeds) {
+        d.seedGrids.upload(mesh.seeds->grids, "the seed grids");
+        d.seeds.upload(mesh.seeds->seeds, "the seeds");
+    }
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     d.uploadSeconds =
@@ -175,7 +181,8 @@ std::uint64_t CudaScene::geometryBytes() const {
     const Impl& d = *impl_;
     return d.points.bytes() + d.tets.bytes() + d.values.bytes() + d.neighbors.bytes() +
            d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
-           d.partitionBvhNodes.bytes() + d.partitionCells.bytes();
+           d.partitionBvhNodes.bytes() + d.partitionCells.bytes() + d.seedGrids.bytes() +
+           d.seeds.bytes();
 }
 
 double CudaScene::uploadSeconds() const {
@@ -249,9 +256,10 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         scene.kd.bvh.nodes = d.partitionBvhNodes.data();
         scene.kd.bvh.primIds = d.partitionCells.data();
         scene.shading = d.shading.data();
-        // GPU: walking stays coherent across a warp where divergent BVH searches do not, so
-        // samples always walk from the previous one, for longer.
-        scene.longStep = INFINITY;
+        if (d.mesh.seeds)
+            scene.seeds = {d.seedGrids.data(), d.seeds.data()};
+        else
+            scene.longStep = INFINITY;  // without seeds, walking beats divergent BVH searches
         scene.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;
         cuda::frameKernel<<<grid, block>>>(frame, PartitionMarch{scene}, d.totals.data());
     }

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/seed_grid.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/range_stats.h"
 
@@ -36,19 +37,20 @@ UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, flo
     return {st.maxOpacity, adaptive ? adaptiveStep(v, s1, s2, power) : s1};
 }
 
-/// On the CPU, steps longer than this many s1 locate samples with the partition's BVH instead
-/// of walking from the previous sample's tetrahedron (measured on Blunt Fin: a walk crosses about
-/// three tetrahedra per s1, and a BVH search costs about as much as ten walk steps).
-inline constexpr float kCpuLongStep = 3.f;
+/// Steps longer than this many s1 start their point location from the partition's seed grid
+/// instead of the previous sample's tetrahedron: a walk from the previous sample crosses about
+/// three tetrahedra per s1, a walk from the seed about as many whatever the step (PERFORMANCE.md).
+inline constexpr float kLongStep = 2.f;
 
 /// Scene for the partition integrator: the reference scene plus the partitions and their
 /// per-transfer-function shading.
 struct PartitionSceneView {
     SceneView base;
     KdView kd;
+    SeedGridView seeds;  ///< per-partition walk starts; without them long steps search the BVH
     const PartitionShading* shading = nullptr;
-    bool skipTransparent = true;    ///< skip partitions whose maximum opacity is 0
-    float longStep = kCpuLongStep;  ///< steps above this many s1 search the BVH, not walk
+    bool skipTransparent = true;  ///< skip partitions whose maximum opacity is 0
+    float longStep = kLongStep;   ///< steps above this many s1 do not walk from the previous sample
 };
 
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
@@ -90,13 +92,23 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const float k0 = ceilf(c0 / s1);
         const float k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
         const float m = shade.step / s1;  // step in grid units (1 for s1)
-        // Long steps cross more tetrahedra than a walk takes: search the partition's BVH.
+        // Short steps walk from the previous sample's tetrahedron; long steps (and samples with
+        // no previous tetrahedron) walk from the seed of the sample's grid cell, or search the
+        // partition's BVH when there are no seed grids.
         const bool walk = m <= scene.longStep;
         for (float k = k0; k < k1; k += m) {
             const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
+            const Vec3f pos = ray.at(k * s1);
             ++counters.samples;
-            tet = locator.locateIn(scene.kd.bvh, part.bvhRoot, ray.at(k * s1), walk ? tet : kNoTet,
-                                   bary, counters.locate);
+            std::uint32_t start = walk ? tet : kNoTet;
+            if (start == kNoTet && scene.seeds.grids) {
+                start = scene.seeds.seed(p, pos);
+                if (start == kNoTet) {  // no cell of the partition near pos
+                    tet = kNoTet;
+                    continue;
+                }
+            }
+            tet = locator.locateIn(scene.kd.bvh, part.bvhRoot, pos, start, bary, counters.locate);
             if (tet == kNoTet) continue;
             const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
             const float a = correctOpacity(c.w, length, unit);

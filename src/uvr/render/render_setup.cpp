@@ -49,6 +49,10 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
             progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
                      " cells each)");
         out.kd = buildKdPartitions(out.tets, options.kd);
+        if (options.seedGrids) {
+            if (progress) progress("building seed grids");
+            out.seeds = buildSeedGrids(out.tets, *out.kd);
+        }
     }
     return out;
 }
@@ -125,6 +129,7 @@ PartitionSceneView FrameSetup::partitionScene(const PreparedMesh& mesh, bool ski
     PartitionSceneView v;
     v.base = scene(mesh);
     v.kd = mesh.kd->view();
+    if (mesh.seeds) v.seeds = mesh.seeds->view();
     v.shading = shading.data();
     v.skipTransparent = skip;
     return v;

@@ -10,6 +10,7 @@
 
 #include "uvr/accel/bvh.h"
 #include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/seed_grid.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/tet_mesh.h"
@@ -24,6 +25,7 @@ namespace uvr {
 /// What prepareMesh builds besides tetrahedra, BVH and neighbours.
 struct PrepareOptions {
     bool partitions = true;  ///< build the k-d partitions the partition integrator needs
+    bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
     KdBuildOptions kd;
 };
 
@@ -34,10 +36,11 @@ struct PreparedMesh {
     Bvh bvh;
     std::vector<std::uint32_t> neighbors;
     std::optional<KdPartitions> kd;
-    std::uint64_t sourceCells = 0;  ///< cells of the mesh before splitting
-    double splitSeconds = 0.0;      ///< time to split cells into tetrahedra
-    double bvhSeconds = 0.0;        ///< time to build the BVH
-    double adjacencySeconds = 0.0;  ///< time to find face neighbours
+    std::optional<SeedGrids> seeds;  ///< per-partition walk starts (with partitions)
+    std::uint64_t sourceCells = 0;   ///< cells of the mesh before splitting
+    double splitSeconds = 0.0;       ///< time to split cells into tetrahedra
+    double bvhSeconds = 0.0;         ///< time to build the BVH
+    double adjacencySeconds = 0.0;   ///< time to find face neighbours
 
     /// Point locator over this mesh.
     TetLocator locator() const { return {tets.view(), bvh.view(), neighbors.data()}; }

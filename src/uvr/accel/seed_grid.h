@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/core/host_device.h"
+#include "uvr/mesh/tet_mesh.h"
+
+namespace uvr {
+
+/// One partition's uniform grid over its shrunk box (40 bytes).
+struct PartitionGrid {
+    Vec3f lo;                 ///< grid origin (the partition box's low corner)
+    Vec3f cellsPerUnit;       ///< grid cells per world unit on each axis
+    std::uint32_t dims[3]{};  ///< cells on each axis (>= 1)
+    std::uint32_t first = 0;  ///< index of the grid's first cell in the seed array
+};
+
+/// Plain-data view of the seed grids for CPU and GPU kernels.
+struct SeedGridView {
+    const PartitionGrid* grids = nullptr;  ///< one per k-d partition; null: no seed grids
+    const std::uint32_t* seeds = nullptr;  ///< per grid cell: a tetrahedron id or kNoTet
+
+    /// A tetrahedron of `partition` close to p to start a walk from, or kNoTet when no cell of
+    /// the partition overlaps p's grid cell (so none contains p). Exact for p in the partition's
+    /// box: cell indices are monotonic in p and clamped, so a tetrahedron containing p has p's
+    /// grid cell inside the range of its own bounds.
+    UVR_HOST_DEVICE std::uint32_t seed(std::uint32_t partition, Vec3f p) const {
+        const PartitionGrid& g = grids[partition];
+        std::uint32_t i[3];
+        for (int a = 0; a < 3; ++a) i[a] = cellIndex(g, a, p[a]);
+        return seeds[g.first + (i[2] * g.dims[1] + i[1]) * g.dims[0] + i[0]];
+    }
+
+    /// Grid cell index of coordinate x on axis a, clamped to the grid (monotonic in x).
+    UVR_HOST_DEVICE static std::uint32_t cellIndex(const PartitionGrid& g, int a, float x) {
+        const float f = (x - g.lo[a]) * g.cellsPerUnit[a];
+        if (!(f > 0.f)) return 0;  // also NaN
+        const float last = static_cast<float>(g.dims[a] - 1);
+        return static_cast<std::uint32_t>(f < last ? f : last);
+    }
+};
+
+/// Tetrahedra per grid cell the builder aims for: a seed is then about one tetrahedron edge from
+/// any point of its cell, so a walk from it takes a few steps whatever the ray's step length.
+inline constexpr float kTetsPerSeedCell = 2.f;
+
+/// Seed grids of all partitions: for every grid cell, the partition's tetrahedron containing the
+/// cell's centre, else the one overlapping the cell whose centroid lies closest to the centre,
+/// else kNoTet. Point location with long steps starts its walk there (O(1) per sample instead of
+/// a walk whose length grows with the step, or a BVH search).
+struct SeedGrids {
+    std::vector<PartitionGrid> grids;
+    std::vector<std::uint32_t> seeds;
+    double buildSeconds = 0.0;
+
+    /// View for kernels; this object must outlive it.
+    SeedGridView view() const { return {grids.data(), seeds.data()}; }
+    /// Bytes held (grids and seeds).
+    std::uint64_t bytes() const {
+        return grids.size() * sizeof(PartitionGrid) + seeds.size() * sizeof(std::uint32_t);
+    }
+};
+
+/// Builds the seed grids of every partition of kd over mesh, in parallel over partitions; the
+/// result does not depend on the thread count.
+SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd,
+                         float tetsPerCell = kTetsPerSeedCell);
+
+}  // namespace uvr
