@@ -46,14 +46,12 @@ struct KdView {
 /// Deepest k-d tree the builder makes (and the traversal stack holds).
 inline constexpr int kKdMaxDepth = 40;
 
-/// Ordered front-to-back traversal of the k-d tree along a ray (exact: the interval [tMin, tMax]
-/// is cut at each split plane's t, and the pieces are handed out in order, so no partition is
-/// skipped or visited twice whatever the precision). Calls leaf(partition, t0, t1) for each leaf
-/// region the ray crosses, with consecutive, non-overlapping [t0, t1) pieces, until leaf returns
-/// true (e.g. once the ray is opaque).
-template <class Leaf>
-UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, float tMin,
-                                float tMax, Leaf&& leaf) {
+/// Ordered front-to-back traversal of the k-d tree along a ray, one leaf at a time (exact: the
+/// interval [tMin, tMax] is cut at each split plane's t, and the pieces come out in order, so no
+/// partition is skipped or visited twice whatever the precision). An iterator rather than a
+/// callback, so that a GPU thread can interleave "next leaf" with its samples in one loop and
+/// the threads of a warp need not wait for each other at every partition boundary.
+struct KdLeafIterator {
     struct Entry {
         std::uint32_t node;
         float t0, t1;
@@ -61,35 +59,63 @@ UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, 
     Entry stack[kKdMaxDepth + 1];
     int top = 0;
     std::uint32_t node = 0;
-    float t0 = tMin, t1 = tMax;
-    while (true) {
-        const KdNode n = kd.nodes[node];
-        if (!n.isLeaf()) {
-            const int a = n.axis();
-            const float o = ray.org[a], d = ray.dir[a];
-            // Near side: where the ray starts; on the plane, the side it heads to.
-            const bool belowFirst = o < n.split || (o == n.split && d <= 0.f);
-            const std::uint32_t nearNode = n.child() + (belowFirst ? 0u : 1u);
-            const std::uint32_t farNode = n.child() + (belowFirst ? 1u : 0u);
-            const float tSplit = (n.split - o) * invDir[a];
-            if (d == 0.f || o == n.split || !(tSplit > 0.f) || tSplit >= t1) {
-                node = nearNode;  // never crossing the plane inside the interval
-            } else if (tSplit <= t0) {
-                node = farNode;  // crossed before the interval starts
-            } else {
-                stack[top++] = {farNode, tSplit, t1};
-                node = nearNode;
-                t1 = tSplit;
+    float t0 = 0.f, t1 = 0.f;
+    bool done = false;
+
+    UVR_HOST_DEVICE KdLeafIterator(float tMin, float tMax) : t0(tMin), t1(tMax) {}
+
+    /// The next leaf region the ray crosses: its partition and the consecutive, non-overlapping
+    /// piece [a, b) of the ray in it; false once every leaf has been handed out.
+    UVR_HOST_DEVICE bool next(const KdView& kd, const Ray& ray, Vec3f invDir, std::uint32_t& leaf,
+                              float& a, float& b) {
+        if (done) return false;
+        while (true) {
+            const KdNode n = kd.nodes[node];
+            if (!n.isLeaf()) {
+                const int axis = n.axis();
+                const float o = ray.org[axis], d = ray.dir[axis];
+                // Near side: where the ray starts; on the plane, the side it heads to.
+                const bool belowFirst = o < n.split || (o == n.split && d <= 0.f);
+                const std::uint32_t nearNode = n.child() + (belowFirst ? 0u : 1u);
+                const std::uint32_t farNode = n.child() + (belowFirst ? 1u : 0u);
+                const float tSplit = (n.split - o) * invDir[axis];
+                if (d == 0.f || o == n.split || !(tSplit > 0.f) || tSplit >= t1) {
+                    node = nearNode;  // never crossing the plane inside the interval
+                } else if (tSplit <= t0) {
+                    node = farNode;  // crossed before the interval starts
+                } else {
+                    stack[top++] = {farNode, tSplit, t1};
+                    node = nearNode;
+                    t1 = tSplit;
+                }
+                continue;
             }
-            continue;
+            leaf = n.child();
+            a = t0;
+            b = t1;
+            if (top == 0) {
+                done = true;
+            } else {
+                --top;
+                node = stack[top].node;
+                t0 = stack[top].t0;
+                t1 = stack[top].t1;
+            }
+            return true;
         }
-        if (leaf(n.child(), t0, t1)) return;
-        if (top == 0) return;
-        --top;
-        node = stack[top].node;
-        t0 = stack[top].t0;
-        t1 = stack[top].t1;
     }
+};
+
+/// Calls leaf(partition, t0, t1) for each leaf region the ray crosses in front-to-back order
+/// (KdLeafIterator), until leaf returns true (e.g. once the ray is opaque).
+template <class Leaf>
+UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, float tMin,
+                                float tMax, Leaf&& leaf) {
+    KdLeafIterator it(tMin, tMax);
+    std::uint32_t p = 0;
+    float t0 = 0.f, t1 = 0.f;
+    while (it.next(kd, ray, invDir, p, t0, t1))
+        if (leaf(p, t0, t1)) return;
 }
 
 /// Build parameters.

@@ -29,7 +29,7 @@ PartitionGrid layoutGrid(const Bounds3f& box, double target) {
     double h = volume > 0.0 ? std::cbrt(volume / target) : maxExt / kMaxGridSide;
     if (!(h > 0.0)) h = 1.0;
     auto side = [&](float e) {
-        const double n = std::ceil(double(e) / h);
+        const double n = std::round(double(e) / h);
         return static_cast<std::uint32_t>(std::clamp(n, 1.0, double(kMaxGridSide)));
     };
     for (int guard = 0; guard < 200; ++guard, h *= 1.25) {

@@ -76,48 +76,59 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const float stopAlpha = scene.base.params.terminationAlpha;
     std::uint32_t tet = kNoTet;
     float bary[4];
-    kdTraverse(scene.kd, ray, inv, tEnter, tExit, [&](std::uint32_t p, float t0, float t1) {
-        const KdPartition& part = scene.kd.partitions[p];
-        const PartitionShading shade = scene.shading[p];
-        ++counters.partitionsVisited;
-        if (part.cellCount == 0) return false;
-        if (scene.skipTransparent && !(shade.maxOpacity > 0.f)) {
-            ++counters.partitionsSkipped;
-            return false;
-        }
-        // Only the part of [t0, t1) inside the shrunk box can hold cells.
-        float c0 = t0, c1 = t1;
-        if (!intersectBox(part.box, ray.org, inv, c0, c1)) return false;
-        // Reference grid points owned: [K0, K1); the ray's end point belongs to the last piece.
-        const float k0 = ceilf(c0 / s1);
-        const float k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
-        const float m = shade.step / s1;  // step in grid units (1 for s1)
-        // Short steps walk from the previous sample's tetrahedron; long steps (and samples with
-        // no previous tetrahedron) walk from the seed of the sample's grid cell, or search the
-        // partition's BVH when there are no seed grids.
-        const bool walk = m <= scene.longStep;
-        for (float k = k0; k < k1; k += m) {
-            const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
-            const Vec3f pos = ray.at(k * s1);
-            ++counters.samples;
-            std::uint32_t start = walk ? tet : kNoTet;
-            if (start == kNoTet && scene.seeds.grids) {
-                start = scene.seeds.seed(p, pos);
-                if (start == kNoTet) {  // no cell of the partition near pos
-                    tet = kNoTet;
-                    continue;
-                }
+    // One loop whose every iteration either takes a sample or moves to the next partition, so
+    // GPU threads of a warp crossing partition boundaries at different samples stay together.
+    KdLeafIterator leaves(tEnter, tExit);
+    std::uint32_t p = 0, root = 0;
+    float k = 0.f, k1 = 0.f, m = 1.f;
+    bool walk = true;
+    while (true) {
+        if (!(k < k1)) {
+            float t0, t1;
+            if (!leaves.next(scene.kd, ray, inv, p, t0, t1)) break;
+            const KdPartition& part = scene.kd.partitions[p];
+            const PartitionShading shade = scene.shading[p];
+            ++counters.partitionsVisited;
+            if (part.cellCount == 0) continue;
+            if (scene.skipTransparent && !(shade.maxOpacity > 0.f)) {
+                ++counters.partitionsSkipped;
+                continue;
             }
-            tet = locator.locateIn(scene.kd.bvh, part.bvhRoot, pos, start, bary, counters.locate);
-            if (tet == kNoTet) continue;
-            const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
-            const float a = correctOpacity(c.w, length, unit);
-            if (a <= 0.f) continue;
-            compositeFrontToBack(acc, c.xyz(), a);
-            if (acc.w >= stopAlpha) return true;
+            // Only the part of [t0, t1) inside the shrunk box can hold cells.
+            float c0 = t0, c1 = t1;
+            if (!intersectBox(part.box, ray.org, inv, c0, c1)) continue;
+            // Reference grid points owned: [K0, K1); the ray's end point belongs to the last
+            // piece.
+            k = ceilf(c0 / s1);
+            k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
+            m = shade.step / s1;  // step in grid units (1 for s1)
+            root = part.bvhRoot;
+            // Short steps walk from the previous sample's tetrahedron; long steps (and samples
+            // with no previous tetrahedron) walk from the seed of the sample's grid cell, or
+            // search the partition's BVH when there are no seed grids.
+            walk = m <= scene.longStep;
+            continue;
         }
-        return false;
-    });
+        const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
+        const Vec3f pos = ray.at(k * s1);
+        k += m;
+        ++counters.samples;
+        std::uint32_t start = walk ? tet : kNoTet;
+        if (start == kNoTet && scene.seeds.grids) {
+            start = scene.seeds.seed(p, pos);
+            if (start == kNoTet) {  // no cell of the partition near pos
+                tet = kNoTet;
+                continue;
+            }
+        }
+        tet = locator.locateIn(scene.kd.bvh, root, pos, start, bary, counters.locate);
+        if (tet == kNoTet) continue;
+        const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
+        const float a = correctOpacity(c.w, length, unit);
+        if (a <= 0.f) continue;
+        compositeFrontToBack(acc, c.xyz(), a);
+        if (acc.w >= stopAlpha) break;
+    }
     return acc;
 }
 
