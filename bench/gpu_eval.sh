@@ -4,7 +4,7 @@
 # meshes and on large procedural / refined meshes, with and without seed grids, and an Nsight
 # Compute profile of the frame kernels. Logs and tables go to OUT.
 # Usage: bench/gpu_eval.sh BUILD_DIR DATA_DIR OUT STAGE...
-#   STAGE: tests | real | ncu | box:CELLS | refine:MESH:LEVELS | graded:CELLS
+#   STAGE: tests | real | ncu | box:CELLS | refine:MESH:LEVELS | graded:CELLS | leaves:MESH_FILE
 set -u
 build=$1
 data=$2
@@ -60,6 +60,14 @@ for stage in "$@"; do
       [ -f "$mesh" ] || /usr/bin/time -f "refine: %e s, %M KB peak" "$uvr" -q refine \
         "$data/$name.vtk" "$mesh" --levels "$levels" $mem
       bench "$name-x$levels-semi" "$mesh" "$semi"
+      ;;
+    leaves:*)  # the k-d leaf size on the GPU, s2 = 16 and 64 s1
+      mesh=${stage#leaves:}
+      for n in 1024 4096 16384 65536; do
+        echo "== $(basename "$mesh") --leaf-cells $n"
+        "$uvr" -q bench "$mesh" $view $mem --device cuda --opacity "$semi" --repeat 10 \
+          --sweep 16,64 --leaf-cells "$n" 2>&1 | grep -E "tetrahedra|reference|skipping only|both"
+      done
       ;;
     *) echo "unknown stage $stage" >&2 ;;
   esac

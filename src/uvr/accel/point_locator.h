@@ -55,23 +55,36 @@ struct TetLocator {
     UVR_HOST_DEVICE std::uint32_t locateIn(const BvhView& tree, std::uint32_t root, Vec3f p,
                                            std::uint32_t hint, float bary[4],
                                            LocateCounters& counters) const {
-        if (hint != kNoTet && neighbors) {
-            std::uint32_t t = hint;
-            for (int step = 0; step < maxWalkSteps; ++step) {
-                ++counters.walkSteps;
-                const Tet& tet = mesh.tets[t];
-                if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
-                                     mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
-                    break;
-                int worst = 0;
-                for (int i = 1; i < 4; ++i)
-                    if (bary[i] < bary[worst]) worst = i;
-                if (bary[worst] >= -kBaryEpsilon) return t;
-                const std::uint32_t next = neighbors[4 * t + worst];
-                if (next == kNoTet) break;
-                t = next;
-            }
+        const std::uint32_t t = walk(p, hint, bary, counters);
+        return t != kNoTet ? t : search(tree, root, p, bary, counters);
+    }
+
+    /// Walk across faces from tetrahedron `start` towards p (at most maxWalkSteps tetrahedra):
+    /// the tetrahedron containing p, or kNoTet when the walk leaves the mesh, meets a degenerate
+    /// tetrahedron or runs out of steps (or start is kNoTet, or there are no neighbours).
+    UVR_HOST_DEVICE std::uint32_t walk(Vec3f p, std::uint32_t start, float bary[4],
+                                       LocateCounters& counters) const {
+        if (start == kNoTet || !neighbors) return kNoTet;
+        std::uint32_t t = start;
+        for (int step = 0; step < maxWalkSteps; ++step) {
+            ++counters.walkSteps;
+            const Tet& tet = mesh.tets[t];
+            if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
+                                 mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
+                return kNoTet;
+            int worst = 0;
+            for (int i = 1; i < 4; ++i)
+                if (bary[i] < bary[worst]) worst = i;
+            if (bary[worst] >= -kBaryEpsilon) return t;
+            t = neighbors[4 * t + worst];
+            if (t == kNoTet) return kNoTet;
         }
+        return kNoTet;
+    }
+
+    /// Search of the tree at `root` of `tree` for a tetrahedron containing p, or kNoTet.
+    UVR_HOST_DEVICE std::uint32_t search(const BvhView& tree, std::uint32_t root, Vec3f p,
+                                         float bary[4], LocateCounters& counters) const {
         ++counters.bvhQueries;
         std::uint32_t found = kNoTet;
         bvhVisitPoint(

@@ -113,15 +113,17 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const Vec3f pos = ray.at(k * s1);
         k += m;
         ++counters.samples;
-        std::uint32_t start = walk ? tet : kNoTet;
-        if (start == kNoTet && scene.seeds.grids) {
-            start = scene.seeds.seed(p, pos);
-            if (start == kNoTet) {  // no cell of the partition near pos
-                tet = kNoTet;
-                continue;
-            }
+        // Point location: a walk from the previous sample's tetrahedron (short steps), else
+        // from the seed of the sample's grid cell (none: no cell of the partition is near, the
+        // sample is in empty space), else a search of the partition's BVH (walks stop at
+        // boundaries of non-convex meshes and at seams of unshared points).
+        tet = walk ? locator.walk(pos, tet, bary, counters.locate) : kNoTet;
+        if (tet == kNoTet && scene.seeds.grids) {
+            const std::uint32_t seed = scene.seeds.seed(p, pos);
+            if (seed == kNoTet) continue;
+            tet = locator.walk(pos, seed, bary, counters.locate);
         }
-        tet = locator.locateIn(scene.kd.bvh, root, pos, start, bary, counters.locate);
+        if (tet == kNoTet) tet = locator.search(scene.kd.bvh, root, pos, bary, counters.locate);
         if (tet == kNoTet) continue;
         const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
         const float a = correctOpacity(c.w, length, unit);
