@@ -82,8 +82,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         const std::optional<Vec3f> background = flags->backgroundColor();
         const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
         if (flags->threads > 0) omp_set_num_threads(flags->threads);
-        const PreparedMesh prepared = prepareMesh(mesh, field, flags->prepareOptions(),
-                                                  [&](const std::string& s) { ctx.step(s); });
+        const PreparedMesh prepared =
+            prepareMesh(mesh, field, flags->prepareOptions(/*withReference=*/true),
+                        [&](const std::string& s) { ctx.step(s); });
         FrameRenderer renderer(prepared, flags->useCuda(), ctx);
         const float s1 = makeFrameSetup(prepared, base).params.step;
         const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;

@@ -250,9 +250,10 @@ bool RenderFlags::useCuda() const {
     return device == "cuda" || (device == "auto" && cudaDeviceAvailable());
 }
 
-PrepareOptions RenderFlags::prepareOptions() const {
+PrepareOptions RenderFlags::prepareOptions(bool withReference) const {
     PrepareOptions o;
     o.partitions = method == "adaptive";
+    o.meshBvh = !o.partitions || withReference;  // the partition integrator uses its own BVHs
     o.seedGrids = !noSeedGrid;
     if (leafCells)
         o.kd.leafCells = leafCells;

@@ -71,9 +71,10 @@ struct RenderFlags {
     std::optional<Vec3f> backgroundColor() const;
     /// True when --device asks for CUDA, or is auto and a CUDA device is present.
     bool useCuda() const;
-    /// What mesh preparation the flags need (partitions only for the adaptive method; the
-    /// device's default leaf size unless --leaf-cells is given).
-    PrepareOptions prepareOptions() const;
+    /// What mesh preparation the flags need (partitions only for the adaptive method, the mesh
+    /// BVH only for the reference marcher, or also with the adaptive method when withReference;
+    /// the device's default leaf size unless --leaf-cells is given).
+    PrepareOptions prepareOptions(bool withReference = false) const;
 };
 
 /// Renders frames of one prepared mesh on the device the flags chose (auto: CUDA when a device

@@ -132,6 +132,25 @@ TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
     }
 }
 
+// The partition integrator locates with the partitions' own BVHs and seed grids: preparing
+// without the mesh BVH (less memory) gives the same image, and the reference is refused there.
+TEST(PartitionIntegrator, NeedsNoMeshBvh) {
+    Mesh m = testing::makeHexGrid(
+        10, -1.f, 1.f, [](Vec3f p) { return std::sin(3 * p.x) * std::cos(2 * p.y) + p.z; }, 0.3f);
+    PrepareOptions o;
+    o.kd.leafCells = 64;
+    const PreparedMesh with = prepareMesh(m, selectScalarField(m, {}), o);
+    o.meshBvh = false;
+    const PreparedMesh without = prepareMesh(m, selectScalarField(m, {}), o);
+    EXPECT_TRUE(without.bvh.nodes.empty());
+    RenderSettings s = baseSettings();
+    EXPECT_THROW(renderCpu(without, s), Error);
+    s.method = RenderMethod::Partitions;
+    const RenderResult a = renderCpu(with, s), b = renderCpu(without, s);
+    EXPECT_EQ(a.stats.samples, b.stats.samples);
+    EXPECT_LT(maxDifference(a.image, b.image), 1e-6f);
+}
+
 TEST(PartitionShading, NormalisedVarianceMapsToTheStepRange) {
     const PreparedMesh pm = jitteredGrid(32);
     RenderSettings s = baseSettings();

@@ -27,17 +27,20 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
     out.tets = tetrahedralize(mesh, field);
     out.splitSeconds = secondsSince(start);
 
-    start = std::chrono::steady_clock::now();
-    if (progress)
-        progress("building the BVH over " + std::to_string(out.tets.tets.size()) + " tetrahedra");
-    std::vector<Bounds3f> boxes(out.tets.tets.size());
-    std::vector<Vec3f> centers(out.tets.tets.size());
-    for (std::size_t t = 0; t < boxes.size(); ++t) {
-        for (std::uint32_t v : out.tets.tets[t].v) boxes[t].extend(out.tets.points[v]);
-        centers[t] = boxes[t].center();
+    if (options.meshBvh) {
+        start = std::chrono::steady_clock::now();
+        if (progress)
+            progress("building the BVH over " + std::to_string(out.tets.tets.size()) +
+                     " tetrahedra");
+        std::vector<Bounds3f> boxes(out.tets.tets.size());
+        std::vector<Vec3f> centers(out.tets.tets.size());
+        for (std::size_t t = 0; t < boxes.size(); ++t) {
+            for (std::uint32_t v : out.tets.tets[t].v) boxes[t].extend(out.tets.points[v]);
+            centers[t] = boxes[t].center();
+        }
+        out.bvh = buildBvh(boxes, centers);
+        out.bvhSeconds = secondsSince(start);
     }
-    out.bvh = buildBvh(boxes, centers);
-    out.bvhSeconds = secondsSince(start);
 
     start = std::chrono::steady_clock::now();
     if (progress) progress("finding face neighbours");
@@ -159,6 +162,9 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                        std::to_string(f.params.step) + " (s2 must be >= s1)");
     if (settings.method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
+    if (settings.method == RenderMethod::Reference && mesh.bvh.nodes.empty() &&
+        !mesh.tets.tets.empty())
+        throwError(ErrorKind::Argument, "", "the reference method needs the mesh BVH");
     if (settings.method == RenderMethod::Partitions && shadePartitions) {
         const auto start = std::chrono::steady_clock::now();
         const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,

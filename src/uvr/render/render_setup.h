@@ -24,6 +24,7 @@ namespace uvr {
 
 /// What prepareMesh builds besides tetrahedra, BVH and neighbours.
 struct PrepareOptions {
+    bool meshBvh = true;     ///< build the BVH over all tetrahedra the reference marcher needs
     bool partitions = true;  ///< build the k-d partitions the partition integrator needs
     bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
     KdBuildOptions kd;
@@ -33,7 +34,7 @@ struct PrepareOptions {
 /// k-d partitions, built once and reused by every frame and transfer-function change.
 struct PreparedMesh {
     TetMesh tets;
-    Bvh bvh;
+    Bvh bvh;  ///< over all tetrahedra; empty unless PrepareOptions::meshBvh
     std::vector<std::uint32_t> neighbors;
     std::optional<KdPartitions> kd;
     std::optional<SeedGrids> seeds;  ///< per-partition walk starts (with partitions)
