@@ -165,6 +165,23 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         std::printf("transfer-function update: %.3f ms for %zu partitions\n",
                     variants.back().last.setup.tfUpdateSeconds * 1e3,
                     prepared.kd->partitions.size());
+        const double seedSeconds = prepared.seeds ? prepared.seeds->buildSeconds : 0.0;
+        std::printf(
+            "preparation (%d CPU threads): split %.2f s, mesh BVH %.2f s, neighbours %.2f s, "
+            "partitions %.2f s, seed grids %.2f s\n",
+            threads, prepared.splitSeconds, prepared.bvhSeconds, prepared.adjacencySeconds,
+            prepared.kd->buildSeconds, seedSeconds);
+        if (renderer.gpu()) {
+            // The mesh BVH serves only the reference; `uvr render --method adaptive` leaves it out.
+            const double tets = double(std::max<std::size_t>(1, prepared.tets.tets.size()));
+            const double all = double(renderer.gpu()->geometryBytes());
+            const double meshBvh = double(prepared.bvh.nodes.size() * sizeof(BvhNode) +
+                                          prepared.bvh.primIds.size() * sizeof(std::uint32_t));
+            std::printf(
+                "device memory: %.2f GiB, %.1f bytes per tetrahedron; without the mesh "
+                "BVH (adaptive method alone) %.1f bytes per tetrahedron\n",
+                all / 1073741824.0, all / tets, (all - meshBvh) / tets);
+        }
         // Files.
         if (!csv->empty())
             writeFileAtomically(*csv, [&](const std::string& tmp) {
