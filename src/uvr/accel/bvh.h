@@ -7,6 +7,7 @@
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
+#include "uvr/mesh/tet_mesh.h"
 
 namespace uvr {
 
@@ -76,5 +77,9 @@ struct Bvh {
 /// kBvhMaxDepth (falling back to median splits near the limit).
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
+
+/// Bounding box and box centre of every tetrahedron of a mesh (resizes both arrays); parallel.
+void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
+                        std::vector<Vec3f>& centers);
 
 }  // namespace uvr

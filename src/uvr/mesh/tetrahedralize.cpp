@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/mesh/tet_mesh.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "uvr/core/error.h"
@@ -144,36 +145,61 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
     const bool cellData = field.association == Association::Cell;
     UVR_CHECK(field.values.size() == (cellData ? mesh.cellCount() : mesh.pointCount()),
               "field '" << field.name << "' has " << field.values.size() << " values");
-    std::uint64_t estimate = 0;
-    for (CellType t : mesh.cellTypes)
-        estimate += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
-    out.tets.reserve(estimate);
-    if (cellData) out.values.reserve(estimate);
-    for (std::uint64_t c = 0; c < mesh.cellCount(); ++c) {
-        const CellSplit split = splitCell(mesh, c);
-        for (int t = 0; t < split.count; ++t) {
-            out.tets.push_back(split.tets[t]);
-            out.totalVolume += split.volume6[t] / 6.0;
-            if (cellData) out.values.push_back(field.values[c]);
+    // Two passes over fixed chunks of cells (so the result does not depend on the thread
+    // count): count each chunk's tetrahedra, then split again into the chunk's place.
+    constexpr std::int64_t kChunk = 1 << 14;
+    const std::int64_t cellCount = static_cast<std::int64_t>(mesh.cellCount());
+    const std::int64_t chunks = (cellCount + kChunk - 1) / kChunk;
+    std::vector<std::uint64_t> chunkStart(chunks + 1, 0);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        std::uint64_t count = 0;
+        for (std::int64_t i = c * kChunk; i < std::min(cellCount, (c + 1) * kChunk); ++i)
+            count += static_cast<std::uint64_t>(splitCell(mesh, i).count);
+        chunkStart[c + 1] = count;
+    }
+    for (std::int64_t c = 0; c < chunks; ++c) chunkStart[c + 1] += chunkStart[c];
+    out.tets.resize(chunkStart[chunks]);
+    if (cellData) out.values.resize(chunkStart[chunks]);
+    // Per chunk: volume (summed in chunk order below), bounds and value range of used points.
+    struct ChunkSums {
+        double volume = 0.0;
+        Bounds3f bounds;
+        float lo = INFINITY, hi = -INFINITY;
+    };
+    std::vector<ChunkSums> sums(chunks);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        std::uint64_t at = chunkStart[c];
+        ChunkSums& s = sums[c];
+        for (std::int64_t i = c * kChunk; i < std::min(cellCount, (c + 1) * kChunk); ++i) {
+            const CellSplit split = splitCell(mesh, i);
+            for (int t = 0; t < split.count; ++t) {
+                out.tets[at] = split.tets[t];
+                s.volume += split.volume6[t] / 6.0;
+                for (std::uint32_t v : split.tets[t].v) {
+                    s.bounds.extend(out.points[v]);
+                    if (!cellData && std::isfinite(field.values[v]))
+                        s.lo = std::fmin(s.lo, field.values[v]),
+                        s.hi = std::fmax(s.hi, field.values[v]);
+                }
+                if (cellData) {
+                    out.values[at] = field.values[i];
+                    if (std::isfinite(field.values[i]))
+                        s.lo = std::fmin(s.lo, field.values[i]),
+                        s.hi = std::fmax(s.hi, field.values[i]);
+                }
+                ++at;
+            }
         }
     }
     if (!cellData) out.values = field.values;
-    // Bounds and value range over what the tets actually use.
-    std::vector<bool> used(out.points.size(), false);
-    for (const Tet& t : out.tets)
-        for (std::uint32_t v : t.v) used[v] = true;
     float lo = INFINITY, hi = -INFINITY;
-    for (std::size_t i = 0; i < out.points.size(); ++i) {
-        if (!used[i]) continue;
-        out.bounds.extend(out.points[i]);
-        if (!cellData && std::isfinite(out.values[i])) {
-            lo = std::fmin(lo, out.values[i]);
-            hi = std::fmax(hi, out.values[i]);
-        }
+    for (const ChunkSums& s : sums) {
+        out.totalVolume += s.volume;
+        out.bounds.extend(s.bounds);
+        lo = std::fmin(lo, s.lo), hi = std::fmax(hi, s.hi);
     }
-    if (cellData)
-        for (float v : out.values)
-            if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);
     if (lo <= hi) out.valueMin = lo, out.valueMax = hi;
     return out;
 }
