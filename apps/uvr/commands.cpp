@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "uvr/cpu/threads.h"
 
 namespace uvr::cli {
 
@@ -183,6 +184,44 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                  start);
         start = Clock::now();
         writeMesh(mesh, *out);
+        ctx.done("wrote " + *out, start);
+    });
+}
+
+void addRefineCommand(CLI::App& app, Context& ctx) {
+    auto* cmd = app.add_subcommand(
+        "refine",
+        "Split every tetrahedron into 8 at its edge midpoints, --levels times (non-tetrahedral "
+        "cells are split into tetrahedra first); point fields are interpolated, cell fields "
+        "copied");
+    auto in = std::make_shared<std::string>();
+    auto out = std::make_shared<std::string>();
+    auto levels = std::make_shared<int>(1);
+    auto threads = std::make_shared<int>(0);
+    cmd->add_option("IN", *in, "Input mesh")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
+    cmd->add_option("--levels", *levels, "Refinement levels (x8 tetrahedra each)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, kMaxRefineLevels));
+    cmd->add_option("--threads", *threads, "CPU threads (default: all cores)")
+        ->check(CLI::Range(1, 4096));
+    cmd->callback([in, out, levels, threads, &ctx] {
+        checkOutputPath(*out);
+        // Refuse an unwritable format before the (possibly long) refinement.
+        const std::string ext = fileExtension(*out);
+        if (ext != ".uvrm" && ext != ".vtu")
+            throwError(ErrorKind::Argument, *out,
+                       "cannot write this format: the output name must end in .uvrm (native) or "
+                       ".vtu");
+        if (*threads > 0) cpu::setThreadCount(*threads);
+        const Mesh mesh = loadMesh(*in, ctx);
+        auto start = Clock::now();
+        const Mesh refined = refineMesh(mesh, *levels, [&](const std::string& s) { ctx.step(s); });
+        ctx.done("refined to " + std::to_string(refined.pointCount()) + " points, " +
+                     std::to_string(refined.cellCount()) + " tetrahedra",
+                 start);
+        start = Clock::now();
+        writeMesh(refined, *out);
         ctx.done("wrote " + *out, start);
     });
 }
