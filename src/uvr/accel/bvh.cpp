@@ -55,15 +55,29 @@ void sweepBins(int axis, int nb, const Bounds3f* binBox, const std::uint32_t* bi
     }
 }
 
+/// A primitive's box, centre and id, gathered so that a subtree's passes read memory in order.
+struct Prim {
+    Bounds3f box;
+    Vec3f center;
+    std::uint32_t id;
+};
+
 /// Builds the subtree of root task `root` into `nodes` (nodes[0] is its root, inner nodes name
-/// local child indices, leaves global ranges of ids); one thread.
+/// local child indices, leaves global ranges of ids); one thread. The primitives are copied into
+/// a local array that is partitioned in place (cache-friendly), then their ids written back.
 void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
                   std::uint32_t* ids, Task root, const BvhBuildOptions& options,
                   std::vector<BvhNode>& nodes) {
+    const std::uint32_t offset = root.begin;
+    std::vector<Prim> prims(root.end - root.begin);
+    for (std::uint32_t i = 0; i < prims.size(); ++i) {
+        const std::uint32_t id = ids[offset + i];
+        prims[i] = {boxes[id], centers[id], id};
+    }
+    Prim* p = prims.data();
     nodes.clear();
     nodes.emplace_back();
-    root.node = 0;
-    std::vector<Task> stack{root};
+    std::vector<Task> stack{{0, 0, root.end - offset, root.depth}};
     const int nb = std::max(2, options.bins);
     std::vector<Bounds3f> binBox(nb), rightBox(nb);
     std::vector<std::uint32_t> binCount(nb), rightCount(nb);
@@ -72,13 +86,13 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
         stack.pop_back();
         Bounds3f box, cbox;
         for (std::uint32_t i = t.begin; i < t.end; ++i) {
-            box.extend(boxes[ids[i]]);
-            cbox.extend(centers[ids[i]]);
+            box.extend(p[i].box);
+            cbox.extend(p[i].center);
         }
         nodes[t.node].box = box;
         const std::uint32_t count = t.end - t.begin;
         auto makeLeaf = [&] {
-            nodes[t.node].first = t.begin;
+            nodes[t.node].first = offset + t.begin;
             nodes[t.node].count = count;
         };
         if (count <= static_cast<std::uint32_t>(options.maxLeafSize)) {
@@ -99,9 +113,9 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
                 std::fill(binBox.begin(), binBox.end(), Bounds3f{});
                 std::fill(binCount.begin(), binCount.end(), 0u);
                 for (std::uint32_t i = t.begin; i < t.end; ++i) {
-                    int b = static_cast<int>((centers[ids[i]][axis] - cbox.lo[axis]) * scale);
+                    int b = static_cast<int>((p[i].center[axis] - cbox.lo[axis]) * scale);
                     b = std::clamp(b, 0, nb - 1);
-                    binBox[b].extend(boxes[ids[i]]);
+                    binBox[b].extend(p[i].box);
                     ++binCount[b];
                 }
                 sweepBins(axis, nb, binBox.data(), binCount.data(), rightBox.data(),
@@ -113,12 +127,12 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
             const float scale = nb / cext[bestAxis];
             const float lo = cbox.lo[bestAxis];
             mid = static_cast<std::uint32_t>(
-                std::partition(ids + t.begin, ids + t.end,
-                               [&](std::uint32_t id) {
-                                   int b = static_cast<int>((centers[id][bestAxis] - lo) * scale);
+                std::partition(p + t.begin, p + t.end,
+                               [&](const Prim& q) {
+                                   int b = static_cast<int>((q.center[bestAxis] - lo) * scale);
                                    return std::clamp(b, 0, nb - 1) < bestSplit;
                                }) -
-                ids);
+                p);
         } else {
             // All centres coincide (or the depth limit is near): split by count.
             if (t.depth + 1 >= kBvhMaxDepth) {
@@ -127,10 +141,9 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
             }
             const int axis = cbox.longestAxis();
             mid = t.begin + count / 2;
-            std::nth_element(ids + t.begin, ids + mid, ids + t.end,
-                             [&](std::uint32_t a, std::uint32_t b) {
-                                 return centers[a][axis] < centers[b][axis];
-                             });
+            std::nth_element(p + t.begin, p + mid, p + t.end, [&](const Prim& a, const Prim& b) {
+                return a.center[axis] < b.center[axis];
+            });
         }
         const std::uint32_t left = static_cast<std::uint32_t>(nodes.size());
         nodes[t.node].first = left;
@@ -140,6 +153,7 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
         stack.push_back({left + 1, mid, t.end, t.depth + 1});
         stack.push_back({left, t.begin, mid, t.depth + 1});
     }
+    for (std::uint32_t i = 0; i < prims.size(); ++i) ids[offset + i] = prims[i].id;
 }
 
 /// Splits a large node with data-parallel passes (bounds, binned SAH on the longest centre axis,
