@@ -145,37 +145,29 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
     const bool cellData = field.association == Association::Cell;
     UVR_CHECK(field.values.size() == (cellData ? mesh.cellCount() : mesh.pointCount()),
               "field '" << field.name << "' has " << field.values.size() << " values");
-    // Two passes over fixed chunks of cells (so the result does not depend on the thread
-    // count): count each chunk's tetrahedra, then split again into the chunk's place.
+    // Fixed chunks of cells (so the result does not depend on the thread count), each split
+    // into its own list with its volume, bounds and value range; then the lists are moved into
+    // place in chunk order (each freed as soon as it is copied).
     constexpr std::int64_t kChunk = 1 << 14;
     const std::int64_t cellCount = static_cast<std::int64_t>(mesh.cellCount());
     const std::int64_t chunks = (cellCount + kChunk - 1) / kChunk;
-    std::vector<std::uint64_t> chunkStart(chunks + 1, 0);
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < chunks; ++c) {
-        std::uint64_t count = 0;
-        for (std::int64_t i = c * kChunk; i < std::min(cellCount, (c + 1) * kChunk); ++i)
-            count += static_cast<std::uint64_t>(splitCell(mesh, i).count);
-        chunkStart[c + 1] = count;
-    }
-    for (std::int64_t c = 0; c < chunks; ++c) chunkStart[c + 1] += chunkStart[c];
-    out.tets.resize(chunkStart[chunks]);
-    if (cellData) out.values.resize(chunkStart[chunks]);
-    // Per chunk: volume (summed in chunk order below), bounds and value range of used points.
-    struct ChunkSums {
+    struct Chunk {
+        std::vector<Tet> tets;
+        std::vector<std::uint32_t> cells;  ///< source cell of each (cell data only)
         double volume = 0.0;
         Bounds3f bounds;
         float lo = INFINITY, hi = -INFINITY;
     };
-    std::vector<ChunkSums> sums(chunks);
+    std::vector<Chunk> parts(chunks);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
-        std::uint64_t at = chunkStart[c];
-        ChunkSums& s = sums[c];
-        for (std::int64_t i = c * kChunk; i < std::min(cellCount, (c + 1) * kChunk); ++i) {
+        Chunk& s = parts[c];
+        const std::int64_t end = std::min(cellCount, (c + 1) * kChunk);
+        s.tets.reserve(static_cast<std::size_t>(end - c * kChunk));
+        for (std::int64_t i = c * kChunk; i < end; ++i) {
             const CellSplit split = splitCell(mesh, i);
             for (int t = 0; t < split.count; ++t) {
-                out.tets[at] = split.tets[t];
+                s.tets.push_back(split.tets[t]);
                 s.volume += split.volume6[t] / 6.0;
                 for (std::uint32_t v : split.tets[t].v) {
                     s.bounds.extend(out.points[v]);
@@ -184,18 +176,31 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
                         s.hi = std::fmax(s.hi, field.values[v]);
                 }
                 if (cellData) {
-                    out.values[at] = field.values[i];
+                    s.cells.push_back(static_cast<std::uint32_t>(i - c * kChunk));
                     if (std::isfinite(field.values[i]))
                         s.lo = std::fmin(s.lo, field.values[i]),
                         s.hi = std::fmax(s.hi, field.values[i]);
                 }
-                ++at;
             }
         }
     }
+    std::vector<std::uint64_t> chunkStart(chunks + 1, 0);
+    for (std::int64_t c = 0; c < chunks; ++c)
+        chunkStart[c + 1] = chunkStart[c] + parts[c].tets.size();
+    out.tets.resize(chunkStart[chunks]);
+    if (cellData) out.values.resize(chunkStart[chunks]);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        Chunk& s = parts[c];
+        std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
+        for (std::size_t t = 0; t < s.cells.size(); ++t)
+            out.values[chunkStart[c] + t] = field.values[c * kChunk + s.cells[t]];
+        s.tets = {};
+        s.cells = {};
+    }
     if (!cellData) out.values = field.values;
     float lo = INFINITY, hi = -INFINITY;
-    for (const ChunkSums& s : sums) {
+    for (const Chunk& s : parts) {
         out.totalVolume += s.volume;
         out.bounds.extend(s.bounds);
         lo = std::fmin(lo, s.lo), hi = std::fmax(hi, s.hi);
