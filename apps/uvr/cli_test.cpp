@@ -200,6 +200,9 @@ TEST(Cli, RefineMultipliesTetrahedraBy8PerLevel) {
     // Bad levels and unwritable outputs fail cleanly and leave no file behind.
     EXPECT_EQ(uvr("-q refine " + dir + "/b.uvrm " + dir + "/x.uvrm --levels 99", dir).code, 2);
     EXPECT_EQ(uvr("-q refine " + dir + "/b.uvrm " + dir + "/x.png", dir).code, 2);
+    r = uvr("-q --max-memory 1M refine " + dir + "/b.uvrm " + dir + "/x.uvrm --levels 3", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--max-memory"), std::string::npos) << r.err;
     EXPECT_FALSE(std::ifstream(dir + "/x.uvrm").good());
 }
 

@@ -215,6 +215,18 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
                        ".vtu");
         if (*threads > 0) cpu::setThreadCount(*threads);
         const Mesh mesh = loadMesh(*in, ctx);
+        // The output's largest array (4 point indices per tetrahedron) must fit --max-memory;
+        // the estimate splits hexahedra into 6 tetrahedra, wedges and pyramids into 3.
+        std::uint64_t tets = 0;
+        for (CellType t : mesh.cellTypes)
+            tets += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
+        const std::uint64_t outTets = refinedTetCount(tets, *levels);
+        if (ctx.maxMemoryBytes > 0 && outTets > ctx.maxMemoryBytes / 16)
+            throwError(ErrorKind::Resource, *in,
+                       "refining " + std::to_string(tets) + " tetrahedra " +
+                           std::to_string(*levels) + " times makes about " +
+                           std::to_string(outTets) + " tetrahedra, whose " +
+                           std::to_string(16 * outTets) + "-byte index array exceeds --max-memory");
         auto start = Clock::now();
         const Mesh refined = refineMesh(mesh, *levels, [&](const std::string& s) { ctx.step(s); });
         ctx.done("refined to " + std::to_string(refined.pointCount()) + " points, " +

@@ -24,8 +24,9 @@ struct Task {
 /// built by one thread each. Fixed (not derived from the thread count), so the tree is the same
 /// whatever the number of threads.
 constexpr std::uint32_t kSubtreePrims = 1u << 17;
-/// Primitives per chunk of a data-parallel pass.
-constexpr std::int64_t kChunk = 1 << 14;
+/// Primitives per chunk of a data-parallel pass: at least 32 chunks per large node, so many cores
+/// share even the smallest of them (the results do not depend on the chunk size).
+constexpr std::int64_t kChunk = 1 << 12;
 
 /// The SAH sweep over binned boxes and counts: the best split bin on this axis, if it beats
 /// bestCost (then bestCost, bestAxis and bestSplit are updated).
