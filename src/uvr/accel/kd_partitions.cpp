@@ -309,59 +309,79 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         for (Leaf& leaf : local[j].leaves) leaves.push_back(std::move(leaf));
         local[j] = {};
     }
-    // Step 5: each partition's padded shrunk box, whole-cell value range and BVH, in parallel.
+    // Step 5: cell-list offsets (known from the leaves) and room for at most 2 c - 1 BVH nodes
+    // per partition of c cells, reserved once (only what is written becomes resident).
     const std::int64_t leafCount = static_cast<std::int64_t>(leaves.size());
     kd.partitions.resize(leaves.size());
-    std::vector<Bvh> bvhs(leaves.size());
-    const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t p = 0; p < leafCount; ++p) {
-        const Leaf& leaf = leaves[p];
-        KdPartition& part = kd.partitions[p];
-        // Widened by a hair so that samples exactly on a cell face bounding the box are not lost
-        // to rounding in the ray-box clip (it only admits samples that then find no cell).
-        part.box = leaf.shrunk;
-        if (!leaf.shrunk.empty()) part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
-        float lo = INFINITY, hi = -INFINITY;
-        const std::size_t count = leaf.cells.size();
-        std::vector<Bounds3f> leafBoxes(count);
-        std::vector<Vec3f> leafCenters(count);
-        for (std::size_t i = 0; i < count; ++i) {
-            const std::uint32_t c = leaf.cells[i];
-            lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
-            leafBoxes[i] = data.boxes[c];
-            leafCenters[i] = data.centers[c];
-        }
-        part.valueMin = lo <= hi ? lo : 0.f;
-        part.valueMax = lo <= hi ? hi : 0.f;
-        part.cellCount = static_cast<std::uint32_t>(count);
-        bvhs[p] = buildBvh(leafBoxes, leafCenters);
-    }
-    data = {};
-    // Step 6: concatenate the cell lists (in BVH order) and the BVHs.
-    std::uint64_t cells = 0, bvhNodes = 0;
+    std::uint64_t cells = 0, maxNodes = 0;
     for (std::int64_t p = 0; p < leafCount; ++p) {
         kd.partitions[p].firstCell = static_cast<std::uint32_t>(cells);
-        kd.partitions[p].bvhRoot = static_cast<std::uint32_t>(bvhNodes);
         cells += leaves[p].cells.size();
-        bvhNodes += bvhs[p].nodes.size();
-        UVR_CHECK(cells < 0xffffffffull && bvhNodes < 0xffffffffull,
-                  "partition cell lists exceed 32-bit indices");
+        maxNodes += std::max<std::uint64_t>(1, 2 * leaves[p].cells.size());
+        UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
     }
     kd.cells.resize(cells);
-    kd.bvhNodes.resize(bvhNodes);
+    kd.bvhNodes.reserve(maxNodes);
+    // Step 6: batches of partitions (about kBatchCells cells each, so only one batch's BVHs are
+    // held at a time): padded shrunk boxes, whole-cell value ranges, BVHs and cell lists in BVH
+    // order in parallel, then the BVHs appended in partition order.
+    constexpr std::uint64_t kBatchCells = 1u << 22;
+    const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
+    std::vector<Bvh> bvhs;
+    for (std::int64_t b0 = 0; b0 < leafCount;) {
+        std::int64_t b1 = b0;
+        for (std::uint64_t batchCells = 0; b1 < leafCount && batchCells < kBatchCells; ++b1)
+            batchCells += leaves[b1].cells.size();
+        bvhs.assign(b1 - b0, Bvh{});
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t p = 0; p < leafCount; ++p) {
-        const KdPartition& part = kd.partitions[p];
-        for (std::size_t i = 0; i < bvhs[p].nodes.size(); ++i) {
-            BvhNode node = bvhs[p].nodes[i];
-            node.first += node.count > 0 ? part.firstCell : part.bvhRoot;
-            kd.bvhNodes[part.bvhRoot + i] = node;
+        for (std::int64_t p = b0; p < b1; ++p) {
+            Leaf& leaf = leaves[p];
+            KdPartition& part = kd.partitions[p];
+            // Widened by a hair so that samples exactly on a cell face bounding the box are not
+            // lost to rounding in the ray-box clip (it only admits samples that then find no
+            // cell).
+            part.box = leaf.shrunk;
+            if (!leaf.shrunk.empty())
+                part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
+            float lo = INFINITY, hi = -INFINITY;
+            const std::size_t count = leaf.cells.size();
+            std::vector<Bounds3f> leafBoxes(count);
+            std::vector<Vec3f> leafCenters(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const std::uint32_t c = leaf.cells[i];
+                lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
+                leafBoxes[i] = data.boxes[c];
+                leafCenters[i] = data.centers[c];
+            }
+            part.valueMin = lo <= hi ? lo : 0.f;
+            part.valueMax = lo <= hi ? hi : 0.f;
+            part.cellCount = static_cast<std::uint32_t>(count);
+            Bvh& bvh = bvhs[p - b0];
+            bvh = buildBvh(leafBoxes, leafCenters);
+            for (std::size_t i = 0; i < bvh.primIds.size(); ++i)
+                kd.cells[part.firstCell + i] = leaf.cells[bvh.primIds[i]];
+            bvh.primIds = {};
+            leaf = {};
         }
-        for (std::size_t i = 0; i < bvhs[p].primIds.size(); ++i)
-            kd.cells[part.firstCell + i] = leaves[p].cells[bvhs[p].primIds[i]];
-        bvhs[p] = {};
-        leaves[p] = {};
+        const std::size_t batchStart = kd.bvhNodes.size();
+        std::size_t end = batchStart;
+        for (std::int64_t p = b0; p < b1; ++p) {
+            kd.partitions[p].bvhRoot = static_cast<std::uint32_t>(end);
+            end += bvhs[p - b0].nodes.size();
+            UVR_CHECK(end < 0xffffffffull, "partition BVH nodes exceed 32-bit indices");
+        }
+        kd.bvhNodes.resize(end);
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::int64_t p = b0; p < b1; ++p) {
+            const KdPartition& part = kd.partitions[p];
+            const std::vector<BvhNode>& nodes = bvhs[p - b0].nodes;
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                BvhNode node = nodes[i];
+                node.first += node.count > 0 ? part.firstCell : part.bvhRoot;
+                kd.bvhNodes[part.bvhRoot + i] = node;
+            }
+        }
+        b0 = b1;
     }
     kd.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
