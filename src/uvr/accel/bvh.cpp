@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 
 namespace uvr {
 
@@ -264,7 +265,7 @@ Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
     // nodes of at most kSubtreePrims primitives become subtree jobs.
     bvh.nodes.emplace_back();
     std::vector<Task> stack{{0, 0, n, 1}}, jobs;
-    std::vector<std::uint32_t> scratch(n);
+    ScratchVector<std::uint32_t> scratch(n);
     while (!stack.empty()) {
         const Task t = stack.back();
         stack.pop_back();

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 
 namespace uvr {
 
@@ -71,7 +72,7 @@ float keyFloat(std::uint32_t k) {
 float parallelKth(const CellData& data, const std::vector<std::uint32_t>& cells, int axis,
                   std::size_t k) {
     const std::int64_t count = static_cast<std::int64_t>(cells.size());
-    std::vector<std::uint32_t> keys(cells.size());
+    ScratchVector<std::uint32_t> keys(cells.size());
 #pragma omp parallel for schedule(static)
     for (std::int64_t i = 0; i < count; ++i) keys[i] = floatKey(data.centers[cells[i]][axis]);
     const std::int64_t chunks = (count + kChunk - 1) / kChunk;

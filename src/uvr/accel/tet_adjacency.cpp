@@ -5,6 +5,7 @@
 #include <atomic>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 
 namespace uvr {
 
@@ -50,7 +51,7 @@ std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh) {
     for (std::size_t p = 0; p < points; ++p) offsets[p + 1] += offsets[p];
     // Step 2: scatter faces into their buckets (in any order; step 3 sorts each bucket by its
     // full key, so the result does not depend on the order).
-    std::vector<FaceEntry> faces(static_cast<std::size_t>(4 * n));
+    ScratchVector<FaceEntry> faces(static_cast<std::size_t>(4 * n));
     {
         std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
 #pragma omp parallel for schedule(static)

@@ -6,6 +6,7 @@
 #include <atomic>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 #include "uvr/mesh/tet_mesh.h"
 
 namespace uvr {
@@ -74,7 +75,7 @@ const std::array<Children, 3>& templates() {
 /// A tetrahedral mesh being refined: points, tetrahedra and the point fields' values.
 struct Work {
     std::vector<Vec3f> points;
-    std::vector<Tet> tets;
+    ScratchVector<Tet> tets;
     std::vector<Field> pointFields;
 };
 
@@ -93,7 +94,7 @@ void refineOnce(Work& w) {
         }
     for (std::int64_t p = 0; p < pointCount; ++p) offsets[p + 1] += offsets[p];
     std::vector<std::uint32_t> ends(pointCount);  // end of the unique run of each bucket
-    std::vector<std::uint32_t> other(offsets[pointCount]);
+    ScratchVector<std::uint32_t> other(offsets[pointCount]);
     {
         std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
 #pragma omp parallel for schedule(static)
@@ -140,7 +141,7 @@ void refineOnce(Work& w) {
                                     f.values[std::uint64_t(b) * f.components + c]);
             }
     // Step 3: the 8 children of each tetrahedron, in place of children 8t .. 8t+7.
-    std::vector<Tet> children(static_cast<std::size_t>(8 * tetCount));
+    ScratchVector<Tet> children(static_cast<std::size_t>(8 * tetCount));
     const auto& tmpl = templates();
 #pragma omp parallel for schedule(static)
     for (std::int64_t t = 0; t < tetCount; ++t) {
