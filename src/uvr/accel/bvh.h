@@ -74,7 +74,8 @@ struct Bvh {
 
 /// Builds a BVH with binned SAH splits (Wald 2007, "On fast construction of SAH-based bounding
 /// volume hierarchies") over primitive boxes and their centres; O(n log n). Depth is bounded by
-/// kBvhMaxDepth (falling back to median splits near the limit).
+/// kBvhMaxDepth (falling back to median splits near the limit). Parallel (large nodes by
+/// data-parallel passes, then subtrees one per thread) and bit-identical for any thread count.
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
 
