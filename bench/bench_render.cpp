@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
-// Benchmarks of mesh preparation and the CPU reference marcher on procedural meshes.
+// Benchmarks of mesh preparation (whole and step by step, with 1 or 2 threads), refinement and
+// the CPU reference marcher on procedural meshes.
 // Record results in docs/PERFORMANCE.md with device, commit, date and command.
 #include <benchmark/benchmark.h>
 
 #include <map>
 
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/cpu/threads.h"
 #include "uvr/uvr.h"
 
 namespace {
@@ -64,6 +67,77 @@ void BM_KdBuild(benchmark::State& state) {
                                                   benchmark::Counter::kIsIterationInvariantRate);
 }
 
+/// Tetrahedra of a box mesh of about `cells` tetrahedra (split, no BVH), cached.
+const uvr::TetMesh& boxTets(std::uint64_t cells) {
+    static std::map<std::uint64_t, uvr::TetMesh> cache;
+    auto it = cache.find(cells);
+    if (it == cache.end()) {
+        const uvr::Mesh& mesh = boxMesh(cells);
+        it =
+            cache.emplace(cells, uvr::tetrahedralize(mesh, uvr::selectScalarField(mesh, {}))).first;
+    }
+    return it->second;
+}
+
+/// Sets the thread count from a benchmark argument for the scope of one case.
+struct Threads {
+    explicit Threads(std::int64_t n) { uvr::cpu::setThreadCount(static_cast<int>(n)); }
+    ~Threads() { uvr::cpu::setThreadCount(0); }
+};
+
+/// Preparation steps one at a time (args: tetrahedra, threads): splitting cells, per-tet boxes
+/// plus the BVH, face neighbours, k-d partitions (65536 cells per leaf, the CUDA default).
+void BM_PrepSplit(benchmark::State& state) {
+    const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
+    const uvr::ScalarField field = uvr::selectScalarField(mesh, {});
+    const Threads threads(state.range(1));
+    for (auto _ : state) benchmark::DoNotOptimize(uvr::tetrahedralize(mesh, field));
+    state.counters["tets/s"] = benchmark::Counter(static_cast<double>(mesh.cellCount()),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_PrepBvh(benchmark::State& state) {
+    const uvr::TetMesh& tets = boxTets(static_cast<std::uint64_t>(state.range(0)));
+    const Threads threads(state.range(1));
+    for (auto _ : state) {
+        std::vector<uvr::Bounds3f> boxes;
+        std::vector<uvr::Vec3f> centers;
+        uvr::tetBoxesAndCenters(tets, boxes, centers);
+        benchmark::DoNotOptimize(uvr::buildBvh(boxes, centers));
+    }
+    state.counters["tets/s"] = benchmark::Counter(static_cast<double>(tets.tets.size()),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_PrepNeighbors(benchmark::State& state) {
+    const uvr::TetMesh& tets = boxTets(static_cast<std::uint64_t>(state.range(0)));
+    const Threads threads(state.range(1));
+    for (auto _ : state) benchmark::DoNotOptimize(uvr::buildTetNeighbors(tets));
+    state.counters["tets/s"] = benchmark::Counter(static_cast<double>(tets.tets.size()),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_PrepKd(benchmark::State& state) {
+    const uvr::TetMesh& tets = boxTets(static_cast<std::uint64_t>(state.range(0)));
+    const Threads threads(state.range(1));
+    uvr::KdBuildOptions options;
+    options.leafCells = 65536;
+    for (auto _ : state) benchmark::DoNotOptimize(uvr::buildKdPartitions(tets, options));
+    state.counters["tets/s"] = benchmark::Counter(static_cast<double>(tets.tets.size()),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+/// Red refinement (args: source tetrahedra, levels, threads); output tetrahedra per second.
+void BM_Refine(benchmark::State& state) {
+    const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
+    const int levels = static_cast<int>(state.range(1));
+    const Threads threads(state.range(2));
+    std::uint64_t out = 0;
+    for (auto _ : state) out = uvr::refineMesh(mesh, levels).cellCount();
+    state.counters["out tets/s"] =
+        benchmark::Counter(static_cast<double>(out), benchmark::Counter::kIsIterationInvariantRate);
+}
+
 /// Transfer-function update (Morrical et al. 2019, Sec. 2.1): range tables of the baked table,
 /// then maximum opacity, variance and step of every partition; one thread.
 void BM_TfUpdate(benchmark::State& state) {
@@ -88,6 +162,26 @@ void BM_TfUpdate(benchmark::State& state) {
 
 BENCHMARK(BM_KdBuild)->Arg(1000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TfUpdate)->Args({1000, 64})->Args({1000000, 512})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PrepSplit)
+    ->Args({1000, 1})
+    ->ArgsProduct({{1000000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PrepBvh)
+    ->Args({1000, 1})
+    ->ArgsProduct({{1000000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PrepNeighbors)
+    ->Args({1000, 1})
+    ->ArgsProduct({{1000000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PrepKd)
+    ->Args({1000, 1})
+    ->ArgsProduct({{1000000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Refine)
+    ->Args({1000, 1, 1})
+    ->ArgsProduct({{100000}, {2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Generate)->Arg(1000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Prepare)->Arg(1000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RenderReference)

@@ -43,7 +43,8 @@ TEST(Cli, HelpListsEverySubcommand) {
     const std::string dir = testing::scratchDir();
     const CliRun r = uvr("--help", dir);
     EXPECT_EQ(r.code, 0);
-    for (const char* cmd : {"info", "render", "demo", "convert", "generate", "compare", "bench"})
+    for (const char* cmd :
+         {"info", "render", "demo", "convert", "generate", "refine", "compare", "bench"})
         EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
     const CliRun rh = uvr("render --help", dir);
     EXPECT_EQ(rh.code, 0);
@@ -181,6 +182,28 @@ TEST(Cli, GenerateAndDemo) {
     r = uvr("-q demo --cells 5000 --size 32x32 -o " + dir + "/demo.png", dir);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(readPng(dir + "/demo.png").width, 32);
+}
+
+TEST(Cli, RefineMultipliesTetrahedraBy8PerLevel) {
+    const std::string dir = testing::scratchDir();
+    CliRun r = uvr("-q generate box --cells 1000 --fields linear -o " + dir + "/b.uvrm", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = uvr("-q info --json " + dir + "/b.uvrm", dir);
+    const auto cells = nlohmann::json::parse(r.out)["cells"].get<std::uint64_t>();
+    r = uvr("-q refine " + dir + "/b.uvrm " + dir + "/r.vtu --levels 2", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = uvr("-q info --json " + dir + "/r.vtu", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["cells"].get<std::uint64_t>(), 64 * cells);
+    EXPECT_TRUE(j["validation"].empty()) << j["validation"];
+    // Bad levels and unwritable outputs fail cleanly and leave no file behind.
+    EXPECT_EQ(uvr("-q refine " + dir + "/b.uvrm " + dir + "/x.uvrm --levels 99", dir).code, 2);
+    EXPECT_EQ(uvr("-q refine " + dir + "/b.uvrm " + dir + "/x.png", dir).code, 2);
+    r = uvr("-q --max-memory 1M refine " + dir + "/b.uvrm " + dir + "/x.uvrm --levels 3", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--max-memory"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::ifstream(dir + "/x.uvrm").good());
 }
 
 TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "uvr/cpu/threads.h"
 
 namespace uvr::cli {
 
@@ -183,6 +184,56 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                  start);
         start = Clock::now();
         writeMesh(mesh, *out);
+        ctx.done("wrote " + *out, start);
+    });
+}
+
+void addRefineCommand(CLI::App& app, Context& ctx) {
+    auto* cmd = app.add_subcommand(
+        "refine",
+        "Split every tetrahedron into 8 at its edge midpoints, --levels times (non-tetrahedral "
+        "cells are split into tetrahedra first); point fields are interpolated, cell fields "
+        "copied");
+    auto in = std::make_shared<std::string>();
+    auto out = std::make_shared<std::string>();
+    auto levels = std::make_shared<int>(1);
+    auto threads = std::make_shared<int>(0);
+    cmd->add_option("IN", *in, "Input mesh")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
+    cmd->add_option("--levels", *levels, "Refinement levels (x8 tetrahedra each)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, kMaxRefineLevels));
+    cmd->add_option("--threads", *threads, "CPU threads (default: all cores)")
+        ->check(CLI::Range(1, 4096));
+    cmd->callback([in, out, levels, threads, &ctx] {
+        checkOutputPath(*out);
+        // Refuse an unwritable format before the (possibly long) refinement.
+        const std::string ext = fileExtension(*out);
+        if (ext != ".uvrm" && ext != ".vtu")
+            throwError(ErrorKind::Argument, *out,
+                       "cannot write this format: the output name must end in .uvrm (native) or "
+                       ".vtu");
+        if (*threads > 0) cpu::setThreadCount(*threads);
+        const Mesh mesh = loadMesh(*in, ctx);
+        // The output's largest array (4 point indices per tetrahedron) must fit --max-memory;
+        // the estimate splits hexahedra into 6 tetrahedra, wedges and pyramids into 3.
+        std::uint64_t tets = 0;
+        for (CellType t : mesh.cellTypes)
+            tets += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
+        const std::uint64_t outTets = refinedTetCount(tets, *levels);
+        if (ctx.maxMemoryBytes > 0 && outTets > ctx.maxMemoryBytes / 16)
+            throwError(ErrorKind::Resource, *in,
+                       "refining " + std::to_string(tets) + " tetrahedra " +
+                           std::to_string(*levels) + " times makes about " +
+                           std::to_string(outTets) + " tetrahedra, whose " +
+                           std::to_string(16 * outTets) + "-byte index array exceeds --max-memory");
+        auto start = Clock::now();
+        const Mesh refined = refineMesh(mesh, *levels, [&](const std::string& s) { ctx.step(s); });
+        ctx.done("refined to " + std::to_string(refined.pointCount()) + " points, " +
+                     std::to_string(refined.cellCount()) + " tetrahedra",
+                 start);
+        start = Clock::now();
+        writeMesh(refined, *out);
         ctx.done("wrote " + *out, start);
     });
 }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The uvr command-line tool: info, render, demo, convert, generate, compare, bench.
+// The uvr command-line tool: info, render, demo, convert, generate, refine, compare, bench.
 #include <cstdio>
 #include <new>
 
@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
     cli::addDemoCommand(app, ctx);
     cli::addConvertCommand(app, ctx);
     cli::addGenerateCommand(app, ctx);
+    cli::addRefineCommand(app, ctx);
     cli::addCompareCommand(app, ctx);
     cli::addBenchCommand(app, ctx);
     try {

@@ -10,6 +10,7 @@
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/procedural.h"
+#include "uvr/mesh/refine.h"
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/mesh/validate.h"
 #include "uvr/render/camera.h"

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 
 namespace uvr {
 
@@ -20,37 +21,81 @@ struct Task {
     std::uint32_t node, begin, end, depth;
 };
 
-}  // namespace
+/// Nodes with more primitives are split by data-parallel passes; smaller ones are whole subtrees
+/// built by one thread each. Fixed (not derived from the thread count), so the tree is the same
+/// whatever the number of threads.
+constexpr std::uint32_t kSubtreePrims = 1u << 17;
+/// Primitives per chunk of a data-parallel pass: at least 32 chunks per large node, so many cores
+/// share even the smallest of them (the results do not depend on the chunk size).
+constexpr std::int64_t kChunk = 1 << 12;
 
-Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
-             const BvhBuildOptions& options) {
-    UVR_CHECK(boxes.size() == centers.size(), "boxes and centres differ in count");
-    UVR_CHECK(boxes.size() < 0xffffffffull, "too many primitives for a 32-bit BVH");
-    Bvh bvh;
-    const std::uint32_t n = static_cast<std::uint32_t>(boxes.size());
-    if (n == 0) return bvh;
-    bvh.primIds.resize(n);
-    std::iota(bvh.primIds.begin(), bvh.primIds.end(), 0u);
-    bvh.nodes.reserve(2 * (n / std::max(1, options.maxLeafSize)) + 2);
-    bvh.nodes.emplace_back();
-    std::vector<Task> stack{{0, 0, n, 1}};
+/// The SAH sweep over binned boxes and counts: the best split bin on this axis, if it beats
+/// bestCost (then bestCost, bestAxis and bestSplit are updated).
+void sweepBins(int axis, int nb, const Bounds3f* binBox, const std::uint32_t* binCount,
+               Bounds3f* rightBox, std::uint32_t* rightCount, float& bestCost, int& bestAxis,
+               int& bestSplit) {
+    Bounds3f acc;
+    std::uint32_t accCount = 0;
+    for (int b = nb - 1; b > 0; --b) {
+        acc.extend(binBox[b]);
+        accCount += binCount[b];
+        rightBox[b] = acc;
+        rightCount[b] = accCount;
+    }
+    acc = Bounds3f{};
+    accCount = 0;
+    for (int b = 0; b < nb - 1; ++b) {
+        acc.extend(binBox[b]);
+        accCount += binCount[b];
+        if (accCount == 0 || rightCount[b + 1] == 0) continue;
+        const float cost = halfArea(acc) * accCount + halfArea(rightBox[b + 1]) * rightCount[b + 1];
+        if (cost < bestCost) {
+            bestCost = cost;
+            bestAxis = axis;
+            bestSplit = b + 1;
+        }
+    }
+}
+
+/// A primitive's box, centre and id, gathered so that a subtree's passes read memory in order.
+struct Prim {
+    Bounds3f box;
+    Vec3f center;
+    std::uint32_t id;
+};
+
+/// Builds the subtree of root task `root` into `nodes` (nodes[0] is its root, inner nodes name
+/// local child indices, leaves global ranges of ids); one thread. The primitives are copied into
+/// a local array that is partitioned in place (cache-friendly), then their ids written back.
+void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
+                  std::uint32_t* ids, Task root, const BvhBuildOptions& options,
+                  std::vector<BvhNode>& nodes) {
+    const std::uint32_t offset = root.begin;
+    std::vector<Prim> prims(root.end - root.begin);
+    for (std::uint32_t i = 0; i < prims.size(); ++i) {
+        const std::uint32_t id = ids[offset + i];
+        prims[i] = {boxes[id], centers[id], id};
+    }
+    Prim* p = prims.data();
+    nodes.clear();
+    nodes.emplace_back();
+    std::vector<Task> stack{{0, 0, root.end - offset, root.depth}};
     const int nb = std::max(2, options.bins);
     std::vector<Bounds3f> binBox(nb), rightBox(nb);
     std::vector<std::uint32_t> binCount(nb), rightCount(nb);
-    std::uint32_t* ids = bvh.primIds.data();
     while (!stack.empty()) {
         const Task t = stack.back();
         stack.pop_back();
         Bounds3f box, cbox;
         for (std::uint32_t i = t.begin; i < t.end; ++i) {
-            box.extend(boxes[ids[i]]);
-            cbox.extend(centers[ids[i]]);
+            box.extend(p[i].box);
+            cbox.extend(p[i].center);
         }
-        bvh.nodes[t.node].box = box;
+        nodes[t.node].box = box;
         const std::uint32_t count = t.end - t.begin;
         auto makeLeaf = [&] {
-            bvh.nodes[t.node].first = t.begin;
-            bvh.nodes[t.node].count = count;
+            nodes[t.node].first = offset + t.begin;
+            nodes[t.node].count = count;
         };
         if (count <= static_cast<std::uint32_t>(options.maxLeafSize)) {
             makeLeaf();
@@ -70,33 +115,13 @@ Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
                 std::fill(binBox.begin(), binBox.end(), Bounds3f{});
                 std::fill(binCount.begin(), binCount.end(), 0u);
                 for (std::uint32_t i = t.begin; i < t.end; ++i) {
-                    int b = static_cast<int>((centers[ids[i]][axis] - cbox.lo[axis]) * scale);
+                    int b = static_cast<int>((p[i].center[axis] - cbox.lo[axis]) * scale);
                     b = std::clamp(b, 0, nb - 1);
-                    binBox[b].extend(boxes[ids[i]]);
+                    binBox[b].extend(p[i].box);
                     ++binCount[b];
                 }
-                Bounds3f acc;
-                std::uint32_t accCount = 0;
-                for (int b = nb - 1; b > 0; --b) {
-                    acc.extend(binBox[b]);
-                    accCount += binCount[b];
-                    rightBox[b] = acc;
-                    rightCount[b] = accCount;
-                }
-                acc = Bounds3f{};
-                accCount = 0;
-                for (int b = 0; b < nb - 1; ++b) {
-                    acc.extend(binBox[b]);
-                    accCount += binCount[b];
-                    if (accCount == 0 || rightCount[b + 1] == 0) continue;
-                    const float cost =
-                        halfArea(acc) * accCount + halfArea(rightBox[b + 1]) * rightCount[b + 1];
-                    if (cost < bestCost) {
-                        bestCost = cost;
-                        bestAxis = axis;
-                        bestSplit = b + 1;
-                    }
-                }
+                sweepBins(axis, nb, binBox.data(), binCount.data(), rightBox.data(),
+                          rightCount.data(), bestCost, bestAxis, bestSplit);
             }
         }
         std::uint32_t mid;
@@ -104,12 +129,12 @@ Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
             const float scale = nb / cext[bestAxis];
             const float lo = cbox.lo[bestAxis];
             mid = static_cast<std::uint32_t>(
-                std::partition(ids + t.begin, ids + t.end,
-                               [&](std::uint32_t id) {
-                                   int b = static_cast<int>((centers[id][bestAxis] - lo) * scale);
+                std::partition(p + t.begin, p + t.end,
+                               [&](const Prim& q) {
+                                   int b = static_cast<int>((q.center[bestAxis] - lo) * scale);
                                    return std::clamp(b, 0, nb - 1) < bestSplit;
                                }) -
-                ids);
+                p);
         } else {
             // All centres coincide (or the depth limit is near): split by count.
             if (t.depth + 1 >= kBvhMaxDepth) {
@@ -118,20 +143,186 @@ Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
             }
             const int axis = cbox.longestAxis();
             mid = t.begin + count / 2;
-            std::nth_element(ids + t.begin, ids + mid, ids + t.end,
-                             [&](std::uint32_t a, std::uint32_t b) {
-                                 return centers[a][axis] < centers[b][axis];
-                             });
+            std::nth_element(p + t.begin, p + mid, p + t.end, [&](const Prim& a, const Prim& b) {
+                return a.center[axis] < b.center[axis];
+            });
+        }
+        const std::uint32_t left = static_cast<std::uint32_t>(nodes.size());
+        nodes[t.node].first = left;
+        nodes[t.node].count = 0;
+        nodes.emplace_back();
+        nodes.emplace_back();
+        stack.push_back({left + 1, mid, t.end, t.depth + 1});
+        stack.push_back({left, t.begin, mid, t.depth + 1});
+    }
+    for (std::uint32_t i = 0; i < prims.size(); ++i) ids[offset + i] = prims[i].id;
+}
+
+/// Splits a large node with data-parallel passes (bounds, binned SAH on the longest centre axis,
+/// stable partition through `scratch`); returns the split position, or t.end when the node should
+/// be left to buildSubtree (coincident centres, depth limit). Sets nodes[t.node].box.
+std::uint32_t splitLarge(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
+                         std::uint32_t* ids, std::uint32_t* scratch, const Task& t,
+                         const BvhBuildOptions& options, Bounds3f& nodeBox) {
+    const std::int64_t count = t.end - t.begin;
+    const std::int64_t chunks = (count + kChunk - 1) / kChunk;
+    auto chunkRange = [&](std::int64_t c) {
+        const std::uint32_t b = t.begin + static_cast<std::uint32_t>(c * kChunk);
+        return std::pair{b, static_cast<std::uint32_t>(std::min<std::int64_t>(t.end, b + kChunk))};
+    };
+    // Bounds of boxes and centres (min/max: exact in any order).
+    std::vector<Bounds3f> chunkBox(chunks), chunkCenters(chunks);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const auto [b, e] = chunkRange(c);
+        for (std::uint32_t i = b; i < e; ++i) {
+            chunkBox[c].extend(boxes[ids[i]]);
+            chunkCenters[c].extend(centers[ids[i]]);
+        }
+    }
+    Bounds3f box, cbox;
+    for (std::int64_t c = 0; c < chunks; ++c) box.extend(chunkBox[c]), cbox.extend(chunkCenters[c]);
+    nodeBox = box;
+    const int axis = cbox.longestAxis();
+    const float ext = cbox.extent()[axis];
+    if (t.depth + 2 >= kBvhMaxDepth || !(ext > 0.f)) return t.end;
+    // Binned SAH on the longest centre axis, as buildSubtree does for large nodes.
+    const int nb = std::max(2, options.bins);
+    const float scale = nb / ext, lo = cbox.lo[axis];
+    auto binOf = [&](std::uint32_t id) {
+        return std::clamp(static_cast<int>((centers[id][axis] - lo) * scale), 0, nb - 1);
+    };
+    std::vector<Bounds3f> chunkBins(chunks * nb);
+    std::vector<std::uint32_t> chunkCounts(chunks * nb, 0u);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const auto [b, e] = chunkRange(c);
+        for (std::uint32_t i = b; i < e; ++i) {
+            const int bin = binOf(ids[i]);
+            chunkBins[c * nb + bin].extend(boxes[ids[i]]);
+            ++chunkCounts[c * nb + bin];
+        }
+    }
+    std::vector<Bounds3f> binBox(nb), rightBox(nb);
+    std::vector<std::uint32_t> binCount(nb, 0u), rightCount(nb);
+    for (std::int64_t c = 0; c < chunks; ++c)
+        for (int b = 0; b < nb; ++b) {
+            binBox[b].extend(chunkBins[c * nb + b]);
+            binCount[b] += chunkCounts[c * nb + b];
+        }
+    float bestCost = INFINITY;
+    int bestAxis = -1, bestSplit = 0;
+    sweepBins(axis, nb, binBox.data(), binCount.data(), rightBox.data(), rightCount.data(),
+              bestCost, bestAxis, bestSplit);
+    if (bestAxis < 0) return t.end;
+    // Stable parallel partition: left counts per chunk, their prefix sums, scatter, copy back.
+    std::vector<std::uint32_t> leftBefore(chunks + 1, 0u);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const auto [b, e] = chunkRange(c);
+        std::uint32_t left = 0;
+        for (std::uint32_t i = b; i < e; ++i) left += binOf(ids[i]) < bestSplit;
+        leftBefore[c + 1] = left;
+    }
+    for (std::int64_t c = 0; c < chunks; ++c) leftBefore[c + 1] += leftBefore[c];
+    const std::uint32_t totalLeft = leftBefore[chunks];
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const auto [b, e] = chunkRange(c);
+        std::uint32_t l = t.begin + leftBefore[c];
+        std::uint32_t r = t.begin + totalLeft + (b - t.begin - leftBefore[c]);
+        for (std::uint32_t i = b; i < e; ++i) {
+            if (binOf(ids[i]) < bestSplit)
+                scratch[l++] = ids[i];
+            else
+                scratch[r++] = ids[i];
+        }
+    }
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = t.begin; i < static_cast<std::int64_t>(t.end); ++i) ids[i] = scratch[i];
+    return t.begin + totalLeft;
+}
+
+}  // namespace
+
+Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
+             const BvhBuildOptions& options) {
+    UVR_CHECK(boxes.size() == centers.size(), "boxes and centres differ in count");
+    UVR_CHECK(boxes.size() < 0xffffffffull, "too many primitives for a 32-bit BVH");
+    Bvh bvh;
+    const std::uint32_t n = static_cast<std::uint32_t>(boxes.size());
+    if (n == 0) return bvh;
+    bvh.primIds.resize(n);
+    std::uint32_t* ids = bvh.primIds.data();
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i)
+        ids[i] = static_cast<std::uint32_t>(i);
+    if (n <= kSubtreePrims) {
+        buildSubtree(boxes, centers, ids, {0, 0, n, 1}, options, bvh.nodes);
+        return bvh;
+    }
+    // Step 1: the top of the tree, one large node at a time, each split by parallel passes;
+    // nodes of at most kSubtreePrims primitives become subtree jobs.
+    bvh.nodes.emplace_back();
+    std::vector<Task> stack{{0, 0, n, 1}}, jobs;
+    ScratchVector<std::uint32_t> scratch(n);
+    while (!stack.empty()) {
+        const Task t = stack.back();
+        stack.pop_back();
+        if (t.end - t.begin <= kSubtreePrims) {
+            jobs.push_back(t);
+            continue;
+        }
+        Bounds3f box;
+        const std::uint32_t mid = splitLarge(boxes, centers, ids, scratch.data(), t, options, box);
+        if (mid == t.end) {
+            jobs.push_back(t);
+            continue;
         }
         const std::uint32_t left = static_cast<std::uint32_t>(bvh.nodes.size());
-        bvh.nodes[t.node].first = left;
-        bvh.nodes[t.node].count = 0;
+        bvh.nodes[t.node] = {box, left, 0};
         bvh.nodes.emplace_back();
         bvh.nodes.emplace_back();
         stack.push_back({left + 1, mid, t.end, t.depth + 1});
         stack.push_back({left, t.begin, mid, t.depth + 1});
     }
+    scratch = {};
+    // Step 2: the subtrees, in parallel, each into its own node list.
+    const std::int64_t jobCount = static_cast<std::int64_t>(jobs.size());
+    std::vector<std::vector<BvhNode>> local(jobs.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t j = 0; j < jobCount; ++j)
+        buildSubtree(boxes, centers, ids, jobs[j], options, local[j]);
+    // Step 3: append them in job order (each subtree's root replaces its placeholder).
+    std::vector<std::size_t> base(jobs.size() + 1, bvh.nodes.size());
+    for (std::int64_t j = 0; j < jobCount; ++j) base[j + 1] = base[j] + local[j].size() - 1;
+    UVR_CHECK(base[jobCount] < 0xffffffffull, "too many BVH nodes for 32-bit indices");
+    bvh.nodes.resize(base[jobCount]);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t j = 0; j < jobCount; ++j) {
+        const std::uint32_t offset = static_cast<std::uint32_t>(base[j]) - 1;
+        for (std::size_t i = 0; i < local[j].size(); ++i) {
+            BvhNode node = local[j][i];
+            if (node.count == 0) node.first += offset;
+            bvh.nodes[i == 0 ? jobs[j].node : offset + i] = node;
+        }
+        local[j] = {};
+    }
     return bvh;
+}
+
+void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
+                        std::vector<Vec3f>& centers) {
+    const std::int64_t n = static_cast<std::int64_t>(mesh.tets.size());
+    boxes.resize(n);
+    centers.resize(n);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t t = 0; t < n; ++t) {
+        Bounds3f b;
+        for (std::uint32_t v : mesh.tets[t].v) b.extend(mesh.points[v]);
+        boxes[t] = b;
+        centers[t] = b.center();
+    }
 }
 
 }  // namespace uvr

@@ -7,6 +7,7 @@
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
+#include "uvr/mesh/tet_mesh.h"
 
 namespace uvr {
 
@@ -88,8 +89,13 @@ struct Bvh {
 
 /// Builds a BVH with binned SAH splits (Wald 2007, "On fast construction of SAH-based bounding
 /// volume hierarchies") over primitive boxes and their centres; O(n log n). Depth is bounded by
-/// kBvhMaxDepth (falling back to median splits near the limit).
+/// kBvhMaxDepth (falling back to median splits near the limit). Parallel (large nodes by
+/// data-parallel passes, then subtrees one per thread) and bit-identical for any thread count.
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
+
+/// Bounding box and box centre of every tetrahedron of a mesh (resizes both arrays); parallel.
+void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
+                        std::vector<Vec3f>& centers);
 
 }  // namespace uvr

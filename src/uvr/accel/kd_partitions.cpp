@@ -2,15 +2,41 @@
 #include "uvr/accel/kd_partitions.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 
 namespace uvr {
 
 namespace {
 
+/// Padding of shrunk boxes, relative to the mesh diagonal.
+constexpr float kBoxPadding = 1e-6f;
+/// Nodes with more cells are split by data-parallel passes; smaller ones are whole subtrees built
+/// by one thread each. Fixed (not derived from the thread count), so the partitions are the same
+/// whatever the number of threads.
+constexpr std::size_t kSubtreeCells = 1u << 18;
+/// Cells per chunk of a data-parallel pass.
+constexpr std::int64_t kChunk = 1 << 14;
+
+Bounds3f intersect(const Bounds3f& a, const Bounds3f& b) {
+    Bounds3f r;
+    r.lo = vmax(a.lo, b.lo);
+    r.hi = vmin(a.hi, b.hi);
+    return r;
+}
+
+/// Per-cell boxes, centres and finite value ranges.
+struct CellData {
+    std::vector<Bounds3f> boxes;
+    std::vector<Vec3f> centers;
+    std::vector<float> vmin, vmax;
+};
+
+/// A node to split: its k-d node index, region, cells and depth.
 struct Task {
     std::uint32_t node;
     Bounds3f region;
@@ -18,14 +44,176 @@ struct Task {
     int depth;
 };
 
-/// Padding of shrunk boxes, relative to the mesh diagonal.
-constexpr float kBoxPadding = 1e-6f;
+/// A partition awaiting its BVH: the shrunk box and the cells.
+struct Leaf {
+    Bounds3f shrunk;
+    std::vector<std::uint32_t> cells;
+};
 
-Bounds3f intersect(const Bounds3f& a, const Bounds3f& b) {
-    Bounds3f r;
-    r.lo = vmax(a.lo, b.lo);
-    r.hi = vmin(a.hi, b.hi);
-    return r;
+/// A subtree built by one thread: nodes with local indices (node 0 is its root; a leaf's child
+/// field names its entry of `leaves`).
+struct LocalTree {
+    std::vector<KdNode> nodes;
+    std::vector<Leaf> leaves;
+};
+
+/// Order-preserving map of a float to an unsigned key (for radix selection).
+std::uint32_t floatKey(float f) {
+    const std::uint32_t u = std::bit_cast<std::uint32_t>(f);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+float keyFloat(std::uint32_t k) {
+    return std::bit_cast<float>((k & 0x80000000u) ? (k & 0x7fffffffu) : ~k);
+}
+
+/// The k-th smallest centre coordinate on `axis` of the cells (what std::nth_element picks), by
+/// parallel radix selection: four 8-bit histogram passes from the most significant digit.
+float parallelKth(const CellData& data, const std::vector<std::uint32_t>& cells, int axis,
+                  std::size_t k) {
+    const std::int64_t count = static_cast<std::int64_t>(cells.size());
+    ScratchVector<std::uint32_t> keys(cells.size());
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < count; ++i) keys[i] = floatKey(data.centers[cells[i]][axis]);
+    const std::int64_t chunks = (count + kChunk - 1) / kChunk;
+    std::vector<std::uint64_t> histograms(chunks * 256);
+    std::uint32_t prefix = 0, mask = 0;
+    for (int shift = 24; shift >= 0; shift -= 8) {
+        std::fill(histograms.begin(), histograms.end(), 0u);
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::int64_t c = 0; c < chunks; ++c) {
+            std::uint64_t* h = histograms.data() + c * 256;
+            const std::int64_t end = std::min(count, (c + 1) * kChunk);
+            for (std::int64_t i = c * kChunk; i < end; ++i)
+                if ((keys[i] & mask) == prefix) ++h[(keys[i] >> shift) & 255u];
+        }
+        std::uint64_t total[256] = {};
+        for (std::int64_t c = 0; c < chunks; ++c)
+            for (int d = 0; d < 256; ++d) total[d] += histograms[c * 256 + d];
+        int digit = 0;
+        while (k >= total[digit]) k -= total[digit++];
+        prefix |= static_cast<std::uint32_t>(digit) << shift;
+        mask |= 255u << shift;
+    }
+    return keyFloat(prefix);
+}
+
+/// Splits a large task with data-parallel passes (Morrical et al. 2019, Sec. 2.1: median of the
+/// cell centres on the longest axis of the occupied region). Returns false when the node should
+/// be left to buildSubtree (which then makes it a leaf); else fills the children's cell lists
+/// (in the parent's order), the axis and the plane.
+bool splitLarge(const CellData& data, const Task& task, const KdBuildOptions& options,
+                std::vector<std::uint32_t>& left, std::vector<std::uint32_t>& right, int& axis,
+                float& plane) {
+    const std::int64_t count = static_cast<std::int64_t>(task.cells.size());
+    const std::int64_t chunks = (count + kChunk - 1) / kChunk;
+    std::vector<Bounds3f> chunkBounds(chunks);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const std::int64_t end = std::min(count, (c + 1) * kChunk);
+        for (std::int64_t i = c * kChunk; i < end; ++i)
+            chunkBounds[c].extend(data.boxes[task.cells[i]]);
+    }
+    Bounds3f cellBounds;
+    for (const Bounds3f& b : chunkBounds) cellBounds.extend(b);
+    const Bounds3f shrunk = intersect(task.region, cellBounds);
+    if (!(static_cast<std::size_t>(count) > options.leafCells && task.depth < options.maxDepth &&
+          !shrunk.empty()))
+        return false;
+    axis = shrunk.longestAxis();
+    plane = parallelKth(data, task.cells, axis, static_cast<std::size_t>(count / 2));
+    // A cell touching the plane goes to both sides (see buildSubtree).
+    std::vector<std::uint64_t> before(2 * (chunks + 1), 0u);  // [left, right] per chunk
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const std::int64_t end = std::min(count, (c + 1) * kChunk);
+        std::uint64_t l = 0, r = 0;
+        for (std::int64_t i = c * kChunk; i < end; ++i) {
+            l += data.boxes[task.cells[i]].lo[axis] <= plane;
+            r += data.boxes[task.cells[i]].hi[axis] >= plane;
+        }
+        before[2 * (c + 1)] = l;
+        before[2 * (c + 1) + 1] = r;
+    }
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        before[2 * (c + 1)] += before[2 * c];
+        before[2 * (c + 1) + 1] += before[2 * c + 1];
+    }
+    const std::uint64_t nl = before[2 * chunks], nr = before[2 * chunks + 1];
+    if (!(plane > task.region.lo[axis] && plane < task.region.hi[axis] &&
+          std::max(nl, nr) * 10 <= static_cast<std::uint64_t>(count) * 9))
+        return false;
+    left.resize(nl);
+    right.resize(nr);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        const std::int64_t end = std::min(count, (c + 1) * kChunk);
+        std::uint64_t l = before[2 * c], r = before[2 * c + 1];
+        for (std::int64_t i = c * kChunk; i < end; ++i) {
+            const std::uint32_t cell = task.cells[i];
+            if (data.boxes[cell].lo[axis] <= plane) left[l++] = cell;
+            if (data.boxes[cell].hi[axis] >= plane) right[r++] = cell;
+        }
+    }
+    return true;
+}
+
+/// Builds the k-d subtree of a task with one thread (median splits as splitLarge; a node whose
+/// split would not reduce the larger side below 90% of its cells becomes a leaf).
+LocalTree buildSubtree(const CellData& data, Task root, const KdBuildOptions& options) {
+    LocalTree out;
+    out.nodes.emplace_back();
+    root.node = 0;
+    std::vector<Task> stack;
+    stack.push_back(std::move(root));
+    while (!stack.empty()) {
+        Task task = std::move(stack.back());
+        stack.pop_back();
+        const std::size_t count = task.cells.size();
+        Bounds3f cellBounds;
+        for (std::uint32_t c : task.cells) cellBounds.extend(data.boxes[c]);
+        const Bounds3f shrunk = intersect(task.region, cellBounds);
+        // Median split of the cell centres along the longest axis of the occupied region.
+        bool split = count > options.leafCells && task.depth < options.maxDepth && !shrunk.empty();
+        std::vector<std::uint32_t> left, right;
+        int axis = 0;
+        float plane = 0.f;
+        if (split) {
+            axis = shrunk.longestAxis();
+            // The median value of a copy: the children keep the parent's cell order.
+            std::vector<float> keys(count);
+            for (std::size_t i = 0; i < count; ++i) keys[i] = data.centers[task.cells[i]][axis];
+            auto mid = keys.begin() + count / 2;
+            std::nth_element(keys.begin(), mid, keys.end());
+            plane = *mid;
+            // A cell touching the plane goes to both sides, so every point of a child's closed
+            // region that lies in a cell finds that cell in the child's list.
+            for (std::uint32_t c : task.cells) {
+                if (data.boxes[c].lo[axis] <= plane) left.push_back(c);
+                if (data.boxes[c].hi[axis] >= plane) right.push_back(c);
+            }
+            const std::size_t larger = std::max(left.size(), right.size());
+            split = plane > task.region.lo[axis] && plane < task.region.hi[axis] &&
+                    larger * 10 <= count * 9;
+        }
+        if (split) {
+            const std::uint32_t child = static_cast<std::uint32_t>(out.nodes.size());
+            out.nodes[task.node].split = plane;
+            out.nodes[task.node].bits = (child << 2) | static_cast<std::uint32_t>(axis);
+            out.nodes.emplace_back();
+            out.nodes.emplace_back();
+            Bounds3f below = task.region, above = task.region;
+            below.hi[axis] = plane;
+            above.lo[axis] = plane;
+            task.cells = {};
+            stack.push_back({child + 1, above, std::move(right), task.depth + 1});
+            stack.push_back({child, below, std::move(left), task.depth + 1});
+            continue;
+        }
+        out.nodes[task.node].bits = (static_cast<std::uint32_t>(out.leaves.size()) << 2) | 3u;
+        out.leaves.push_back({shrunk, std::move(task.cells)});
+    }
+    return out;
 }
 
 }  // namespace
@@ -38,105 +226,164 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     KdPartitions kd;
     kd.bounds = mesh.bounds;
     kd.leafCells = options.leafCells;
-    // Per-cell boxes, centres and finite value ranges.
-    std::vector<Bounds3f> boxes(n);
-    std::vector<Vec3f> centers(n);
-    std::vector<float> vmin(n, INFINITY), vmax(n, -INFINITY);
+    // Step 1: per-cell boxes, centres and finite value ranges.
+    CellData data;
+    data.boxes.resize(n);
+    data.centers.resize(n);
+    data.vmin.resize(n);
+    data.vmax.resize(n);
     const bool cellData = mesh.association == Association::Cell;
-    for (std::size_t t = 0; t < n; ++t) {
+    const std::int64_t tetCount = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t t = 0; t < tetCount; ++t) {
+        Bounds3f box;
+        float lo = INFINITY, hi = -INFINITY;
         for (std::uint32_t v : mesh.tets[t].v) {
-            boxes[t].extend(mesh.points[v]);
+            box.extend(mesh.points[v]);
             if (!cellData && std::isfinite(mesh.values[v])) {
-                vmin[t] = std::min(vmin[t], mesh.values[v]);
-                vmax[t] = std::max(vmax[t], mesh.values[v]);
+                lo = std::min(lo, mesh.values[v]);
+                hi = std::max(hi, mesh.values[v]);
             }
         }
-        if (cellData && std::isfinite(mesh.values[t])) vmin[t] = vmax[t] = mesh.values[t];
-        centers[t] = boxes[t].center();
+        if (cellData && std::isfinite(mesh.values[t])) lo = hi = mesh.values[t];
+        data.boxes[t] = box;
+        data.centers[t] = box.center();
+        data.vmin[t] = lo;
+        data.vmax[t] = hi;
     }
+    // Step 2: the top of the tree, one large node at a time, split by parallel passes; nodes of
+    // at most kSubtreeCells cells become subtree jobs.
     kd.nodes.emplace_back();
-    std::vector<Task> stack;
+    std::vector<Task> stack, jobs;
     {
         std::vector<std::uint32_t> all(n);
-        for (std::size_t t = 0; t < n; ++t) all[t] = static_cast<std::uint32_t>(t);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t t = 0; t < tetCount; ++t) all[t] = static_cast<std::uint32_t>(t);
         stack.push_back({0, mesh.bounds, std::move(all), 0});
     }
-    std::vector<Bounds3f> leafBoxes;
-    std::vector<Vec3f> leafCenters;
     while (!stack.empty()) {
         Task task = std::move(stack.back());
         stack.pop_back();
-        const std::size_t count = task.cells.size();
-        Bounds3f cellBounds;
-        for (std::uint32_t c : task.cells) cellBounds.extend(boxes[c]);
-        const Bounds3f shrunk = intersect(task.region, cellBounds);
-        // Median split of the cell centres along the longest axis of the occupied region.
-        bool split = count > options.leafCells && task.depth < options.maxDepth && !shrunk.empty();
         std::vector<std::uint32_t> left, right;
         int axis = 0;
         float plane = 0.f;
-        if (split) {
-            axis = shrunk.longestAxis();
-            auto mid = task.cells.begin() + count / 2;
-            std::nth_element(task.cells.begin(), mid, task.cells.end(),
-                             [&](std::uint32_t a, std::uint32_t b) {
-                                 return centers[a][axis] < centers[b][axis];
-                             });
-            plane = centers[*mid][axis];
-            // A cell touching the plane goes to both sides, so every point of a child's closed
-            // region that lies in a cell finds that cell in the child's list.
-            for (std::uint32_t c : task.cells) {
-                if (boxes[c].lo[axis] <= plane) left.push_back(c);
-                if (boxes[c].hi[axis] >= plane) right.push_back(c);
-            }
-            const std::size_t larger = std::max(left.size(), right.size());
-            split = plane > task.region.lo[axis] && plane < task.region.hi[axis] &&
-                    larger * 10 <= count * 9;
-        }
-        if (split) {
-            const std::uint32_t child = static_cast<std::uint32_t>(kd.nodes.size());
-            kd.nodes[task.node].split = plane;
-            kd.nodes[task.node].bits = (child << 2) | static_cast<std::uint32_t>(axis);
-            kd.nodes.emplace_back();
-            kd.nodes.emplace_back();
-            Bounds3f below = task.region, above = task.region;
-            below.hi[axis] = plane;
-            above.lo[axis] = plane;
-            task.cells = {};
-            stack.push_back({child + 1, above, std::move(right), task.depth + 1});
-            stack.push_back({child, below, std::move(left), task.depth + 1});
+        if (task.cells.size() <= kSubtreeCells ||
+            !splitLarge(data, task, options, left, right, axis, plane)) {
+            jobs.push_back(std::move(task));
             continue;
         }
-        // Leaf: shrunk box, whole-cell value range, and a BVH over its cells.
-        KdPartition part;
-        // Widened by a hair so that samples exactly on a cell face bounding the box are not lost
-        // to rounding in the ray-box clip (it only admits samples that then find no cell).
-        part.box = shrunk;
-        const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
-        if (!shrunk.empty()) part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
-        float lo = INFINITY, hi = -INFINITY;
-        for (std::uint32_t c : task.cells) lo = std::min(lo, vmin[c]), hi = std::max(hi, vmax[c]);
-        part.valueMin = lo <= hi ? lo : 0.f;
-        part.valueMax = lo <= hi ? hi : 0.f;
-        part.firstCell = static_cast<std::uint32_t>(kd.cells.size());
-        part.cellCount = static_cast<std::uint32_t>(count);
-        part.bvhRoot = static_cast<std::uint32_t>(kd.bvhNodes.size());
-        leafBoxes.resize(count);
-        leafCenters.resize(count);
-        for (std::size_t i = 0; i < count; ++i) {
-            leafBoxes[i] = boxes[task.cells[i]];
-            leafCenters[i] = centers[task.cells[i]];
-        }
-        const Bvh bvh = buildBvh(leafBoxes, leafCenters);
-        for (BvhNode node : bvh.nodes) {
-            node.first += node.count > 0 ? part.firstCell : part.bvhRoot;
-            kd.bvhNodes.push_back(node);
-        }
-        for (std::uint32_t local : bvh.primIds) kd.cells.push_back(task.cells[local]);
-        kd.nodes[task.node].bits = (static_cast<std::uint32_t>(kd.partitions.size()) << 2) | 3u;
-        kd.partitions.push_back(part);
+        const std::uint32_t child = static_cast<std::uint32_t>(kd.nodes.size());
+        kd.nodes[task.node].split = plane;
+        kd.nodes[task.node].bits = (child << 2) | static_cast<std::uint32_t>(axis);
+        kd.nodes.emplace_back();
+        kd.nodes.emplace_back();
+        Bounds3f below = task.region, above = task.region;
+        below.hi[axis] = plane;
+        above.lo[axis] = plane;
+        stack.push_back({child + 1, above, std::move(right), task.depth + 1});
+        stack.push_back({child, below, std::move(left), task.depth + 1});
     }
-    UVR_CHECK(kd.cells.size() < 0xffffffffull, "partition cell lists exceed 32-bit indices");
+    // Step 3: the subtrees, in parallel.
+    const std::int64_t jobCount = static_cast<std::int64_t>(jobs.size());
+    std::vector<LocalTree> local(jobs.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t j = 0; j < jobCount; ++j) {
+        const std::uint32_t node = jobs[j].node;
+        local[j] = buildSubtree(data, std::move(jobs[j]), options);
+        jobs[j].node = node;
+    }
+    // Step 4: append the subtrees in job order (each root replaces its placeholder) and number
+    // their leaves.
+    std::vector<Leaf> leaves;
+    for (std::int64_t j = 0; j < jobCount; ++j) {
+        const std::uint32_t nodeOffset = static_cast<std::uint32_t>(kd.nodes.size()) - 1;
+        const std::uint32_t leafOffset = static_cast<std::uint32_t>(leaves.size());
+        for (std::size_t i = 0; i < local[j].nodes.size(); ++i) {
+            KdNode node = local[j].nodes[i];
+            const std::uint32_t c = node.child() + (node.isLeaf() ? leafOffset : nodeOffset);
+            node.bits = (c << 2) | (node.bits & 3u);
+            if (i == 0)
+                kd.nodes[jobs[j].node] = node;
+            else
+                kd.nodes.push_back(node);
+        }
+        for (Leaf& leaf : local[j].leaves) leaves.push_back(std::move(leaf));
+        local[j] = {};
+    }
+    // Step 5: cell-list offsets (known from the leaves) and room for at most 2 c - 1 BVH nodes
+    // per partition of c cells, reserved once (only what is written becomes resident).
+    const std::int64_t leafCount = static_cast<std::int64_t>(leaves.size());
+    kd.partitions.resize(leaves.size());
+    std::uint64_t cells = 0, maxNodes = 0;
+    for (std::int64_t p = 0; p < leafCount; ++p) {
+        kd.partitions[p].firstCell = static_cast<std::uint32_t>(cells);
+        cells += leaves[p].cells.size();
+        maxNodes += std::max<std::uint64_t>(1, 2 * leaves[p].cells.size());
+        UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
+    }
+    kd.cells.resize(cells);
+    kd.bvhNodes.reserve(maxNodes);
+    // Step 6: batches of partitions (about kBatchCells cells each, so only one batch's BVHs are
+    // held at a time): padded shrunk boxes, whole-cell value ranges, BVHs and cell lists in BVH
+    // order in parallel, then the BVHs appended in partition order.
+    constexpr std::uint64_t kBatchCells = 1u << 22;
+    const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
+    std::vector<Bvh> bvhs;
+    for (std::int64_t b0 = 0; b0 < leafCount;) {
+        std::int64_t b1 = b0;
+        for (std::uint64_t batchCells = 0; b1 < leafCount && batchCells < kBatchCells; ++b1)
+            batchCells += leaves[b1].cells.size();
+        bvhs.assign(b1 - b0, Bvh{});
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::int64_t p = b0; p < b1; ++p) {
+            Leaf& leaf = leaves[p];
+            KdPartition& part = kd.partitions[p];
+            // Widened by a hair so that samples exactly on a cell face bounding the box are not
+            // lost to rounding in the ray-box clip (it only admits samples that then find no
+            // cell).
+            part.box = leaf.shrunk;
+            if (!leaf.shrunk.empty())
+                part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
+            float lo = INFINITY, hi = -INFINITY;
+            const std::size_t count = leaf.cells.size();
+            std::vector<Bounds3f> leafBoxes(count);
+            std::vector<Vec3f> leafCenters(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const std::uint32_t c = leaf.cells[i];
+                lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
+                leafBoxes[i] = data.boxes[c];
+                leafCenters[i] = data.centers[c];
+            }
+            part.valueMin = lo <= hi ? lo : 0.f;
+            part.valueMax = lo <= hi ? hi : 0.f;
+            part.cellCount = static_cast<std::uint32_t>(count);
+            Bvh& bvh = bvhs[p - b0];
+            bvh = buildBvh(leafBoxes, leafCenters);
+            for (std::size_t i = 0; i < bvh.primIds.size(); ++i)
+                kd.cells[part.firstCell + i] = leaf.cells[bvh.primIds[i]];
+            bvh.primIds = {};
+            leaf = {};
+        }
+        const std::size_t batchStart = kd.bvhNodes.size();
+        std::size_t end = batchStart;
+        for (std::int64_t p = b0; p < b1; ++p) {
+            kd.partitions[p].bvhRoot = static_cast<std::uint32_t>(end);
+            end += bvhs[p - b0].nodes.size();
+            UVR_CHECK(end < 0xffffffffull, "partition BVH nodes exceed 32-bit indices");
+        }
+        kd.bvhNodes.resize(end);
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::int64_t p = b0; p < b1; ++p) {
+            const KdPartition& part = kd.partitions[p];
+            const std::vector<BvhNode>& nodes = bvhs[p - b0].nodes;
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                BvhNode node = nodes[i];
+                node.first += node.count > 0 ? part.firstCell : part.bvhRoot;
+                kd.bvhNodes[part.bvhRoot + i] = node;
+            }
+        }
+        b0 = b1;
+    }
     kd.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return kd;

@@ -153,6 +153,8 @@ struct KdPartitions {
 /// Builds the partitions with median splits of cell centres along the longest axis of each node
 /// (Morrical et al. 2019, Sec. 2.1); O(n log n) for well-shaped meshes. A node whose split would
 /// not reduce the larger side below 90% of its cells becomes a leaf, which bounds duplication.
+/// Parallel (large nodes by data-parallel passes, then subtrees and partition BVHs one per
+/// thread) and bit-identical for any thread count.
 KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options = {});
 
 }  // namespace uvr

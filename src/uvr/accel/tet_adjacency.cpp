@@ -2,45 +2,92 @@
 #include "uvr/accel/tet_adjacency.h"
 
 #include <algorithm>
+#include <atomic>
 
 #include "uvr/core/error.h"
+#include "uvr/core/scratch_vector.h"
 
 namespace uvr {
 
+namespace {
+
+/// A face in its smallest vertex's bucket: the other two vertex ids (sorted) and the slot
+/// 4 * tet + opposite vertex.
+struct FaceEntry {
+    std::uint32_t b, c, slot;
+};
+
+/// Tetrahedra per parallel chunk (fixed, so results never depend on the thread count).
+constexpr std::int64_t kChunk = 1 << 14;
+
+}  // namespace
+
 std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh) {
-    const std::uint64_t n = mesh.tets.size();
-    UVR_CHECK(n < kNoTet / 4, "too many tetrahedra for 32-bit neighbour ids");
-    struct FaceKey {
-        std::uint32_t a, b, c, slot;  // sorted vertex ids; slot = 4 * tet + opposite vertex
+    const std::int64_t n = static_cast<std::int64_t>(mesh.tets.size());
+    UVR_CHECK(static_cast<std::uint64_t>(n) < kNoTet / 4,
+              "too many tetrahedra for 32-bit neighbour ids");
+    const std::size_t points = mesh.points.size();
+    const Tet* tets = mesh.tets.data();
+    // Faces bucketed by their smallest vertex id (a counting sort, vertex-to-face CSR), so each
+    // bucket is a handful of faces sorted on its own instead of one sort of 4n faces.
+    // Step 1: faces per smallest vertex.
+    std::vector<std::uint32_t> offsets(points + 1, 0);
+    auto faceOf = [&](std::int64_t t, int i, std::uint32_t f[3]) {
+        int k = 0;
+        for (int j = 0; j < 4; ++j)
+            if (j != i) f[k++] = tets[t].v[j];
+        if (f[0] > f[1]) std::swap(f[0], f[1]);
+        if (f[1] > f[2]) std::swap(f[1], f[2]);
+        if (f[0] > f[1]) std::swap(f[0], f[1]);
     };
-    std::vector<FaceKey> faces(4 * n);
-    for (std::uint64_t t = 0; t < n; ++t) {
-        const auto& v = mesh.tets[t].v;
+#pragma omp parallel for schedule(static)
+    for (std::int64_t t = 0; t < n; ++t)
         for (int i = 0; i < 4; ++i) {
-            std::uint32_t f[3], k = 0;
-            for (int j = 0; j < 4; ++j)
-                if (j != i) f[k++] = v[j];
-            std::sort(f, f + 3);
-            faces[4 * t + i] = {f[0], f[1], f[2], static_cast<std::uint32_t>(4 * t + i)};
+            std::uint32_t f[3];
+            faceOf(t, i, f);
+            std::atomic_ref<std::uint32_t>(offsets[f[0] + 1])
+                .fetch_add(1, std::memory_order_relaxed);
         }
+    for (std::size_t p = 0; p < points; ++p) offsets[p + 1] += offsets[p];
+    // Step 2: scatter faces into their buckets (in any order; step 3 sorts each bucket by its
+    // full key, so the result does not depend on the order).
+    ScratchVector<FaceEntry> faces(static_cast<std::size_t>(4 * n));
+    {
+        std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t t = 0; t < n; ++t)
+            for (int i = 0; i < 4; ++i) {
+                std::uint32_t f[3];
+                faceOf(t, i, f);
+                const std::uint32_t at = std::atomic_ref<std::uint32_t>(fill[f[0]])
+                                             .fetch_add(1, std::memory_order_relaxed);
+                faces[at] = {f[1], f[2], static_cast<std::uint32_t>(4 * t + i)};
+            }
     }
-    std::sort(faces.begin(), faces.end(), [](const FaceKey& x, const FaceKey& y) {
-        if (x.a != y.a) return x.a < y.a;
-        if (x.b != y.b) return x.b < y.b;
-        return x.c < y.c;
-    });
-    std::vector<std::uint32_t> neighbors(4 * n, kNoTet);
-    auto same = [](const FaceKey& x, const FaceKey& y) {
-        return x.a == y.a && x.b == y.b && x.c == y.c;
-    };
-    for (std::size_t i = 0; i < faces.size();) {
-        std::size_t j = i + 1;
-        while (j < faces.size() && same(faces[i], faces[j])) ++j;
-        if (j - i == 2) {  // an interior face; non-manifold faces (3+) stay boundary
-            neighbors[faces[i].slot] = faces[i + 1].slot / 4;
-            neighbors[faces[i + 1].slot] = faces[i].slot / 4;
+    // Step 3: sort each bucket and pair equal faces.
+    std::vector<std::uint32_t> neighbors(static_cast<std::size_t>(4 * n), kNoTet);
+    const std::int64_t pointCount = static_cast<std::int64_t>(points);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t start = 0; start < pointCount; start += kChunk) {
+        const std::int64_t end = std::min(pointCount, start + kChunk);
+        for (std::int64_t p = start; p < end; ++p) {
+            FaceEntry* first = faces.data() + offsets[p];
+            FaceEntry* last = faces.data() + offsets[p + 1];
+            std::sort(first, last, [](const FaceEntry& x, const FaceEntry& y) {
+                if (x.b != y.b) return x.b < y.b;
+                if (x.c != y.c) return x.c < y.c;
+                return x.slot < y.slot;
+            });
+            for (FaceEntry* i = first; i < last;) {
+                FaceEntry* j = i + 1;
+                while (j < last && j->b == i->b && j->c == i->c) ++j;
+                if (j - i == 2) {  // an interior face; non-manifold faces (3+) stay boundary
+                    neighbors[i[0].slot] = i[1].slot / 4;
+                    neighbors[i[1].slot] = i[0].slot / 4;
+                }
+                i = j;
+            }
         }
-        i = j;
     }
     return neighbors;
 }

@@ -15,6 +15,9 @@ namespace cpu {
 int threadCount() {
     return omp_get_max_threads();
 }
+void setThreadCount(int n) {
+    omp_set_num_threads(n >= 1 ? n : omp_get_num_procs());
+}
 int currentThread() {
     return omp_get_thread_num();
 }

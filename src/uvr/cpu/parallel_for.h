@@ -3,13 +3,9 @@
 
 #include <cstdint>
 
+#include "uvr/cpu/threads.h"
+
 namespace uvr::cpu {
-
-/// Number of threads parallelFor uses.
-int threadCount();
-
-/// Index of the calling thread inside parallelFor.
-int currentThread();
 
 /// Runs body(i, threadIndex) for i in [0, n) on all cores (OpenMP, dynamic schedule in chunks),
 /// threadIndex in [0, threadCount()).

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/mesh/tet_mesh.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "uvr/core/error.h"
@@ -144,36 +145,66 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
     const bool cellData = field.association == Association::Cell;
     UVR_CHECK(field.values.size() == (cellData ? mesh.cellCount() : mesh.pointCount()),
               "field '" << field.name << "' has " << field.values.size() << " values");
-    std::uint64_t estimate = 0;
-    for (CellType t : mesh.cellTypes)
-        estimate += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
-    out.tets.reserve(estimate);
-    if (cellData) out.values.reserve(estimate);
-    for (std::uint64_t c = 0; c < mesh.cellCount(); ++c) {
-        const CellSplit split = splitCell(mesh, c);
-        for (int t = 0; t < split.count; ++t) {
-            out.tets.push_back(split.tets[t]);
-            out.totalVolume += split.volume6[t] / 6.0;
-            if (cellData) out.values.push_back(field.values[c]);
+    // Fixed chunks of cells (so the result does not depend on the thread count), each split
+    // into its own list with its volume, bounds and value range; then the lists are moved into
+    // place in chunk order (each freed as soon as it is copied).
+    constexpr std::int64_t kChunk = 1 << 14;
+    const std::int64_t cellCount = static_cast<std::int64_t>(mesh.cellCount());
+    const std::int64_t chunks = (cellCount + kChunk - 1) / kChunk;
+    struct Chunk {
+        std::vector<Tet> tets;
+        std::vector<std::uint32_t> cells;  ///< source cell of each (cell data only)
+        double volume = 0.0;
+        Bounds3f bounds;
+        float lo = INFINITY, hi = -INFINITY;
+    };
+    std::vector<Chunk> parts(chunks);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        Chunk& s = parts[c];
+        const std::int64_t end = std::min(cellCount, (c + 1) * kChunk);
+        s.tets.reserve(static_cast<std::size_t>(end - c * kChunk));
+        for (std::int64_t i = c * kChunk; i < end; ++i) {
+            const CellSplit split = splitCell(mesh, i);
+            for (int t = 0; t < split.count; ++t) {
+                s.tets.push_back(split.tets[t]);
+                s.volume += split.volume6[t] / 6.0;
+                for (std::uint32_t v : split.tets[t].v) {
+                    s.bounds.extend(out.points[v]);
+                    if (!cellData && std::isfinite(field.values[v]))
+                        s.lo = std::fmin(s.lo, field.values[v]),
+                        s.hi = std::fmax(s.hi, field.values[v]);
+                }
+                if (cellData) {
+                    s.cells.push_back(static_cast<std::uint32_t>(i - c * kChunk));
+                    if (std::isfinite(field.values[i]))
+                        s.lo = std::fmin(s.lo, field.values[i]),
+                        s.hi = std::fmax(s.hi, field.values[i]);
+                }
+            }
         }
+    }
+    std::vector<std::uint64_t> chunkStart(chunks + 1, 0);
+    for (std::int64_t c = 0; c < chunks; ++c)
+        chunkStart[c + 1] = chunkStart[c] + parts[c].tets.size();
+    out.tets.resize(chunkStart[chunks]);
+    if (cellData) out.values.resize(chunkStart[chunks]);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        Chunk& s = parts[c];
+        std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
+        for (std::size_t t = 0; t < s.cells.size(); ++t)
+            out.values[chunkStart[c] + t] = field.values[c * kChunk + s.cells[t]];
+        s.tets = {};
+        s.cells = {};
     }
     if (!cellData) out.values = field.values;
-    // Bounds and value range over what the tets actually use.
-    std::vector<bool> used(out.points.size(), false);
-    for (const Tet& t : out.tets)
-        for (std::uint32_t v : t.v) used[v] = true;
     float lo = INFINITY, hi = -INFINITY;
-    for (std::size_t i = 0; i < out.points.size(); ++i) {
-        if (!used[i]) continue;
-        out.bounds.extend(out.points[i]);
-        if (!cellData && std::isfinite(out.values[i])) {
-            lo = std::fmin(lo, out.values[i]);
-            hi = std::fmax(hi, out.values[i]);
-        }
+    for (const Chunk& s : parts) {
+        out.totalVolume += s.volume;
+        out.bounds.extend(s.bounds);
+        lo = std::fmin(lo, s.lo), hi = std::fmax(hi, s.hi);
     }
-    if (cellData)
-        for (float v : out.values)
-            if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);
     if (lo <= hi) out.valueMin = lo, out.valueMax = hi;
     return out;
 }

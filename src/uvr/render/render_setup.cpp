@@ -32,12 +32,9 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
         if (progress)
             progress("building the BVH over " + std::to_string(out.tets.tets.size()) +
                      " tetrahedra");
-        std::vector<Bounds3f> boxes(out.tets.tets.size());
-        std::vector<Vec3f> centers(out.tets.tets.size());
-        for (std::size_t t = 0; t < boxes.size(); ++t) {
-            for (std::uint32_t v : out.tets.tets[t].v) boxes[t].extend(out.tets.points[v]);
-            centers[t] = boxes[t].center();
-        }
+        std::vector<Bounds3f> boxes;
+        std::vector<Vec3f> centers;
+        tetBoxesAndCenters(out.tets, boxes, centers);
         out.bvh = buildBvh(boxes, centers);
         out.bvhSeconds = secondsSince(start);
     }

@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "uvr/mesh/mesh.h"
+
+namespace uvr {
+
+/// Most refinement levels refineMesh accepts (each multiplies the tetrahedra by 8).
+inline constexpr int kMaxRefineLevels = 8;
+
+/// Tetrahedra (and points) refineMesh produces at most: neighbour tables and k-d partitions
+/// index 4 * tetrahedra with 32-bit ids.
+inline constexpr std::uint64_t kMaxRefinedTets = 1ull << 30;
+
+/// Tetrahedra of the output of refineMesh for a mesh of `tets` tetrahedra (after splitting).
+inline std::uint64_t refinedTetCount(std::uint64_t tets, int levels) {
+    return levels >= 0 && levels <= kMaxRefineLevels ? tets << (3 * levels) : 0;
+}
+
+/// Uniform red refinement (Bey 1995, "Tetrahedral grid refinement"): every cell is first split
+/// into positively oriented tetrahedra (splitCell: the conforming split of `uvr render`,
+/// zero-volume tetrahedra dropped), then `levels` times every tetrahedron is split into 8 at its
+/// edge midpoints (4 corner tetrahedra and the inner octahedron cut along its shortest diagonal).
+/// Midpoints shared by neighbouring tetrahedra are made once, so the result is conforming. Point
+/// fields are interpolated linearly at midpoints (every component), cell fields are copied to the
+/// children. Parallel and deterministic: the same input gives the same output bit for bit
+/// whatever the thread count. Points keep their indices; new points follow. progress(message) is
+/// called at each step when given. Throws Error(Argument) for levels outside
+/// [0, kMaxRefineLevels] and Error(Resource) when the result would exceed kMaxRefinedTets
+/// tetrahedra or 32-bit point indices.
+Mesh refineMesh(const Mesh& mesh, int levels,
+                const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace uvr
