@@ -358,7 +358,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
             part.valueMax = lo <= hi ? hi : 0.f;
             part.cellCount = static_cast<std::uint32_t>(count);
             Bvh& bvh = bvhs[p - b0];
-            bvh = buildBvh(leafBoxes, leafCenters);
+            bvh = buildBvh(leafBoxes, leafCenters, BvhBuildOptions{options.bvhLeafSize});
             for (std::size_t i = 0; i < bvh.primIds.size(); ++i)
                 kd.cells[part.firstCell + i] = leaf.cells[bvh.primIds[i]];
             bvh.primIds = {};

@@ -122,6 +122,9 @@ UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, 
 struct KdBuildOptions {
     std::uint32_t leafCells = 1024;  ///< split nodes holding more cells (PERFORMANCE.md)
     int maxDepth = kKdMaxDepth;      ///< never deeper than this (at most kKdMaxDepth)
+    /// Tetrahedra per leaf of the partitions' BVHs at most: seed grids leave them few searches,
+    /// so leaves of 8 halve their memory against 4 (PERFORMANCE.md).
+    int bvhLeafSize = 8;
 };
 
 /// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its
