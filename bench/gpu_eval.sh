@@ -5,6 +5,7 @@
 # Compute profile of the frame kernels. Logs and tables go to OUT.
 # Usage: bench/gpu_eval.sh BUILD_DIR DATA_DIR OUT STAGE...
 #   STAGE: tests | real | ncu | box:CELLS | refine:MESH:LEVELS | graded:CELLS | leaves:MESH_FILE
+# REPEAT (10) and SWEEP (8,16,32,64) set the timed frames and the s2 / s1 sweep of each bench.
 set -u
 build=$1
 data=$2
@@ -20,8 +21,8 @@ bench() {  # bench NAME MESH OPACITY [extra flags]
   name=$1 mesh=$2 spec=$3
   shift 3
   echo "== $name (opacity $spec) $*"
-  "$uvr" -q bench "$mesh" $view $mem --device cuda --opacity "$spec" --repeat 10 \
-    --sweep 8,16,32,64 --json "$out/$name.json" "$@" 2>&1 | tee "$out/$name.txt"
+  "$uvr" -q bench "$mesh" $view $mem --device cuda --opacity "$spec" --repeat "${REPEAT:-10}" \
+    --sweep "${SWEEP:-8,16,32,64}" --json "$out/$name.json" "$@" 2>&1 | tee "$out/$name.txt"
 }
 for stage in "$@"; do
   case $stage in
