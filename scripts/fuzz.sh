@@ -27,11 +27,17 @@ else
 fi
 
 bin=build/fuzz
+# The seeds are written with a uvr binary: the release build's when there is one (CI builds it
+# first), else the fuzz build's own.
+seeder=build/release/uvr
+[ -x $seeder ] || seeder=$bin/uvr
+cli=""
+[ $seeder = build/release/uvr ] || cli=uvr_cli
 if [ -z "${FUZZ_SKIP_BUILD:-}" ]; then  # set when another fuzz.sh has just built
   cmake --preset fuzz >/dev/null
-  cmake --build --preset fuzz -j"${FUZZ_BUILD_JOBS:-2}" --target uvr_cli $ALL >/dev/null
+  cmake --build --preset fuzz -j"${FUZZ_BUILD_JOBS:-2}" --target $cli $ALL >/dev/null
 fi
-[ -d $bin/seeds ] || scripts/fuzz_seeds.sh $bin/seeds $bin/uvr
+[ -d $bin/seeds ] || scripts/fuzz_seeds.sh $bin/seeds $seeder
 mkdir -p $bin/logs
 
 status=0
