@@ -69,7 +69,8 @@ for t in "$@"; do
   if [ $rc -ne 0 ] || [ "$found" -ne 0 ]; then
     status=1
     echo "  $t failed (exit $rc): see $bin/logs/$name.log and $findings/" >&2
-    grep -m3 -E '^(==[0-9]+==ERROR|SUMMARY|.*runtime error|uvr internal error)' $bin/logs/$name.log >&2 || true
+    grep -m3 -E '^(==[0-9]+==ERROR|SUMMARY|.*runtime error|terminate called)' $bin/logs/$name.log \
+      >&2 || true
   fi
 done
 [ $ci -eq 0 ] || [ $status -eq 0 ] || echo "fuzz.sh --ci: findings above" >&2
