@@ -1,11 +1,13 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# Installs every build and test dependency of uvr from Debian 12's packages (run as root).
+# Installs every build and test dependency of uvr from Debian 12's packages (run as root); clang
+# with libFuzzer (libclang-rt-14-dev) and its OpenMP (libomp-dev) build the fuzz targets.
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
   zlib1g-dev libpng-dev libexpat1-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
+  clang libclang-rt-14-dev libomp-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage"
 missing=""
 for p in $PACKAGES; do

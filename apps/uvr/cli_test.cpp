@@ -2,11 +2,18 @@
 // End-to-end tests of the uvr command-line tool: exit codes, messages, outputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "test_support.h"
 #include "uvr/render/image.h"
@@ -253,6 +260,56 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     EXPECT_EQ(readPng(dir + "/p.png").width, 800);
     EXPECT_TRUE(std::filesystem::exists(dir + "/reference_samples.png"));
     EXPECT_TRUE(std::filesystem::exists(dir + "/b.csv"));
+}
+
+/// Starts `uvr ARGS` with stderr to errPath, waits until that stderr holds `marker` (or the run
+/// ends), sends it SIGTERM and returns its wait status.
+int interruptWhenLogged(const std::vector<std::string>& args, const std::string& errPath,
+                        const std::string& marker) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        const int fd = ::open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(fd, 2);
+        std::vector<char*> argv;
+        const std::string bin = testing::uvrBinary();
+        argv.push_back(const_cast<char*>(bin.c_str()));
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        ::execv(bin.c_str(), argv.data());
+        ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(pid, &status, WNOHANG) == 0) {
+        std::ifstream in(errPath);
+        const std::string log((std::istreambuf_iterator<char>(in)), {});
+        if (log.find(marker) != std::string::npos) {
+            ::kill(pid, SIGTERM);
+            ::waitpid(pid, &status, 0);
+            return status;
+        }
+        ::usleep(2000);
+    }
+    return status;
+}
+
+TEST(Cli, InterruptedRenderLeavesThePreviousOutputUntouched) {
+    // Killed while rendering (SIGTERM after the "rendering" progress line), uvr must leave the
+    // existing output as it was and no partial or temporary file beside it.
+    const std::string dir = testing::scratchDir();
+    const std::string out = dir + "/out.png";
+    testing::writeFile(out, "previous image");
+    const int status = interruptWhenLogged(
+        {"demo", "--cells", "20000", "--size", "4096x4096", "--threads", "1", "-o", out},
+        dir + "/log.txt", "rendering '");
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the render finished before it could be interrupted";
+    EXPECT_EQ(WTERMSIG(status), SIGTERM);
+    std::ifstream in(out);
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), {}), "previous image");
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    EXPECT_EQ(files, (std::vector<std::string>{"log.txt", "out.png"}));
 }
 
 }  // namespace

@@ -23,11 +23,9 @@ std::vector<char> readFileBytes(const std::string& path, std::uint64_t maxBytes,
                        what + " of " + std::to_string(size) + " bytes exceeds the limit of " +
                            std::to_string(maxBytes) + " bytes");
     }
+    checkRegularFile(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throwError(ErrorKind::Io, path, "is a folder, not a file");
     in.seekg(0, std::ios::end);
     std::streamoff size = in.tellg();
     if (size < 0) throwError(ErrorKind::Io, path, "cannot determine the file size");
@@ -35,6 +33,15 @@ std::vector<char> readFileBytes(const std::string& path, std::uint64_t maxBytes,
     std::vector<char> bytes(static_cast<size_t>(size));
     if (size > 0 && !in.read(bytes.data(), size)) throwError(ErrorKind::Io, path, "read failed");
     return bytes;
+}
+
+void checkRegularFile(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status))
+        throwError(ErrorKind::Io, path, "is a folder, not a file");
+    if (!ec && !std::filesystem::is_regular_file(status))
+        throwError(ErrorKind::Io, path, "is not a regular file (a device, pipe or socket)");
 }
 
 std::uint64_t fileSize(const std::string& path) {

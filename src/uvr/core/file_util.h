@@ -14,6 +14,10 @@ namespace uvr {
 std::vector<char> readFileBytes(const std::string& path, std::uint64_t maxBytes = 0,
                                 const std::string& what = "file");
 
+/// Throws Error(Io) when path names a folder, device, pipe or socket (checked before opening: a
+/// pipe would block and a device has no size); a missing file is left to the caller's open.
+void checkRegularFile(const std::string& path);
+
 /// Size of a file in bytes; throws Error(Io) when it cannot be opened.
 std::uint64_t fileSize(const std::string& path);
 

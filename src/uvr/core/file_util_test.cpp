@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <sys/stat.h>
+
 #include "test_support.h"
 #include "uvr/core/error.h"
 
@@ -68,6 +70,21 @@ TEST(FileUtil, ReadErrorsNameTheFile) {
     EXPECT_EQ(fileExtension("a/b.VTU"), ".vtu");
     EXPECT_THROW(checkAllocation("f", "points", 1ull << 40, 12, 1ull << 30), Error);
     EXPECT_NO_THROW(checkAllocation("f", "points", 1ull << 40, 12, 0));
+}
+
+TEST(FileUtil, DevicesAndPipesAreRefusedWithoutBlocking) {
+    // A .pvtu piece or a --tf argument may name any path: a pipe would block the open forever and
+    // /dev/zero has no size to read.
+    const std::string dir = testing::scratchDir();
+    const std::string fifo = dir + "/pipe.vtu";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    for (const std::string& path : {fifo, std::string("/dev/zero")}) {
+        const Error e = testing::catchError([&] { (void)readFileBytes(path); });
+        EXPECT_EQ(e.kind(), ErrorKind::Io) << e.what();
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(testing::catchError([&] { (void)readFileBytes(dir); }).kind(), ErrorKind::Io);
 }
 
 }  // namespace

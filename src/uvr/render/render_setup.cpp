@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/render/render_setup.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -135,6 +136,14 @@ PartitionSceneView FrameSetup::partitionScene(const PreparedMesh& mesh, bool ski
     return v;
 }
 
+namespace {
+
+/// Most sample grid steps t / s1 from the camera to any point of the mesh: the integrators count
+/// grid points in float, which counts exactly only up to 2^24.
+constexpr double kMaxGridSteps = 16e6;
+
+}  // namespace
+
 FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
                           bool shadePartitions) {
     validateSettings(settings);
@@ -171,6 +180,23 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                             settings.power, settings.adaptive);
         f.tfUpdateSeconds = secondsSince(start);
     }
+    // The integrators count sample grid points k = t / s1 from the camera in float: at 2^24 and
+    // beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
+    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
+    double farthest = 0.0;
+    for (int c = 0; c < 8; ++c) {
+        const Bounds3f& b = mesh.tets.bounds;
+        const Vec3f corner((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y,
+                           (c & 4) ? b.hi.z : b.lo.z);
+        farthest = std::max(farthest, double(length(corner - f.camera.position)));
+    }
+    if (farthest / f.params.step > kMaxGridSteps)
+        throwError(ErrorKind::Argument, "",
+                   "the camera is " +
+                       std::to_string(static_cast<long long>(farthest / f.params.step)) +
+                       " steps of " + std::to_string(f.params.step) +
+                       " from the far side of the mesh (at most 16 million): move the camera "
+                       "closer (and widen --view-angle) or use a larger --step");
     const double samplesPerRay = mesh.tets.bounds.diagonal() / f.params.step;
     if (samplesPerRay > 1e7)
         throwError(ErrorKind::Argument, "",

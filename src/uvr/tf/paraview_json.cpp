@@ -153,6 +153,23 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
         if (bracket != std::string::npos) msg = msg.substr(bracket + 2);
         throwParseError(path, atByte(e.byte),
                         "expected JSON (a ParaView colour-map export), got " + msg);
+    } catch (const Json::exception& e) {
+        // A well-formed number too large for a double ("number overflow parsing '1e999'") is an
+        // out_of_range error without an offset: find the quoted number in the file.
+        std::string msg = e.what();
+        size_t bracket = msg.find("] ");
+        if (bracket != std::string::npos) msg = msg.substr(bracket + 2);
+        std::uint64_t offset = 0;
+        const size_t open = msg.find('\''), close = msg.rfind('\'');
+        if (open != std::string::npos && close > open + 1) {
+            const std::string token = msg.substr(open + 1, close - open - 1);
+            const auto it = std::search(bytes.begin(), bytes.end(), token.begin(), token.end());
+            if (it != bytes.end()) offset = static_cast<std::uint64_t>(it - bytes.begin());
+        }
+        throwParseError(path, atByte(offset),
+                        "expected JSON (a ParaView colour-map export) with numbers a double can "
+                        "hold, got " +
+                            msg);
     }
 
     // Step 1: the colour-map object (ParaView exports an array of them; the first is used).

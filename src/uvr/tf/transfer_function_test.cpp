@@ -293,6 +293,9 @@ TEST(TransferFunction, MalformedParaViewExportsNameFileAndKey) {
          "\"ColorSpace\"", "\"CMYK\""},
         {"step", "[{\"ColorSpace\": \"Step\", \"RGBPoints\": [0, 1, 1, 1]}]",
          ErrorKind::Unsupported, "\"ColorSpace\"", "Step"},
+        // Found by fuzz_colormap_json: a number beyond a double escaped as a JSON library error.
+        {"overflow", "[{\"RGBPoints\": [0, 1, 1, 1e999]}]", ErrorKind::Parse, "byte 25",
+         "number overflow parsing '1e999'"},
     };
     for (const Case& c : cases) {
         std::string path = writeFile(dir + "/" + c.name + ".json", c.json);

@@ -17,6 +17,7 @@ namespace {
 enum class Format { Legacy, Vtu, Pvtu, Native, Unknown };
 
 Format sniffFormat(const std::string& path) {
+    checkRegularFile(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
     char head[512] = {};

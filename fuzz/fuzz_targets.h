@@ -1,0 +1,187 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The body of every fuzz target, shared by the libFuzzer entry points (fuzz_*.cpp) and the
+// regression test that replays the kept inputs (fuzz_regression_test.cpp).
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
+#include "../apps/uvr/cli_common.h"
+#include "uvr/core/error.h"
+#include "uvr/mesh/field_select.h"
+#include "uvr/mesh/io/native.h"
+#include "uvr/mesh/io/read_options.h"
+#include "uvr/mesh/io/vtk_legacy.h"
+#include "uvr/mesh/io/vtu.h"
+#include "uvr/mesh/mesh.h"
+#include "uvr/mesh/procedural.h"
+#include "uvr/mesh/validate.h"
+#include "uvr/render/camera.h"
+#include "uvr/tf/transfer_function.h"
+
+namespace uvr::fuzz {
+
+/// Memory limit every fuzzed load runs under (the CLI's --max-memory), well below libFuzzer's
+/// 2 GB RSS limit so that an allocation the limit misses is reported as a finding.
+inline constexpr std::uint64_t kFuzzMaxMemory = 256ull << 20;
+
+/// A folder private to this process (under TMPDIR or /tmp), removed at exit.
+inline const std::string& scratchFolder() {
+    static const std::string folder = [] {
+        const char* base = std::getenv("TMPDIR");
+        std::string pattern = std::string(base && *base ? base : "/tmp") + "/uvr_fuzz_XXXXXX";
+        if (!::mkdtemp(pattern.data())) std::abort();
+        static std::string removeAtExit;
+        removeAtExit = pattern;
+        std::atexit([] {
+            std::error_code ec;
+            std::filesystem::remove_all(removeAtExit, ec);
+        });
+        return pattern;
+    }();
+    return folder;
+}
+
+/// Writes bytes to NAME in the scratch folder and returns the file's path.
+inline std::string writeInput(const std::string& name, const std::uint8_t* data, std::size_t size) {
+    const std::string path = scratchFolder() + "/" + name;
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) std::abort();
+    if (size && std::fwrite(data, 1, size, f) != size) std::abort();
+    std::fclose(f);
+    return path;
+}
+
+/// Read options of every fuzzed load.
+inline ReadOptions fuzzReadOptions() {
+    ReadOptions options;
+    options.maxMemoryBytes = kFuzzMaxMemory;
+    return options;
+}
+
+/// Runs f and swallows the library's documented failure, a uvr::Error, unless it reports a
+/// broken invariant (ErrorKind::Internal: a bug), which propagates like any other exception.
+/// Escaping exceptions, crashes and sanitizer reports are findings.
+template <typename F>
+void expectCleanError(F&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        if (e.kind() == ErrorKind::Internal) throw;
+    }
+}
+
+/// What the CLI does with a mesh after loading it, short of rendering: full validation (cell
+/// classification) and extraction of the default field.
+inline void useMesh(const Mesh& mesh, const std::string& path) {
+    (void)validateMesh(mesh, path);
+    if (!mesh.fields.empty()) (void)selectScalarField(mesh, FieldSpec{});
+}
+
+/// Legacy VTK reader (ASCII and BINARY, versions 1.0 to 5.1).
+inline void fuzzVtkLegacy(const std::uint8_t* data, std::size_t size) {
+    const std::string path = writeInput("input.vtk", data, size);
+    expectCleanError([&] { useMesh(readVtkLegacy(path, fuzzReadOptions()), path); });
+}
+
+/// VTK XML .vtu reader (ascii, base64, appended raw/base64, zlib, header types, byte orders).
+inline void fuzzVtu(const std::uint8_t* data, std::size_t size) {
+    const std::string path = writeInput("input.vtu", data, size);
+    expectCleanError([&] { useMesh(readVtu(path, fuzzReadOptions()), path); });
+}
+
+/// Parallel .pvtu reader: the input is written as input.pvtu beside a small valid piece,
+/// piece0.vtu (written once per process), so that inputs naming it reach the merge.
+inline void fuzzPvtu(const std::uint8_t* data, std::size_t size) {
+    static const bool pieceWritten = [] {
+        ProceduralSpec spec;
+        spec.targetCells = 200;
+        spec.fields = {ProceduralField::Linear, ProceduralField::Constant};
+        writeVtu(generateMesh(spec), scratchFolder() + "/piece0.vtu");
+        return true;
+    }();
+    (void)pieceWritten;
+    const std::string path = writeInput("input.pvtu", data, size);
+    expectCleanError([&] { useMesh(readPvtu(path, fuzzReadOptions()), path); });
+}
+
+/// Native .uvrm reader.
+inline void fuzzNative(const std::uint8_t* data, std::size_t size) {
+    const std::string path = writeInput("input.uvrm", data, size);
+    expectCleanError([&] { useMesh(readNative(path, fuzzReadOptions()), path); });
+}
+
+/// ParaView colour-map JSON import, then the baked table.
+inline void fuzzColormapJson(const std::uint8_t* data, std::size_t size) {
+    const std::string path = writeInput("input.json", data, size);
+    expectCleanError([&] { (void)loadParaViewColorMap(path).bake(64); });
+}
+
+/// ParaView camera (.pvcc) loader, then camera validation and ray setup.
+inline void fuzzPvcc(const std::uint8_t* data, std::size_t size) {
+    const std::string path = writeInput("input.pvcc", data, size);
+    expectCleanError([&] {
+        const Camera camera = loadPvcc(path);
+        validateCamera(camera);
+        (void)makeCameraRays(camera, 4, 3);
+    });
+}
+
+/// The command line's text specs; the first byte picks the parser, the rest is the text:
+/// --opacity (then the baked table), --field, --range, --size, a vector (--camera-position),
+/// --max-memory, a --tf preset name.
+inline void fuzzSpecs(const std::uint8_t* data, std::size_t size) {
+    if (size == 0) return;
+    const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
+    expectCleanError([&] {
+        switch (data[0] % 7) {
+            case 0: {
+                TransferFunction tf = transferFunctionPreset("viridis");
+                applyOpacitySpec(tf, text);
+                (void)tf.bake(64);
+                break;
+            }
+            case 1:
+                (void)parseFieldSpec(text);
+                break;
+            case 2:
+                (void)cli::parseRange("--range", text);
+                break;
+            case 3:
+                (void)cli::parseSize("--size", text);
+                break;
+            case 4:
+                (void)cli::parseVec3("--camera-position", text);
+                break;
+            case 5:
+                (void)cli::parseBytes("--max-memory", text);
+                break;
+            default:
+                (void)transferFunctionPreset(text);
+                break;
+        }
+    });
+}
+
+/// A fuzz target: its name (the folder of its seeds and kept inputs) and its body.
+struct FuzzTarget {
+    const char* name;
+    void (*run)(const std::uint8_t* data, std::size_t size);
+};
+
+/// Every fuzz target.
+inline constexpr FuzzTarget kFuzzTargets[] = {{"vtk_legacy", fuzzVtkLegacy},
+                                              {"vtu", fuzzVtu},
+                                              {"pvtu", fuzzPvtu},
+                                              {"native", fuzzNative},
+                                              {"colormap_json", fuzzColormapJson},
+                                              {"pvcc", fuzzPvcc},
+                                              {"specs", fuzzSpecs}};
+
+}  // namespace uvr::fuzz
