@@ -1,14 +1,14 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# Builds the libFuzzer targets (CMake preset 'fuzz': clang, ASan + UBSan) and runs them.
+# Builds the libFuzzer targets (CMake preset 'asan': clang, ASan + UBSan) and runs them.
 #
 #   scripts/fuzz.sh SECONDS [TARGET...]   run each target (all by default) for SECONDS, one after
-#                                         the other, growing build/fuzz/corpus/<target>
+#                                         the other, growing build/asan/corpus/<target>
 #   scripts/fuzz.sh --ci [SECONDS]        CI's short pass: every target over its seeds and the
 #                                         kept regression inputs, SECONDS in all (60)
 #
 # Seeds: scripts/fuzz_seeds.sh (real meshes from ../shared/data, generated variants, fuzz/seeds/).
-# Crashing, leaking or slow inputs land in build/fuzz/findings/<target>/; logs in build/fuzz/logs/.
+# Crashing, leaking or slow inputs land in build/asan/findings/<target>/; logs in build/asan/logs/.
 # Prints one line per target (executions, coverage, findings) and exits 1 when anything was found.
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -26,7 +26,7 @@ else
   [ $# -gt 0 ] || set -- $ALL
 fi
 
-bin=build/fuzz
+bin=build/asan
 # The seeds are written with a uvr binary: the release build's when there is one (CI builds it
 # first), else the fuzz build's own.
 seeder=build/release/uvr
@@ -34,8 +34,8 @@ seeder=build/release/uvr
 cli=""
 [ $seeder = build/release/uvr ] || cli=uvr_cli
 if [ -z "${FUZZ_SKIP_BUILD:-}" ]; then  # set when another fuzz.sh has just built
-  cmake --preset fuzz >/dev/null
-  cmake --build --preset fuzz -j"${FUZZ_BUILD_JOBS:-2}" --target $cli $ALL >/dev/null
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j"${FUZZ_BUILD_JOBS:-2}" --target $cli $ALL >/dev/null
 fi
 [ -d $bin/seeds ] || scripts/fuzz_seeds.sh $bin/seeds $seeder
 mkdir -p $bin/logs
