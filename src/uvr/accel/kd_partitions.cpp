@@ -57,6 +57,22 @@ struct LocalTree {
     std::vector<Leaf> leaves;
 };
 
+/// Makes node task.node an inner node splitting `axis` at `plane` with two new children in
+/// nodes, and pushes the children's tasks (below the plane last, so it is taken first).
+void splitNode(std::vector<KdNode>& nodes, std::vector<Task>& stack, const Task& task, int axis,
+               float plane, std::vector<std::uint32_t>&& left, std::vector<std::uint32_t>&& right) {
+    const std::uint32_t child = static_cast<std::uint32_t>(nodes.size());
+    nodes[task.node].split = plane;
+    nodes[task.node].bits = (child << 2) | static_cast<std::uint32_t>(axis);
+    nodes.emplace_back();
+    nodes.emplace_back();
+    Bounds3f below = task.region, above = task.region;
+    below.hi[axis] = plane;
+    above.lo[axis] = plane;
+    stack.push_back({child + 1, above, std::move(right), task.depth + 1});
+    stack.push_back({child, below, std::move(left), task.depth + 1});
+}
+
 /// Order-preserving map of a float to an unsigned key (for radix selection).
 std::uint32_t floatKey(float f) {
     const std::uint32_t u = std::bit_cast<std::uint32_t>(f);
@@ -197,17 +213,8 @@ LocalTree buildSubtree(const CellData& data, Task root, const KdBuildOptions& op
                     larger * 10 <= count * 9;
         }
         if (split) {
-            const std::uint32_t child = static_cast<std::uint32_t>(out.nodes.size());
-            out.nodes[task.node].split = plane;
-            out.nodes[task.node].bits = (child << 2) | static_cast<std::uint32_t>(axis);
-            out.nodes.emplace_back();
-            out.nodes.emplace_back();
-            Bounds3f below = task.region, above = task.region;
-            below.hi[axis] = plane;
-            above.lo[axis] = plane;
             task.cells = {};
-            stack.push_back({child + 1, above, std::move(right), task.depth + 1});
-            stack.push_back({child, below, std::move(left), task.depth + 1});
+            splitNode(out.nodes, stack, task, axis, plane, std::move(left), std::move(right));
             continue;
         }
         out.nodes[task.node].bits = (static_cast<std::uint32_t>(out.leaves.size()) << 2) | 3u;
@@ -272,16 +279,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
             jobs.push_back(std::move(task));
             continue;
         }
-        const std::uint32_t child = static_cast<std::uint32_t>(kd.nodes.size());
-        kd.nodes[task.node].split = plane;
-        kd.nodes[task.node].bits = (child << 2) | static_cast<std::uint32_t>(axis);
-        kd.nodes.emplace_back();
-        kd.nodes.emplace_back();
-        Bounds3f below = task.region, above = task.region;
-        below.hi[axis] = plane;
-        above.lo[axis] = plane;
-        stack.push_back({child + 1, above, std::move(right), task.depth + 1});
-        stack.push_back({child, below, std::move(left), task.depth + 1});
+        splitNode(kd.nodes, stack, task, axis, plane, std::move(left), std::move(right));
     }
     // Step 3: the subtrees, in parallel.
     const std::int64_t jobCount = static_cast<std::int64_t>(jobs.size());

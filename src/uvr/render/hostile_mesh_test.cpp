@@ -45,10 +45,10 @@ std::uint32_t gridId(std::size_t n, std::size_t i, std::size_t j, std::size_t k)
     return static_cast<std::uint32_t>((k * n + j) * n + i);
 }
 
-/// A grid of hexahedra on the given planes (the same along x, y, z), split by uvr's loader; the
-/// point field "f" is 1 everywhere.
-Mesh hexGridOnPlanes(const Planes& planes) {
-    Mesh m;
+/// The grid points on the given planes (the same along x, y, z) appended to m, and cell(c) called
+/// with the 8 corner ids (VTK hexahedron order) of every grid cell.
+template <class Cell>
+void gridOnPlanes(Mesh& m, const Planes& planes, Cell&& cell) {
     const std::size_t n = planes.size();
     for (std::size_t k = 0; k < n; ++k)
         for (std::size_t j = 0; j < n; ++j)
@@ -60,8 +60,15 @@ Mesh hexGridOnPlanes(const Planes& planes) {
                 std::uint32_t c[8];
                 for (int v = 0; v < 8; ++v)
                     c[v] = gridId(n, i + kCorner[v][0], j + kCorner[v][1], k + kCorner[v][2]);
-                m.addCell(CellType::Hexahedron, c);
+                cell(c);
             }
+}
+
+/// A grid of hexahedra on the given planes (the same along x, y, z), split by uvr's loader; the
+/// point field "f" is 1 everywhere.
+Mesh hexGridOnPlanes(const Planes& planes) {
+    Mesh m;
+    gridOnPlanes(m, planes, [&](const auto& c) { m.addCell(CellType::Hexahedron, c); });
     m.fields.push_back({"f", Association::Point, 1, std::vector<float>(m.points.size(), 1.f)});
     return m;
 }
@@ -237,31 +244,23 @@ TEST(HostileMesh, DegenerateAndInvertedCellsRenderTheExactImage) {
     const Planes planes = uniformPlanes(4, 0.f, 1.f);
     Mesh m;
     const std::size_t n = planes.size();
-    for (std::size_t k = 0; k < n; ++k)
-        for (std::size_t j = 0; j < n; ++j)
-            for (std::size_t i = 0; i < n; ++i)
-                m.points.emplace_back(planes[i], planes[j], planes[k]);
-    for (std::size_t k = 0; k + 1 < n; ++k)
-        for (std::size_t j = 0; j + 1 < n; ++j)
-            for (std::size_t i = 0; i + 1 < n; ++i) {
-                std::uint32_t c[8];
-                for (int v = 0; v < 8; ++v)
-                    c[v] = gridId(n, i + kCorner[v][0], j + kCorner[v][1], k + kCorner[v][2]);
-                addKuhnTets(m, c);
-                const std::uint32_t flat[4] = {c[0], c[1], c[2], c[3]};
-                m.addCell(CellType::Tetra, flat);
-                const std::uint32_t needle[4] = {gridId(n, 0, j, k), gridId(n, 1, j, k),
-                                                 gridId(n, 2, j, k), c[7]};
-                m.addCell(CellType::Tetra, needle);
-            }
+    gridOnPlanes(m, planes, [&](const auto& c) {
+        addKuhnTets(m, c);
+        const std::uint32_t flat[4] = {c[0], c[1], c[2], c[3]};
+        m.addCell(CellType::Tetra, flat);
+        const std::size_t j = c[0] / n % n, k = c[0] / (n * n);  // c[0] is corner (i, j, k)
+        const std::uint32_t needle[4] = {gridId(n, 0, j, k), gridId(n, 1, j, k), gridId(n, 2, j, k),
+                                         c[7]};
+        m.addCell(CellType::Tetra, needle);
+    });
     m.fields.push_back({"f", Association::Point, 1, std::vector<float>(m.points.size(), 1.f)});
     const PreparedMesh pm = prepare(m);
     EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox), 500);
 }
 
 TEST(HostileMesh, CoincidentPointsRenderTheExactImage) {
-    // Every cell has its own copies of its corners: no shared point ids, so no face neighbours
-    // (the walk cannot cross a face) and every shared face is a pair of coincident triangles.
+    // Every cell has its own copies of its corners: no shared point ids, every shared face is a
+    // pair of coincident triangles (face neighbours are found by position, buildTetNeighbors).
     const Mesh grid = hexGridOnPlanes(uniformPlanes(5, 0.f, 1.f));
     Mesh m;
     for (std::uint64_t c = 0; c < grid.cellCount(); ++c) {
