@@ -5,7 +5,8 @@
 # Compute profile of the frame kernels. Logs and tables go to OUT.
 # Usage: bench/gpu_eval.sh BUILD_DIR DATA_DIR OUT STAGE...
 #   STAGE: tests | real | ncu | box:CELLS | refine:MESH:LEVELS | graded:CELLS | leaves:MESH_FILE
-# REPEAT (10) and SWEEP (8,16,32,64) set the timed frames and the s2 / s1 sweep of each bench.
+# REPEAT (10) and SWEEP (8,16,32,64) set the timed frames and the s2 / s1 sweep of each bench;
+# BUILD (auto) is its --build-device: where the BVHs are built (cpu: binned SAH, cuda: LBVH).
 set -u
 build=$1
 data=$2
@@ -21,13 +22,14 @@ bench() {  # bench NAME MESH OPACITY [extra flags]
   name=$1 mesh=$2 spec=$3
   shift 3
   echo "== $name (opacity $spec) $*"
-  "$uvr" -q bench "$mesh" $view $mem --device cuda --opacity "$spec" --repeat "${REPEAT:-10}" \
-    --sweep "${SWEEP:-8,16,32,64}" --json "$out/$name.json" "$@" 2>&1 | tee "$out/$name.txt"
+  "$uvr" -q bench "$mesh" $view $mem --device cuda --build-device "${BUILD:-auto}" \
+    --opacity "$spec" --repeat "${REPEAT:-10}" --sweep "${SWEEP:-8,16,32,64}" \
+    --json "$out/$name.json" "$@" 2>&1 | tee "$out/$name.txt"
 }
 for stage in "$@"; do
   case $stage in
     tests)
-      "$build/uvr_tests" --gtest_filter='Cuda*:SeedGrid*:PartitionIntegrator*' 2>&1 |
+      "$build/uvr_tests" --gtest_filter='Cuda*:SeedGrid*:PartitionIntegrator*:Lbvh*' 2>&1 |
         tee "$out/tests.txt" | tail -n 25
       ;;
     real)

@@ -196,6 +196,12 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Where to render: cpu, cuda, or auto (CUDA when a device is present)")
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
         ->capture_default_str();
+    app.add_option("--build-device", buildDevice,
+                   "Where the BVHs are built: cpu (binned SAH trees on the CPU threads), cuda "
+                   "(linear BVHs on the GPU: seconds for 100M+ tetrahedra), or auto (cuda when "
+                   "rendering on CUDA and the mesh has 4M tetrahedra or more)")
+        ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
+        ->capture_default_str();
     app.add_option("--threads", threads, "CPU threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
 }
@@ -250,8 +256,17 @@ bool RenderFlags::useCuda() const {
     return device == "cuda" || (device == "auto" && cudaDeviceAvailable());
 }
 
+bool RenderFlags::buildOnCuda() const {
+    return buildDevice == "cuda" || (buildDevice == "auto" && useCuda());
+}
+
 PrepareOptions RenderFlags::prepareOptions(bool withReference) const {
     PrepareOptions o;
+    if (buildOnCuda()) {
+        o.lbvh = buildLbvhCuda;
+        o.lbvhDevice = "the GPU";
+        if (buildDevice == "auto") o.lbvhMinTets = kAutoGpuBuildTets;
+    }
     o.partitions = method == "adaptive";
     o.meshBvh = !o.partitions || withReference;  // the partition integrator uses its own BVHs
     o.seedGrids = !noSeedGrid;

@@ -56,6 +56,7 @@ struct RenderFlags {
     std::uint32_t leafCells = 0;
     bool noSeedGrid = false;
     std::string device = "auto";
+    std::string buildDevice = "auto";
     std::string heatmapFile;
     std::uint32_t heatmapMax = 0;
     std::string background;
@@ -71,6 +72,8 @@ struct RenderFlags {
     std::optional<Vec3f> backgroundColor() const;
     /// True when --device asks for CUDA, or is auto and a CUDA device is present.
     bool useCuda() const;
+    /// True when --build-device asks for CUDA, or is auto and the render is on CUDA.
+    bool buildOnCuda() const;
     /// What mesh preparation the flags need (partitions only for the adaptive method, the mesh
     /// BVH only for the reference marcher, or also with the adaptive method when withReference;
     /// the device's default leaf size unless --leaf-cells is given).

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "test_support.h"
+#include "uvr/cuda/cuda_renderer.h"
 #include "uvr/render/image.h"
 
 namespace uvr {
@@ -73,6 +74,7 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
              "render " + spx + " -o " + out + " --field nosuch",
              "render " + spx + " -o " + out + " --tf nosuch",
              "render " + spx + " -o " + out + " --opacity zigzag",
+             "render " + spx + " -o " + out + " --build-device gpu",
              "render " + spx + " -o " + dir + "/missing/o.png",
              "render " + spx + " --bogus -o " + out, "render " + spx, "frobnicate"}) {
         const CliRun r = uvr("-q " + args, dir);
@@ -80,6 +82,30 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
         EXPECT_EQ(lineCount(r.err), 1) << args << "\n" << r.err;
         EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << r.err;
         EXPECT_FALSE(std::filesystem::exists(out)) << args;
+    }
+}
+
+TEST(Cli, GpuBuildRendersTheSameImageOrIsRefusedClearly) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string spx = testing::sharedData("spx.vtk");
+    for (const char* method : {"reference", "adaptive"}) {
+        const std::string args = "-q render " + spx + " --device cpu --method " + method +
+                                 " --size 64x48 --opacity 0:0,1:0.5 -o ";
+        const CliRun cpu = uvr(args + dir + "/cpu.png --build-device cpu", dir);
+        ASSERT_EQ(cpu.code, 0) << cpu.err;
+        const CliRun gpu = uvr(args + dir + "/gpu.png --build-device cuda", dir);
+        if (!cudaDeviceAvailable()) {
+            EXPECT_NE(gpu.code, 0);
+            EXPECT_EQ(lineCount(gpu.err), 1) << gpu.err;
+            EXPECT_NE(gpu.err.find("CUDA"), std::string::npos) << gpu.err;
+            EXPECT_FALSE(std::filesystem::exists(dir + "/gpu.png"));
+            continue;
+        }
+        ASSERT_EQ(gpu.code, 0) << gpu.err;
+        const CliRun cmp =
+            uvr("compare " + dir + "/cpu.png " + dir + "/gpu.png --min-ssim 0.99", dir);
+        EXPECT_EQ(cmp.code, 0) << method << ": " << cmp.out << cmp.err;
     }
 }
 

@@ -11,6 +11,10 @@ namespace uvr {
 
 namespace {
 
+/// Deepest SAH tree (within kBvhMaxDepth).
+constexpr int kSahMaxDepth = 64;
+static_assert(kSahMaxDepth <= kBvhMaxDepth);
+
 float halfArea(const Bounds3f& b) {
     if (b.empty()) return 0.f;
     const Vec3f e = b.extent();
@@ -105,7 +109,7 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
         int bestAxis = -1, bestSplit = 0;
         float bestCost = INFINITY;
         const Vec3f cext = cbox.extent();
-        if (t.depth + 2 < kBvhMaxDepth) {
+        if (t.depth + 2 < kSahMaxDepth) {
             // Large nodes bin only the longest centre axis (a third of the work, nearly the
             // same trees); small nodes try all three.
             const bool allAxes = count <= 4096;
@@ -137,7 +141,7 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
                 p);
         } else {
             // All centres coincide (or the depth limit is near): split by count.
-            if (t.depth + 1 >= kBvhMaxDepth) {
+            if (t.depth + 1 >= kSahMaxDepth) {
                 makeLeaf();
                 continue;
             }
@@ -185,7 +189,7 @@ std::uint32_t splitLarge(std::span<const Bounds3f> boxes, std::span<const Vec3f>
     nodeBox = box;
     const int axis = cbox.longestAxis();
     const float ext = cbox.extent()[axis];
-    if (t.depth + 2 >= kBvhMaxDepth || !(ext > 0.f)) return t.end;
+    if (t.depth + 2 >= kSahMaxDepth || !(ext > 0.f)) return t.end;
     // Binned SAH on the longest centre axis, as buildSubtree does for large nodes.
     const int nb = std::max(2, options.bins);
     const float scale = nb / ext, lo = cbox.lo[axis];

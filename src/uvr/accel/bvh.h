@@ -26,8 +26,9 @@ struct BvhView {
     std::uint32_t nodeCount = 0;
 };
 
-/// Deepest stack a BVH traversal needs; the builder guarantees the tree is no deeper.
-inline constexpr int kBvhMaxDepth = 64;
+/// Deepest stack a BVH traversal needs; the builders guarantee the tree is no deeper (binned SAH
+/// trees stop at 64 levels, linear BVHs need up to 96: lbvh.h).
+inline constexpr int kBvhMaxDepth = 96;
 
 /// Relative tolerance of point queries: a box counts as containing points up to this fraction of
 /// its largest extent outside it, so a point that a containment test with a relative tolerance
@@ -89,7 +90,7 @@ struct Bvh {
 
 /// Builds a BVH with binned SAH splits (Wald 2007, "On fast construction of SAH-based bounding
 /// volume hierarchies") over primitive boxes and their centres; O(n log n). Depth is bounded by
-/// kBvhMaxDepth (falling back to median splits near the limit). Parallel (large nodes by
+/// 64 levels (falling back to median splits near the limit). Parallel (large nodes by
 /// data-parallel passes, then subtrees one per thread) and bit-identical for any thread count.
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});

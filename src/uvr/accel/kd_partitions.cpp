@@ -73,6 +73,19 @@ void splitNode(std::vector<KdNode>& nodes, std::vector<Task>& stack, const Task&
     stack.push_back({child, below, std::move(left), task.depth + 1});
 }
 
+/// A partition's padded shrunk box, whole-cell value range and cell count.
+void describePartition(const CellData& data, const Leaf& leaf, Vec3f pad, KdPartition& part) {
+    // Widened by a hair so that samples exactly on a cell face bounding the box are not lost to
+    // rounding in the ray-box clip (it only admits samples that then find no cell).
+    part.box = leaf.shrunk;
+    if (!leaf.shrunk.empty()) part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
+    float lo = INFINITY, hi = -INFINITY;
+    for (std::uint32_t c : leaf.cells) lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
+    part.valueMin = lo <= hi ? lo : 0.f;
+    part.valueMax = lo <= hi ? hi : 0.f;
+    part.cellCount = static_cast<std::uint32_t>(leaf.cells.size());
+}
+
 /// Order-preserving map of a float to an unsigned key (for radix selection).
 std::uint32_t floatKey(float f) {
     const std::uint32_t u = std::bit_cast<std::uint32_t>(f);
@@ -320,12 +333,45 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
     }
     kd.cells.resize(cells);
-    kd.bvhNodes.reserve(maxNodes);
-    // Step 6: batches of partitions (about kBatchCells cells each, so only one batch's BVHs are
-    // held at a time): padded shrunk boxes, whole-cell value ranges, BVHs and cell lists in BVH
-    // order in parallel, then the BVHs appended in partition order.
-    constexpr std::uint64_t kBatchCells = 1u << 22;
     const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
+    if (options.lbvh) {
+        // Step 6, LBVH: the cell lists in partition order, then one segmented build (e.g. on the
+        // GPU) that sorts each list into its BVH's order.
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::int64_t p = 0; p < leafCount; ++p) {
+            describePartition(data, leaves[p], pad, kd.partitions[p]);
+            std::copy(leaves[p].cells.begin(), leaves[p].cells.end(),
+                      kd.cells.begin() + kd.partitions[p].firstCell);
+            leaves[p] = {};
+        }
+        LbvhInput input;
+        input.mesh = &mesh;
+        input.tetIds = kd.cells;
+        input.segmentBegin.resize(leafCount + 1);
+        input.segmentBounds.resize(leafCount);
+        for (std::int64_t p = 0; p < leafCount; ++p) {
+            input.segmentBegin[p] = kd.partitions[p].firstCell;
+            input.segmentBounds[p] = kd.partitions[p].box;
+        }
+        input.segmentBegin[leafCount] = cells;
+        input.leafSize = options.bvhLeafSize;
+        LbvhResult r = options.lbvh(input);
+        std::vector<std::uint32_t> sorted(cells);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t k = 0; k < static_cast<std::int64_t>(cells); ++k)
+            sorted[k] = kd.cells[r.order[k]];
+        kd.cells = std::move(sorted);
+        kd.bvhNodes = std::move(r.nodes);
+        for (std::int64_t p = 0; p < leafCount; ++p) kd.partitions[p].bvhRoot = r.roots[p];
+        kd.buildSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return kd;
+    }
+    kd.bvhNodes.reserve(maxNodes);
+    // Step 6, binned SAH: batches of partitions (about kBatchCells cells each, so only one
+    // batch's BVHs are held at a time): padded shrunk boxes, whole-cell value ranges, BVHs and
+    // cell lists in BVH order in parallel, then the BVHs appended in partition order.
+    constexpr std::uint64_t kBatchCells = 1u << 22;
     std::vector<Bvh> bvhs;
     for (std::int64_t b0 = 0; b0 < leafCount;) {
         std::int64_t b1 = b0;
@@ -336,25 +382,14 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         for (std::int64_t p = b0; p < b1; ++p) {
             Leaf& leaf = leaves[p];
             KdPartition& part = kd.partitions[p];
-            // Widened by a hair so that samples exactly on a cell face bounding the box are not
-            // lost to rounding in the ray-box clip (it only admits samples that then find no
-            // cell).
-            part.box = leaf.shrunk;
-            if (!leaf.shrunk.empty())
-                part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
-            float lo = INFINITY, hi = -INFINITY;
+            describePartition(data, leaf, pad, part);
             const std::size_t count = leaf.cells.size();
             std::vector<Bounds3f> leafBoxes(count);
             std::vector<Vec3f> leafCenters(count);
             for (std::size_t i = 0; i < count; ++i) {
-                const std::uint32_t c = leaf.cells[i];
-                lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
-                leafBoxes[i] = data.boxes[c];
-                leafCenters[i] = data.centers[c];
+                leafBoxes[i] = data.boxes[leaf.cells[i]];
+                leafCenters[i] = data.centers[leaf.cells[i]];
             }
-            part.valueMin = lo <= hi ? lo : 0.f;
-            part.valueMax = lo <= hi ? hi : 0.f;
-            part.cellCount = static_cast<std::uint32_t>(count);
             Bvh& bvh = bvhs[p - b0];
             bvh = buildBvh(leafBoxes, leafCenters, BvhBuildOptions{options.bvhLeafSize});
             for (std::size_t i = 0; i < bvh.primIds.size(); ++i)

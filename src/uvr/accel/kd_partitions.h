@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "uvr/accel/bvh.h"
+#include "uvr/accel/lbvh.h"
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/ray.h"
@@ -125,6 +126,9 @@ struct KdBuildOptions {
     /// Tetrahedra per leaf of the partitions' BVHs at most: seed grids leave them few searches,
     /// so leaves of 8 halve their memory against 4 (PERFORMANCE.md).
     int bvhLeafSize = 8;
+    /// When set, the partitions' BVHs are LBVHs from this builder (buildLbvhCuda: on the GPU);
+    /// else binned SAH trees built on the CPU threads.
+    LbvhBuilder lbvh;
 };
 
 /// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its

@@ -39,13 +39,25 @@ public:
         }
         capacity_ = size_ = n;
     }
-    /// Allocates and copies a host vector.
-    void upload(const std::vector<T>& host, const char* what) {
-        reserve(host.size(), what);
-        if (!host.empty())
-            check(cudaMemcpy(ptr_, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice),
+    /// Allocates and copies n host elements.
+    void upload(const T* host, std::size_t n, const char* what) {
+        reserve(n, what);
+        if (n > 0)
+            check(cudaMemcpy(ptr_, host, n * sizeof(T), cudaMemcpyHostToDevice),
                   "cudaMemcpy(upload)", __FILE__, __LINE__);
     }
+    /// Allocates and copies a host vector.
+    void upload(const std::vector<T>& host, const char* what) {
+        upload(host.data(), host.size(), what);
+    }
+    /// Copies the first n elements to host memory.
+    void download(T* host, std::size_t n) const {
+        if (n > 0)
+            check(cudaMemcpy(host, ptr_, n * sizeof(T), cudaMemcpyDeviceToHost),
+                  "cudaMemcpy(download)", __FILE__, __LINE__);
+    }
+    /// Frees the memory now.
+    void clear() { release(); }
     T* data() const { return ptr_; }
     std::size_t size() const { return size_; }
     std::size_t bytes() const { return size_ * sizeof(T); }

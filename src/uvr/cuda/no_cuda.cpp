@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The CUDA entry points of a build without CUDA (UVR_ENABLE_CUDA=OFF): no device, clear errors.
 #include "uvr/core/error.h"
+#include "uvr/cuda/cuda_lbvh.h"
 #include "uvr/cuda/cuda_renderer.h"
 
 namespace uvr {
@@ -33,6 +34,12 @@ std::uint64_t CudaScene::geometryBytes() const {
 
 double CudaScene::uploadSeconds() const {
     return 0.0;
+}
+
+LbvhResult buildLbvhCuda(const LbvhInput&) {
+    throwError(ErrorKind::Unsupported, "",
+               "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
+               "compiler and UVR_ENABLE_CUDA=ON)");
 }
 
 }  // namespace uvr

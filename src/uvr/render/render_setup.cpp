@@ -28,15 +28,22 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
     out.tets = tetrahedralize(mesh, field);
     out.splitSeconds = secondsSince(start);
 
+    // Linear BVHs (typically built on the GPU) only where the mesh is large enough to pay.
+    const LbvhBuilder lbvh = out.tets.tets.size() >= options.lbvhMinTets ? options.lbvh : nullptr;
+    out.lbvh = static_cast<bool>(lbvh);
     if (options.meshBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
             progress("building the BVH over " + std::to_string(out.tets.tets.size()) +
-                     " tetrahedra");
-        std::vector<Bounds3f> boxes;
-        std::vector<Vec3f> centers;
-        tetBoxesAndCenters(out.tets, boxes, centers);
-        out.bvh = buildBvh(boxes, centers);
+                     " tetrahedra" + (lbvh ? " (LBVH on " + options.lbvhDevice + ")" : ""));
+        if (lbvh) {
+            out.bvh = buildMeshLbvh(out.tets, lbvh);
+        } else {
+            std::vector<Bounds3f> boxes;
+            std::vector<Vec3f> centers;
+            tetBoxesAndCenters(out.tets, boxes, centers);
+            out.bvh = buildBvh(boxes, centers);
+        }
         out.bvhSeconds = secondsSince(start);
     }
 
@@ -48,14 +55,22 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
     if (options.partitions) {
         if (progress)
             progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
-                     " cells each)");
-        out.kd = buildKdPartitions(out.tets, options.kd);
+                     " cells each" +
+                     (lbvh ? ", their BVHs on " + options.lbvhDevice : std::string()) + ")");
+        KdBuildOptions kd = options.kd;
+        if (lbvh) kd.lbvh = lbvh;
+        out.kd = buildKdPartitions(out.tets, kd);
         if (options.seedGrids) {
             if (progress) progress("building seed grids");
             out.seeds = buildSeedGrids(out.tets, *out.kd);
         }
     }
     return out;
+}
+
+PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field) {
+    const PrepareOptions defaults;
+    return prepareMesh(mesh, field, defaults);
 }
 
 float defaultStep(const TetMesh& mesh) {

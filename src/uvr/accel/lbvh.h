@@ -1,0 +1,194 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Linear BVHs (Karras 2012, "Maximizing parallelism in the construction of BVHs, octrees, and k-d
+// trees"): primitives sorted by the Morton code of their box centres and a binary radix tree over
+// them, every node computed independently of the others; subtrees of at most `leafSize`
+// primitives become leaves, so leaves follow the tree's spatial splits. That is what lets the GPU
+// build a BVH over hundreds of millions of tetrahedra in about a second (the CPU's binned SAH takes
+// minutes). The per-element math below is shared by the CPU driver (lbvh.cpp, also the GPU's test
+// oracle) and the CUDA one (cuda/lbvh_build.cu), so both build bit-identical trees.
+//
+// Layout (the BvhNode layout of bvh.h): a segment whose radix tree keeps K inner nodes (those of
+// more than leafSize primitives) takes 2 K + 1 nodes from its base; the root is node base + 0,
+// and the kept inner node of rank r (in index order) has its children at base + 2 r + 1 and
+// base + 2 r + 2, so siblings are adjacent. Depth: each level of a radix tree lengthens the common
+// prefix of the (63-bit Morton code, 32-bit index) keys by at least a bit, so no path has more
+// than 95 inner nodes, within kBvhMaxDepth.
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "uvr/accel/bvh.h"
+#include "uvr/core/bounds.h"
+#include "uvr/core/host_device.h"
+#include "uvr/mesh/tet_mesh.h"
+
+namespace uvr {
+
+/// "No node": the parent of a root.
+inline constexpr std::uint32_t kLbvhNone = 0xffffffffu;
+
+/// Bounding box of tetrahedron t.
+UVR_HOST_DEVICE inline Bounds3f tetBounds(const Vec3f* points, const Tet& t) {
+    Bounds3f b;
+    for (int k = 0; k < 4; ++k) b.extend(points[t.v[k]]);
+    return b;
+}
+
+/// Spreads the low 21 bits of v to every third bit.
+UVR_HOST_DEVICE inline std::uint64_t spreadBits3(std::uint64_t v) {
+    v &= 0x1fffffull;
+    v = (v | (v << 32)) & 0x1f00000000ffffull;
+    v = (v | (v << 16)) & 0x1f0000ff0000ffull;
+    v = (v | (v << 8)) & 0x100f00f00f00f00full;
+    v = (v | (v << 4)) & 0x10c30c30c30c30c3ull;
+    v = (v | (v << 2)) & 0x1249249249249249ull;
+    return v;
+}
+
+/// Cells per axis of the Morton grid (21 bits each, 63 in all): fine enough that graded meshes
+/// (cells 1000x smaller near a wall than in the far field) still get distinct codes.
+inline constexpr float kMortonGrid = 2097152.f;
+
+/// 63-bit Morton code of p on a 2^21-per-axis grid over `bounds` (points outside, NaN and flat
+/// axes clamp into the grid).
+UVR_HOST_DEVICE inline std::uint64_t morton63(Vec3f p, const Bounds3f& bounds) {
+    std::uint64_t q[3];
+    for (int a = 0; a < 3; ++a) {
+        const float ext = bounds.hi[a] - bounds.lo[a];
+        const float scale = ext > 0.f ? kMortonGrid / ext : 0.f;
+        float x = (p[a] - bounds.lo[a]) * scale;
+        x = x > 0.f ? x : 0.f;  // also NaN
+        x = x < kMortonGrid - 1.f ? x : kMortonGrid - 1.f;
+        q[a] = static_cast<std::uint64_t>(x);
+    }
+    return (spreadBits3(q[0]) << 2) | (spreadBits3(q[1]) << 1) | spreadBits3(q[2]);
+}
+
+UVR_HOST_DEVICE inline int countLeadingZeros64(std::uint64_t x) {
+#if defined(__CUDA_ARCH__)
+    return __clzll(static_cast<long long>(x));
+#else
+    return x == 0 ? 64 : __builtin_clzll(x);
+#endif
+}
+
+/// Karras's delta(i, j): the common prefix length of keys i and j of m sorted keys, ties broken
+/// by index (so every key is distinct); -1 when j lies outside [0, m).
+UVR_HOST_DEVICE inline int lbvhDelta(const std::uint64_t* keys, std::int64_t m, std::int64_t i,
+                                     std::int64_t j) {
+    if (j < 0 || j >= m) return -1;
+    const std::uint64_t a = keys[i], b = keys[j];
+    if (a == b)
+        return 32 + countLeadingZeros64(static_cast<std::uint64_t>(i) ^
+                                        static_cast<std::uint64_t>(j));
+    return countLeadingZeros64(a ^ b);
+}
+
+/// Inner node i (0 <= i < m - 1) of the radix tree over m sorted keys: the leaves it covers,
+/// [first, last], and its split: leaves first..split go left, split + 1..last right. The left
+/// child is inner node `split` unless it covers one leaf, the right one inner node split + 1.
+struct LbvhInner {
+    std::int64_t first = 0, last = 0, split = 0;
+};
+
+/// Karras 2012, Fig. 4: the range and split of inner node i.
+UVR_HOST_DEVICE inline LbvhInner lbvhInnerNode(const std::uint64_t* keys, std::int64_t m,
+                                               std::int64_t i) {
+    const int d = lbvhDelta(keys, m, i, i + 1) > lbvhDelta(keys, m, i, i - 1) ? 1 : -1;
+    const int deltaMin = lbvhDelta(keys, m, i, i - d);
+    std::int64_t lMax = 2;
+    while (lbvhDelta(keys, m, i, i + lMax * d) > deltaMin) lMax *= 2;
+    std::int64_t l = 0;
+    for (std::int64_t t = lMax / 2; t >= 1; t /= 2)
+        if (lbvhDelta(keys, m, i, i + (l + t) * d) > deltaMin) l += t;
+    const std::int64_t j = i + l * d;
+    const int deltaNode = lbvhDelta(keys, m, i, j);
+    std::int64_t s = 0, t = l;
+    do {
+        t = (t + 1) / 2;
+        if (lbvhDelta(keys, m, i, i + (s + t) * d) > deltaNode) s += t;
+    } while (t > 1);
+    LbvhInner r;
+    r.first = i < j ? i : j;
+    r.last = i < j ? j : i;
+    r.split = i + s * d + (d < 0 ? -1 : 0);
+    return r;
+}
+
+/// A leaf over sorted primitives [first, first + count) (positions in the whole input).
+UVR_HOST_DEVICE inline BvhNode lbvhLeaf(const Vec3f* points, const Tet* tets,
+                                        const std::uint32_t* tetIds, const std::uint32_t* order,
+                                        std::uint64_t first, std::uint64_t count) {
+    BvhNode leaf;
+    for (std::uint64_t k = first; k < first + count; ++k) {
+        const std::uint32_t prim = order[k];
+        leaf.box.extend(tetBounds(points, tets[tetIds ? tetIds[prim] : prim]));
+    }
+    leaf.first = static_cast<std::uint32_t>(first);
+    leaf.count = static_cast<std::uint32_t>(count);
+    return leaf;
+}
+
+/// Index of the segment holding element x: the last s with begin[s] <= x (begin ascending, of
+/// `count` + 1 entries, begin[0] = 0 <= x < begin[count]); empty segments are passed over.
+UVR_HOST_DEVICE inline std::uint32_t lbvhSegmentOf(const std::uint64_t* begin, std::uint32_t count,
+                                                   std::uint64_t x) {
+    std::uint32_t lo = 0, hi = count;  // begin[lo] <= x < begin[hi]
+    while (hi - lo > 1) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (begin[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/// What an LBVH build reads: primitives are tetrahedra (tetIds[i], or i when tetIds is empty),
+/// grouped in consecutive segments that each get their own tree (the k-d partitions' BVHs; one
+/// segment for the mesh BVH).
+struct LbvhInput {
+    const TetMesh* mesh = nullptr;
+    std::span<const std::uint32_t> tetIds;  ///< primitive -> tetrahedron; empty: the identity
+    std::vector<std::uint64_t> segmentBegin;     ///< S + 1 offsets into the primitives
+    std::vector<Bounds3f> segmentBounds;         ///< S boxes the Morton codes quantise
+    int leafSize = 4;                            ///< primitives per leaf at most
+
+    std::uint64_t primCount() const {
+        return tetIds.empty() ? (mesh ? mesh->tets.size() : 0) : tetIds.size();
+    }
+};
+
+/// Per segment, how many before it hold primitives (each adds a root or single leaf to the
+/// node count: 2 K + 1 per segment).
+struct LbvhPlan {
+    std::vector<std::uint32_t> occupiedBefore;  ///< S + 1 entries
+};
+
+/// Checks the input (offsets, sizes, 32-bit limits; throws Error(Internal) naming what is wrong)
+/// and counts the occupied segments.
+LbvhPlan planLbvh(const LbvhInput& input);
+
+/// A built LBVH: the nodes of every segment, the primitives in leaf order (order[k] is the input
+/// position of the k-th; leaves name ranges of k), and each segment's root node (its base; an
+/// empty segment has no nodes).
+struct LbvhResult {
+    std::vector<BvhNode> nodes;
+    std::vector<std::uint32_t> order;
+    std::vector<std::uint32_t> roots;
+};
+
+/// An LBVH builder: the CPU one (buildLbvhCpu) or the CUDA one (buildLbvhCuda).
+using LbvhBuilder = std::function<LbvhResult(const LbvhInput&)>;
+
+/// Builds the LBVHs on the CPU threads (OpenMP); the GPU's builder returns the same trees.
+LbvhResult buildLbvhCpu(const LbvhInput& input);
+
+/// The mesh BVH over every tetrahedron, built by an LBVH builder.
+Bvh buildMeshLbvh(const TetMesh& mesh, const LbvhBuilder& build, int leafSize = 4);
+
+}  // namespace uvr
