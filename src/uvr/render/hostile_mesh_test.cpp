@@ -16,6 +16,7 @@
 
 #include "test_meshes.h"
 #include "test_support.h"
+#include "uvr/accel/lbvh.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/reference_marcher.h"
@@ -206,9 +207,10 @@ int renderAndCheck(const PreparedMesh& pm, const RenderSettings& s, const Bounds
     return covered;
 }
 
-PreparedMesh prepare(const Mesh& m, std::uint32_t leafCells = 32) {
+PreparedMesh prepare(const Mesh& m, std::uint32_t leafCells = 32, bool lbvh = false) {
     PrepareOptions o;
     o.kd.leafCells = leafCells;
+    if (lbvh) o.lbvh = buildLbvhCpu;  // the linear BVHs the GPU builds (bit-identical)
     return prepareMesh(m, selectScalarField(m, {}), o);
 }
 
@@ -254,8 +256,12 @@ TEST(HostileMesh, DegenerateAndInvertedCellsRenderTheExactImage) {
         m.addCell(CellType::Tetra, needle);
     });
     m.fields.push_back({"f", Association::Point, 1, std::vector<float>(m.points.size(), 1.f)});
-    const PreparedMesh pm = prepare(m);
-    EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox), 500);
+    for (const bool lbvh : {false, true}) {  // SAH trees, linear BVHs
+        const PreparedMesh pm = prepare(m, 32, lbvh);
+        EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox),
+                  500)
+            << (lbvh ? "LBVH" : "SAH");
+    }
 }
 
 TEST(HostileMesh, CoincidentPointsRenderTheExactImage) {
@@ -272,8 +278,12 @@ TEST(HostileMesh, CoincidentPointsRenderTheExactImage) {
         m.addCell(CellType::Hexahedron, ids);
     }
     m.fields.push_back({"f", Association::Point, 1, std::vector<float>(m.points.size(), 1.f)});
-    const PreparedMesh pm = prepare(m);
-    EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox), 500);
+    for (const bool lbvh : {false, true}) {  // SAH trees, linear BVHs
+        const PreparedMesh pm = prepare(m, 32, lbvh);
+        EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox),
+                  500)
+            << (lbvh ? "LBVH" : "SAH");
+    }
 }
 
 TEST(HostileMesh, CellsFromMicrometreToMegametreRenderTheExactImage) {
@@ -281,7 +291,11 @@ TEST(HostileMesh, CellsFromMicrometreToMegametreRenderTheExactImage) {
     Planes planes{0.f};
     for (int e = -6; e <= 6; ++e) planes.push_back(std::pow(10.f, float(e)));
     const Bounds3f box{{0.f, 0.f, 0.f}, {1e6f, 1e6f, 1e6f}};
-    const PreparedMesh pm = prepare(hexGridOnPlanes(planes));
+    const Mesh m = hexGridOnPlanes(planes);
+    EXPECT_GT(renderAndCheck(prepare(m, 32, /*lbvh=*/true),
+                             constantSettings(obliqueCamera(box), 41, 37), box),
+              500);
+    const PreparedMesh pm = prepare(m);
     EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(box), 41, 37), box), 500);
     // Also at a step resolving the small cells near the origin, looking at that corner.
     Camera close;
