@@ -167,11 +167,11 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                     prepared.kd->partitions.size());
         const double seedSeconds = prepared.seeds ? prepared.seeds->buildSeconds : 0.0;
         std::printf(
-            "preparation (%d CPU threads, BVHs on %s): split %.2f s, mesh BVH %.2f s, "
-            "neighbours %.2f s, partitions %.2f s, seed grids %.2f s\n",
-            threads, prepared.lbvh ? "the GPU" : "the CPU", prepared.splitSeconds,
+            "preparation (%d CPU threads, BVHs and k-d tree on %s): split %.2f s, mesh BVH %.2f s, "
+            "neighbours %.2f s, partitions %.2f s (k-d tree %.2f s), seed grids %.2f s\n",
+            threads, prepared.builtElsewhere ? "the GPU" : "the CPU", prepared.splitSeconds,
             prepared.bvhSeconds, prepared.adjacencySeconds, prepared.kd->buildSeconds,
-            seedSeconds);
+            prepared.kd->treeSeconds, seedSeconds);
         if (renderer.gpu()) {
             // The mesh BVH serves only the reference; `uvr render --method adaptive` leaves it out.
             const double tets = double(std::max<std::size_t>(1, prepared.tets.tets.size()));
@@ -204,7 +204,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["partitions"] = prepared.kd->partitions.size();
                 j["partition_build_seconds"] = prepared.kd->buildSeconds;
                 j["mesh_bvh_seconds"] = prepared.bvhSeconds;
-                j["bvh_build_device"] = prepared.lbvh ? "cuda" : "cpu";
+                j["bvh_build_device"] = prepared.builtElsewhere ? "cuda" : "cpu";
                 j["image"] = {base.width, base.height};
                 j["s1"] = s1;
                 j["power"] = base.power;

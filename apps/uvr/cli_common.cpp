@@ -197,8 +197,9 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
         ->capture_default_str();
     app.add_option("--build-device", buildDevice,
-                   "Where the BVHs are built: cpu (binned SAH trees on the CPU threads), cuda "
-                   "(linear BVHs on the GPU: seconds for 100M+ tetrahedra), or auto (cuda when "
+                   "Where the BVHs and k-d partitions are built: cpu (binned SAH trees on the CPU "
+                   "threads), cuda (on the GPU, linear BVHs: seconds for 100M+ tetrahedra), or "
+                   "auto (cuda when "
                    "rendering on CUDA and the mesh has 4M tetrahedra or more)")
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
         ->capture_default_str();
@@ -264,8 +265,9 @@ PrepareOptions RenderFlags::prepareOptions(bool withReference) const {
     PrepareOptions o;
     if (buildOnCuda()) {
         o.lbvh = buildLbvhCuda;
-        o.lbvhDevice = "the GPU";
-        if (buildDevice == "auto") o.lbvhMinTets = kAutoGpuBuildTets;
+        o.kdSplitter = buildKdTreeCuda;
+        o.builderDevice = "the GPU";
+        if (buildDevice == "auto") o.builderMinTets = kAutoGpuBuildTets;
     }
     o.partitions = method == "adaptive";
     o.meshBvh = !o.partitions || withReference;  // the partition integrator uses its own BVHs

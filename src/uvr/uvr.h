@@ -5,7 +5,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
 #include "uvr/cpu/cpu_renderer.h"
-#include "uvr/cuda/cuda_lbvh.h"
+#include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/mesh_reader.h"

@@ -5,6 +5,8 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <optional>
+#include <span>
 
 #include "uvr/core/error.h"
 #include "uvr/core/scratch_vector.h"
@@ -21,13 +23,6 @@ constexpr float kBoxPadding = 1e-6f;
 constexpr std::size_t kSubtreeCells = 1u << 18;
 /// Cells per chunk of a data-parallel pass.
 constexpr std::int64_t kChunk = 1 << 14;
-
-Bounds3f intersect(const Bounds3f& a, const Bounds3f& b) {
-    Bounds3f r;
-    r.lo = vmax(a.lo, b.lo);
-    r.hi = vmin(a.hi, b.hi);
-    return r;
-}
 
 /// Per-cell boxes, centres and finite value ranges.
 struct CellData {
@@ -74,26 +69,17 @@ void splitNode(std::vector<KdNode>& nodes, std::vector<Task>& stack, const Task&
 }
 
 /// A partition's padded shrunk box, whole-cell value range and cell count.
-void describePartition(const CellData& data, const Leaf& leaf, Vec3f pad, KdPartition& part) {
+void describePartition(const CellData& data, const Bounds3f& shrunk,
+                       std::span<const std::uint32_t> cells, Vec3f pad, KdPartition& part) {
     // Widened by a hair so that samples exactly on a cell face bounding the box are not lost to
     // rounding in the ray-box clip (it only admits samples that then find no cell).
-    part.box = leaf.shrunk;
-    if (!leaf.shrunk.empty()) part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
+    part.box = shrunk;
+    if (!shrunk.empty()) part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
     float lo = INFINITY, hi = -INFINITY;
-    for (std::uint32_t c : leaf.cells) lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
+    for (std::uint32_t c : cells) lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
     part.valueMin = lo <= hi ? lo : 0.f;
     part.valueMax = lo <= hi ? hi : 0.f;
-    part.cellCount = static_cast<std::uint32_t>(leaf.cells.size());
-}
-
-/// Order-preserving map of a float to an unsigned key (for radix selection).
-std::uint32_t floatKey(float f) {
-    const std::uint32_t u = std::bit_cast<std::uint32_t>(f);
-    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
-}
-
-float keyFloat(std::uint32_t k) {
-    return std::bit_cast<float>((k & 0x80000000u) ? (k & 0x7fffffffu) : ~k);
+    part.cellCount = static_cast<std::uint32_t>(cells.size());
 }
 
 /// The k-th smallest centre coordinate on `axis` of the cells (what std::nth_element picks), by
@@ -103,7 +89,8 @@ float parallelKth(const CellData& data, const std::vector<std::uint32_t>& cells,
     const std::int64_t count = static_cast<std::int64_t>(cells.size());
     ScratchVector<std::uint32_t> keys(cells.size());
 #pragma omp parallel for schedule(static)
-    for (std::int64_t i = 0; i < count; ++i) keys[i] = floatKey(data.centers[cells[i]][axis]);
+    for (std::int64_t i = 0; i < count; ++i)
+        keys[i] = kdsplit::floatKey(data.centers[cells[i]][axis]);
     const std::int64_t chunks = (count + kChunk - 1) / kChunk;
     std::vector<std::uint64_t> histograms(chunks * 256);
     std::uint32_t prefix = 0, mask = 0;
@@ -124,7 +111,7 @@ float parallelKth(const CellData& data, const std::vector<std::uint32_t>& cells,
         prefix |= static_cast<std::uint32_t>(digit) << shift;
         mask |= 255u << shift;
     }
-    return keyFloat(prefix);
+    return kdsplit::keyFloat(prefix);
 }
 
 /// Splits a large task with data-parallel passes (Morrical et al. 2019, Sec. 2.1: median of the
@@ -145,9 +132,8 @@ bool splitLarge(const CellData& data, const Task& task, const KdBuildOptions& op
     }
     Bounds3f cellBounds;
     for (const Bounds3f& b : chunkBounds) cellBounds.extend(b);
-    const Bounds3f shrunk = intersect(task.region, cellBounds);
-    if (!(static_cast<std::size_t>(count) > options.leafCells && task.depth < options.maxDepth &&
-          !shrunk.empty()))
+    const Bounds3f shrunk = kdsplit::shrunkRegion(task.region, cellBounds);
+    if (!kdsplit::wantsSplit(count, task.depth, shrunk, options.leafCells, options.maxDepth))
         return false;
     axis = shrunk.longestAxis();
     plane = parallelKth(data, task.cells, axis, static_cast<std::size_t>(count / 2));
@@ -158,8 +144,8 @@ bool splitLarge(const CellData& data, const Task& task, const KdBuildOptions& op
         const std::int64_t end = std::min(count, (c + 1) * kChunk);
         std::uint64_t l = 0, r = 0;
         for (std::int64_t i = c * kChunk; i < end; ++i) {
-            l += data.boxes[task.cells[i]].lo[axis] <= plane;
-            r += data.boxes[task.cells[i]].hi[axis] >= plane;
+            l += kdsplit::goesBelow(data.boxes[task.cells[i]], axis, plane);
+            r += kdsplit::goesAbove(data.boxes[task.cells[i]], axis, plane);
         }
         before[2 * (c + 1)] = l;
         before[2 * (c + 1) + 1] = r;
@@ -169,9 +155,7 @@ bool splitLarge(const CellData& data, const Task& task, const KdBuildOptions& op
         before[2 * (c + 1) + 1] += before[2 * c + 1];
     }
     const std::uint64_t nl = before[2 * chunks], nr = before[2 * chunks + 1];
-    if (!(plane > task.region.lo[axis] && plane < task.region.hi[axis] &&
-          std::max(nl, nr) * 10 <= static_cast<std::uint64_t>(count) * 9))
-        return false;
+    if (!kdsplit::keepsSplit(task.region, axis, plane, nl, nr, count)) return false;
     left.resize(nl);
     right.resize(nr);
 #pragma omp parallel for schedule(dynamic, 1)
@@ -180,8 +164,8 @@ bool splitLarge(const CellData& data, const Task& task, const KdBuildOptions& op
         std::uint64_t l = before[2 * c], r = before[2 * c + 1];
         for (std::int64_t i = c * kChunk; i < end; ++i) {
             const std::uint32_t cell = task.cells[i];
-            if (data.boxes[cell].lo[axis] <= plane) left[l++] = cell;
-            if (data.boxes[cell].hi[axis] >= plane) right[r++] = cell;
+            if (kdsplit::goesBelow(data.boxes[cell], axis, plane)) left[l++] = cell;
+            if (kdsplit::goesAbove(data.boxes[cell], axis, plane)) right[r++] = cell;
         }
     }
     return true;
@@ -201,9 +185,10 @@ LocalTree buildSubtree(const CellData& data, Task root, const KdBuildOptions& op
         const std::size_t count = task.cells.size();
         Bounds3f cellBounds;
         for (std::uint32_t c : task.cells) cellBounds.extend(data.boxes[c]);
-        const Bounds3f shrunk = intersect(task.region, cellBounds);
+        const Bounds3f shrunk = kdsplit::shrunkRegion(task.region, cellBounds);
         // Median split of the cell centres along the longest axis of the occupied region.
-        bool split = count > options.leafCells && task.depth < options.maxDepth && !shrunk.empty();
+        bool split =
+            kdsplit::wantsSplit(count, task.depth, shrunk, options.leafCells, options.maxDepth);
         std::vector<std::uint32_t> left, right;
         int axis = 0;
         float plane = 0.f;
@@ -218,12 +203,10 @@ LocalTree buildSubtree(const CellData& data, Task root, const KdBuildOptions& op
             // A cell touching the plane goes to both sides, so every point of a child's closed
             // region that lies in a cell finds that cell in the child's list.
             for (std::uint32_t c : task.cells) {
-                if (data.boxes[c].lo[axis] <= plane) left.push_back(c);
-                if (data.boxes[c].hi[axis] >= plane) right.push_back(c);
+                if (kdsplit::goesBelow(data.boxes[c], axis, plane)) left.push_back(c);
+                if (kdsplit::goesAbove(data.boxes[c], axis, plane)) right.push_back(c);
             }
-            const std::size_t larger = std::max(left.size(), right.size());
-            split = plane > task.region.lo[axis] && plane < task.region.hi[axis] &&
-                    larger * 10 <= count * 9;
+            split = kdsplit::keepsSplit(task.region, axis, plane, left.size(), right.size(), count);
         }
         if (split) {
             task.cells = {};
@@ -248,8 +231,8 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     kd.leafCells = options.leafCells;
     // Step 1: per-cell boxes, centres and finite value ranges.
     CellData data;
-    data.boxes.resize(n);
-    data.centers.resize(n);
+    const bool needBoxes = !options.splitter || !options.lbvh;  // for the CPU's splits or SAH
+    if (needBoxes) data.boxes.resize(n), data.centers.resize(n);
     data.vmin.resize(n);
     data.vmax.resize(n);
     const bool cellData = mesh.association == Association::Cell;
@@ -266,84 +249,101 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
             }
         }
         if (cellData && std::isfinite(mesh.values[t])) lo = hi = mesh.values[t];
-        data.boxes[t] = box;
-        data.centers[t] = box.center();
+        if (needBoxes) data.boxes[t] = box, data.centers[t] = box.center();
         data.vmin[t] = lo;
         data.vmax[t] = hi;
     }
-    // Step 2: the top of the tree, one large node at a time, split by parallel passes; nodes of
-    // at most kSubtreeCells cells become subtree jobs.
-    kd.nodes.emplace_back();
-    std::vector<Task> stack, jobs;
-    {
-        std::vector<std::uint32_t> all(n);
+    std::vector<Leaf> leaves;  // the CPU's leaves; or, from a splitter, `tree`
+    std::optional<KdTree> tree;
+    if (options.splitter) {
+        // Steps 2-4 elsewhere (the GPU): the same splits and leaves.
+        tree = options.splitter(mesh, options);
+        kd.nodes = std::move(tree->nodes);
+    } else {
+        // Step 2: the top of the tree, one large node at a time, split by parallel passes; nodes of
+        // at most kSubtreeCells cells become subtree jobs.
+        kd.nodes.emplace_back();
+        std::vector<Task> stack, jobs;
+        {
+            std::vector<std::uint32_t> all(n);
 #pragma omp parallel for schedule(static)
-        for (std::int64_t t = 0; t < tetCount; ++t) all[t] = static_cast<std::uint32_t>(t);
-        stack.push_back({0, mesh.bounds, std::move(all), 0});
-    }
-    while (!stack.empty()) {
-        Task task = std::move(stack.back());
-        stack.pop_back();
-        std::vector<std::uint32_t> left, right;
-        int axis = 0;
-        float plane = 0.f;
-        if (task.cells.size() <= kSubtreeCells ||
-            !splitLarge(data, task, options, left, right, axis, plane)) {
-            jobs.push_back(std::move(task));
-            continue;
+            for (std::int64_t t = 0; t < tetCount; ++t) all[t] = static_cast<std::uint32_t>(t);
+            stack.push_back({0, mesh.bounds, std::move(all), 0});
         }
-        splitNode(kd.nodes, stack, task, axis, plane, std::move(left), std::move(right));
-    }
-    // Step 3: the subtrees, in parallel.
-    const std::int64_t jobCount = static_cast<std::int64_t>(jobs.size());
-    std::vector<LocalTree> local(jobs.size());
+        while (!stack.empty()) {
+            Task task = std::move(stack.back());
+            stack.pop_back();
+            std::vector<std::uint32_t> left, right;
+            int axis = 0;
+            float plane = 0.f;
+            if (task.cells.size() <= kSubtreeCells ||
+                !splitLarge(data, task, options, left, right, axis, plane)) {
+                jobs.push_back(std::move(task));
+                continue;
+            }
+            splitNode(kd.nodes, stack, task, axis, plane, std::move(left), std::move(right));
+        }
+        // Step 3: the subtrees, in parallel.
+        const std::int64_t jobCount = static_cast<std::int64_t>(jobs.size());
+        std::vector<LocalTree> local(jobs.size());
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t j = 0; j < jobCount; ++j) {
-        const std::uint32_t node = jobs[j].node;
-        local[j] = buildSubtree(data, std::move(jobs[j]), options);
-        jobs[j].node = node;
-    }
-    // Step 4: append the subtrees in job order (each root replaces its placeholder) and number
-    // their leaves.
-    std::vector<Leaf> leaves;
-    for (std::int64_t j = 0; j < jobCount; ++j) {
-        const std::uint32_t nodeOffset = static_cast<std::uint32_t>(kd.nodes.size()) - 1;
-        const std::uint32_t leafOffset = static_cast<std::uint32_t>(leaves.size());
-        for (std::size_t i = 0; i < local[j].nodes.size(); ++i) {
-            KdNode node = local[j].nodes[i];
-            const std::uint32_t c = node.child() + (node.isLeaf() ? leafOffset : nodeOffset);
-            node.bits = (c << 2) | (node.bits & 3u);
-            if (i == 0)
-                kd.nodes[jobs[j].node] = node;
-            else
-                kd.nodes.push_back(node);
+        for (std::int64_t j = 0; j < jobCount; ++j) {
+            const std::uint32_t node = jobs[j].node;
+            local[j] = buildSubtree(data, std::move(jobs[j]), options);
+            jobs[j].node = node;
         }
-        for (Leaf& leaf : local[j].leaves) leaves.push_back(std::move(leaf));
-        local[j] = {};
+        // Step 4: append the subtrees in job order (each root replaces its placeholder) and number
+        // their leaves.
+        for (std::int64_t j = 0; j < jobCount; ++j) {
+            const std::uint32_t nodeOffset = static_cast<std::uint32_t>(kd.nodes.size()) - 1;
+            const std::uint32_t leafOffset = static_cast<std::uint32_t>(leaves.size());
+            for (std::size_t i = 0; i < local[j].nodes.size(); ++i) {
+                KdNode node = local[j].nodes[i];
+                const std::uint32_t c = node.child() + (node.isLeaf() ? leafOffset : nodeOffset);
+                node.bits = (c << 2) | (node.bits & 3u);
+                if (i == 0)
+                    kd.nodes[jobs[j].node] = node;
+                else
+                    kd.nodes.push_back(node);
+            }
+            for (Leaf& leaf : local[j].leaves) leaves.push_back(std::move(leaf));
+            local[j] = {};
+        }
     }
+    kd.treeSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // Step 5: cell-list offsets (known from the leaves) and room for at most 2 c - 1 BVH nodes
     // per partition of c cells, reserved once (only what is written becomes resident).
-    const std::int64_t leafCount = static_cast<std::int64_t>(leaves.size());
-    kd.partitions.resize(leaves.size());
+    const std::int64_t leafCount =
+        static_cast<std::int64_t>(tree ? tree->leafShrunk.size() : leaves.size());
+    auto cellsOf = [&](std::int64_t p) -> std::span<const std::uint32_t> {
+        if (!tree) return leaves[p].cells;
+        return std::span<const std::uint32_t>(tree->leafCells)
+            .subspan(tree->leafBegin[p], tree->leafBegin[p + 1] - tree->leafBegin[p]);
+    };
+    auto shrunkOf = [&](std::int64_t p) { return tree ? tree->leafShrunk[p] : leaves[p].shrunk; };
+    kd.partitions.resize(leafCount);
     std::uint64_t cells = 0, maxNodes = 0;
     for (std::int64_t p = 0; p < leafCount; ++p) {
         kd.partitions[p].firstCell = static_cast<std::uint32_t>(cells);
-        cells += leaves[p].cells.size();
-        maxNodes += std::max<std::uint64_t>(1, 2 * leaves[p].cells.size());
+        cells += cellsOf(p).size();
+        maxNodes += std::max<std::uint64_t>(1, 2 * cellsOf(p).size());
         UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
     }
-    kd.cells.resize(cells);
     const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
     if (options.lbvh) {
         // Step 6, LBVH: the cell lists in partition order, then one segmented build (e.g. on the
         // GPU) that sorts each list into its BVH's order.
+        if (!tree) kd.cells.resize(cells);
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::int64_t p = 0; p < leafCount; ++p) {
-            describePartition(data, leaves[p], pad, kd.partitions[p]);
+            describePartition(data, shrunkOf(p), cellsOf(p), pad, kd.partitions[p]);
+            if (tree) continue;
             std::copy(leaves[p].cells.begin(), leaves[p].cells.end(),
                       kd.cells.begin() + kd.partitions[p].firstCell);
             leaves[p] = {};
         }
+        if (tree) kd.cells = std::move(tree->leafCells);  // already in partition order
         LbvhInput input;
         input.mesh = &mesh;
         input.tetIds = kd.cells;
@@ -367,6 +367,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return kd;
     }
+    kd.cells.resize(cells);
     kd.bvhNodes.reserve(maxNodes);
     // Step 6, binned SAH: batches of partitions (about kBatchCells cells each, so only one
     // batch's BVHs are held at a time): padded shrunk boxes, whole-cell value ranges, BVHs and
@@ -376,26 +377,26 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     for (std::int64_t b0 = 0; b0 < leafCount;) {
         std::int64_t b1 = b0;
         for (std::uint64_t batchCells = 0; b1 < leafCount && batchCells < kBatchCells; ++b1)
-            batchCells += leaves[b1].cells.size();
+            batchCells += cellsOf(b1).size();
         bvhs.assign(b1 - b0, Bvh{});
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::int64_t p = b0; p < b1; ++p) {
-            Leaf& leaf = leaves[p];
+            const std::span<const std::uint32_t> leafCells = cellsOf(p);
             KdPartition& part = kd.partitions[p];
-            describePartition(data, leaf, pad, part);
-            const std::size_t count = leaf.cells.size();
+            describePartition(data, shrunkOf(p), leafCells, pad, part);
+            const std::size_t count = leafCells.size();
             std::vector<Bounds3f> leafBoxes(count);
             std::vector<Vec3f> leafCenters(count);
             for (std::size_t i = 0; i < count; ++i) {
-                leafBoxes[i] = data.boxes[leaf.cells[i]];
-                leafCenters[i] = data.centers[leaf.cells[i]];
+                leafBoxes[i] = data.boxes[leafCells[i]];
+                leafCenters[i] = data.centers[leafCells[i]];
             }
             Bvh& bvh = bvhs[p - b0];
             bvh = buildBvh(leafBoxes, leafCenters, BvhBuildOptions{options.bvhLeafSize});
             for (std::size_t i = 0; i < bvh.primIds.size(); ++i)
-                kd.cells[part.firstCell + i] = leaf.cells[bvh.primIds[i]];
+                kd.cells[part.firstCell + i] = leafCells[bvh.primIds[i]];
             bvh.primIds = {};
-            leaf = {};
+            if (!tree) leaves[p] = {};
         }
         const std::size_t batchStart = kd.bvhNodes.size();
         std::size_t end = batchStart;

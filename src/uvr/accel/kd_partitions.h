@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <bit>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "uvr/accel/bvh.h"
@@ -119,6 +121,79 @@ UVR_HOST_DEVICE void kdTraverse(const KdView& kd, const Ray& ray, Vec3f invDir, 
         if (leaf(p, t0, t1)) return;
 }
 
+/// The split rules of the k-d build (Morrical et al. 2019, Sec. 2.1), shared by the CPU build and
+/// the GPU's (cuda/kd_build.cu).
+namespace kdsplit {
+
+/// Order-preserving map of a float to an unsigned key (radix selection and sorting).
+UVR_HOST_DEVICE inline std::uint32_t floatKey(float f) {
+#if defined(__CUDA_ARCH__)
+    const std::uint32_t u = __float_as_uint(f);
+#else
+    const std::uint32_t u = std::bit_cast<std::uint32_t>(f);
+#endif
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+/// Inverse of floatKey.
+UVR_HOST_DEVICE inline float keyFloat(std::uint32_t k) {
+    const std::uint32_t u = (k & 0x80000000u) ? (k & 0x7fffffffu) : ~k;
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(u);
+#else
+    return std::bit_cast<float>(u);
+#endif
+}
+
+/// A node's occupied region: its region clipped to the bounds of its cells.
+UVR_HOST_DEVICE inline Bounds3f shrunkRegion(const Bounds3f& region, const Bounds3f& cellBounds) {
+    Bounds3f r;
+    r.lo = vmax(region.lo, cellBounds.lo);
+    r.hi = vmin(region.hi, cellBounds.hi);
+    return r;
+}
+
+/// Whether a node of `count` cells at `depth` is split at all (else it is a leaf); the split is
+/// then along the longest axis of the shrunk region at the median cell centre.
+inline bool wantsSplit(std::uint64_t count, int depth, const Bounds3f& shrunk,
+                       std::uint32_t leafCells, int maxDepth) {
+    return count > leafCells && depth < maxDepth && !shrunk.empty();
+}
+
+/// The sides of the plane a cell box goes to: below when it reaches the plane from below, above
+/// when it reaches it from above (a cell touching the plane goes to both, so every point of a
+/// child's closed region that lies in a cell finds that cell in the child's list).
+UVR_HOST_DEVICE inline bool goesBelow(const Bounds3f& box, int axis, float plane) {
+    return box.lo[axis] <= plane;
+}
+UVR_HOST_DEVICE inline bool goesAbove(const Bounds3f& box, int axis, float plane) {
+    return box.hi[axis] >= plane;
+}
+
+/// Whether a split is kept: the plane strictly inside the region, and neither side left with more
+/// than 90% of the cells (which bounds duplication).
+inline bool keepsSplit(const Bounds3f& region, int axis, float plane, std::uint64_t below,
+                       std::uint64_t above, std::uint64_t count) {
+    return plane > region.lo[axis] && plane < region.hi[axis] &&
+           (below > above ? below : above) * 10 <= count * 9;
+}
+
+}  // namespace kdsplit
+
+/// A k-d tree before its partitions are described: nodes (a leaf names its entry of the leaf
+/// arrays), each leaf's shrunk region and its cells (leaf l has cells[begin[l] .. begin[l + 1])).
+struct KdTree {
+    std::vector<KdNode> nodes;
+    std::vector<Bounds3f> leafShrunk;
+    std::vector<std::uint64_t> leafBegin{0};
+    std::vector<std::uint32_t> leafCells;
+};
+
+struct KdBuildOptions;
+
+/// Builds the k-d tree of buildKdPartitions elsewhere (buildKdTreeCuda: on the GPU).
+using KdSplitter = std::function<KdTree(const TetMesh&, const KdBuildOptions&)>;
+
 /// Build parameters.
 struct KdBuildOptions {
     std::uint32_t leafCells = 1024;  ///< split nodes holding more cells (PERFORMANCE.md)
@@ -129,6 +204,9 @@ struct KdBuildOptions {
     /// When set, the partitions' BVHs are LBVHs from this builder (buildLbvhCuda: on the GPU);
     /// else binned SAH trees built on the CPU threads.
     LbvhBuilder lbvh;
+    /// When set, the k-d tree (splits, leaves and their cells) comes from this splitter
+    /// (buildKdTreeCuda: on the GPU; the same partitions as the CPU's); else the CPU threads.
+    KdSplitter splitter;
 };
 
 /// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its
@@ -142,6 +220,7 @@ struct KdPartitions {
     Bounds3f bounds;
     std::uint32_t leafCells = 0;  ///< the build's leaf size
     double buildSeconds = 0.0;
+    double treeSeconds = 0.0;  ///< of buildSeconds, the k-d tree (the rest: cell lists and BVHs)
 
     /// View for kernels; this object must outlive it.
     KdView view() const {

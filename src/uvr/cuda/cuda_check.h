@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace uvr::cuda {
@@ -58,6 +59,12 @@ public:
     }
     /// Frees the memory now.
     void clear() { release(); }
+    /// Exchanges the allocations of two arrays.
+    void swap(DeviceArray& other) noexcept {
+        std::swap(ptr_, other.ptr_);
+        std::swap(size_, other.size_);
+        std::swap(capacity_, other.capacity_);
+    }
     T* data() const { return ptr_; }
     std::size_t size() const { return size_; }
     std::size_t bytes() const { return size_ * sizeof(T); }

@@ -8,7 +8,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/cuda/cuda_check.h"
-#include "uvr/cuda/cuda_lbvh.h"
+#include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
 
 namespace uvr {

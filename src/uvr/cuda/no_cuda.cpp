@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The CUDA entry points of a build without CUDA (UVR_ENABLE_CUDA=OFF): no device, clear errors.
 #include "uvr/core/error.h"
-#include "uvr/cuda/cuda_lbvh.h"
+#include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
 
 namespace uvr {
@@ -37,6 +37,12 @@ double CudaScene::uploadSeconds() const {
 }
 
 LbvhResult buildLbvhCuda(const LbvhInput&) {
+    throwError(ErrorKind::Unsupported, "",
+               "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
+               "compiler and UVR_ENABLE_CUDA=ON)");
+}
+
+KdTree buildKdTreeCuda(const TetMesh&, const KdBuildOptions&) {
     throwError(ErrorKind::Unsupported, "",
                "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
                "compiler and UVR_ENABLE_CUDA=ON)");

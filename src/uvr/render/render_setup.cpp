@@ -28,14 +28,16 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
     out.tets = tetrahedralize(mesh, field);
     out.splitSeconds = secondsSince(start);
 
-    // Linear BVHs (typically built on the GPU) only where the mesh is large enough to pay.
-    const LbvhBuilder lbvh = out.tets.tets.size() >= options.lbvhMinTets ? options.lbvh : nullptr;
-    out.lbvh = static_cast<bool>(lbvh);
+    // The other builders (the GPU's) only where the mesh is large enough to pay.
+    const bool elsewhere = out.tets.tets.size() >= options.builderMinTets;
+    const LbvhBuilder lbvh = elsewhere ? options.lbvh : nullptr;
+    const KdSplitter splitter = elsewhere ? options.kdSplitter : nullptr;
+    out.builtElsewhere = elsewhere && (lbvh || splitter);
     if (options.meshBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
             progress("building the BVH over " + std::to_string(out.tets.tets.size()) +
-                     " tetrahedra" + (lbvh ? " (LBVH on " + options.lbvhDevice + ")" : ""));
+                     " tetrahedra" + (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
         if (lbvh) {
             out.bvh = buildMeshLbvh(out.tets, lbvh);
         } else {
@@ -56,9 +58,10 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
         if (progress)
             progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
                      " cells each" +
-                     (lbvh ? ", their BVHs on " + options.lbvhDevice : std::string()) + ")");
+                     (out.builtElsewhere ? ", on " + options.builderDevice : std::string()) + ")");
         KdBuildOptions kd = options.kd;
         if (lbvh) kd.lbvh = lbvh;
+        if (splitter) kd.splitter = splitter;
         out.kd = buildKdPartitions(out.tets, kd);
         if (options.seedGrids) {
             if (progress) progress("building seed grids");

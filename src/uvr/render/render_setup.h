@@ -32,8 +32,11 @@ struct PrepareOptions {
     /// (buildLbvhCuda: on the GPU, in seconds for 100M+ tetrahedra); else binned SAH trees built
     /// on the CPU threads. It overrides kd.lbvh.
     LbvhBuilder lbvh;
-    std::string lbvhDevice = "cpu";  ///< where lbvh builds, for progress messages
-    std::uint64_t lbvhMinTets = 0;   ///< lbvh only for meshes of at least this many tetrahedra
+    /// When set, the k-d tree comes from this splitter (buildKdTreeCuda: on the GPU); it
+    /// overrides kd.splitter.
+    KdSplitter kdSplitter;
+    std::string builderDevice = "cpu";  ///< where lbvh and kdSplitter build (progress messages)
+    std::uint64_t builderMinTets = 0;   ///< use them only from this many tetrahedra
 };
 
 /// A mesh made ready for rendering one field: tetrahedra, BVH, face neighbours and (optionally)
@@ -48,7 +51,7 @@ struct PreparedMesh {
     double splitSeconds = 0.0;       ///< time to split cells into tetrahedra
     double bvhSeconds = 0.0;         ///< time to build the BVH
     double adjacencySeconds = 0.0;   ///< time to find face neighbours
-    bool lbvh = false;               ///< the BVHs are LBVHs (PrepareOptions::lbvh), not SAH trees
+    bool builtElsewhere = false;  ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
 
     /// Point locator over this mesh.
     TetLocator locator() const { return {tets.view(), bvh.view(), neighbors.data()}; }
@@ -58,8 +61,8 @@ struct PreparedMesh {
 using ProgressFn = std::function<void(const std::string&)>;
 
 /// Splits cells, builds the BVH over the tetrahedra and the face-neighbour table.
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field,
-                         const PrepareOptions& options, const ProgressFn& progress = {});
+PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const PrepareOptions& options,
+                         const ProgressFn& progress = {});
 /// prepareMesh with the default options.
 PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field);
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include "uvr/accel/kd_partitions.h"
 #include "uvr/accel/lbvh.h"
 
 namespace uvr {
@@ -16,5 +17,11 @@ inline constexpr std::uint64_t kAutoGpuBuildTets = 4000000;
 /// return. Throws Error(Resource) naming the need and the free memory when it does not fit,
 /// Error(Unsupported) when uvr was built without CUDA or no device is present.
 LbvhResult buildLbvhCuda(const LbvhInput& input);
+
+/// Builds the k-d tree of buildKdPartitions on the GPU, one level at a time (every node of a
+/// level at once: bounds, a sort of (node, centre) keys for the medians, scans for the sides): the
+/// same splits, leaves and cell lists as the CPU's build, numbered breadth-first. Throws as
+/// buildLbvhCuda does.
+KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options);
 
 }  // namespace uvr

@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: MIT
+// GPU tests of the GPU builders (linear BVHs, k-d trees): skipped without a CUDA device (and
+// refused clearly in a build without CUDA); run on the GPU machine.
+#include "uvr/cuda/cuda_build.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <tuple>
+
+#include "test_meshes.h"
+#include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/cuda/cuda_renderer.h"
+#include "uvr/mesh/procedural.h"
+#include "uvr/render/image_metrics.h"
+#include "uvr/render/render_setup.h"
+
+namespace uvr {
+namespace {
+
+#define UVR_REQUIRE_GPU() \
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription()
+
+bool sameNodes(const std::vector<BvhNode>& a, const std::vector<BvhNode>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(BvhNode)) == 0;
+}
+
+TetMesh proceduralTets(std::uint64_t cells) {
+    ProceduralSpec spec;
+    spec.targetCells = cells;
+    const Mesh m = generateMesh(spec);
+    return tetrahedralize(m, selectScalarField(m, {}));
+}
+
+TEST(CudaLbvh, WithoutADeviceTheBuildIsRefusedClearly) {
+    if (cudaDeviceAvailable()) GTEST_SKIP() << "a CUDA device is present";
+    const Mesh m = testing::makeHexGrid(2, 0.f, 1.f, [](Vec3f p) { return p.x; });
+    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}));
+    EXPECT_THROW(buildMeshLbvh(mesh, buildLbvhCuda), Error);
+    EXPECT_THROW(buildKdTreeCuda(mesh, {}), Error);
+}
+
+TEST(CudaLbvh, MeshTreeIsBitIdenticalToTheCpuBuild) {
+    UVR_REQUIRE_GPU();
+    const TetMesh mesh = proceduralTets(300000);
+    for (int leaf : {1, 4}) {
+        const Bvh cpu = buildMeshLbvh(mesh, buildLbvhCpu, leaf);
+        const Bvh gpu = buildMeshLbvh(mesh, buildLbvhCuda, leaf);
+        EXPECT_TRUE(sameNodes(cpu.nodes, gpu.nodes)) << "leaf size " << leaf;
+        EXPECT_EQ(cpu.primIds, gpu.primIds) << "leaf size " << leaf;
+    }
+}
+
+TEST(CudaLbvh, PartitionTreesAreBitIdenticalToTheCpuBuild) {
+    UVR_REQUIRE_GPU();
+    const TetMesh mesh = proceduralTets(200000);
+    KdBuildOptions o;
+    o.leafCells = 4096;
+    o.lbvh = buildLbvhCpu;
+    const KdPartitions cpu = buildKdPartitions(mesh, o);
+    o.lbvh = buildLbvhCuda;
+    const KdPartitions gpu = buildKdPartitions(mesh, o);
+    ASSERT_GT(cpu.partitions.size(), 16u);
+    EXPECT_TRUE(sameNodes(cpu.bvhNodes, gpu.bvhNodes));
+    EXPECT_EQ(cpu.cells, gpu.cells);
+    ASSERT_EQ(cpu.partitions.size(), gpu.partitions.size());
+    for (std::size_t p = 0; p < cpu.partitions.size(); ++p)
+        ASSERT_EQ(cpu.partitions[p].bvhRoot, gpu.partitions[p].bvhRoot) << p;
+}
+
+/// The partitions as a comparable set: (shrunk box, value range, cells in order) by box.
+std::vector<std::tuple<std::vector<float>, float, float, std::vector<std::uint32_t>>> partitionSet(
+    const KdPartitions& kd) {
+    std::vector<std::tuple<std::vector<float>, float, float, std::vector<std::uint32_t>>> out;
+    for (const KdPartition& p : kd.partitions) {
+        std::vector<std::uint32_t> cells(kd.cells.begin() + p.firstCell,
+                                         kd.cells.begin() + p.firstCell + p.cellCount);
+        out.push_back({{p.box.lo.x, p.box.lo.y, p.box.lo.z, p.box.hi.x, p.box.hi.y, p.box.hi.z},
+                       p.valueMin,
+                       p.valueMax,
+                       std::move(cells)});
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+TEST(CudaKd, SameSplitsLeavesAndCellsAsTheCpuBuild) {
+    UVR_REQUIRE_GPU();
+    for (const std::uint64_t cells : {1000ull, 300000ull}) {
+        const TetMesh mesh = proceduralTets(cells);
+        for (const std::uint32_t leafCells : {64u, 4096u}) {
+            KdBuildOptions o;
+            o.leafCells = leafCells;
+            o.lbvh = buildLbvhCpu;  // the same BVHs either way: the cells come out in BVH order
+            const KdPartitions cpu = buildKdPartitions(mesh, o);
+            o.splitter = buildKdTreeCuda;
+            const KdPartitions gpu = buildKdPartitions(mesh, o);
+            ASSERT_EQ(cpu.nodes.size(), gpu.nodes.size()) << cells << " / " << leafCells;
+            ASSERT_EQ(cpu.partitions.size(), gpu.partitions.size());
+            EXPECT_TRUE(partitionSet(cpu) == partitionSet(gpu)) << cells << " / " << leafCells;
+            // The trees locate points in partitions of the same box.
+            std::mt19937 rng(9);
+            std::uniform_real_distribution<float> u(0.f, 1.f);
+            for (int q = 0; q < 2000; ++q) {
+                const Vec3f p = mesh.bounds.lo +
+                                (mesh.bounds.hi - mesh.bounds.lo) * Vec3f(u(rng), u(rng), u(rng));
+                auto leafBox = [&](const KdPartitions& kd) {
+                    std::uint32_t node = 0;
+                    while (!kd.nodes[node].isLeaf()) {
+                        const KdNode n = kd.nodes[node];
+                        node = n.child() + (p[n.axis()] <= n.split ? 0u : 1u);
+                    }
+                    return kd.partitions[kd.nodes[node].child()].box;
+                };
+                const Bounds3f a = leafBox(cpu), b = leafBox(gpu);
+                ASSERT_TRUE(a.lo == b.lo && a.hi == b.hi) << "query " << q;
+            }
+        }
+    }
+}
+
+TEST(CudaKd, PreparedOnTheGpuRendersAsOnTheCpu) {
+    UVR_REQUIRE_GPU();
+    const Mesh m = generateMesh([] {
+        ProceduralSpec spec;
+        spec.targetCells = 200000;
+        return spec;
+    }());
+    PrepareOptions o;
+    o.kd.leafCells = 4096;
+    const PreparedMesh cpu = prepareMesh(m, selectScalarField(m, {}), o);
+    o.lbvh = buildLbvhCuda;
+    o.kdSplitter = buildKdTreeCuda;
+    const PreparedMesh gpu = prepareMesh(m, selectScalarField(m, {}), o);
+    EXPECT_TRUE(gpu.builtElsewhere);
+    RenderSettings s;
+    s.width = 128;
+    s.height = 96;
+    s.method = RenderMethod::Partitions;
+    s.tf = transferFunctionPreset("cool-to-warm");
+    applyOpacitySpec(s.tf, "0:0,1:0.3");
+    const RenderResult a = renderCpu(cpu, s), b = renderCpu(gpu, s);
+    EXPECT_GE(compareImages(toRgb8(a.image), toRgb8(b.image)).ssim, 0.999);
+    EXPECT_NEAR(double(b.stats.samples), double(a.stats.samples), 1e-3 * a.stats.samples);
+}
+
+}  // namespace
+}  // namespace uvr

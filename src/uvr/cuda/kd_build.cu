@@ -1,0 +1,342 @@
+// SPDX-License-Identifier: MIT
+// The GPU's k-d tree build: one level of the tree at a time, every node of the level at once.
+// Memory, sorts, scans and launches only: the split rules are the shared kdsplit:: functions of
+// accel/kd_partitions.h, so the partitions are those of the CPU's build (same planes, same cells
+// in the same order; only the numbering of nodes and partitions differs: breadth-first here).
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include <bit>
+
+#include "uvr/core/error.h"
+#include "uvr/cuda/cuda_build.h"
+#include "uvr/cuda/cuda_check.h"
+#include "uvr/cuda/cuda_renderer.h"
+
+namespace uvr {
+
+namespace cuda {
+namespace {
+
+/// Elements per thread of the bounds pass (runs of one node's cells are reduced locally first).
+constexpr std::uint64_t kBoundsChunk = 256;
+constexpr int kBlock = 256;
+
+__device__ std::uint64_t globalThread() {
+    return static_cast<std::uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+}
+
+int blocksFor(std::uint64_t n) {
+    return static_cast<int>((n + kBlock - 1) / kBlock);
+}
+
+/// Tetrahedron boxes, and the first level: every tetrahedron in node 0.
+__global__ void boxesKernel(const Vec3f* points, const Tet* tets, std::uint64_t n, Bounds3f* boxes,
+                            std::uint32_t* cells, std::uint32_t* nodeOf) {
+    const std::uint64_t t = globalThread();
+    if (t >= n) return;
+    boxes[t] = tetBounds(points, tets[t]);
+    cells[t] = static_cast<std::uint32_t>(t);
+    nodeOf[t] = 0;
+}
+
+/// Adds a box to node s's bounds, kept as six order-preserving keys (atomic min / max).
+__device__ void flushBounds(const Bounds3f& b, std::uint32_t* keys) {
+    for (int a = 0; a < 3; ++a) {
+        atomicMin(&keys[a], kdsplit::floatKey(b.lo[a]));
+        atomicMax(&keys[3 + a], kdsplit::floatKey(b.hi[a]));
+    }
+}
+
+/// Bounds of each node's cells: a chunk of consecutive elements per thread, flushed whenever the
+/// node changes.
+__global__ void boundsKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
+                             std::uint64_t count, const Bounds3f* boxes, std::uint32_t* keys) {
+    const std::uint64_t begin = globalThread() * kBoundsChunk;
+    if (begin >= count) return;
+    const std::uint64_t end = begin + kBoundsChunk < count ? begin + kBoundsChunk : count;
+    std::uint32_t node = nodeOf[begin];
+    Bounds3f b;
+    for (std::uint64_t i = begin; i < end; ++i) {
+        if (nodeOf[i] != node) {
+            flushBounds(b, keys + 6 * node);
+            node = nodeOf[i];
+            b = Bounds3f{};
+        }
+        b.extend(boxes[cells[i]]);
+    }
+    flushBounds(b, keys + 6 * node);
+}
+
+/// Sort keys: the node in the high word, the cell centre on the node's axis in the low.
+__global__ void centreKeysKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
+                                 std::uint64_t count, const Bounds3f* boxes,
+                                 const std::uint32_t* axis, std::uint64_t* keys) {
+    const std::uint64_t i = globalThread();
+    if (i >= count) return;
+    const std::uint32_t s = nodeOf[i];
+    keys[i] = (static_cast<std::uint64_t>(s) << 32) |
+              kdsplit::floatKey(boxes[cells[i]].center()[axis[s]]);
+}
+
+/// Each node's median centre: the (count / 2)-th smallest, as the CPU's selection picks.
+__global__ void medianKernel(const std::uint64_t* sortedKeys, const std::uint64_t* begin,
+                             std::uint32_t nodes, float* plane) {
+    const std::uint64_t s = globalThread();
+    if (s >= nodes) return;
+    const std::uint64_t count = begin[s + 1] - begin[s];
+    plane[s] = kdsplit::keyFloat(static_cast<std::uint32_t>(sortedKeys[begin[s] + count / 2]));
+}
+
+/// Which side(s) of its node's plane each cell goes to (nodes not splitting: neither).
+__global__ void sidesKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
+                            std::uint64_t count, const Bounds3f* boxes, const std::uint32_t* axis,
+                            const float* plane, const std::uint32_t* splitting,
+                            std::uint32_t* below, std::uint32_t* above) {
+    const std::uint64_t i = globalThread();
+    if (i >= count) return;
+    const std::uint32_t s = nodeOf[i];
+    const Bounds3f& box = boxes[cells[i]];
+    below[i] = splitting[s] && kdsplit::goesBelow(box, static_cast<int>(axis[s]), plane[s]);
+    above[i] = splitting[s] && kdsplit::goesAbove(box, static_cast<int>(axis[s]), plane[s]);
+}
+
+/// Per node: how many cells go below and above (differences of the exclusive scans).
+__global__ void sideCountsKernel(const std::uint32_t* belowScan, const std::uint32_t* aboveScan,
+                                 const std::uint64_t* begin, std::uint32_t nodes,
+                                 std::uint64_t* counts) {
+    const std::uint64_t s = globalThread();
+    if (s >= nodes) return;
+    counts[4 * s + 0] = belowScan[begin[s]];
+    counts[4 * s + 1] = belowScan[begin[s + 1]] - belowScan[begin[s]];
+    counts[4 * s + 2] = aboveScan[begin[s]];
+    counts[4 * s + 3] = aboveScan[begin[s + 1]] - aboveScan[begin[s]];
+}
+
+/// Where a split node's children go in the next level.
+struct ChildPlace {
+    std::uint64_t belowBegin, aboveBegin;  ///< first element of each child
+    std::uint64_t belowBase, aboveBase;    ///< the scans' values at the node's first element
+    std::uint32_t below, above;            ///< the children's indices in the next level
+    std::uint32_t split;                   ///< 0: the node became a leaf
+};
+
+/// Order-preserving scatter of the cells of split nodes into the next level.
+__global__ void scatterKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
+                              std::uint64_t count, const std::uint32_t* below,
+                              const std::uint32_t* above, const std::uint32_t* belowScan,
+                              const std::uint32_t* aboveScan, const ChildPlace* places,
+                              std::uint32_t* nextCells, std::uint32_t* nextNodeOf) {
+    const std::uint64_t i = globalThread();
+    if (i >= count) return;
+    const ChildPlace& p = places[nodeOf[i]];
+    if (!p.split) return;
+    if (below[i]) {
+        const std::uint64_t k = p.belowBegin + belowScan[i] - p.belowBase;
+        nextCells[k] = cells[i];
+        nextNodeOf[k] = p.below;
+    }
+    if (above[i]) {
+        const std::uint64_t k = p.aboveBegin + aboveScan[i] - p.aboveBase;
+        nextCells[k] = cells[i];
+        nextNodeOf[k] = p.above;
+    }
+}
+
+/// Exclusive sum of count + 1 flags (the last is 0): scan[count] is the total.
+void exclusiveSum(const std::uint32_t* in, std::uint32_t* out, std::uint64_t count,
+                  DeviceArray<unsigned char>& temp) {
+    std::size_t bytes = 0;
+    UVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, count + 1));
+    temp.reserve(bytes, "the scan's scratch (GPU k-d build)");
+    UVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.data(), bytes, in, out, count + 1));
+}
+
+/// A node of the level being split.
+struct LevelNode {
+    std::uint32_t node;  ///< its k-d node
+    Bounds3f region;
+    int depth;
+};
+
+}  // namespace
+}  // namespace cuda
+
+KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
+    if (!cudaDeviceAvailable())
+        throwError(ErrorKind::Unsupported, "", "GPU k-d build: no CUDA device found");
+    UVR_CHECK(options.leafCells >= 1, "leaf size must be positive");
+    const std::uint64_t n = mesh.tets.size();
+    UVR_CHECK(n < (1ull << 30), "too many tetrahedra for k-d partitions");
+    KdTree tree;
+    tree.nodes.emplace_back();
+    if (n == 0) {  // one empty partition, as the CPU's build makes
+        tree.nodes[0].bits = 3u;
+        tree.leafShrunk.push_back(kdsplit::shrunkRegion(mesh.bounds, Bounds3f{}));
+        tree.leafBegin.push_back(0);
+        return tree;
+    }
+    tree.leafCells.reserve(n + n / 4);
+    cuda::DeviceArray<Bounds3f> boxes;
+    cuda::DeviceArray<std::uint32_t> cells, nodeOf, nextCells, nextNodeOf;
+    boxes.reserve(n, "the tetrahedron boxes (GPU k-d build)");
+    cells.reserve(n, "the cell lists (GPU k-d build)");
+    nodeOf.reserve(n, "the cells' nodes (GPU k-d build)");
+    {
+        cuda::DeviceArray<Vec3f> points;
+        cuda::DeviceArray<Tet> tets;
+        points.upload(mesh.points, "the mesh points (GPU k-d build)");
+        tets.upload(mesh.tets, "the tetrahedra (GPU k-d build)");
+        cuda::boxesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(
+            points.data(), tets.data(), n, boxes.data(), cells.data(), nodeOf.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        UVR_CUDA_CHECK(cudaDeviceSynchronize());
+    }
+    cuda::DeviceArray<std::uint64_t> keys[2], begin, counts;
+    cuda::DeviceArray<std::uint32_t> boundKeys, axis, splitting, below, above, belowScan, aboveScan;
+    cuda::DeviceArray<float> planes;
+    cuda::DeviceArray<cuda::ChildPlace> places;
+    cuda::DeviceArray<unsigned char> temp;
+    std::vector<cuda::LevelNode> level{{0, mesh.bounds, 0}};
+    std::vector<std::uint64_t> levelBegin{0, n};
+    std::uint64_t count = n;
+    while (!level.empty()) {
+        const std::uint32_t m = static_cast<std::uint32_t>(level.size());
+        begin.upload(levelBegin, "the node offsets (GPU k-d build)");
+        // Bounds of every node's cells, then the shrunk regions and split axes on the host.
+        std::vector<std::uint32_t> hostKeys(6 * std::size_t(m));
+        for (std::uint32_t s = 0; s < m; ++s)
+            for (int a = 0; a < 3; ++a)
+                hostKeys[6 * s + a] = 0xffffffffu, hostKeys[6 * s + 3 + a] = 0;
+        boundKeys.upload(hostKeys, "the node bounds (GPU k-d build)");
+        cuda::boundsKernel<<<cuda::blocksFor((count + cuda::kBoundsChunk - 1) / cuda::kBoundsChunk),
+                             cuda::kBlock>>>(cells.data(), nodeOf.data(), count, boxes.data(),
+                                             boundKeys.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        boundKeys.download(hostKeys.data(), hostKeys.size());
+        std::vector<Bounds3f> shrunk(m);
+        std::vector<std::uint32_t> hostAxis(m), hostSplitting(m);
+        bool anySplit = false;
+        for (std::uint32_t s = 0; s < m; ++s) {
+            Bounds3f cellBounds;
+            for (int a = 0; a < 3; ++a) {
+                cellBounds.lo[a] = kdsplit::keyFloat(hostKeys[6 * s + a]);
+                cellBounds.hi[a] = kdsplit::keyFloat(hostKeys[6 * s + 3 + a]);
+            }
+            shrunk[s] = kdsplit::shrunkRegion(level[s].region, cellBounds);
+            hostAxis[s] = static_cast<std::uint32_t>(shrunk[s].longestAxis());
+            hostSplitting[s] =
+                kdsplit::wantsSplit(levelBegin[s + 1] - levelBegin[s], level[s].depth, shrunk[s],
+                                    options.leafCells, options.maxDepth);
+            anySplit = anySplit || hostSplitting[s];
+        }
+        std::vector<float> hostPlanes(m, 0.f);
+        std::vector<std::uint64_t> hostCounts(4 * std::size_t(m), 0);
+        if (anySplit) {
+            // Median centres: one sort of (node, centre) keys for the whole level.
+            axis.upload(hostAxis, "the split axes (GPU k-d build)");
+            splitting.upload(hostSplitting, "the split flags (GPU k-d build)");
+            keys[0].reserve(count, "the centre keys (GPU k-d build)");
+            keys[1].reserve(count, "the sorted centre keys (GPU k-d build)");
+            cuda::centreKeysKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(
+                cells.data(), nodeOf.data(), count, boxes.data(), axis.data(), keys[0].data());
+            UVR_CUDA_CHECK(cudaGetLastError());
+            cub::DoubleBuffer<std::uint64_t> keyBuffer(keys[0].data(), keys[1].data());
+            const int endBit = 32 + std::bit_width(m - 1);
+            std::size_t bytes = 0;
+            UVR_CUDA_CHECK(
+                cub::DeviceRadixSort::SortKeys(nullptr, bytes, keyBuffer, count, 0, endBit));
+            temp.reserve(bytes, "the radix sort's scratch (GPU k-d build)");
+            UVR_CUDA_CHECK(
+                cub::DeviceRadixSort::SortKeys(temp.data(), bytes, keyBuffer, count, 0, endBit));
+            planes.reserve(m, "the split planes (GPU k-d build)");
+            cuda::medianKernel<<<cuda::blocksFor(m), cuda::kBlock>>>(
+                keyBuffer.Current(), begin.data(), m, planes.data());
+            UVR_CUDA_CHECK(cudaGetLastError());
+            planes.download(hostPlanes.data(), m);
+            // Sides and their counts.
+            below.reserve(count + 1, "the below flags (GPU k-d build)");
+            above.reserve(count + 1, "the above flags (GPU k-d build)");
+            belowScan.reserve(count + 1, "the below offsets (GPU k-d build)");
+            aboveScan.reserve(count + 1, "the above offsets (GPU k-d build)");
+            UVR_CUDA_CHECK(cudaMemset(below.data() + count, 0, sizeof(std::uint32_t)));
+            UVR_CUDA_CHECK(cudaMemset(above.data() + count, 0, sizeof(std::uint32_t)));
+            cuda::sidesKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(
+                cells.data(), nodeOf.data(), count, boxes.data(), axis.data(), planes.data(),
+                splitting.data(), below.data(), above.data());
+            UVR_CUDA_CHECK(cudaGetLastError());
+            cuda::exclusiveSum(below.data(), belowScan.data(), count, temp);
+            cuda::exclusiveSum(above.data(), aboveScan.data(), count, temp);
+            counts.reserve(4 * std::size_t(m), "the side counts (GPU k-d build)");
+            cuda::sideCountsKernel<<<cuda::blocksFor(m), cuda::kBlock>>>(
+                belowScan.data(), aboveScan.data(), begin.data(), m, counts.data());
+            UVR_CUDA_CHECK(cudaGetLastError());
+            counts.download(hostCounts.data(), hostCounts.size());
+        }
+        // The host decides each node: split (children to the next level) or leaf (its cells,
+        // one contiguous run, copied out).
+        std::vector<cuda::ChildPlace> hostPlaces(m);
+        std::vector<cuda::LevelNode> next;
+        std::vector<std::uint64_t> nextBegin{0};
+        for (std::uint32_t s = 0; s < m; ++s) {
+            const cuda::LevelNode& ln = level[s];
+            const std::uint64_t nodeCount = levelBegin[s + 1] - levelBegin[s];
+            const int a = static_cast<int>(hostAxis[s]);
+            const float plane = hostPlanes[s];
+            const std::uint64_t nBelow = hostCounts[4 * s + 1], nAbove = hostCounts[4 * s + 3];
+            cuda::ChildPlace& p = hostPlaces[s];
+            p = {};
+            if (hostSplitting[s] &&
+                kdsplit::keepsSplit(ln.region, a, plane, nBelow, nAbove, nodeCount)) {
+                const std::uint32_t child = static_cast<std::uint32_t>(tree.nodes.size());
+                tree.nodes[ln.node].split = plane;
+                tree.nodes[ln.node].bits = (child << 2) | static_cast<std::uint32_t>(a);
+                tree.nodes.emplace_back();
+                tree.nodes.emplace_back();
+                Bounds3f lower = ln.region, upper = ln.region;
+                lower.hi[a] = plane;
+                upper.lo[a] = plane;
+                p.split = 1;
+                p.belowBase = hostCounts[4 * s + 0];
+                p.aboveBase = hostCounts[4 * s + 2];
+                p.below = static_cast<std::uint32_t>(next.size());
+                p.belowBegin = nextBegin.back();
+                next.push_back({child, lower, ln.depth + 1});
+                nextBegin.push_back(nextBegin.back() + nBelow);
+                p.above = static_cast<std::uint32_t>(next.size());
+                p.aboveBegin = nextBegin.back();
+                next.push_back({child + 1, upper, ln.depth + 1});
+                nextBegin.push_back(nextBegin.back() + nAbove);
+                continue;
+            }
+            const std::uint32_t leaf = static_cast<std::uint32_t>(tree.leafShrunk.size());
+            tree.nodes[ln.node].bits = (leaf << 2) | 3u;
+            tree.leafShrunk.push_back(shrunk[s]);
+            const std::size_t at = tree.leafCells.size();
+            tree.leafCells.resize(at + nodeCount);
+            UVR_CUDA_CHECK(cudaMemcpy(tree.leafCells.data() + at, cells.data() + levelBegin[s],
+                                      nodeCount * sizeof(std::uint32_t), cudaMemcpyDeviceToHost));
+            tree.leafBegin.push_back(tree.leafCells.size());
+            UVR_CHECK(tree.leafCells.size() < 0xffffffffull,
+                      "partition cell lists exceed 32-bit indices");
+        }
+        if (next.empty()) break;
+        const std::uint64_t nextCount = nextBegin.back();
+        places.upload(hostPlaces, "the child places (GPU k-d build)");
+        nextCells.reserve(nextCount, "the next level's cells (GPU k-d build)");
+        nextNodeOf.reserve(nextCount, "the next level's nodes (GPU k-d build)");
+        cuda::scatterKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(
+            cells.data(), nodeOf.data(), count, below.data(), above.data(), belowScan.data(),
+            aboveScan.data(), places.data(), nextCells.data(), nextNodeOf.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        cells.swap(nextCells);
+        nodeOf.swap(nextNodeOf);
+        level = std::move(next);
+        levelBegin = std::move(nextBegin);
+        count = nextCount;
+    }
+    UVR_CUDA_CHECK(cudaDeviceSynchronize());
+    return tree;
+}
+
+}  // namespace uvr
