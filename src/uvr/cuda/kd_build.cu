@@ -322,6 +322,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
         }
         if (next.empty()) break;
         const std::uint64_t nextCount = nextBegin.back();
+        UVR_CHECK(nextCount < 0xffffffffull, "k-d cell lists exceed 32-bit offsets");
         places.upload(hostPlaces, "the child places (GPU k-d build)");
         nextCells.reserve(nextCount, "the next level's cells (GPU k-d build)");
         nextNodeOf.reserve(nextCount, "the next level's nodes (GPU k-d build)");
