@@ -6,7 +6,7 @@
 # Usage: bench/gpu_eval.sh BUILD_DIR DATA_DIR OUT STAGE...
 #   STAGE: tests | real | ncu | box:CELLS | refine:MESH:LEVELS | graded:CELLS | leaves:MESH_FILE
 # REPEAT (10) and SWEEP (8,16,32,64) set the timed frames and the s2 / s1 sweep of each bench;
-# BUILD (auto) is its --build-device: where the BVHs are built (cpu: binned SAH, cuda: LBVH).
+# BUILD (auto) is its --build-device: where the BVHs and k-d partitions are built.
 set -u
 build=$1
 data=$2
@@ -14,7 +14,11 @@ out=$3
 shift 3
 mkdir -p "$out"
 uvr="$build/uvr"
+# OPACITY replaces the semi-transparent transfer function of the box, graded and refine stages
+# (e.g. OPACITY=step:0.5:0.5 for a binary one; TAG then names their outputs).
 semi="0:0,1:0.1"
+large=${OPACITY:-$semi}
+tag=${TAG:-semi}
 view="--size 1024x1024 --azimuth -30 --elevation 25 --background 1,1,1"
 # The GPU machine's MemTotal can start small and grow: give loads a fixed budget.
 mem="--max-memory 100G"
@@ -55,14 +59,14 @@ for stage in "$@"; do
       mesh=/tmp/$shape$cells.uvrm
       [ -f "$mesh" ] || /usr/bin/time -f "generate: %e s, %M KB peak" "$uvr" -q generate "$shape" \
         --cells "$cells" -o "$mesh" $mem
-      bench "$shape$cells-semi" "$mesh" "$semi"
+      bench "$shape$cells-$tag" "$mesh" "$large"
       ;;
     refine:*)
       rest=${stage#refine:} name=${rest%%:*} levels=${rest#*:}
       mesh=/tmp/$name-x$levels.uvrm
       [ -f "$mesh" ] || /usr/bin/time -f "refine: %e s, %M KB peak" "$uvr" -q refine \
         "$data/$name.vtk" "$mesh" --levels "$levels" $mem
-      bench "$name-x$levels-semi" "$mesh" "$semi"
+      bench "$name-x$levels-$tag" "$mesh" "$large"
       ;;
     leaves:*)  # the k-d leaf size on the GPU, s2 = 16 and 64 s1
       mesh=${stage#leaves:}
