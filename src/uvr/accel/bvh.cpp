@@ -322,8 +322,7 @@ void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
     centers.resize(n);
 #pragma omp parallel for schedule(static)
     for (std::int64_t t = 0; t < n; ++t) {
-        Bounds3f b;
-        for (std::uint32_t v : mesh.tets[t].v) b.extend(mesh.points[v]);
+        const Bounds3f b = tetBounds(mesh.points.data(), mesh.tets[t]);
         boxes[t] = b;
         centers[t] = b.center();
     }

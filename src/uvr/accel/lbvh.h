@@ -31,13 +31,6 @@ namespace uvr {
 /// "No node": the parent of a root.
 inline constexpr std::uint32_t kLbvhNone = 0xffffffffu;
 
-/// Bounding box of tetrahedron t.
-UVR_HOST_DEVICE inline Bounds3f tetBounds(const Vec3f* points, const Tet& t) {
-    Bounds3f b;
-    for (int k = 0; k < 4; ++k) b.extend(points[t.v[k]]);
-    return b;
-}
-
 /// Spreads the low 21 bits of v to every third bit.
 UVR_HOST_DEVICE inline std::uint64_t spreadBits3(std::uint64_t v) {
     v &= 0x1fffffull;
@@ -83,8 +76,8 @@ UVR_HOST_DEVICE inline int lbvhDelta(const std::uint64_t* keys, std::int64_t m, 
     if (j < 0 || j >= m) return -1;
     const std::uint64_t a = keys[i], b = keys[j];
     if (a == b)
-        return 32 + countLeadingZeros64(static_cast<std::uint64_t>(i) ^
-                                        static_cast<std::uint64_t>(j));
+        return 32 +
+               countLeadingZeros64(static_cast<std::uint64_t>(i) ^ static_cast<std::uint64_t>(j));
     return countLeadingZeros64(a ^ b);
 }
 
@@ -119,20 +112,6 @@ UVR_HOST_DEVICE inline LbvhInner lbvhInnerNode(const std::uint64_t* keys, std::i
     return r;
 }
 
-/// A leaf over sorted primitives [first, first + count) (positions in the whole input).
-UVR_HOST_DEVICE inline BvhNode lbvhLeaf(const Vec3f* points, const Tet* tets,
-                                        const std::uint32_t* tetIds, const std::uint32_t* order,
-                                        std::uint64_t first, std::uint64_t count) {
-    BvhNode leaf;
-    for (std::uint64_t k = first; k < first + count; ++k) {
-        const std::uint32_t prim = order[k];
-        leaf.box.extend(tetBounds(points, tets[tetIds ? tetIds[prim] : prim]));
-    }
-    leaf.first = static_cast<std::uint32_t>(first);
-    leaf.count = static_cast<std::uint32_t>(count);
-    return leaf;
-}
-
 /// Index of the segment holding element x: the last s with begin[s] <= x (begin ascending, of
 /// `count` + 1 entries, begin[0] = 0 <= x < begin[count]); empty segments are passed over.
 UVR_HOST_DEVICE inline std::uint32_t lbvhSegmentOf(const std::uint64_t* begin, std::uint32_t count,
@@ -148,15 +127,126 @@ UVR_HOST_DEVICE inline std::uint32_t lbvhSegmentOf(const std::uint64_t* begin, s
     return lo;
 }
 
+/// The arrays of one build (host vectors for buildLbvhCpu, device memory for buildLbvhCuda), with
+/// the per-element work of each step: the drivers only sort, scan, loop or launch over the
+/// elements and, for the refit, supply the atomic count and the box loads.
+/// Element g of segment s (begin[s] <= g < begin[s + 1]) stands for inner node g - begin[s] of
+/// the segment's radix tree.
+struct LbvhBuildView {
+    const Vec3f* points = nullptr;
+    const Tet* tets = nullptr;
+    const std::uint32_t* tetIds = nullptr;  ///< null: primitive i is tetrahedron i
+    const std::uint64_t* segmentBegin = nullptr;
+    const Bounds3f* segmentBounds = nullptr;  ///< what each segment's Morton codes quantise
+    std::uint32_t segments = 0;
+    std::int64_t leafSize = 1;
+    const std::uint64_t* keys = nullptr;            ///< sorted Morton keys, per element
+    const std::uint32_t* order = nullptr;           ///< input position of each sorted element
+    const std::uint32_t* rank = nullptr;            ///< n + 1: kept inner nodes before element g
+    const std::uint32_t* occupiedBefore = nullptr;  ///< LbvhPlan::occupiedBefore
+    std::uint32_t* roots = nullptr;
+    std::uint32_t* innerSlot = nullptr;
+    std::uint32_t* innerParent = nullptr;
+    BvhNode* nodes = nullptr;
+
+    UVR_HOST_DEVICE std::uint32_t segmentOf(std::uint64_t g) const {
+        return lbvhSegmentOf(segmentBegin, segments, g);
+    }
+    UVR_HOST_DEVICE Bounds3f primBounds(std::uint64_t prim) const {
+        return tetBounds(points, tets[tetIds ? tetIds[prim] : prim]);
+    }
+    /// Step 1: the Morton key of primitive `prim` (input position) of segment s.
+    UVR_HOST_DEVICE std::uint64_t mortonKey(std::uint64_t prim, std::uint32_t s) const {
+        return morton63(primBounds(prim).center(), segmentBounds[s]);
+    }
+    /// A leaf over sorted elements [first, first + count).
+    UVR_HOST_DEVICE BvhNode leaf(std::uint64_t first, std::uint64_t count) const {
+        BvhNode node;
+        for (std::uint64_t k = first; k < first + count; ++k) node.box.extend(primBounds(order[k]));
+        node.first = static_cast<std::uint32_t>(first);
+        node.count = static_cast<std::uint32_t>(count);
+        return node;
+    }
+    UVR_HOST_DEVICE LbvhInner inner(std::int64_t g, std::uint32_t s) const {
+        const std::int64_t b = static_cast<std::int64_t>(segmentBegin[s]);
+        return lbvhInnerNode(keys + b, static_cast<std::int64_t>(segmentBegin[s + 1]) - b, g - b);
+    }
+    /// Step 2: whether element g is an inner node of more than leafSize primitives (kept).
+    UVR_HOST_DEVICE bool keepsInner(std::int64_t g) const {
+        const std::uint32_t s = segmentOf(g);
+        if (g + 1 >= static_cast<std::int64_t>(segmentBegin[s + 1])) return false;  // no node
+        const LbvhInner r = inner(g, s);
+        return r.last - r.first + 1 > leafSize;
+    }
+    UVR_HOST_DEVICE bool kept(std::int64_t g) const { return rank[g + 1] != rank[g]; }
+    /// The first of kept inner node g's two adjacent child nodes.
+    UVR_HOST_DEVICE std::uint32_t firstChild(std::uint32_t s, std::int64_t g) const {
+        return roots[s] + 2 * (rank[g] - rank[segmentBegin[s]]) + 1;
+    }
+    /// Segment s's root node (once rank is known); a segment of at most leafSize primitives is
+    /// that one leaf, written here.
+    UVR_HOST_DEVICE void placeRoot(std::uint32_t s) const {
+        const std::uint64_t b = segmentBegin[s], count = segmentBegin[s + 1] - b;
+        roots[s] = 2 * rank[b] + occupiedBefore[s];
+        if (count > 0 && count <= static_cast<std::uint64_t>(leafSize))
+            nodes[roots[s]] = leaf(b, count);
+    }
+    /// Step 3, for kept inner node g: its kept children learn their node and parent, its leaf
+    /// children are written.
+    UVR_HOST_DEVICE void nameChildren(std::int64_t g) const {
+        const std::uint32_t s = segmentOf(g);
+        const std::int64_t b = static_cast<std::int64_t>(segmentBegin[s]);
+        const LbvhInner r = inner(g, s);
+        const std::uint32_t slot = firstChild(s, g);
+        if (g == b) innerSlot[g] = roots[s], innerParent[g] = kLbvhNone;
+        const std::int64_t lo[2] = {r.first, r.split + 1}, hi[2] = {r.split, r.last};
+        for (int side = 0; side < 2; ++side) {
+            const std::int64_t count = hi[side] - lo[side] + 1;
+            if (count > leafSize) {
+                const std::int64_t child = b + r.split + side;
+                innerSlot[child] = slot + side;
+                innerParent[child] = static_cast<std::uint32_t>(g);
+            } else {
+                nodes[slot + side] = leaf(b + lo[side], count);
+            }
+        }
+    }
+    /// Step 4, for kept inner node g: once per leaf child, up the tree; at each node,
+    /// firstArrival(p) counts the arrival and says whether it was the first (then the sibling's
+    /// subtree is not done and its last thread goes on), loadBox reads a child's box as another
+    /// thread wrote it.
+    template <class FirstArrival, class LoadBox>
+    UVR_HOST_DEVICE void refitFrom(std::int64_t g, FirstArrival&& firstArrival,
+                                   LoadBox&& loadBox) const {
+        const std::uint32_t s = segmentOf(g);
+        const LbvhInner r = inner(g, s);
+        const int leafChildren =
+            (r.split - r.first + 1 <= leafSize) + (r.last - r.split <= leafSize);
+        for (int k = 0; k < leafChildren; ++k) {
+            for (std::uint32_t p = static_cast<std::uint32_t>(g); p != kLbvhNone;
+                 p = innerParent[p]) {
+                if (firstArrival(p)) break;
+                const std::uint32_t left = firstChild(s, p);
+                BvhNode node;
+                node.box = loadBox(nodes + left);
+                node.box.extend(loadBox(nodes + left + 1));
+                node.first = left;
+                node.count = 0;
+                nodes[innerSlot[p]] = node;
+            }
+        }
+    }
+};
+
 /// What an LBVH build reads: primitives are tetrahedra (tetIds[i], or i when tetIds is empty),
 /// grouped in consecutive segments that each get their own tree (the k-d partitions' BVHs; one
 /// segment for the mesh BVH).
 struct LbvhInput {
     const TetMesh* mesh = nullptr;
-    std::span<const std::uint32_t> tetIds;  ///< primitive -> tetrahedron; empty: the identity
-    std::vector<std::uint64_t> segmentBegin;     ///< S + 1 offsets into the primitives
-    std::vector<Bounds3f> segmentBounds;         ///< S boxes the Morton codes quantise
-    int leafSize = 4;                            ///< primitives per leaf at most
+    std::span<const std::uint32_t> tetIds;    ///< primitive -> tetrahedron; empty: the identity
+    std::vector<std::uint64_t> segmentBegin;  ///< S + 1 offsets into the primitives
+    std::vector<Bounds3f> segmentBounds;      ///< S boxes the Morton codes quantise
+    int leafSize = 4;                         ///< primitives per leaf at most
 
     std::uint64_t primCount() const {
         return tetIds.empty() ? (mesh ? mesh->tets.size() : 0) : tetIds.size();

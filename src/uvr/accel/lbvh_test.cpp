@@ -88,7 +88,9 @@ TEST(Lbvh, InnerNodesAreTheRadixTreeOfTheKeys) {
         std::vector<std::uint64_t> keys(m);
         for (auto& k : keys) k = key(rng);
         std::sort(keys.begin(), keys.end());
-        auto delta = [&](std::int64_t i, std::int64_t j) { return lbvhDelta(keys.data(), m, i, j); };
+        auto delta = [&](std::int64_t i, std::int64_t j) {
+            return lbvhDelta(keys.data(), m, i, j);
+        };
         std::vector<int> covered(m - 1 + m, 0);  // inner nodes, then leaves
         covered[0] = 1;                          // the root is node 0
         for (std::int64_t i = 0; i + 1 < m; ++i) {
@@ -97,7 +99,8 @@ TEST(Lbvh, InnerNodesAreTheRadixTreeOfTheKeys) {
             ASSERT_LE(r.first, r.split);
             ASSERT_LT(r.split, r.last);
             int prefix = 96;  // common prefix of the whole range
-            for (std::int64_t k = r.first; k < r.last; ++k) prefix = std::min(prefix, delta(k, k + 1));
+            for (std::int64_t k = r.first; k < r.last; ++k)
+                prefix = std::min(prefix, delta(k, k + 1));
             EXPECT_EQ(delta(r.first, r.last), prefix);
             EXPECT_LT(delta(r.first, r.first - 1), prefix);  // maximal on both sides
             EXPECT_LT(delta(r.last, r.last + 1), prefix);
@@ -113,7 +116,7 @@ TEST(Lbvh, MeshTreeHoldsEveryTetrahedronOnceInExactNestedBoxes) {
     const PreparedMesh pm = prepared(jitteredGrid(9), /*lbvh=*/true);
     const Bvh& bvh = pm.bvh;
     const std::size_t n = pm.tets.tets.size();
-    EXPECT_EQ(bvh.nodes.size() % 2, 1u);               // 2 K + 1
+    EXPECT_EQ(bvh.nodes.size() % 2, 1u);                 // 2 K + 1
     EXPECT_GE(bvh.nodes.size(), 2 * ((n + 3) / 4) - 1);  // leaves of at most 4
     EXPECT_LE(bvh.nodes.size(), 2 * n - 1);
     const std::vector<std::uint32_t> reached = checkTree(pm.tets, bvh.nodes, bvh.primIds, 0, 4);
@@ -178,11 +181,11 @@ TEST(Lbvh, SegmentsGetTheirOwnTreesIncludingEmptyAndSingleLeafOnes) {
     ASSERT_EQ(r.roots.size(), 4u);
     std::vector<std::uint32_t> tetOf(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) tetOf[k] = ids[r.order[k]];
-    const std::vector<std::uint32_t> segments[] = {
-        checkTree(mesh, r.nodes, tetOf, r.roots[0], 8), {},
-        checkTree(mesh, r.nodes, tetOf, r.roots[2], 8),
-        checkTree(mesh, r.nodes, tetOf, r.roots[3], 8)};
-    EXPECT_EQ(r.roots[1], r.roots[2]);  // the empty segment has no nodes
+    const std::vector<std::uint32_t> segments[] = {checkTree(mesh, r.nodes, tetOf, r.roots[0], 8),
+                                                   {},
+                                                   checkTree(mesh, r.nodes, tetOf, r.roots[2], 8),
+                                                   checkTree(mesh, r.nodes, tetOf, r.roots[3], 8)};
+    EXPECT_EQ(r.roots[1], r.roots[2]);         // the empty segment has no nodes
     EXPECT_EQ(r.nodes[r.roots[2]].count, 3u);  // three tets: one leaf
     for (int s : {0, 2, 3}) {
         ASSERT_EQ(segments[s].size(), in.segmentBegin[s + 1] - in.segmentBegin[s]) << s;

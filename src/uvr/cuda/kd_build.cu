@@ -12,6 +12,7 @@
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_check.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/cuda/launch.cuh"
 
 namespace uvr {
 
@@ -20,15 +21,6 @@ namespace {
 
 /// Elements per thread of the bounds pass (runs of one node's cells are reduced locally first).
 constexpr std::uint64_t kBoundsChunk = 256;
-constexpr int kBlock = 256;
-
-__device__ std::uint64_t globalThread() {
-    return static_cast<std::uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-}
-
-int blocksFor(std::uint64_t n) {
-    return static_cast<int>((n + kBlock - 1) / kBlock);
-}
 
 /// Tetrahedron boxes, and the first level: every tetrahedron in node 0.
 __global__ void boxesKernel(const Vec3f* points, const Tet* tets, std::uint64_t n, Bounds3f* boxes,
@@ -146,10 +138,9 @@ __global__ void scatterKernel(const std::uint32_t* cells, const std::uint32_t* n
 /// Exclusive sum of count + 1 flags (the last is 0): scan[count] is the total.
 void exclusiveSum(const std::uint32_t* in, std::uint32_t* out, std::uint64_t count,
                   DeviceArray<unsigned char>& temp) {
-    std::size_t bytes = 0;
-    UVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, count + 1));
-    temp.reserve(bytes, "the scan's scratch (GPU k-d build)");
-    UVR_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.data(), bytes, in, out, count + 1));
+    withScratch(temp, "the scan's scratch (GPU k-d build)", [&](void* scratch, std::size_t& bytes) {
+        return cub::DeviceScan::ExclusiveSum(scratch, bytes, in, out, count + 1);
+    });
 }
 
 /// A node of the level being split.
@@ -243,12 +234,11 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
             UVR_CUDA_CHECK(cudaGetLastError());
             cub::DoubleBuffer<std::uint64_t> keyBuffer(keys[0].data(), keys[1].data());
             const int endBit = 32 + std::bit_width(m - 1);
-            std::size_t bytes = 0;
-            UVR_CUDA_CHECK(
-                cub::DeviceRadixSort::SortKeys(nullptr, bytes, keyBuffer, count, 0, endBit));
-            temp.reserve(bytes, "the radix sort's scratch (GPU k-d build)");
-            UVR_CUDA_CHECK(
-                cub::DeviceRadixSort::SortKeys(temp.data(), bytes, keyBuffer, count, 0, endBit));
+            cuda::withScratch(temp, "the radix sort's scratch (GPU k-d build)",
+                              [&](void* scratch, std::size_t& bytes) {
+                                  return cub::DeviceRadixSort::SortKeys(scratch, bytes, keyBuffer,
+                                                                        count, 0, endBit);
+                              });
             planes.reserve(m, "the split planes (GPU k-d build)");
             cuda::medianKernel<<<cuda::blocksFor(m), cuda::kBlock>>>(
                 keyBuffer.Current(), begin.data(), m, planes.data());

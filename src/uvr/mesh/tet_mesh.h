@@ -17,6 +17,13 @@ struct Tet {
     std::uint32_t v[4];
 };
 
+/// Bounding box of tetrahedron t.
+UVR_HOST_DEVICE inline Bounds3f tetBounds(const Vec3f* points, const Tet& t) {
+    Bounds3f b;
+    for (int k = 0; k < 4; ++k) b.extend(points[t.v[k]]);
+    return b;
+}
+
 /// Plain-data view of a TetMesh for CPU and GPU kernels.
 struct TetMeshView {
     const Vec3f* points = nullptr;
