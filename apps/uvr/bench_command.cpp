@@ -1,15 +1,16 @@
 // SPDX-License-Identifier: MIT
 // `uvr bench`: the paper's evaluation (Morrical et al. 2019, Figs. 4-6) for one mesh, camera and
 // transfer function: reference, skipping only, adaptive only, both, and a sweep over s2.
-#include <omp.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "uvr/core/text.h"
+#include "uvr/cpu/threads.h"
 
 namespace uvr::cli {
 
@@ -71,22 +72,41 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                     "Write each configuration's image and sample heat map (all on the reference's "
                     "scale) into this folder");
     cmd->callback([=, &ctx] {
-        for (const std::string* out : {csv.get(), json.get(), plot.get()})
-            if (!out->empty()) checkOutputPath(*out);
+        applyThreads(flags->threads);
+        std::vector<NamedFile> outputs;
+        for (auto [flag, out] : {std::pair{"--csv", csv.get()}, std::pair{"--json", json.get()},
+                                 std::pair{"--plot", plot.get()}}) {
+            if (out->empty()) continue;
+            if (*out == "-")
+                throwError(ErrorKind::Argument, "-",
+                           std::string(flag) + ": bench prints its table on standard output; "
+                                               "name a file");
+            outputs.push_back({flag, *out});
+        }
+        std::vector<NamedFile> inputs = flags->inputs();
+        inputs.push_back({"the input mesh", *file});
+        checkOutputsDistinct(inputs, outputs);
+        for (const NamedFile& out : outputs) resolveOutput(out.path);
+        // Every variant's last frame is kept until the table is printed.
+        checkMemoryEstimate(ctx,
+                            "--size " + flags->size + ": the frames of " +
+                                std::to_string(4 + sweep->size()) + " variants",
+                            frameMemoryBytes(*flags, 4 + sweep->size()));
         if (!images->empty() && !std::filesystem::is_directory(*images))
             throwError(ErrorKind::Io, *images, "not a folder");
         flags->method = "adaptive";  // partitions are needed; variants pick their integrator
         const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
-        const RenderSettings base = flags->settings(mesh.bounds());
+        const RenderSettings base = flags->settings(mesh.bounds(), *file);
+        ctx.setActivity(*file, "preparing the mesh and rendering it");
         const std::optional<Vec3f> background = flags->backgroundColor();
         const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
-        if (flags->threads > 0) omp_set_num_threads(flags->threads);
         const PreparedMesh prepared =
             prepareMesh(mesh, field, flags->prepareOptions(/*withReference=*/true),
                         [&](const std::string& s) { ctx.step(s); });
         FrameRenderer renderer(prepared, flags->useCuda(), ctx);
-        const float s1 = makeFrameSetup(prepared, base).params.step;
+        const FrameSetup setup = makeFrameSetup(prepared, base);
+        const float s1 = static_cast<float>(setup.params.step / setup.frame.scale);  // file units
         const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;
 
         std::vector<Variant> variants;
@@ -140,7 +160,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             }
         }
         // Table.
-        const int threads = omp_get_max_threads();
+        const int threads = cpu::threadCount();
         const double refTime = variants.front().medianSeconds;
         // Samples per second per CPU core, or for the whole GPU.
         const std::string where =
@@ -149,7 +169,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         std::printf(
             "%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
             "p = %g, %s, median of %d frames\n",
-            file->c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
+            printable(*file).c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
             prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
             base.power, where.c_str(), *repeat);
         std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
@@ -185,18 +205,18 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         }
         // Files.
         if (!csv->empty())
-            writeFileAtomically(*csv, [&](const std::string& tmp) {
-                std::ofstream out(tmp);
+            writeOutput(*csv, [&](OutputFile& csvFile) {
+                std::ostringstream out;
                 out << "configuration,s2_over_s1,seconds_per_frame,samples,samples_per_pixel,"
                        "speedup,ssim,psnr\n";
                 for (const Variant& v : variants)
                     out << '"' << v.name << "\"," << v.s2Factor << ',' << v.medianSeconds << ','
                         << v.samples << ',' << v.samples / (double(base.width) * base.height) << ','
                         << refTime / v.medianSeconds << ',' << v.ssim << ',' << v.psnr << '\n';
-                if (!out) throwError(ErrorKind::Io, *csv, "cannot write");
+                csvFile.write(out.str());
             });
         if (!json->empty())
-            writeFileAtomically(*json, [&](const std::string& tmp) {
+            writeOutput(*json, [&](OutputFile& out) {
                 nlohmann::json j;
                 j["file"] = *file;
                 j["field"] = field.name;
@@ -220,7 +240,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                                          {"speedup", refTime / v.medianSeconds},
                                          {"ssim", v.ssim},
                                          {"psnr", v.psnr}});
-                std::ofstream(tmp) << j.dump(2) << "\n";
+                out.write(jsonText(j) + "\n");
             });
         if (!plot->empty()) {
             PlotSpec spec;

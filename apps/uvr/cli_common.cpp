@@ -1,20 +1,31 @@
 // SPDX-License-Identifier: MIT
 #include "cli_common.h"
 
-#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
+
+#include "uvr/core/text.h"
+#include "uvr/cpu/threads.h"
 
 namespace uvr::cli {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// A length or coordinate in the file's units for JSON: a float where it fits (as the file gives
+/// them), else a double (the default camera of a mesh near 1e38 lies beyond float's range).
+nlohmann::json fileNumber(double v) {
+    return std::fabs(v) <= FLT_MAX ? nlohmann::json(static_cast<float>(v)) : nlohmann::json(v);
+}
 
 [[noreturn]] void badFlag(const std::string& flag, const std::string& text,
                           const std::string& what) {
@@ -52,13 +63,55 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
 }  // namespace
 
 void Context::step(const std::string& message) const {
-    if (!quiet) std::fprintf(stderr, "uvr: %s\n", message.c_str());
+    if (!quiet) std::fprintf(stderr, "uvr: %s\n", printable(message).c_str());
 }
 
 void Context::done(const std::string& message, Clock::time_point start) const {
     if (!quiet)
-        std::fprintf(stderr, "uvr: %s (%.2f s)\n", message.c_str(),
+        std::fprintf(stderr, "uvr: %s (%.2f s)\n", printable(message).c_str(),
                      std::chrono::duration<double>(Clock::now() - start).count());
+}
+
+void Context::setActivity(const std::string& file, const std::string& what) const {
+    activityFile_ = file;
+    activity_ = what;
+}
+
+std::string Context::outOfMemoryMessage() const {
+    std::string m = activityFile_.empty() ? "" : activityFile_ + ": ";
+    m += "out of memory";
+    if (!activity_.empty()) m += " while " + activity_;
+    return m;
+}
+
+std::string threadsHelp() {
+    return "CPU threads: 1 to " + std::to_string(cpu::maxThreadCount()) +
+           " (4 per hardware thread, at least 64, at most 1024), or 0 for the default: "
+           "OMP_NUM_THREADS when set, else every hardware thread";
+}
+
+void applyThreads(int threads) {
+    const int cap = cpu::maxThreadCount();
+    if (threads < 0 || threads > cap)
+        throwError(ErrorKind::Argument, "",
+                   "--threads " + std::to_string(threads) + ": expected 1 to " +
+                       std::to_string(cap) +
+                       " (4 per hardware thread, at least 64, at most "
+                       "1024), or 0 for the default");
+    if (threads > 0) cpu::setThreadCount(threads);
+}
+
+void capEnvironmentThreads() {
+    const int cap = cpu::maxThreadCount();
+    if (cpu::threadCount() <= cap) return;
+    const char* env = std::getenv("OMP_NUM_THREADS");
+    std::fprintf(stderr, "uvr: note: OMP_NUM_THREADS=%s is more than %d threads; using %d\n",
+                 env ? printableShort(env, 40).c_str() : "?", cap, cap);
+    cpu::setThreadCount(cap);
+}
+
+std::string jsonText(const nlohmann::json& j) {
+    return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::uint64_t parseBytes(const std::string& flag, const std::string& text) {
@@ -137,7 +190,7 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--opacity", opacity,
                    "Opacity: ramp, ramp:A, constant:A, step:T[:A] (binary) or x0:a0,x1:a1,... "
                    "over the normalised range (default: the JSON's Points, else ramp)")
-        ->capture_default_str();
+        ->default_str(opacity.value_or(""));
     app.add_option("--range", range,
                    "Value range lo,hi the transfer function spans "
                    "(default: the field's range)");
@@ -202,15 +255,14 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "(cuda when rendering on CUDA and the mesh has 4M tetrahedra or more)")
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
         ->capture_default_str();
-    app.add_option("--threads", threads, "CPU threads (default: all cores)")
-        ->check(CLI::Range(0, 4096));
+    app.add_option("--threads", threads, threadsHelp())->capture_default_str();
 }
 
-RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
+RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& source) const {
     RenderSettings s;
     std::tie(s.width, s.height) = parseSize("--size", size);
     s.tf = loadTransferFunction(tf);
-    if (!opacity.empty()) applyOpacitySpec(s.tf, opacity);
+    if (opacity) applyOpacitySpec(s.tf, *opacity);  // an empty spec is refused, not ignored
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
@@ -224,15 +276,38 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds) const {
         throwError(ErrorKind::Argument, "",
                    "--no-skip, --no-adaptive, --max-step, --leaf-cells and --no-seed-grid need "
                    "--method adaptive");
-    Camera cam = resetCamera(bounds, float(s.width) / float(s.height));
+    // The camera file, else the default camera fitted to the bounds (its error names the mesh)
+    // where camera flags leave its position or focal point to it; with no camera flag the
+    // renderer resets the camera itself.
+    Camera cam;
     bool custom = false;
-    if (!cameraFile.empty()) cam = loadPvcc(cameraFile), custom = true;
+    const bool placed = !cameraPosition.empty() && !cameraFocal.empty();
+    const bool adjusted = !cameraPosition.empty() || !cameraFocal.empty() || !cameraUp.empty() ||
+                          viewAngle || azimuth != 0.f || elevation != 0.f;
+    if (!cameraFile.empty()) {
+        cam = loadPvcc(cameraFile), custom = true;
+    } else if (adjusted && !placed) {
+        try {
+            cam = resetCamera(bounds, float(s.width) / float(s.height));
+        } catch (const Error& e) {
+            if (source.empty()) throw;
+            throwError(e.kind(), source, e.what());
+        }
+    }
     if (!cameraPosition.empty())
         cam.position = parseVec3("--camera-position", cameraPosition), custom = true;
     if (!cameraFocal.empty())
         cam.focalPoint = parseVec3("--camera-focal", cameraFocal), custom = true;
     if (!cameraUp.empty()) cam.viewUp = parseVec3("--camera-up", cameraUp), custom = true;
-    if (viewAngle) cam.viewAngle = *viewAngle, custom = true;
+    if (viewAngle) {
+        if (!(*viewAngle >= kMinViewAngle && *viewAngle <= kMaxViewAngle)) {
+            std::ostringstream os;
+            os << "--view-angle " << *viewAngle << ": expected degrees in [" << kMinViewAngle
+               << ", " << kMaxViewAngle << "]";
+            throwError(ErrorKind::Argument, "", os.str());
+        }
+        cam.viewAngle = *viewAngle, custom = true;
+    }
     if (!std::isfinite(azimuth) || !std::isfinite(elevation))
         throwError(ErrorKind::Argument, "", "--azimuth/--elevation must be finite");
     validateCamera(cam);
@@ -250,6 +325,27 @@ std::optional<Vec3f> RenderFlags::backgroundColor() const {
             throwError(ErrorKind::Argument, "",
                        "--background '" + background + "': components must lie in [0,1]");
     return c;
+}
+
+std::vector<NamedFile> RenderFlags::outputs() const {
+    std::vector<NamedFile> out;
+    if (!output.empty()) out.push_back({"-o", output});
+    if (!heatmapFile.empty()) out.push_back({"--heatmap", heatmapFile});
+    if (!statsFile.empty()) out.push_back({"--stats", statsFile});
+    return out;
+}
+
+std::vector<NamedFile> RenderFlags::inputs() const {
+    std::vector<NamedFile> in{{"--tf", tf}};
+    if (!cameraFile.empty()) in.push_back({"--camera", cameraFile});
+    return in;
+}
+
+void RenderFlags::checkFiles(const std::string& meshFile) const {
+    std::vector<NamedFile> in = inputs();
+    if (!meshFile.empty()) in.push_back({"the input mesh", meshFile});
+    checkOutputsDistinct(in, outputs());
+    for (const NamedFile& out : outputs()) resolveOutput(out.path);
 }
 
 bool RenderFlags::useCuda() const {
@@ -300,9 +396,65 @@ RenderResult FrameRenderer::render(const RenderSettings& settings) {
     return gpu_ ? gpu_->render(settings) : renderCpu(mesh_, settings);
 }
 
+void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes) {
+    if (ctx.maxMemoryBytes == 0 || bytes <= ctx.maxMemoryBytes) return;
+    throwError(ErrorKind::Resource, "",
+               what + " would need about " + std::to_string(bytes) +
+                   " bytes, more than the --max-memory limit of " +
+                   std::to_string(ctx.maxMemoryBytes) + " bytes");
+}
+
+std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames) {
+    const auto [width, height] = parseSize("--size", flags.size);
+    const std::uint64_t w = static_cast<std::uint64_t>(std::max(width, 0));
+    const std::uint64_t h = static_cast<std::uint64_t>(std::max(height, 0));
+    std::uint64_t bytes = w * h * kFrameBytesPerPixel;
+    if (!flags.heatmapFile.empty()) bytes += (w + kHeatmapLegendWidth) * h * kHeatmapBytesPerPixel;
+    return frames * bytes;
+}
+
+void checkFrameMemory(const RenderFlags& flags, const Context& ctx) {
+    checkMemoryEstimate(ctx,
+                        "--size " + flags.size + ": the image buffers (" +
+                            std::to_string(kFrameBytesPerPixel) + " bytes per pixel" +
+                            (flags.heatmapFile.empty()
+                                 ? std::string()
+                                 : ", " + std::to_string(kHeatmapBytesPerPixel) +
+                                       " more for the --heatmap") +
+                            ")",
+                        frameMemoryBytes(flags));
+}
+
+std::function<void(double)> progressPrinter(const Context& ctx, const std::string& what) {
+    if (ctx.quiet) return {};
+    struct State {
+        Clock::time_point start = Clock::now();
+        double next = 2.0;  // seconds: the first report, then every 2 s
+    };
+    auto state = std::make_shared<State>();
+    return [&ctx, what, state](double fraction) {
+        const double t = std::chrono::duration<double>(Clock::now() - state->start).count();
+        if (t < state->next || !(fraction > 0.0 && fraction < 1.0)) return;
+        state->next = t + 2.0;
+        const double eta = t * (1.0 - fraction) / fraction;
+        char line[160];
+        if (eta < 120.0)
+            std::snprintf(line, sizeof line, "%s: %d%% (ETA %.0f s)", what.c_str(),
+                          static_cast<int>(fraction * 100.0), eta);
+        else if (eta < 7200.0)
+            std::snprintf(line, sizeof line, "%s: %d%% (ETA %.0f min)", what.c_str(),
+                          static_cast<int>(fraction * 100.0), eta / 60.0);
+        else
+            std::snprintf(line, sizeof line, "%s: %d%% (ETA %.1f h)", what.c_str(),
+                          static_cast<int>(fraction * 100.0), eta / 3600.0);
+        ctx.step(line);
+    };
+}
+
 Mesh loadMesh(const std::string& path, const Context& ctx) {
     auto start = Clock::now();
     ctx.step("reading " + path);
+    ctx.setActivity(path, "reading the mesh");
     ReadOptions options;
     options.maxMemoryBytes = ctx.maxMemoryBytes;
     Mesh mesh = readMesh(path, options);  // every reader checks the structure it returns
@@ -315,31 +467,41 @@ Mesh loadMesh(const std::string& path, const Context& ctx) {
 
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx) {
-    if (flags.threads > 0) omp_set_num_threads(flags.threads);
     const std::optional<Vec3f> background = flags.backgroundColor();
-    checkOutputPath(flags.output);
-    if (!flags.statsFile.empty()) checkOutputPath(flags.statsFile);
-    if (!flags.heatmapFile.empty()) checkOutputPath(flags.heatmapFile);
     const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
     auto start = Clock::now();
     const ValidationReport report = validateMesh(mesh, source);
     for (const std::string& f : report.findings()) ctx.step("validation: " + f);
-    // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
-    const RenderSettings settings = flags.settings(mesh.bounds());
+    if (report.bounds.empty())
+        throwError(ErrorKind::Validation, source,
+                   mesh.cellCount() == 0
+                       ? "the mesh has no volumetric cells: nothing to render"
+                       : "no cell has volume: all " + std::to_string(mesh.cellCount()) +
+                             " cell(s) are flat (thinner than 1e-7 of their size) or use "
+                             "NaN/Inf points; nothing to render");
+    // Every flag is parsed before the expensive preparation, so a bad flag fails fast. The
+    // camera fits the rendered cells (unused and NaN/Inf points and flat cells left out).
+    RenderSettings settings = flags.settings(report.bounds, source);
     validateSettings(settings);
+    settings.progress = progressPrinter(ctx, "rendering");
+    ctx.setActivity(source, "preparing the mesh for rendering");
     PreparedMesh prepared = prepareMesh(mesh, field, flags.prepareOptions(),
                                         [&](const std::string& s) { ctx.step(s); });
     ctx.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
     ctx.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
              std::to_string(settings.height));
+    ctx.setActivity(source, "rendering it at " + std::to_string(settings.width) + "x" +
+                                std::to_string(settings.height));
     FrameRenderer renderer(prepared, flags.useCuda(), ctx);
     RenderResult result = renderer.render(settings);
+    ctx.setActivity(flags.output, "writing the image");
     char line[200];
     std::snprintf(line, sizeof line,
                   "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
                   renderer.deviceName(), result.stats.seconds,
                   static_cast<unsigned long long>(result.stats.samples),
-                  result.stats.meanSamplesPerPixel(), result.setup.params.step);
+                  result.stats.meanSamplesPerPixel(),
+                  result.setup.params.step / result.setup.frame.scale);
     ctx.step(line);
     if (settings.method == RenderMethod::Partitions) {
         std::snprintf(line, sizeof line,
@@ -371,7 +533,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                                               std::max<std::size_t>(1, prepared.tets.tets.size())},
                 {"upload_seconds", renderer.gpu()->uploadSeconds()}};
         }
-        j["threads"] = omp_get_max_threads();
+        j["threads"] = cpu::threadCount();
         j["method"] = flags.method;
         if (prepared.kd) {
             const KdPartitions& kd = *prepared.kd;
@@ -391,7 +553,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                                    {"bytes", prepared.seeds->bytes()},
                                    {"build_seconds", prepared.seeds->buildSeconds}};
             j["tf_update_seconds"] = result.setup.tfUpdateSeconds;
-            j["max_step"] = result.setup.maxStep;
+            j["max_step"] = fileNumber(result.setup.maxStep / result.setup.frame.scale);
             j["power"] = settings.power;
             j["skip"] = settings.skip;
             j["adaptive"] = settings.adaptive;
@@ -414,19 +576,21 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
             result.stats.seconds > 0 ? double(result.stats.samples) / result.stats.seconds : 0.0;
         j["walk_steps"] = result.stats.walkSteps;
         j["bvh_queries"] = result.stats.bvhQueries;
-        j["step"] = result.setup.params.step;
-        j["opacity_unit"] = result.setup.params.opacityUnit;
+        // Lengths and positions in the file's units (the mesh may render scaled and moved).
+        const MeshFrame& frame = result.setup.frame;
+        const auto number = fileNumber;
+        j["step"] = number(result.setup.params.step / frame.scale);
+        j["opacity_unit"] = number(result.setup.params.opacityUnit / frame.scale);
         j["range"] = {result.setup.rangeLo, result.setup.rangeHi};
         const Camera& c = result.setup.camera;
-        j["camera"] = {{"position", {c.position.x, c.position.y, c.position.z}},
-                       {"focal_point", {c.focalPoint.x, c.focalPoint.y, c.focalPoint.z}},
+        double position[3], focal[3];
+        frame.toFile(c.position, position);
+        frame.toFile(c.focalPoint, focal);
+        j["camera"] = {{"position", {number(position[0]), number(position[1]), number(position[2])}},
+                       {"focal_point", {number(focal[0]), number(focal[1]), number(focal[2])}},
                        {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
                        {"view_angle", c.viewAngle}};
-        writeFileAtomically(flags.statsFile, [&](const std::string& tmp) {
-            std::ofstream out(tmp);
-            out << j.dump(2) << "\n";
-            if (!out) throwError(ErrorKind::Io, flags.statsFile, "cannot write");
-        });
+        writeTextOutput(flags.statsFile, jsonText(j) + "\n");
         ctx.step("wrote " + flags.statsFile);
     }
     return result;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <chrono>
 #include <optional>
@@ -16,12 +17,36 @@ namespace uvr::cli {
 class Context {
 public:
     bool quiet = false;
-    std::uint64_t maxMemoryBytes = 0;  ///< per array a reader allocates; 0 = no limit
-    /// Prints a step message.
+    std::uint64_t maxMemoryBytes = 0;  ///< a whole load, image buffers, meshes; 0 = no limit
+    /// Prints a step message (control characters and invalid UTF-8 escaped: one line).
     void step(const std::string& message) const;
     /// Prints a message with the seconds since `start`.
     void done(const std::string& message, std::chrono::steady_clock::time_point start) const;
+    /// Records what uvr is doing now and with which file ("" for none), for the message when
+    /// memory runs out: "FILE: out of memory while WHAT".
+    void setActivity(const std::string& file, const std::string& what) const;
+    /// The one-line message for running out of memory during the current activity.
+    std::string outOfMemoryMessage() const;
+
+private:
+    mutable std::string activityFile_, activity_;
 };
+
+/// Applies a --threads value: 0 keeps the default (OMP_NUM_THREADS when set, else every hardware
+/// thread), 1 .. cpu::maxThreadCount() sets the count; anything else throws Error(Argument) naming
+/// the flag and the limit. Every command with --threads uses this one rule.
+void applyThreads(int threads);
+
+/// Caps an OMP_NUM_THREADS above cpu::maxThreadCount() with a note on stderr (called once at
+/// start-up).
+void capEnvironmentThreads();
+
+/// Help text of every --threads flag.
+std::string threadsHelp();
+
+/// The JSON text uvr writes (indented by 2): names from files are arbitrary bytes, so invalid
+/// UTF-8 in strings becomes U+FFFD instead of failing (control characters are escaped by JSON).
+std::string jsonText(const nlohmann::json& j);
 
 /// Parses a byte count with an optional K, M, G or T suffix (powers of 1024) for a flag.
 std::uint64_t parseBytes(const std::string& flag, const std::string& text);
@@ -41,7 +66,7 @@ struct RenderFlags {
     std::string output;
     std::string field;
     std::string tf = "cool-to-warm";
-    std::string opacity;
+    std::optional<std::string> opacity;  ///< unset: the JSON's Points, else ramp
     std::string range;
     std::string size = "1024x1024";
     std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
@@ -66,10 +91,18 @@ struct RenderFlags {
     /// Adds the flags to a subcommand; oneFrame adds those of a single render (output, method,
     /// heat map, stats), which `bench` chooses itself.
     void registerOn(CLI::App& app, bool oneFrame = true);
-    /// Parses the flags into render settings; the default camera fits the bounds.
-    RenderSettings settings(const Bounds3f& bounds) const;
+    /// Parses the flags into render settings; the default camera fits the bounds (of the mesh
+    /// named source, which an error resetting the camera names).
+    RenderSettings settings(const Bounds3f& bounds, const std::string& source = "") const;
     /// The --background colour, if given (checked to lie in [0, 1]).
     std::optional<Vec3f> backgroundColor() const;
+    /// The files a single render writes (-o, --heatmap, --stats), for checks before any work.
+    std::vector<NamedFile> outputs() const;
+    /// The files the flags read (--tf when it names a file, --camera).
+    std::vector<NamedFile> inputs() const;
+    /// Checks before any work that every output can be written and that none names an input
+    /// (the mesh file, when not empty, or a file the flags read) or another output.
+    void checkFiles(const std::string& meshFile) const;
     /// True when --device asks for CUDA, or is auto and a CUDA device is present.
     bool useCuda() const;
     /// True when --build-device asks for CUDA, or is auto and the render is on CUDA.
@@ -105,6 +138,21 @@ Mesh loadMesh(const std::string& path, const Context& ctx);
 /// Prepares, renders and writes the PNG (and stats JSON); returns the result.
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx);
+
+/// Refuses with Error(Resource) an estimate above --max-memory: "WHAT would need about N bytes,
+/// more than the --max-memory limit of M bytes" (what names the flags responsible).
+void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes);
+
+/// Host bytes of `frames` frames at the flags' --size written as PNGs (with a heat map each when
+/// --heatmap is given), for checks before any work.
+std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames = 1);
+
+/// Checks before any work that the frame buffers of the flags' --size fit --max-memory.
+void checkFrameMemory(const RenderFlags& flags, const Context& ctx);
+
+/// A RenderSettings::progress that prints "uvr: rendering: 35% (ETA 12 s)" on stderr about every
+/// 2 s once a frame has taken 2 s; empty with --quiet.
+std::function<void(double)> progressPrinter(const Context& ctx, const std::string& what);
 
 /// Registers the subcommands.
 void addInfoCommand(CLI::App& app, Context& ctx);

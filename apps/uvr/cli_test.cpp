@@ -27,11 +27,13 @@ struct CliRun {
     std::string out, err;
 };
 
-/// Runs `uvr ARGS` in dir, capturing stdout and stderr.
-CliRun uvr(const std::string& args, const std::string& dir) {
+/// Runs `uvr ARGS` in dir, capturing stdout and stderr; env is put before the command (e.g.
+/// "OMP_NUM_THREADS=8 ").
+CliRun uvr(const std::string& args, const std::string& dir, const std::string& env = "") {
     const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
     CliRun r;
-    r.code = testing::runCommand(testing::uvrBinary() + " " + args + " >" + out + " 2>" + err);
+    r.code =
+        testing::runCommand(env + testing::uvrBinary() + " " + args + " >" + out + " 2>" + err);
     auto slurp = [](const std::string& p) {
         std::ifstream in(p);
         std::stringstream ss;
@@ -336,6 +338,190 @@ TEST(Cli, InterruptedRenderLeavesThePreviousOutputUntouched) {
         files.push_back(e.path().filename().string());
     std::sort(files.begin(), files.end());
     EXPECT_EQ(files, (std::vector<std::string>{"log.txt", "out.png"}));
+}
+
+/// Expects a refusal: exit code 2 and exactly one stderr line "uvr: error: ..." holding every
+/// piece.
+void expectOneLineError(const CliRun& r, const std::vector<std::string>& pieces,
+                        const std::string& what) {
+    EXPECT_EQ(r.code, 2) << what << "\n" << r.err;
+    EXPECT_EQ(lineCount(r.err), 1) << what << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << what << "\n" << r.err;
+    for (const std::string& p : pieces)
+        EXPECT_NE(r.err.find(p), std::string::npos) << what << ": no '" << p << "' in " << r.err;
+}
+
+/// A legacy VTK cube of five tetrahedra with point field `name` holding `values` (8 numbers).
+std::string fiveTetCube(const std::string& name, const std::string& values) {
+    return "# vtk DataFile Version 3.0\nfive tetrahedra\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+           "POINTS 8 float\n0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1\n"
+           "CELLS 5 25\n4 0 1 3 4\n4 1 2 3 6\n4 1 4 5 6\n4 3 4 6 7\n4 1 3 4 6\n"
+           "CELL_TYPES 5\n10 10 10 10 10\nPOINT_DATA 8\nSCALARS " +
+           name + " float 1\nLOOKUP_TABLE default\n" + values + "\n";
+}
+
+TEST(Cli, FieldSpanningTheWholeFloatRangeRendersWithBothMethods) {
+    // The range's width overflows float: it used to crash both integrators (SIGSEGV).
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = testing::writeFile(
+        dir + "/huge.vtk", fiveTetCube("f", "-3e38 3e38 -3e38 3e38 3e38 -3e38 3e38 -3e38"));
+    for (const char* method : {"reference", "adaptive"}) {
+        const std::string png = dir + "/" + method + ".png", stats = dir + "/" + method + ".json";
+        const CliRun r =
+            uvr("-q render " + mesh + " --method " + method +
+                    " --size 32x32 --opacity constant:0.5 -o " + png + " --stats " + stats,
+                dir);
+        ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+        std::ifstream in(stats);
+        const auto j = nlohmann::json::parse(in);
+        EXPECT_FLOAT_EQ(j["range"][0].get<float>(), -3e38f);
+        EXPECT_FLOAT_EQ(j["range"][1].get<float>(), 3e38f);
+        const Image img = readPng(png);
+        int covered = 0;
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x) covered += img.at(x, y).w > 0.1f;
+        EXPECT_GT(covered, 100) << method;
+    }
+}
+
+TEST(Cli, NamesWithInvalidUtf8OrControlCharactersStayValidJsonAndOneLine) {
+    const std::string dir = testing::scratchDir();
+    // A field name with bytes that are not UTF-8 and an escape sequence (legal in VTK files).
+    const std::string bad =
+        testing::writeFile(dir + "/bad.vtk", fiveTetCube("f\xff\xfe\x1b[31m", "0 1 2 3 4 5 6 7"));
+    const CliRun info = uvr("-q info --json " + bad, dir);
+    ASSERT_EQ(info.code, 0) << info.err;
+    const auto j = nlohmann::json::parse(info.out);  // throws on invalid JSON
+    ASSERT_EQ(j["fields"].size(), 1u);
+    EXPECT_EQ(j["fields"][0]["name"].get<std::string>().substr(0, 1), "f");
+    const CliRun text = uvr("-q info " + bad, dir);
+    ASSERT_EQ(text.code, 0) << text.err;
+    EXPECT_NE(text.out.find("f\\xff\\xfe\\x1b[31m"), std::string::npos) << text.out;
+    EXPECT_EQ(text.out.find('\x1b'), std::string::npos);
+    const CliRun render = uvr(
+        "-q render " + bad + " --size 16x16 -o " + dir + "/b.png --stats " + dir + "/b.json", dir);
+    ASSERT_EQ(render.code, 0) << render.err;
+    std::ifstream in(dir + "/b.json");
+    EXPECT_EQ(nlohmann::json::parse(in)["field"].get<std::string>().substr(0, 1), "f");
+    // Errors quoting the name stay one line, escaped.
+    expectOneLineError(uvr("-q render " + bad + " -o " + dir + "/c.png --field nosuch", dir),
+                       {"f\\xff\\xfe\\x1b[31m"}, "unknown field");
+    // A file name with a newline: progress lines and the error stay one line each.
+    const std::string newline = testing::writeFile(dir + "/new\nline.vtk", "not a mesh\n");
+    const CliRun r = uvr("render '" + newline + "' -o " + dir + "/d.png", dir);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.find("\nline.vtk"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("uvr: error: " + dir + "/new\\nline.vtk: "), std::string::npos) << r.err;
+}
+
+TEST(Cli, SameNamedFieldsAreListedByInfoAndNamedRightByRender) {
+    const std::string dir = testing::scratchDir();
+    const std::string two = testing::writeFile(
+        dir + "/two.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7") +
+                              "SCALARS f float 1\nLOOKUP_TABLE default\n7 6 5 4 3 2 1 9\n");
+    const CliRun info = uvr("-q info --json " + two, dir);
+    ASSERT_EQ(info.code, 0) << info.err;
+    const auto j = nlohmann::json::parse(info.out);
+    ASSERT_EQ(j["fields"].size(), 2u);
+    EXPECT_EQ(j["fields"][1]["range"][1].get<double>(), 9.0);
+    ASSERT_EQ(j["validation"].size(), 1u);
+    EXPECT_NE(j["validation"][0].get<std::string>().find("2 point fields are named 'f'"),
+              std::string::npos);
+    const CliRun render = uvr("-q render " + two + " -o " + dir + "/t.png --field f", dir);
+    expectOneLineError(render, {"--field 'f'", "2 point fields", "cannot tell them apart"},
+                       "duplicate field");
+    EXPECT_EQ(render.err.find("point and cell"), std::string::npos) << render.err;
+}
+
+TEST(Cli, ThreadCountsFollowOneRuleInEveryCommand) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh =
+        testing::writeFile(dir + "/m.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7"));
+    const std::string render = "-q render " + mesh + " --size 8x8 -o " + dir + "/o.png";
+    for (const std::string& cmd : {render, "-q demo --cells 1000 --size 8x8 -o " + dir + "/d.png",
+                                   "-q bench " + mesh + " --size 16x16 --repeat 1 --sweep 2",
+                                   "-q refine " + mesh + " " + dir + "/r.uvrm"}) {
+        for (const char* bad : {"4096", "-1"})
+            expectOneLineError(uvr(cmd + " --threads " + bad, dir),
+                               {std::string("--threads ") + bad + ": expected 1 to "}, cmd);
+        // 0 is the default (OMP_NUM_THREADS, else all cores) for every command.
+        const CliRun zero = uvr(cmd + " --threads 0", dir);
+        EXPECT_EQ(zero.code, 0) << cmd << ": " << zero.err;
+    }
+    // An environment asking for thousands of threads is capped with a note.
+    const CliRun env = uvr(render + " --stats " + dir + "/s.json", dir, "OMP_NUM_THREADS=5000 ");
+    ASSERT_EQ(env.code, 0) << env.err;
+    EXPECT_NE(env.err.find("uvr: note: OMP_NUM_THREADS=5000 is more than"), std::string::npos)
+        << env.err;
+    std::ifstream in(dir + "/s.json");
+    EXPECT_LE(nlohmann::json::parse(in)["threads"].get<int>(), 1024);
+}
+
+TEST(Cli, MeaninglessValuesAndUnreadableTextAreRefusedInOneLine) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh =
+        testing::writeFile(dir + "/m.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7"));
+    const std::string render = "-q render " + mesh + " --size 8x8 -o " + dir + "/o.png ";
+    expectOneLineError(uvr(render + "--opacity ''", dir), {"--opacity \"\": empty spec"},
+                       "empty opacity");
+    for (const char* angle : {"1e-30", "0.001", "179.5", "nan", "inf", "-5"})
+        expectOneLineError(uvr(render + "--view-angle " + angle, dir),
+                           {"--view-angle ", "expected degrees in [0.01, 179]"}, angle);
+    EXPECT_EQ(uvr(render + "--view-angle 0.5", dir).code, 0);
+    // A colour map in UTF-16 and one nested 100,000 deep (a stack overflow before).
+    std::string utf16 = "\xFF\xFE";
+    for (char c : std::string("[{\"RGBPoints\": [0, 1, 1, 1]}]")) utf16 += std::string{c, '\0'};
+    const std::string wide = testing::writeFile(dir + "/wide.json", utf16);
+    expectOneLineError(uvr(render + "--tf " + wide, dir),
+                       {wide + ": byte 0: UTF-16 text is not supported"}, "UTF-16 JSON");
+    const std::string deep =
+        testing::writeFile(dir + "/deep.json", std::string(100000, '[') + std::string(100000, ']'));
+    expectOneLineError(uvr(render + "--tf " + deep, dir),
+                       {deep + ": byte 64: JSON nested deeper than 64 levels"}, "deep JSON");
+    // A camera file in UTF-32 (UTF-16 is XML's other required encoding, and is read).
+    std::string utf32 = "\xFF\xFE";
+    utf32 += std::string("\0\0", 2);
+    for (char c : std::string("<?xml version=\"1.0\"?><PVCameraConfiguration/>"))
+        utf32 += std::string{c, '\0', '\0', '\0'};
+    const std::string cam = testing::writeFile(dir + "/cam.pvcc", utf32);
+    expectOneLineError(uvr(render + "--camera " + cam, dir),
+                       {cam + ": byte 0: UTF-32 text is not supported"}, "UTF-32 camera");
+    // A camera file whose number_of_elements disagrees with its elements.
+    const std::string declared = testing::writeFile(
+        dir + "/declared.pvcc",
+        "<?xml version=\"1.0\"?>\n<PVCameraConfiguration>\n"
+        "  <Property name=\"CameraPosition\" number_of_elements=\"4\">\n"
+        "    <Element index=\"0\" value=\"3\"/><Element index=\"1\" value=\"2\"/>"
+        "<Element index=\"2\" value=\"4\"/>\n  </Property>\n</PVCameraConfiguration>\n");
+    expectOneLineError(uvr(render + "--camera " + declared, dir),
+                       {declared + ": line 3: property CameraPosition: expected "
+                                   "number_of_elements=\"3\", got \"4\""},
+                       "declared count");
+}
+
+TEST(Cli, CameraAndMemoryErrorsNameTheFile) {
+    const std::string dir = testing::scratchDir();
+    // No points: nothing to fit the default camera to (or to render).
+    const std::string empty = testing::writeFile(
+        dir + "/empty.vtk",
+        "# vtk DataFile Version 3.0\nempty\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 0 float\n"
+        "CELLS 0 0\nCELL_TYPES 0\nCELL_DATA 0\nSCALARS c float 1\nLOOKUP_TABLE default\n");
+    expectOneLineError(uvr("-q render " + empty + " -o " + dir + "/e.png", dir),
+                       {"uvr: error: " + empty + ": "}, "empty mesh");
+#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+    // Out of memory (an address-space limit the image buffers exceed): the file and the step.
+    const std::string mesh =
+        testing::writeFile(dir + "/m.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7"));
+    const CliRun r = uvr(
+        "-q render " + mesh + " --device cpu --threads 2 --size 12000x12000 -o " + dir + "/o.png",
+        dir, "ulimit -v 1000000; ");
+    expectOneLineError(r, {"uvr: error: " + mesh + ": "}, "out of memory");
+    if (r.err.find("out of memory") != std::string::npos) {
+        EXPECT_NE(r.err.find(mesh + ": out of memory while rendering it at 12000x12000"),
+                  std::string::npos)
+            << r.err;
+    }
+#endif
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 
 namespace uvr::cli {
@@ -40,20 +41,30 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
         if (!b.empty()) j["bounds"] = {{b.lo.x, b.hi.x}, {b.lo.y, b.hi.y}, {b.lo.z, b.hi.z}};
         j["fields"] = nlohmann::json::array();
         for (const Field& f : mesh.fields) {
-            const ScalarField s = selectScalarField(mesh, FieldSpec{f.name, f.association, -1});
+            const ScalarField s = scalarFieldOf(mesh, f);  // not by name: linear in the fields
             const auto [lo, hi] = finiteRange(s.values);
             j["fields"].push_back({{"name", f.name},
                                    {"association", associationName(f.association)},
                                    {"components", f.components},
                                    {"range", {lo, hi}}});
         }
-        j["validation"] = report.findings();
+        // Fields sharing a name and association are all listed; --field cannot tell them apart.
+        std::vector<std::string> findings = report.findings();
+        std::map<std::pair<std::string, Association>, int> sameName;
+        for (const Field& f : mesh.fields) ++sameName[{f.name, f.association}];
+        for (const auto& [key, count] : sameName)
+            if (count > 1)
+                findings.push_back(std::to_string(count) + " " + associationName(key.second) +
+                                   " fields are named '" + key.first +
+                                   "': --field selects none of them");
+        j["validation"] = findings;
         j["notes"] = mesh.notes;
         if (*json) {
-            std::printf("%s\n", j.dump(2).c_str());
+            std::printf("%s\n", jsonText(j).c_str());
             return;
         }
-        std::printf("file:    %s\n", file->c_str());
+        // Names from the file are printed escaped (no control characters, valid UTF-8).
+        std::printf("file:    %s\n", printable(*file).c_str());
         std::printf("points:  %llu\n", static_cast<unsigned long long>(mesh.pointCount()));
         std::printf("cells:   %llu", static_cast<unsigned long long>(mesh.cellCount()));
         const char* sep = " (";
@@ -71,15 +82,15 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
         for (const auto& f : j["fields"]) {
             const int nc = f["components"];
             std::printf("  %-24s %-5s %d component%s  %srange [%s, %s]\n",
-                        f["name"].get<std::string>().c_str(),
+                        printable(f["name"].get<std::string>()).c_str(),
                         f["association"].get<std::string>().c_str(), nc, nc == 1 ? " " : "s",
                         nc == 1 ? "" : "magnitude ", fmt(f["range"][0].get<double>()).c_str(),
                         fmt(f["range"][1].get<double>()).c_str());
         }
         std::printf("validation:\n");
-        if (report.findings().empty()) std::printf("  no problems found\n");
-        for (const std::string& s : report.findings()) std::printf("  %s\n", s.c_str());
-        for (const std::string& s : mesh.notes) std::printf("note: %s\n", s.c_str());
+        if (findings.empty()) std::printf("  no problems found\n");
+        for (const std::string& s : findings) std::printf("  %s\n", printable(s).c_str());
+        for (const std::string& s : mesh.notes) std::printf("note: %s\n", printable(s).c_str());
     });
 }
 
@@ -90,6 +101,9 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
     flags->registerOn(*cmd);
     cmd->callback([file, flags, &ctx] {
+        applyThreads(flags->threads);
+        flags->checkFiles(*file);
+        checkFrameMemory(*flags, ctx);
         const Mesh mesh = loadMesh(*file, ctx);
         renderAndWrite(mesh, *file, *flags, ctx);
     });
@@ -114,11 +128,25 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(2000000000)));
     cmd->callback([flags, cells, &ctx] {
+        applyThreads(flags->threads);
+        flags->checkFiles("");
         ProceduralSpec spec;
         spec.shape = ProceduralShape::Box;
         spec.targetCells = *cells;
+        // The mesh, what rendering prepares from it and the frame, before generating anything.
+        const std::uint64_t tets = proceduralTetCount(spec);
+        checkMemoryEstimate(ctx,
+                            "--cells " + std::to_string(*cells) + " --size " + flags->size +
+                                ": generating, preparing and rendering " + std::to_string(tets) +
+                                " tetrahedra (" + std::to_string(proceduralMeshBytes(spec)) +
+                                " bytes for the mesh, " + std::to_string(kPrepareBytesPerTet) +
+                                " per tetrahedron to prepare it, " +
+                                std::to_string(frameMemoryBytes(*flags)) + " for the image)",
+                            proceduralMeshBytes(spec) + tets * kPrepareBytesPerTet +
+                                frameMemoryBytes(*flags));
         auto start = Clock::now();
         ctx.step("generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)");
+        ctx.setActivity("", "generating the demo mesh");
         const Mesh mesh = generateMesh(spec);
         ctx.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra", start);
         renderAndWrite(mesh, "demo", *flags, ctx);
@@ -133,9 +161,11 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("IN", *in, "Input mesh")->required();
     cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
     cmd->callback([in, out, &ctx] {
-        checkOutputPath(*out);
+        checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
+        resolveOutput(*out);
         const Mesh mesh = loadMesh(*in, ctx);
         auto start = Clock::now();
+        ctx.setActivity(*out, "writing the mesh");
         writeMesh(mesh, *out);
         ctx.done("wrote " + *out, start);
     });
@@ -162,16 +192,21 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                     "Fields to write, first is the default: jet, marschner_lobb, linear, constant")
         ->delimiter(',');
     cmd->callback([shape, out, spec, fields, &ctx] {
-        checkOutputPath(*out);
+        resolveOutput(*out);
         spec->shape = parseProceduralShape(*shape);
         if (!fields->empty()) {
             spec->fields.clear();
             for (const std::string& f : *fields) spec->fields.push_back(parseProceduralField(f));
         }
+        checkMemoryEstimate(ctx,
+                            "--cells " + std::to_string(spec->targetCells) + ": the mesh of " +
+                                std::to_string(proceduralTetCount(*spec)) + " tetrahedra",
+                            proceduralMeshBytes(*spec));
         auto start = Clock::now();
         ctx.step("generating " + std::string(proceduralShapeName(spec->shape)) + " with about " +
                  std::to_string(spec->targetCells) + " tetrahedra");
         int lastPercent = -10;
+        ctx.setActivity(*out, "generating the mesh");
         const Mesh mesh = generateMesh(*spec, [&](double f) {
             const int percent = static_cast<int>(f * 100);
             if (percent >= lastPercent + 10) {
@@ -183,6 +218,7 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                      std::to_string(mesh.cellCount()) + " tetrahedra",
                  start);
         start = Clock::now();
+        ctx.setActivity(*out, "writing the mesh");
         writeMesh(mesh, *out);
         ctx.done("wrote " + *out, start);
     });
@@ -203,17 +239,17 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("--levels", *levels, "Refinement levels (x8 tetrahedra each)")
         ->capture_default_str()
         ->check(CLI::Range(0, kMaxRefineLevels));
-    cmd->add_option("--threads", *threads, "CPU threads (default: all cores)")
-        ->check(CLI::Range(1, 4096));
+    cmd->add_option("--threads", *threads, threadsHelp())->capture_default_str();
     cmd->callback([in, out, levels, threads, &ctx] {
-        checkOutputPath(*out);
+        applyThreads(*threads);
+        checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
+        resolveOutput(*out);
         // Refuse an unwritable format before the (possibly long) refinement.
         const std::string ext = fileExtension(*out);
         if (ext != ".uvrm" && ext != ".vtu")
             throwError(ErrorKind::Argument, *out,
                        "cannot write this format: the output name must end in .uvrm (native) or "
                        ".vtu");
-        if (*threads > 0) cpu::setThreadCount(*threads);
         const Mesh mesh = loadMesh(*in, ctx);
         // The output's largest array (4 point indices per tetrahedron) must fit --max-memory;
         // the estimate splits hexahedra into 6 tetrahedra, wedges and pyramids into 3.
@@ -228,11 +264,13 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
                            std::to_string(outTets) + " tetrahedra, whose " +
                            std::to_string(16 * outTets) + "-byte index array exceeds --max-memory");
         auto start = Clock::now();
+        ctx.setActivity(*in, "refining the mesh");
         const Mesh refined = refineMesh(mesh, *levels, [&](const std::string& s) { ctx.step(s); });
         ctx.done("refined to " + std::to_string(refined.pointCount()) + " points, " +
                      std::to_string(refined.cellCount()) + " tetrahedra",
                  start);
         start = Clock::now();
+        ctx.setActivity(*out, "writing the mesh");
         writeMesh(refined, *out);
         ctx.done("wrote " + *out, start);
     });

@@ -85,7 +85,7 @@ void addCompareCommand(CLI::App& app, Context& ctx) {
                 j["min_ssim"] = **minSsim;
                 j["pass"] = pass;
             }
-            std::printf("%s\n", j.dump(2).c_str());
+            std::printf("%s\n", jsonText(j).c_str());
         } else {
             char psnr[32];
             if (std::isinf(r.psnr))

@@ -4,9 +4,12 @@
 #include <new>
 
 #include "cli_common.h"
+#include "uvr/core/text.h"
 
 int main(int argc, char** argv) {
     using namespace uvr;
+    // Ctrl-C or a kill leaves no temporary output behind; a closed pipe is a write error.
+    installOutputSignalHandlers();
     CLI::App app{
         "uvr: GPU-ready renderer for unstructured volume meshes (VTK .vtk/.vtu/.pvtu, "
         "native .uvrm)",
@@ -18,9 +21,12 @@ int main(int argc, char** argv) {
     app.add_flag("-q,--quiet", ctx.quiet, "No progress messages on stderr");
     std::string maxMemory;
     app.add_option("--max-memory", maxMemory,
-                   "Largest array a file load may allocate, e.g. 16G (default: 80% of physical "
-                   "memory); larger declared sizes are refused before allocating");
+                   "Memory limit, e.g. 16G (default: 80% of physical memory): the most a file "
+                   "load holds in all (its arrays, pieces and file buffers), and the estimated "
+                   "image buffers of --size and meshes of --cells; larger needs are refused "
+                   "before allocating");
     app.parse_complete_callback([&] {
+        cli::capEnvironmentThreads();
         ctx.maxMemoryBytes = maxMemory.empty() ? cli::defaultMaxMemory()
                                                : cli::parseBytes("--max-memory", maxMemory);
     });
@@ -43,16 +49,17 @@ int main(int argc, char** argv) {
     } catch (const CLI::RuntimeError& e) {
         return e.get_exit_code();  // a completed command's own exit status (compare --min-ssim)
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "uvr: error: %s (see uvr --help)\n", e.what());
+        std::fprintf(stderr, "uvr: error: %s (see uvr --help)\n", printable(e.what()).c_str());
         return 2;
     } catch (const Error& e) {
-        std::fprintf(stderr, "uvr: error: %s\n", e.what());
+        // Messages quote names from files: escaped, they stay one line.
+        std::fprintf(stderr, "uvr: error: %s\n", printable(e.what()).c_str());
         return e.kind() == ErrorKind::Internal ? 70 : 2;
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "uvr: error: out of memory\n");
+        std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.outOfMemoryMessage()).c_str());
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "uvr: internal error: %s\n", e.what());
+        std::fprintf(stderr, "uvr: internal error: %s\n", printable(e.what()).c_str());
         return 70;
     }
     return 0;

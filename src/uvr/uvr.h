@@ -4,6 +4,7 @@
 /// The uvr library facade: everything an application needs to read, render and write.
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/output_file.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"

@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/core/file_util.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -49,36 +47,6 @@ std::uint64_t fileSize(const std::string& path) {
     auto size = std::filesystem::file_size(path, ec);
     if (ec) throwError(ErrorKind::Io, path, "cannot open: " + ec.message());
     return size;
-}
-
-void writeFileAtomically(const std::string& path,
-                         const std::function<void(const std::string&)>& write) {
-    std::string tmp = path + ".tmp" + std::to_string(::getpid());
-    try {
-        write(tmp);
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::remove(tmp.c_str());
-        throwError(ErrorKind::Io, path, "cannot write: " + ec.message());
-    }
-}
-
-void checkOutputPath(const std::string& path) {
-    if (path.empty()) throwError(ErrorKind::Argument, "", "empty output file name");
-    std::string folder = parentFolder(path);
-    if (folder.empty()) folder = ".";
-    std::error_code ec;
-    if (!std::filesystem::is_directory(folder, ec))
-        throwError(ErrorKind::Io, path, "cannot write: folder '" + folder + "' does not exist");
-    if (::access(folder.c_str(), W_OK) != 0)
-        throwError(ErrorKind::Io, path, "cannot write: folder '" + folder + "' is not writable");
-    if (std::filesystem::is_directory(path, ec))
-        throwError(ErrorKind::Io, path, "cannot write: is a folder");
 }
 
 std::string fileExtension(const std::string& path) {

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,16 +19,6 @@ void checkRegularFile(const std::string& path);
 
 /// Size of a file in bytes; throws Error(Io) when it cannot be opened.
 std::uint64_t fileSize(const std::string& path);
-
-/// Writes a file atomically: write(tmpPath) fills a temporary file beside path, which is renamed
-/// over path only when write returns normally; on any exception the temporary is removed, so
-/// path is never left half-written.
-void writeFileAtomically(const std::string& path,
-                         const std::function<void(const std::string&)>& write);
-
-/// Throws Error(Io) unless path's folder exists and is writable (checked before long work, so
-/// a bad output path fails fast).
-void checkOutputPath(const std::string& path);
 
 /// Lower-cased extension of a path including the dot (".vtu"), or "" if none.
 std::string fileExtension(const std::string& path);

@@ -14,37 +14,6 @@
 namespace uvr {
 namespace {
 
-TEST(FileUtil, AtomicWriteLeavesNothingWhenTheWriterFails) {
-    const std::string dir = testing::scratchDir();
-    const std::string path = dir + "/out.txt";
-    EXPECT_THROW(writeFileAtomically(path,
-                                     [](const std::string& tmp) {
-                                         std::ofstream(tmp) << "half";
-                                         throw Error(ErrorKind::Io, "disk full");
-                                     }),
-                 Error);
-    EXPECT_TRUE(std::filesystem::is_empty(dir));
-    writeFileAtomically(path, [](const std::string& tmp) { std::ofstream(tmp) << "whole"; });
-    std::ifstream in(path);
-    std::string s;
-    in >> s;
-    EXPECT_EQ(s, "whole");
-    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);
-}
-
-TEST(FileUtil, OutputPathChecksNameTheFolder) {
-    const std::string dir = testing::scratchDir();
-    EXPECT_NO_THROW(checkOutputPath(dir + "/a.png"));
-    try {
-        checkOutputPath(dir + "/missing/a.png");
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.kind(), ErrorKind::Io);
-        EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos);
-    }
-    EXPECT_THROW(checkOutputPath(dir), Error);
-}
-
 TEST(FileUtil, ReadRefusesFilesAboveTheLimitBeforeReading) {
     const std::string path =
         testing::writeFile(testing::scratchDir() + "/big.json", std::string(100, 'x'));

@@ -15,8 +15,13 @@ namespace cpu {
 int threadCount() {
     return omp_get_max_threads();
 }
+int maxThreadCount() {
+    const int procs = omp_get_num_procs();
+    return procs >= 256 ? 1024 : (procs >= 16 ? 4 * procs : 64);
+}
 void setThreadCount(int n) {
-    omp_set_num_threads(n >= 1 ? n : omp_get_num_procs());
+    const int cap = maxThreadCount();
+    omp_set_num_threads(n >= 1 ? (n < cap ? n : cap) : omp_get_num_procs());
 }
 int currentThread() {
     return omp_get_thread_num();
@@ -26,13 +31,15 @@ int currentThread() {
 namespace {
 
 /// Runs the pixel kernel over the frame in 8x8 tiles (neighbouring rays, and their
-/// tetrahedra, stay on one core) and sums the counters.
+/// tetrahedra, stay on one core), sums the counters and reports the tiles done.
 template <class March>
-void launchFrame(const FrameView& frame, RenderStats& stats, const March& march) {
+void launchFrame(const FrameView& frame, RenderStats& stats, const March& march,
+                 const std::function<void(double)>& report) {
     std::vector<RenderStats> perThread(cpu::threadCount());
     constexpr int kTile = 8;
     const int tilesX = (frame.width + kTile - 1) / kTile;
     const int tilesY = (frame.height + kTile - 1) / kTile;
+    FrameProgress progress(report, std::int64_t(tilesX) * tilesY);
     cpu::parallelFor(std::int64_t(tilesX) * tilesY, 1, [&](std::int64_t tile, int thread) {
         const int x0 = static_cast<int>(tile % tilesX) * kTile;
         const int y0 = static_cast<int>(tile / tilesX) * kTile;
@@ -40,7 +47,9 @@ void launchFrame(const FrameView& frame, RenderStats& stats, const March& march)
         for (int y = y0; y < y0 + kTile && y < frame.height; ++y)
             for (int x = x0; x < x0 + kTile && x < frame.width; ++x)
                 s.add(shadePixel(frame, x, y, march));
+        progress.partDone();
     });
+    progress.finish();
     for (const RenderStats& s : perThread) stats.merge(s);
 }
 
@@ -55,10 +64,12 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
                           settings.height, result.setup.rays};
     const auto start = std::chrono::steady_clock::now();
     if (settings.method == RenderMethod::Reference)
-        launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)});
+        launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)},
+                    settings.progress);
     else
         launchFrame(frame, result.stats,
-                    PartitionMarch{result.setup.partitionScene(mesh, settings.skip)});
+                    PartitionMarch{result.setup.partitionScene(mesh, settings.skip)},
+                    settings.progress);
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;

@@ -67,12 +67,13 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
         if (!field)
             throwError(ErrorKind::Argument, "", "no field to render: " + describeFields(mesh));
     } else {
-        int matches = 0;
+        int matches = 0, pointMatches = 0;
         for (const Field& f : mesh.fields) {
             if (f.name != spec.name) continue;
             if (spec.association && f.association != *spec.association) continue;
             if (!field) field = &f;
             ++matches;
+            pointMatches += f.association == Association::Point;
         }
         if (!field)
             throwError(ErrorKind::Argument, "",
@@ -80,19 +81,36 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
                            (spec.association ? std::string(":") + associationName(*spec.association)
                                              : "") +
                            "' not found; " + describeFields(mesh));
-        if (matches > 1)
+        if (matches == 2 && pointMatches == 1)
             throwError(ErrorKind::Argument, "",
                        "--field '" + spec.name +
                            "' exists as point and cell data: add ':point' or ':cell'");
+        if (matches > 1) {
+            const int cellMatches = matches - pointMatches;
+            const std::string points = std::to_string(pointMatches) + " point";
+            const std::string cells = std::to_string(cellMatches) + " cell";
+            throwError(ErrorKind::Argument, "",
+                       "--field '" + spec.name + "': " +
+                           (cellMatches == 0    ? points
+                            : pointMatches == 0 ? cells
+                                                : points + " and " + cells) +
+                           " fields have this name and --field cannot tell them apart; rename "
+                           "them in the file");
+        }
     }
+    return scalarFieldOf(mesh, *field, spec.component);
+}
+
+ScalarField scalarFieldOf(const Mesh& mesh, const Field& fieldRef, int component) {
+    const Field* field = &fieldRef;
     const std::uint64_t tuples =
         field->association == Association::Point ? mesh.pointCount() : mesh.cellCount();
     UVR_CHECK(field->tupleCount() == tuples && field->values.size() == tuples * field->components,
               "field '" << field->name << "' holds " << field->values.size() << " values for "
                         << tuples << " tuples");
-    if (spec.component >= field->components)
+    if (component >= field->components)
         throwError(ErrorKind::Argument, "",
-                   "--field '" + field->name + "': component " + std::to_string(spec.component) +
+                   "--field '" + field->name + "': component " + std::to_string(component) +
                        " does not exist (the field has " + std::to_string(field->components) + ")");
     ScalarField out;
     out.name = field->name;
@@ -103,10 +121,10 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
         return out;
     }
     out.values.resize(tuples);
-    if (spec.component >= 0) {
-        out.name += ":" + std::to_string(spec.component);
+    if (component >= 0) {
+        out.name += ":" + std::to_string(component);
         for (std::uint64_t i = 0; i < tuples; ++i)
-            out.values[i] = field->values[i * nc + spec.component];
+            out.values[i] = field->values[i * nc + component];
     } else {
         out.name += ":magnitude";
         for (std::uint64_t i = 0; i < tuples; ++i) {

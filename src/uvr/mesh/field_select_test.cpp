@@ -53,6 +53,23 @@ TEST(FieldSelect, PointAndCellOfTheSameNameNeedAQualifier) {
     }
 }
 
+TEST(FieldSelect, TwoPointFieldsOfTheSameNameAreNotCalledPointAndCell) {
+    Mesh m = meshWithFields();
+    m.fields.push_back({"p", Association::Point, 1, {5, 6, 7, 8}});
+    for (const char* spec : {"p", "p:point"}) {
+        try {
+            selectScalarField(m, parseFieldSpec(spec));
+            FAIL() << spec;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Argument);
+            const std::string what = e.what();
+            EXPECT_NE(what.find("cannot tell them apart"), std::string::npos) << what;
+            EXPECT_EQ(what.find("exists as point and cell"), std::string::npos) << what;
+        }
+    }
+    EXPECT_EQ(selectScalarField(m, parseFieldSpec("p:cell")).values, std::vector<float>{7});
+}
+
 TEST(FieldSelect, UnknownNamesQualifiersAndComponentsAreArgumentErrors) {
     const Mesh m = meshWithFields();
     try {

@@ -19,7 +19,13 @@ void Mesh::addCell(CellType type, std::span<const std::uint32_t> ids) {
 
 Bounds3f Mesh::bounds() const {
     Bounds3f b;
-    for (const Vec3f& p : points) b.extend(p);
+    for (std::uint64_t c = 0; c < cellCount(); ++c) {
+        const auto ids = cell(c);
+        bool finite = true;
+        for (std::uint32_t id : ids) finite = finite && id < points.size() && isFinite(points[id]);
+        if (finite)
+            for (std::uint32_t id : ids) b.extend(points[id]);
+    }
     return b;
 }
 

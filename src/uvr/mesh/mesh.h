@@ -50,7 +50,8 @@ struct Mesh {
     }
     /// Appends a cell; ids must hold cornerCount(type) indices.
     void addCell(CellType type, std::span<const std::uint32_t> ids);
-    /// Bounds of all points.
+    /// Bounds of the points used by cells without NaN/Inf corners (the cells that can render;
+    /// validateMesh's bounds also leave out zero-volume ones); unused points do not count.
     Bounds3f bounds() const;
     /// First field with this name and association, or nullptr.
     const Field* findField(const std::string& name, Association association) const;

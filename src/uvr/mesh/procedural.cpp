@@ -262,9 +262,29 @@ void checkPointCount(const Block& block, const ProceduralSpec& spec) {
                        " points; at most 4294967295 (32-bit indices) are supported");
 }
 
+/// The shell's (u, v, r) extents: around the axis, around the tube, across the wall.
+constexpr double kShellLenU = 2.0 * kPi * kShellMajorRadius;
+constexpr double kShellLenV = 2.0 * kPi * 0.5 * (kShellInnerRadius + kShellOuterRadius);
+constexpr double kShellLenR = kShellOuterRadius - kShellInnerRadius;
+
+/// The block of cubes generateMesh splits for the spec's shape and target size.
+Block proceduralBlock(const ProceduralSpec& spec) {
+    if (spec.shape != ProceduralShape::Shell) {
+        const std::uint32_t n = cubeResolution(spec.targetCells);
+        return Block{n, n, n, false, false};
+    }
+    const double h = std::cbrt(6.0 * kShellLenU * kShellLenV * kShellLenR /
+                               static_cast<double>(std::max<std::uint64_t>(spec.targetCells, 1)));
+    auto cubes = [h](double len, double minimum) {
+        return static_cast<std::uint32_t>(std::clamp(std::round(len / h), minimum, 1.0e6));
+    };
+    return Block{cubes(kShellLenU, 16.0), cubes(kShellLenV, 8.0), cubes(kShellLenR, 1.0), true,
+                 true};
+}
+
 void generateBox(const ProceduralSpec& spec, bool graded, Mesh& mesh, ProgressReporter& progress) {
-    const std::uint32_t n = cubeResolution(spec.targetCells);
-    const Block block{n, n, n, false, false};
+    const Block block = proceduralBlock(spec);
+    const std::uint32_t n = block.nx;
     checkPointCount(block, spec);
     const AxisSamples axis = axisSamples(n, graded);
     mesh.points.resize(block.pointCount());
@@ -297,15 +317,11 @@ void generateBox(const ProceduralSpec& spec, bool graded, Mesh& mesh, ProgressRe
 /// radius scaled by kShellJitterScale and at least 16 x 8 x 1 cubes, inversions first appeared
 /// (over 1600 seeds and sizes at the largest jitter) only at a scale of 0.9 to 1.0.
 void generateShell(const ProceduralSpec& spec, Mesh& mesh, ProgressReporter& progress) {
-    constexpr double kR = kShellMajorRadius, kR0 = kShellInnerRadius, kR1 = kShellOuterRadius;
+    constexpr double kR = kShellMajorRadius, kR0 = kShellInnerRadius;
     constexpr double kShellJitterScale = 0.6;
     const double jitter = kShellJitterScale * spec.jitter;
-    const double lenU = 2.0 * kPi * kR, lenV = 2.0 * kPi * 0.5 * (kR0 + kR1), lenR = kR1 - kR0;
-    const double h = std::cbrt(6.0 * lenU * lenV * lenR / static_cast<double>(spec.targetCells));
-    auto cubes = [h](double len, double minimum) {
-        return static_cast<std::uint32_t>(std::clamp(std::round(len / h), minimum, 1.0e6));
-    };
-    const Block block{cubes(lenU, 16.0), cubes(lenV, 8.0), cubes(lenR, 1.0), true, true};
+    const double lenR = kShellLenR;
+    const Block block = proceduralBlock(spec);
     checkPointCount(block, spec);
     mesh.points.resize(block.pointCount());
     std::uint64_t index = 0;
@@ -334,6 +350,18 @@ void generateShell(const ProceduralSpec& spec, Mesh& mesh, ProgressReporter& pro
 }
 
 }  // namespace
+
+std::uint64_t proceduralMeshBytes(const ProceduralSpec& spec) {
+    const Block block = proceduralBlock(spec);
+    const std::uint64_t pointBytes = sizeof(Vec3f) + sizeof(float) * spec.fields.size();
+    const std::uint64_t cellBytes =
+        sizeof(CellType) + sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t);
+    return block.pointCount() * pointBytes + block.cellCount() * cellBytes;
+}
+
+std::uint64_t proceduralTetCount(const ProceduralSpec& spec) {
+    return proceduralBlock(spec).cellCount();
+}
 
 Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>& progress) {
     if (spec.targetCells == 0)

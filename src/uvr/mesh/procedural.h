@@ -53,6 +53,13 @@ struct ProceduralSpec {
 /// is called now and then when given.
 Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>& progress = {});
 
+/// Tetrahedra generateMesh(spec) makes (from the same grid it builds).
+std::uint64_t proceduralTetCount(const ProceduralSpec& spec);
+
+/// Bytes of the points, cells and fields of the mesh generateMesh(spec) makes, known before
+/// generating (for a memory limit).
+std::uint64_t proceduralMeshBytes(const ProceduralSpec& spec);
+
 /// The analytic value of a procedural field at p (what the mesh stores at its points).
 float proceduralFieldValue(ProceduralField field, Vec3f p);
 

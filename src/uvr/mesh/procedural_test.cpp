@@ -359,5 +359,26 @@ TEST(Procedural, BadSpecsAndNamesAreArgumentErrors) {
         EXPECT_EQ(parseProceduralField(proceduralFieldName(f)), f);
 }
 
+TEST(Procedural, SizeIsKnownBeforeGenerating) {
+    // `generate` and `demo` check --max-memory from these before generating anything.
+    for (const ProceduralShape shape :
+         {ProceduralShape::Box, ProceduralShape::Shell, ProceduralShape::Graded}) {
+        for (const std::uint64_t cells : {1ull, 777ull, 20000ull}) {
+            ProceduralSpec spec;
+            spec.shape = shape;
+            spec.targetCells = cells;
+            spec.fields = {ProceduralField::Jet, ProceduralField::Linear};
+            const Mesh m = generateMesh(spec);
+            EXPECT_EQ(proceduralTetCount(spec), m.cellCount());
+            std::uint64_t bytes = m.points.size() * sizeof(Vec3f) + m.cellTypes.size() +
+                                  m.cellOffsets.size() * 8 + m.cellIndices.size() * 4;
+            for (const Field& f : m.fields) bytes += f.values.size() * 4;
+            // Exact up to the one extra cell offset.
+            EXPECT_LE(bytes, proceduralMeshBytes(spec) + 8);
+            EXPECT_GE(bytes, proceduralMeshBytes(spec));
+        }
+    }
+}
+
 }  // namespace
 }  // namespace uvr

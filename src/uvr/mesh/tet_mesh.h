@@ -24,6 +24,42 @@ UVR_HOST_DEVICE inline Bounds3f tetBounds(const Vec3f* points, const Tet& t) {
     return b;
 }
 
+/// The exact similarity from a mesh file's coordinates to the rendering coordinates of its
+/// TetMesh: local = (file - origin) * scale, with scale a power of two and origin a float beside
+/// which every rendered point lies (so both steps are exact for them). The identity unless the
+/// mesh is too large or too small for float32 kernels (cubed cell edges and squared distances
+/// overflow or underflow) or lies too far from the origin for float32 to resolve its size
+/// (frameForBounds).
+struct MeshFrame {
+    Vec3f origin{0.f, 0.f, 0.f};  ///< file position of the rendering origin
+    double scale = 1.0;           ///< rendering units per file unit
+
+    /// True for the identity (file coordinates are the rendering coordinates).
+    bool identity() const { return scale == 1.0 && origin == Vec3f(0.f); }
+    /// Rendering coordinates of a file position, in double (they may lie beyond float's range).
+    void toLocal(Vec3f file, double out[3]) const {
+        for (int a = 0; a < 3; ++a) out[a] = (double(file[a]) - origin[a]) * scale;
+    }
+    /// File coordinates of a rendering position, in double (they may lie beyond float's range).
+    void toFile(Vec3f local, double out[3]) const {
+        for (int a = 0; a < 3; ++a) out[a] = double(local[a]) / scale + origin[a];
+    }
+};
+
+/// Mesh diagonals outside [2^-kFrameScaleExponent, 2^kFrameScaleExponent] are scaled to [1, 2):
+/// within, float32 kernels keep cubed edges and squared distances in range for cells down to
+/// 2^-18 of the mesh; beyond it, a 1e-30 mesh underflows and a 1e38 one overflows.
+inline constexpr int kFrameScaleExponent = 24;
+/// An axis whose centre lies more than 2^kFrameShiftExponent mesh diagonals from 0 is translated
+/// to it: float32 resolves positions there to no better than 2^-16 of the mesh (a mesh at
+/// x = 1e7 of size 1 has float spacing 1 in x).
+inline constexpr int kFrameShiftExponent = 8;
+
+/// The frame for a mesh with these (file) bounds: the identity for an empty box or one of
+/// moderate size near the origin; else a power-of-two scale bringing the diagonal into [1, 2)
+/// and, per far axis, a translation to the box's centre.
+MeshFrame frameForBounds(const Bounds3f& bounds);
+
 /// Plain-data view of a TetMesh for CPU and GPU kernels.
 struct TetMeshView {
     const Vec3f* points = nullptr;
@@ -50,7 +86,10 @@ struct TetMesh {
     std::vector<float> values;
     Association association = Association::Point;
     std::string fieldName;
-    Bounds3f bounds;       ///< bounds of the points used by tets
+    /// Maps the file's coordinates to those of points, bounds and totalVolume (the identity for
+    /// meshes of moderate size near the origin).
+    MeshFrame frame;
+    Bounds3f bounds;       ///< bounds of the points used by tets (finite)
     float valueMin = 0.f;  ///< finite range of the field over the tets' values
     float valueMax = 0.f;
     double totalVolume = 0.0;  ///< sum of tetrahedron volumes
@@ -70,7 +109,8 @@ struct TetMesh {
 int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[6][4]);
 
 /// Splits every cell of the mesh into tetrahedra and attaches the field; inverted cells are
-/// re-oriented, zero-volume tetrahedra dropped (validateMesh reports both).
+/// re-oriented, zero-volume tetrahedra (also those with a NaN/Inf corner) dropped (validateMesh
+/// reports both); points are mapped by frameForBounds of the kept tetrahedra's bounds.
 TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field);
 
 }  // namespace uvr

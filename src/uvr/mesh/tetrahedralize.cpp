@@ -206,7 +206,45 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
         lo = std::fmin(lo, s.lo), hi = std::fmax(hi, s.hi);
     }
     if (lo <= hi) out.valueMin = lo, out.valueMax = hi;
+    out.frame = frameForBounds(out.bounds);
+    if (!out.frame.identity()) {
+        const MeshFrame& f = out.frame;
+        const std::int64_t n = static_cast<std::int64_t>(out.points.size());
+#pragma omp parallel for schedule(static)
+        for (std::int64_t i = 0; i < n; ++i) {
+            double p[3];
+            f.toLocal(out.points[i], p);
+            out.points[i] = Vec3f(float(p[0]), float(p[1]), float(p[2]));
+        }
+        double blo[3], bhi[3];
+        f.toLocal(out.bounds.lo, blo);
+        f.toLocal(out.bounds.hi, bhi);
+        out.bounds = {Vec3f(float(blo[0]), float(blo[1]), float(blo[2])),
+                      Vec3f(float(bhi[0]), float(bhi[1]), float(bhi[2]))};
+        out.totalVolume *= f.scale * f.scale * f.scale;
+    }
     return out;
+}
+
+MeshFrame frameForBounds(const Bounds3f& bounds) {
+    MeshFrame f;
+    if (bounds.empty() || !isFinite(bounds.lo) || !isFinite(bounds.hi)) return f;
+    double diag2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        const double e = double(bounds.hi[a]) - bounds.lo[a];
+        diag2 += e * e;
+    }
+    const double diag = std::sqrt(diag2);
+    if (!(diag > 0.0)) return f;  // a single point: nothing to render anyway
+    if (diag < std::ldexp(1.0, -kFrameScaleExponent) || diag > std::ldexp(1.0, kFrameScaleExponent))
+        f.scale = std::ldexp(1.0, -std::ilogb(diag));
+    for (int a = 0; a < 3; ++a) {
+        // The centre is at least 2^8 diagonals from 0, so every point p of the box lies within
+        // [c / 2, 2 c] of it and p - c is exact (Sterbenz).
+        const double c = 0.5 * (double(bounds.lo[a]) + bounds.hi[a]);
+        if (std::fabs(c) > std::ldexp(diag, kFrameShiftExponent)) f.origin[a] = float(c);
+    }
+    return f;
 }
 
 }  // namespace uvr

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <random>
@@ -171,6 +172,43 @@ TEST(Tetrahedralize, BarycentricsReproduceLinearFunctions) {
     }
     float bary[4];
     EXPECT_FALSE(tetBarycentrics(a, a, b, c, a, bary));  // degenerate
+}
+
+TEST(Tetrahedralize, FrameIsTheIdentityExceptAtTheEdgesOfFloat) {
+    const auto box = [](Vec3f lo, Vec3f hi) { return Bounds3f{lo, hi}; };
+    EXPECT_TRUE(frameForBounds(box(Vec3f(0.f), Vec3f(1.f))).identity());
+    EXPECT_TRUE(frameForBounds(box(Vec3f(-1e6f), Vec3f(1e6f))).identity());
+    EXPECT_TRUE(frameForBounds(box(Vec3f(1e-6f), Vec3f(2e-6f))).identity());
+    EXPECT_TRUE(frameForBounds(Bounds3f{}).identity());
+    // Too small and too large: a power of two bringing the diagonal into [1, 2).
+    for (const float s : {1e-30f, 1e38f, 1e-40f}) {
+        const MeshFrame f = frameForBounds(box(Vec3f(0.f), Vec3f(s)));
+        const double diagonal = std::sqrt(3.0) * s * f.scale;
+        EXPECT_GE(diagonal, 1.0) << s;
+        EXPECT_LT(diagonal, 2.0) << s;
+        EXPECT_EQ(std::exp2(std::round(std::log2(f.scale))), f.scale) << s;
+        EXPECT_EQ(f.origin, Vec3f(0.f)) << s;
+    }
+    // Far from the origin on x and z: moved to the centre there, not scaled.
+    const MeshFrame far = frameForBounds(box({1e7f, 0.f, -1e7f - 2.f}, {1e7f + 2.f, 1.f, -1e7f}));
+    EXPECT_EQ(far.scale, 1.0);
+    EXPECT_EQ(far.origin, Vec3f(1e7f + 1.f, 0.f, -1e7f - 1.f));
+
+    // tetrahedralize maps the used points exactly: a tetrahedron scaled by 2^100.
+    Mesh m;
+    m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {NAN, 0, 0}};
+    const std::uint32_t ids[4] = {0, 1, 2, 3};
+    m.addCell(CellType::Tetra, ids);
+    const ScalarField field{"f", Association::Point, {1, 2, 3, 4, 5}};
+    const TetMesh unit = tetrahedralize(m, field);
+    EXPECT_TRUE(unit.frame.identity());
+    for (Vec3f& p : m.points) p = p * std::ldexp(1.f, 100);
+    const TetMesh huge = tetrahedralize(m, field);
+    EXPECT_EQ(huge.frame.scale, std::ldexp(1.0, -100));
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(huge.points[i], unit.points[i]) << i;
+    EXPECT_EQ(huge.bounds.lo, unit.bounds.lo);
+    EXPECT_EQ(huge.bounds.hi, unit.bounds.hi);
+    EXPECT_DOUBLE_EQ(huge.totalVolume, unit.totalVolume);
 }
 
 }  // namespace

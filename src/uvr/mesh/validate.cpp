@@ -67,7 +67,10 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
     std::vector<bool> used(mesh.pointCount(), false);
     for (std::uint64_t c = 0; c < mesh.cellCount(); ++c) {
         for (std::uint32_t id : mesh.cell(c)) used[id] = true;
-        switch (splitCell(mesh, c).shape) {
+        const CellSplit split = splitCell(mesh, c);
+        for (int t = 0; t < split.count; ++t)
+            for (std::uint32_t v : split.tets[t].v) r.bounds.extend(mesh.points[v]);
+        switch (split.shape) {
             case CellShape::Valid:
                 break;
             case CellShape::Inverted:
@@ -126,8 +129,11 @@ std::vector<std::string> ValidationReport::findings() const {
                       " coincident point(s) (same position as an earlier point)");
     if (nonFinitePoints)
         out.push_back(std::to_string(nonFinitePoints) +
-                      " point(s) with NaN/Inf coordinates: cells using them are dropped");
-    if (unusedPoints) out.push_back(std::to_string(unusedPoints) + " point(s) used by no cell");
+                      " point(s) with NaN/Inf coordinates: cells using them are dropped (the "
+                      "bounds leave them out)");
+    if (unusedPoints)
+        out.push_back(std::to_string(unusedPoints) +
+                      " point(s) used by no cell (the bounds leave them out)");
     for (const NonFiniteField& f : nonFiniteFields)
         out.push_back(std::string(associationName(f.association)) + " field '" + f.name +
                       "': " + std::to_string(f.count) + " NaN/Inf value(s) (first at " +

@@ -27,6 +27,9 @@ struct ValidationReport {
     std::uint64_t unusedPoints = 0;      ///< points no cell references
     std::uint64_t firstInvertedCell = 0, firstZeroVolumeCell = 0, firstDistortedCell = 0;
     std::vector<NonFiniteField> nonFiniteFields;
+    /// Bounds of the points of the tetrahedra rendered (those tetrahedralize keeps: finite, of
+    /// non-zero volume); empty when nothing renders. Unused and NaN/Inf points lie outside it.
+    Bounds3f bounds;
 
     /// Human-readable findings, one per line ("77 zero-volume cells (first: cell 1234)"); empty
     /// when the mesh is clean.

@@ -57,6 +57,38 @@ TEST(Validate, NonFiniteValuesAndCoincidentPointsAreCounted) {
     EXPECT_EQ(r.findings().size(), 3u);
 }
 
+TEST(Validate, BoundsAreThoseOfTheRenderedCells) {
+    // An unused NaN point, an unused far point, and a flat cell far away lie outside the bounds;
+    // so does a cell using a NaN point.
+    Mesh m = unitTet();
+    m.points.push_back({NAN, 0, 0});
+    m.points.push_back({1e30f, 0, 0});
+    m.points.push_back({-50, -50, -50});
+    m.points.push_back({-50, -40, -50});
+    m.points.push_back({-40, -50, -50});
+    m.points.push_back({-45, -45, -50});  // all four in z = -50: a flat tetrahedron
+    const std::uint32_t flat[4] = {6, 7, 8, 9};
+    m.addCell(CellType::Tetra, flat);
+    const std::uint32_t withNan[4] = {1, 2, 3, 4};
+    m.addCell(CellType::Tetra, withNan);
+    const ValidationReport r = validateMesh(m);
+    EXPECT_EQ(r.bounds.lo, Vec3f(0.f));
+    EXPECT_EQ(r.bounds.hi, Vec3f(1.f));
+    EXPECT_EQ(r.nonFinitePoints, 1u);
+    EXPECT_EQ(r.unusedPoints, 1u);
+    // Mesh::bounds leaves out the NaN point, its cell and unused points, not the flat cell.
+    const Bounds3f b = m.bounds();
+    EXPECT_EQ(b.lo, Vec3f(-50.f));
+    EXPECT_EQ(b.hi, Vec3f(1.f));
+    // Nothing rendered: empty bounds.
+    Mesh flatOnly;
+    flatOnly.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3f, 0.3f, 1e-7f}};
+    const std::uint32_t ids[4] = {0, 1, 2, 3};
+    flatOnly.addCell(CellType::Tetra, ids);
+    EXPECT_TRUE(validateMesh(flatOnly).bounds.empty());
+    EXPECT_FALSE(flatOnly.bounds().empty());
+}
+
 // The data README documents these counts for the classic data sets.
 TEST(Validate, BluntFinHas77ZeroVolumeTetsAnd39CoincidentPoints) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";

@@ -5,7 +5,9 @@
 
 #include <array>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <numbers>
@@ -14,6 +16,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/text.h"
 
 namespace uvr {
 
@@ -24,10 +27,39 @@ constexpr double kDegToRad = std::numbers::pi / 180.0;
 /// Largest camera file read; real .pvcc files are about 2 kilobytes.
 constexpr std::uint64_t kMaxPvccBytes = 16ull << 20;
 
+/// Double-precision vector for camera arithmetic, whose results may lie beyond float's range
+/// (a mesh near 1e38) even when its inputs do not.
+struct Vec3d {
+    double x = 0.0, y = 0.0, z = 0.0;
+};
+Vec3d toDouble(Vec3f v) { return {v.x, v.y, v.z}; }
+Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec3d cross(Vec3d a, Vec3d b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+Vec3d normalize(Vec3d a) { return a * (1.0 / std::sqrt(dot(a, a))); }
+
 /// Rotates v about the unit axis by angle radians (Rodrigues' rotation formula, right-handed).
-Vec3f rotate(Vec3f v, Vec3f axis, double angle) {
-    float c = static_cast<float>(std::cos(angle)), s = static_cast<float>(std::sin(angle));
-    return v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1.f - c));
+Vec3d rotate(Vec3d v, Vec3d axis, double angle) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    return v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1.0 - c));
+}
+
+/// v in float; throws Error(Argument) naming `what` when a component lies beyond float's range.
+Vec3f toFloat(Vec3d v, const std::string& what) {
+    for (double c : {v.x, v.y, v.z})
+        if (!(std::fabs(c) <= double(FLT_MAX))) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.3g", c);
+            throwError(ErrorKind::Argument, "",
+                       what + " would lie at " + buf +
+                           ", beyond float32 range (3.4e38): rescale the mesh or give "
+                           "--camera-position and --camera-focal");
+        }
+    return {float(v.x), float(v.y), float(v.z)};
 }
 
 std::string formatVec(Vec3f v) {
@@ -50,7 +82,8 @@ struct PvccParser {
     std::map<std::string, PvccProperty> properties;
     std::string current;  ///< name of the open <Property>, "" outside one
     bool sawRoot = false;
-    std::string error;  ///< first error found by a handler (without file and line)
+    std::uint64_t rootLine = 1;  ///< line of <PVCameraConfiguration>
+    std::string error;           ///< first error found by a handler (without file and line)
     std::uint64_t errorLine = 0;
 
     void fail(const std::string& message) {
@@ -72,7 +105,10 @@ const char* attribute(const XML_Char** attrs, const char* name) {
 void XMLCALL onStart(void* data, const XML_Char* name, const XML_Char** attrs) {
     auto* p = static_cast<PvccParser*>(data);
     std::string tag = name;
-    if (tag == "PVCameraConfiguration") p->sawRoot = true;
+    if (tag == "PVCameraConfiguration") {
+        p->sawRoot = true;
+        p->rootLine = XML_GetCurrentLineNumber(p->parser);
+    }
     if (tag == "Property") {
         const char* propName = attribute(attrs, "name");
         p->current = propName ? propName : "";
@@ -84,8 +120,9 @@ void XMLCALL onStart(void* data, const XML_Char* name, const XML_Char** attrs) {
             char* end = nullptr;
             long count = std::strtol(n, &end, 10);
             if (end == n || *end != '\0' || count < 0) {
-                p->fail("property " + p->current +
-                        ": expected an integer number_of_elements, got \"" + n + "\"");
+                p->fail("property " + printableShort(p->current) +
+                        ": expected an integer number_of_elements, got \"" + printableShort(n) +
+                        "\"");
                 return;
             }
             prop.declaredCount = count;
@@ -96,12 +133,14 @@ void XMLCALL onStart(void* data, const XML_Char* name, const XML_Char** attrs) {
         char* end = nullptr;
         long i = index ? std::strtol(index, &end, 10) : -1;
         if (!index || end == index || *end != '\0' || i < 0 || i > 1000) {
-            p->fail("property " + p->current + ": expected an Element with an index, got \"" +
-                    (index ? index : "") + "\"");
+            p->fail("property " + printableShort(p->current) +
+                    ": expected an Element with an index, got \"" +
+                    printableShort(index ? index : "") + "\"");
             return;
         }
         if (!value) {
-            p->fail("property " + p->current + ": Element " + std::to_string(i) + " has no value");
+            p->fail("property " + printableShort(p->current) + ": Element " + std::to_string(i) +
+                    " has no value");
             return;
         }
         p->properties[p->current].elements[static_cast<int>(i)] = value;
@@ -117,14 +156,18 @@ void XMLCALL onEnd(void* data, const XML_Char* name) {
 std::vector<double> propertyValues(const PvccParser& p, const std::string& name, int count) {
     auto it = p.properties.find(name);
     if (it == p.properties.end()) {
-        throwParseError(p.path, "property " + name,
+        throwParseError(p.path, atLine(p.rootLine) + ": property " + name,
                         "expected a <Property name=\"" + name + "\"> with " +
                             std::to_string(count) + " element(s), found none");
     }
     const PvccProperty& prop = it->second;
     std::string where = atLine(prop.line) + ": property " + name;
-    if (static_cast<int>(prop.elements.size()) != count ||
-        (prop.declaredCount >= 0 && prop.declaredCount != count)) {
+    if (prop.declaredCount >= 0 && prop.declaredCount != count) {
+        throwParseError(p.path, where,
+                        "expected number_of_elements=\"" + std::to_string(count) + "\", got \"" +
+                            std::to_string(prop.declaredCount) + "\"");
+    }
+    if (static_cast<int>(prop.elements.size()) != count) {
         throwParseError(p.path, where,
                         "expected " + std::to_string(count) + " element(s), got " +
                             std::to_string(prop.elements.size()));
@@ -143,7 +186,7 @@ std::vector<double> propertyValues(const PvccParser& p, const std::string& name,
         if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
             throwParseError(p.path, where,
                             "element " + std::to_string(i) + ": expected a finite number, got \"" +
-                                e->second + "\"");
+                                printableShort(e->second) + "\"");
         }
         values.push_back(v);
     }
@@ -167,16 +210,19 @@ Camera resetCamera(const Bounds3f& bounds, float aspect) {
             "camera aspect (width / height) must be positive, got " + std::to_string(aspect));
     }
     // vtkRenderer::ResetCamera: fit the bounding sphere into the view angle (the horizontal one
-    // when the image is taller than wide); a zero radius becomes 0.5 as in VTK.
-    double radius = bounds.diagonal();
+    // when the image is taller than wide); a zero radius becomes 0.5 as in VTK. In double: the
+    // diagonal of bounds beyond 1.8e19 overflows float, the camera of bounds near 1e38 too.
+    const Vec3d lo = toDouble(bounds.lo), hi = toDouble(bounds.hi);
+    double radius = std::sqrt(dot(hi - lo, hi - lo));
     radius = radius == 0.0 ? 0.5 : 0.5 * radius;
     Camera cam;
     cam.viewAngle = 30.f;
     double angle = cam.viewAngle * kDegToRad;
     if (aspect < 1.f) angle = 2.0 * std::atan(std::tan(0.5 * angle) * aspect);
     double distance = radius / std::sin(0.5 * angle);
-    cam.focalPoint = bounds.center();
-    cam.position = cam.focalPoint + Vec3f(0.f, 0.f, static_cast<float>(distance));
+    const Vec3d focal = (lo + hi) * 0.5;
+    cam.focalPoint = toFloat(focal, "the reset camera's focal point");
+    cam.position = toFloat(focal + Vec3d{0.0, 0.0, distance}, "the reset camera");
     cam.viewUp = Vec3f(0.f, 1.f, 0.f);
     return cam;
 }
@@ -184,25 +230,32 @@ Camera resetCamera(const Bounds3f& bounds, float aspect) {
 Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
     validateCamera(camera);
     Camera out = camera;
-    Vec3f offset = camera.position - camera.focalPoint;
-    Vec3f up = normalize(camera.viewUp);
+    // In double: the offset between float points can exceed float's range.
+    const Vec3d focal = toDouble(camera.focalPoint);
+    Vec3d offset = toDouble(camera.position) - focal;
+    Vec3d up = normalize(toDouble(camera.viewUp));
     // vtkCamera::Azimuth: rotate the position about view up (as given) through the focal point.
     offset = rotate(offset, up, azimuthDeg * kDegToRad);
-    Vec3f dir = normalize(-offset);
+    const Vec3d dir = normalize(offset * -1.0);
     up = normalize(up - dir * dot(up, dir));
     // vtkCamera::Elevation: rotate about the negated right axis, so positive angles move the
     // camera towards view up. View up turns with it (the orthogonalised up VTK gives for angles
     // within +-90 degrees, and well defined at the poles).
-    Vec3f axis = normalize(cross(up, dir));
+    const Vec3d axis = normalize(cross(up, dir));
     offset = rotate(offset, axis, elevationDeg * kDegToRad);
     up = normalize(rotate(up, axis, elevationDeg * kDegToRad));
-    out.position = camera.focalPoint + offset;
-    out.viewUp = up;
+    out.position = toFloat(focal + offset, "the orbited camera");
+    out.viewUp = {float(up.x), float(up.y), float(up.z)};
     return out;
 }
 
 Camera loadPvcc(const std::string& path) {
     std::vector<char> bytes = readFileBytes(path, kMaxPvccBytes, "camera file");
+    // XML processors read UTF-8 and UTF-16 (expat converts UTF-16 to UTF-8), not UTF-32.
+    const char* wide = wideTextEncoding(bytes.data(), bytes.size());
+    if (wide && std::string(wide) == "UTF-32")
+        throwParseError(path, atByte(0),
+                        "UTF-32 text is not supported; save the camera file as UTF-8");
 
     PvccParser state;
     state.path = path;
@@ -223,7 +276,10 @@ Camera loadPvcc(const std::string& path) {
     if (!state.error.empty()) throwParseError(path, atLine(state.errorLine), state.error);
     if (!xmlError.empty()) {
         throwParseError(path, atLine(xmlLine),
-                        "expected XML (a ParaView camera configuration), got: " + xmlError);
+                        "expected XML (a ParaView camera configuration), got: " + xmlError +
+                            (wide ? std::string(" (the file is ") + wide +
+                                        " text; save the camera file as UTF-8)"
+                                  : std::string()));
     }
     if (!state.sawRoot) {
         throwParseError(path, atLine(1),
@@ -238,12 +294,14 @@ Camera loadPvcc(const std::string& path) {
     if (state.properties.count("CameraParallelProjection") &&
         propertyValues(state, "CameraParallelProjection", 1)[0] != 0.0) {
         throwError(ErrorKind::Unsupported, path,
-                   "property CameraParallelProjection: parallel projection is not supported");
+                   atLine(state.properties["CameraParallelProjection"].line) +
+                       ": property CameraParallelProjection: parallel projection is not "
+                       "supported");
     }
     try {
         validateCamera(cam);
     } catch (const Error& e) {
-        throwError(ErrorKind::Parse, path, e.what());
+        throwParseError(path, atLine(state.rootLine), e.what());
     }
     return cam;
 }
@@ -256,25 +314,32 @@ void validateCamera(const Camera& camera) {
                        ", focal point " + formatVec(camera.focalPoint) + ", view up " +
                        formatVec(camera.viewUp) + ", angle " + std::to_string(camera.viewAngle));
     }
-    Vec3f offset = camera.focalPoint - camera.position;
-    float dist = length(offset);
-    float scale = std::max(maxComponent(vmax(camera.position, -camera.position)),
-                           maxComponent(vmax(camera.focalPoint, -camera.focalPoint)));
-    if (!(dist > 0.f) || dist <= 1e-6f * scale) {
+    // In double: the offset of float points near 1e38 overflows float and that of points 1e-30
+    // apart underflows its square. Distinct points must lie more than two float spacings of
+    // their coordinates apart, so the view direction means something.
+    const Vec3d offset = toDouble(camera.focalPoint) - toDouble(camera.position);
+    const double dist = std::sqrt(dot(offset, offset));
+    const double scale = std::max(maxComponent(vmax(camera.position, -camera.position)),
+                                  maxComponent(vmax(camera.focalPoint, -camera.focalPoint)));
+    if (!(dist > 0.0) || dist <= 2.0 * FLT_EPSILON * scale) {
         throwError(ErrorKind::Argument, "",
                    "camera position " + formatVec(camera.position) +
                        " equals the focal point; expected distinct points");
     }
-    float upLen = length(camera.viewUp);
-    if (!(upLen > 0.f) || length(cross(offset / dist, camera.viewUp / upLen)) < 1e-4f) {
+    const Vec3d up = toDouble(camera.viewUp), dir = offset * (1.0 / dist);
+    const double upLen = std::sqrt(dot(up, up));
+    const Vec3d sine = cross(dir, up * (1.0 / upLen));
+    if (!(upLen > 0.0) || std::sqrt(dot(sine, sine)) < 1e-4) {
         throwError(ErrorKind::Argument, "",
                    "camera view up " + formatVec(camera.viewUp) +
-                       " is zero or parallel to the view direction " + formatVec(offset / dist));
+                       " is zero or parallel to the view direction " +
+                       formatVec({float(dir.x), float(dir.y), float(dir.z)}));
     }
-    if (!(camera.viewAngle > 0.f && camera.viewAngle < 180.f)) {
-        throwError(ErrorKind::Argument, "",
-                   "camera view angle must be in (0, 180) degrees, got " +
-                       std::to_string(camera.viewAngle));
+    if (!(camera.viewAngle >= kMinViewAngle && camera.viewAngle <= kMaxViewAngle)) {
+        std::ostringstream os;
+        os << "camera view angle must be in [" << kMinViewAngle << ", " << kMaxViewAngle
+           << "] degrees, got " << camera.viewAngle;
+        throwError(ErrorKind::Argument, "", os.str());
     }
 }
 
@@ -285,10 +350,14 @@ CameraRays makeCameraRays(const Camera& camera, int width, int height) {
                    "image size must be positive, got " + std::to_string(width) + " x " +
                        std::to_string(height));
     }
-    // Pinhole camera with the image plane at unit distance along the view direction.
-    Vec3f dir = normalize(camera.focalPoint - camera.position);
-    Vec3f right = normalize(cross(dir, camera.viewUp));
-    Vec3f up = cross(right, dir);
+    // Pinhole camera with the image plane at unit distance along the view direction (the
+    // directions in double: the offset may lie beyond float's range).
+    const Vec3d dirD = normalize(toDouble(camera.focalPoint) - toDouble(camera.position));
+    const Vec3d rightD = normalize(cross(dirD, toDouble(camera.viewUp)));
+    const Vec3d upD = cross(rightD, dirD);
+    const Vec3f dir(float(dirD.x), float(dirD.y), float(dirD.z));
+    const Vec3f right(float(rightD.x), float(rightD.y), float(rightD.z));
+    const Vec3f up(float(upD.x), float(upD.y), float(upD.z));
     float halfH = static_cast<float>(std::tan(0.5 * camera.viewAngle * kDegToRad));
     float halfW = halfH * static_cast<float>(width) / static_cast<float>(height);
     CameraRays rays;

@@ -18,6 +18,12 @@ struct Camera {
     float viewAngle = 30.f;
 };
 
+/// Smallest and largest vertical view angle in degrees a camera may have: narrower views make
+/// every pixel's ray the same direction to float precision, and 180 degrees and beyond have no
+/// image plane (ParaView allows up to 179).
+inline constexpr float kMinViewAngle = 0.01f;
+inline constexpr float kMaxViewAngle = 179.f;
+
 /// ParaView's "reset camera" for the bounds: looking down -Z with +Y up, view angle 30 degrees,
 /// the bounding sphere fitted to the view (also horizontally when aspect = width/height < 1).
 Camera resetCamera(const Bounds3f& bounds, float aspect);
@@ -31,7 +37,8 @@ Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg);
 Camera loadPvcc(const std::string& path);
 
 /// Throws Error(Argument) when the camera cannot produce an image: non-finite values, position
-/// equal to the focal point, view up parallel to the view direction, angle outside (0, 180).
+/// equal to the focal point, view up parallel to the view direction, angle outside
+/// [kMinViewAngle, kMaxViewAngle].
 void validateCamera(const Camera& camera);
 
 /// Precomputed primary-ray generator for a width x height image; plain data for CPU and GPU.

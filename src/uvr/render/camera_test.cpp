@@ -177,9 +177,11 @@ TEST(Camera, ValidateRejectsDegenerateCameras) {
     c = Camera{}, c.focalPoint = c.position, cases.push_back({c, "equals the focal point"});
     c = Camera{}, c.viewUp = {0.f, 0.f, 2.f}, cases.push_back({c, "parallel"});
     c = Camera{}, c.viewUp = {0.f, 0.f, 0.f}, cases.push_back({c, "parallel"});
-    c = Camera{}, c.viewAngle = 0.f, cases.push_back({c, "(0, 180)"});
-    c = Camera{}, c.viewAngle = 180.f, cases.push_back({c, "(0, 180)"});
-    c = Camera{}, c.viewAngle = -10.f, cases.push_back({c, "(0, 180)"});
+    c = Camera{}, c.viewAngle = 0.f, cases.push_back({c, "[0.01, 179]"});
+    c = Camera{}, c.viewAngle = 1e-30f, cases.push_back({c, "[0.01, 179]"});
+    c = Camera{}, c.viewAngle = 179.5f, cases.push_back({c, "[0.01, 179]"});
+    c = Camera{}, c.viewAngle = 180.f, cases.push_back({c, "[0.01, 179]"});
+    c = Camera{}, c.viewAngle = -10.f, cases.push_back({c, "[0.01, 179]"});
     for (const Case& k : cases) {
         Error e = catchError([&] { validateCamera(k.cam); });
         EXPECT_EQ(e.kind(), ErrorKind::Argument) << e.what();
@@ -239,6 +241,33 @@ TEST(Camera, LoadsParaViewCameraFile) {
     EXPECT_FLOAT_EQ(cam.viewAngle, 22.5f);
 }
 
+TEST(Camera, Utf16CameraFilesReadTheSameAndUtf32IsRefused) {
+    // XML processors must read UTF-16 (XML 1.0, Sec. 4.3.3); expat does, with or without a
+    // byte-order mark. A UTF-16 file that declares itself UTF-8 gets a hint.
+    const std::string dir = scratchDir();
+    const std::string text = pvcc(kPosition, "22.5");
+    const auto utf16 = [](const std::string& ascii, bool bigEndian, bool bom) {
+        std::string out = bom ? (bigEndian ? "\xFE\xFF" : "\xFF\xFE") : "";
+        for (char c : ascii) out += bigEndian ? std::string{'\0', c} : std::string{c, '\0'};
+        return out;
+    };
+    const Camera want = loadPvcc(writeFile(dir + "/utf8.pvcc", text));
+    for (const bool be : {false, true})
+        for (const bool bom : {false, true}) {
+            const Camera got = loadPvcc(writeFile(dir + "/utf16.pvcc", utf16(text, be, bom)));
+            expectVec(got.position, want.position, 0.f, "position");
+            expectVec(got.viewUp, want.viewUp, 0.f, "view up");
+            EXPECT_EQ(got.viewAngle, want.viewAngle);
+        }
+    std::string declared = text;
+    declared.replace(0, 21, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>");
+    const std::string path = writeFile(dir + "/declared.pvcc", utf16(declared, false, true));
+    const Error e = catchError([&] { loadPvcc(path); });
+    EXPECT_EQ(e.kind(), ErrorKind::Parse);
+    EXPECT_THAT(e.what(), HasSubstr(path + ": line 1: "));
+    EXPECT_THAT(e.what(), HasSubstr("UTF-16 text; save the camera file as UTF-8"));
+}
+
 TEST(Camera, BadCameraFilesNameFileAndProperty) {
     std::string dir = scratchDir();
     std::string twoElements = R"(<Element index="0" value="1"/><Element index="1" value="2"/>)";
@@ -250,6 +279,8 @@ TEST(Camera, BadCameraFilesNameFileAndProperty) {
     missing.erase(from, to - from);
     std::string parallel = pvcc(kPosition);
     parallel.replace(parallel.find("value=\"0\"/>\n      <Domain"), 9, "value=\"1\"");
+    std::string declared = pvcc(kPosition);
+    declared.replace(declared.find("number_of_elements=\"3\""), 22, "number_of_elements=\"4\"");
     struct Case {
         const char* name;
         std::string text;
@@ -258,17 +289,29 @@ TEST(Camera, BadCameraFilesNameFileAndProperty) {
         const char* what;
     };
     const Case cases[] = {
-        {"missing", missing, ErrorKind::Parse, "property CameraViewUp", "found none"},
+        {"missing", missing, ErrorKind::Parse, "line 2: property CameraViewUp", "found none"},
         {"count", pvcc(twoElements), ErrorKind::Parse, "line 4: property CameraPosition",
          "expected 3 element(s), got 2"},
         {"word", pvcc(word), ErrorKind::Parse, "property CameraPosition",
          "element 1: expected a finite number, got \"abc\""},
-        {"angle", pvcc(kPosition, "180"), ErrorKind::Parse, "view angle", "(0, 180)"},
+        {"angle", pvcc(kPosition, "180"), ErrorKind::Parse, "line 2: ", "[0.01, 179] degrees"},
+        {"tinyangle", pvcc(kPosition, "1e-30"), ErrorKind::Parse, "line 2: ", "got 1e-30"},
+        // number_of_elements disagreeing with the elements present (was "expected 3 element(s),
+        // got 3").
+        {"declared", declared, ErrorKind::Parse, "line 4: property CameraPosition",
+         "expected number_of_elements=\"3\", got \"4\""},
+        // Character references put control characters into values: quoted escaped, one line.
+        {"controls", pvcc(R"(<Element index="0" value="1"/><Element index="1" value="x&#10;y&#9;z"/>
+      <Element index="2" value="3"/>)"),
+         ErrorKind::Parse, "line 4: property CameraPosition", "got \"x\\ny\\tz\""},
         {"notxml", "CameraPosition 1 2 3\n", ErrorKind::Parse, "line 1", "expected XML"},
         {"unclosed", pvcc(kPosition).substr(0, 300), ErrorKind::Parse, "line ", "expected XML"},
         {"otherxml", "<?xml version=\"1.0\"?>\n<VTKFile/>\n", ErrorKind::Parse, "line 1",
          "PVCameraConfiguration"},
-        {"parallel", parallel, ErrorKind::Unsupported, "CameraParallelProjection", "parallel"},
+        {"parallel", parallel, ErrorKind::Unsupported, "line 25: property CameraParallelProjection",
+         "parallel"},
+        {"utf32", std::string("\xFF\xFE\0\0<\0\0\0", 8), ErrorKind::Parse, "byte 0",
+         "UTF-32 text is not supported; save the camera file as UTF-8"},
     };
     for (const Case& c : cases) {
         std::string path = writeFile(dir + "/" + c.name + ".pvcc", c.text);
@@ -277,6 +320,7 @@ TEST(Camera, BadCameraFilesNameFileAndProperty) {
         EXPECT_THAT(e.what(), HasSubstr(path + ": ")) << c.name;
         EXPECT_THAT(e.what(), HasSubstr(c.where)) << c.name;
         EXPECT_THAT(e.what(), HasSubstr(c.what)) << c.name;
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << c.name;
     }
     Error e = catchError([&] { loadPvcc(dir + "/absent.pvcc"); });
     EXPECT_EQ(e.kind(), ErrorKind::Io);

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -415,6 +416,201 @@ TEST(HostileMesh, RaysExactlyAlongFacesEdgesAndSplitPlanesLoseNothing) {
             EXPECT_EQ(bad, 0) << method.name << (jittered ? " jittered" : " regular");
         }
     }
+}
+
+TEST(HostileMesh, FieldSpanningTheFloatRangeRendersLikeTheSameFieldScaledDown) {
+    // A linear field from -S to S over a 2^3 hexahedron grid: the transfer function spans the
+    // field's range, so the image must not depend on S. At S = 3e38 and FLT_MAX the range's
+    // width overflows float (it used to make the table index NaN and crash every integrator).
+    const auto meshScaled = [](float scale) {
+        return testing::makeHexGrid(2, 0.f, 1.f, [scale](Vec3f p) {
+            return p.x >= 1.f ? scale : (p.x <= 0.f ? -scale : (2.f * p.x - 1.f) * scale);
+        });
+    };
+    const Mesh unit = meshScaled(1.f);
+    RenderSettings s;
+    s.width = s.height = 24;
+    s.camera = obliqueCamera(kUnitBox);
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "0:0.1,0.5:0.9,1:0.3");
+    for (const Method& method : kMethods) {
+        s.method = method.method;
+        s.adaptive = method.adaptive;
+        const RenderResult want = renderCpu(prepare(unit, 4), s);
+        for (const float scale : {3e38f, std::numeric_limits<float>::max()}) {
+            const RenderResult got = renderCpu(prepare(meshScaled(scale), 4), s);
+            EXPECT_EQ(got.setup.rangeLo, -scale);
+            EXPECT_EQ(got.setup.rangeHi, scale);
+            int visible = 0;
+            for (int y = 0; y < s.height; ++y)
+                for (int x = 0; x < s.width; ++x) {
+                    const Vec4f gv = got.image.at(x, y), wv = want.image.at(x, y);
+                    const float g[4] = {gv.x, gv.y, gv.z, gv.w}, w[4] = {wv.x, wv.y, wv.z, wv.w};
+                    for (int c = 0; c < 4; ++c) {
+                        ASSERT_TRUE(std::isfinite(g[c])) << method.name << " " << scale;
+                        ASSERT_NEAR(g[c], w[c], 1e-3f)
+                            << method.name << " " << scale << " pixel (" << x << ", " << y << ")";
+                    }
+                    visible += gv.w > 0.05f;
+                }
+            EXPECT_GT(visible, 100) << method.name << " " << scale;
+        }
+    }
+}
+
+/// The grid [-0.5, 0.5]^3 of 4^3 hexahedra (diagonal sqrt(3), in [1, 2): it renders unscaled and
+/// unmoved) mapped by p * scale + offset, with a point field varying across it; every coordinate
+/// is exact in float for the scales and offsets used below.
+Mesh gridScaledAndMoved(float scale, Vec3f offset) {
+    Mesh m = hexGridOnPlanes(uniformPlanes(4, -0.5f, 0.5f));
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+        const Vec3f p = m.points[i];
+        m.fields[0].values[i] = p.x + 2.f * p.y - p.z;
+        m.points[i] = p * scale + offset;
+    }
+    return m;
+}
+
+TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
+    // Coordinates near 1e38 (its default camera lies beyond float's range), 1e-30 and 1e-42
+    // (denormal: cubed edges underflow float), and meshes far from the origin for their size
+    // (float spacing 1/8 at 2^20): each renders scaled by a power of two and moved exactly onto
+    // the unit grid, so the images are the unit grid's bit for bit. They used to be refused
+    // with a camera at inf, "empty bounds" or "-9223372036854775808 steps".
+    struct Case {
+        float scale;
+        Vec3f offset;
+        bool exactCamera;  // the explicit camera maps exactly onto the unit grid's
+    };
+    const float far = std::ldexp(1.f, 20);
+    const Case cases[] = {{std::ldexp(1.f, 127), Vec3f(0.f), false},
+                          {std::ldexp(1.f, 126), Vec3f(0.f), true},
+                          {std::ldexp(1.f, -100), Vec3f(0.f), true},
+                          {std::ldexp(1.f, -140), Vec3f(0.f), false},
+                          {1.f, Vec3f(far, 0.f, -far), false},
+                          {std::ldexp(1.f, -100), Vec3f(0.f, std::ldexp(1.f, -80), 0.f), false}};
+    const Mesh unit = gridScaledAndMoved(1.f, Vec3f(0.f));
+    const PreparedMesh unitPm = prepare(unit, 16);
+    ASSERT_TRUE(unitPm.tets.frame.identity());
+    const Bounds3f box{Vec3f(-0.5f), Vec3f(0.5f)};
+    const Camera oblique = obliqueCamera(box);
+    RenderSettings s;
+    s.width = 24;
+    s.height = 20;
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "0:0.1,0.5:0.9,1:0.3");
+    for (const Method& method : kMethods) {
+        s.method = method.method;
+        s.adaptive = method.adaptive;
+        for (const bool explicitCamera : {false, true}) {
+            RenderSettings want = s;
+            if (explicitCamera) want.camera = oblique;
+            const RenderResult w = renderCpu(unitPm, want);
+            int visible = 0;
+            for (int y = 0; y < s.height; ++y)
+                for (int x = 0; x < s.width; ++x) visible += w.image.at(x, y).w > 0.05f;
+            EXPECT_GT(visible, 100) << method.name;
+            for (const Case& c : cases) {
+                if (explicitCamera && !c.exactCamera) continue;
+                const PreparedMesh pm = prepare(gridScaledAndMoved(c.scale, c.offset), 16);
+                ASSERT_EQ(pm.tets.tets.size(), unitPm.tets.tets.size()) << c.scale;
+                EXPECT_FALSE(pm.tets.frame.identity()) << c.scale;
+                RenderSettings got = s;
+                if (explicitCamera) {
+                    got.camera = oblique;
+                    got.camera->position = oblique.position * c.scale + c.offset;
+                    got.camera->focalPoint = oblique.focalPoint * c.scale + c.offset;
+                }
+                const RenderResult g = renderCpu(pm, got);
+                const std::string what = std::string(method.name) + " scale " +
+                                         std::to_string(std::log2(c.scale)) +
+                                         (explicitCamera ? " explicit camera" : " default camera");
+                EXPECT_FLOAT_EQ(g.setup.params.step / pm.tets.frame.scale,
+                                w.setup.params.step * c.scale)
+                    << what;
+                int differ = 0;
+                for (int y = 0; y < s.height; ++y)
+                    for (int x = 0; x < s.width; ++x) {
+                        const Vec4f a = g.image.at(x, y), b = w.image.at(x, y);
+                        differ += !(a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w);
+                    }
+                EXPECT_EQ(differ, 0) << what;
+            }
+        }
+    }
+}
+
+TEST(HostileMesh, CameraFarFromATinyMeshIsRefusedInStepsItCanCount) {
+    // A mesh 1e-30 across and a camera 1 away: 1.8e31 steps, which overflowed the message's
+    // integer ("the camera is -9223372036854775808 steps of 0.000000").
+    const PreparedMesh pm = prepare(gridScaledAndMoved(std::ldexp(1.f, -100), Vec3f(0.f)));
+    Camera far;
+    far.position = {0.f, 0.f, 1.f};
+    const RenderSettings s = constantSettings(far, 8, 8);
+    const Error e = testing::catchError([&] { (void)renderCpu(pm, s); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the camera is 1.84e+31 steps of 5.43e-32 from the far side"),
+              std::string::npos)
+        << what;
+}
+
+TEST(HostileMesh, ThinSlabRendersTheExactImage) {
+    // A slab 1e-6 thick (its cells 1e-6 of their width, well above the zero-volume threshold),
+    // seen edge-on: rays along the middle row run inside it.
+    Mesh m = hexGridOnPlanes(uniformPlanes(4, 0.f, 1.f));
+    for (Vec3f& p : m.points) p.z *= 1e-6f;
+    const Bounds3f box{Vec3f(0.f), Vec3f(1.f, 1.f, 1e-6f)};
+    const PreparedMesh pm = prepare(m);
+    ASSERT_EQ(pm.tets.tets.size(), 6u * 64u);
+    Camera edgeOn;
+    edgeOn.position = {-1.2f, -0.7f, 0.5e-6f};
+    edgeOn.focalPoint = {0.5f, 0.5f, 0.5e-6f};
+    edgeOn.viewUp = {0.f, 0.f, 1.f};
+    EXPECT_GT(renderAndCheck(pm, constantSettings(edgeOn, 21, 9), box), 10);
+    // The default camera looks through it (at most one sample per ray): it renders.
+    RenderSettings s = constantSettings(edgeOn, 21, 9);
+    s.camera.reset();
+    EXPECT_NO_THROW((void)renderCpu(pm, s));
+}
+
+TEST(HostileMesh, MeshWithNothingToRenderIsRefusedOrTransparent) {
+    // One sliver 1e-7 thick (below the zero-volume threshold: its volume is rounding noise in
+    // float) and four identical points: no tetrahedron is left. The default camera has nothing
+    // to frame (it used to say "cannot reset the camera to empty or non-finite bounds"); a
+    // given camera sees nothing.
+    for (const Vec3f apex : {Vec3f(0.3f, 0.3f, 1e-7f), Vec3f(0.f)}) {
+        Mesh m;
+        m.points = {{0, 0, 0}, apex == Vec3f(0.f) ? apex : Vec3f(1, 0, 0),
+                    apex == Vec3f(0.f) ? apex : Vec3f(0, 1, 0), apex};
+        const std::uint32_t ids[4] = {0, 1, 2, 3};
+        m.addCell(CellType::Tetra, ids);
+        m.fields.push_back({"f", Association::Point, 1, {1.f, 1.f, 1.f, 1.f}});
+        const PreparedMesh pm = prepare(m);
+        ASSERT_TRUE(pm.tets.tets.empty());
+        RenderSettings s = constantSettings(obliqueCamera(kUnitBox), 8, 8);
+        for (const Method& method : kMethods) {
+            s.method = method.method;
+            s.adaptive = method.adaptive;
+            const RenderResult r = renderCpu(pm, s);
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x) EXPECT_EQ(r.image.at(x, y).w, 0.f) << method.name;
+        }
+        s.camera.reset();
+        const Error e = testing::catchError([&] { (void)renderCpu(pm, s); });
+        EXPECT_NE(std::string(e.what()).find("no cell of non-zero volume"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(HostileMesh, DefaultStepOfAMeshOfSliversIsAtLeastATenThousandthOfTheDiagonal) {
+    TetMesh t;
+    t.tets.resize(1000);
+    t.totalVolume = 1e-12;  // mean 1e-15: a step of 5e-6 without the floor
+    t.bounds = kUnitBox;
+    EXPECT_FLOAT_EQ(defaultStep(t), float(kMinDefaultStepFraction * std::sqrt(3.0)));
+    t.totalVolume = 1.0 / 6;  // an ordinary mean: 0.5 cbrt(1 / 6000)
+    EXPECT_FLOAT_EQ(defaultStep(t), float(0.5 * std::cbrt(1.0 / 6000)));
 }
 
 }  // namespace

@@ -8,9 +8,11 @@
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/output_file.h"
 
 namespace uvr {
 
@@ -53,9 +55,30 @@ std::uint8_t toByte(float v) {
     return static_cast<std::uint8_t>(std::lround(v * 255.f));
 }
 
+/// Where encodePng's bytes go: an output file, with the first failure kept for rethrowing.
+struct PngSink {
+    OutputFile* out = nullptr;
+    std::exception_ptr failure;
+};
+
+/// libpng's write callback: bytes into the output; a failure is kept and ends the encoding.
+void writeToSink(png_structp png, png_bytep data, png_size_t count) {
+    auto* sink = static_cast<PngSink*>(png_get_io_ptr(png));
+    bool failed = false;
+    try {
+        sink->out->write(data, count);
+    } catch (...) {
+        sink->failure = std::current_exception();
+        failed = true;
+    }
+    if (failed) png_error(png, "write failed");  // longjmp: no C++ object is alive here
+}
+
+void flushSink(png_structp) {}
+
 /// libpng write with setjmp error handling; no C++ objects live in this frame. Returns false
 /// with state.message set on failure.
-bool encodePng(std::FILE* file, int width, int height, bool alpha, png_bytep* rows,
+bool encodePng(PngSink& sink, int width, int height, bool alpha, png_bytep* rows,
                PngErrorState& state) {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &state, pngError, pngWarning);
     if (!png) {
@@ -69,7 +92,7 @@ bool encodePng(std::FILE* file, int width, int height, bool alpha, png_bytep* ro
         png_destroy_write_struct(&png, info ? &info : nullptr);
         return false;
     }
-    png_init_io(png, file);
+    png_set_write_fn(png, &sink, writeToSink, flushSink);
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                  alpha ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -163,19 +186,13 @@ void writePng(const std::string& path, const Image& image, const std::optional<V
     for (int y = 0; y < image.height; ++y)
         rows[y] = &bytes[static_cast<size_t>(y) * image.width * channels];
 
-    writeFileAtomically(path, [&](const std::string& tmp) {
-        std::FILE* file = std::fopen(tmp.c_str(), "wb");
-        if (!file) {
-            throwError(ErrorKind::Io, path, std::string("cannot write: ") + std::strerror(errno));
-        }
-        PngErrorState state;
-        bool ok = encodePng(file, image.width, image.height, alpha, rows.data(), state);
-        bool closed = std::fclose(file) == 0;
-        if (!ok) throwError(ErrorKind::Io, path, std::string("PNG write failed: ") + state.message);
-        if (!closed) {
-            throwError(ErrorKind::Io, path, std::string("cannot write: ") + std::strerror(errno));
-        }
-    });
+    OutputFile out(path);
+    PngSink sink{&out, nullptr};
+    PngErrorState state;
+    const bool ok = encodePng(sink, image.width, image.height, alpha, rows.data(), state);
+    if (sink.failure) std::rethrow_exception(sink.failure);
+    if (!ok) throwError(ErrorKind::Io, path, std::string("PNG write failed: ") + state.message);
+    out.commit();
 }
 
 Image readPng(const std::string& path) {

@@ -2,8 +2,11 @@
 #include "uvr/render/render_setup.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
@@ -77,9 +80,11 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field) {
 }
 
 float defaultStep(const TetMesh& mesh) {
+    const double diagonal = mesh.bounds.diagonal();
     if (mesh.tets.empty() || !(mesh.totalVolume > 0.0))
-        return 0.01f * std::fmax(mesh.bounds.diagonal(), 1e-30f);
-    return static_cast<float>(0.5 * std::cbrt(mesh.totalVolume / double(mesh.tets.size())));
+        return diagonal > 0.0 ? static_cast<float>(0.01 * diagonal) : 1.f;
+    const double mean = 0.5 * std::cbrt(mesh.totalVolume / double(mesh.tets.size()));
+    return static_cast<float>(std::max(mean, kMinDefaultStepFraction * diagonal));
 }
 
 float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount) {
@@ -160,6 +165,43 @@ namespace {
 /// grid points in float, which counts exactly only up to 2^24.
 constexpr double kMaxGridSteps = 16e6;
 
+std::string fmtG(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return buf;
+}
+
+/// Refuses a frame whose estimated work (every ray across the bounds' diagonal) exceeds
+/// kMaxSamplesPerRay or kMaxFrameSamples, naming the step that would be accepted.
+void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, float step) {
+    const Bounds3f& bounds = mesh.tets.bounds;
+    const FrameWork w = estimateFrameWork(bounds, step, settings.width, settings.height);
+    if (w.samplesPerRay <= kMaxSamplesPerRay && w.samples <= kMaxFrameSamples) return;
+    const double pixels = double(settings.width) * settings.height;
+    // Lengths shown in the file's units (the mesh renders scaled by frame.scale).
+    const double unit = 1.0 / mesh.tets.frame.scale;
+    const double diagonal = bounds.diagonal() * unit;
+    // The smallest step within both caps, rounded up to two significant digits.
+    const double least =
+        std::max(diagonal / kMaxSamplesPerRay, diagonal * pixels / kMaxFrameSamples);
+    const double scale = std::pow(10.0, std::floor(std::log10(least)) - 1.0);
+    const double suggest = std::ceil(least / scale * 1.0001) * scale;
+    const std::string what = settings.step > 0.f
+                                 ? "--step " + fmtG(step * unit)
+                                 : "the default step " + fmtG(step * unit) +
+                                       " (from the mean cell size)";
+    throwError(ErrorKind::Argument, "",
+               what + " would take up to " + fmtG(w.samples) + " samples (" +
+                   std::to_string(settings.width) + "x" + std::to_string(settings.height) +
+                   " pixels x " + fmtG(w.samplesPerRay) + " per ray across the bounds' diagonal " +
+                   fmtG(diagonal) + "), more than the " +
+                   (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
+                                                        : "10^12 samples per frame") +
+                   " allowed: use --step " + fmtG(suggest) + " or larger" +
+                   (settings.step > 0.f ? " (the default here is " + fmtG(defaultStep(mesh.tets) * unit) + ")"
+                                        : std::string()));
+}
+
 }  // namespace
 
 FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
@@ -170,20 +212,75 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
     f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
     const float aspect = float(settings.width) / float(settings.height);
-    f.camera = settings.camera ? *settings.camera : resetCamera(mesh.tets.bounds, aspect);
-    validateCamera(f.camera);
-    f.rays = makeCameraRays(f.camera, settings.width, settings.height);
-    f.params.step = settings.step > 0.f ? settings.step : defaultStep(mesh.tets);
+    // Settings are in the file's units; the prepared mesh is in rendering units (mesh.tets.frame:
+    // the identity unless the mesh is very large, very small or far from the origin).
+    const MeshFrame& frame = mesh.tets.frame;
+    f.frame = frame;
+    const Bounds3f& bounds = mesh.tets.bounds;
+    const bool empty = mesh.tets.tets.empty();
+    if (empty && !settings.camera)
+        throwError(ErrorKind::Argument, "",
+                   "the mesh has no cell of non-zero volume (every cell is flat or uses NaN/Inf "
+                   "points): nothing to render");
+    const auto toLocal = [&](float length, const char* flag) {
+        const double v = double(length) * frame.scale;
+        if (!frame.identity() && !(v >= double(FLT_MIN) && v <= double(FLT_MAX)))
+            throwError(ErrorKind::Argument, "",
+                       std::string(flag) + " " + fmtG(length) +
+                           ": out of float32 range against the mesh, which renders scaled by " +
+                           fmtG(frame.scale) + " (it is " + fmtG(bounds.diagonal() / frame.scale) +
+                           " across)");
+        return static_cast<float>(v);
+    };
+    f.params.step = settings.step > 0.f ? toLocal(settings.step, "--step") : defaultStep(mesh.tets);
     f.params.opacityUnit = settings.opacityUnit > 0.f
-                               ? settings.opacityUnit
-                               : defaultOpacityUnit(mesh.tets.bounds, mesh.sourceCells);
+                               ? toLocal(settings.opacityUnit, "--opacity-unit")
+                               : defaultOpacityUnit(bounds, mesh.sourceCells);
     f.params.terminationAlpha = settings.terminationAlpha;
-    // A ray of the bounds' diagonal must not need more samples than a float counts exactly.
-    f.maxStep = settings.maxStep > 0.f ? settings.maxStep : kDefaultMaxStepFactor * f.params.step;
+    f.maxStep = settings.maxStep > 0.f
+                    ? toLocal(settings.maxStep, "--max-step")
+                    : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
         throwError(ErrorKind::Argument, "",
-                   "--max-step " + std::to_string(f.maxStep) + " is below --step " +
-                       std::to_string(f.params.step) + " (s2 must be >= s1)");
+                   "--max-step " + fmtG(f.maxStep / frame.scale) + " is below --step " +
+                       fmtG(f.params.step / frame.scale) + " (s2 must be >= s1)");
+    // The camera in rendering units (the reset camera is in them already), in double until it
+    // is known to fit float.
+    const Camera given = settings.camera ? *settings.camera : resetCamera(bounds, aspect);
+    const MeshFrame cameraFrame = settings.camera ? frame : MeshFrame{};
+    double position[3], focal[3];
+    cameraFrame.toLocal(given.position, position);
+    cameraFrame.toLocal(given.focalPoint, focal);
+    // The integrators count sample grid points k = t / s1 from the camera in float: at 2^24 and
+    // beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
+    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
+    if (!empty) {
+        double farthest = 0.0;
+        for (int c = 0; c < 8; ++c) {
+            const Vec3f corner((c & 1) ? bounds.hi.x : bounds.lo.x,
+                               (c & 2) ? bounds.hi.y : bounds.lo.y,
+                               (c & 4) ? bounds.hi.z : bounds.lo.z);
+            double d2 = 0.0;
+            for (int a = 0; a < 3; ++a) d2 += (corner[a] - position[a]) * (corner[a] - position[a]);
+            farthest = std::max(farthest, std::sqrt(d2));
+        }
+        const double steps = farthest / f.params.step;
+        if (!(steps <= kMaxGridSteps))
+            throwError(ErrorKind::Argument, "",
+                       "the camera is " + fmtG(steps) + " steps of " +
+                           fmtG(f.params.step / frame.scale) +
+                           " from the far side of the mesh (at most 16 million): move the camera "
+                           "closer (and widen --view-angle) or use a larger --step");
+    }
+    f.camera = given;
+    f.camera.position = Vec3f(float(position[0]), float(position[1]), float(position[2]));
+    f.camera.focalPoint = Vec3f(float(focal[0]), float(focal[1]), float(focal[2]));
+    if (!isFinite(f.camera.position) || !isFinite(f.camera.focalPoint))
+        throwError(ErrorKind::Argument, "",
+                   "the camera lies beyond float32 range from the mesh, which renders scaled by " +
+                       fmtG(frame.scale) + ": move the camera closer");
+    validateCamera(f.camera);
+    f.rays = makeCameraRays(f.camera, settings.width, settings.height);
     if (settings.method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
     if (settings.method == RenderMethod::Reference && mesh.bvh.nodes.empty() &&
@@ -198,30 +295,34 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                             settings.power, settings.adaptive);
         f.tfUpdateSeconds = secondsSince(start);
     }
-    // The integrators count sample grid points k = t / s1 from the camera in float: at 2^24 and
-    // beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
-    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
-    double farthest = 0.0;
-    for (int c = 0; c < 8; ++c) {
-        const Bounds3f& b = mesh.tets.bounds;
-        const Vec3f corner((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y,
-                           (c & 4) ? b.hi.z : b.lo.z);
-        farthest = std::max(farthest, double(length(corner - f.camera.position)));
-    }
-    if (farthest / f.params.step > kMaxGridSteps)
-        throwError(ErrorKind::Argument, "",
-                   "the camera is " +
-                       std::to_string(static_cast<long long>(farthest / f.params.step)) +
-                       " steps of " + std::to_string(f.params.step) +
-                       " from the far side of the mesh (at most 16 million): move the camera "
-                       "closer (and widen --view-angle) or use a larger --step");
-    const double samplesPerRay = mesh.tets.bounds.diagonal() / f.params.step;
-    if (samplesPerRay > 1e7)
-        throwError(ErrorKind::Argument, "",
-                   "--step " + std::to_string(f.params.step) + " would take " +
-                       std::to_string(static_cast<long long>(samplesPerRay)) +
-                       " samples per ray (at most 10 million)");
+    checkFrameWork(mesh, settings, f.params.step);
     return f;
+}
+
+FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height) {
+    FrameWork w;
+    const double diagonal = bounds.empty() ? 0.0 : bounds.diagonal();
+    if (!(diagonal > 0.0)) return w;
+    w.samplesPerRay = step > 0.f ? diagonal / step : INFINITY;
+    w.samples = w.samplesPerRay * std::max(width, 0) * std::max(height, 0);
+    return w;
+}
+
+void FrameProgress::partDone() {
+    const std::int64_t done = done_.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (!report_ || done >= total_ || !reporting_.try_lock()) return;
+    const double fraction = double(done_.load(std::memory_order_relaxed)) / double(total_);
+    if (fraction > reported_ && fraction < 1.0) {
+        reported_ = fraction;
+        report_(fraction);
+    }
+    reporting_.unlock();
+}
+
+void FrameProgress::finish() {
+    const std::lock_guard<std::mutex> lock(reporting_);
+    if (report_) report_(1.0);
+    reported_ = 1.0;
 }
 
 }  // namespace uvr

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -67,8 +69,14 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
 PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field);
 
 /// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume,
-/// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray.
+/// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray;
+/// at least kMinDefaultStepFraction of the bounds' diagonal (a mesh of slivers has a tiny mean
+/// volume).
 float defaultStep(const TetMesh& mesh);
+
+/// Smallest default step relative to the bounds' diagonal: at most 10^4 samples across the mesh
+/// (a uniform mesh reaches this at about 2 * 10^10 tetrahedra).
+inline constexpr double kMinDefaultStepFraction = 1e-4;
 
 /// ParaView's default ScalarOpacityUnitDistance: bounds diagonal / cbrt(cell count).
 float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount);
@@ -95,11 +103,63 @@ struct RenderSettings {
     float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
     float terminationAlpha = 0.99f;
     int tfTableSize = 1024;  ///< entries of the baked transfer function
+    /// Called during a CPU render with the fraction of the frame done, increasing, the last call
+    /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
+    /// is one launch and reports nothing.)
+    std::function<void(double)> progress;
 };
 
 /// Throws Error(Argument) for settings that cannot render: image size outside [1, 16384] per
 /// side, non-finite or non-positive step or opacity unit, bad range, bad camera.
 void validateSettings(const RenderSettings& settings);
+
+/// Most samples one ray may take across the mesh bounds' diagonal at the step s1: the default
+/// step takes 2 to 3 samples per cell, so this is a step 40 times finer than the default on a
+/// mesh of a billion cells; finer steps are far smaller than any cell and change nothing seen.
+inline constexpr double kMaxSamplesPerRay = 1e5;
+/// Most samples a frame may take (pixels x samples per ray): about an hour for 16 CPU cores
+/// (2e7 samples per second each), minutes on a GPU.
+inline constexpr double kMaxFrameSamples = 1e12;
+
+/// Upper bound on the work of a frame: every pixel's ray crossing the bounds' whole diagonal.
+struct FrameWork {
+    double samplesPerRay = 0.0;  ///< bounds diagonal / step
+    double samples = 0.0;        ///< pixels x samplesPerRay
+};
+
+/// The work estimate of a width x height frame of the bounds at a step.
+FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height);
+
+/// Host bytes per pixel of a frame rendered and written as a PNG: the float image (16), the
+/// per-pixel sample counts (4) and the PNG's 8-bit rows (4).
+inline constexpr std::uint64_t kFrameBytesPerPixel = 24;
+/// Host bytes per pixel of a sample-count heat map written as a PNG (float image and 8-bit rows),
+/// counted over the image and its legend.
+inline constexpr std::uint64_t kHeatmapBytesPerPixel = 20;
+/// Host bytes prepareMesh needs per tetrahedron, an upper estimate for memory limits: the
+/// tetrahedra, the BVH with its build arrays, the neighbours, partitions and seed grids took
+/// 120 to 130 bytes on 4-million-tetrahedron procedural meshes.
+inline constexpr std::uint64_t kPrepareBytesPerTet = 160;
+
+/// Counts finished parts of a frame from many threads and reports the fraction done to a
+/// callback (RenderSettings::progress) from one thread at a time, increasing; finish() reports 1.
+class FrameProgress {
+public:
+    /// Reports to `report` (may be empty: nothing is reported) out of `total` parts.
+    FrameProgress(const std::function<void(double)>& report, std::int64_t total)
+        : report_(report), total_(total > 0 ? total : 1) {}
+    /// Marks one part done (thread-safe) and reports unless another thread is reporting.
+    void partDone();
+    /// Reports 1 (call after the parallel loop).
+    void finish();
+
+private:
+    std::function<void(double)> report_;
+    std::int64_t total_;
+    std::atomic<std::int64_t> done_{0};
+    std::mutex reporting_;
+    double reported_ = 0.0;
+};
 
 /// Default s2 / s1 of the adaptive step.
 inline constexpr float kDefaultMaxStepFactor = 16.f;
@@ -119,6 +179,9 @@ struct FrameSetup {
     std::vector<PartitionShading> shading;  ///< per partition (partition method only)
     double tfUpdateSeconds = 0.0;           ///< range tables + shading of all partitions
     float maxStep = 0.f;                    ///< s2 in effect
+    /// The prepared mesh's frame: camera, rays, params and maxStep are in its rendering units
+    /// (lengths divided by frame.scale are in the file's units).
+    MeshFrame frame;
     Camera camera;
     CameraRays rays;
     MarchParams params;

@@ -6,6 +6,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/text.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {
@@ -25,11 +26,46 @@ std::string lower(std::string s) {
     return s;
 }
 
-/// A short, one-line rendering of a JSON value for error messages.
+/// Deepest nesting of arrays and objects accepted (ParaView's exports nest 3 levels).
+constexpr int kMaxJsonDepth = 64;
+
+/// A short, one-line rendering of a JSON value for error messages: scalars as JSON (strings
+/// cut to about 40 characters, invalid UTF-8 and control characters escaped), arrays and
+/// objects by their size, so that no large or deeply nested value is ever serialised.
 std::string describe(const Json& v) {
-    std::string s = v.dump();
-    if (s.size() > 40) s = s.substr(0, 37) + "...";
-    return s;
+    if (v.is_array()) return "an array of " + std::to_string(v.size()) + " value(s)";
+    if (v.is_object()) return "an object with " + std::to_string(v.size()) + " key(s)";
+    if (v.is_string()) return "\"" + printableShort(v.get_ref<const std::string&>(), 38) + "\"";
+    return v.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+/// Refuses UTF-16 and UTF-32 text and arrays or objects nested deeper than kMaxJsonDepth
+/// (found by a scan of the brackets outside strings, before the parser sees them), naming the
+/// byte offset.
+void checkJsonShape(const std::string& path, const std::vector<char>& bytes) {
+    if (const char* wide = wideTextEncoding(bytes.data(), bytes.size()))
+        throwParseError(path, atByte(0),
+                        std::string(wide) + " text is not supported; save the colour map as UTF-8");
+    int depth = 0;
+    bool inString = false;
+    for (std::size_t i = 0; i < bytes.size(); ++i) {
+        const char c = bytes[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throwParseError(path, atByte(i),
+                                "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                                    " levels (a ParaView colour map nests 3)");
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
 }
 
 /// Reads a flat array of numbers whose length is a non-zero multiple of 4.
@@ -144,6 +180,7 @@ std::vector<ColorPoint> expandHsv(const std::vector<ColorPoint>& in) {
 
 TransferFunction loadParaViewColorMap(const std::string& path) {
     std::vector<char> bytes = readFileBytes(path, kMaxJsonBytes, "colour-map file");
+    checkJsonShape(path, bytes);
     Json doc;
     try {
         doc = Json::parse(bytes.begin(), bytes.end());
@@ -151,8 +188,9 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
         std::string msg = e.what();
         size_t bracket = msg.find("] ");
         if (bracket != std::string::npos) msg = msg.substr(bracket + 2);
-        throwParseError(path, atByte(e.byte),
-                        "expected JSON (a ParaView colour-map export), got " + msg);
+        throwParseError(
+            path, atByte(e.byte),
+            "expected JSON (a ParaView colour-map export), got " + printableShort(msg, 160));
     } catch (const Json::exception& e) {
         // A well-formed number too large for a double ("number overflow parsing '1e999'") is an
         // out_of_range error without an offset: find the quoted number in the file.
@@ -169,7 +207,7 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
         throwParseError(path, atByte(offset),
                         "expected JSON (a ParaView colour-map export) with numbers a double can "
                         "hold, got " +
-                            msg);
+                            printableShort(msg, 160));
     }
 
     // Step 1: the colour-map object (ParaView exports an array of them; the first is used).

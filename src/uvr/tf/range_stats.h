@@ -30,11 +30,8 @@ struct TfRangeView {
     /// end points, so the maximum is exact for the piecewise-linear function.
     UVR_HOST_DEVICE RangeStats query(float lo, float hi) const {
         const int n = table.count;
-        const float scale = table.hi > table.lo ? float(n - 1) / (table.hi - table.lo) : 0.f;
-        auto position = [&](float v) {
-            float f = (v - table.lo) * scale;
-            return f < 0.f ? 0.f : (f > float(n - 1) ? float(n - 1) : f);
-        };
+        // Positions in [0, n - 1] for any values (NaN, infinities, overflowing ranges).
+        auto position = [&](float v) { return tfTablePosition(v, table.lo, table.hi, n); };
         const float f0 = position(lo), f1 = position(hi < lo ? lo : hi);
         const Vec4f e0 = table.sample(lo), e1 = table.sample(hi < lo ? lo : hi);
         // Entries strictly between the end points: indices i0 .. i1 - 1.

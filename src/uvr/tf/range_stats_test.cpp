@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 namespace uvr {
@@ -12,9 +13,8 @@ namespace {
 /// strictly between them.
 RangeStats bruteForce(const TfTableView& t, float lo, float hi) {
     std::vector<Vec4f> pts{t.sample(lo), t.sample(hi)};
-    const float scale = float(t.count - 1) / (t.hi - t.lo);
-    const float f0 = std::clamp((lo - t.lo) * scale, 0.f, float(t.count - 1));
-    const float f1 = std::clamp((hi - t.lo) * scale, 0.f, float(t.count - 1));
+    const float f0 = tfTablePosition(lo, t.lo, t.hi, t.count);
+    const float f1 = tfTablePosition(hi, t.lo, t.hi, t.count);
     for (int i = 0; i < t.count; ++i)
         if (float(i) > f0 && float(i) < f1) pts.push_back(t.entries[i]);
     RangeStats s;
@@ -61,6 +61,47 @@ TEST(RangeStats, ConstantTableHasZeroVarianceAndRampMaxIsTheUpperEnd) {
     const TfRangeTables rt(r);
     EXPECT_NEAR(rt.view(r).query(0.2f, 0.355f).maxOpacity, 0.355f, 1e-6f);
     EXPECT_EQ(rt.view(r).query(-1.f, -0.5f).maxOpacity, 0.f);  // below the range: first entry
+}
+
+TEST(TfTablePosition, AnyInputGivesAPositionInsideTheTable) {
+    constexpr float kMax = std::numeric_limits<float>::max();
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    const float kNaN = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_FLOAT_EQ(tfTablePosition(0.5f, 0.f, 1.f, 11), 5.f);
+    // A range spanning the whole float range: its width overflows, its midpoint is the middle.
+    EXPECT_FLOAT_EQ(tfTablePosition(0.f, -kMax, kMax, 11), 5.f);
+    EXPECT_FLOAT_EQ(tfTablePosition(kMax, -kMax, kMax, 11), 10.f);
+    EXPECT_FLOAT_EQ(tfTablePosition(-kMax, -kMax, kMax, 11), 0.f);
+    EXPECT_FLOAT_EQ(tfTablePosition(1.5e38f, -3e38f, 3e38f, 5), 3.f);
+    // Out of range, infinite and NaN values and degenerate ranges: a position in [0, count - 1].
+    const float values[] = {-kInf, -kMax, -1e30f, -1.f, 0.f, 1e-45f, 1.f, 1e30f, kMax, kInf, kNaN};
+    const float bounds[] = {-kInf, -kMax, -1.f, 0.f, 1e-45f, 1.f, kMax, kInf, kNaN};
+    for (float v : values)
+        for (float lo : bounds)
+            for (float hi : bounds)
+                for (int count : {1, 2, 1024}) {
+                    const float f = tfTablePosition(v, lo, hi, count);
+                    ASSERT_TRUE(f >= 0.f && f <= float(count - 1))
+                        << f << " for " << v << " in [" << lo << ", " << hi << "], " << count;
+                }
+    EXPECT_EQ(tfTablePosition(kNaN, 0.f, 1.f, 8), 0.f);
+    EXPECT_EQ(tfTablePosition(kInf, 0.f, 1.f, 8), 7.f);
+    EXPECT_EQ(tfTablePosition(-kInf, 0.f, 1.f, 8), 0.f);
+    EXPECT_EQ(tfTablePosition(0.5f, 1.f, 0.f, 8), 0.f);  // inverted range: the first entry
+}
+
+TEST(TfTablePosition, SamplingAndRangeStatsOverTheWholeFloatRange) {
+    constexpr float kMax = std::numeric_limits<float>::max();
+    // Opacity only in the middle of the table: a partition spanning it must see it.
+    std::vector<Vec4f> e(64, Vec4f(0.f, 0.f, 0.f, 0.f));
+    e[32] = Vec4f(1.f, 1.f, 1.f, 0.75f);
+    const TfTableView t{e.data(), 64, -kMax, kMax};
+    const TfRangeTables tables(t);
+    EXPECT_EQ(tables.view(t).query(-kMax, kMax).maxOpacity, 0.75f);
+    EXPECT_EQ(tables.view(t).query(-3e38f, -1e38f).maxOpacity, 0.f);
+    EXPECT_GT(t.sample(1e36f).w, 0.f);
+    EXPECT_EQ(t.sample(std::numeric_limits<float>::infinity()).w, 0.f);
+    EXPECT_EQ(t.sample(std::numeric_limits<float>::quiet_NaN()).w, 0.f);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/text.h"
 
 namespace uvr {
 
@@ -133,7 +134,7 @@ Vec3f interpolateDiverging(Vec3f a, Vec3f b, double f) {
 
 [[noreturn]] void badSpec(const std::string& spec, const std::string& why) {
     throwError(ErrorKind::Argument, "",
-               "bad opacity spec \"" + spec + "\": " + why +
+               "--opacity \"" + printableShort(spec, 60) + "\": " + printableShort(why, 100) +
                    "; expected \"ramp\", \"ramp:A\", \"constant:A\", \"step:T[:A]\" or "
                    "\"x0:a0,x1:a1,...\" with numbers in [0, 1]");
 }
@@ -225,6 +226,7 @@ std::vector<Vec4f> TransferFunction::bake(int n) const {
 }
 
 void applyOpacitySpec(TransferFunction& tf, const std::string& spec) {
+    if (spec.empty()) badSpec(spec, "empty spec");
     std::vector<OpacityPoint> points;
     std::vector<std::string> fields = split(spec, ':');
     const std::string& kind = fields[0];

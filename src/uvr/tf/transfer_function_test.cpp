@@ -266,12 +266,30 @@ TEST(TransferFunction, MalformedParaViewExportsNameFileAndKey) {
     std::string dir = scratchDir();
     struct Case {
         const char* name;
-        const char* json;
+        std::string json;
         ErrorKind kind;
         const char* where;
         const char* what;
     };
+    // 100,000 levels of nesting (a stack overflow printing the value in the message before).
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    const std::string deepInKey =
+        "[{\"RGBPoints\": " + std::string(100000, '[') + std::string(100000, ']') + "}]";
+    const std::string utf16 = std::string("\xFF\xFE[\0{\0}\0]\0", 10);
     const Case cases[] = {
+        {"deep", deep, ErrorKind::Parse, "byte 64", "JSON nested deeper than 64 levels"},
+        {"deepkey", deepInKey, ErrorKind::Parse, "byte 77", "JSON nested deeper than 64 levels"},
+        {"brackets",
+         "[{\"Name\": \"[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[\", "
+         "\"RGBPoints\": [0, 1, 1, 1], \"Points\": [[0, 1, 0.5, 0], 1, 0.5, 0]}]",
+         ErrorKind::Parse, "\"Points\"[0]", "finite number, got an array of 4 value(s)"},
+        {"utf16", utf16, ErrorKind::Parse, "byte 0",
+         "UTF-16 text is not supported; save the colour map as UTF-8"},
+        {"nested", "[[1, 2]]", ErrorKind::Parse, "colour map 0",
+         "expected a colour-map object, got an array of 2 value(s)"},
+        {"controls", "[{\"ColorSpace\": \"a\\nb\\u0000\\u00ff\", \"RGBPoints\": [0, 1, 1, 1]}]",
+         ErrorKind::Parse, "\"ColorSpace\"", "got \"a\\nb\\x00\xC3\xBF\""},
+        {"badutf8", "[{\"ColorSpace\": \"\xFF\"}]", ErrorKind::Parse, "byte ", "\\xff"},
         {"notjson", "[{\"RGBPoints\": [0, 1, 1, 1,]}]", ErrorKind::Parse, "byte 28", "JSON"},
         {"empty", "[]", ErrorKind::Parse, "top level", "empty array"},
         {"scalar", "42", ErrorKind::Parse, "colour map", "colour-map object"},

@@ -13,6 +13,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/output_file.h"
 #include "uvr/mesh/validate.h"
 
 namespace uvr {
@@ -270,6 +271,9 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
                             ", but it has " + std::to_string(size) + " bytes");
     for (const ArraySpan& a : arrays)
         checkAllocation(path, a.what, a.count, a.elementBytes, options.maxMemoryBytes);
+    const BudgetedOptions budgeted(options);
+    for (const ArraySpan& a : arrays)
+        budgeted.budget().charge(path, a.what, a.count, a.elementBytes);
 
     // Arrays: one bulk read each, straight into the mesh's vectors.
     Mesh mesh;
@@ -331,49 +335,38 @@ void writeNative(const Mesh& mesh, const std::string& path) {
         storeLe<std::uint64_t>(head, f.values.size());
     }
 
-    writeFileAtomically(path, [&](const std::string& tmp) {
-        FilePtr file(std::fopen(tmp.c_str(), "wb"), &std::fclose);
-        if (!file)
-            throwError(ErrorKind::Io, path,
-                       "cannot create " + tmp + ": " + std::string(std::strerror(errno)));
-        std::uint64_t offset = 0;
-        auto put = [&](const void* data, std::uint64_t bytes) {
-            if (bytes != 0 && std::fwrite(data, 1, bytes, file.get()) != bytes)
-                throwError(ErrorKind::Io, path,
-                           "write failed at " + atByte(offset) + ": " + std::strerror(errno));
-            offset += bytes;
-        };
-        // Arrays in file order, each after zero padding to a multiple of 8; on big-endian hosts
-        // they are swapped chunk by chunk into a scratch buffer.
-        auto putArray = [&](const void* data, std::uint64_t count, size_t wordBytes) {
-            static constexpr unsigned char kZeros[8] = {};
-            put(kZeros, align8(offset) - offset);
-            if constexpr (std::endian::native == std::endian::little) {
-                put(data, count * wordBytes);
-            } else {
-                std::vector<unsigned char> chunk;
-                const auto* p = static_cast<const unsigned char*>(data);
-                constexpr std::uint64_t kWords = 1 << 20;
-                for (std::uint64_t i = 0; i < count; i += kWords) {
-                    const std::uint64_t n = std::min(kWords, count - i);
-                    chunk.assign(p + i * wordBytes, p + (i + n) * wordBytes);
-                    swapWordsIfBigEndian(chunk.data(), n, wordBytes);
-                    put(chunk.data(), chunk.size());
-                }
+    OutputFile file(path);
+    std::uint64_t offset = 0;
+    auto put = [&](const void* data, std::uint64_t bytes) {
+        file.write(data, bytes);
+        offset += bytes;
+    };
+    // Arrays in file order, each after zero padding to a multiple of 8; on big-endian hosts
+    // they are swapped chunk by chunk into a scratch buffer.
+    auto putArray = [&](const void* data, std::uint64_t count, size_t wordBytes) {
+        static constexpr unsigned char kZeros[8] = {};
+        put(kZeros, align8(offset) - offset);
+        if constexpr (std::endian::native == std::endian::little) {
+            put(data, count * wordBytes);
+        } else {
+            std::vector<unsigned char> chunk;
+            const auto* p = static_cast<const unsigned char*>(data);
+            constexpr std::uint64_t kWords = 1 << 20;
+            for (std::uint64_t i = 0; i < count; i += kWords) {
+                const std::uint64_t n = std::min(kWords, count - i);
+                chunk.assign(p + i * wordBytes, p + (i + n) * wordBytes);
+                swapWordsIfBigEndian(chunk.data(), n, wordBytes);
+                put(chunk.data(), chunk.size());
             }
-        };
-        put(head.data(), head.size());
-        putArray(mesh.points.data(), mesh.points.size() * 3, 4);
-        putArray(mesh.cellTypes.data(), mesh.cellTypes.size(), 1);
-        putArray(mesh.cellOffsets.data(), mesh.cellOffsets.size(), 8);
-        putArray(mesh.cellIndices.data(), mesh.cellIndices.size(), 4);
-        for (const Field& f : mesh.fields) putArray(f.values.data(), f.values.size(), 4);
-        if (std::fflush(file.get()) != 0)
-            throwError(ErrorKind::Io, path, std::string("write failed: ") + std::strerror(errno));
-        std::FILE* raw = file.release();
-        if (std::fclose(raw) != 0)
-            throwError(ErrorKind::Io, path, std::string("write failed: ") + std::strerror(errno));
-    });
+        }
+    };
+    put(head.data(), head.size());
+    putArray(mesh.points.data(), mesh.points.size() * 3, 4);
+    putArray(mesh.cellTypes.data(), mesh.cellTypes.size(), 1);
+    putArray(mesh.cellOffsets.data(), mesh.cellOffsets.size(), 8);
+    putArray(mesh.cellIndices.data(), mesh.cellIndices.size(), 4);
+    for (const Field& f : mesh.fields) putArray(f.values.data(), f.values.size(), 4);
+    file.commit();
 }
 
 }  // namespace uvr

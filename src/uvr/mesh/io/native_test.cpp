@@ -301,7 +301,10 @@ TEST(Native, MemoryLimitIsAResourceError) {
     options.maxMemoryBytes = 100;  // the points need 12 x 12 = 144 bytes
     expectError([&] { readNative(path, options); }, ErrorKind::Resource,
                 {path, "points", "memory limit"});
-    options.maxMemoryBytes = 144;
+    options.maxMemoryBytes = 144;  // the limit bounds all arrays of the load together
+    expectError([&] { readNative(path, options); }, ErrorKind::Resource,
+                {path, "with the 144 bytes this load holds so far", "memory limit of 144"});
+    options.maxMemoryBytes = meshBytes(mixedMesh());
     EXPECT_NO_THROW(readNative(path, options));
 }
 

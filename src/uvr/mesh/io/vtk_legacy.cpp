@@ -420,6 +420,7 @@ std::vector<float> LegacyParser::readFloats(const ArrayDesc& desc, ScalarType ty
                                             const KeywordLine& kw) {
     Values values(*this, desc, type, kw);
     checkAllocation(file_, desc.unit, values.total(), sizeof(float), options_.maxMemoryBytes);
+    options_.budget->charge(file_, desc.unit, values.total(), sizeof(float));
     std::vector<float> out(values.total());
     for (float& v : out) v = static_cast<float>(values.nextDouble());
     lastComponents_ = desc.components;
@@ -496,9 +497,11 @@ void LegacyParser::readPoints(const KeywordLine& kw) {
                  "POINTS " + std::to_string(n) + ": more than 2^32 - 1 points");
     const std::vector<float> xyz = readFloats({n, 3, "point triples"}, type, kw);
     checkAllocation(file_, "POINTS", n, sizeof(Vec3f), options_.maxMemoryBytes);
+    options_.budget->charge(file_, "POINTS", n, sizeof(Vec3f));
     mesh_.points.resize(n);
     for (std::uint64_t i = 0; i < n; ++i)
         mesh_.points[i] = Vec3f(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    options_.budget->release(xyz.size() * sizeof(float));
     havePoints_ = true;
 }
 
@@ -526,6 +529,8 @@ void LegacyParser::readClassicCells(const KeywordLine& kw, std::uint64_t cellCou
                     options_.maxMemoryBytes);
     checkAllocation(file_, "CELLS connectivity", size - cellCount, sizeof(std::int64_t),
                     options_.maxMemoryBytes);
+    options_.budget->charge(file_, "CELLS offsets", cellCount + 1, sizeof(std::int64_t));
+    options_.budget->charge(file_, "CELLS connectivity", size - cellCount, sizeof(std::int64_t));
     cells_.offsets.reserve(cellCount + 1);
     cells_.offsets.push_back(0);
     cells_.connectivity.reserve(size - cellCount);
@@ -561,6 +566,7 @@ void LegacyParser::readOffsetCells(std::uint64_t offsetCount, std::uint64_t conn
         fail(where(offKw), "expected an integer type for OFFSETS, got " + quote(offKw.tokens[1]));
     Values offsets(*this, {offsetCount, 1, "OFFSETS entries"}, offType, offKw);
     checkAllocation(file_, "OFFSETS", offsetCount, sizeof(std::int64_t), options_.maxMemoryBytes);
+    options_.budget->charge(file_, "OFFSETS", offsetCount, sizeof(std::int64_t));
     cells_.offsets.reserve(offsetCount == 0 ? 1 : offsetCount);
     std::int64_t previous = 0;
     for (std::uint64_t i = 0; i < offsetCount; ++i) {
@@ -598,6 +604,7 @@ void LegacyParser::readOffsetCells(std::uint64_t offsetCount, std::uint64_t conn
     Values conn(*this, {connectivitySize, 1, "CONNECTIVITY entries"}, conType, conKw);
     checkAllocation(file_, "CONNECTIVITY", connectivitySize, sizeof(std::int64_t),
                     options_.maxMemoryBytes);
+    options_.budget->charge(file_, "CONNECTIVITY", connectivitySize, sizeof(std::int64_t));
     cells_.connectivity.resize(connectivitySize);
     for (std::int64_t& id : cells_.connectivity) id = conn.nextInt();
     cellCount_ = offsetCount == 0 ? 0 : offsetCount - 1;
@@ -613,6 +620,7 @@ void LegacyParser::readCellTypes(const KeywordLine& kw) {
                             std::to_string(cellCount_) + " cells of CELLS");
     Values values(*this, {n, 1, "cell types"}, ScalarType::Int32, kw);
     checkAllocation(file_, "CELL_TYPES", n, sizeof(std::int32_t), options_.maxMemoryBytes);
+    options_.budget->charge(file_, "CELL_TYPES", n, sizeof(std::int32_t));
     cells_.types.resize(n);
     for (std::uint64_t c = 0; c < n; ++c) {
         const std::int64_t t = values.nextInt();
@@ -663,7 +671,10 @@ void LegacyParser::readFieldData(const KeywordLine& kw, const Association* assoc
                      (*association == Association::Point ? " (POINT_DATA)" : " (CELL_DATA)"));
         std::vector<float> values =
             readFloats({n, comps, "tuples of FIELD array " + quote(head.tokens[0])}, type, head);
-        if (association) addField(head.tokens[0], *association, comps, std::move(values));
+        if (association)
+            addField(head.tokens[0], *association, comps, std::move(values));
+        else
+            options_.budget->release(values.size() * sizeof(float));  // dataset FIELD: skipped
     }
 }
 
@@ -725,8 +736,10 @@ void LegacyParser::readAttributes(KeywordLine kw) {
                 requireTokens(kw, 3, "LOOKUP_TABLE name size");
                 const std::uint64_t entries = parseCount(kw, 2, "a table size");
                 const std::int64_t saved = lastComponents_;
-                readFloats({entries, 4, "lookup table entries"},
-                           binary_ ? ScalarType::UInt8 : ScalarType::Float32, kw);
+                const std::vector<float> table =
+                    readFloats({entries, 4, "lookup table entries"},
+                               binary_ ? ScalarType::UInt8 : ScalarType::Float32, kw);
+                options_.budget->release(table.size() * sizeof(float));
                 lastComponents_ = saved;
             } else if (key == "FIELD") {
                 readFieldData(kw, &assoc, n);
@@ -776,6 +789,10 @@ Mesh LegacyParser::parse() {
         }
     }
     if (!haveCells_) cells_.offsets.assign(1, 0);
+    options_.budget->charge(file_, "the cells", cells_.types.size(),
+                            sizeof(CellType) + sizeof(std::uint64_t));
+    options_.budget->charge(file_, "the cell connectivity", cells_.connectivity.size(),
+                            sizeof(std::uint32_t));
     // Cells last: appendVtkCells filters the cell fields read above to the kept cells.
     appendVtkCells(cells_, mesh_, file_);
     return std::move(mesh_);
@@ -784,9 +801,15 @@ Mesh LegacyParser::parse() {
 }  // namespace
 
 Mesh readVtkLegacy(const std::string& path, const ReadOptions& options) {
-    const std::vector<char> bytes = readFileBytes(path);
-    LegacyParser parser(path, bytes, options);
-    return parser.parse();
+    const BudgetedOptions budgeted(options);
+    LoadBudget& budget = budgeted.budget();
+    const std::uint64_t heldBefore = budget.used();
+    // The size is charged before reading, so a huge (or sparse) file is refused unread.
+    const std::vector<char> bytes = readFileCharged(path, budget);
+    LegacyParser parser(path, bytes, budgeted.options());
+    Mesh mesh = parser.parse();
+    budget.resetTo(heldBefore + meshBytes(mesh));  // the file and the raw cells are freed next
+    return mesh;
 }
 
 }  // namespace uvr

@@ -642,5 +642,53 @@ TEST_F(VtkLegacyBadBinary, AbsurdAndWrongCounts) {
                     {"byte " + std::to_string(p), "POINT_DATA 2289 does not match 2288 points"});
 }
 
+// ---------------------------------------------------------------------------------------------
+// Memory and time: the limit bounds the whole load; many fields load in linear time.
+
+TEST(VtkLegacyLimits, AFileLargerThanTheMemoryLimitIsRefusedUnread) {
+    // A 2 GiB sparse file (a valid header, then holes): refused from its size, before reading.
+    const std::string path = scratchDir() + "/sparse.vtk";
+    writeFile(path, "# vtk DataFile Version 3.0\nsparse\nASCII\nDATASET UNSTRUCTURED_GRID\n");
+    std::filesystem::resize_file(path, std::uint64_t(2) << 30);
+    ReadOptions options;
+    options.maxMemoryBytes = 64 << 20;
+    try {
+        readVtkLegacy(path, options);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Resource);
+        EXPECT_EQ(std::string(e.what()), path +
+                                             ": the file needs 2147483648 bytes, which exceed "
+                                             "the memory limit of 67108864 bytes (--max-memory)");
+    }
+    std::filesystem::remove(path);
+}
+
+TEST(VtkLegacyLimits, TheLimitBoundsAllArraysTogether) {
+    // 40 point fields of 1000 values (4000 bytes each, 160 KB in all) under a 300 KB limit
+    // that the 174 KB file fits: each array fits, all of them together do not.
+    std::string text =
+        "# vtk DataFile Version 3.0\nfields\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 1000 "
+        "float\n" +
+        std::string(12000, '\0') + "\nPOINT_DATA 1000\n";
+    for (int f = 0; f < 40; ++f)
+        text += "SCALARS f" + std::to_string(f) + " float 1\nLOOKUP_TABLE default\n" +
+                std::string(4000, '\0') + "\n";
+    const std::string path = writeFile(scratchDir() + "/fields.vtk", text);
+    ReadOptions options;
+    options.maxMemoryBytes = 300000;
+    try {
+        readVtkLegacy(path, options);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Resource);
+        EXPECT_THAT(e.what(), HasSubstr(path + ": tuples of SCALARS 'f"));
+        EXPECT_THAT(e.what(), HasSubstr("needs 4000 bytes, which with the "));
+        EXPECT_THAT(e.what(), HasSubstr("exceed the memory limit of 300000 bytes (--max-memory)"));
+    }
+    options.maxMemoryBytes = 0;
+    EXPECT_EQ(readVtkLegacy(path, options).fields.size(), 40u);
+}
+
 }  // namespace
 }  // namespace uvr

@@ -11,9 +11,11 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string_view>
 #include <type_traits>
+#include <unordered_map>
 #include <vector>
 
 #include "uvr/core/error.h"
@@ -69,6 +71,8 @@ struct XmlDoc {
     bool appendedBase64 = false;
     std::uint64_t appendedStart = 0;  // file byte offset just after the '_' marker
     std::uint64_t appendedEnd = 0;    // file byte offset of </AppendedData>
+    std::uint64_t fileBytes = 0;      // size of the file
+    mutable std::uint64_t decodedBytes = 0;  // binary payload bytes decoded so far, all arrays
 };
 
 // ---- XML parsing with expat ----
@@ -274,6 +278,7 @@ void XMLCALL textHandler(void* data, const XML_Char* s, int len) {
 XmlDoc parseXml(const std::string& path, const std::vector<char>& bytes) {
     XmlDoc doc;
     doc.file = path;
+    doc.fileBytes = bytes.size();
     std::string_view all(bytes.data(), bytes.size());
     // Step 1: the XML ends at the <AppendedData ...> start tag when there is one.
     std::size_t xmlEnd = all.size();
@@ -418,6 +423,21 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
         checkAllocation(doc.file, a.label, totalBytes / es, es, options.maxMemoryBytes);
     };
 
+    // All payloads of a file together must fit what it can hold at deflate's maximum ratio, so
+    // data reused by many arrays (or many Pieces) cannot expand without bound; then the load's
+    // memory budget.
+    auto chargeDecoded = [&](std::uint64_t bytes) {
+        const std::uint64_t possible = doc.fileBytes * kMaxZlibRatio;
+        if (doc.decodedBytes > possible || bytes > possible - doc.decodedBytes)
+            fail(std::to_string(bytes) + " bytes more make " +
+                 std::to_string(doc.decodedBytes + bytes) +
+                 " bytes decoded from the file's arrays, more than its " +
+                 std::to_string(doc.fileBytes) + " bytes can hold at deflate's maximum ratio of " +
+                 std::to_string(kMaxZlibRatio) + ":1 (data reused by many arrays?)");
+        doc.decodedBytes += bytes;
+        options.budget->charge(doc.file, a.label, bytes, 1);
+    };
+
     std::vector<unsigned char> out;
     if (!doc.compressed) {
         const std::uint64_t nbytes = header(1, "size header")[0];
@@ -425,6 +445,7 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
         if (nbytes > src.remaining())
             fail("declares " + std::to_string(nbytes) + " bytes, but only " +
                  std::to_string(src.remaining()) + " remain");
+        chargeDecoded(nbytes);
         src.read(static_cast<std::size_t>(nbytes), out);
         return out;
     }
@@ -448,9 +469,17 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
     if (compressedTotal > src.remaining())
         fail("compressed blocks of " + std::to_string(compressedTotal) + " bytes run past the " +
              "end of the data (" + std::to_string(src.remaining()) + " bytes remain)");
-    if (total / kMaxZlibRatio > compressedTotal + 64 * blocks)
-        fail(std::to_string(compressedTotal) + " compressed bytes cannot inflate to the " +
-             std::to_string(total) + " bytes the header declares");
+    // Checked block by block before allocating: a block of s bytes inflates to at most 1032 * s.
+    for (std::uint64_t b = 0; b < blocks; ++b) {
+        const std::uint64_t expect = (b + 1 == blocks && lastSize != 0) ? lastSize : blockSize;
+        if (expect > sizes[b] * kMaxZlibRatio)  // sizes[b] <= remaining(): no overflow
+            fail("zlib block " + std::to_string(b) + " of " + std::to_string(blocks) + ": " +
+                 std::to_string(sizes[b]) + " compressed bytes cannot inflate to the " +
+                 std::to_string(expect) + " bytes the header declares (at most " +
+                 std::to_string(sizes[b] * kMaxZlibRatio) + " at deflate's maximum ratio of " +
+                 std::to_string(kMaxZlibRatio) + ":1)");
+    }
+    chargeDecoded(total);
     out.resize(static_cast<std::size_t>(total));
     std::vector<unsigned char> block;
     for (std::uint64_t b = 0; b < blocks; ++b) {
@@ -488,6 +517,7 @@ std::vector<T> parseAscii(const XmlDoc& doc, const ArrayDesc& a,
     if (expected && count != *expected)
         throwParseError(doc.file, atLine(a.line), sizeMismatch(a, count, *expected));
     checkAllocation(doc.file, a.label, count, sizeof(T), options.maxMemoryBytes);
+    options.budget->charge(doc.file, a.label, count, sizeof(T));
     std::vector<T> out;
     out.reserve(static_cast<std::size_t>(count));
     const bool integer = isIntegerType(*a.type);
@@ -546,6 +576,7 @@ std::vector<T> convertValues(const std::vector<unsigned char>& raw, bool swap, c
                              const ArrayDesc& a, const ReadOptions& options) {
     const std::size_t count = raw.size() / sizeof(S);
     checkAllocation(doc.file, a.label, count, sizeof(T), options.maxMemoryBytes);
+    options.budget->charge(doc.file, a.label, count, sizeof(T));
     std::vector<T> out(count);
     unsigned char buf[sizeof(S)];
     for (std::size_t i = 0; i < count; ++i) {
@@ -561,6 +592,7 @@ std::vector<T> convertValues(const std::vector<unsigned char>& raw, bool swap, c
         else
             out[i] = static_cast<T>(v);
     }
+    options.budget->release(raw.size());  // the caller frees raw on return
     return out;
 }
 
@@ -637,6 +669,20 @@ std::string fieldKey(const Field& f) {
     return std::string(associationName(f.association)) + " DataArray '" + f.name + "'";
 }
 
+/// Association and name of a field as one map key.
+std::string fieldId(const Field& f) {
+    return (f.association == Association::Point ? "p" : "c") + f.name;
+}
+
+/// The first field of each association and name, for merging Pieces in linear time.
+template <class F>
+std::unordered_map<std::string, F*> indexFields(std::vector<F>& fields) {
+    std::unordered_map<std::string, F*> index;
+    index.reserve(fields.size());
+    for (F& f : fields) index.emplace(fieldId(f), &f);
+    return index;
+}
+
 void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t index,
                const ReadOptions& options, RawGrid& grid) {
     const PieceDesc& p = doc.pieces[index];
@@ -666,8 +712,11 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         if (pointBase + p.points > std::numeric_limits<std::uint32_t>::max())
             throwError(ErrorKind::Unsupported, doc.file,
                        label + ": more than 4294967295 points in all are not supported");
+        options.budget->charge(doc.file, label + ": points", p.points, sizeof(Vec3f));
+        if (index == 0) grid.points.reserve(p.points);
         for (std::size_t i = 0; i < p.points; ++i)
             grid.points.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+        options.budget->release(xyz.size() * sizeof(float));
     }
 
     // Cells: VTK XML offsets are END offsets; VtkCellArrays wants n + 1 starting at 0.
@@ -691,6 +740,10 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         const std::vector<std::int64_t> conn = readArray<std::int64_t>(
             bytes, doc, connA, static_cast<std::uint64_t>(ends.back()), options);
         VtkCellArrays& out = grid.cells;
+        options.budget->charge(doc.file, label + ": cells", types.size(),
+                               sizeof(std::int32_t) + sizeof(std::int64_t));
+        options.budget->charge(doc.file, label + ": connectivity", conn.size(),
+                               sizeof(std::int64_t));
         const std::int64_t connBase = static_cast<std::int64_t>(out.connectivity.size());
         if (out.offsets.empty()) out.offsets.push_back(0);
         for (std::size_t c = 0; c < types.size(); ++c) {
@@ -705,6 +758,8 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         out.connectivity.reserve(out.connectivity.size() + conn.size());
         for (std::int64_t id : conn)
             out.connectivity.push_back(id < 0 ? id : id + static_cast<std::int64_t>(pointBase));
+        options.budget->release((ends.size() + types.size() + conn.size()) *
+                                sizeof(std::int64_t));
     }
 
     // Point and cell fields, concatenated across Pieces by name and association.
@@ -728,27 +783,30 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         grid.fields = std::move(fields);
         return;
     }
+    const auto pieceFields = indexFields(fields);
     for (const Field& f : grid.fields) {
-        auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& g) {
-            return g.name == f.name && g.association == f.association;
-        });
-        if (it == fields.end())
+        const auto found = pieceFields.find(fieldId(f));
+        if (found == pieceFields.end())
             throwParseError(doc.file, atLine(p.line),
                             label + " has no " + fieldKey(f) + ", which Piece 0 has");
+        const Field* it = found->second;
         if (it->components != f.components)
             throwParseError(doc.file, atLine(p.line),
                             label + ": " + fieldKey(f) + " has " + std::to_string(it->components) +
                                 " components, Piece 0 has " + std::to_string(f.components));
     }
+    const auto gridFields = indexFields(grid.fields);
     for (Field& g : fields) {
-        auto it = std::find_if(grid.fields.begin(), grid.fields.end(), [&](const Field& f) {
-            return g.name == f.name && g.association == f.association;
-        });
-        if (it == grid.fields.end())
+        const auto found = gridFields.find(fieldId(g));
+        if (found == gridFields.end())
             throwParseError(doc.file, atLine(p.line),
                             label + " has " + fieldKey(g) + ", which Piece 0 lacks");
+        Field* it = found->second;
+        options.budget->charge(doc.file, label + ": " + fieldKey(g), g.values.size(),
+                               sizeof(float));
         it->values.insert(it->values.end(), g.values.begin(), g.values.end());
     }
+    for (const Field& g : fields) options.budget->release(g.values.size() * sizeof(float));
 }
 
 Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allowParallel);
@@ -759,16 +817,37 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
     const fs::path folder = fs::path(path).parent_path();
     std::error_code ec;
     const fs::path self = fs::weakly_canonical(fs::path(path), ec);
-    Mesh mesh;
+    // Every piece's file, checked before reading any: not the .pvtu itself, and each file once
+    // (one piece listed many times would multiply the load).
+    std::vector<std::string> piecePaths;
+    std::map<std::string, std::size_t> firstListing;  // canonical path -> piece index
     for (std::size_t k = 0; k < doc.pieces.size(); ++k) {
         const PieceDesc& p = doc.pieces[k];
         const fs::path source = fs::path(p.source);
-        const std::string piecePath = (source.is_absolute() ? source : folder / source).string();
+        piecePaths.push_back((source.is_absolute() ? source : folder / source).string());
         const std::string label = "Piece " + std::to_string(k) + " ('" + p.source + "')";
         std::error_code ec2;
-        if (fs::weakly_canonical(fs::path(piecePath), ec2) == self && !ec && !ec2)
+        const fs::path canonical = fs::weakly_canonical(fs::path(piecePaths.back()), ec2);
+        if (canonical == self && !ec && !ec2)
             throwParseError(path, atLine(p.line), label + " names the .pvtu file itself");
+        const auto [first, fresh] =
+            firstListing.emplace(ec2 ? piecePaths.back() : canonical.string(), k);
+        if (!fresh)
+            throwParseError(path, atLine(p.line),
+                            label + " is listed twice: Piece " + std::to_string(first->second) +
+                                " (line " + std::to_string(doc.pieces[first->second].line) +
+                                ") names the same file");
+    }
+    LoadBudget& budget = *options.budget;
+    const std::uint64_t heldBefore = budget.used();
+    Mesh mesh;
+    std::unordered_map<std::string, Field*> meshFields;
+    for (std::size_t k = 0; k < doc.pieces.size(); ++k) {
+        const PieceDesc& p = doc.pieces[k];
+        const std::string& piecePath = piecePaths[k];
+        const std::string label = "Piece " + std::to_string(k) + " ('" + p.source + "')";
         Mesh piece = readVtuFile(piecePath, options, false);
+        budget.charge(path, label, meshBytes(piece), 1);  // its copy in the merged mesh
 
         // Merge: points appended, indices offset, fields concatenated by name and association.
         const std::uint64_t pointBase = mesh.points.size();
@@ -786,10 +865,14 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
             mesh.notes.push_back("piece " + std::to_string(k) + ": " + note);
         if (k == 0) {
             mesh.fields = std::move(piece.fields);
+            meshFields = indexFields(mesh.fields);
+            budget.resetTo(heldBefore + meshBytes(mesh));
             continue;
         }
+        const auto pieceFields = indexFields(piece.fields);
         for (const Field& f : mesh.fields) {
-            const Field* g = piece.findField(f.name, f.association);
+            const auto found = pieceFields.find(fieldId(f));
+            const Field* g = found == pieceFields.end() ? nullptr : found->second;
             if (!g)
                 throwParseError(path, atLine(p.line),
                                 label + " has no " + fieldKey(f) + ", which piece 0 has");
@@ -800,27 +883,35 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
                                     std::to_string(f.components));
         }
         for (const Field& g : piece.fields) {
-            auto it = std::find_if(mesh.fields.begin(), mesh.fields.end(), [&](const Field& f) {
-                return g.name == f.name && g.association == f.association;
-            });
-            if (it == mesh.fields.end())
+            const auto found = meshFields.find(fieldId(g));
+            if (found == meshFields.end())
                 throwParseError(path, atLine(p.line),
                                 label + " has " + fieldKey(g) + ", which piece 0 lacks");
+            Field* it = found->second;
             it->values.insert(it->values.end(), g.values.begin(), g.values.end());
         }
+        budget.resetTo(heldBefore + meshBytes(mesh));  // the piece is freed next
     }
     return mesh;
 }
 
 Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allowParallel) {
-    const std::vector<char> bytes = readFileBytes(path);
+    LoadBudget& budget = *options.budget;
+    const std::uint64_t heldBefore = budget.used();
+    const std::vector<char> bytes = readFileCharged(path, budget);
     const XmlDoc doc = parseXml(path, bytes);
+    std::uint64_t textBytes = 0;
+    for (const PieceDesc& p : doc.pieces)
+        for (const ArrayDesc& a : p.arrays) textBytes += a.text.size();
+    budget.charge(path, "the inline DataArray text", textBytes, 1);
     if (doc.type == "PUnstructuredGrid") {
         if (!allowParallel)
             throwError(ErrorKind::Unsupported, path,
                        "is a PUnstructuredGrid (.pvtu); a .pvtu piece must be an "
                        "UnstructuredGrid .vtu file");
-        return readPvtuFile(path, doc, options);
+        Mesh mesh = readPvtuFile(path, doc, options);
+        budget.resetTo(heldBefore + meshBytes(mesh));  // the file is freed on return
+        return mesh;
     }
     if (doc.pieces.empty())
         throwParseError(path, atByte(0),
@@ -831,23 +922,34 @@ Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allow
     mesh.points = std::move(grid.points);
     mesh.fields = std::move(grid.fields);
     if (grid.cells.offsets.empty()) grid.cells.offsets.push_back(0);
+    budget.charge(path, "the cells", grid.cells.types.size(),
+                  sizeof(CellType) + sizeof(std::uint64_t));
+    budget.charge(path, "the cell connectivity", grid.cells.connectivity.size(),
+                  sizeof(std::uint32_t));
     appendVtkCells(grid.cells, mesh, path);
+    budget.resetTo(heldBefore + meshBytes(mesh));  // the file and the raw cells are freed next
     return mesh;
 }
 
 }  // namespace
 
 Mesh readVtu(const std::string& path, const ReadOptions& options) {
-    return readVtuFile(path, options, true);
+    const BudgetedOptions budgeted(options);
+    return readVtuFile(path, budgeted.options(), true);
 }
 
 Mesh readPvtu(const std::string& path, const ReadOptions& options) {
-    const std::vector<char> bytes = readFileBytes(path);
+    const BudgetedOptions budgeted(options);
+    LoadBudget& budget = budgeted.budget();
+    const std::uint64_t heldBefore = budget.used();
+    const std::vector<char> bytes = readFileCharged(path, budget);
     const XmlDoc doc = parseXml(path, bytes);
     if (doc.type != "PUnstructuredGrid")
         throwError(ErrorKind::Unsupported, path,
                    "VTKFile type '" + doc.type + "' is not a PUnstructuredGrid (.pvtu)");
-    return readPvtuFile(path, doc, options);
+    Mesh mesh = readPvtuFile(path, doc, budgeted.options());
+    budget.resetTo(heldBefore + meshBytes(mesh));
+    return mesh;
 }
 
 }  // namespace uvr

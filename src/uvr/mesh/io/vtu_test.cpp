@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <zlib.h>
+
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
@@ -182,9 +184,15 @@ TEST(VtuSharedData, FireUgRefusesAnArrayAboveTheMemoryLimit) {
     if (!uvr::testing::haveSharedData()) GTEST_SKIP() << "no shared data";
     const std::string path = uvr::testing::sharedData("fire_ug.vtu");
     ReadOptions options;
-    options.maxMemoryBytes = 100000;  // below the 12323 * 3 * 4 bytes of the points
+    // The limit bounds the whole load: the file's 631781 bytes fit, its points' 12323 * 3 * 4
+    // decoded bytes on top do not.
+    options.maxMemoryBytes = 700000;
     expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
-                {path, "Piece 0: DataArray 'Points'", "36969 entries", "memory limit of 100000"});
+                {path, "Piece 0: DataArray 'Points' needs 147876 bytes",
+                 "with the 631781 bytes this load holds so far", "memory limit of 700000"});
+    options.maxMemoryBytes = 100000;  // below the file itself: refused before reading it
+    expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
+                {path + ": the file needs 631781 bytes", "memory limit of 100000"});
 }
 
 // ---- files written by VTK and meshio ----
@@ -397,12 +405,12 @@ TEST_F(VtuErrors, AbsurdCountsAreRefusedBeforeAllocating) {
 
 TEST_F(VtuErrors, MemoryLimitIsAResourceError) {
     ReadOptions options;
-    options.maxMemoryBytes = 300;  // 'Points' needs 26 * 3 * 8 raw bytes
+    options.maxMemoryBytes = 300;  // less than each file: the load's total is bounded
     for (const char* name : {kAscii, kRaw, kB64Zlib}) {
         SCOPED_TRACE(name);
         const std::string path = variant(name);
         expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
-                    {path, "DataArray 'Points'", "memory limit of 300 bytes"});
+                    {path, "memory limit of 300 bytes"});
     }
 }
 
@@ -543,6 +551,135 @@ TEST_F(VtuErrors, PvtuNamingItselfOrAMissingPieceIsRefused) {
     const std::string nested = write("nested.pvtu", replaceOnce(text, "three_0.vtu", "other.pvtu"));
     expectError([&] { readPvtu(nested); }, ErrorKind::Unsupported,
                 {dir_ + "/other.pvtu", "a .pvtu piece must be an UnstructuredGrid .vtu"});
+}
+
+// ---- amplification: sizes a small file declares or reuses ----
+
+/// Little-endian UInt32, as in a header_type="UInt32" payload header.
+std::string le32(std::uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    return s;
+}
+
+/// A zlib-compressed UInt32 payload (one block) of n zero bytes: header + table + stream.
+std::string zlibZerosPayload(std::uint32_t n) {
+    const std::vector<unsigned char> zeros(n, 0);
+    uLongf size = compressBound(n);
+    std::string stream(size, '\0');
+    EXPECT_EQ(compress2(reinterpret_cast<Bytef*>(stream.data()), &size, zeros.data(), n, 9), Z_OK);
+    stream.resize(size);
+    return le32(1) + le32(n) + le32(n) + le32(static_cast<std::uint32_t>(size)) + stream;
+}
+
+/// A Piece of `points` points and no cells whose Points lie at appended offset 0.
+std::string pointsPiece(std::uint64_t points) {
+    return "<Piece NumberOfPoints=\"" + std::to_string(points) +
+           "\" NumberOfCells=\"0\"><Points><DataArray type=\"Float32\" "
+           "NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece>\n";
+}
+
+/// A zlib-compressed .vtu with raw appended data.
+std::string appendedZlibVtu(const std::string& pieces, const std::string& data) {
+    return "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+           "byte_order=\"LittleEndian\" header_type=\"UInt32\" "
+           "compressor=\"vtkZLibDataCompressor\">\n<UnstructuredGrid>\n" +
+           pieces + "</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_" + data +
+           "\n</AppendedData>\n</VTKFile>\n";
+}
+
+TEST(VtuAmplification, BlockHeadersDeclaringGigabytesAreRefusedBeforeAllocating) {
+    // 65536 blocks of 65532 bytes (4 GiB of points) whose compressed sizes are 1 byte each: a
+    // 330 KB file. Deflate expands at most 1032:1, so block 0 is refused before any allocation.
+    constexpr std::uint32_t kBlocks = 65536, kBlock = 65532;
+    std::string data = le32(kBlocks) + le32(kBlock) + le32(0);
+    for (std::uint32_t b = 0; b < kBlocks; ++b) data += le32(1);
+    data += std::string(kBlocks, 'x');
+    const std::uint64_t points = std::uint64_t(kBlocks) * kBlock / 12;
+    const std::string text = appendedZlibVtu(pointsPiece(points), data);
+    const std::string path = testing::writeFile(testing::scratchDir() + "/bomb.vtu", text);
+    const std::uint64_t blocksAt = text.find("\n_") + 2 + 12 + 4 * std::uint64_t(kBlocks);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte " + std::to_string(blocksAt) + ": Piece 0: DataArray 'Points': ",
+                 "zlib block 0 of 65536: 1 compressed bytes cannot inflate to the 65532 bytes the "
+                 "header declares (at most 1032 at deflate's maximum ratio of 1032:1)"});
+}
+
+TEST(VtuAmplification, OneBlockReusedByManyPiecesIsBoundedByTheFileAndTheLimit) {
+    // 40 Pieces of 100000 points each, all reading the same 1.2 MB block of zeros (about 1.2 KB
+    // compressed): 48 MB of points from a 9 KB file.
+    std::string pieces;
+    for (int k = 0; k < 40; ++k) pieces += pointsPiece(100000);
+    const std::string text = appendedZlibVtu(pieces, zlibZerosPayload(1200000));
+    ASSERT_LT(text.size(), 12000u);
+    const std::string dir = testing::scratchDir();
+    const std::string path = testing::writeFile(dir + "/reuse.vtu", text);
+    // Without a limit: what 1032 times the file can hold.
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte ", "DataArray 'Points'",
+                 "bytes decoded from the file's arrays, more than its " +
+                     std::to_string(text.size()) +
+                     " bytes can hold at deflate's maximum ratio of 1032:1"});
+    // With a limit: every array fits it, all of them together do not.
+    ReadOptions options;
+    options.maxMemoryBytes = 4 << 20;
+    expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
+                {path + ": Piece ", "this load holds so far",
+                 "exceed the memory limit of 4194304 bytes (--max-memory)"});
+    // One piece is a legitimate file (its 1.2 MB of zeros compress 1000:1).
+    const std::string one = testing::writeFile(
+        dir + "/one.vtu", appendedZlibVtu(pointsPiece(100000), zlibZerosPayload(1200000)));
+    EXPECT_EQ(readVtu(one).pointCount(), 100000u);
+}
+
+TEST(VtuAmplification, PvtuListingAPieceTwiceIsRefusedBeforeReadingIt) {
+    const std::string dir = testing::scratchDir();
+    const std::string piece = appendedZlibVtu(pointsPiece(10), zlibZerosPayload(120));
+    testing::writeFile(dir + "/p.vtu", piece);
+    fs::create_symlink("p.vtu", dir + "/link.vtu");
+    auto pvtu = [&](const std::string& name, const std::vector<std::string>& sources) {
+        std::string text =
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\">\n"
+            "<PUnstructuredGrid GhostLevel=\"0\">\n<PPoints><PDataArray type=\"Float32\" "
+            "NumberOfComponents=\"3\"/></PPoints>\n";
+        for (const std::string& s : sources) text += "<Piece Source=\"" + s + "\"/>\n";
+        return testing::writeFile(dir + "/" + name,
+                                  text + "</PUnstructuredGrid>\n</VTKFile>\n");
+    };
+    const std::string twice = pvtu("twice.pvtu", {"p.vtu", "./sub/../p.vtu"});
+    fs::create_directory(dir + "/sub");
+    expectError([&] { readPvtu(twice); }, ErrorKind::Parse,
+                {twice + ": line 6: Piece 1 ('./sub/../p.vtu') is listed twice: Piece 0 (line 5) "
+                         "names the same file"});
+    const std::string linked = pvtu("linked.pvtu", {"link.vtu", "p.vtu"});
+    expectError([&] { readPvtu(linked); }, ErrorKind::Parse,
+                {linked + ": line 6: Piece 1 ('p.vtu') is listed twice"});
+    const std::vector<std::string> sixty(60, "p.vtu");
+    const std::string many = pvtu("many.pvtu", sixty);
+    expectError([&] { readPvtu(many); }, ErrorKind::Parse, {many + ": line 6: Piece 1 "});
+    EXPECT_EQ(readPvtu(pvtu("once.pvtu", {"p.vtu"})).pointCount(), 10u);
+}
+
+TEST(VtuAmplification, ManyFieldsInTwoPiecesMergeInLinearTime) {
+    // 2 x 30000 point fields: merging Pieces by a linear search per field took ~10^9 string
+    // comparisons (minutes under the sanitizers); a hash lookup takes ~10^5.
+    constexpr int kFields = 30000;
+    std::string piece =
+        "<Piece NumberOfPoints=\"1\" NumberOfCells=\"0\"><Points><DataArray type=\"Float32\" "
+        "NumberOfComponents=\"3\" format=\"ascii\">0 0 0</DataArray></Points><PointData>";
+    for (int f = 0; f < kFields; ++f)
+        piece += "<DataArray type=\"Float32\" Name=\"f" + std::to_string(f) +
+                 "\" format=\"ascii\">" + std::to_string(f) + "</DataArray>";
+    piece += "</PointData></Piece>\n";
+    const std::string text =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
+        "<UnstructuredGrid>\n" +
+        piece + piece + "</UnstructuredGrid>\n</VTKFile>\n";
+    const std::string path = testing::writeFile(testing::scratchDir() + "/fields.vtu", text);
+    const Mesh mesh = readVtu(path);
+    ASSERT_EQ(mesh.fields.size(), std::size_t(kFields));
+    EXPECT_EQ(mesh.fields.back().name, "f" + std::to_string(kFields - 1));
+    EXPECT_EQ(mesh.fields.back().values, (std::vector<float>{kFields - 1, kFields - 1}));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/output_file.h"
 #include "uvr/mesh/validate.h"
 
 namespace uvr {
@@ -49,12 +50,9 @@ std::string xmlEscape(const std::string& s) {
 /// Writes values converted to little-endian T, a chunk at a time, so that no array is copied whole.
 class LittleEndianWriter {
 public:
-    LittleEndianWriter(std::FILE* file, const std::string& path) : file_(file), path_(path) {}
+    explicit LittleEndianWriter(OutputFile& file) : file_(file) {}
 
-    void bytes(const void* data, std::uint64_t count) {
-        if (count != 0 && std::fwrite(data, 1, count, file_) != count)
-            throwError(ErrorKind::Io, path_, std::string("write failed: ") + std::strerror(errno));
-    }
+    void bytes(const void* data, std::uint64_t count) { file_.write(data, count); }
 
     /// Writes T(get(i)) for i in [0, count).
     template <typename T, typename Get>
@@ -76,8 +74,7 @@ public:
     }
 
 private:
-    std::FILE* file_;
-    const std::string& path_;
+    OutputFile& file_;
 };
 
 }  // namespace
@@ -132,40 +129,33 @@ void writeVtu(const Mesh& mesh, const std::string& path) {
         "  <AppendedData encoding=\"raw\">\n"
         "   _";
 
-    writeFileAtomically(path, [&](const std::string& tmp) {
-        std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(tmp.c_str(), "wb"),
-                                                             &std::fclose);
-        if (!file)
-            throwError(ErrorKind::Io, path,
-                       "cannot create " + tmp + ": " + std::string(std::strerror(errno)));
-        LittleEndianWriter out(file.get(), path);
-        out.bytes(xml.data(), xml.size());
-        auto blockHeader = [&](std::uint64_t bytes) {
-            out.values<std::uint64_t>(1, [bytes](std::uint64_t) { return bytes; });
-        };
-        for (Association association : {Association::Point, Association::Cell}) {
-            for (const Field& f : mesh.fields) {
-                if (f.association != association) continue;
-                blockHeader(f.values.size() * 4);
-                out.values<float>(f.values.size(), [&f](std::uint64_t i) { return f.values[i]; });
-            }
+    OutputFile file(path);
+    LittleEndianWriter out(file);
+    out.bytes(xml.data(), xml.size());
+    auto blockHeader = [&](std::uint64_t bytes) {
+        out.values<std::uint64_t>(1, [bytes](std::uint64_t) { return bytes; });
+    };
+    for (Association association : {Association::Point, Association::Cell}) {
+        for (const Field& f : mesh.fields) {
+            if (f.association != association) continue;
+            blockHeader(f.values.size() * 4);
+            out.values<float>(f.values.size(), [&f](std::uint64_t i) { return f.values[i]; });
         }
-        blockHeader(mesh.pointCount() * 12);
-        out.values<float>(mesh.pointCount() * 3,
-                          [&](std::uint64_t i) { return mesh.points[i / 3][int(i % 3)]; });
-        blockHeader(mesh.cellIndices.size() * 8);
-        out.values<std::int64_t>(mesh.cellIndices.size(),
-                                 [&](std::uint64_t i) { return mesh.cellIndices[i]; });
-        // VTK's offsets are the END of each cell's run of connectivity.
-        blockHeader(cells * 8);
-        out.values<std::int64_t>(cells, [&](std::uint64_t c) { return mesh.cellOffsets[c + 1]; });
-        blockHeader(cells);
-        out.bytes(mesh.cellTypes.data(), cells);
-        const std::string tail = "\n  </AppendedData>\n</VTKFile>\n";
-        out.bytes(tail.data(), tail.size());
-        if (std::fclose(file.release()) != 0)
-            throwError(ErrorKind::Io, path, std::string("write failed: ") + std::strerror(errno));
-    });
+    }
+    blockHeader(mesh.pointCount() * 12);
+    out.values<float>(mesh.pointCount() * 3,
+                      [&](std::uint64_t i) { return mesh.points[i / 3][int(i % 3)]; });
+    blockHeader(mesh.cellIndices.size() * 8);
+    out.values<std::int64_t>(mesh.cellIndices.size(),
+                             [&](std::uint64_t i) { return mesh.cellIndices[i]; });
+    // VTK's offsets are the END of each cell's run of connectivity.
+    blockHeader(cells * 8);
+    out.values<std::int64_t>(cells, [&](std::uint64_t c) { return mesh.cellOffsets[c + 1]; });
+    blockHeader(cells);
+    out.bytes(mesh.cellTypes.data(), cells);
+    const std::string tail = "\n  </AppendedData>\n</VTKFile>\n";
+    out.bytes(tail.data(), tail.size());
+    file.commit();
 }
 
 }  // namespace uvr

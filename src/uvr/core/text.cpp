@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/core/text.h"
+
+#include <cstdint>
+
+namespace uvr {
+
+namespace {
+
+/// Length of the valid UTF-8 sequence starting at s[i] (1 to 4), or 0 when it is invalid
+/// (RFC 3629: no overlong forms, no surrogates, nothing past U+10FFFF); cp receives the code
+/// point.
+std::size_t utf8Sequence(std::string_view s, std::size_t i, std::uint32_t& cp) {
+    const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+    const unsigned char b0 = byte(i);
+    std::size_t n;
+    std::uint32_t min;
+    if (b0 < 0x80) {
+        cp = b0;
+        return 1;
+    } else if ((b0 & 0xE0) == 0xC0) {
+        n = 2, min = 0x80, cp = b0 & 0x1F;
+    } else if ((b0 & 0xF0) == 0xE0) {
+        n = 3, min = 0x800, cp = b0 & 0x0F;
+    } else if ((b0 & 0xF8) == 0xF0) {
+        n = 4, min = 0x10000, cp = b0 & 0x07;
+    } else {
+        return 0;
+    }
+    if (s.size() - i < n) return 0;
+    for (std::size_t k = 1; k < n; ++k) {
+        if ((byte(i + k) & 0xC0) != 0x80) return 0;
+        cp = (cp << 6) | (byte(i + k) & 0x3F);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
+    return n;
+}
+
+void appendHex(std::string& out, const char* prefix, unsigned v, int digits) {
+    static const char kHex[] = "0123456789abcdef";
+    out += prefix;
+    for (int d = digits - 1; d >= 0; --d) out += kHex[(v >> (4 * d)) & 0xF];
+}
+
+/// Appends the printable form of the character at s[i] and returns its length in bytes.
+std::size_t appendPrintable(std::string& out, std::string_view s, std::size_t i) {
+    std::uint32_t cp = 0;
+    const std::size_t n = utf8Sequence(s, i, cp);
+    if (n == 0) {
+        appendHex(out, "\\x", static_cast<unsigned char>(s[i]), 2);
+        return 1;
+    }
+    if (cp == '\n') {
+        out += "\\n";
+    } else if (cp == '\r') {
+        out += "\\r";
+    } else if (cp == '\t') {
+        out += "\\t";
+    } else if (cp < 0x20 || cp == 0x7F) {
+        appendHex(out, "\\x", cp, 2);
+    } else if (cp >= 0x80 && cp <= 0x9F) {
+        appendHex(out, "\\u", cp, 4);
+    } else {
+        out.append(s.substr(i, n));
+    }
+    return n;
+}
+
+}  // namespace
+
+std::string printable(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size();) i += appendPrintable(out, text, i);
+    return out;
+}
+
+std::string printableShort(std::string_view text, std::size_t maxBytes) {
+    if (maxBytes < 4) maxBytes = 4;
+    std::string out;
+    std::size_t cut = 0;  // length of out at the last boundary that leaves room for "..."
+    for (std::size_t i = 0; i < text.size();) {
+        i += appendPrintable(out, text, i);
+        if (out.size() <= maxBytes - 3) cut = out.size();
+        if (out.size() > maxBytes) return out.substr(0, cut) + "...";
+    }
+    return out;
+}
+
+bool isValidUtf8(std::string_view text) {
+    std::uint32_t cp = 0;
+    for (std::size_t i = 0; i < text.size();) {
+        const std::size_t n = utf8Sequence(text, i, cp);
+        if (n == 0) return false;
+        i += n;
+    }
+    return true;
+}
+
+const char* wideTextEncoding(const void* data, std::size_t size) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    if (size >= 4 && ((b[0] == 0 && b[1] == 0 && b[2] == 0xFE && b[3] == 0xFF) ||
+                      (b[0] == 0xFF && b[1] == 0xFE && b[2] == 0 && b[3] == 0)))
+        return "UTF-32";
+    if (size >= 2 && ((b[0] == 0xFE && b[1] == 0xFF) || (b[0] == 0xFF && b[1] == 0xFE)))
+        return "UTF-16";
+    if (size < 4) return nullptr;
+    // No byte-order mark: an ASCII character (such as '<', '{' or a space) with NUL bytes.
+    const bool z0 = b[0] == 0, z1 = b[1] == 0, z2 = b[2] == 0, z3 = b[3] == 0;
+    if ((!z0 && z1 && z2 && z3) || (z0 && z1 && z2 && !z3)) return "UTF-32";
+    if ((!z0 && z1 && !z2 && z3) || (z0 && !z1 && z2 && !z3)) return "UTF-16";
+    return nullptr;
+}
+
+}  // namespace uvr

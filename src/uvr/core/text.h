@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+namespace uvr {
+
+/// Text from a file (a field or file name, a quoted token) made safe for a one-line message or
+/// output line: valid UTF-8 is kept, control characters become \n, \r, \t or \xNN (C1 controls
+/// \u0080 .. \u009F), and every byte of invalid UTF-8 becomes \xNN. For display only: a
+/// backslash already in the text is kept as it is, so the escaping is not reversible.
+std::string printable(std::string_view text);
+
+/// printable(text) when it is at most maxBytes long, else cut on a character (or escape) boundary
+/// with "..." appended to at most maxBytes (maxBytes >= 4).
+std::string printableShort(std::string_view text, std::size_t maxBytes = 40);
+
+/// True when text is well-formed UTF-8 (no overlong forms, surrogates or code points past
+/// U+10FFFF).
+bool isValidUtf8(std::string_view text);
+
+/// "UTF-32" or "UTF-16" when the start of a text file is in one of those encodings (a byte-order
+/// mark, or NUL bytes among the first four, which UTF-8 text never has), else nullptr. Readers of
+/// UTF-8 formats use it to refuse such files with a clear message.
+const char* wideTextEncoding(const void* data, std::size_t size);
+
+}  // namespace uvr
