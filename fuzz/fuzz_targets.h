@@ -4,9 +4,11 @@
 // The body of every fuzz target, shared by the libFuzzer entry points (fuzz_*.cpp) and the
 // regression test that replays the kept inputs (fuzz_regression_test.cpp).
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -22,7 +24,11 @@
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/mesh/validate.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/cpu/threads.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/image.h"
+#include "uvr/render/render_setup.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr::fuzz {
@@ -169,6 +175,104 @@ inline void fuzzSpecs(const std::uint8_t* data, std::size_t size) {
     });
 }
 
+/// Reads the render target's input: bytes in order, then zeros once they run out.
+class ByteReader {
+public:
+    ByteReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+    std::uint8_t byte() { return pos_ < size_ ? data_[pos_++] : 0; }
+    /// Four bytes as a float, any bit pattern (NaN, infinities, denormals, 3e38).
+    float real() {
+        std::uint8_t b[4] = {byte(), byte(), byte(), byte()};
+        float v;
+        std::memcpy(&v, b, sizeof v);
+        return v;
+    }
+
+private:
+    const std::uint8_t* data_;
+    std::size_t size_;
+    std::size_t pos_ = 0;
+};
+
+/// Most samples per ray the render target renders (a frame of 8x6 pixels under the sanitizers
+/// stays well below a second); frames estimated above it are prepared and set up, not rendered.
+inline constexpr double kFuzzMaxSamplesPerRay = 4000.0;
+
+/// The whole render path on a tiny mesh with arbitrary values: 4 to 19 points (raw float
+/// coordinates), 1 to 8 cells (tetrahedra, pyramids, wedges, hexahedra on any of the points), a
+/// point or cell field of raw floats, then the method, opacity, range, step and camera (the
+/// default or raw floats) of an 8x6 frame rendered on the CPU and written as a PNG. Every
+/// finished frame must hold premultiplied pixels with alpha in [0, 1] and no NaN. One CPU thread:
+/// parallel fuzzing processes would oversubscribe the cores.
+inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
+    static const bool oneThread = (cpu::setThreadCount(1), true);
+    (void)oneThread;
+    ByteReader in(data, size);
+    const std::uint8_t shape = in.byte(), cells = in.byte(), flags = in.byte(), view = in.byte();
+    Mesh mesh;
+    const int pointCount = 4 + shape % 16;
+    for (int i = 0; i < pointCount; ++i) {
+        const float x = in.real(), y = in.real(), z = in.real();
+        mesh.points.emplace_back(x, y, z);
+    }
+    constexpr CellType kTypes[4] = {CellType::Tetra, CellType::Pyramid, CellType::Wedge,
+                                    CellType::Hexahedron};
+    const int cellCount = 1 + cells % 8;
+    for (int c = 0; c < cellCount; ++c) {
+        const CellType type = kTypes[in.byte() % 4];
+        std::uint32_t ids[8];
+        for (int k = 0; k < cornerCount(type); ++k) ids[k] = in.byte() % pointCount;
+        mesh.addCell(type, std::span<const std::uint32_t>(ids, cornerCount(type)));
+    }
+    const bool cellField = flags & 1;
+    std::vector<float> values(cellField ? cellCount : pointCount);
+    for (float& v : values) v = in.real();
+    mesh.fields.push_back({"f", cellField ? Association::Cell : Association::Point, 1, values});
+
+    static const char* const kOpacities[4] = {"ramp", "step:0.5",
+                                              "0:0,0.45:0,0.5:1,0.55:0,1:0", "constant:1"};
+    RenderSettings settings;
+    settings.width = 8;
+    settings.height = 6;
+    settings.tfTableSize = 64;
+    settings.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(settings.tf, kOpacities[(flags >> 1) & 3]);
+    const int method = (flags >> 3) & 3;
+    settings.method = method == 0 ? RenderMethod::Reference : RenderMethod::Partitions;
+    settings.skip = method != 2;
+    settings.adaptive = method != 3;
+    if (flags & 0x20) settings.range = std::pair{in.real(), in.real()};
+    if (flags & 0x40) settings.step = in.real();
+    if (flags & 0x80) {
+        Camera camera;
+        camera.position = Vec3f(in.real(), in.real(), in.real());
+        camera.focalPoint = Vec3f(in.real(), in.real(), in.real());
+        camera.viewUp = Vec3f(in.real(), in.real(), in.real());
+        camera.viewAngle = 0.01f + float(view % 179);
+        settings.camera = camera;
+    }
+    expectCleanError([&] {
+        (void)validateMesh(mesh, "fuzz");
+        const ScalarField field = selectScalarField(mesh, FieldSpec{});
+        PrepareOptions options;
+        options.kd.leafCells = 2;  // several partitions from a handful of tetrahedra
+        const PreparedMesh prepared = prepareMesh(mesh, field, options);
+        const FrameSetup setup = makeFrameSetup(prepared, settings);
+        if (!prepared.tets.tets.empty() &&
+            prepared.tets.bounds.diagonal() / setup.params.step > kFuzzMaxSamplesPerRay)
+            return;
+        const RenderResult result = renderCpu(prepared, settings);
+        for (const Vec4f& p : result.image.pixels)
+            if (!(p.w >= 0.f && p.w <= 1.0001f) || !std::isfinite(p.x) || !std::isfinite(p.y) ||
+                !std::isfinite(p.z)) {
+                std::fprintf(stderr, "fuzzRender: pixel (%g, %g, %g, %g) out of range\n", p.x, p.y,
+                             p.z, p.w);
+                std::abort();
+            }
+        writePng(scratchFolder() + "/frame.png", result.image);
+    });
+}
+
 /// A fuzz target: its name (the folder of its seeds and kept inputs) and its body.
 struct FuzzTarget {
     const char* name;
@@ -182,6 +286,7 @@ inline constexpr FuzzTarget kFuzzTargets[] = {{"vtk_legacy", fuzzVtkLegacy},
                                               {"native", fuzzNative},
                                               {"colormap_json", fuzzColormapJson},
                                               {"pvcc", fuzzPvcc},
-                                              {"specs", fuzzSpecs}};
+                                              {"specs", fuzzSpecs},
+                                              {"render", fuzzRender}};
 
 }  // namespace uvr::fuzz

@@ -13,13 +13,13 @@
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs"
+ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs fuzz_render"
 ci=0
 if [ "${1:-}" = "--ci" ]; then
   ci=1
   total=${2:-60}
   set -- $ALL
-  per=$((total / 7))
+  per=$((total / 8))
 else
   per=${1:?usage: scripts/fuzz.sh SECONDS [TARGET...] | scripts/fuzz.sh --ci [SECONDS]}
   shift
@@ -53,9 +53,18 @@ for t in "$@"; do
   # -timeout: 10 s per input is a hang. Leak detection stays on (a leak is a finding). Long runs
   # go on after a finding (fork mode) to collect every one; CI's pass stops at the first.
   keepgoing=""
+  # -max_len: long enough for deep nesting (a 200 KB JSON), zlib header bombs and reused blocks
+  # (a 330 KB .vtu), many pieces and fields; the render target's input is a few hundred bytes.
+  case $name in
+    vtk_legacy|vtu|native) maxlen=1048576 ;;
+    colormap_json) maxlen=262144 ;;
+    pvtu|pvcc) maxlen=65536 ;;
+    specs) maxlen=4096 ;;
+    *) maxlen=2048 ;;
+  esac
   [ $ci -eq 1 ] || keepgoing="-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"
   set +e
-  $bin/fuzz/$t -max_total_time="$per" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  $bin/fuzz/$t -max_total_time="$per" -max_len=$maxlen -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     $keepgoing -artifact_prefix="$findings/" $inputs >$bin/logs/$name.log 2>&1
   rc=$?
   set -e

@@ -3,7 +3,8 @@
 # Builds the fuzzing seed corpora in OUTDIR/<target>/ from the real meshes in ../shared/data (the
 # small ones), meshes written by uvr itself (generate/convert), VTK's own writers (every VTU
 # encoding, legacy 4.2/5.1 ASCII/BINARY, when python3-vtk9 is installed) and the hand-made seeds
-# in fuzz/seeds/. Real data is copied into OUTDIR (a build folder), never into the repository.
+# in fuzz/seeds/, and the hostile inputs of tests/tools/write_hostile_seeds.py (deep nesting, zlib
+# header bombs, reused blocks and pieces, many fields, extreme values for the render target). Real data is copied into OUTDIR (a build folder), never into the repository.
 # Usage: scripts/fuzz_seeds.sh OUTDIR UVR_BINARY [SHARED_DATA_DIR]
 set -eu
 out=$1
@@ -12,8 +13,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 data=${3:-$root/../shared/data}
 # The fuzz build's CLI is instrumented; its leak checker is not what this script is about.
 export ASAN_OPTIONS=detect_leaks=0
-for t in vtk_legacy vtu pvtu native colormap_json pvcc specs; do mkdir -p "$out/$t"; done
-for t in colormap_json pvcc specs pvtu; do cp "$root/fuzz/seeds/$t/"* "$out/$t/"; done
+for t in vtk_legacy vtu pvtu native colormap_json pvcc specs render; do mkdir -p "$out/$t"; done
+for t in colormap_json pvcc specs pvtu render; do cp "$root/fuzz/seeds/$t/"* "$out/$t/"; done
 
 # Real meshes (the large Blunt Fin and Oxygen Post files are left out: too slow per execution).
 if [ -d "$data" ]; then
@@ -53,4 +54,6 @@ if /usr/bin/python3 -c 'import vtk, meshio' 2>/dev/null; then
 else
   echo "fuzz_seeds.sh: python3-vtk9/python3-meshio missing: no VTK-written seeds" >&2
 fi
+# Hostile inputs: nesting, amplification, extreme values (plain Python, no VTK needed).
+/usr/bin/python3 "$root/tests/tools/write_hostile_seeds.py" "$out"
 echo "fuzz_seeds.sh: seeds in $out: $(find "$out" -type f | wc -l) files"

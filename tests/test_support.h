@@ -62,6 +62,23 @@ inline bool pythonHas(const std::string& module) {
     return std::system(cmd.c_str()) == 0;
 }
 
+/// True when this build runs under AddressSanitizer (whose shadow memory needs far more address
+/// space than an address-space limit such as `ulimit -v` leaves): gcc defines
+/// __SANITIZE_ADDRESS__, clang answers __has_feature.
+constexpr bool underAddressSanitizer() {
+#if defined(__SANITIZE_ADDRESS__)
+    return true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+    return true;
+#else
+    return false;
+#endif
+#else
+    return false;
+#endif
+}
+
 /// Path of the uvr command-line binary built beside the tests.
 inline std::string uvrBinary() {
     const char* env = std::getenv("UVR_BIN");  // a carried binary on another machine

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <nlohmann/json.hpp>
 
@@ -513,12 +514,16 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                       double(result.stats.partitionsSkipped) / (settings.width * settings.height));
         ctx.step(line);
     }
-    writePng(flags.output, result.image, background);
-    ctx.step("wrote " + flags.output);
+    // Every output is written first and committed after the last one succeeded: a failure (a
+    // full disk) leaves none of them behind.
+    std::vector<std::unique_ptr<OutputFile>> outputs;
+    outputs.push_back(std::make_unique<OutputFile>(flags.output));
+    writePng(*outputs.back(), result.image, background);
     if (!flags.heatmapFile.empty()) {
-        writePng(flags.heatmapFile, sampleHeatmap(result.sampleCounts, settings.width,
-                                                  settings.height, flags.heatmapMax));
-        ctx.step("wrote " + flags.heatmapFile);
+        ctx.setActivity(flags.heatmapFile, "writing the heat map");
+        outputs.push_back(std::make_unique<OutputFile>(flags.heatmapFile));
+        writePng(*outputs.back(), sampleHeatmap(result.sampleCounts, settings.width,
+                                                settings.height, flags.heatmapMax));
     }
     if (!flags.statsFile.empty()) {
         nlohmann::json j;
@@ -590,8 +595,13 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                        {"focal_point", {number(focal[0]), number(focal[1]), number(focal[2])}},
                        {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
                        {"view_angle", c.viewAngle}};
-        writeTextOutput(flags.statsFile, jsonText(j) + "\n");
-        ctx.step("wrote " + flags.statsFile);
+        outputs.push_back(std::make_unique<OutputFile>(flags.statsFile));
+        outputs.back()->write(jsonText(j) + "\n");
+    }
+    for (const auto& out : outputs) out->finish();  // buffered bytes reach the disk (or fail)
+    for (const auto& out : outputs) {
+        out->commit();
+        ctx.step("wrote " + out->path());
     }
     return result;
 }

@@ -25,6 +25,14 @@ struct Task {
     std::uint32_t node, begin, end, depth;
 };
 
+/// Bin of centre coordinate v among nb bins of width 1 / scale from lo, clamped to [0, nb - 1]
+/// before converting (NaN to 0): a centre extent so small (denormal) that nb / extent overflows to
+/// infinity still bins every centre, above lo into the last bin and at lo into the first.
+int binIndex(float v, float lo, float scale, int nb) {
+    const float f = (v - lo) * scale;
+    return f > 0.f ? (f < float(nb - 1) ? static_cast<int>(f) : nb - 1) : 0;
+}
+
 /// Nodes with more primitives are split by data-parallel passes; smaller ones are whole subtrees
 /// built by one thread each. Fixed (not derived from the thread count), so the tree is the same
 /// whatever the number of threads.
@@ -119,8 +127,7 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
                 std::fill(binBox.begin(), binBox.end(), Bounds3f{});
                 std::fill(binCount.begin(), binCount.end(), 0u);
                 for (std::uint32_t i = t.begin; i < t.end; ++i) {
-                    int b = static_cast<int>((p[i].center[axis] - cbox.lo[axis]) * scale);
-                    b = std::clamp(b, 0, nb - 1);
+                    const int b = binIndex(p[i].center[axis], cbox.lo[axis], scale, nb);
                     binBox[b].extend(p[i].box);
                     ++binCount[b];
                 }
@@ -135,8 +142,8 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
             mid = static_cast<std::uint32_t>(
                 std::partition(p + t.begin, p + t.end,
                                [&](const Prim& q) {
-                                   int b = static_cast<int>((q.center[bestAxis] - lo) * scale);
-                                   return std::clamp(b, 0, nb - 1) < bestSplit;
+                                   return binIndex(q.center[bestAxis], lo, scale, nb) <
+                                          bestSplit;
                                }) -
                 p);
         } else {
@@ -194,7 +201,7 @@ std::uint32_t splitLarge(std::span<const Bounds3f> boxes, std::span<const Vec3f>
     const int nb = std::max(2, options.bins);
     const float scale = nb / ext, lo = cbox.lo[axis];
     auto binOf = [&](std::uint32_t id) {
-        return std::clamp(static_cast<int>((centers[id][axis] - lo) * scale), 0, nb - 1);
+        return binIndex(centers[id][axis], lo, scale, nb);
     };
     std::vector<Bounds3f> chunkBins(chunks * nb);
     std::vector<std::uint32_t> chunkCounts(chunks * nb, 0u);

@@ -71,6 +71,26 @@ TEST(Bvh, DegenerateInputsBuild) {
     EXPECT_EQ(hits, 1000);
 }
 
+TEST(Bvh, CentresApartByDenormalsBuild) {
+    // Centres 1e-42 apart in x (found by the render fuzz target): the bin scale nb / extent
+    // overflowed to infinity and the bin index conversion was undefined. Both the data-parallel
+    // pass (more than 2^17 boxes) and the per-thread subtrees meet such nodes.
+    for (const int n : {64, 140000}) {
+        std::vector<Bounds3f> boxes(n);
+        std::vector<Vec3f> centers(n);
+        for (int i = 0; i < n; ++i) {
+            const float dx = float(i % 1000) * 1e-42f;
+            boxes[i].extend(Vec3f(dx, 0.f, 0.f));
+            boxes[i].extend(Vec3f(1.f + dx, 1.f, 1.f));
+            centers[i] = Vec3f(dx, 0.5f, 0.5f);
+        }
+        const Bvh bvh = buildBvh(boxes, centers);
+        int hits = 0;
+        bvhVisitPoint(bvh.view(), Vec3f(0.5f), [&](std::uint32_t) { return ++hits, false; });
+        EXPECT_EQ(hits, n);
+    }
+}
+
 TEST(PointLocation, BvhAndWalkAgreeWithBruteForce) {
     const PreparedMesh pm = jitteredGrid();
     const TetLocator loc = pm.locator();

@@ -239,8 +239,9 @@ void OutputFile::flush() {
 }
 
 void OutputFile::write(const void* data, std::size_t bytes) {
-    if (committed_ || fd_ < 0)
+    if (finished_ || fd_ < 0)
         throwError(ErrorKind::Internal, target_.path, "write after the output was closed");
+    if (bytes == 0) return;  // an empty array's data() may be null
     const char* p = static_cast<const char*>(data);
     if (buffered_ + bytes > buffer_.size()) {
         flush();
@@ -253,8 +254,8 @@ void OutputFile::write(const void* data, std::size_t bytes) {
     buffered_ += bytes;
 }
 
-void OutputFile::commit() {
-    if (committed_) return;
+void OutputFile::finish() {
+    if (finished_) return;
     flush();
     if (target_.kind == OutputKind::Atomic) {
         // The replaced file's permissions (and owner, where permitted), or the umask's.
@@ -272,6 +273,13 @@ void OutputFile::commit() {
         fd_ = -1;
         if (::close(fd) != 0) ioError(target_.path, "cannot write", errno);
     }
+    fd_ = -1;
+    finished_ = true;
+}
+
+void OutputFile::commit() {
+    if (committed_) return;
+    finish();
     if (target_.kind == OutputKind::Atomic) {
         if (::rename(tmp_.c_str(), target_.target.c_str()) != 0)
             ioError(target_.path, "cannot write", errno);

@@ -55,7 +55,10 @@ public:
     void write(std::string_view text) { write(text.data(), text.size()); }
     /// Bytes appended so far.
     std::uint64_t size() const { return written_ + buffered_; }
-    /// Flushes and closes (checked), then renames the temporary over the target.
+    /// Flushes and closes (checked) without making the output appear: after finish() on every
+    /// output of a command, the commits that follow only rename.
+    void finish();
+    /// finish(), then renames the temporary over the target.
     void commit();
     /// The path as given.
     const std::string& path() const { return target_.path; }
@@ -73,6 +76,7 @@ private:
     std::vector<char> buffer_;
     std::size_t buffered_ = 0;
     std::uint64_t written_ = 0;
+    bool finished_ = false;
     bool committed_ = false;
 };
 

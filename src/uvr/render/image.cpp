@@ -158,6 +158,13 @@ void compositeToRgb8(const Vec4f& pixel, const Vec3f& background, std::uint8_t o
 }
 
 void writePng(const std::string& path, const Image& image, const std::optional<Vec3f>& background) {
+    OutputFile out(path);
+    writePng(out, image, background);
+    out.commit();
+}
+
+void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& background) {
+    const std::string& path = out.path();
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
         throwError(ErrorKind::Argument, path,
@@ -171,28 +178,26 @@ void writePng(const std::string& path, const Image& image, const std::optional<V
     std::vector<std::uint8_t> bytes(image.pixels.size() * channels);
     for (size_t i = 0; i < image.pixels.size(); ++i) {
         Vec4f p = image.pixels[i];
-        std::uint8_t* out = &bytes[i * channels];
+        std::uint8_t* px = &bytes[i * channels];
         if (alpha) {
             float inv = p.w > 0.f ? 1.f / p.w : 0.f;
-            out[0] = toByte(p.x * inv);
-            out[1] = toByte(p.y * inv);
-            out[2] = toByte(p.z * inv);
-            out[3] = toByte(p.w);
+            px[0] = toByte(p.x * inv);
+            px[1] = toByte(p.y * inv);
+            px[2] = toByte(p.z * inv);
+            px[3] = toByte(p.w);
         } else {
-            compositeToRgb8(p, *background, out);
+            compositeToRgb8(p, *background, px);
         }
     }
     std::vector<png_bytep> rows(static_cast<size_t>(image.height));
     for (int y = 0; y < image.height; ++y)
         rows[y] = &bytes[static_cast<size_t>(y) * image.width * channels];
 
-    OutputFile out(path);
     PngSink sink{&out, nullptr};
     PngErrorState state;
     const bool ok = encodePng(sink, image.width, image.height, alpha, rows.data(), state);
     if (sink.failure) std::rethrow_exception(sink.failure);
     if (!ok) throwError(ErrorKind::Io, path, std::string("PNG write failed: ") + state.message);
-    out.commit();
 }
 
 Image readPng(const std::string& path) {

@@ -9,6 +9,10 @@
 #include "uvr/core/vec.h"
 
 namespace uvr {
+class OutputFile;
+}
+
+namespace uvr {
 
 /// An RGBA float image, row 0 at the top, colours premultiplied by alpha (as front-to-back
 /// compositing produces them).
@@ -31,6 +35,11 @@ void compositeToRgb8(const Vec4f& pixel, const Vec3f& background, std::uint8_t o
 /// premultiplied) colour when background is empty, else RGB composited over the background.
 /// Throws Error(Io) naming the file.
 void writePng(const std::string& path, const Image& image,
+              const std::optional<Vec3f>& background = std::nullopt);
+
+/// Encodes the image as writePng does into an output the caller commits (several outputs of one
+/// command can then appear together, after all of them were written).
+void writePng(OutputFile& out, const Image& image,
               const std::optional<Vec3f>& background = std::nullopt);
 
 /// Reads an 8-bit or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette) into a premultiplied
