@@ -16,6 +16,8 @@
 
 #include "../apps/uvr/cli_common.h"
 #include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/cpu/threads.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
@@ -24,8 +26,6 @@
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/mesh/validate.h"
-#include "uvr/cpu/cpu_renderer.h"
-#include "uvr/cpu/threads.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/image.h"
 #include "uvr/render/render_setup.h"
@@ -229,8 +229,8 @@ inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
     for (float& v : values) v = in.real();
     mesh.fields.push_back({"f", cellField ? Association::Cell : Association::Point, 1, values});
 
-    static const char* const kOpacities[4] = {"ramp", "step:0.5",
-                                              "0:0,0.45:0,0.5:1,0.55:0,1:0", "constant:1"};
+    static const char* const kOpacities[4] = {"ramp", "step:0.5", "0:0,0.45:0,0.5:1,0.55:0,1:0",
+                                              "constant:1"};
     RenderSettings settings;
     settings.width = 8;
     settings.height = 6;

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <sstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cli_common.h"
 #include "uvr/core/text.h"
@@ -79,8 +79,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             if (out->empty()) continue;
             if (*out == "-")
                 throwError(ErrorKind::Argument, "-",
-                           std::string(flag) + ": bench prints its table on standard output; "
-                                               "name a file");
+                           std::string(flag) +
+                               ": bench prints its table on standard output; "
+                               "name a file");
             outputs.push_back({flag, *out});
         }
         std::vector<NamedFile> inputs = flags->inputs();

@@ -10,8 +10,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
-#include <sstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
@@ -180,7 +180,10 @@ std::pair<int, int> parseSize(const std::string& flag, const std::string& text) 
 }
 
 void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
-    if (oneFrame) app.add_option("-o,--output", output, "Output PNG file")->required();
+    if (oneFrame)
+        app.add_option("-o,--output", output,
+                       "Output PNG file, or - for standard output (not a terminal)")
+            ->required();
     app.add_option("--field", field,
                    "Field to render: NAME[:point|:cell][:magnitude|:x|:y|:z|:N] "
                    "(default: the first scalar field)");
@@ -415,15 +418,15 @@ std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames) {
 }
 
 void checkFrameMemory(const RenderFlags& flags, const Context& ctx) {
-    checkMemoryEstimate(ctx,
-                        "--size " + flags.size + ": the image buffers (" +
-                            std::to_string(kFrameBytesPerPixel) + " bytes per pixel" +
-                            (flags.heatmapFile.empty()
-                                 ? std::string()
-                                 : ", " + std::to_string(kHeatmapBytesPerPixel) +
-                                       " more for the --heatmap") +
-                            ")",
-                        frameMemoryBytes(flags));
+    checkMemoryEstimate(
+        ctx,
+        "--size " + flags.size + ": the image buffers (" + std::to_string(kFrameBytesPerPixel) +
+            " bytes per pixel" +
+            (flags.heatmapFile.empty()
+                 ? std::string()
+                 : ", " + std::to_string(kHeatmapBytesPerPixel) + " more for the --heatmap") +
+            ")",
+        frameMemoryBytes(flags));
 }
 
 std::function<void(double)> progressPrinter(const Context& ctx, const std::string& what) {
@@ -497,12 +500,11 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     RenderResult result = renderer.render(settings);
     ctx.setActivity(flags.output, "writing the image");
     char line[200];
-    std::snprintf(line, sizeof line,
-                  "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
-                  renderer.deviceName(), result.stats.seconds,
-                  static_cast<unsigned long long>(result.stats.samples),
-                  result.stats.meanSamplesPerPixel(),
-                  result.setup.params.step / result.setup.frame.scale);
+    std::snprintf(
+        line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
+        renderer.deviceName(), result.stats.seconds,
+        static_cast<unsigned long long>(result.stats.samples), result.stats.meanSamplesPerPixel(),
+        result.setup.params.step / result.setup.frame.scale);
     ctx.step(line);
     if (settings.method == RenderMethod::Partitions) {
         std::snprintf(line, sizeof line,
@@ -591,10 +593,11 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         double position[3], focal[3];
         frame.toFile(c.position, position);
         frame.toFile(c.focalPoint, focal);
-        j["camera"] = {{"position", {number(position[0]), number(position[1]), number(position[2])}},
-                       {"focal_point", {number(focal[0]), number(focal[1]), number(focal[2])}},
-                       {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
-                       {"view_angle", c.viewAngle}};
+        j["camera"] = {
+            {"position", {number(position[0]), number(position[1]), number(position[2])}},
+            {"focal_point", {number(focal[0]), number(focal[1]), number(focal[2])}},
+            {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
+            {"view_angle", c.viewAngle}};
         outputs.push_back(std::make_unique<OutputFile>(flags.statsFile));
         outputs.back()->write(jsonText(j) + "\n");
     }

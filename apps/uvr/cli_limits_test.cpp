@@ -9,39 +9,15 @@
 #include <sstream>
 #include <string>
 
+#include "cli_test_support.h"
 #include "test_support.h"
 
 namespace uvr {
 namespace {
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
-
-/// Runs `uvr ARGS` in dir, capturing stdout and stderr.
-CliRun uvr(const std::string& args, const std::string& dir) {
-    const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-    CliRun r;
-    r.code = testing::runCommand("cd " + dir + " && " + testing::uvrBinary() + " " + args + " >" +
-                                 out + " 2>" + err);
-    auto slurp = [](const std::string& p) {
-        std::ifstream in(p);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        return ss.str();
-    };
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
-
-/// Expects exit status 2 and one error line holding every part.
-void expectRefused(const CliRun& r, const std::vector<std::string>& parts) {
-    EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    for (const std::string& p : parts) EXPECT_NE(r.err.find(p), std::string::npos) << r.err;
-}
+using cli_testing::CliRun;
+using cli_testing::expectOneLineError;
+using cli_testing::uvr;
 
 /// A unit cube of 5 tetrahedra with the point field x, as a legacy ASCII file.
 std::string writeCube(const std::string& path) {
@@ -56,11 +32,11 @@ std::string writeCube(const std::string& path) {
 TEST(CliLimits, ImageBuffersAboveMaxMemoryAreRefusedBeforeLoading) {
     const std::string dir = testing::scratchDir();
     const std::string cube = writeCube(dir + "/cube.vtk");
-    expectRefused(
+    expectOneLineError(
         uvr("-q render " + cube + " -o out.png --size 16384x16384 --max-memory 100M", dir),
         {"--size 16384x16384: the image buffers (24 bytes per pixel) would need about "
          "6442450944 bytes, more than the --max-memory limit of 104857600 bytes"});
-    expectRefused(
+    expectOneLineError(
         uvr("-q render " + cube + " -o out.png --size 2048x2048 --heatmap h.png --max-memory 100M",
             dir),
         {"--size 2048x2048: the image buffers (24 bytes per pixel, 20 more for the --heatmap)"});
@@ -70,12 +46,12 @@ TEST(CliLimits, ImageBuffersAboveMaxMemoryAreRefusedBeforeLoading) {
 
 TEST(CliLimits, GeneratedMeshesAboveMaxMemoryAreRefusedBeforeGenerating) {
     const std::string dir = testing::scratchDir();
-    expectRefused(uvr("-q generate --cells 4000000000 -o g.uvrm --max-memory 1G", dir),
-                  {"--cells 4000000000: the mesh of ", " tetrahedra would need about ",
-                   "more than the --max-memory limit of 1073741824 bytes"});
-    expectRefused(uvr("-q demo --cells 2000000000 -o d.png --max-memory 1G", dir),
-                  {"--cells 2000000000 --size 1024x1024: generating, preparing and rendering",
-                   "more than the --max-memory limit of 1073741824 bytes"});
+    expectOneLineError(uvr("-q generate --cells 4000000000 -o g.uvrm --max-memory 1G", dir),
+                       {"--cells 4000000000: the mesh of ", " tetrahedra would need about ",
+                        "more than the --max-memory limit of 1073741824 bytes"});
+    expectOneLineError(uvr("-q demo --cells 2000000000 -o d.png --max-memory 1G", dir),
+                       {"--cells 2000000000 --size 1024x1024: generating, preparing and rendering",
+                        "more than the --max-memory limit of 1073741824 bytes"});
     EXPECT_FALSE(std::filesystem::exists(dir + "/g.uvrm"));
     EXPECT_FALSE(std::filesystem::exists(dir + "/d.png"));
     EXPECT_EQ(uvr("-q generate --cells 1000 -o g.uvrm --max-memory 1M", dir).code, 0);
@@ -85,10 +61,11 @@ TEST(CliLimits, AbsurdStepIsRefusedWithTheEstimateAndAStepThatWorks) {
     // 3e-6 over a unit cube is 577,000 samples per ray: 64x64 pixels would take minutes.
     const std::string dir = testing::scratchDir();
     const std::string cube = writeCube(dir + "/cube.vtk");
-    expectRefused(uvr("-q render " + cube + " -o out.png --size 64x64 --step 3e-6", dir),
-                  {"--step 3e-06 would take up to 2.36e+09 samples (64x64 pixels x 5.77e+05 per "
-                   "ray across the bounds' diagonal 1.73), more than the 100,000 samples per ray "
-                   "allowed: use --step 1.8e-05 or larger (the default here is "});
+    expectOneLineError(
+        uvr("-q render " + cube + " -o out.png --size 64x64 --step 3e-6", dir),
+        {"--step 3e-06 would take up to 2.36e+09 samples (64x64 pixels x 5.77e+05 per "
+         "ray across the bounds' diagonal 1.73), more than the 100,000 samples per ray "
+         "allowed: use --step 1.8e-05 or larger (the default here is "});
     EXPECT_FALSE(std::filesystem::exists(dir + "/out.png"));
     EXPECT_EQ(uvr("-q render " + cube + " -o out.png --size 64x64 --step 1.8e-5", dir).code, 0);
 }
@@ -104,9 +81,9 @@ TEST(CliLimits, MaxMemoryBoundsTheWholeLoad) {
         text += "SCALARS f" + std::to_string(f) + " float 1\nLOOKUP_TABLE default\n" +
                 std::string(40000, '\0') + "\n";
     const std::string path = testing::writeFile(dir + "/fields.vtk", text);
-    expectRefused(uvr("-q info " + path + " --max-memory 3M", dir),
-                  {path + ": tuples of SCALARS 'f", "needs 40000 bytes, which with the ",
-                   "exceed the memory limit of 3145728 bytes (--max-memory)"});
+    expectOneLineError(uvr("-q info " + path + " --max-memory 3M", dir),
+                       {path + ": tuples of SCALARS 'f", "needs 40000 bytes, which with the ",
+                        "exceed the memory limit of 3145728 bytes (--max-memory)"});
     EXPECT_EQ(uvr("-q info " + path + " --max-memory 6M", dir).code, 0);
 }
 

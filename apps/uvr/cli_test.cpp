@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "cli_test_support.h"
 #include "test_support.h"
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/io/mesh_reader.h"
@@ -24,32 +25,10 @@
 namespace uvr {
 namespace {
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
-
-/// Runs `uvr ARGS` in dir, capturing stdout and stderr; env is put before the command (e.g.
-/// "OMP_NUM_THREADS=8 ").
-CliRun uvr(const std::string& args, const std::string& dir, const std::string& env = "") {
-    const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-    CliRun r;
-    r.code =
-        testing::runCommand(env + testing::uvrBinary() + " " + args + " >" + out + " 2>" + err);
-    auto slurp = [](const std::string& p) {
-        std::ifstream in(p);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        return ss.str();
-    };
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
-
-int lineCount(const std::string& s) {
-    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
-}
+using cli_testing::CliRun;
+using cli_testing::expectOneLineError;
+using cli_testing::lineCount;
+using cli_testing::uvr;
 
 TEST(Cli, HelpListsEverySubcommand) {
     const std::string dir = testing::scratchDir();
@@ -322,6 +301,15 @@ int interruptWhenLogged(const std::vector<std::string>& args, const std::string&
     return status;
 }
 
+/// Names of the files in a folder, sorted.
+std::vector<std::string> fileNames(const std::string& dir) {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
 TEST(Cli, InterruptedRenderLeavesThePreviousOutputUntouched) {
     // Killed while rendering (SIGTERM after the "rendering" progress line), uvr must leave the
     // existing output as it was and no partial or temporary file beside it.
@@ -335,11 +323,7 @@ TEST(Cli, InterruptedRenderLeavesThePreviousOutputUntouched) {
     EXPECT_EQ(WTERMSIG(status), SIGTERM);
     std::ifstream in(out);
     EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), {}), "previous image");
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(dir))
-        files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    EXPECT_EQ(files, (std::vector<std::string>{"log.txt", "out.png"}));
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"log.txt", "out.png"}));
 }
 
 TEST(Cli, InterruptedConvertLeavesNoTemporary) {
@@ -356,22 +340,7 @@ TEST(Cli, InterruptedConvertLeavesNoTemporary) {
     EXPECT_EQ(WTERMSIG(status), SIGTERM);
     std::ifstream old(out);
     EXPECT_EQ(std::string((std::istreambuf_iterator<char>(old)), {}), "previous mesh");
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(dir))
-        files.push_back(e.path().filename().string());
-    std::sort(files.begin(), files.end());
-    EXPECT_EQ(files, (std::vector<std::string>{"in.uvrm", "log.txt", "out.vtu"}));
-}
-
-/// Expects a refusal: exit code 2 and exactly one stderr line "uvr: error: ..." holding every
-/// piece.
-void expectOneLineError(const CliRun& r, const std::vector<std::string>& pieces,
-                        const std::string& what) {
-    EXPECT_EQ(r.code, 2) << what << "\n" << r.err;
-    EXPECT_EQ(lineCount(r.err), 1) << what << "\n" << r.err;
-    EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << what << "\n" << r.err;
-    for (const std::string& p : pieces)
-        EXPECT_NE(r.err.find(p), std::string::npos) << what << ": no '" << p << "' in " << r.err;
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"in.uvrm", "log.txt", "out.vtu"}));
 }
 
 /// A legacy VTK cube of five tetrahedra with point field `name` holding `values` (8 numbers).
@@ -552,12 +521,10 @@ TEST(Cli, OutputsNeverDestroyWhatTheirPathNames) {
     const std::string mesh =
         testing::writeFile(dir + "/m.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7"));
     const std::string render = "-q render " + mesh + " --size 16x16 --device cpu ";
-    auto names = [&] {
-        std::vector<std::string> files;
-        for (const auto& e : std::filesystem::directory_iterator(dir))
-            if (e.path().filename() != "stdout.txt" && e.path().filename() != "stderr.txt")
-                files.push_back(e.path().filename().string());
-        std::sort(files.begin(), files.end());
+    auto names = [&] {  // without the runs' captured output
+        std::vector<std::string> files = fileNames(dir);
+        std::erase_if(files,
+                      [](const std::string& f) { return f == "stdout.txt" || f == "stderr.txt"; });
         return files;
     };
     // Onto the input mesh (also through a symbolic link), or two outputs onto one file.
@@ -566,8 +533,8 @@ TEST(Cli, OutputsNeverDestroyWhatTheirPathNames) {
                        {"-o names the input mesh", "refusing to overwrite an input"}, "-o mesh");
     expectOneLineError(uvr(render + "-o " + dir + "/a.png --heatmap " + dir + "/a.png", dir),
                        {"--heatmap names the same file as -o"}, "two outputs");
-    expectOneLineError(uvr("-q convert " + mesh + " " + mesh, dir),
-                       {"OUT names the input mesh"}, "convert onto itself");
+    expectOneLineError(uvr("-q convert " + mesh + " " + mesh, dir), {"OUT names the input mesh"},
+                       "convert onto itself");
     EXPECT_EQ(names(), (std::vector<std::string>{"alias.vtk", "m.vtk"}));
     EXPECT_EQ(readMesh(mesh).cellCount(), 5u);
     // A character device is written in place, never replaced.

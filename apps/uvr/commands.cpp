@@ -135,15 +135,14 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
         spec.targetCells = *cells;
         // The mesh, what rendering prepares from it and the frame, before generating anything.
         const std::uint64_t tets = proceduralTetCount(spec);
-        checkMemoryEstimate(ctx,
-                            "--cells " + std::to_string(*cells) + " --size " + flags->size +
-                                ": generating, preparing and rendering " + std::to_string(tets) +
-                                " tetrahedra (" + std::to_string(proceduralMeshBytes(spec)) +
-                                " bytes for the mesh, " + std::to_string(kPrepareBytesPerTet) +
-                                " per tetrahedron to prepare it, " +
-                                std::to_string(frameMemoryBytes(*flags)) + " for the image)",
-                            proceduralMeshBytes(spec) + tets * kPrepareBytesPerTet +
-                                frameMemoryBytes(*flags));
+        checkMemoryEstimate(
+            ctx,
+            "--cells " + std::to_string(*cells) + " --size " + flags->size +
+                ": generating, preparing and rendering " + std::to_string(tets) + " tetrahedra (" +
+                std::to_string(proceduralMeshBytes(spec)) + " bytes for the mesh, " +
+                std::to_string(kPrepareBytesPerTet) + " per tetrahedron to prepare it, " +
+                std::to_string(frameMemoryBytes(*flags)) + " for the image)",
+            proceduralMeshBytes(spec) + tets * kPrepareBytesPerTet + frameMemoryBytes(*flags));
         auto start = Clock::now();
         ctx.step("generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)");
         ctx.setActivity("", "generating the demo mesh");

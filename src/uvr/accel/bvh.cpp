@@ -142,8 +142,7 @@ void buildSubtree(std::span<const Bounds3f> boxes, std::span<const Vec3f> center
             mid = static_cast<std::uint32_t>(
                 std::partition(p + t.begin, p + t.end,
                                [&](const Prim& q) {
-                                   return binIndex(q.center[bestAxis], lo, scale, nb) <
-                                          bestSplit;
+                                   return binIndex(q.center[bestAxis], lo, scale, nb) < bestSplit;
                                }) -
                 p);
         } else {
@@ -200,9 +199,7 @@ std::uint32_t splitLarge(std::span<const Bounds3f> boxes, std::span<const Vec3f>
     // Binned SAH on the longest centre axis, as buildSubtree does for large nodes.
     const int nb = std::max(2, options.bins);
     const float scale = nb / ext, lo = cbox.lo[axis];
-    auto binOf = [&](std::uint32_t id) {
-        return binIndex(centers[id][axis], lo, scale, nb);
-    };
+    auto binOf = [&](std::uint32_t id) { return binIndex(centers[id][axis], lo, scale, nb); };
     std::vector<Bounds3f> chunkBins(chunks * nb);
     std::vector<std::uint32_t> chunkCounts(chunks * nb, 0u);
 #pragma omp parallel for schedule(dynamic, 1)

@@ -355,8 +355,8 @@ void checkOutputsDistinct(const std::vector<NamedFile>& inputs,
         for (size_t k = 0; k < i; ++k)
             if (!outIds[i].device && same(outIds[i], outIds[k]))
                 throwError(ErrorKind::Argument, outputs[i].path,
-                           outputs[i].role + " names the same file as " + outputs[k].role +
-                               " '" + outputs[k].path + "'");
+                           outputs[i].role + " names the same file as " + outputs[k].role + " '" +
+                               outputs[k].path + "'");
     }
 }
 

@@ -25,8 +25,8 @@ struct OutputTarget {
     std::string path;    ///< as given (used in messages)
     std::string target;  ///< what is written: the end of the symbolic-link chain, or "-"
     OutputKind kind = OutputKind::Atomic;
-    bool exists = false;    ///< the target exists (a regular file is then replaced)
-    unsigned mode = 0666;   ///< permission bits for the written file (the replaced file's own)
+    bool exists = false;        ///< the target exists (a regular file is then replaced)
+    unsigned mode = 0666;       ///< permission bits for the written file (the replaced file's own)
     unsigned uid = 0, gid = 0;  ///< owner of the replaced file (restored where permitted)
 };
 

@@ -104,7 +104,7 @@ TEST(OutputFile, SymbolicLinksAreWrittenThroughAndKept) {
     const std::string dir = testing::scratchDir();
     fs::create_directories(dir + "/runs/42");
     const std::string target = testing::writeFile(dir + "/runs/42/out.png", "old");
-    fs::create_symlink("runs/42/out.png", dir + "/latest.png");  // relative link
+    fs::create_symlink("runs/42/out.png", dir + "/latest.png");   // relative link
     fs::create_symlink(dir + "/latest.png", dir + "/chain.png");  // absolute link to a link
     writeTextOutput(dir + "/chain.png", "new");
     EXPECT_TRUE(fs::is_symlink(dir + "/latest.png"));
@@ -225,8 +225,7 @@ TEST(OutputFile, TerminalsAreRefused) {
     const int code = withTerminalStdout([](const std::string& tty) {
         const std::string dash = errorOf([] { resolveOutput("-"); });
         const std::string named = errorOf([&] { OutputFile out(tty); });
-        return contains(dash, "standard output is a terminal") &&
-                       contains(named, "is a terminal")
+        return contains(dash, "standard output is a terminal") && contains(named, "is a terminal")
                    ? 0
                    : 1;
     });
@@ -264,8 +263,7 @@ TEST(OutputFile, AFileSizeLimitIsAnErrorThatLeavesNothingBehind) {
         installOutputSignalHandlers();  // SIGXFSZ ignored: the write fails instead
         rlimit limit{4096, 4096};
         ::setrlimit(RLIMIT_FSIZE, &limit);
-        const std::string msg =
-            errorOf([&] { writeTextOutput(path, std::string(3 << 20, 'x')); });
+        const std::string msg = errorOf([&] { writeTextOutput(path, std::string(3 << 20, 'x')); });
         ::_exit(contains(msg, "cannot write (after") && contains(msg, "File too large") ? 0 : 1);
     }
     int status = 0;
@@ -301,19 +299,20 @@ TEST(OutputFile, OutputsNamingAnInputOrEachOtherAreRefused) {
     fs::create_symlink(mesh, dir + "/alias.vtk");
     const std::vector<NamedFile> inputs{{"the input mesh", mesh}, {"--tf", "cool-to-warm"}};
     EXPECT_EQ(errorOf([&] { checkOutputsDistinct(inputs, {{"-o", dir + "/a.png"}}); }), "");
-    for (const std::string& out : {mesh, dir + "/alias.vtk", dir + "/../" +
-                                                                   fs::path(dir).filename().string() +
-                                                                   "/mesh.vtk"}) {
+    for (const std::string& out :
+         {mesh, dir + "/alias.vtk",
+          dir + "/../" + fs::path(dir).filename().string() + "/mesh.vtk"}) {
         const std::string msg = errorOf([&] { checkOutputsDistinct(inputs, {{"-o", out}}); });
-        EXPECT_EQ(msg, out + ": -o names the input mesh '" + mesh +
-                           "': refusing to overwrite an input");
+        EXPECT_EQ(msg,
+                  out + ": -o names the input mesh '" + mesh + "': refusing to overwrite an input");
     }
     EXPECT_EQ(slurp(mesh), "mesh");
     // Two outputs naming one file, existing or not yet, however spelt.
-    EXPECT_EQ(errorOf([&] {
-                  checkOutputsDistinct(inputs, {{"-o", dir + "/s.png"}, {"--heatmap", dir + "/./s.png"}});
-              }),
-              dir + "/./s.png: --heatmap names the same file as -o '" + dir + "/s.png'");
+    EXPECT_EQ(
+        errorOf([&] {
+            checkOutputsDistinct(inputs, {{"-o", dir + "/s.png"}, {"--heatmap", dir + "/./s.png"}});
+        }),
+        dir + "/./s.png: --heatmap names the same file as -o '" + dir + "/s.png'");
     EXPECT_TRUE(contains(errorOf([&] {
                              checkOutputsDistinct({}, {{"-o", "-"}, {"--stats", "-"}});
                          }),

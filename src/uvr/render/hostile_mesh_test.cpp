@@ -581,8 +581,10 @@ TEST(HostileMesh, MeshWithNothingToRenderIsRefusedOrTransparent) {
     // given camera sees nothing.
     for (const Vec3f apex : {Vec3f(0.3f, 0.3f, 1e-7f), Vec3f(0.f)}) {
         Mesh m;
-        m.points = {{0, 0, 0}, apex == Vec3f(0.f) ? apex : Vec3f(1, 0, 0),
-                    apex == Vec3f(0.f) ? apex : Vec3f(0, 1, 0), apex};
+        m.points = {{0, 0, 0},
+                    apex == Vec3f(0.f) ? apex : Vec3f(1, 0, 0),
+                    apex == Vec3f(0.f) ? apex : Vec3f(0, 1, 0),
+                    apex};
         const std::uint32_t ids[4] = {0, 1, 2, 3};
         m.addCell(CellType::Tetra, ids);
         m.fields.push_back({"f", Association::Point, 1, {1.f, 1.f, 1.f, 1.f}});

@@ -186,10 +186,9 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
         std::max(diagonal / kMaxSamplesPerRay, diagonal * pixels / kMaxFrameSamples);
     const double scale = std::pow(10.0, std::floor(std::log10(least)) - 1.0);
     const double suggest = std::ceil(least / scale * 1.0001) * scale;
-    const std::string what = settings.step > 0.f
-                                 ? "--step " + fmtG(step * unit)
-                                 : "the default step " + fmtG(step * unit) +
-                                       " (from the mean cell size)";
+    const std::string what = settings.step > 0.f ? "--step " + fmtG(step * unit)
+                                                 : "the default step " + fmtG(step * unit) +
+                                                       " (from the mean cell size)";
     throwError(ErrorKind::Argument, "",
                what + " would take up to " + fmtG(w.samples) + " samples (" +
                    std::to_string(settings.width) + "x" + std::to_string(settings.height) +
@@ -198,8 +197,9 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
                    (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
                                                         : "10^12 samples per frame") +
                    " allowed: use --step " + fmtG(suggest) + " or larger" +
-                   (settings.step > 0.f ? " (the default here is " + fmtG(defaultStep(mesh.tets) * unit) + ")"
-                                        : std::string()));
+                   (settings.step > 0.f
+                        ? " (the default here is " + fmtG(defaultStep(mesh.tets) * unit) + ")"
+                        : std::string()));
 }
 
 }  // namespace
@@ -237,9 +237,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                ? toLocal(settings.opacityUnit, "--opacity-unit")
                                : defaultOpacityUnit(bounds, mesh.sourceCells);
     f.params.terminationAlpha = settings.terminationAlpha;
-    f.maxStep = settings.maxStep > 0.f
-                    ? toLocal(settings.maxStep, "--max-step")
-                    : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
+    f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "--max-step")
+                                       : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
         throwError(ErrorKind::Argument, "",
                    "--max-step " + fmtG(f.maxStep / frame.scale) + " is below --step " +

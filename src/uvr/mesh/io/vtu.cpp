@@ -69,9 +69,9 @@ struct XmlDoc {
     std::vector<PieceDesc> pieces;
     bool hasAppended = false;
     bool appendedBase64 = false;
-    std::uint64_t appendedStart = 0;  // file byte offset just after the '_' marker
-    std::uint64_t appendedEnd = 0;    // file byte offset of </AppendedData>
-    std::uint64_t fileBytes = 0;      // size of the file
+    std::uint64_t appendedStart = 0;         // file byte offset just after the '_' marker
+    std::uint64_t appendedEnd = 0;           // file byte offset of </AppendedData>
+    std::uint64_t fileBytes = 0;             // size of the file
     mutable std::uint64_t decodedBytes = 0;  // binary payload bytes decoded so far, all arrays
 };
 
@@ -758,8 +758,7 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         out.connectivity.reserve(out.connectivity.size() + conn.size());
         for (std::int64_t id : conn)
             out.connectivity.push_back(id < 0 ? id : id + static_cast<std::int64_t>(pointBase));
-        options.budget->release((ends.size() + types.size() + conn.size()) *
-                                sizeof(std::int64_t));
+        options.budget->release((ends.size() + types.size() + conn.size()) * sizeof(std::int64_t));
     }
 
     // Point and cell fields, concatenated across Pieces by name and association.

@@ -615,11 +615,11 @@ TEST(VtuAmplification, OneBlockReusedByManyPiecesIsBoundedByTheFileAndTheLimit) 
     const std::string dir = testing::scratchDir();
     const std::string path = testing::writeFile(dir + "/reuse.vtu", text);
     // Without a limit: what 1032 times the file can hold.
-    expectError([&] { readVtu(path); }, ErrorKind::Parse,
-                {path + ": byte ", "DataArray 'Points'",
-                 "bytes decoded from the file's arrays, more than its " +
-                     std::to_string(text.size()) +
-                     " bytes can hold at deflate's maximum ratio of 1032:1"});
+    expectError(
+        [&] { readVtu(path); }, ErrorKind::Parse,
+        {path + ": byte ", "DataArray 'Points'",
+         "bytes decoded from the file's arrays, more than its " + std::to_string(text.size()) +
+             " bytes can hold at deflate's maximum ratio of 1032:1"});
     // With a limit: every array fits it, all of them together do not.
     ReadOptions options;
     options.maxMemoryBytes = 4 << 20;
@@ -643,8 +643,7 @@ TEST(VtuAmplification, PvtuListingAPieceTwiceIsRefusedBeforeReadingIt) {
             "<PUnstructuredGrid GhostLevel=\"0\">\n<PPoints><PDataArray type=\"Float32\" "
             "NumberOfComponents=\"3\"/></PPoints>\n";
         for (const std::string& s : sources) text += "<Piece Source=\"" + s + "\"/>\n";
-        return testing::writeFile(dir + "/" + name,
-                                  text + "</PUnstructuredGrid>\n</VTKFile>\n");
+        return testing::writeFile(dir + "/" + name, text + "</PUnstructuredGrid>\n</VTKFile>\n");
     };
     const std::string twice = pvtu("twice.pvtu", {"p.vtu", "./sub/../p.vtu"});
     fs::create_directory(dir + "/sub");
