@@ -200,10 +200,10 @@ inline constexpr double kFuzzMaxSamplesPerRay = 4000.0;
 
 /// The whole render path on a tiny mesh with arbitrary values: 4 to 19 points (raw float
 /// coordinates), 1 to 8 cells (tetrahedra, pyramids, wedges, hexahedra on any of the points), a
-/// point or cell field of raw floats, then the method, opacity, range, step and camera (the
-/// default or raw floats) of an 8x6 frame rendered on the CPU and written as a PNG. Every
-/// finished frame must hold premultiplied pixels with alpha in [0, 1] and no NaN. One CPU thread:
-/// parallel fuzzing processes would oversubscribe the cores.
+/// point or cell field of raw floats, then the method (reference, exact, three partition variants),
+/// opacity, range, step and camera (the default or raw floats) of an 8x6 frame rendered on the CPU
+/// and written as a PNG. Every finished frame must hold premultiplied pixels with alpha in [0, 1]
+/// and no NaN. One CPU thread: parallel fuzzing processes would oversubscribe the cores.
 inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
     static const bool oneThread = (cpu::setThreadCount(1), true);
     (void)oneThread;
@@ -238,7 +238,9 @@ inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
     settings.tf = transferFunctionPreset("viridis");
     applyOpacitySpec(settings.tf, kOpacities[(flags >> 1) & 3]);
     const int method = (flags >> 3) & 3;
-    settings.method = method == 0 ? RenderMethod::Reference : RenderMethod::Partitions;
+    settings.method = method != 0      ? RenderMethod::Partitions
+                      : (shape & 0x10) ? RenderMethod::Exact
+                                       : RenderMethod::Reference;
     settings.skip = method != 2;
     settings.adaptive = method != 3;
     if (flags & 0x20) settings.range = std::pair{in.real(), in.real()};

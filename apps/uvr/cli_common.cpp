@@ -209,19 +209,23 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees")
         ->capture_default_str();
     app.add_option("--step", step,
-                   "Sample spacing s1 (default: 0.5 * cube root of the mean tetrahedron volume)");
+                   "Sample spacing s1 (default: 0.5 * cube root of the mean tetrahedron volume)")
+        ->check(CLI::PositiveNumber);  // 0 means nothing: it is refused, not taken as the default
     app.add_option("--opacity-unit", opacityUnit,
                    "Distance over which a TF opacity applies (default: ParaView's "
-                   "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))");
+                   "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))")
+        ->check(CLI::PositiveNumber);
     if (oneFrame)
         app.add_option("--method", method,
-                       "Integrator: reference (fixed step s1 everywhere) or adaptive (k-d "
-                       "partitions, space skipping, adaptive steps; Morrical et al. 2019)")
-            ->check(CLI::IsMember({"reference", "adaptive"}))
+                       "Integrator: reference (fixed step s1 everywhere), adaptive (k-d "
+                       "partitions, space skipping, adaptive steps; Morrical et al. 2019) or "
+                       "exact (no sampling: every tetrahedron's segment integrated exactly)")
+            ->check(CLI::IsMember({"reference", "adaptive", "exact"}))
             ->capture_default_str();
     app.add_option("--max-step", maxStep,
                    "Adaptive: largest step s2 (default: " +
-                       std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)");
+                       std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)")
+        ->check(CLI::PositiveNumber);
     app.add_option("--power", power, "Adaptive: power p >= 1 of the step formula")
         ->capture_default_str();
     if (oneFrame) {
@@ -270,12 +274,14 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
-    s.method = method == "adaptive" ? RenderMethod::Partitions : RenderMethod::Reference;
+    s.method = method == "adaptive" ? RenderMethod::Partitions
+               : method == "exact"  ? RenderMethod::Exact
+                                    : RenderMethod::Reference;
     s.maxStep = maxStep;
     s.power = power;
     s.skip = !noSkip;
     s.adaptive = !noAdaptive;
-    if (s.method == RenderMethod::Reference &&
+    if (s.method != RenderMethod::Partitions &&
         (noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid))
         throwError(ErrorKind::Argument, "",
                    "--no-skip, --no-adaptive, --max-step, --leaf-cells and --no-seed-grid need "

@@ -21,6 +21,7 @@
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/render/image.h"
+#include "uvr/render/image_metrics.h"
 
 namespace uvr {
 namespace {
@@ -172,6 +173,30 @@ TEST(Cli, RenderWritesPngAndStats) {
     EXPECT_EQ(j["image"]["width"], 64);
     EXPECT_EQ(j["mesh"]["cells"], 12936);
     EXPECT_GT(j["render_seconds"].get<double>(), 0);
+}
+
+TEST(Cli, ExactMethodAgreesWithTheReferenceAtASixteenthOfItsStep) {
+    // The Oxygen Post has seams of unshared faces (its O-grid): rays that cross them are located
+    // again, never dropped, so exact equals the converged fixed-step image.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string post = testing::sharedData("post_tets.vtk");
+    const std::string view =
+        " --size 96x96 --azimuth -30 --elevation 25 --opacity 0:0,0.3:0.6,0.35:0,0.7:0.8,1:0.2 ";
+    const CliRun e = uvr("-q render " + post + " --method exact -o e.png" + view, dir);
+    ASSERT_EQ(e.code, 0) << e.err;
+    const CliRun f =
+        uvr("-q render " + post + " --method reference --step 0.00587 -o f.png" + view, dir);
+    ASSERT_EQ(f.code, 0) << f.err;
+    const ImageComparison m =
+        compareImages(toRgb8(readPng(dir + "/e.png")), toRgb8(readPng(dir + "/f.png")));
+    EXPECT_GE(m.ssim, 0.999);
+    expectOneLineError(uvr("-q render " + post + " --method exact --max-step 1 -o x.png", dir),
+                       {"need --method adaptive"}, "exact with --max-step");
+    // 0 means nothing: refused, not taken as the default.
+    for (const char* flag : {"--step", "--opacity-unit", "--max-step"})
+        expectOneLineError(uvr("-q render " + post + " " + flag + " 0 -o x.png", dir), {flag},
+                           std::string(flag) + " 0");
 }
 
 TEST(Cli, ConvertedMeshRendersIdentically) {

@@ -102,10 +102,11 @@ def vtk_legacy_seeds(out):
           "POINTS 4000000000 float\n")
 
 
-def render_seed(points, cells, values, flags, view=0, extra=()):
-    """An input of the render target (fuzzRender in fuzz/fuzz_targets.h)."""
+def render_seed(points, cells, values, flags, view=0, extra=(), exact=False):
+    """An input of the render target (fuzzRender in fuzz/fuzz_targets.h); exact picks the exact
+    integrator where the method bits say reference."""
     types = {4: 0, 5: 1, 6: 2, 8: 3}
-    data = bytes([len(points) - 4, len(cells) - 1, flags, view])
+    data = bytes([(len(points) - 4) | (0x10 if exact else 0), len(cells) - 1, flags, view])
     for p in points:
         data += struct.pack("<3f", *p)
     for c in cells:
@@ -125,6 +126,10 @@ def render_seeds(out):
               render_seed(tet, [(0, 1, 2, 3)], [0, 1, 2, 3], flags_for(method, 2)))
         write(out, "hex_m%d.bin" % method,
               render_seed(cube, hexa, [float(i) for i in range(8)], flags_for(method, 0)))
+    write(out, "tet_exact.bin",
+          render_seed(tet, [(0, 1, 2, 3)], [0, 1, 2, 3], flags_for(0, 2), exact=True))
+    write(out, "hex_exact.bin",
+          render_seed(cube, hexa, [float(i) for i in range(8)], flags_for(0, 0), exact=True))
     # Values spanning the float range; a cell field at the float's ends.
     write(out, "wide_field.bin", render_seed(tet, [(0, 1, 2, 3)], [-3e38, 3e38, -1e38, 1e38],
                                              flags_for(1, 0)))

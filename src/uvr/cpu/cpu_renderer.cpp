@@ -66,6 +66,8 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     if (settings.method == RenderMethod::Reference)
         launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)},
                     settings.progress);
+    else if (settings.method == RenderMethod::Exact)
+        launchFrame(frame, result.stats, ExactMarch{result.setup.scene(mesh)}, settings.progress);
     else
         launchFrame(frame, result.stats,
                     PartitionMarch{result.setup.partitionScene(mesh, settings.skip)},

@@ -245,6 +245,9 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     if (settings.method == RenderMethod::Reference) {
         cuda::frameKernel<<<grid, block>>>(frame, ReferenceMarch{d.deviceScene(result.setup)},
                                            d.totals.data());
+    } else if (settings.method == RenderMethod::Exact) {
+        cuda::frameKernel<<<grid, block>>>(frame, ExactMarch{d.deviceScene(result.setup)},
+                                           d.totals.data());
     } else {
         if (!d.mesh.kd)
             throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");

@@ -72,6 +72,7 @@ TEST(Cuda, ProceduralMeshMatchesCpuForEveryMethod) {
     o.kd.leafCells = 128;
     const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
     expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Reference), "reference");
+    expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Exact), "exact");
     RenderSettings s = settingsFor(pm, RenderMethod::Partitions);
     expectSameAsCpu(pm, s, "skipping + adaptive");
     s.skip = false;
@@ -90,6 +91,7 @@ TEST(Cuda, RealMeshesMatchCpu) {
         expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Reference), std::string(name) + " ref");
         expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Partitions),
                         std::string(name) + " adaptive");
+        expectSameAsCpu(pm, settingsFor(pm, RenderMethod::Exact), std::string(name) + " exact");
     }
 }
 

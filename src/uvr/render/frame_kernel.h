@@ -6,6 +6,7 @@
 #include "uvr/core/host_device.h"
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/exact_integrator.h"
 #include "uvr/render/reference_marcher.h"
 
 namespace uvr {
@@ -37,6 +38,14 @@ struct ReferenceMarch {
     SceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
         return marchReference(scene, ray, counters);
+    }
+};
+
+/// The exact integrator as a functor for shadePixel (its "samples" are tetrahedra crossed).
+struct ExactMarch {
+    SceneView scene;
+    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
+        return integrateExact(scene, ray, counters);
     }
 };
 

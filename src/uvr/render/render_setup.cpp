@@ -282,9 +282,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.rays = makeCameraRays(f.camera, settings.width, settings.height);
     if (settings.method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
-    if (settings.method == RenderMethod::Reference && mesh.bvh.nodes.empty() &&
+    if (settings.method != RenderMethod::Partitions && mesh.bvh.nodes.empty() &&
         !mesh.tets.tets.empty())
-        throwError(ErrorKind::Argument, "", "the reference method needs the mesh BVH");
+        throwError(
+            ErrorKind::Argument, "",
+            std::string(settings.method == RenderMethod::Exact ? "the exact" : "the reference") +
+                " method needs the mesh BVH");
     if (settings.method == RenderMethod::Partitions && shadePartitions) {
         const auto start = std::chrono::steady_clock::now();
         const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,

@@ -85,6 +85,7 @@ float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount);
 enum class RenderMethod {
     Reference,   ///< fixed step s1 through the whole volume (the yardstick)
     Partitions,  ///< k-d partitions with space skipping and adaptive steps (Morrical et al. 2019)
+    Exact,       ///< no sampling: each tetrahedron's segment integrated exactly (the ground truth)
 };
 
 /// What to render and how.

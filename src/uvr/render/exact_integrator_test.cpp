@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: MIT
+// The exact integrator against closed forms (constant opacity, constant fields through convex and
+// non-convex meshes), brute-force quadrature of its model (linear opacity, a transfer-function
+// step crossing inside one tetrahedron) and the fixed-step reference at a tiny step.
+#include "uvr/render/exact_integrator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "test_meshes.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/mesh/field_select.h"
+
+namespace uvr {
+namespace {
+
+/// The model by brute force: a fine front-to-back composition over n steps of the marchers'
+/// corrected opacity 1 - (1 - alpha)^(h / unit), in double (in float, 1 - (1 - alpha)^1e-5 is
+/// mostly rounding); its error falls as 1 / n.
+Vec4f fineComposite(const TfTableView& tf, float s0, float s1, double len, double unit, int n) {
+    double acc[4] = {0.0, 0.0, 0.0, 0.0};
+    const double h = len / n;
+    for (int i = 0; i < n; ++i) {
+        const float s = static_cast<float>(s0 + (s1 - s0) * (i + 0.5) / n);
+        const Vec4f c = tf.sample(s);
+        const double a = c.w >= 1.f ? 1.0 : -std::expm1(h / unit * std::log1p(-double(c.w)));
+        const double w = (1.0 - acc[3]) * a;
+        acc[0] += w * c.x, acc[1] += w * c.y, acc[2] += w * c.z, acc[3] += w;
+    }
+    return Vec4f(float(acc[0]), float(acc[1]), float(acc[2]), float(acc[3]));
+}
+
+void expectNear(Vec4f a, Vec4f b, float tol, const std::string& what) {
+    EXPECT_NEAR(a.x, b.x, tol) << what;
+    EXPECT_NEAR(a.y, b.y, tol) << what;
+    EXPECT_NEAR(a.z, b.z, tol) << what;
+    EXPECT_NEAR(a.w, b.w, tol) << what;
+}
+
+TEST(ExactIntegrator, ConstantOpacityIsTheClosedForm) {
+    // alpha 0.3 per unit 0.5 over 1.7: 1 - 0.7^(1.7 / 0.5); the colour is c times that.
+    for (const double a : {0.0, 1e-6, 0.3, 0.999}) {
+        Vec4f acc(0.f, 0.f, 0.f, 0.f);
+        exact::compositePiece(Vec3f(0.2f, 0.4f, 0.8f), a, Vec3f(0.2f, 0.4f, 0.8f), a, 1.7, 0.5,
+                              acc);
+        const double want = 1.0 - std::pow(1.0 - a, 1.7 / 0.5);
+        EXPECT_NEAR(acc.w, want, 1e-6) << a;
+        EXPECT_NEAR(acc.x, 0.2 * want, 1e-6) << a;
+        EXPECT_NEAR(acc.z, 0.8 * want, 1e-6) << a;
+    }
+    // Opacity 1 over an interval: opaque at once, in the colour at its start.
+    Vec4f acc(0.f, 0.f, 0.f, 0.f);
+    exact::compositePiece(Vec3f(1.f, 0.f, 0.f), 1.0, Vec3f(0.f, 1.f, 0.f), 1.0, 0.1, 1.0, acc);
+    expectNear(acc, Vec4f(1.f, 0.f, 0.f, 1.f), 0.f, "opaque");
+}
+
+TEST(ExactIntegrator, LinearOpacityAndColourMatchBruteForce) {
+    // A two-entry table: colour and opacity linear in the value, so one piece; the brute force
+    // converges to the same integral.
+    const std::vector<Vec4f> entries{Vec4f(1.f, 0.f, 0.f, 0.05f), Vec4f(0.f, 0.f, 1.f, 0.95f)};
+    const TfTableView tf{entries.data(), 2, 0.f, 1.f};
+    for (const auto& [s0, s1, len] : {std::tuple{0.f, 1.f, 2.0}, std::tuple{1.f, 0.f, 0.3},
+                                      std::tuple{0.2f, 0.7f, 5.0}, std::tuple{0.5f, 0.5f, 1.0}}) {
+        Vec4f acc(0.f, 0.f, 0.f, 0.f);
+        exact::integrateSegment(tf, s0, s1, len, 0.4, acc);
+        const Vec4f want = fineComposite(tf, s0, s1, len, 0.4, 400000);
+        expectNear(acc, want, 2e-5f, "segment " + std::to_string(s0) + " -> " + std::to_string(s1));
+    }
+    // An opacity reaching 1 at one end: finite optical depth (ln w is integrable at 0).
+    const std::vector<Vec4f> toOne{Vec4f(1.f, 1.f, 1.f, 0.f), Vec4f(1.f, 1.f, 1.f, 1.f)};
+    const TfTableView tfOne{toOne.data(), 2, 0.f, 1.f};
+    Vec4f acc(0.f, 0.f, 0.f, 0.f);
+    exact::integrateSegment(tfOne, 0.f, 1.f, 0.2, 1.0, acc);
+    // -integral_0^1 ln(1 - x) dx * 0.2 = 0.2: alpha = 1 - e^-0.2.
+    EXPECT_NEAR(acc.w, 1.0 - std::exp(-0.2), 1e-6);
+}
+
+TEST(ExactIntegrator, TransferFunctionStepInsideOneSegmentIsNotMissed) {
+    // A narrow opacity band (0 outside [0.49, 0.51] of the range, 0.9 inside) crossed by one
+    // segment: a point sample every 0.1 of the range misses it; the exact integral does not.
+    TransferFunction tf = transferFunctionPreset("grayscale");
+    applyOpacitySpec(tf, "0:0,0.4899:0,0.49:0.9,0.51:0.9,0.5101:0,1:0");
+    const std::vector<Vec4f> table = tf.bake(1 << 16);
+    const TfTableView view{table.data(), static_cast<int>(table.size()), 0.f, 1.f};
+    Vec4f acc(0.f, 0.f, 0.f, 0.f);
+    exact::integrateSegment(view, 0.f, 1.f, 1.0, 1.0, acc);
+    // 0.02 of the segment at alpha 0.9 per unit, plus the two 1e-4 ramps (about half each).
+    const double inBand = 0.02 + 1e-4;
+    EXPECT_NEAR(acc.w, 1.0 - std::pow(0.1, inBand), 2e-3);
+    const Vec4f brute = fineComposite(view, 0.f, 1.f, 1.0, 1.0, 2000000);
+    EXPECT_NEAR(acc.w, brute.w, 1e-4);
+}
+
+/// A grid of n^3 hexahedra over [lo, hi]^3 with the point field f, prepared for rendering.
+PreparedMesh preparedGrid(int n, float lo, float hi, const std::function<float(Vec3f)>& f,
+                          float jitter = 0.f) {
+    const Mesh m = testing::makeHexGrid(n, lo, hi, f, jitter);
+    return prepareMesh(m, selectScalarField(m, {}));
+}
+
+RenderSettings exactSettings(const Bounds3f& box, int size) {
+    RenderSettings s;
+    s.width = s.height = size;
+    s.method = RenderMethod::Exact;
+    s.camera = orbitCamera(resetCamera(box, 1.f), 33.f, 27.f);
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "constant:0.2");
+    s.opacityUnit = 0.5f;
+    return s;
+}
+
+/// The ray's span inside a box, in double.
+bool boxSpan(const Bounds3f& b, const Ray& ray, double& t0, double& t1) {
+    t0 = 0.0, t1 = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        const double lo = (double(b.lo[a]) - ray.org[a]) / ray.dir[a];
+        const double hi = (double(b.hi[a]) - ray.org[a]) / ray.dir[a];
+        t0 = std::max(t0, std::min(lo, hi));
+        t1 = std::min(t1, std::max(lo, hi));
+    }
+    return t0 < t1;
+}
+
+TEST(ExactIntegrator, ConstantFieldThroughJitteredGridIsTheChordLength) {
+    // Every pixel: alpha = 1 - (1 - 0.2)^(chord / 0.5), the chord through the box; no sampling
+    // band, no cracks between the 6 * 6^3 jittered tetrahedra.
+    const Bounds3f box{Vec3f(0.f), Vec3f(1.f)};
+    const PreparedMesh pm = preparedGrid(
+        6, 0.f, 1.f, [](Vec3f) { return 1.f; }, 0.3f);
+    const RenderSettings s = exactSettings(box, 48);
+    const RenderResult r = renderCpu(pm, s);
+    int covered = 0;
+    double worst = 0.0;
+    for (int y = 0; y < s.height; ++y)
+        for (int x = 0; x < s.width; ++x) {
+            const Ray ray = r.setup.rays.ray(x + 0.5f, y + 0.5f);
+            double t0, t1;
+            const double chord = boxSpan(box, ray, t0, t1) ? t1 - t0 : 0.0;
+            covered += chord > 0.0;
+            const double want = 1.0 - std::pow(0.8, chord / 0.5);
+            worst = std::max(worst, std::fabs(r.image.at(x, y).w - want));
+        }
+    EXPECT_GT(covered, 1000);
+    EXPECT_LT(worst, 1e-4);
+}
+
+TEST(ExactIntegrator, RaysLeavingANonConvexMeshAndReenteringKeepBothParts) {
+    // Two unit cubes with a gap of 0.5 between them along x: rays through both integrate both.
+    Mesh a = testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; });
+    const Mesh b = testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; });
+    const std::uint32_t base = static_cast<std::uint32_t>(a.points.size());
+    for (Vec3f p : b.points) a.points.push_back(p + Vec3f(1.5f, 0.f, 0.f));
+    for (std::uint64_t c = 0; c < b.cellCount(); ++c) {
+        std::vector<std::uint32_t> ids;
+        for (std::uint32_t id : b.cell(c)) ids.push_back(id + base);
+        a.addCell(b.cellTypes[c], ids);
+    }
+    a.fields[0].values.insert(a.fields[0].values.end(), b.fields[0].values.begin(),
+                              b.fields[0].values.end());
+    const PreparedMesh pm = prepareMesh(a, selectScalarField(a, {}));
+    const Bounds3f boxA{Vec3f(0.f), Vec3f(1.f)}, boxB{Vec3f(1.5f, 0.f, 0.f), Vec3f(2.5f, 1.f, 1.f)};
+    RenderSettings s = exactSettings(Bounds3f{Vec3f(0.f), Vec3f(2.5f, 1.f, 1.f)}, 48);
+    s.camera = orbitCamera(resetCamera(Bounds3f{Vec3f(0.f), Vec3f(2.5f, 1.f, 1.f)}, 1.f), 70.f,
+                           10.f);  // looking mostly along x, through both cubes
+    const RenderResult r = renderCpu(pm, s);
+    int both = 0;
+    double worst = 0.0;
+    for (int y = 0; y < s.height; ++y)
+        for (int x = 0; x < s.width; ++x) {
+            const Ray ray = r.setup.rays.ray(x + 0.5f, y + 0.5f);
+            double a0, a1, b0, b1;
+            const double chord = (boxSpan(boxA, ray, a0, a1) ? a1 - a0 : 0.0) +
+                                 (boxSpan(boxB, ray, b0, b1) ? b1 - b0 : 0.0);
+            both += boxSpan(boxA, ray, a0, a1) && boxSpan(boxB, ray, b0, b1);
+            const double err = std::fabs(r.image.at(x, y).w - (1.0 - std::pow(0.8, chord / 0.5)));
+            worst = std::max(worst, err);
+        }
+    EXPECT_GT(both, 100);
+    EXPECT_LT(worst, 1e-4);
+}
+
+TEST(ExactIntegrator, LinearFieldMatchesTheReferenceAtATinyStep) {
+    // A linear field under a ramp with two bands: the fixed-step reference converges to the
+    // exact image as its step shrinks (its error falls about linearly with the step).
+    const Bounds3f box{Vec3f(-1.f), Vec3f(1.f)};
+    const PreparedMesh pm = preparedGrid(
+        5, -1.f, 1.f, [](Vec3f p) { return p.x + 2.f * p.y - p.z; }, 0.25f);
+    RenderSettings s = exactSettings(box, 32);
+    applyOpacitySpec(s.tf, "0:0,0.3:0.6,0.35:0,0.6:0,0.7:0.8,0.8:0,1:0.2");
+    const RenderResult e = renderCpu(pm, s);
+    double errCoarse = 0.0, errFine = 0.0;
+    for (const float factor : {1.f, 1.f / 32.f}) {
+        RenderSettings ref = s;
+        ref.method = RenderMethod::Reference;
+        ref.step = defaultStep(pm.tets) * factor;
+        ref.terminationAlpha = 1.f;
+        const RenderResult r = renderCpu(pm, ref);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < r.image.pixels.size(); ++i)
+            for (int c = 0; c < 4; ++c) {
+                const Vec4f a = r.image.pixels[i], b = e.image.pixels[i];
+                const float av[4] = {a.x, a.y, a.z, a.w}, bv[4] = {b.x, b.y, b.z, b.w};
+                worst = std::max(worst, double(std::fabs(av[c] - bv[c])));
+            }
+        (factor == 1.f ? errCoarse : errFine) = worst;
+    }
+    EXPECT_LT(errFine, 0.01) << "coarse " << errCoarse;
+    EXPECT_LT(errFine, 0.25 * errCoarse);
+}
+
+}  // namespace
+}  // namespace uvr
