@@ -283,14 +283,20 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
                 "/b.json --plot " + dir + "/p.png --images " + dir,
             dir);
     ASSERT_EQ(r.code, 0) << r.err;
-    for (const char* row : {"reference", "skipping only", "adaptive only", "skipping + adaptive",
-                            "both, s2 = 2 s1", "both, s2 = 4 s1"})
+    for (const char* row : {"exact (1 frame)", "reference", "skipping only", "adaptive only",
+                            "skipping + adaptive", "both, s2 = 2 s1", "both, s2 = 4 s1"})
         EXPECT_NE(r.out.find(row), std::string::npos) << row;
     std::ifstream in(dir + "/b.json");
     const auto j = nlohmann::json::parse(in);
     ASSERT_EQ(j["rows"].size(), 6u);
-    EXPECT_EQ(j["rows"][0]["ssim"].get<double>(), 1.0);    // the reference against itself
-    EXPECT_GE(j["rows"][1]["ssim"].get<double>(), 0.995);  // skipping only: same samples
+    EXPECT_EQ(j["ssim_against"], "exact");
+    EXPECT_GT(j["exact"]["tetrahedra_crossed"].get<double>(), 0);
+    // Against the exact image: the reference close, skipping only takes the same samples.
+    const double ref = j["rows"][0]["ssim"].get<double>();
+    EXPECT_GE(ref, 0.98);
+    EXPECT_LT(ref, 1.0);
+    EXPECT_NEAR(j["rows"][1]["ssim"].get<double>(), ref, 0.005);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/exact.png"));
     EXPECT_EQ(readPng(dir + "/p.png").width, 800);
     EXPECT_TRUE(std::filesystem::exists(dir + "/reference_samples.png"));
     EXPECT_TRUE(std::filesystem::exists(dir + "/b.csv"));
