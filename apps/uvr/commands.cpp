@@ -187,8 +187,10 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("--jitter", spec->jitter, "Interior point jitter, fraction of the spacing")
         ->capture_default_str()
         ->check(CLI::Range(0.f, kMaxProceduralJitter));
-    cmd->add_option("--fields", *fields,
-                    "Fields to write, first is the default: jet, marschner_lobb, linear, constant")
+    cmd->add_option(
+           "--fields", *fields,
+           "Fields to write, first is the default: jet, marschner_lobb, multiscale, linear, "
+           "constant")
         ->delimiter(',');
     cmd->callback([shape, out, spec, fields, &ctx] {
         resolveOutput(*out);

@@ -78,13 +78,13 @@ double gradientNoise(double x, double y, double z) {
 }
 
 /// Fractal Brownian motion: `octaves` octaves of gradient noise, each at twice the frequency and
-/// half the amplitude of the previous; normalised to roughly [-1, 1].
-double fbm(double x, double y, double z, int octaves) {
+/// `gain` times the amplitude of the previous; normalised to roughly [-1, 1].
+double fbm(double x, double y, double z, int octaves, double gain = 0.5) {
     double sum = 0.0, amplitude = 1.0, norm = 0.0;
     for (int o = 0; o < octaves; ++o) {
         sum += amplitude * gradientNoise(x, y, z);
         norm += amplitude;
-        amplitude *= 0.5;
+        amplitude *= gain;
         x = 2.0 * x + 17.13;  // shift each octave so lattice zeros do not line up
         y = 2.0 * y + 5.71;
         z = 2.0 * z + 11.37;
@@ -107,6 +107,16 @@ double jetValue(double x, double y, double z) {
     const double core = std::exp(-(r * r) / (width * width));
     const double intensity = (1.0 - 0.5 * h) * (1.0 + 0.5 * turb);
     return std::clamp(core * intensity, 0.0, 1.0);
+}
+
+/// The multiscale field: octaves of gradient noise from wavelength 1 (half the domain) down to
+/// cellSize, each 1/sqrt(2) of the previous in amplitude; values in [0, 1].
+double multiscaleValue(double x, double y, double z, double cellSize) {
+    int octaves = 8;
+    if (cellSize > 0.0)
+        octaves = std::clamp(static_cast<int>(std::ceil(-std::log2(cellSize))) + 1, 1, 30);
+    return std::clamp(0.5 + 1.2 * fbm(x + 0.37, y + 0.61, z + 0.13, octaves, std::sqrt(0.5)), 0.0,
+                      1.0);
 }
 
 /// Marschner & Lobb (1994), "An evaluation of reconstruction filters for volume rendering",
@@ -396,6 +406,7 @@ Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>&
     }
 
     mesh.fields.reserve(spec.fields.size());
+    const double cellSize = proceduralCellSize(spec);
     for (ProceduralField f : spec.fields) {
         Field field;
         field.name = proceduralFieldName(f);
@@ -406,7 +417,7 @@ Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>&
         for (size_t begin = 0; begin < mesh.points.size(); begin += kChunk) {
             const size_t end = std::min(begin + kChunk, mesh.points.size());
             for (size_t i = begin; i < end; ++i)
-                field.values[i] = proceduralFieldValue(f, mesh.points[i]);
+                field.values[i] = proceduralFieldValue(f, mesh.points[i], cellSize);
             reporter.advance(static_cast<double>(end - begin));
         }
         mesh.fields.push_back(std::move(field));
@@ -415,7 +426,11 @@ Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>&
     return mesh;
 }
 
-float proceduralFieldValue(ProceduralField field, Vec3f p) {
+double proceduralCellSize(const ProceduralSpec& spec) {
+    return 2.0 / std::cbrt(std::max(1.0, static_cast<double>(spec.targetCells) / 6.0));
+}
+
+float proceduralFieldValue(ProceduralField field, Vec3f p, double cellSize) {
     const double x = p.x, y = p.y, z = p.z;
     switch (field) {
         case ProceduralField::Constant:
@@ -426,6 +441,8 @@ float proceduralFieldValue(ProceduralField field, Vec3f p) {
             return static_cast<float>(jetValue(x, y, z));
         case ProceduralField::MarschnerLobb:
             return static_cast<float>(marschnerLobbValue(x, y, z));
+        case ProceduralField::Multiscale:
+            return static_cast<float>(multiscaleValue(x, y, z, cellSize));
     }
     return 0.f;
 }
@@ -440,6 +457,8 @@ const char* proceduralFieldName(ProceduralField field) {
             return "jet";
         case ProceduralField::MarschnerLobb:
             return "marschner_lobb";
+        case ProceduralField::Multiscale:
+            return "multiscale";
     }
     return "?";
 }
@@ -465,12 +484,13 @@ ProceduralShape parseProceduralShape(const std::string& name) {
 }
 
 ProceduralField parseProceduralField(const std::string& name) {
-    for (ProceduralField f : {ProceduralField::Constant, ProceduralField::Linear,
-                              ProceduralField::Jet, ProceduralField::MarschnerLobb})
+    for (ProceduralField f :
+         {ProceduralField::Constant, ProceduralField::Linear, ProceduralField::Jet,
+          ProceduralField::MarschnerLobb, ProceduralField::Multiscale})
         if (name == proceduralFieldName(f)) return f;
     throwError(ErrorKind::Argument, "",
                "unknown procedural field '" + name +
-                   "': expected constant, linear, jet or marschner_lobb");
+                   "': expected constant, linear, jet, marschner_lobb or multiscale");
 }
 
 }  // namespace uvr

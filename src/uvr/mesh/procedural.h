@@ -24,6 +24,11 @@ enum class ProceduralField {
     Linear,         ///< "linear": x + 2y - z (reproduced exactly by linear interpolation)
     Jet,            ///< "jet": a turbulent plume rising along +y (smooth, deterministic noise)
     MarschnerLobb,  ///< "marschner_lobb": Marschner & Lobb 1994 test signal over [-1,1]^3
+    /// "multiscale": gradient noise with octaves from half the domain down to the cell size, each
+    /// 1/sqrt(2) of the previous in amplitude, so detail (and the steepest gradients) exists at
+    /// every scale however fine the mesh (the jet is smooth at the cell size of large meshes,
+    /// which flatters adaptive sampling); values in [0, 1].
+    Multiscale,
 };
 
 /// Largest allowed ProceduralSpec::jitter: a Kuhn tetrahedron stays positively oriented while each
@@ -60,8 +65,13 @@ std::uint64_t proceduralTetCount(const ProceduralSpec& spec);
 /// generating (for a memory limit).
 std::uint64_t proceduralMeshBytes(const ProceduralSpec& spec);
 
-/// The analytic value of a procedural field at p (what the mesh stores at its points).
-float proceduralFieldValue(ProceduralField field, Vec3f p);
+/// The analytic value of a procedural field at p (what the mesh stores at its points); cellSize is
+/// the mesh's cell edge, the wavelength of the multiscale field's finest octave (0: 8 octaves).
+float proceduralFieldValue(ProceduralField field, Vec3f p, double cellSize = 0.0);
+
+/// Cell edge of a procedural mesh: the cube edge of its Kuhn grid over [-1, 1]^3 (6 tetrahedra per
+/// cube; the graded mesh's cells vary about it).
+double proceduralCellSize(const ProceduralSpec& spec);
 
 /// Field name as written into the mesh ("jet", ...).
 const char* proceduralFieldName(ProceduralField field);

@@ -380,5 +380,47 @@ TEST(Procedural, SizeIsKnownBeforeGenerating) {
     }
 }
 
+TEST(Procedural, MultiscaleFieldHasDetailDownToTheCellSize) {
+    // Mean absolute difference of the field between points a fine cell apart: with octaves down
+    // to that cell size it is several times what the same field stopping at a 16x coarser cell
+    // has (which is smooth there), and far above the jet's.
+    constexpr double kFine = 1.0 / 512, kCoarse = 1.0 / 32;
+    double fine = 0.0, coarse = 0.0, jet = 0.0, lo = 1.0, hi = 0.0;
+    int n = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const Vec3f p(-0.9f + 1.8f * float((i * 37) % 1000) / 1000.f,
+                      -0.9f + 1.8f * float((i * 91) % 997) / 997.f,
+                      -0.9f + 1.8f * float((i * 53) % 991) / 991.f);
+        const Vec3f q = p + Vec3f(float(kFine), 0.f, 0.f);
+        const float v = proceduralFieldValue(ProceduralField::Multiscale, p, kFine);
+        fine += std::fabs(proceduralFieldValue(ProceduralField::Multiscale, q, kFine) - v);
+        coarse += std::fabs(proceduralFieldValue(ProceduralField::Multiscale, q, kCoarse) -
+                            proceduralFieldValue(ProceduralField::Multiscale, p, kCoarse));
+        jet += std::fabs(proceduralFieldValue(ProceduralField::Jet, q) -
+                         proceduralFieldValue(ProceduralField::Jet, p));
+        lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
+        ++n;
+    }
+    EXPECT_GT(fine, 2.0 * coarse);
+    EXPECT_GT(fine, 10.0 * jet);
+    EXPECT_GE(lo, 0.0);
+    EXPECT_LE(hi, 1.0);
+    EXPECT_GT(hi - lo, 0.5);  // the values span most of [0, 1]
+    // A generated mesh stores the field with octaves down to its own cell size.
+    ProceduralSpec spec = makeSpec(ProceduralShape::Box, 200000);
+    spec.fields = {ProceduralField::Multiscale};
+    const Mesh m = generateMesh(spec);
+    const double h = proceduralCellSize(spec);
+    EXPECT_NEAR(h, 2.0 / 32.0, 0.002);  // about 32 cubes per axis
+    int differ = 0;
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+        ASSERT_EQ(m.fields[0].values[i],
+                  proceduralFieldValue(ProceduralField::Multiscale, m.points[i], h));
+        differ += m.fields[0].values[i] !=
+                  proceduralFieldValue(ProceduralField::Multiscale, m.points[i], kFine);
+    }
+    EXPECT_GT(differ, int(m.points.size() / 2));
+}
+
 }  // namespace
 }  // namespace uvr
