@@ -17,6 +17,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
 #include "uvr/core/text.h"
+#include "uvr/core/vec3d.h"
 
 namespace uvr {
 
@@ -26,33 +27,6 @@ constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 /// Largest camera file read; real .pvcc files are about 2 kilobytes.
 constexpr std::uint64_t kMaxPvccBytes = 16ull << 20;
-
-/// Double-precision vector for camera arithmetic, whose results may lie beyond float's range
-/// (a mesh near 1e38) even when its inputs do not.
-struct Vec3d {
-    double x = 0.0, y = 0.0, z = 0.0;
-};
-Vec3d toDouble(Vec3f v) {
-    return {v.x, v.y, v.z};
-}
-Vec3d operator+(Vec3d a, Vec3d b) {
-    return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-Vec3d operator-(Vec3d a, Vec3d b) {
-    return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-Vec3d operator*(Vec3d a, double s) {
-    return {a.x * s, a.y * s, a.z * s};
-}
-double dot(Vec3d a, Vec3d b) {
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-Vec3d cross(Vec3d a, Vec3d b) {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-Vec3d normalize(Vec3d a) {
-    return a * (1.0 / std::sqrt(dot(a, a)));
-}
 
 /// Rotates v about the unit axis by angle radians (Rodrigues' rotation formula, right-handed).
 Vec3d rotate(Vec3d v, Vec3d axis, double angle) {

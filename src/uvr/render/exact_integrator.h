@@ -25,6 +25,7 @@
 #include "uvr/accel/bvh.h"
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
+#include "uvr/core/vec3d.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/tf_table.h"
 
@@ -179,23 +180,6 @@ UVR_HOST_DEVICE inline void integrateSegment(const TfTableView& tf, float s0, fl
     }
 }
 
-/// Double-precision point and vector for the ray-tetrahedron clipping.
-struct Vec3d {
-    double x, y, z;
-};
-UVR_HOST_DEVICE inline Vec3d toD(Vec3f v) {
-    return {v.x, v.y, v.z};
-}
-UVR_HOST_DEVICE inline Vec3d sub(Vec3d a, Vec3d b) {
-    return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-UVR_HOST_DEVICE inline double dotD(Vec3d a, Vec3d b) {
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-UVR_HOST_DEVICE inline Vec3d crossD(Vec3d a, Vec3d b) {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 /// The span [tIn, tOut] of a ray inside a tetrahedron and the face (opposite vertex exitFace)
 /// through which it leaves; empty when tIn > tOut.
 struct TetSpan {
@@ -207,15 +191,15 @@ struct TetSpan {
 UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t, const Ray& ray) {
     const Tet& tet = mesh.tets[t];
     Vec3d p[4];
-    for (int i = 0; i < 4; ++i) p[i] = toD(mesh.points[tet.v[i]]);
-    const Vec3d o = toD(ray.org), d = toD(ray.dir);
+    for (int i = 0; i < 4; ++i) p[i] = toDouble(mesh.points[tet.v[i]]);
+    const Vec3d o = toDouble(ray.org), d = toDouble(ray.dir);
     TetSpan s;
     for (int i = 0; i < 4; ++i) {
         // Face opposite vertex i; its normal points away from vertex i.
         const Vec3d a = p[(i + 1) & 3], b = p[(i + 2) & 3], c = p[(i + 3) & 3];
-        Vec3d n = crossD(sub(b, a), sub(c, a));
-        if (dotD(n, sub(p[i], a)) > 0.0) n = {-n.x, -n.y, -n.z};
-        const double num = dotD(n, sub(a, o)), den = dotD(n, d);
+        Vec3d n = cross(b - a, c - a);
+        if (dot(n, p[i] - a) > 0.0) n = {-n.x, -n.y, -n.z};
+        const double num = dot(n, a - o), den = dot(n, d);
         if (den > 0.0) {
             const double t1 = num / den;
             if (t1 < s.tOut) s.tOut = t1, s.exitFace = i;
