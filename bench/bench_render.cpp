@@ -139,7 +139,8 @@ void BM_Refine(benchmark::State& state) {
 }
 
 /// Transfer-function update (Morrical et al. 2019, Sec. 2.1): range tables of the baked table,
-/// then maximum opacity, variance and step of every partition; one thread.
+/// and breakpoints of the baked table, then maximum opacity, rate, variance and step of every
+/// partition; one thread.
 void BM_TfUpdate(benchmark::State& state) {
     const uvr::Mesh& mesh = boxMesh(static_cast<std::uint64_t>(state.range(0)));
     uvr::PrepareOptions options;
@@ -150,10 +151,16 @@ void BM_TfUpdate(benchmark::State& state) {
     const std::vector<uvr::Vec4f> baked = tf.bake(1024);
     const uvr::TfTableView table{baked.data(), 1024, prepared.tets.valueMin,
                                  prepared.tets.valueMax};
+    uvr::StepRuleParams rule;
+    rule.s1 = 0.01f;
+    rule.s2 = 0.16f;
+    rule.valuePerEntry = (table.hi - table.lo) / 1023.f;
     for (auto _ : state) {
         const uvr::TfRangeTables ranges(table);
-        benchmark::DoNotOptimize(uvr::computePartitionShading(*prepared.kd, ranges.view(table),
-                                                              0.01f, 0.16f, 2.f, true));
+        const std::vector<std::int32_t> breaks = uvr::tfTableBreaks(baked.data(), 1024);
+        benchmark::DoNotOptimize(breaks.data());
+        benchmark::DoNotOptimize(uvr::computePartitionShading(*prepared.kd, prepared.gradientSpread,
+                                                              ranges.view(table), rule));
     }
     state.counters["partitions"] = static_cast<double>(prepared.kd->partitions.size());
 }

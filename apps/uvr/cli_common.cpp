@@ -222,12 +222,35 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                        "exact (no sampling: every tetrahedron's segment integrated exactly)")
             ->check(CLI::IsMember({"reference", "adaptive", "exact"}))
             ->capture_default_str();
+    app.add_option("--sampling", sampling,
+                   "Reference and adaptive: preintegrated (integrate between consecutive samples, "
+                   "the scalar linear from one to the next: no transfer-function feature is "
+                   "missed) or point (point samples with opacity correction, as in Morrical et "
+                   "al. 2019)")
+        ->check(CLI::IsMember({"preintegrated", "point"}))
+        ->capture_default_str();
+    app.add_option("--step-rule", stepRule,
+                   "Adaptive: how each partition's step is chosen: error (bounded integration "
+                   "error from the transfer function's rate of change and the field's gradients; "
+                   "--quality) or variance (Morrical et al. 2019's normalised colour variance; "
+                   "--power)")
+        ->check(CLI::IsMember({"error", "variance"}))
+        ->capture_default_str();
+    {
+        char help[200];
+        std::snprintf(help, sizeof help,
+                      "Adaptive, --step-rule error: the SSIM against the exact integrator to aim "
+                      "at, in [%g, %g] (default %g; docs/PERFORMANCE.md shows what it gives)",
+                      double(kMinQuality), double(kMaxQuality), double(kDefaultQuality));
+        app.add_option("--quality", quality, help);
+    }
     app.add_option("--max-step", maxStep,
                    "Adaptive: largest step s2 (default: " +
                        std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)")
         ->check(CLI::PositiveNumber);
-    app.add_option("--power", power, "Adaptive: power p >= 1 of the step formula")
-        ->capture_default_str();
+    app.add_option("--power", power,
+                   "Adaptive, --step-rule variance: power p >= 1 of the step formula (default "
+                   "2)");
     if (oneFrame) {
         app.add_flag("--no-skip", noSkip,
                      "Adaptive: also march partitions of zero opacity (\"adaptive only\")");
@@ -278,14 +301,29 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
                : method == "exact"  ? RenderMethod::Exact
                                     : RenderMethod::Reference;
     s.maxStep = maxStep;
-    s.power = power;
+    if (power) s.power = *power;
+    s.stepRule = stepRule == "variance" ? StepRule::Variance : StepRule::ErrorBound;
+    if (quality) s.quality = *quality;
+    s.preintegrated = sampling == "preintegrated";
     s.skip = !noSkip;
     s.adaptive = !noAdaptive;
     if (s.method != RenderMethod::Partitions &&
-        (noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid))
+        (noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid || quality || power ||
+         stepRule != "error"))
         throwError(ErrorKind::Argument, "",
-                   "--no-skip, --no-adaptive, --max-step, --leaf-cells and --no-seed-grid need "
-                   "--method adaptive");
+                   "--no-skip, --no-adaptive, --max-step, --step-rule, --quality, --power, "
+                   "--leaf-cells and --no-seed-grid need --method adaptive");
+    if (stepRule == "variance" && quality)
+        throwError(ErrorKind::Argument, "",
+                   "--quality sets the error rule's target: it needs "
+                   "--step-rule error (the default), not variance");
+    if (stepRule == "error" && power)
+        throwError(ErrorKind::Argument, "",
+                   "--power shapes the variance rule's step: it needs --step-rule variance");
+    if (s.method == RenderMethod::Exact && sampling != "preintegrated")
+        throwError(ErrorKind::Argument, "",
+                   "--sampling applies to the reference and adaptive methods; exact does not "
+                   "sample");
     // The camera file, else the default camera fitted to the bounds (its error names the mesh)
     // where camera flags leave its position or focal point to it; with no camera flag the
     // renderer resets the camera itself.
@@ -548,6 +586,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         }
         j["threads"] = cpu::threadCount();
         j["method"] = flags.method;
+        if (settings.method != RenderMethod::Exact) j["sampling"] = flags.sampling;
         if (prepared.kd) {
             const KdPartitions& kd = *prepared.kd;
             std::vector<std::uint32_t> sizes;
@@ -567,7 +606,13 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                                    {"build_seconds", prepared.seeds->buildSeconds}};
             j["tf_update_seconds"] = result.setup.tfUpdateSeconds;
             j["max_step"] = fileNumber(result.setup.maxStep / result.setup.frame.scale);
-            j["power"] = settings.power;
+            j["step_rule"] = flags.stepRule;
+            if (settings.stepRule == StepRule::ErrorBound) {
+                j["quality"] = settings.quality;
+                j["tolerance"] = result.setup.stepRule.tolerance;
+            } else {
+                j["power"] = settings.power;
+            }
             j["skip"] = settings.skip;
             j["adaptive"] = settings.adaptive;
             j["partitions_visited"] = result.stats.partitionsVisited;

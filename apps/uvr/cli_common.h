@@ -75,8 +75,11 @@ struct RenderFlags {
     float step = 0.f;
     float opacityUnit = 0.f;
     std::string method = "reference";
+    std::string stepRule = "error";
+    std::optional<float> quality;  ///< unset: kDefaultQuality
+    std::string sampling = "preintegrated";
     float maxStep = 0.f;
-    float power = 2.f;
+    std::optional<float> power;  ///< unset: 2
     bool noSkip = false, noAdaptive = false;
     std::uint32_t leafCells = 0;
     bool noSeedGrid = false;

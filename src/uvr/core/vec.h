@@ -108,6 +108,9 @@ struct Vec4f {
     UVR_HOST_DEVICE constexpr Vec4f() = default;
     UVR_HOST_DEVICE constexpr Vec4f(float a, float b, float c, float d) : x(a), y(b), z(c), w(d) {}
     UVR_HOST_DEVICE constexpr Vec3f xyz() const { return {x, y, z}; }
+    UVR_HOST_DEVICE constexpr float operator[](int i) const {
+        return i == 0 ? x : (i == 1 ? y : (i == 2 ? z : w));
+    }
 };
 UVR_HOST_DEVICE constexpr Vec4f operator+(Vec4f a, Vec4f b) {
     return {a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w};

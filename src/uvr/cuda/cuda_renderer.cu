@@ -74,13 +74,13 @@ __global__ void partitionStatsKernel(TfRangeView range, const KdPartition* parti
 }
 
 /// Transfer-function update, pass 2: the shared per-partition shading.
-__global__ void partitionShadeKernel(const RangeStats* stats, std::uint32_t count,
-                                     const unsigned* varianceBounds, float s1, float s2,
-                                     float power, bool adaptive, PartitionShading* shading) {
+__global__ void partitionShadeKernel(const RangeStats* stats, const float* gradientSpread,
+                                     std::uint32_t count, const unsigned* varianceBounds,
+                                     StepRuleParams rule, PartitionShading* shading) {
     const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
     if (p >= count) return;
     const float lo = __uint_as_float(varianceBounds[0]), hi = __uint_as_float(varianceBounds[1]);
-    shading[p] = shadePartition(stats[p], lo, hi, s1, s2, power, adaptive);
+    shading[p] = shadePartition(stats[p], gradientSpread[p], lo, hi, rule);
 }
 
 }  // namespace
@@ -116,14 +116,17 @@ struct CudaScene::Impl {
     cuda::DeviceArray<std::uint32_t> bvhPrims;
     cuda::DeviceArray<KdNode> kdNodes;
     cuda::DeviceArray<KdPartition> partitions;
+    cuda::DeviceArray<float> gradientSpread;
     cuda::DeviceArray<BvhNode> partitionBvhNodes;
     cuda::DeviceArray<std::uint32_t> partitionCells;
     cuda::DeviceArray<PartitionGrid> seedGrids;
     cuda::DeviceArray<std::uint32_t> seeds;
     // Per frame / transfer function.
     cuda::DeviceArray<Vec4f> tfTable;
+    cuda::DeviceArray<std::int32_t> tfBreaks;
     cuda::DeviceArray<double> tfPrefix;
     cuda::DeviceArray<float> tfMaxLevels;
+    cuda::DeviceArray<float> tfRateLevels;
     cuda::DeviceArray<RangeStats> partitionStats;
     cuda::DeviceArray<unsigned> varianceBounds;
     cuda::DeviceArray<PartitionShading> shading;
@@ -144,6 +147,7 @@ struct CudaScene::Impl {
         v.locator.bvh.primIds = bvhPrims.data();
         v.locator.neighbors = neighbors.data();
         v.tf.entries = tfTable.data();
+        v.tf.breaks = tfBreaks.data();
         return v;
     }
 };
@@ -162,6 +166,7 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
     if (mesh.kd) {
         d.kdNodes.upload(mesh.kd->nodes, "the k-d nodes");
         d.partitions.upload(mesh.kd->partitions, "the partitions");
+        d.gradientSpread.upload(mesh.gradientSpread, "the partition gradient spreads");
         d.partitionBvhNodes.upload(mesh.kd->bvhNodes, "the partition BVH nodes");
         d.partitionCells.upload(mesh.kd->cells, "the partition cell lists");
     }
@@ -181,8 +186,8 @@ std::uint64_t CudaScene::geometryBytes() const {
     const Impl& d = *impl_;
     return d.points.bytes() + d.tets.bytes() + d.values.bytes() + d.neighbors.bytes() +
            d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
-           d.partitionBvhNodes.bytes() + d.partitionCells.bytes() + d.seedGrids.bytes() +
-           d.seeds.bytes();
+           d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() + d.partitionCells.bytes() +
+           d.seedGrids.bytes() + d.seeds.bytes();
 }
 
 double CudaScene::uploadSeconds() const {
@@ -200,10 +205,13 @@ void CudaScene::updateShading(RenderResult& result, const RenderSettings& settin
     const TfRangeTables tables(hostTable);
     d.tfPrefix.upload(tables.prefix, "the transfer-function prefix sums");
     d.tfMaxLevels.upload(tables.maxLevels, "the transfer-function maxima");
+    d.tfRateLevels.upload(tables.rateLevels, "the transfer-function rates");
     TfRangeView range = tables.view(hostTable);
     range.table.entries = d.tfTable.data();
+    range.table.breaks = d.tfBreaks.data();
     range.prefix = d.tfPrefix.data();
     range.maxLevels = d.tfMaxLevels.data();
+    range.rateLevels = d.tfRateLevels.data();
     d.partitionStats.reserve(n, "the partition statistics");
     d.varianceBounds.upload(std::vector<unsigned>{0x7f800000u, 0u}, "the variance bounds");
     d.shading.reserve(n, "the partition shading");
@@ -212,9 +220,9 @@ void CudaScene::updateShading(RenderResult& result, const RenderSettings& settin
     cuda::partitionStatsKernel<<<grid, block>>>(range, d.partitions.data(), n,
                                                 d.partitionStats.data(), d.varianceBounds.data());
     UVR_CUDA_CHECK(cudaGetLastError());
-    cuda::partitionShadeKernel<<<grid, block>>>(d.partitionStats.data(), n, d.varianceBounds.data(),
-                                                f.params.step, f.maxStep, settings.power,
-                                                settings.adaptive, d.shading.data());
+    cuda::partitionShadeKernel<<<grid, block>>>(d.partitionStats.data(), d.gradientSpread.data(), n,
+                                                d.varianceBounds.data(), f.stepRule,
+                                                d.shading.data());
     UVR_CUDA_CHECK(cudaGetLastError());
     f.shading.resize(n);
     UVR_CUDA_CHECK(cudaMemcpy(f.shading.data(), d.shading.data(), n * sizeof(PartitionShading),
@@ -229,6 +237,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     result.setup = makeFrameSetup(d.mesh, settings, /*shadePartitions=*/false);
     // Transfer-function state: the only per-change upload (a few kilobytes).
     d.tfTable.upload(result.setup.tfTable, "the transfer function");
+    d.tfBreaks.upload(result.setup.tfBreaks, "the transfer function's breakpoints");
     const std::size_t pixelCount = static_cast<std::size_t>(settings.width) * settings.height;
     d.pixels.reserve(pixelCount, "the image");
     d.sampleCounts.reserve(pixelCount, "the sample counts");

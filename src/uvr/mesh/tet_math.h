@@ -29,6 +29,17 @@ UVR_HOST_DEVICE inline bool tetBarycentrics(Vec3f p, Vec3f a, Vec3f b, Vec3f c, 
     return true;
 }
 
+/// Gradient of the linear function taking values va..vd at the corners of tetrahedron (a, b, c,
+/// d): the solution g of (b - a) . g = vb - va, (c - a) . g = vc - va, (d - a) . g = vd - va, by
+/// Cramer's rule. Non-finite for a degenerate tetrahedron.
+UVR_HOST_DEVICE inline Vec3f tetGradient(Vec3f a, Vec3f b, Vec3f c, Vec3f d, float va, float vb,
+                                         float vc, float vd) {
+    const Vec3f e1 = b - a, e2 = c - a, e3 = d - a;
+    const Vec3f n1 = cross(e2, e3), n2 = cross(e3, e1), n3 = cross(e1, e2);
+    const float inv = 1.f / dot(e1, n1);
+    return (n1 * (vb - va) + n2 * (vc - va) + n3 * (vd - va)) * inv;
+}
+
 /// Tolerance on barycentric coordinates for "p lies in the tetrahedron": points within this
 /// relative distance outside a face still count, so points on shared faces never fall between
 /// neighbours because of rounding.

@@ -17,6 +17,28 @@ struct PartitionShading {
     float step = 0.f;        ///< sample spacing inside the partition
 };
 
+/// How the partition integrator chooses each partition's step.
+enum class StepRule : std::uint8_t {
+    /// From a bound on the integration error per opacity unit (errorBoundStep; the default).
+    ErrorBound,
+    /// Morrical et al. 2019, Sec. 2.4: from the colour variance over the partition's value range,
+    /// normalised over the visible partitions (adaptiveStep).
+    Variance,
+};
+
+/// Everything the step rules need besides a partition's own statistics.
+struct StepRuleParams {
+    StepRule rule = StepRule::ErrorBound;
+    bool adaptive = true;  ///< false: every partition at s1
+    float s1 = 1.f;        ///< smallest step (the reference's spacing)
+    float s2 = 16.f;       ///< largest step
+    float power = 2.f;     ///< Variance: power p >= 1 of the step formula
+    /// ErrorBound: the optical depth error allowed per opacity unit (see errorBoundStep).
+    float tolerance = 0.05f;
+    /// ErrorBound: value change per table entry, (hi - lo) / (count - 1) of the baked table.
+    float valuePerEntry = 1.f;
+};
+
 /// Adaptive step (Morrical et al. 2019, Sec. 2.4): s = max(s1 + (s2 - s1) |min(v, 1) - 1|^p, s1)
 /// for normalised colour variance v (v >= 1 gives s1, v = 0 gives s2).
 UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) {
@@ -25,16 +47,37 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
     return s > s1 ? s : s1;
 }
 
-/// Shading of one partition from its range statistics (Morrical et al. 2019, Sec. 2.1, 2.4): the
-/// variance normalised by the minimum lo and maximum hi over the visible partitions (1 when they
-/// are all equal and positive), invisible partitions at v = 0 (s2), and the adaptive step; every
-/// step is s1 when adaptive is false. Shared by the CPU loop and the CUDA kernel.
-UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, float lo, float hi,
-                                                       float s1, float s2, float power,
-                                                       bool adaptive) {
+/// Error-bound step (issue 11, beyond the paper): with pre-integration the segment between two
+/// samples is exact while the scalar is linear between them; the error comes from its deviation
+/// from linear, at most spread * h / 4 over a step h when the directional derivative along the
+/// ray varies by at most `spread` (the spread of the partition's cell gradients). Through the
+/// transfer function, whose optical depth per unit (and emission) changes by at most maxRate
+/// per table entry over the partition's value range, that is an optical depth error of at most
+/// maxRate / valuePerEntry * spread * h / 4 per opacity unit. The step keeps it at the
+/// tolerance: h = 4 tolerance valuePerEntry / (maxRate spread), clamped to [s1, s2]. A linear
+/// field (spread 0) or a transfer function constant over the range (maxRate 0) gets s2; a
+/// cell-centred field (infinite spread) s1.
+UVR_HOST_DEVICE inline float errorBoundStep(float maxRate, float spread, const StepRuleParams& r) {
+    if (!(maxRate > 0.f) || !(spread > 0.f)) return r.s2;
+    const float h = 4.f * r.tolerance * (r.valuePerEntry / maxRate) / spread;
+    if (!(h >= r.s1)) return r.s1;  // also NaN
+    return h < r.s2 ? h : r.s2;
+}
+
+/// Shading of one partition: its maximum opacity (0: skipped) and step. ErrorBound:
+/// errorBoundStep from the range statistics and the partition's gradient spread. Variance
+/// (Morrical et al. 2019, Sec. 2.1, 2.4): the variance normalised by the minimum lo and maximum
+/// hi over the visible partitions (1 when they are all equal and positive), invisible partitions
+/// at v = 0 (s2), and the adaptive step. Every step is s1 when adaptive is false. Shared by the
+/// CPU loop and the CUDA kernel.
+UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, float spread, float lo,
+                                                       float hi, const StepRuleParams& r) {
+    if (!r.adaptive) return {st.maxOpacity, r.s1};
+    if (r.rule == StepRule::ErrorBound)
+        return {st.maxOpacity, st.maxOpacity > 0.f ? errorBoundStep(st.maxRate, spread, r) : r.s2};
     float v = 0.f;
     if (st.maxOpacity > 0.f) v = hi > lo ? (st.variance - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
-    return {st.maxOpacity, adaptive ? adaptiveStep(v, s1, s2, power) : s1};
+    return {st.maxOpacity, adaptiveStep(v, r.s1, r.s2, r.power)};
 }
 
 /// Steps longer than this many s1 start their point location from the partition's seed grid
@@ -55,8 +98,10 @@ struct PartitionSceneView {
 
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
 /// back in exact order; skips unoccupied space (outside the shrunk boxes) and, when asked,
-/// partitions with zero maximum opacity; marches each visited partition with its own step s and
-/// opacity correction, locating samples among the partition's cells; stops early once opaque.
+/// partitions with zero maximum opacity; marches each visited partition with its own step s,
+/// locating samples among the partition's cells and integrating between consecutive samples
+/// (SampleSegments; point samples with opacity correction when params.preintegrated is off);
+/// stops early once opaque.
 ///
 /// Sample placement: a partition's piece of the ray owns the reference grid points
 /// t = k * s1 for k in [K0, K1); its samples sit at (K0 + j * s / s1) * s1 and each one stands
@@ -74,16 +119,19 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const float s1 = scene.base.params.step;
     const float unit = scene.base.params.opacityUnit;
     const float stopAlpha = scene.base.params.terminationAlpha;
+    const TfTableView& tf = scene.base.tf;
+    const bool preintegrated = scene.base.params.preintegrated;
+    SampleSegments segments;
     std::uint32_t tet = kNoTet;
     float bary[4];
     // One loop whose every iteration either takes a sample or moves to the next partition, so
     // GPU threads of a warp crossing partition boundaries at different samples stay together.
     KdLeafIterator leaves(tEnter, tExit);
     std::uint32_t p = 0, root = 0;
-    float k = 0.f, k1 = 0.f, m = 1.f;
+    float k = 0.f, k1 = 0.f, kStop = 0.f, m = 1.f;
     bool walk = true;
     while (true) {
-        if (!(k < k1)) {
+        if (!(k < kStop)) {
             float t0, t1;
             if (!leaves.next(scene.kd, ray, inv, p, t0, t1)) break;
             const KdPartition& part = scene.kd.partitions[p];
@@ -102,6 +150,16 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             k = ceilf(c0 / s1);
             k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
             m = shade.step / s1;  // step in grid units (1 for s1)
+            // Pre-integrated steps longer than s1 divide the piece evenly into at least two
+            // (but no step below s1): the piece's last sample then owns a step's length at most,
+            // and a piece of a linear field is integrated exactly.
+            kStop = k1;
+            if (preintegrated && m > 1.f) {
+                const float span = k1 - k;
+                const float parts = fmaxf(2.f, ceilf(span / m));
+                m = fmaxf(1.f, span / parts);
+                kStop = k1 - 0.5f * m;  // rounding in k += m must not add a sample at k1
+            }
             root = part.bvhRoot;
             // Short steps walk from the previous sample's tetrahedron; long steps (and samples
             // with no previous tetrahedron) walk from the seed of the sample's grid cell, or
@@ -110,6 +168,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             continue;
         }
         const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
+        const float kSample = k;
         const Vec3f pos = ray.at(k * s1);
         k += m;
         ++counters.samples;
@@ -118,19 +177,26 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         // sample is in empty space), else a search of the partition's BVH (walks stop at
         // boundaries of non-convex meshes and at seams of unshared points).
         tet = walk ? locator.walk(pos, tet, bary, counters.locate) : kNoTet;
+        bool emptySpace = false;
         if (tet == kNoTet && scene.seeds.grids) {
             const std::uint32_t seed = scene.seeds.seed(p, pos);
-            if (seed == kNoTet) continue;
-            tet = locator.walk(pos, seed, bary, counters.locate);
+            emptySpace = seed == kNoTet;
+            if (!emptySpace) tet = locator.walk(pos, seed, bary, counters.locate);
         }
-        if (tet == kNoTet) tet = locator.search(scene.kd.bvh, root, pos, bary, counters.locate);
-        if (tet == kNoTet) continue;
-        const Vec4f c = scene.base.tf.sample(locator.mesh.interpolate(tet, bary));
-        const float a = correctOpacity(c.w, length, unit);
-        if (a <= 0.f) continue;
-        compositeFrontToBack(acc, c.xyz(), a);
-        if (acc.w >= stopAlpha) break;
+        if (tet == kNoTet && !emptySpace)
+            tet = locator.search(scene.kd.bvh, root, pos, bary, counters.locate);
+        const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate(tet, bary);
+        if (preintegrated) {
+            segments.add(tf, kSample, k1, tet != kNoTet, v, s1, unit, acc);
+        } else if (tet != kNoTet) {
+            const Vec4f c = tf.sample(v);
+            const float a = correctOpacity(c.w, length, unit);
+            if (a <= 0.f) continue;
+            compositeFrontToBack(acc, c.xyz(), a);
+        }
+        if (acc.w >= stopAlpha) return acc;
     }
+    if (preintegrated) segments.finish(tf, s1, unit, acc);
     return acc;
 }
 

@@ -155,6 +155,7 @@ TEST(PartitionShading, NormalisedVarianceMapsToTheStepRange) {
     const PreparedMesh pm = jitteredGrid(32);
     RenderSettings s = baseSettings();
     s.method = RenderMethod::Partitions;
+    s.stepRule = StepRule::Variance;
     s.maxStep = 1.f;
     s.step = 0.05f;
     const FrameSetup f = makeFrameSetup(pm, s);

@@ -43,8 +43,8 @@ TEST(ExactIntegrator, ConstantOpacityIsTheClosedForm) {
     // alpha 0.3 per unit 0.5 over 1.7: 1 - 0.7^(1.7 / 0.5); the colour is c times that.
     for (const double a : {0.0, 1e-6, 0.3, 0.999}) {
         Vec4f acc(0.f, 0.f, 0.f, 0.f);
-        exact::compositePiece(Vec3f(0.2f, 0.4f, 0.8f), a, Vec3f(0.2f, 0.4f, 0.8f), a, 1.7, 0.5,
-                              acc);
+        segment::compositePiece(Vec3f(0.2f, 0.4f, 0.8f), a, Vec3f(0.2f, 0.4f, 0.8f), a, 1.7, 0.5,
+                                acc);
         const double want = 1.0 - std::pow(1.0 - a, 1.7 / 0.5);
         EXPECT_NEAR(acc.w, want, 1e-6) << a;
         EXPECT_NEAR(acc.x, 0.2 * want, 1e-6) << a;
@@ -52,7 +52,7 @@ TEST(ExactIntegrator, ConstantOpacityIsTheClosedForm) {
     }
     // Opacity 1 over an interval: opaque at once, in the colour at its start.
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
-    exact::compositePiece(Vec3f(1.f, 0.f, 0.f), 1.0, Vec3f(0.f, 1.f, 0.f), 1.0, 0.1, 1.0, acc);
+    segment::compositePiece(Vec3f(1.f, 0.f, 0.f), 1.0, Vec3f(0.f, 1.f, 0.f), 1.0, 0.1, 1.0, acc);
     expectNear(acc, Vec4f(1.f, 0.f, 0.f, 1.f), 0.f, "opaque");
 }
 
@@ -64,7 +64,7 @@ TEST(ExactIntegrator, LinearOpacityAndColourMatchBruteForce) {
     for (const auto& [s0, s1, len] : {std::tuple{0.f, 1.f, 2.0}, std::tuple{1.f, 0.f, 0.3},
                                       std::tuple{0.2f, 0.7f, 5.0}, std::tuple{0.5f, 0.5f, 1.0}}) {
         Vec4f acc(0.f, 0.f, 0.f, 0.f);
-        exact::integrateSegment(tf, s0, s1, len, 0.4, acc);
+        segment::integrate(tf, s0, s1, len, 0.4, acc);
         const Vec4f want = fineComposite(tf, s0, s1, len, 0.4, 400000);
         expectNear(acc, want, 2e-5f, "segment " + std::to_string(s0) + " -> " + std::to_string(s1));
     }
@@ -72,7 +72,7 @@ TEST(ExactIntegrator, LinearOpacityAndColourMatchBruteForce) {
     const std::vector<Vec4f> toOne{Vec4f(1.f, 1.f, 1.f, 0.f), Vec4f(1.f, 1.f, 1.f, 1.f)};
     const TfTableView tfOne{toOne.data(), 2, 0.f, 1.f};
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
-    exact::integrateSegment(tfOne, 0.f, 1.f, 0.2, 1.0, acc);
+    segment::integrate(tfOne, 0.f, 1.f, 0.2, 1.0, acc);
     // -integral_0^1 ln(1 - x) dx * 0.2 = 0.2: alpha = 1 - e^-0.2.
     EXPECT_NEAR(acc.w, 1.0 - std::exp(-0.2), 1e-6);
 }
@@ -85,7 +85,7 @@ TEST(ExactIntegrator, TransferFunctionStepInsideOneSegmentIsNotMissed) {
     const std::vector<Vec4f> table = tf.bake(1 << 16);
     const TfTableView view{table.data(), static_cast<int>(table.size()), 0.f, 1.f};
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
-    exact::integrateSegment(view, 0.f, 1.f, 1.0, 1.0, acc);
+    segment::integrate(view, 0.f, 1.f, 1.0, 1.0, acc);
     // 0.02 of the segment at alpha 0.9 per unit, plus the two 1e-4 ramps (about half each).
     const double inBand = 0.02 + 1e-4;
     EXPECT_NEAR(acc.w, 1.0 - std::pow(0.1, inBand), 2e-3);

@@ -8,6 +8,7 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/segment_integral.h"
 #include "uvr/tf/tf_table.h"
 
 namespace uvr {
@@ -17,6 +18,9 @@ struct MarchParams {
     float step = 0.f;                ///< sample spacing s1 along the ray (world units)
     float opacityUnit = 1.f;         ///< distance over which a TF opacity applies (ParaView's unit)
     float terminationAlpha = 0.99f;  ///< early ray termination threshold on accumulated opacity
+    /// Integrate between consecutive samples with the scalar linear from one to the next
+    /// (SampleSegments) instead of point samples with opacity correction.
+    bool preintegrated = true;
 };
 
 /// Everything a ray needs, as plain data for CPU and GPU.
@@ -53,10 +57,67 @@ UVR_HOST_DEVICE inline void compositeFrontToBack(Vec4f& acc, Vec3f rgb, float a)
     acc.w += w;
 }
 
+/// Pre-integration for the sample-based methods (issue 11): the segment between two consecutive
+/// samples inside the mesh, at grid positions k (in units of s1), is integrated with the scalar
+/// running linearly from one sample's value to the next (segment::integrate), so a
+/// transfer-function feature between two samples is integrated, never missed, and no step is
+/// too long where the field is linear. Each sample owns the distance to the next sample, as a
+/// point sample does: the last sample of a run inside the mesh (before a sample that found no
+/// cell, a gap between the pieces of the ray that partitions own, or the end of the ray) owns
+/// the distance up to the next sample or the end of its piece, over which the run's last slope
+/// is extended (its value held for a run of one sample). So a run of n samples covers the same
+/// distance as n point samples, a linear field is integrated exactly, and with equal steps the
+/// partition integrator takes exactly the reference's segments.
+struct SampleSegments {
+    float kLast = 0.f;     ///< grid position of the last sample
+    float kEnd = 0.f;      ///< end of the piece of the ray the last sample belongs to
+    float vLast = 0.f;     ///< its value (when inside)
+    float kPrev = 0.f;     ///< grid position of the sample before it in the run
+    float vPrev = 0.f;     ///< its value
+    bool inRun = false;    ///< the sample before the last one is in the last one's run
+    bool inside = false;   ///< the last sample found a cell
+    bool started = false;  ///< a sample was taken
+
+    /// Adds the sample at grid position k of a piece of the ray that ends at kPieceEnd (the
+    /// next piece continues it when it starts there); `in`: it found a cell, with value v.
+    UVR_HOST_DEVICE void add(const TfTableView& tf, float k, float kPieceEnd, bool in, float v,
+                             float s1, double unit, Vec4f& acc) {
+        const bool goesOn = started && inside && in && k <= kEnd;
+        if (goesOn)
+            segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc);
+        else if (started && inside)  // the run ends
+            endRun(tf, (k < kEnd ? k : kEnd) - kLast, s1, unit, acc);
+        inRun = goesOn;
+        kPrev = kLast;
+        vPrev = vLast;
+        kLast = k;
+        kEnd = kPieceEnd;
+        vLast = v;
+        inside = in;
+        started = true;
+    }
+    /// Ends the last run at the end of the ray.
+    UVR_HOST_DEVICE void finish(const TfTableView& tf, float s1, double unit, Vec4f& acc) const {
+        if (started && inside) endRun(tf, kEnd - kLast, s1, unit, acc);
+    }
+
+private:
+    /// The last sample's share: `steps` grid steps along the run's last slope (in double: the
+    /// difference of two values may overflow float).
+    UVR_HOST_DEVICE void endRun(const TfTableView& tf, float steps, float s1, double unit,
+                                Vec4f& acc) const {
+        double end = vLast;
+        if (inRun) end += (double(vLast) - vPrev) * (double(steps) / (double(kLast) - kPrev));
+        segment::integrate(tf, vLast, end, double(steps) * s1, unit, acc);
+    }
+};
+
 /// The reference ray marcher: samples at fixed spacing s1 on the global grid t = k * s1 between
 /// the ray's entry into and exit from the mesh bounds, locates each sample's tetrahedron
-/// (previous tetrahedron first), interpolates barycentrically, classifies through the transfer
-/// function, composites front to back with opacity correction and stops early once opaque.
+/// (previous tetrahedron first), interpolates barycentrically and integrates between
+/// consecutive samples (SampleSegments; or, with params.preintegrated off, classifies each sample
+/// through the transfer function and composites it with opacity correction), front to back,
+/// stopping early once opaque.
 UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -70,18 +131,24 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float kEnd = floorf(t1 / s);
     std::uint32_t tet = kNoTet;
     float bary[4];
+    const float unit = scene.params.opacityUnit;
+    SampleSegments segments;
     for (; k <= kEnd; k += 1.f) {
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
         tet = scene.locator.locate(p, tet, bary, counters.locate);
-        if (tet == kNoTet) continue;
-        const float v = scene.locator.mesh.interpolate(tet, bary);
-        const Vec4f c = scene.tf.sample(v);
-        const float a = correctOpacity(c.w, s, scene.params.opacityUnit);
-        if (a <= 0.f) continue;
-        compositeFrontToBack(acc, c.xyz(), a);
-        if (acc.w >= scene.params.terminationAlpha) break;
+        const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate(tet, bary);
+        if (scene.params.preintegrated) {
+            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc);
+        } else if (tet != kNoTet) {
+            const Vec4f c = scene.tf.sample(v);
+            const float a = correctOpacity(c.w, s, unit);
+            if (a <= 0.f) continue;
+            compositeFrontToBack(acc, c.xyz(), a);
+        }
+        if (acc.w >= scene.params.terminationAlpha) return acc;
     }
+    if (scene.params.preintegrated) segments.finish(scene.tf, s, unit, acc);
     return acc;
 }
 

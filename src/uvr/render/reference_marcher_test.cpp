@@ -78,10 +78,15 @@ TEST(ReferenceMarcher, GapsAndMissesAreTransparent) {
 
 TEST(ReferenceMarcher, EarlyTerminationStopsAtOpacity) {
     Fixture f(twoCubes(), Vec4f(1.f, 1.f, 1.f, 1.f), 0.01f, 1.f);
-    RayCounters counters;
-    const Vec4f c = marchReference(f.scene, {{-0.5f, 0.4f, 0.4f}, {1.f, 0.f, 0.f}}, counters);
-    EXPECT_FLOAT_EQ(c.w, 1.f);
-    EXPECT_EQ(counters.samples, 1u);
+    // A point sample is opaque at once; a pre-integrated segment once the second sample closes
+    // it.
+    for (const bool preintegrated : {false, true}) {
+        f.scene.params.preintegrated = preintegrated;
+        RayCounters counters;
+        const Vec4f c = marchReference(f.scene, {{-0.5f, 0.4f, 0.4f}, {1.f, 0.f, 0.f}}, counters);
+        EXPECT_FLOAT_EQ(c.w, 1.f);
+        EXPECT_EQ(counters.samples, preintegrated ? 2u : 1u);
+    }
 }
 
 TEST(ReferenceMarcher, NanValuesAreTransparent) {

@@ -10,6 +10,8 @@
 
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
+#include "uvr/mesh/tet_math.h"
+#include "uvr/tf/tf_table.h"
 
 namespace uvr {
 
@@ -70,8 +72,41 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
             if (progress) progress("building seed grids");
             out.seeds = buildSeedGrids(out.tets, *out.kd);
         }
+        out.gradientSpread = partitionGradientSpread(out.tets, *out.kd);
     }
     return out;
+}
+
+std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd) {
+    const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+    std::vector<float> out(n, 0.f);
+    if (tets.association == Association::Cell) {
+        for (std::int64_t p = 0; p < n; ++p)
+            if (kd.partitions[p].cellCount > 0) out[p] = INFINITY;
+        return out;
+    }
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::int64_t p = 0; p < n; ++p) {
+        const KdPartition& part = kd.partitions[p];
+        Bounds3f box;
+        for (std::uint32_t i = 0; i < part.cellCount; ++i) {
+            const Tet& t = tets.tets[kd.cells[part.firstCell + i]];
+            const Vec3f g = tetGradient(
+                tets.points[t.v[0]], tets.points[t.v[1]], tets.points[t.v[2]], tets.points[t.v[3]],
+                tets.values[t.v[0]], tets.values[t.v[1]], tets.values[t.v[2]], tets.values[t.v[3]]);
+            if (isFinite(g)) box.extend(g);
+        }
+        out[p] = box.empty() ? 0.f : length(box.hi - box.lo);
+    }
+    return out;
+}
+
+float toleranceForQuality(float quality) {
+    if (!(quality >= kMinQuality && quality <= kMaxQuality))
+        throwError(ErrorKind::Argument, "",
+                   "--quality " + std::to_string(quality) + ": expected a number in [" +
+                       std::to_string(kMinQuality) + ", " + std::to_string(kMaxQuality) + "]");
+    return kToleranceScale * (1.f - quality);
 }
 
 PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field) {
@@ -119,12 +154,15 @@ void validateSettings(const RenderSettings& s) {
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
+    toleranceForQuality(s.quality);  // throws for a quality out of range
 }
 
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
-                                                      const TfRangeView& range, float s1, float s2,
-                                                      float power, bool adaptive) {
+                                                      const std::vector<float>& gradientSpread,
+                                                      const TfRangeView& range,
+                                                      const StepRuleParams& rule) {
     const std::size_t n = kd.partitions.size();
+    UVR_CHECK(gradientSpread.size() == n, "partition gradient spreads missing");
     std::vector<RangeStats> stats(n);
     float lo = INFINITY, hi = -INFINITY;
     for (std::size_t p = 0; p < n; ++p) {
@@ -134,14 +172,14 @@ std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
     }
     std::vector<PartitionShading> out(n);
     for (std::size_t p = 0; p < n; ++p)
-        out[p] = shadePartition(stats[p], lo, hi, s1, s2, power, adaptive);
+        out[p] = shadePartition(stats[p], gradientSpread[p], lo, hi, rule);
     return out;
 }
 
 SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     SceneView v;
     v.locator = mesh.locator();
-    v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi};
+    v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi, tfBreaks.data()};
     v.bounds = mesh.tets.bounds;
     v.params = params;
     return v;
@@ -209,6 +247,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     validateSettings(settings);
     FrameSetup f;
     f.tfTable = settings.tf.bake(settings.tfTableSize);
+    f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
     f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
     f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
     const float aspect = float(settings.width) / float(settings.height);
@@ -237,6 +276,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                ? toLocal(settings.opacityUnit, "--opacity-unit")
                                : defaultOpacityUnit(bounds, mesh.sourceCells);
     f.params.terminationAlpha = settings.terminationAlpha;
+    f.params.preintegrated = settings.preintegrated;
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "--max-step")
                                        : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
@@ -288,13 +328,21 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
             ErrorKind::Argument, "",
             std::string(settings.method == RenderMethod::Exact ? "the exact" : "the reference") +
                 " method needs the mesh BVH");
+    f.stepRule.rule = settings.stepRule;
+    f.stepRule.adaptive = settings.adaptive;
+    f.stepRule.s1 = f.params.step;
+    f.stepRule.s2 = f.maxStep;
+    f.stepRule.power = settings.power;
+    f.stepRule.tolerance = toleranceForQuality(settings.quality);
+    f.stepRule.valuePerEntry =
+        static_cast<float>((double(f.rangeHi) - double(f.rangeLo)) / (f.tfTable.size() - 1));
     if (settings.method == RenderMethod::Partitions && shadePartitions) {
         const auto start = std::chrono::steady_clock::now();
         const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
                                 f.rangeHi};
         const TfRangeTables ranges(table);
-        f.shading = computePartitionShading(*mesh.kd, ranges.view(table), f.params.step, f.maxStep,
-                                            settings.power, settings.adaptive);
+        f.shading =
+            computePartitionShading(*mesh.kd, mesh.gradientSpread, ranges.view(table), f.stepRule);
         f.tfUpdateSeconds = secondsSince(start);
     }
     checkFrameWork(mesh, settings, f.params.step);

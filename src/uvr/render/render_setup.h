@@ -49,11 +49,14 @@ struct PreparedMesh {
     std::vector<std::uint32_t> neighbors;
     std::optional<KdPartitions> kd;
     std::optional<SeedGrids> seeds;  ///< per-partition walk starts (with partitions)
-    std::uint64_t sourceCells = 0;   ///< cells of the mesh before splitting
-    double splitSeconds = 0.0;       ///< time to split cells into tetrahedra
-    double bvhSeconds = 0.0;         ///< time to build the BVH
-    double adjacencySeconds = 0.0;   ///< time to find face neighbours
-    bool builtElsewhere = false;  ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
+    /// Per partition (with partitions): the spread of its cells' field gradients, the diagonal
+    /// of their bounding box (partitionGradientSpread), for the error-bound step rule.
+    std::vector<float> gradientSpread;
+    std::uint64_t sourceCells = 0;  ///< cells of the mesh before splitting
+    double splitSeconds = 0.0;      ///< time to split cells into tetrahedra
+    double bvhSeconds = 0.0;        ///< time to build the BVH
+    double adjacencySeconds = 0.0;  ///< time to find face neighbours
+    bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
 
     /// Point locator over this mesh.
     TetLocator locator() const { return {tets.view(), bvh.view(), neighbors.data()}; }
@@ -67,6 +70,13 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
                          const ProgressFn& progress = {});
 /// prepareMesh with the default options.
 PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field);
+
+/// Per partition, the diagonal of the bounding box of the field gradients of its cells (each
+/// linear tetrahedron's constant gradient): it bounds how much the derivative of the field along
+/// any ray varies inside the partition. 0 for a partition without cells or with a linear field;
+/// infinite for a cell-centred field (piecewise constant: its jumps have no gradient bound).
+/// Cells with non-finite gradients (degenerate, or NaN values) are left out.
+std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd);
 
 /// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume,
 /// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray;
@@ -88,11 +98,33 @@ enum class RenderMethod {
     Exact,       ///< no sampling: each tetrahedron's segment integrated exactly (the ground truth)
 };
 
+/// Default --quality: the error-bound rule's SSIM target against the exact integrator.
+inline constexpr float kDefaultQuality = 0.99f;
+/// Range of --quality.
+inline constexpr float kMinQuality = 0.5f;
+inline constexpr float kMaxQuality = 0.9999f;
+
+/// Tolerance per unit of (1 - quality) (toleranceForQuality).
+inline constexpr float kToleranceScale = 5.f;
+
+/// The error-bound rule's tolerance (StepRuleParams::tolerance, optical depth error per opacity
+/// unit) for a quality: measured on the evaluation matrix (docs/PERFORMANCE.md), the worst-case
+/// SSIM against exact stays at or above the quality for tolerance kToleranceScale * (1 -
+/// quality).
+float toleranceForQuality(float quality);
+
 /// What to render and how.
 struct RenderSettings {
     RenderMethod method = RenderMethod::Reference;
+    StepRule stepRule = StepRule::ErrorBound;  ///< how the partition method picks steps
+    /// The error-bound rule's target: the SSIM against the exact integrator that it aims at for
+    /// typical data (toleranceForQuality), in [kMinQuality, kMaxQuality].
+    float quality = kDefaultQuality;
+    /// Sample-based methods integrate between consecutive samples (false: point samples with
+    /// opacity correction, as in Morrical et al. 2019).
+    bool preintegrated = true;
     float maxStep = 0.f;   ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1
-    float power = 2.f;     ///< adaptive power p >= 1
+    float power = 2.f;     ///< variance rule: adaptive power p >= 1
     bool skip = true;      ///< skip partitions of zero maximum opacity
     bool adaptive = true;  ///< adaptive steps (false: every partition at s1)
     int width = 1024;
@@ -166,17 +198,20 @@ private:
 inline constexpr float kDefaultMaxStepFactor = 16.f;
 
 /// Per-partition shading for a transfer function (Morrical et al. 2019, Sec. 2.1): each
-/// partition's maximum opacity and colour variance over its value range (O(1) per partition from
-/// the table's range statistics, independent of cell count), variances normalised to [0, 1] by
-/// the minimum and maximum over the visible partitions, and the adaptive step from it (s1 for
-/// every partition when adaptive is false; s2 for invisible partitions).
+/// partition's maximum opacity, rate and colour variance over its value range (O(1) per
+/// partition from the table's range statistics, independent of cell count) and its step by the
+/// rule (shadePartition; for the variance rule the variances are normalised to [0, 1] by the
+/// minimum and maximum over the visible partitions).
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
-                                                      const TfRangeView& range, float s1, float s2,
-                                                      float power, bool adaptive);
+                                                      const std::vector<float>& gradientSpread,
+                                                      const TfRangeView& range,
+                                                      const StepRuleParams& rule);
 
 /// Host-side frame state built from settings: the baked table, the camera and the parameters.
 struct FrameSetup {
     std::vector<Vec4f> tfTable;
+    std::vector<std::int32_t> tfBreaks;     ///< tfTableBreaks of tfTable
+    StepRuleParams stepRule;                ///< the partition method's step rule and its inputs
     std::vector<PartitionShading> shading;  ///< per partition (partition method only)
     double tfUpdateSeconds = 0.0;           ///< range tables + shading of all partitions
     float maxStep = 0.f;                    ///< s2 in effect

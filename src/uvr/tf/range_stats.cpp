@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/tf/range_stats.h"
 
+#include <cmath>
+
 namespace uvr {
 
 TfRangeTables::TfRangeTables(const TfTableView& table) {
@@ -16,13 +18,26 @@ TfRangeTables::TfRangeTables(const TfTableView& table) {
     levels = 1;
     while ((1 << levels) <= n) ++levels;
     maxLevels.assign(static_cast<std::size_t>(levels) * n, 0.f);
-    for (int i = 0; i < n; ++i) maxLevels[i] = table.entries[i].w;
-    for (int k = 1; k < levels; ++k)
-        for (int i = 0; i + (1 << k) <= n; ++i) {
-            const float a = maxLevels[(k - 1) * n + i];
-            const float b = maxLevels[(k - 1) * n + i + (1 << (k - 1))];
-            maxLevels[k * n + i] = a > b ? a : b;
-        }
+    rateLevels.assign(static_cast<std::size_t>(levels) * n, 0.f);
+    for (int i = 0; i < n; ++i) {
+        const Vec4f e = table.entries[i];
+        maxLevels[i] = e.w;
+        if (i + 1 == n) break;
+        const Vec4f f = table.entries[i + 1];
+        const float te = opticalDepthPerUnit(e.w), tf = opticalDepthPerUnit(f.w);
+        float rate = std::fabs(tf - te);
+        for (int c = 0; c < 3; ++c) rate = std::fmax(rate, std::fabs(f[c] * tf - e[c] * te));
+        rateLevels[i] = rate;
+    }
+    for (std::vector<float>* sparse : {&maxLevels, &rateLevels}) {
+        float* s = sparse->data();
+        for (int k = 1; k < levels; ++k)
+            for (int i = 0; i + (1 << k) <= n; ++i) {
+                const float a = s[(k - 1) * n + i];
+                const float b = s[(k - 1) * n + i + (1 << (k - 1))];
+                s[k * n + i] = a > b ? a : b;
+            }
+    }
 }
 
 }  // namespace uvr

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -31,6 +32,24 @@ RangeStats bruteForce(const TfTableView& t, float lo, float hi) {
     return s;
 }
 
+/// The largest rate (RangeStats::maxRate) over the table's pieces that [lo, hi] overlaps.
+float bruteForceRate(const TfTableView& t, float lo, float hi) {
+    const float f0 = tfTablePosition(lo, t.lo, t.hi, t.count);
+    const float f1 = tfTablePosition(hi, t.lo, t.hi, t.count);
+    float rate = 0.f;
+    for (int i = 0; i + 1 < t.count; ++i) {
+        const bool overlaps = (float(i + 1) > f0 && float(i) < f1) ||
+                              (f0 >= float(i) && f0 < float(i + 1)) ||
+                              (i + 2 == t.count && f0 >= float(i + 1));
+        if (!overlaps) continue;
+        const Vec4f a = t.entries[i], b = t.entries[i + 1];
+        const float ta = opticalDepthPerUnit(a.w), tb = opticalDepthPerUnit(b.w);
+        rate = std::max(rate, std::fabs(tb - ta));
+        for (int c = 0; c < 3; ++c) rate = std::max(rate, std::fabs(b[c] * tb - a[c] * ta));
+    }
+    return rate;
+}
+
 TEST(RangeStats, MatchBruteForceOnRandomTablesAndRanges) {
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -46,6 +65,7 @@ TEST(RangeStats, MatchBruteForceOnRandomTablesAndRanges) {
             const RangeStats got = view.query(a, b), want = bruteForce(table, a, b);
             ASSERT_FLOAT_EQ(got.maxOpacity, want.maxOpacity) << count << " " << a << " " << b;
             ASSERT_NEAR(got.variance, std::max(want.variance, 0.f), 1e-5f);
+            ASSERT_FLOAT_EQ(got.maxRate, bruteForceRate(table, a, b)) << count << " " << a;
         }
     }
 }
@@ -61,6 +81,23 @@ TEST(RangeStats, ConstantTableHasZeroVarianceAndRampMaxIsTheUpperEnd) {
     const TfRangeTables rt(r);
     EXPECT_NEAR(rt.view(r).query(0.2f, 0.355f).maxOpacity, 0.355f, 1e-6f);
     EXPECT_EQ(rt.view(r).query(-1.f, -0.5f).maxOpacity, 0.f);  // below the range: first entry
+}
+
+TEST(RangeStats, RateIsTheSteepestChangeOfOpticalDepthOrEmission) {
+    // Opacity 0 up to entry 50, 0.5 from entry 51: the rate is -ln(0.5) (times the white colour)
+    // on the piece 50-51 and 0 elsewhere.
+    std::vector<Vec4f> step(101, Vec4f(1.f, 1.f, 1.f, 0.f));
+    for (int i = 51; i <= 100; ++i) step[i].w = 0.5f;
+    const TfTableView t{step.data(), 101, 0.f, 1.f};
+    const TfRangeTables tables(t);
+    EXPECT_FLOAT_EQ(tables.view(t).query(0.1f, 0.9f).maxRate, std::log(2.f));
+    EXPECT_FLOAT_EQ(tables.view(t).query(0.505f, 0.505f).maxRate, std::log(2.f));
+    EXPECT_EQ(tables.view(t).query(0.1f, 0.45f).maxRate, 0.f);
+    EXPECT_EQ(tables.view(t).query(0.6f, 2.f).maxRate, 0.f);
+    // Opacity 1 is capped: a finite rate.
+    step[100].w = 1.f;
+    const TfRangeTables capped(t);
+    EXPECT_NEAR(capped.view(t).query(0.95f, 1.f).maxRate, -std::log(1e-6f) - std::log(2.f), 0.1f);
 }
 
 TEST(TfTablePosition, AnyInputGivesAPositionInsideTheTable) {

@@ -2,6 +2,9 @@
 #pragma once
 
 #include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "uvr/core/host_device.h"
 #include "uvr/core/vec.h"
@@ -30,6 +33,22 @@ struct TfTableView {
     int count = 0;
     float lo = 0.f;
     float hi = 1.f;
+    /// Optional breakpoints (tfTableBreaks): 2 * count indices, breaks[i] the first breakpoint
+    /// above entry i, breaks[count + i] the last one below it. Between two consecutive
+    /// breakpoints the table is linear to within kTfBreakTolerance, so the integrators need not
+    /// split a segment at the entries in between. Null: every entry is a breakpoint.
+    const std::int32_t* breaks = nullptr;
+
+    /// The first breakpoint (a table position) above position g in [0, count - 1).
+    UVR_HOST_DEVICE int breakAbove(double g) const {
+        const int i = static_cast<int>(g);
+        return breaks ? breaks[i] : i + 1;
+    }
+    /// The last breakpoint below position g in (0, count - 1].
+    UVR_HOST_DEVICE int breakBelow(double g) const {
+        const int i = static_cast<int>(ceil(g));
+        return breaks ? breaks[count + i] : i - 1;
+    }
 
     /// Linearly interpolated RGBA at value v (clamped to the range; a zero-width range maps
     /// everything to the first entry; NaN maps to fully transparent).
@@ -42,5 +61,17 @@ struct TfTableView {
         return entries[i] * (1.f - w) + entries[i + 1] * w;
     }
 };
+
+/// Largest difference (per RGBA channel) between a baked table and its linear interpolation
+/// between breakpoints: far below one 8-bit level (1 / 255), so integrating between
+/// breakpoints instead of between all entries changes no pixel.
+inline constexpr float kTfBreakTolerance = 1e-4f;
+
+/// Breakpoints of a baked table (the layout of TfTableView::breaks): the entries where the
+/// table stops being linear to within `tolerance` in every channel, chosen greedily from the
+/// first entry in one O(count) pass (for each run, the interval of chord slopes that keeps every
+/// entry inside the run within tolerance). Both ends are always breakpoints.
+std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count,
+                                        float tolerance = kTfBreakTolerance);
 
 }  // namespace uvr

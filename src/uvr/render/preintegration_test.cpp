@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+// Pre-integrated sampling and the error-bound step rule (issue 11, sections 2 and 3), held to
+// the exact integrator: a transfer-function band between two samples, linear fields at long
+// steps, the rule's ends and its gradient metadata, and the rule against exact on a smooth field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "test_meshes.h"
+#include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/mesh/field_select.h"
+#include "uvr/render/adaptive_marcher.h"
+#include "uvr/render/image_metrics.h"
+
+namespace uvr {
+namespace {
+
+float maxDifference(const Image& a, const Image& b) {
+    float d = 0.f;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 4; ++c) d = std::fmax(d, std::fabs(a.pixels[i][c] - b.pixels[i][c]));
+    return d;
+}
+
+/// A unit cube of 4^3 hexahedra (jittered inside) with the point field f, partitions of at most
+/// leafCells tetrahedra.
+PreparedMesh cube(const std::function<float(Vec3f)>& f, std::uint32_t leafCells = 64, int n = 4) {
+    const Mesh m = testing::makeHexGrid(n, 0.f, 1.f, f, 0.2f);
+    PrepareOptions o;
+    o.kd.leafCells = leafCells;
+    return prepareMesh(m, selectScalarField(m, {}), o);
+}
+
+/// Looking down the z axis at the cube, field range [0, 1], opacity only in a band of the
+/// normalised range.
+RenderSettings bandSettings(const char* opacity, float step) {
+    RenderSettings s;
+    s.width = s.height = 24;
+    s.camera = Camera{};
+    s.camera->position = Vec3f(0.5f, 0.5f, 3.f);
+    s.camera->focalPoint = Vec3f(0.5f, 0.5f, 0.5f);
+    s.camera->viewUp = Vec3f(0.f, 1.f, 0.f);
+    s.camera->viewAngle = 20.f;
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, opacity);
+    s.range = std::pair{0.f, 1.f};
+    s.step = step;
+    s.opacityUnit = 0.1f;
+    s.terminationAlpha = 1.f;
+    return s;
+}
+
+TEST(Preintegration, BandBetweenTwoSamplesIsIntegratedNotMissed) {
+    // v = z, samples 0.1 apart along the central ray at z = 3 - 0.1 k: the band [0.52, 0.58]
+    // lies between the samples at z = 0.5 and 0.6. Point samples miss it; pre-integration is
+    // exact for a linear field (the tails beyond the band are transparent).
+    const PreparedMesh pm = cube([](Vec3f p) { return p.z; });
+    RenderSettings s = bandSettings("0:0,0.52:0,0.53:0.8,0.57:0.8,0.58:0,1:0", 0.1f);
+    RenderSettings e = s;
+    e.method = RenderMethod::Exact;
+    const RenderResult exact = renderCpu(pm, e);
+    const Vec4f centre = exact.image.at(12, 12);
+    EXPECT_GT(centre.w, 0.3f);  // 0.05 through the band at 0.8 per 0.1: about 0.6
+    s.preintegrated = false;
+    EXPECT_LT(renderCpu(pm, s).image.at(12, 12).w, 0.05f);  // missed or nearly
+    s.preintegrated = true;
+    const RenderResult ref = renderCpu(pm, s);
+    EXPECT_LT(maxDifference(ref.image, exact.image), 2e-4f);
+    // The partition method too, at every rule (the variance rule's steps are up to 16 s1).
+    s.method = RenderMethod::Partitions;
+    for (const StepRule rule : {StepRule::ErrorBound, StepRule::Variance}) {
+        s.stepRule = rule;
+        EXPECT_LT(maxDifference(renderCpu(pm, s).image, exact.image), 2e-4f);
+    }
+}
+
+TEST(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
+    // A linear field has no gradient spread: the error-bound rule gives every visible partition
+    // s2, and pre-integration along linear segments (and the runs' last slopes) is still exact.
+    const PreparedMesh pm = cube([](Vec3f p) { return 0.3f * p.x + 0.5f * p.y + p.z; }, 64, 6);
+    RenderSettings s = bandSettings("0:0,0.3:0.6,0.35:0,0.6:0,0.7:0.8,0.8:0,1:0.2", 0.02f);
+    s.range = std::pair{0.f, 1.8f};
+    RenderSettings e = s;
+    e.method = RenderMethod::Exact;
+    const RenderResult exact = renderCpu(pm, e);
+    s.method = RenderMethod::Partitions;
+    s.maxStep = 0.3f;  // 15 s1
+    const RenderResult a = renderCpu(pm, s);
+    for (const PartitionShading& sh : a.setup.shading) {
+        if (sh.maxOpacity > 0.f) {
+            EXPECT_FLOAT_EQ(sh.step, 0.3f);
+        }
+    }
+    s.method = RenderMethod::Reference;
+    const RenderResult r = renderCpu(pm, s);
+    EXPECT_LT(a.stats.samples * 3, r.stats.samples);
+    // Inside the mesh both are exact; where a ray leaves it, the last sample owns the distance
+    // to the grid point after the exit (as a point sample does), the same for both methods, so
+    // the long steps give the reference's image.
+    EXPECT_LT(maxDifference(a.image, r.image), 1e-3f);
+    EXPECT_GT(compareImages(toRgb8(exact.image), toRgb8(r.image)).ssim, 0.99);
+}
+
+TEST(ErrorBoundStep, EndsAndFormula) {
+    StepRuleParams r;
+    r.s1 = 0.01f;
+    r.s2 = 0.16f;
+    r.tolerance = 0.05f;
+    r.valuePerEntry = 0.002f;
+    EXPECT_EQ(errorBoundStep(0.f, 5.f, r), 0.16f);        // constant transfer function
+    EXPECT_EQ(errorBoundStep(0.3f, 0.f, r), 0.16f);       // linear field
+    EXPECT_EQ(errorBoundStep(0.3f, INFINITY, r), 0.01f);  // cell-centred field
+    EXPECT_EQ(errorBoundStep(NAN, 1.f, r), 0.16f);
+    // h = 4 * 0.05 * 0.002 / (0.1 * 0.5) = 0.008 -> s1; with spread 0.05: 0.08.
+    EXPECT_EQ(errorBoundStep(0.1f, 0.5f, r), 0.01f);
+    EXPECT_NEAR(errorBoundStep(0.1f, 0.05f, r), 0.08f, 1e-6f);
+    // Invisible partitions get s2 whatever their rate.
+    const RangeStats invisible{0.f, 0.3f, 5.f};
+    EXPECT_EQ(shadePartition(invisible, 1.f, 0.f, 1.f, r).step, 0.16f);
+    r.adaptive = false;
+    EXPECT_EQ(shadePartition(RangeStats{0.5f, 0.3f, 5.f}, 0.f, 0.f, 1.f, r).step, 0.01f);
+}
+
+TEST(PartitionGradientSpread, BoundsTheGradientsOfTheCells) {
+    // A linear field: every tetrahedron has the same gradient (spread at rounding level). The
+    // field x^2: gradients (2x, 0, 0) over the partition's cells, so the spread is about twice
+    // the partition's extent in x.
+    const PreparedMesh lin = cube([](Vec3f p) { return 2.f * p.x - p.y + 0.5f * p.z; }, 32, 6);
+    for (float spread : lin.gradientSpread) EXPECT_LT(spread, 1e-4f);
+    // Piecewise-linear gradients of x^2 on tetrahedra of size h = 1/6 err by up to about
+    // 2h (more with the jitter) in every component.
+    const PreparedMesh quad = cube([](Vec3f p) { return p.x * p.x; }, 32, 6);
+    ASSERT_EQ(quad.gradientSpread.size(), quad.kd->partitions.size());
+    const float h = 1.f / 6.f;
+    for (std::size_t p = 0; p < quad.kd->partitions.size(); ++p) {
+        const KdPartition& part = quad.kd->partitions[p];
+        if (part.cellCount == 0) continue;
+        const float width = part.box.hi.x - part.box.lo.x;
+        EXPECT_GT(quad.gradientSpread[p], 2.f * (width - 2.f * h)) << p;
+        EXPECT_LT(quad.gradientSpread[p], 2.f * width + 4.f * h) << p;
+    }
+    // A cell-centred field has no gradient bound.
+    Mesh cells = testing::makeHexGrid(3, 0.f, 1.f);
+    cells.fields.push_back({"c", Association::Cell, 1, std::vector<float>(27, 1.f)});
+    const PreparedMesh cc = prepareMesh(cells, selectScalarField(cells, parseFieldSpec("c")));
+    for (float spread : cc.gradientSpread) EXPECT_EQ(spread, INFINITY);
+}
+
+TEST(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
+    // A smooth non-linear field under a two-band transfer function: the default quality's rule
+    // stays as close to exact as the reference and takes fewer samples; a lower quality takes
+    // fewer still.
+    const PreparedMesh pm =
+        cube([](Vec3f p) { return std::sin(4.f * p.x) * std::cos(3.f * p.y) + p.z; }, 64, 10);
+    RenderSettings s;
+    s.width = s.height = 64;
+    s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), 35.f, 25.f);
+    s.tf = transferFunctionPreset("cool-to-warm");
+    applyOpacitySpec(s.tf, "0:0,0.3:0,0.35:0.7,0.4:0,0.6:0,0.65:0.9,0.7:0,1:0.1");
+    RenderSettings e = s;
+    e.method = RenderMethod::Exact;
+    const Rgb8Image exact = toRgb8(renderCpu(pm, e).image);
+    const RenderResult ref = renderCpu(pm, s);
+    s.method = RenderMethod::Partitions;
+    const RenderResult good = renderCpu(pm, s);
+    s.quality = 0.9f;
+    const RenderResult rough = renderCpu(pm, s);
+    // On a mesh of 10^3 cells the reference's step is a 36th of the depth, and where rays enter
+    // and leave the mesh its samples own up to a step beyond it: that is most of its difference.
+    const double refSsim = compareImages(exact, toRgb8(ref.image)).ssim;
+    EXPECT_GE(refSsim, 0.97);
+    EXPECT_GE(compareImages(exact, toRgb8(good.image)).ssim, refSsim - 0.005);
+    int longer = 0;
+    for (const PartitionShading& sh : good.setup.shading)
+        longer += sh.maxOpacity > 0.f && sh.step > 1.5f * ref.setup.params.step;
+    EXPECT_GT(longer, 0);  // visible partitions with steps beyond s1
+    EXPECT_LT(good.stats.samples, ref.stats.samples);
+    EXPECT_LT(rough.stats.samples, good.stats.samples);
+}
+
+TEST(ErrorBoundRule, QualityOutOfRangeIsRefused) {
+    EXPECT_THROW(toleranceForQuality(1.f), Error);
+    EXPECT_THROW(toleranceForQuality(0.f), Error);
+    EXPECT_THROW(toleranceForQuality(NAN), Error);
+    EXPECT_GT(toleranceForQuality(0.9f), toleranceForQuality(0.99f));
+}
+
+}  // namespace
+}  // namespace uvr
