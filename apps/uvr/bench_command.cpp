@@ -93,8 +93,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         // Every variant's last frame is kept until the table is printed.
         checkMemoryEstimate(ctx,
                             "--size " + flags->size + ": the frames of " +
-                                std::to_string(4 + sweep->size()) + " variants",
-                            frameMemoryBytes(*flags, 4 + sweep->size()));
+                                std::to_string(6 + sweep->size()) + " variants",
+                            frameMemoryBytes(*flags, 6 + sweep->size()));
         if (!images->empty() && !std::filesystem::is_directory(*images))
             throwError(ErrorKind::Io, *images, "not a folder");
         flags->method = "adaptive";  // partitions are needed; variants pick their integrator
@@ -114,7 +114,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
 
         std::vector<Variant> variants;
         auto add = [&](const std::string& name, RenderMethod method, bool skip, bool adaptive,
-                       float s2) {
+                       float s2) -> Variant& {
             Variant v;
             v.name = name;
             v.settings = base;
@@ -124,11 +124,20 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             v.settings.maxStep = s2;
             v.s2Factor = adaptive ? s2 / s1 : 0.0;
             variants.push_back(v);
+            return variants.back();
         };
         add("reference", RenderMethod::Reference, false, false, defaultS2);
         add("skipping only", RenderMethod::Partitions, true, false, defaultS2);
         add("adaptive only", RenderMethod::Partitions, false, true, defaultS2);
         add("skipping + adaptive", RenderMethod::Partitions, true, true, defaultS2);
+        // Morrical et al. 2019 as published, for comparison: point samples, variance rule.
+        add("reference, point", RenderMethod::Reference, false, false, defaultS2)
+            .settings.preintegrated = false;
+        Variant& paper =
+            add("paper: variance, point", RenderMethod::Partitions, true, true, defaultS2);
+        paper.settings.preintegrated = false;
+        paper.settings.stepRule = StepRule::Variance;
+        const std::size_t kSweepStart = variants.size();
         for (double f : *sweep) {
             char name[64];
             std::snprintf(name, sizeof name, "both, s2 = %g s1", f);
@@ -174,6 +183,12 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         }
         // Table.
         const int threads = cpu::threadCount();
+        char ruleBuf[64];
+        if (base.stepRule == StepRule::ErrorBound)
+            std::snprintf(ruleBuf, sizeof ruleBuf, "error (quality %g)", double(base.quality));
+        else
+            std::snprintf(ruleBuf, sizeof ruleBuf, "variance (p = %g)", double(base.power));
+        const std::string ruleText = ruleBuf;
         const double refTime = variants.front().medianSeconds;
         // Samples per second per CPU core, or for the whole GPU.
         const std::string where =
@@ -181,10 +196,10 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         const int units = renderer.gpu() ? 1 : threads;
         std::printf(
             "%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
-            "p = %g, %s, median of %d frames\n",
+            "step rule %s, %s, median of %d frames\n",
             printable(*file).c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
             prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
-            base.power, where.c_str(), *repeat);
+            ruleText.c_str(), where.c_str(), *repeat);
         std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
                     "samples", "spp", renderer.gpu() ? "Msps" : "Msps/core", "speed-up",
                     "SSIM/exact");
@@ -246,7 +261,10 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["bvh_build_device"] = prepared.builtElsewhere ? "cuda" : "cpu";
                 j["image"] = {base.width, base.height};
                 j["s1"] = s1;
+                j["step_rule"] = base.stepRule == StepRule::ErrorBound ? "error" : "variance";
+                j["quality"] = base.quality;
                 j["power"] = base.power;
+                j["sampling"] = base.preintegrated ? "preintegrated" : "point";
                 j["threads"] = threads;
                 j["device"] = where;
                 j["repeat"] = *repeat;
@@ -277,7 +295,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             time.y.push_back(variants[1].medianSeconds * 1e3);
             ssim.x.push_back(1.0);
             ssim.y.push_back(variants[1].ssim);
-            for (std::size_t i = 4; i < variants.size(); ++i) {
+            for (std::size_t i = kSweepStart; i < variants.size(); ++i) {
                 time.x.push_back(variants[i].s2Factor);
                 time.y.push_back(variants[i].medianSeconds * 1e3);
                 ssim.x.push_back(variants[i].s2Factor);

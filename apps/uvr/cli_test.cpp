@@ -175,6 +175,42 @@ TEST(Cli, RenderWritesPngAndStats) {
     EXPECT_GT(j["render_seconds"].get<double>(), 0);
 }
 
+TEST(Cli, StepRuleQualityAndSamplingFlags) {
+    // The defaults pre-integrate and use the error rule; the paper's point samples and variance
+    // rule are there for comparison; every bad combination gets its one-line error.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string spx = testing::sharedData("spx.vtk") + " --size 48x48 ";
+    const std::string two = " --opacity 0:0,0.3:0,0.32:0.8,0.34:0,0.6:0,0.62:0.8,0.64:0,1:0";
+    ASSERT_EQ(uvr("-q render " + spx + two + " --method exact -o e.png", dir).code, 0);
+    const auto ssimOf = [&](const std::string& flags) {
+        const CliRun r = uvr("-q render " + spx + two + flags + " -o x.png --stats s.json", dir);
+        EXPECT_EQ(r.code, 0) << flags << ": " << r.err;
+        return compareImages(toRgb8(readPng(dir + "/e.png")), toRgb8(readPng(dir + "/x.png"))).ssim;
+    };
+    EXPECT_GE(ssimOf(" --method adaptive --quality 0.99"), 0.98);
+    std::ifstream stats(dir + "/s.json");
+    const auto j = nlohmann::json::parse(stats);
+    EXPECT_EQ(j["step_rule"], "error");
+    EXPECT_EQ(j["sampling"], "preintegrated");
+    EXPECT_FLOAT_EQ(j["quality"].get<float>(), 0.99f);
+    EXPECT_GE(ssimOf(" --method reference"), 0.98);
+    EXPECT_LT(ssimOf(" --method adaptive --step-rule variance --power 2 --sampling point"), 0.98);
+    const std::pair<const char*, const char*> bad[] = {
+        {" --method adaptive --quality 1", "--quality"},
+        {" --method adaptive --quality 0.2", "--quality"},
+        {" --method reference --quality 0.9", "need --method adaptive"},
+        {" --method adaptive --step-rule variance --quality 0.9", "--step-rule error"},
+        {" --method adaptive --power 3", "--step-rule variance"},
+        {" --method adaptive --step-rule fastest", "--step-rule"},
+        {" --method exact --sampling point", "exact does not sample"},
+        {" --sampling linear", "--sampling"},
+    };
+    for (const auto& [flags, says] : bad)
+        expectOneLineError(uvr("-q render " + spx + flags + " -o y.png", dir), {says}, flags);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/y.png"));
+}
+
 TEST(Cli, ExactMethodAgreesWithTheReferenceAtASixteenthOfItsStep) {
     // The Oxygen Post has seams of unshared faces (its O-grid): rays that cross them are located
     // again, never dropped, so exact equals the converged fixed-step image.
@@ -283,12 +319,15 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
                 "/b.json --plot " + dir + "/p.png --images " + dir,
             dir);
     ASSERT_EQ(r.code, 0) << r.err;
-    for (const char* row : {"exact (1 frame)", "reference", "skipping only", "adaptive only",
-                            "skipping + adaptive", "both, s2 = 2 s1", "both, s2 = 4 s1"})
+    for (const char* row :
+         {"exact (1 frame)", "reference", "skipping only", "adaptive only", "skipping + adaptive",
+          "reference, point", "paper: variance, point", "both, s2 = 2 s1", "both, s2 = 4 s1"})
         EXPECT_NE(r.out.find(row), std::string::npos) << row;
     std::ifstream in(dir + "/b.json");
     const auto j = nlohmann::json::parse(in);
-    ASSERT_EQ(j["rows"].size(), 6u);
+    ASSERT_EQ(j["rows"].size(), 8u);
+    EXPECT_EQ(j["step_rule"], "error");
+    EXPECT_EQ(j["sampling"], "preintegrated");
     EXPECT_EQ(j["ssim_against"], "exact");
     EXPECT_GT(j["exact"]["tetrahedra_crossed"].get<double>(), 0);
     // Against the exact image: the reference close, skipping only takes the same samples.

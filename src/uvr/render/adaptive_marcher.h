@@ -122,6 +122,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const TfTableView& tf = scene.base.tf;
     const bool preintegrated = scene.base.params.preintegrated;
     SampleSegments segments;
+    std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     std::uint32_t tet = kNoTet;
     float bary[4];
     // One loop whose every iteration either takes a sample or moves to the next partition, so
@@ -187,7 +188,52 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             tet = locator.search(scene.kd.bvh, root, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate(tet, bary);
         if (preintegrated) {
-            segments.add(tf, kSample, k1, tet != kNoTet, v, s1, unit, acc);
+            // A step longer than s1 from inside the mesh to outside it, or back in: the mesh's
+            // boundary lies somewhere in the step. Bisect for it with point locations (walks
+            // from the inside end) to within s1, so a run ends or starts there to within a
+            // reference step instead of a long one (long steps would show the partitions'
+            // blocks along the mesh's silhouette).
+            const bool in = tet != kNoTet;
+            if (segments.started && segments.inside != in && kSample <= segments.kEnd &&
+                kSample - segments.kLast > 1.f) {
+                float lo = segments.kLast, hi = kSample;  // inside end first when leaving
+                std::uint32_t from = in ? tet : lastInside;
+                float probeBary[4];
+                while (fabsf(hi - lo) > 1.f) {
+                    const float mid = floorf(0.5f * (lo + hi) + 0.5f);
+                    if (mid == lo || mid == hi) break;
+                    ++counters.samples;
+                    std::uint32_t found =
+                        locator.walk(ray.at(mid * s1), from, probeBary, counters.locate);
+                    if (found == kNoTet)
+                        found = locator.search(scene.kd.bvh, root, ray.at(mid * s1), probeBary,
+                                               counters.locate);
+                    if ((found != kNoTet) == in) {  // the mid is on the current sample's side
+                        hi = mid;
+                        if (found != kNoTet) from = found;
+                    } else {
+                        if (found != kNoTet) {  // leaving: the run goes on to the mid
+                            segments.add(tf, mid, k1, true,
+                                         locator.mesh.interpolate(found, probeBary), s1, unit, acc);
+                            from = found;
+                        }
+                        lo = mid;
+                    }
+                }
+                // Entering: the run starts at the first position found inside (hi); leaving:
+                // it ends at the first position found outside.
+                if (in && hi < kSample) {
+                    const std::uint32_t first =
+                        locator.walk(ray.at(hi * s1), from, probeBary, counters.locate);
+                    if (first != kNoTet)
+                        segments.add(tf, hi, k1, true, locator.mesh.interpolate(first, probeBary),
+                                     s1, unit, acc);
+                } else if (!in) {
+                    segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
+                }
+            }
+            if (in) lastInside = tet;
+            segments.add(tf, kSample, k1, in, v, s1, unit, acc);
         } else if (tet != kNoTet) {
             const Vec4f c = tf.sample(v);
             const float a = correctOpacity(c.w, length, unit);

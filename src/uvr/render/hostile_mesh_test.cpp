@@ -541,8 +541,8 @@ TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
 }
 
 TEST(HostileMesh, CameraFarFromATinyMeshIsRefusedInStepsItCanCount) {
-    // A mesh 1e-30 across and a camera 1 away: 1.8e31 steps, which overflowed the message's
-    // integer ("the camera is -9223372036854775808 steps of 0.000000").
+    // A mesh 1e-30 across and a camera 1 away: 1.9e32 steps (of the diagonal / 256), which
+    // overflowed the message's integer ("the camera is -9223372036854775808 steps of 0.000000").
     const PreparedMesh pm = prepare(gridScaledAndMoved(std::ldexp(1.f, -100), Vec3f(0.f)));
     Camera far;
     far.position = {0.f, 0.f, 1.f};
@@ -550,7 +550,7 @@ TEST(HostileMesh, CameraFarFromATinyMeshIsRefusedInStepsItCanCount) {
     const Error e = testing::catchError([&] { (void)renderCpu(pm, s); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
     const std::string what = e.what();
-    EXPECT_NE(what.find("the camera is 1.84e+31 steps of 5.43e-32 from the far side"),
+    EXPECT_NE(what.find("the camera is 1.87e+32 steps of 5.34e-33 from the far side"),
               std::string::npos)
         << what;
 }
@@ -611,8 +611,10 @@ TEST(HostileMesh, DefaultStepOfAMeshOfSliversIsAtLeastATenThousandthOfTheDiagona
     t.totalVolume = 1e-12;  // mean 1e-15: a step of 5e-6 without the floor
     t.bounds = kUnitBox;
     EXPECT_FLOAT_EQ(defaultStep(t), float(kMinDefaultStepFraction * std::sqrt(3.0)));
-    t.totalVolume = 1.0 / 6;  // an ordinary mean: 0.5 cbrt(1 / 6000)
-    EXPECT_FLOAT_EQ(defaultStep(t), float(0.5 * std::cbrt(1.0 / 6000)));
+    t.totalVolume = 1.0 / 6;  // few cells: 256 samples across the diagonal
+    EXPECT_FLOAT_EQ(defaultStep(t), float(std::sqrt(3.0) / 256));
+    t.tets.resize(1000000);  // an ordinary mean: 0.5 cbrt(1 / 6e6)
+    EXPECT_FLOAT_EQ(defaultStep(t), float(0.5 * std::cbrt(1.0 / 6e6)));
 }
 
 }  // namespace

@@ -84,7 +84,7 @@ struct SampleSegments {
                              float s1, double unit, Vec4f& acc) {
         const bool goesOn = started && inside && in && k <= kEnd;
         if (goesOn)
-            segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc);
+            segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc, true);
         else if (started && inside)  // the run ends
             endRun(tf, (k < kEnd ? k : kEnd) - kLast, s1, unit, acc);
         inRun = goesOn;
@@ -108,7 +108,7 @@ private:
                                 Vec4f& acc) const {
         double end = vLast;
         if (inRun) end += (double(vLast) - vPrev) * (double(steps) / (double(kLast) - kPrev));
-        segment::integrate(tf, vLast, end, double(steps) * s1, unit, acc);
+        segment::integrate(tf, vLast, end, double(steps) * s1, unit, acc, true);
     }
 };
 

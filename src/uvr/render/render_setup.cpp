@@ -119,7 +119,8 @@ float defaultStep(const TetMesh& mesh) {
     if (mesh.tets.empty() || !(mesh.totalVolume > 0.0))
         return diagonal > 0.0 ? static_cast<float>(0.01 * diagonal) : 1.f;
     const double mean = 0.5 * std::cbrt(mesh.totalVolume / double(mesh.tets.size()));
-    return static_cast<float>(std::max(mean, kMinDefaultStepFraction * diagonal));
+    const double step = std::min(mean, diagonal / kMinSamplesPerDiagonal);
+    return static_cast<float>(std::max(step, kMinDefaultStepFraction * diagonal));
 }
 
 float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount) {

@@ -80,9 +80,14 @@ std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitio
 
 /// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume,
 /// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray;
-/// at least kMinDefaultStepFraction of the bounds' diagonal (a mesh of slivers has a tiny mean
-/// volume).
+/// at most the bounds' diagonal / kMinSamplesPerDiagonal (a mesh of few cells is cheap to sample
+/// finely, and where a ray enters and leaves the mesh a sample's share is uncertain by a step);
+/// at least kMinDefaultStepFraction of the diagonal (a mesh of slivers has a tiny mean volume).
 float defaultStep(const TetMesh& mesh);
+
+/// Fewest samples the default step takes across the bounds' diagonal (it decides the step of
+/// meshes below about 400,000 tetrahedra).
+inline constexpr double kMinSamplesPerDiagonal = 256;
 
 /// Smallest default step relative to the bounds' diagonal: at most 10^4 samples across the mesh
 /// (a uniform mesh reaches this at about 2 * 10^10 tetrahedra).

@@ -1,0 +1,356 @@
+// SPDX-License-Identifier: MIT
+// The evaluation matrix of issue 11 (section 5): every real mesh and two procedural ones, under
+// transfer functions nobody tuned for (narrow and several bands, a step, ramps, a ParaView JSON
+// export) from three views, rendered with every integrator at its defaults and measured against
+// the exact integrator (SSIM of the images composited over black). Prints and writes the worst
+// case, not only the median, with images of each method's worst case.
+//
+//   uvr_quality_matrix --data ../shared/data --out quality [--device cuda] [--size 512]
+//
+// Outputs in --out: cases.csv (one row per mesh, transfer function, view and method),
+// summary.md (the tables docs/PERFORMANCE.md quotes) and worst_<method>.png (exact | method |
+// 4x difference, for the method's worst case).
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/cuda/cuda_build.h"
+#include "uvr/cuda/cuda_renderer.h"
+#include "uvr/mesh/field_select.h"
+#include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/procedural.h"
+#include "uvr/render/image.h"
+#include "uvr/render/image_metrics.h"
+#include "uvr/render/render_setup.h"
+
+namespace {
+
+using namespace uvr;
+
+struct TfCase {
+    std::string name;
+    std::string colors;   ///< preset name or ParaView JSON path
+    std::string opacity;  ///< opacity spec; empty: the JSON's points
+};
+
+struct ViewCase {
+    std::string name;
+    float azimuth, elevation;
+};
+
+struct MethodCase {
+    std::string name;
+    RenderMethod method;
+    StepRule rule;
+    bool preintegrated;
+    float quality = kDefaultQuality;
+};
+
+/// The methods compared, exact first (the yardstick).
+std::vector<MethodCase> kMethods = {
+    {"exact", RenderMethod::Exact, StepRule::ErrorBound, true},
+    {"reference", RenderMethod::Reference, StepRule::ErrorBound, true},
+    {"adaptive", RenderMethod::Partitions, StepRule::ErrorBound, true},
+    {"reference (point samples)", RenderMethod::Reference, StepRule::ErrorBound, false},
+    {"adaptive (paper: variance, point samples)", RenderMethod::Partitions, StepRule::Variance,
+     false},
+};
+
+const std::vector<ViewCase> kViews = {
+    {"front", 0.f, 0.f}, {"oblique", 40.f, 30.f}, {"edge-on", 90.f, 5.f}};
+
+struct Row {
+    std::string mesh, tf, view, method;
+    double ssim = 0.0, psnr = 0.0, ms = 0.0;
+    std::uint64_t samples = 0;
+};
+
+/// One mesh to evaluate: a file of the shared data or a procedural spec.
+struct MeshCase {
+    std::string name;
+    std::string path;  ///< empty: procedural
+    ProceduralSpec spec;
+};
+
+std::string csvQuote(const std::string& s) {
+    return '"' + s + '"';
+}
+
+/// Exact | method | 4x absolute difference, side by side.
+Image sideBySide(const Image& exact, const Image& got) {
+    Image out(exact.width * 3, exact.height);
+    for (int y = 0; y < exact.height; ++y)
+        for (int x = 0; x < exact.width; ++x) {
+            const Vec4f e = exact.at(x, y), g = got.at(x, y);
+            out.at(x, y) = e;
+            out.at(x + exact.width, y) = g;
+            Vec4f d(std::fabs(e.x - g.x) * 4.f, std::fabs(e.y - g.y) * 4.f,
+                    std::fabs(e.z - g.z) * 4.f, 1.f);
+            out.at(x + 2 * exact.width, y) = d;
+        }
+    return out;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{
+        "Quality matrix (issue 11): every integrator at its defaults against the exact "
+        "integrator on real and procedural meshes, many transfer functions and views"};
+    std::string data = "../shared/data", out = "quality", device = "cpu", tfJson;
+    int size = 256, repeat = 1;
+    std::uint64_t proceduralCells = 300000;
+    std::vector<std::string> only;
+    app.add_option("--data", data, "Folder of the real meshes")->capture_default_str();
+    app.add_option("--out", out, "Output folder (created)")->capture_default_str();
+    app.add_option("--device", device, "cpu or cuda")
+        ->check(CLI::IsMember({"cpu", "cuda"}))
+        ->capture_default_str();
+    app.add_option("--size", size, "Image side in pixels")
+        ->check(CLI::Range(16, 4096))
+        ->capture_default_str();
+    app.add_option("--repeat", repeat, "Timed frames per case (median)")
+        ->check(CLI::Range(1, 100))
+        ->capture_default_str();
+    app.add_option("--procedural-cells", proceduralCells,
+                   "Tetrahedra of each procedural mesh (about)")
+        ->capture_default_str();
+    app.add_option("--tf-json", tfJson,
+                   "A ParaView colour-map JSON export used as one of the transfer functions")
+        ->check(CLI::ExistingFile);
+    app.add_option("--meshes", only, "Only these meshes (file names or procedural names)")
+        ->delimiter(',');
+    std::vector<float> qualities;
+    app.add_option("--qualities", qualities,
+                   "Also rows of the adaptive method at these --quality values")
+        ->delimiter(',');
+    std::uint32_t leafCells = 0;
+    app.add_option("--leaf-cells", leafCells,
+                   "Cells per partition (default: 1024 on the CPU, 65536 with CUDA)");
+    std::vector<std::string> onlyTfs;
+    app.add_option("--tfs", onlyTfs, "Only these transfer functions (names as printed)")
+        ->delimiter(',');
+    CLI11_PARSE(app, argc, argv);
+    try {
+        for (float q : qualities) {
+            char name[64];
+            std::snprintf(name, sizeof name, "adaptive, quality %g", double(q));
+            kMethods.push_back({name, RenderMethod::Partitions, StepRule::ErrorBound, true, q});
+        }
+        const bool cuda = device == "cuda";
+        std::filesystem::create_directories(out);
+        std::vector<TfCase> tfs = {
+            {"ramp", "cool-to-warm", "ramp"},
+            {"narrow band", "viridis", "0:0,0.49:0,0.5:1,0.51:0,1:0"},
+            {"two bands", "cool-to-warm", "0:0,0.3:0,0.32:0.8,0.34:0,0.6:0,0.62:0.8,0.64:0,1:0"},
+            {"five bands", "black-body",
+             "0:0,0.1:0,0.11:0.6,0.12:0,0.3:0,0.31:0.6,0.32:0,0.5:0,0.51:0.6,0.52:0,0.7:0,0.71:"
+             "0.6,0.72:0,0.9:0,0.91:0.6,0.92:0,1:0"},
+            {"step", "grayscale", "step:0.5:0.5"},
+            {"dense", "viridis", "0:0.3,1:1"},
+        };
+        if (!tfJson.empty()) tfs.push_back({"ParaView JSON", tfJson, ""});
+        if (!onlyTfs.empty())
+            tfs.erase(std::remove_if(tfs.begin(), tfs.end(),
+                                     [&](const TfCase& t) {
+                                         return std::find(onlyTfs.begin(), onlyTfs.end(), t.name) ==
+                                                onlyTfs.end();
+                                     }),
+                      tfs.end());
+        std::vector<MeshCase> meshes;
+        for (const char* f :
+             {"bluntfin_tets.vtk", "post_tets.vtk", "spx.vtk", "post.vtk", "tetraMesh.vtk",
+              "cylinder_quadratic_as_tets.vtk", "hexa.vtk", "fire_ug.vtu"}) {
+            const std::string path = data + "/" + f;
+            if (std::filesystem::exists(path)) meshes.push_back({f, path, {}});
+        }
+        ProceduralSpec multiscale;
+        multiscale.targetCells = proceduralCells;
+        multiscale.fields = {ProceduralField::Multiscale};
+        meshes.push_back({"procedural-box-multiscale", "", multiscale});
+        ProceduralSpec shell;
+        shell.shape = ProceduralShape::Shell;
+        shell.targetCells = proceduralCells;
+        shell.fields = {ProceduralField::Jet};
+        meshes.push_back({"procedural-shell-jet", "", shell});
+        if (!only.empty())
+            meshes.erase(std::remove_if(meshes.begin(), meshes.end(),
+                                        [&](const MeshCase& m) {
+                                            return std::find(only.begin(), only.end(), m.name) ==
+                                                   only.end();
+                                        }),
+                         meshes.end());
+
+        std::vector<Row> rows;
+        std::map<std::string, std::pair<double, Image>> worstImage;  // method -> (ssim, image)
+        std::map<std::string, Row> worstRow;
+        for (const MeshCase& mc : meshes) {
+            const Mesh mesh = mc.path.empty() ? generateMesh(mc.spec) : readMesh(mc.path);
+            const ScalarField field = selectScalarField(mesh, {});
+            PrepareOptions o;
+            if (cuda) {
+                o.lbvh = buildLbvhCuda;
+                o.kdSplitter = buildKdTreeCuda;
+                o.builderMinTets = 4000000;
+                o.kd.leafCells = 65536;  // the CLI's CUDA default
+            }
+            if (leafCells) o.kd.leafCells = leafCells;
+            const PreparedMesh pm = prepareMesh(mesh, field, o);
+            std::unique_ptr<CudaScene> gpu;
+            if (cuda) gpu = std::make_unique<CudaScene>(pm);
+            std::printf("%s: %zu tetrahedra, field %s, %zu partitions\n", mc.name.c_str(),
+                        pm.tets.tets.size(), field.name.c_str(), pm.kd->partitions.size());
+            std::fflush(stdout);
+            for (const TfCase& tc : tfs)
+                for (const ViewCase& vc : kViews) {
+                    RenderSettings s;
+                    s.width = s.height = size;
+                    s.tf = loadTransferFunction(tc.colors);
+                    if (!tc.opacity.empty()) applyOpacitySpec(s.tf, tc.opacity);
+                    s.camera =
+                        orbitCamera(resetCamera(mesh.bounds(), 1.f), vc.azimuth, vc.elevation);
+                    Image exact;
+                    Rgb8Image exact8;
+                    for (const MethodCase& mcase : kMethods) {
+                        s.method = mcase.method;
+                        s.stepRule = mcase.rule;
+                        s.preintegrated = mcase.preintegrated;
+                        s.quality = mcase.quality;
+                        std::vector<double> times;
+                        RenderResult r;
+                        const int frames = mcase.method == RenderMethod::Exact ? 1 : repeat;
+                        for (int i = 0; i < frames + (cuda ? 1 : 0); ++i) {  // GPU: warm up
+                            r = cuda ? gpu->render(s) : renderCpu(pm, s);
+                            if (!cuda || i > 0) times.push_back(r.stats.seconds);
+                        }
+                        Row row{mc.name, tc.name, vc.name, mcase.name};
+                        row.ms = median(times) * 1e3;
+                        row.samples = r.stats.samples;
+                        if (mcase.method == RenderMethod::Exact) {
+                            exact = r.image;
+                            exact8 = toRgb8(exact);
+                            row.ssim = 1.0;
+                            row.psnr = INFINITY;
+                        } else {
+                            const ImageComparison c = compareImages(exact8, toRgb8(r.image));
+                            row.ssim = c.ssim;
+                            row.psnr = c.psnr;
+                            auto it = worstImage.find(mcase.name);
+                            if (it == worstImage.end() || c.ssim < it->second.first) {
+                                worstImage[mcase.name] = {c.ssim, sideBySide(exact, r.image)};
+                                worstRow[mcase.name] = row;
+                            }
+                        }
+                        rows.push_back(row);
+                    }
+                    std::printf("  %-12s %-8s", tc.name.c_str(), vc.name.c_str());
+                    for (std::size_t i = rows.size() - kMethods.size() + 1; i < rows.size(); ++i)
+                        std::printf(" %.4f", rows[i].ssim);
+                    std::printf("\n");
+                    std::fflush(stdout);
+                }
+        }
+
+        // cases.csv
+        {
+            std::ofstream csv(out + "/cases.csv");
+            csv << "mesh,transfer_function,view,method,ssim_vs_exact,psnr,ms_per_frame,samples\n";
+            for (const Row& r : rows)
+                csv << csvQuote(r.mesh) << ',' << csvQuote(r.tf) << ',' << r.view << ','
+                    << csvQuote(r.method) << ',' << r.ssim << ',' << r.psnr << ',' << r.ms << ','
+                    << r.samples << '\n';
+        }
+        // summary.md: per method the worst and median SSIM, the cases under 0.98, the worst
+        // case; per mesh the worst SSIM of each method and the median speed-up over the
+        // reference.
+        std::ostringstream md;
+        md << "Device: " << (cuda ? cudaDeviceDescription() : "CPU") << "; " << size << "x" << size
+           << " pixels; " << meshes.size() << " meshes x " << tfs.size() << " transfer functions x "
+           << kViews.size()
+           << " views; SSIM against the exact integrator, composited over black.\n\n";
+        md << "| method | worst SSIM | median SSIM | cases < 0.98 | worst case |\n"
+              "|---|---|---|---|---|\n";
+        for (std::size_t m = 1; m < kMethods.size(); ++m) {
+            std::vector<double> ssims;
+            int below = 0;
+            for (const Row& r : rows)
+                if (r.method == kMethods[m].name) ssims.push_back(r.ssim), below += r.ssim < 0.98;
+            const Row& w = worstRow[kMethods[m].name];
+            char line[512];
+            std::snprintf(line, sizeof line, "| %s | %.4f | %.4f | %d of %zu | %s, %s, %s |\n",
+                          kMethods[m].name.c_str(), w.ssim, median(ssims), below, ssims.size(),
+                          w.mesh.c_str(), w.tf.c_str(), w.view.c_str());
+            md << line;
+        }
+        // Per mesh: the worst SSIM of each method, then each method's median time and the
+        // median speed-up of the others over the reference (row order is kMethods' per case).
+        const std::size_t nm = kMethods.size();
+        md << "\n| mesh |";
+        for (std::size_t m = 1; m < nm; ++m) md << " worst SSIM: " << kMethods[m].name << " |";
+        for (std::size_t m = 0; m < nm; ++m) md << " ms: " << kMethods[m].name << " |";
+        for (std::size_t m = 2; m < nm; ++m) md << " speed-up: " << kMethods[m].name << " |";
+        md << "\n|---|";
+        for (std::size_t m = 1; m < 3 * nm - 2; ++m) md << "---|";
+        md << "\n";
+        for (const MeshCase& mc : meshes) {
+            std::vector<double> worst(nm, 1.0);
+            std::vector<std::vector<double>> ms(nm), speedup(nm);
+            for (std::size_t i = 0; i + nm <= rows.size(); i += nm) {
+                if (rows[i].mesh != mc.name) continue;
+                for (std::size_t m = 0; m < nm; ++m) {
+                    worst[m] = std::min(worst[m], rows[i + m].ssim);
+                    ms[m].push_back(rows[i + m].ms);
+                    speedup[m].push_back(rows[i + 1].ms / std::max(rows[i + m].ms, 1e-6));
+                }
+            }
+            md << "| " << mc.name << " |";
+            char cell[32];
+            for (std::size_t m = 1; m < nm; ++m) {
+                std::snprintf(cell, sizeof cell, " %.4f |", worst[m]);
+                md << cell;
+            }
+            for (std::size_t m = 0; m < nm; ++m) {
+                std::snprintf(cell, sizeof cell, " %.2f |", median(ms[m]));
+                md << cell;
+            }
+            for (std::size_t m = 2; m < nm; ++m) {
+                std::snprintf(cell, sizeof cell, " %.2fx |", median(speedup[m]));
+                md << cell;
+            }
+            md << "\n";
+        }
+        {
+            std::ofstream f(out + "/summary.md");
+            f << md.str();
+        }
+        std::printf("\n%s", md.str().c_str());
+        for (const auto& [name, w] : worstImage) {
+            std::string file = name;
+            for (char& c : file)
+                if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.') c = '_';
+            writePng(out + "/worst_" + file + ".png", w.second, Vec3f(0.f, 0.f, 0.f));
+        }
+        return 0;
+    } catch (const Error& e) {
+        std::fprintf(stderr, "uvr_quality_matrix: %s\n", e.what());
+        return 2;
+    }
+}
