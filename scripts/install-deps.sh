@@ -1,14 +1,16 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # Installs every build and test dependency of uvr from Debian 12's packages (run as root); clang
-# with libFuzzer (libclang-rt-14-dev) and its OpenMP (libomp-dev) build the fuzz targets.
+# with libFuzzer (libclang-rt-14-dev) and its OpenMP (libomp-dev) build the fuzz targets; xvfb
+# (xvfb-run) gives VTK the X display the oracle test (tests/tools/vtk_oracle_test.py) needs.
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
   zlib1g-dev libpng-dev libexpat1-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev libomp-dev
-  python3 python3-numpy python3-vtk9 python3-meshio python3-skimage"
+  python3 python3-numpy python3-vtk9 python3-meshio python3-skimage
+  xvfb xauth"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
