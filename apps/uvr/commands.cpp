@@ -95,7 +95,10 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
 }
 
 void addRenderCommand(CLI::App& app, Context& ctx) {
-    auto* cmd = app.add_subcommand("render", "Render a mesh file to a PNG (CPU reference marcher)");
+    auto* cmd = app.add_subcommand(
+        "render",
+        "Render a mesh file to a PNG with the fixed-step reference (pre-integrated), the "
+        "adaptive partition method or the exact integrator (--method), on the CPU or a GPU");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
