@@ -103,6 +103,15 @@ Image sideBySide(const Image& exact, const Image& got) {
     return out;
 }
 
+/// Keeps the items whose name is in `names` (all of them when names is empty).
+template <class T>
+void keepNamed(std::vector<T>& items, const std::vector<std::string>& names) {
+    if (names.empty()) return;
+    std::erase_if(items, [&](const T& item) {
+        return std::find(names.begin(), names.end(), item.name) == names.end();
+    });
+}
+
 double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
@@ -168,13 +177,7 @@ int main(int argc, char** argv) {
             {"dense", "viridis", "0:0.3,1:1"},
         };
         if (!tfJson.empty()) tfs.push_back({"ParaView JSON", tfJson, ""});
-        if (!onlyTfs.empty())
-            tfs.erase(std::remove_if(tfs.begin(), tfs.end(),
-                                     [&](const TfCase& t) {
-                                         return std::find(onlyTfs.begin(), onlyTfs.end(), t.name) ==
-                                                onlyTfs.end();
-                                     }),
-                      tfs.end());
+        keepNamed(tfs, onlyTfs);
         std::vector<MeshCase> meshes;
         for (const char* f :
              {"bluntfin_tets.vtk", "post_tets.vtk", "spx.vtk", "post.vtk", "tetraMesh.vtk",
@@ -191,13 +194,7 @@ int main(int argc, char** argv) {
         shell.targetCells = proceduralCells;
         shell.fields = {ProceduralField::Jet};
         meshes.push_back({"procedural-shell-jet", "", shell});
-        if (!only.empty())
-            meshes.erase(std::remove_if(meshes.begin(), meshes.end(),
-                                        [&](const MeshCase& m) {
-                                            return std::find(only.begin(), only.end(), m.name) ==
-                                                   only.end();
-                                        }),
-                         meshes.end());
+        keepNamed(meshes, only);
 
         std::vector<Row> rows;
         std::map<std::string, std::pair<double, Image>> worstImage;  // method -> (ssim, image)

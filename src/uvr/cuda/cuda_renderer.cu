@@ -194,7 +194,7 @@ double CudaScene::uploadSeconds() const {
     return impl_->uploadSeconds;
 }
 
-void CudaScene::updateShading(RenderResult& result, const RenderSettings& settings) {
+void CudaScene::updateShading(RenderResult& result) {
     Impl& d = *impl_;
     const auto start = std::chrono::steady_clock::now();
     FrameSetup& f = result.setup;
@@ -260,7 +260,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     } else {
         if (!d.mesh.kd)
             throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
-        updateShading(result, settings);
+        updateShading(result);
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
         scene.base = d.deviceScene(result.setup);
         scene.kd.nodes = d.kdNodes.data();

@@ -45,7 +45,7 @@ public:
 private:
     /// Computes the per-partition shading of the frame's transfer function on the GPU (the
     /// shared shadePartition per partition) into the device buffer and result.setup.shading.
-    void updateShading(RenderResult& result, const RenderSettings& settings);
+    void updateShading(RenderResult& result);
 
     struct Impl;
     std::unique_ptr<Impl> impl_;

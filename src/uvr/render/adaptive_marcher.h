@@ -197,40 +197,35 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if (segments.started && segments.inside != in && kSample <= segments.kEnd &&
                 kSample - segments.kLast > 1.f) {
                 float lo = segments.kLast, hi = kSample;  // inside end first when leaving
+                float vHi = v;  // entering: the value at hi, the first position found inside
                 std::uint32_t from = in ? tet : lastInside;
                 float probeBary[4];
                 while (fabsf(hi - lo) > 1.f) {
                     const float mid = floorf(0.5f * (lo + hi) + 0.5f);
                     if (mid == lo || mid == hi) break;
                     ++counters.samples;
-                    std::uint32_t found =
-                        locator.walk(ray.at(mid * s1), from, probeBary, counters.locate);
+                    const Vec3f q = ray.at(mid * s1);
+                    std::uint32_t found = locator.walk(q, from, probeBary, counters.locate);
                     if (found == kNoTet)
-                        found = locator.search(scene.kd.bvh, root, ray.at(mid * s1), probeBary,
-                                               counters.locate);
+                        found = locator.search(scene.kd.bvh, root, q, probeBary, counters.locate);
+                    const float vMid =
+                        found == kNoTet ? 0.f : locator.mesh.interpolate(found, probeBary);
+                    if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;
-                        if (found != kNoTet) from = found;
+                        vHi = vMid;
                     } else {
-                        if (found != kNoTet) {  // leaving: the run goes on to the mid
-                            segments.add(tf, mid, k1, true,
-                                         locator.mesh.interpolate(found, probeBary), s1, unit, acc);
-                            from = found;
-                        }
+                        // Leaving: the run goes on to the mid.
+                        if (found != kNoTet) segments.add(tf, mid, k1, true, vMid, s1, unit, acc);
                         lo = mid;
                     }
                 }
-                // Entering: the run starts at the first position found inside (hi); leaving:
-                // it ends at the first position found outside.
-                if (in && hi < kSample) {
-                    const std::uint32_t first =
-                        locator.walk(ray.at(hi * s1), from, probeBary, counters.locate);
-                    if (first != kNoTet)
-                        segments.add(tf, hi, k1, true, locator.mesh.interpolate(first, probeBary),
-                                     s1, unit, acc);
-                } else if (!in) {
+                // Entering: the run starts at the first position found inside; leaving: it ends
+                // at the first position found outside.
+                if (in && hi < kSample)
+                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc);
+                else if (!in)
                     segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
-                }
             }
             if (in) lastInside = tet;
             segments.add(tf, kSample, k1, in, v, s1, unit, acc);
