@@ -11,14 +11,7 @@
 
 namespace uvr {
 
-namespace {
-
-/// Most cells on one axis of a partition's grid.
-constexpr std::uint32_t kMaxGridSide = 1024;
-
-/// Grid of about `target` cubic-ish cells over box (at least one cell per axis; flat boxes get one
-/// cell across their flat axis).
-PartitionGrid layoutGrid(const Bounds3f& box, double target) {
+PartitionGrid layoutPartitionGrid(const Bounds3f& box, double target) {
     PartitionGrid g;
     g.lo = box.lo;
     const Vec3f ext = box.extent();
@@ -41,8 +34,6 @@ PartitionGrid layoutGrid(const Bounds3f& box, double target) {
     return g;
 }
 
-}  // namespace
-
 SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell) {
     const auto start = std::chrono::steady_clock::now();
     UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
@@ -55,7 +46,7 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
         const KdPartition& part = kd.partitions[p];
         PartitionGrid g;
         if (part.cellCount > 0 && !part.box.empty())
-            g = layoutGrid(part.box, std::max(1.0, part.cellCount / double(tetsPerCell)));
+            g = layoutPartitionGrid(part.box, std::max(1.0, part.cellCount / double(tetsPerCell)));
         else
             g.dims[0] = g.dims[1] = g.dims[2] = 1;
         g.first = static_cast<std::uint32_t>(total);

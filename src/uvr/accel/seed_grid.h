@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,31 @@ struct SeedGridView {
         return static_cast<std::uint32_t>(f < last ? f : last);
     }
 };
+
+/// Most cells on one axis of a partition's grid.
+inline constexpr std::uint32_t kMaxGridSide = 1024;
+
+/// Grid of about `target` cubic-ish cells over box (at least one cell per axis, at most
+/// kMaxGridSide; flat boxes get one cell across their flat axis). `first` is left 0.
+PartitionGrid layoutPartitionGrid(const Bounds3f& box, double target);
+
+/// Where a ray leaves grid cell idx of g: the smallest t at which it crosses one of the cell's
+/// faces ahead (inv: 1 / the ray's direction). The grid's outer cells reach to infinity outward,
+/// as SeedGridView::cellIndex clamps positions outside the grid into them.
+UVR_HOST_DEVICE inline float gridCellExit(const PartitionGrid& g, const std::uint32_t idx[3],
+                                          Vec3f org, Vec3f inv) {
+    float exit = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        if (!(g.cellsPerUnit[a] > 0.f) || inv[a] == 0.f || !(fabsf(inv[a]) < INFINITY)) continue;
+        const bool up = inv[a] > 0.f;
+        if (up ? idx[a] + 1 >= g.dims[a] : idx[a] == 0) continue;  // the outer face: unbounded
+        const float face =
+            g.lo[a] + static_cast<float>(up ? idx[a] + 1 : idx[a]) / g.cellsPerUnit[a];
+        const float t = (face - org[a]) * inv[a];
+        exit = t < exit ? t : exit;
+    }
+    return exit;
+}
 
 /// Tetrahedra per grid cell the builder aims for: a seed is then about one tetrahedron edge from
 /// any point of its cell, so a walk from it takes a few steps whatever the ray's step length.

@@ -40,9 +40,16 @@ constexpr int kGpuMaxWalkSteps = 64;
 /// Counters summed over a frame: samples, walk steps, BVH queries, partitions visited, skipped.
 constexpr int kCounters = 5;
 
+/// Threads per frame block (16 x 8 pixels) and the blocks per multiprocessor the frame kernels
+/// are compiled for: 4 caps them at 128 registers (the partition kernel needed 134, which let
+/// only 3 blocks run per multiprocessor).
+constexpr int kFrameBlock = 128;
+constexpr int kFrameBlocksPerSm = 4;
+
 /// Kernel: one thread per pixel runs the shared pixel body, then the warp sums its counters.
 template <class March>
-__global__ void frameKernel(FrameView frame, March march, unsigned long long* totals) {
+__global__ void __launch_bounds__(kFrameBlock, kFrameBlocksPerSm)
+    frameKernel(FrameView frame, March march, unsigned long long* totals) {
     const int x = blockIdx.x * blockDim.x + threadIdx.x;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     RayCounters c;
@@ -83,6 +90,23 @@ __global__ void partitionShadeKernel(const RangeStats* stats, const float* gradi
     shading[p] = shadePartition(stats[p], gradientSpread[p], lo, hi, rule);
 }
 
+/// Transfer-function update, macrocells (one thread per macrocell): the error-bound shading.
+__global__ void macroShadeKernel(TfRangeView range, const MacroCell* cells, std::uint32_t count,
+                                 StepRuleParams rule, PartitionShading* shading) {
+    const std::uint32_t c = blockIdx.x * blockDim.x + threadIdx.x;
+    if (c >= count) return;
+    shading[c] = shadeMacroCell(cells[c], range, rule);
+}
+
+/// Transfer-function update, last pass (one thread per partition): whether each partition
+/// marches by its macrocells.
+__global__ void macroChoiceKernel(const PartitionGrid* grids, const PartitionShading* cells,
+                                  std::uint32_t count, PartitionShading* shading) {
+    const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
+    if (p >= count) return;
+    shading[p].byMacroCells = macroCellsPay(grids[p], cells, shading[p]);
+}
+
 }  // namespace
 }  // namespace cuda
 
@@ -121,6 +145,8 @@ struct CudaScene::Impl {
     cuda::DeviceArray<std::uint32_t> partitionCells;
     cuda::DeviceArray<PartitionGrid> seedGrids;
     cuda::DeviceArray<std::uint32_t> seeds;
+    cuda::DeviceArray<PartitionGrid> macroGrids;
+    cuda::DeviceArray<MacroCell> macroCells;
     // Per frame / transfer function.
     cuda::DeviceArray<Vec4f> tfTable;
     cuda::DeviceArray<std::int32_t> tfBreaks;
@@ -130,6 +156,8 @@ struct CudaScene::Impl {
     cuda::DeviceArray<RangeStats> partitionStats;
     cuda::DeviceArray<unsigned> varianceBounds;
     cuda::DeviceArray<PartitionShading> shading;
+    cuda::DeviceArray<PartitionShading> macroShading;
+    bool macroActive = false;  ///< macroShading holds this frame's shading (usesMacroCells)
     cuda::DeviceArray<Vec4f> pixels;
     cuda::DeviceArray<std::uint32_t> sampleCounts;
     cuda::DeviceArray<unsigned long long> totals;
@@ -174,6 +202,10 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
         d.seedGrids.upload(mesh.seeds->grids, "the seed grids");
         d.seeds.upload(mesh.seeds->seeds, "the seeds");
     }
+    if (mesh.macro) {
+        d.macroGrids.upload(mesh.macro->grids, "the macrocell grids");
+        d.macroCells.upload(mesh.macro->cells, "the macrocells");
+    }
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     d.uploadSeconds =
@@ -187,7 +219,7 @@ std::uint64_t CudaScene::geometryBytes() const {
     return d.points.bytes() + d.tets.bytes() + d.values.bytes() + d.neighbors.bytes() +
            d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
            d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() + d.partitionCells.bytes() +
-           d.seedGrids.bytes() + d.seeds.bytes();
+           d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes();
 }
 
 double CudaScene::uploadSeconds() const {
@@ -224,6 +256,19 @@ void CudaScene::updateShading(RenderResult& result) {
                                                 d.varianceBounds.data(), f.stepRule,
                                                 d.shading.data());
     UVR_CUDA_CHECK(cudaGetLastError());
+    // The macrocells' shading stays on the GPU.
+    d.macroActive = false;
+    if (usesMacroCells(d.mesh, f.stepRule)) {
+        const std::uint32_t m = static_cast<std::uint32_t>(d.mesh.macro->cells.size());
+        d.macroShading.reserve(m, "the macrocell shading");
+        cuda::macroShadeKernel<<<(m + block - 1) / block, block>>>(
+            range, d.macroCells.data(), m, f.stepRule, d.macroShading.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        cuda::macroChoiceKernel<<<grid, block>>>(d.macroGrids.data(), d.macroShading.data(), n,
+                                                 d.shading.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        d.macroActive = true;
+    }
     f.shading.resize(n);
     UVR_CUDA_CHECK(cudaMemcpy(f.shading.data(), d.shading.data(), n * sizeof(PartitionShading),
                               cudaMemcpyDeviceToHost));
@@ -244,9 +289,15 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
     const FrameView frame{d.pixels.data(), d.sampleCounts.data(), settings.width, settings.height,
                           result.setup.rays};
-    const dim3 block(16, 8);
+    const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);
+    const bool partitions = settings.method == RenderMethod::Partitions;
+    if (partitions && !d.mesh.kd)
+        throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
+    // The transfer function's partition shading is timed on its own (tfUpdateSeconds), as on
+    // the CPU: the events time the frame kernel only.
+    if (partitions) updateShading(result);
     cudaEvent_t begin, end;
     UVR_CUDA_CHECK(cudaEventCreate(&begin));
     UVR_CUDA_CHECK(cudaEventCreate(&end));
@@ -258,9 +309,6 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         cuda::frameKernel<<<grid, block>>>(frame, ExactMarch{d.deviceScene(result.setup)},
                                            d.totals.data());
     } else {
-        if (!d.mesh.kd)
-            throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
-        updateShading(result);
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
         scene.base = d.deviceScene(result.setup);
         scene.kd.nodes = d.kdNodes.data();
@@ -268,6 +316,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         scene.kd.bvh.nodes = d.partitionBvhNodes.data();
         scene.kd.bvh.primIds = d.partitionCells.data();
         scene.shading = d.shading.data();
+        if (d.macroActive) scene.macro = {d.macroGrids.data(), d.macroShading.data()};
         if (d.mesh.seeds)
             scene.seeds = {d.seedGrids.data(), d.seeds.data()};
         else

@@ -103,7 +103,8 @@ TEST(Cuda, PartitionShadingOnTheGpuEqualsTheCpus) {
     o.kd.leafCells = 64;
     const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
     CudaScene gpu(pm);
-    for (const char* opacity : {"0:0,1:0.4", "step:0.6", "constant:0.2"}) {
+    for (const char* opacity :
+         {"0:0,1:0.4", "step:0.6", "constant:0.2", "0:0,0.49:0,0.5:1,0.51:0,1:0"}) {
         RenderSettings s = settingsFor(pm, RenderMethod::Partitions);
         applyOpacitySpec(s.tf, opacity);
         const FrameSetup cpu = makeFrameSetup(pm, s);
@@ -115,6 +116,8 @@ TEST(Cuda, PartitionShadingOnTheGpuEqualsTheCpus) {
             EXPECT_EQ(g.setup.shading[p].maxOpacity > 0.f, cpu.shading[p].maxOpacity > 0.f);
             EXPECT_NEAR(g.setup.shading[p].step, cpu.shading[p].step, 1e-5f * cpu.shading[p].step)
                 << opacity;
+            // The macrocells' shading stays on the GPU; its per-partition choice comes back.
+            EXPECT_EQ(g.setup.shading[p].byMacroCells, cpu.shading[p].byMacroCells) << opacity;
         }
     }
 }

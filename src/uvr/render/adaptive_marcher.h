@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/macro_grid.h"
 #include "uvr/accel/seed_grid.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/range_stats.h"
@@ -15,6 +16,9 @@ namespace uvr {
 struct PartitionShading {
     float maxOpacity = 0.f;  ///< 0: the partition is invisible and can be skipped
     float step = 0.f;        ///< sample spacing inside the partition
+    /// With macrocells (error-bound rule): march the partition by its macrocells' steps and
+    /// skips instead of its own step (macroCellsPay).
+    bool byMacroCells = false;
 };
 
 /// How the partition integrator chooses each partition's step.
@@ -80,6 +84,43 @@ UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, flo
     return {st.maxOpacity, adaptiveStep(v, r.s1, r.s2, r.power)};
 }
 
+/// Shading of one macrocell under the error-bound rule: transparent when no tetrahedron with a
+/// value overlaps it, else shadePartition over its value range and gradient spread.
+UVR_HOST_DEVICE inline PartitionShading shadeMacroCell(const MacroCell& cell,
+                                                       const TfRangeView& range,
+                                                       const StepRuleParams& r) {
+    if (cell.empty()) return {0.f, r.s2};
+    return shadePartition(range.query(cell.valueMin, cell.valueMax), cell.gradientSpread, 0.f, 0.f,
+                          r);
+}
+
+/// The macrocells' layout and their shading for the current transfer function.
+struct MacroShadingView {
+    const PartitionGrid* grids = nullptr;       ///< per partition; null: no macrocells
+    const PartitionShading* shading = nullptr;  ///< per macrocell (shadeMacroCell)
+};
+
+/// A partition steps by its macrocells only where that cuts its samples to at most this
+/// fraction: a macrocell's sample costs up to about twice a partition's on the GPU (the skips
+/// and the long steps, located from seeds, diverge within a warp; PERFORMANCE.md, "Macrocells").
+inline constexpr float kMacroSampleFraction = 0.5f;
+
+/// Whether a visible partition with grid g and shading `partition` pays to march by its
+/// macrocells (`cells`: the shading of every macrocell): the samples per unit length summed
+/// over its macrocells (none in a transparent one, 1 / step in the others) against as many
+/// cells at the partition's own step.
+UVR_HOST_DEVICE inline bool macroCellsPay(const PartitionGrid& g, const PartitionShading* cells,
+                                          const PartitionShading& partition) {
+    if (!(partition.maxOpacity > 0.f) || !(partition.step > 0.f)) return false;
+    const std::uint32_t n = g.dims[0] * g.dims[1] * g.dims[2];
+    float samples = 0.f;
+    for (std::uint32_t c = 0; c < n; ++c) {
+        const PartitionShading& cell = cells[g.first + c];
+        if (cell.maxOpacity > 0.f) samples += 1.f / cell.step;
+    }
+    return samples <= kMacroSampleFraction * static_cast<float>(n) / partition.step;
+}
+
 /// Steps longer than this many s1 start their point location from the partition's seed grid
 /// instead of the previous sample's tetrahedron: a walk from the previous sample crosses about
 /// three tetrahedra per s1, a walk from the seed about as many whatever the step (PERFORMANCE.md).
@@ -92,7 +133,10 @@ struct PartitionSceneView {
     KdView kd;
     SeedGridView seeds;  ///< per-partition walk starts; without them long steps search the BVH
     const PartitionShading* shading = nullptr;
-    bool skipTransparent = true;  ///< skip partitions whose maximum opacity is 0
+    /// Macrocells (null grids: none): when set, each sample's step is its macrocell's, and
+    /// transparent macrocells are skipped like transparent partitions.
+    MacroShadingView macro;
+    bool skipTransparent = true;  ///< skip partitions (and macrocells) whose maximum opacity is 0
     float longStep = kLongStep;   ///< steps above this many s1 do not walk from the previous sample
 };
 
@@ -108,6 +152,12 @@ struct PartitionSceneView {
 /// for the distance to the next (the last one only up to K1 * s1). So with s == s1 the samples
 /// are exactly the reference marcher's, and with larger steps the distances still add up to the
 /// piece's length: no partition crossing gains or loses optical depth.
+///
+/// With macrocells (scene.macro) the step is chosen per sample instead: the step of the
+/// macrocell the sample lies in, ending at most at the first grid point past the macrocell (so
+/// a long step never reaches deep into a macrocell that needs short ones); a sample in a
+/// transparent macrocell is not located: the run of samples ends there (as at a skipped
+/// partition) and the next sample is the first grid point past the macrocell.
 UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
                                              RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -125,16 +175,24 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     std::uint32_t tet = kNoTet;
     float bary[4];
-    // One loop whose every iteration either takes a sample or moves to the next partition, so
-    // GPU threads of a warp crossing partition boundaries at different samples stay together.
+    // One loop whose every iteration takes a sample, skips a transparent macrocell or moves to
+    // the next partition, so GPU threads of a warp crossing partition boundaries at different
+    // samples stay together. The loop leaves only through its condition (no break or return
+    // inside): a branch that can leave the loop has its reconvergence point after the loop, and
+    // warps whose threads split there ran one thread at a time (measured on the H100: 1.2
+    // active threads per instruction, 12x the reference marcher's time at the same samples).
     KdLeafIterator leaves(tEnter, tExit);
     std::uint32_t p = 0, root = 0;
-    float k = 0.f, k1 = 0.f, kStop = 0.f, m = 1.f;
-    bool walk = true;
-    while (true) {
+    float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
+    float kLocated = -INFINITY;  // grid position of the last sample located
+    bool marching = true, opaque = false, macro = false;
+    while (marching) {
         if (!(k < kStop)) {
             float t0, t1;
-            if (!leaves.next(scene.kd, ray, inv, p, t0, t1)) break;
+            if (!leaves.next(scene.kd, ray, inv, p, t0, t1)) {
+                marching = false;
+                continue;
+            }
             const KdPartition& part = scene.kd.partitions[p];
             const PartitionShading shade = scene.shading[p];
             ++counters.partitionsVisited;
@@ -150,33 +208,64 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             // piece.
             k = ceilf(c0 / s1);
             k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
-            m = shade.step / s1;  // step in grid units (1 for s1)
+            mPiece = shade.step / s1;  // step in grid units (1 for s1)
+            macro = scene.macro.grids && shade.byMacroCells;
+            kStop = k1;
             // Pre-integrated steps longer than s1 divide the piece evenly into at least two
             // (but no step below s1): the piece's last sample then owns a step's length at most,
-            // and a piece of a linear field is integrated exactly.
-            kStop = k1;
-            if (preintegrated && m > 1.f) {
+            // and a piece of a linear field is integrated exactly. (Macrocell steps end at the
+            // macrocells instead.)
+            if (!macro && preintegrated && mPiece > 1.f) {
                 const float span = k1 - k;
-                const float parts = fmaxf(2.f, ceilf(span / m));
-                m = fmaxf(1.f, span / parts);
-                kStop = k1 - 0.5f * m;  // rounding in k += m must not add a sample at k1
+                const float parts = fmaxf(2.f, ceilf(span / mPiece));
+                mPiece = fmaxf(1.f, span / parts);
+                kStop = k1 - 0.5f * mPiece;  // rounding in k += m must not add a sample at k1
             }
             root = part.bvhRoot;
-            // Short steps walk from the previous sample's tetrahedron; long steps (and samples
-            // with no previous tetrahedron) walk from the seed of the sample's grid cell, or
-            // search the partition's BVH when there are no seed grids.
-            walk = m <= scene.longStep;
             continue;
         }
-        const float length = ((k + m < k1 ? k + m : k1) - k) * s1;
         const float kSample = k;
         const Vec3f pos = ray.at(k * s1);
-        k += m;
+        float kNext = k + mPiece;
+        bool endsRun = false;  // the sample ends its run: it owns no distance
+        if (macro) {
+            const PartitionGrid& g = scene.macro.grids[p];
+            std::uint32_t idx[3];
+            const PartitionShading cell = scene.macro.shading[macroCellOf(g, pos, idx)];
+            const float m = cell.step / s1;
+            const bool transparent = scene.skipTransparent && !(cell.maxOpacity > 0.f);
+            // The first grid point past the macrocell (at least the next one); not needed for
+            // steps of s1.
+            const float kPast = transparent || m > 1.f
+                                    ? fmaxf(k + 1.f, ceilf(gridCellExit(g, idx, ray.org, inv) / s1))
+                                    : k + 1.f;
+            if (transparent) {
+                // Transparent: the run ends here; the next sample is past the macrocell. After a
+                // long step the mesh may have ended before this point (empty macrocells are
+                // transparent): the sample is then located as usual, which finds the boundary.
+                const bool longGap = preintegrated && segments.started && segments.inside &&
+                                     kSample - segments.kLast > 1.f;
+                if (!longGap) {
+                    if (preintegrated)
+                        segments.add(tf, kSample, kSample, false, 0.f, s1, unit, acc);
+                    k = kPast;
+                    continue;
+                }
+                endsRun = true;
+                kNext = kPast;
+            } else {
+                kNext = fminf(k + m, kPast);
+            }
+        }
+        const float length = ((kNext < k1 ? kNext : k1) - k) * s1;
+        k = kNext;
         ++counters.samples;
         // Point location: a walk from the previous sample's tetrahedron (short steps), else
         // from the seed of the sample's grid cell (none: no cell of the partition is near, the
         // sample is in empty space), else a search of the partition's BVH (walks stop at
         // boundaries of non-convex meshes and at seams of unshared points).
+        const bool walk = kSample - kLocated <= scene.longStep;
+        kLocated = kSample;
         tet = walk ? locator.walk(pos, tet, bary, counters.locate) : kNoTet;
         bool emptySpace = false;
         if (tet == kNoTet && scene.seeds.grids) {
@@ -228,16 +317,16 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
             }
             if (in) lastInside = tet;
-            segments.add(tf, kSample, k1, in, v, s1, unit, acc);
+            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc);
         } else if (tet != kNoTet) {
             const Vec4f c = tf.sample(v);
             const float a = correctOpacity(c.w, length, unit);
-            if (a <= 0.f) continue;
-            compositeFrontToBack(acc, c.xyz(), a);
+            if (a > 0.f) compositeFrontToBack(acc, c.xyz(), a);
         }
-        if (acc.w >= stopAlpha) return acc;
+        opaque = acc.w >= stopAlpha;
+        marching = !opaque;
     }
-    if (preintegrated) segments.finish(tf, s1, unit, acc);
+    if (preintegrated && !opaque) segments.finish(tf, s1, unit, acc);
     return acc;
 }
 

@@ -7,7 +7,7 @@
 // The model is the limit the sample-based methods converge to as their step goes to 0
 // (segment_integral.h): inside a linear tetrahedron the scalar is linear along the ray, so each
 // tetrahedron's segment is integrated in closed form, split only at the transfer function's
-// breakpoints.
+// breakpoints (pieces in float, segment::compositePieceFast: within 1e-4 of the double form).
 // Rays that leave a non-convex mesh, cross a seam of unshared faces or meet a degenerate crossing
 // (an edge or vertex) are located again through the mesh BVH from where they are: nothing along
 // the ray is dropped.
@@ -143,16 +143,30 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     exact::TetSpan span;
     std::uint32_t tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
     if (tet != kNoTet && span.tIn > t) t = span.tIn;  // empty space before the mesh
-    for (std::uint32_t step = 0; tet != kNoTet && step < kExactMaxSteps; ++step) {
+    // The loop leaves only through its condition, so GPU warps reconverge every iteration
+    // (adaptive_marcher.h says why).
+    bool opaque = false;
+    // A point field is continuous across a shared face: the value where the ray leaves one
+    // tetrahedron is where it enters the next (when it continues through that face).
+    const bool continuous = !loc.mesh.cellCentered;
+    bool haveEntry = false;
+    float sEntry = 0.f;
+    for (std::uint32_t step = 0; tet != kNoTet && !opaque && step < kExactMaxSteps; ++step) {
         const double tEnd = span.tOut;
+        bool exitValue = false;
         if (tEnd > t) {
             ++counters.samples;  // one segment per tetrahedron crossed
-            const float s0 = exact::scalarAt(loc, tet, ray, t);
+            const float s0 = haveEntry ? sEntry : exact::scalarAt(loc, tet, ray, t);
             const float s1 = exact::scalarAt(loc, tet, ray, tEnd);
-            segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc);
-            if (acc.w >= segment::kOpacityEnd) break;
+            // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
+            segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
+            opaque = acc.w >= segment::kOpacityEnd;
+            if (opaque) continue;
             t = tEnd;
+            sEntry = s1;
+            exitValue = continuous;
         }
+        haveEntry = false;
         // Across the exit face; located again where there is no neighbour or the crossing is
         // degenerate (the neighbour's span does not continue the ray).
         const std::uint32_t next =
@@ -162,6 +176,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             if (s.tOut > t + eps && s.tIn <= t + eps) {
                 tet = next;
                 span = s;
+                haveEntry = exitValue;
                 continue;
             }
         }

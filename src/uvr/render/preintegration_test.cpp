@@ -11,6 +11,7 @@
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/field_select.h"
+#include "uvr/mesh/procedural.h"
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/image_metrics.h"
 
@@ -103,16 +104,24 @@ TEST(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
     EXPECT_GT(compareImages(toRgb8(exact.image), toRgb8(r.image)).ssim, 0.99);
 }
 
-TEST(Preintegration, FastPiecesMatchTheClosedFormOnShortSteps) {
-    // The sample-based methods' float pieces against the exact integrator's: within 1e-3 for
-    // optical depths up to 0.5, and the same (it falls back) beyond, from any accumulated
-    // opacity.
+TEST(Preintegration, FastPiecesMatchTheClosedForm) {
+    // The sample-based methods' float pieces against the exact integrator's double ones: within
+    // 1e-3 at every optical depth (deep pieces fall back), with opacities of 0, near 1 and 1 at
+    // either end, nearly equal ends, and from any accumulated opacity.
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(0.f, 1.f);
-    for (int i = 0; i < 20000; ++i) {
+    auto opacity = [&] {
+        const float r = u(rng);
+        if (r < 0.15f) return 0.f;
+        if (r < 0.25f) return 1.f;
+        if (r < 0.4f) return 1.f - 1e-3f * u(rng);
+        return u(rng);
+    };
+    for (int i = 0; i < 50000; ++i) {
         const Vec3f c0(u(rng), u(rng), u(rng)), c1(u(rng), u(rng), u(rng));
-        const float a0 = u(rng) < 0.2f ? 0.f : u(rng), a1 = u(rng) < 0.2f ? 0.f : u(rng);
-        const float len = 0.01f + 2.f * u(rng), unit = 0.1f + u(rng);
+        const float a0 = opacity();
+        const float a1 = u(rng) < 0.1f ? a0 * (1.f + 1e-4f * u(rng)) : opacity();
+        const float len = 0.01f + (u(rng) < 0.5f ? 2.f : 40.f) * u(rng), unit = 0.1f + u(rng);
         const float start = u(rng) < 0.5f ? 0.f : u(rng);
         Vec4f fast(0.1f * start, 0.2f * start, 0.3f * start, start), slow = fast;
         segment::compositePieceFast(c0, a0, c1, a1, len, unit, fast);
@@ -197,6 +206,44 @@ TEST(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
     EXPECT_GT(longer, 0);  // visible partitions with steps beyond s1
     EXPECT_LT(good.stats.samples, ref.stats.samples);
     EXPECT_LT(rough.stats.samples, good.stats.samples);
+}
+
+TEST(MacroCells, SkipTransparentSpaceAndStepLongWithTheImageOfExact) {
+    // A smooth field on the non-convex shell (empty macrocells in its hole, a silhouette all
+    // round): under a narrow band most macrocells are transparent and skipped (half the samples
+    // or fewer); under ramps (where partitions may keep their own steps) as under the band, the
+    // image is the exact integrator's, at an oblique and an edge-on view.
+    ProceduralSpec spec;
+    spec.shape = ProceduralShape::Shell;
+    spec.targetCells = 150000;
+    spec.fields = {ProceduralField::Jet};
+    const Mesh mesh = generateMesh(spec);
+    PrepareOptions o;
+    o.kd.leafCells = 4096;
+    const PreparedMesh pm = prepareMesh(mesh, selectScalarField(mesh, {}), o);
+    o.macroGrids = false;
+    const PreparedMesh plain = prepareMesh(mesh, selectScalarField(mesh, {}), o);
+    for (const char* opacity : {"0:0,0.49:0,0.5:1,0.51:0,1:0", "0:0.3,1:1", "0:0,1:0.3"})
+        for (const float azimuth : {40.f, 90.f}) {
+            RenderSettings s;
+            s.width = s.height = 96;
+            s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), azimuth, 10.f);
+            s.tf = transferFunctionPreset("viridis");
+            applyOpacitySpec(s.tf, opacity);
+            s.method = RenderMethod::Exact;
+            const Rgb8Image exact = toRgb8(renderCpu(pm, s).image);
+            s.method = RenderMethod::Partitions;
+            const RenderResult macro = renderCpu(pm, s);
+            const RenderResult partitions = renderCpu(plain, s);
+            const std::string what = std::string(opacity) + " at " + std::to_string(azimuth);
+            EXPECT_GE(compareImages(exact, toRgb8(macro.image)).ssim, 0.99) << what;
+            if (opacity[4] == '0') {  // the band: partitions march by their macrocells
+                int byMacro = 0;
+                for (const PartitionShading& sh : macro.setup.shading) byMacro += sh.byMacroCells;
+                EXPECT_GT(byMacro, 0) << what;
+                EXPECT_LT(macro.stats.samples * 2, partitions.stats.samples) << what;
+            }
+        }
 }
 
 TEST(ErrorBoundRule, QualityOutOfRangeIsRefused) {

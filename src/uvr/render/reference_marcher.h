@@ -133,7 +133,10 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     float bary[4];
     const float unit = scene.params.opacityUnit;
     SampleSegments segments;
-    for (; k <= kEnd; k += 1.f) {
+    // The loop leaves only through its condition, so GPU warps reconverge every iteration
+    // (adaptive_marcher.h says why).
+    bool opaque = false;
+    for (; k <= kEnd && !opaque; k += 1.f) {
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
         tet = scene.locator.locate(p, tet, bary, counters.locate);
@@ -143,12 +146,11 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         } else if (tet != kNoTet) {
             const Vec4f c = scene.tf.sample(v);
             const float a = correctOpacity(c.w, s, unit);
-            if (a <= 0.f) continue;
-            compositeFrontToBack(acc, c.xyz(), a);
+            if (a > 0.f) compositeFrontToBack(acc, c.xyz(), a);
         }
-        if (acc.w >= scene.params.terminationAlpha) return acc;
+        opaque = acc.w >= scene.params.terminationAlpha;
     }
-    if (scene.params.preintegrated) segments.finish(scene.tf, s, unit, acc);
+    if (scene.params.preintegrated && !opaque) segments.finish(scene.tf, s, unit, acc);
     return acc;
 }
 

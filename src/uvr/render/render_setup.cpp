@@ -73,6 +73,10 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
             out.seeds = buildSeedGrids(out.tets, *out.kd);
         }
         out.gradientSpread = partitionGradientSpread(out.tets, *out.kd);
+        if (options.macroGrids) {
+            if (progress) progress("building macrocell grids");
+            out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors);
+        }
     }
     return out;
 }
@@ -177,6 +181,19 @@ std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
     return out;
 }
 
+std::vector<PartitionShading> computeMacroShading(const MacroGrids& macro, const TfRangeView& range,
+                                                  const StepRuleParams& rule) {
+    const std::int64_t n = static_cast<std::int64_t>(macro.cells.size());
+    std::vector<PartitionShading> out(n);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t c = 0; c < n; ++c) out[c] = shadeMacroCell(macro.cells[c], range, rule);
+    return out;
+}
+
+bool usesMacroCells(const PreparedMesh& mesh, const StepRuleParams& rule) {
+    return mesh.macro && rule.rule == StepRule::ErrorBound && rule.adaptive;
+}
+
 SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     SceneView v;
     v.locator = mesh.locator();
@@ -195,6 +212,11 @@ PartitionSceneView FrameSetup::partitionScene(const PreparedMesh& mesh, bool ski
     if (mesh.seeds) v.seeds = mesh.seeds->view();
     v.shading = shading.data();
     v.skipTransparent = skip;
+    if (!macroShading.empty()) {
+        UVR_CHECK(mesh.macro && macroShading.size() == mesh.macro->cells.size(),
+                  "macrocell shading without macrocells");
+        v.macro = {mesh.macro->grids.data(), macroShading.data()};
+    }
     return v;
 }
 
@@ -344,6 +366,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         const TfRangeTables ranges(table);
         f.shading =
             computePartitionShading(*mesh.kd, mesh.gradientSpread, ranges.view(table), f.stepRule);
+        if (usesMacroCells(mesh, f.stepRule)) {
+            f.macroShading = computeMacroShading(*mesh.macro, ranges.view(table), f.stepRule);
+            for (std::size_t p = 0; p < f.shading.size(); ++p)
+                f.shading[p].byMacroCells =
+                    macroCellsPay(mesh.macro->grids[p], f.macroShading.data(), f.shading[p]);
+        }
         f.tfUpdateSeconds = secondsSince(start);
     }
     checkFrameWork(mesh, settings, f.params.step);

@@ -12,6 +12,7 @@
 
 #include "uvr/accel/bvh.h"
 #include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/macro_grid.h"
 #include "uvr/accel/seed_grid.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
@@ -29,6 +30,7 @@ struct PrepareOptions {
     bool meshBvh = true;     ///< build the BVH over all tetrahedra the reference marcher needs
     bool partitions = true;  ///< build the k-d partitions the partition integrator needs
     bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
+    bool macroGrids = true;  ///< with partitions: the macrocells the error-bound rule steps by
     KdBuildOptions kd;
     /// When set, the mesh BVH and the partitions' BVHs are LBVHs from this builder
     /// (buildLbvhCuda: on the GPU, in seconds for 100M+ tetrahedra); else binned SAH trees built
@@ -49,6 +51,9 @@ struct PreparedMesh {
     std::vector<std::uint32_t> neighbors;
     std::optional<KdPartitions> kd;
     std::optional<SeedGrids> seeds;  ///< per-partition walk starts (with partitions)
+    /// Per-partition macrocells (with partitions): value ranges and gradient spreads finer than
+    /// a partition's, for skipping and the error-bound rule's steps.
+    std::optional<MacroGrids> macro;
     /// Per partition (with partitions): the spread of its cells' field gradients, the diagonal
     /// of their bounding box (partitionGradientSpread), for the error-bound step rule.
     std::vector<float> gradientSpread;
@@ -212,14 +217,27 @@ std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
                                                       const TfRangeView& range,
                                                       const StepRuleParams& rule);
 
+/// Per-macrocell shading for a transfer function and the error-bound rule: each macrocell's
+/// maximum opacity over its value range and its step (shadePartition); an empty macrocell is
+/// transparent.
+std::vector<PartitionShading> computeMacroShading(const MacroGrids& macro, const TfRangeView& range,
+                                                  const StepRuleParams& rule);
+
+/// Whether the partition method steps by macrocells for these settings: the error-bound rule
+/// with adaptive steps on a mesh with macrocell grids (the paper's variance rule and "skipping
+/// only" keep one step per partition).
+bool usesMacroCells(const PreparedMesh& mesh, const StepRuleParams& rule);
+
 /// Host-side frame state built from settings: the baked table, the camera and the parameters.
 struct FrameSetup {
     std::vector<Vec4f> tfTable;
     std::vector<std::int32_t> tfBreaks;     ///< tfTableBreaks of tfTable
     StepRuleParams stepRule;                ///< the partition method's step rule and its inputs
     std::vector<PartitionShading> shading;  ///< per partition (partition method only)
-    double tfUpdateSeconds = 0.0;           ///< range tables + shading of all partitions
-    float maxStep = 0.f;                    ///< s2 in effect
+    /// Per macrocell (partition method with usesMacroCells; empty otherwise).
+    std::vector<PartitionShading> macroShading;
+    double tfUpdateSeconds = 0.0;  ///< range tables + shading of all partitions and macrocells
+    float maxStep = 0.f;           ///< s2 in effect
     /// The prepared mesh's frame: camera, rays, params and maxStep are in its rendering units
     /// (lengths divided by frame.scale are in the file's units).
     MeshFrame frame;

@@ -116,38 +116,78 @@ UVR_HOST_DEVICE inline void compositePiece(Vec3f c0, double a0, Vec3f c1, double
     acc.w = static_cast<float>(1.0 - remaining * transEnd);
 }
 
-/// compositePiece in float for the sample-based methods' short steps: the optical depth by
-/// Simpson's rule over the extinction at the ends and the middle (kappa of the linear opacity),
-/// the transmittance at the middle from the quadratic through them, and the mean transmittance by
-/// Simpson's rule; within 1e-3 of compositePiece while the piece's optical depth is at most 0.5 (a
-/// sample step's usually is far less) and kappa bends little over it (the trapezoid rule agrees
-/// with Simpson's to 2%), else (or near opacity 1) it calls compositePiece.
+/// F(w) = w ln w - w in float (0 at w = 0).
+UVR_HOST_DEVICE inline float entropyF(float w) {
+    return w > 0.f ? w * logf(w) - w : 0.f;
+}
+
+/// meanLog in float, given f0 = entropyF(w0): the mean of ln w over [w0, w1] (w >= 0).
+/// Near-equal ends use the series ln m - (d / m)^2 / 24 (the next term, (d / m)^4 / 320, is
+/// below 3e-7 for |d| <= 0.1 m).
+UVR_HOST_DEVICE inline float meanLogF(float w0, float f0, float w1) {
+    const float d = w1 - w0, m = 0.5f * (w0 + w1);
+    if (fabsf(d) <= 0.1f * m) {
+        const float r = d / m;
+        return logf(m) - r * r * (1.f / 24.f);
+    }
+    return (entropyF(w1) - f0) / d;
+}
+
+/// Largest optical depth of a piece compositePieceFast integrates itself (16 sub-intervals);
+/// beyond it (a transmittance below 3e-4 across one piece) it calls compositePiece.
+inline constexpr float kFastMaxDepth = 8.f;
+
+/// Most sub-intervals of compositePieceFast's quadrature.
+inline constexpr int kFastMaxParts = 16;
+
+/// compositePiece in float for the sample-based methods: the optical depth in closed form (as
+/// compositePiece), the mean transmittance by composite 3-point Gauss-Legendre quadrature over
+/// sub-intervals of at most about 0.5 optical depth (at most 16). Within 1e-3 of compositePiece; pieces deeper than
+/// kFastMaxDepth call it.
 UVR_HOST_DEVICE inline void compositePieceFast(Vec3f c0, float a0, Vec3f c1, float a1, float len,
                                                float unit, Vec4f& acc) {
-    a0 = a0 > 0.f ? a0 : 0.f;
-    a1 = a1 > 0.f ? a1 : 0.f;
+    a0 = a0 > 0.f ? (a0 < 1.f ? a0 : 1.f) : 0.f;
+    a1 = a1 > 0.f ? (a1 < 1.f ? a1 : 1.f) : 0.f;
     if (a0 == 0.f && a1 == 0.f) return;
     if (!(len > 0.f)) return;
-    if (a0 < 0.99f && a1 < 0.99f) {
-        const float k0 = -log1pf(-a0), k1 = -log1pf(-a1), km = -log1pf(-0.5f * (a0 + a1));
-        const float scale = len / unit;
-        const float tauEnd = scale * (k0 + 4.f * km + k1) * (1.f / 6.f);
-        // Where the trapezoid and Simpson's rule differ, kappa bends too much for the rule.
-        const float bend = fabsf(0.5f * scale * (k0 + k1) - tauEnd);
-        if (tauEnd <= 0.5f && bend <= 0.02f * tauEnd) {
-            const float tauMid = scale * (5.f * k0 + 8.f * km - k1) * (1.f / 24.f);
-            const float transEnd = expf(-tauEnd), transMid = expf(-tauMid);
-            const float mean = (1.f + 4.f * transMid + transEnd) * (1.f / 6.f);
-            const float remaining = 1.f - acc.w;
-            const float w0 = remaining * (1.f - mean), w1 = remaining * (mean - transEnd);
-            acc.x += w0 * c0.x + w1 * c1.x;
-            acc.y += w0 * c0.y + w1 * c1.y;
-            acc.z += w0 * c0.z + w1 * c1.z;
-            acc.w = 1.f - remaining * transEnd;
-            return;
-        }
+    const float w0 = 1.f - a0, w1 = 1.f - a1;
+    const float scale = len / unit;
+    const float f0 = entropyF(w0);
+    const float tauEnd = -scale * meanLogF(w0, f0, w1);
+    if (!(tauEnd <= kFastMaxDepth) || (w0 == 0.f && w1 == 0.f)) {
+        compositePiece(c0, a0, c1, a1, len, unit, acc);
+        return;
     }
-    compositePiece(c0, a0, c1, a1, len, unit, acc);
+    const float transEnd = expf(-tauEnd);
+    float mean;
+    if (w0 == w1) {
+        mean = tauEnd > 1e-6f ? -expm1f(-tauEnd) / tauEnd : 1.f - 0.5f * tauEnd;
+    } else {
+        // Composite 3-point Gauss-Legendre over n sub-intervals (no node at the ends, where the
+        // extinction -ln w may be singular): T(u) = exp(-tau(u)), tau(u) = -scale u meanLog(w0,
+        // w(u)); n from the larger extinction at the ends, so no sub-interval is deeper than
+        // about 0.5 (at most kFastMaxParts).
+        const float kMax = -logf(fmaxf(fminf(w0, w1), 1e-30f));
+        const float parts = ceilf(2.f * scale * kMax);
+        const int n = parts <= 1.f ? 1 : (parts < kFastMaxParts ? int(parts) : kFastMaxParts);
+        const float h = 1.f / static_cast<float>(n);
+        const float x[3] = {0.1127016654f, 0.5f, 0.8872983346f};
+        const float wgt[3] = {5.f / 18.f, 8.f / 18.f, 5.f / 18.f};
+        float sum = 0.f;
+        for (int j = 0; j < n; ++j)
+            for (int q = 0; q < 3; ++q) {
+                const float u = (static_cast<float>(j) + x[q]) * h;
+                const float w = w0 + (w1 - w0) * u;
+                sum += wgt[q] * expf(scale * u * meanLogF(w0, f0, w > 0.f ? w : 0.f));
+            }
+        mean = sum * h;
+    }
+    const float remaining = 1.f - acc.w;
+    const float k0 = remaining * (1.f - mean), k1 = remaining * (mean - transEnd);
+    acc.x += k0 * c0.x + k1 * c1.x;
+    acc.y += k0 * c0.y + k1 * c1.y;
+    acc.z += k0 * c0.z + k1 * c1.z;
+    acc.w = 1.f - remaining * transEnd;
 }
 
 /// Table entry value (RGBA) at a position g in [0, count - 1] of the table, linear between
@@ -163,8 +203,8 @@ UVR_HOST_DEVICE inline Vec4f tableAt(const TfTableView& tf, double g) {
 
 /// Integrates a segment of length len along which the scalar runs linearly from s0 to s1
 /// through the transfer function, split at the table's breakpoints it crosses (every entry when
-/// the table has none), into acc; fast: each piece by compositePieceFast (the sample-based
-/// methods), else by compositePiece (the exact integrator). A NaN end
+/// the table has none), into acc; fast: each piece by compositePieceFast (in float, what the
+/// renderers use), else by compositePiece (in double). A NaN end
 /// makes the segment transparent (as a NaN sample is).
 UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s1, double len,
                                       double unit, Vec4f& acc, bool fast = false) {

@@ -16,6 +16,15 @@ std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count, float t
     std::vector<std::int32_t> points{0};
     int b = 0;
     while (b < count - 1) {
+        // A run of transparent entries is one piece whatever its colours: nothing is emitted or
+        // absorbed over it (segment::integrate then steps over it at once).
+        if (entries[b].w == 0.f && entries[b + 1].w == 0.f) {
+            int end = b + 1;
+            while (end + 1 < count && entries[end + 1].w == 0.f) ++end;
+            points.push_back(end);
+            b = end;
+            continue;
+        }
         float lo[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
         float hi[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
         int end = b + 1;

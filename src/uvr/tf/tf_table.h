@@ -70,7 +70,8 @@ inline constexpr float kTfBreakTolerance = 1e-4f;
 /// Breakpoints of a baked table (the layout of TfTableView::breaks): the entries where the
 /// table stops being linear to within `tolerance` in every channel, chosen greedily from the
 /// first entry in one O(count) pass (for each run, the interval of chord slopes that keeps every
-/// entry inside the run within tolerance). Both ends are always breakpoints.
+/// entry inside the run within tolerance); a run of entries of opacity 0 is one piece whatever
+/// their colours (it emits and absorbs nothing). Both ends are always breakpoints.
 std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count,
                                         float tolerance = kTfBreakTolerance);
 

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/accel/macro_grid.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "uvr/core/error.h"
+#include "uvr/mesh/tet_math.h"
+
+namespace uvr {
+
+MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
+                           const std::vector<std::uint32_t>& neighbors, float tetsPerCell) {
+    const auto start = std::chrono::steady_clock::now();
+    UVR_CHECK(tetsPerCell > 0.f, "macrocell density must be positive");
+    UVR_CHECK(neighbors.size() == 4 * mesh.tets.size(), "macrocells need the face neighbours");
+    MacroGrids out;
+    const std::size_t n = kd.partitions.size();
+    out.grids.resize(n);
+    std::uint64_t total = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+        const KdPartition& part = kd.partitions[p];
+        PartitionGrid g;
+        if (part.cellCount > 0 && !part.box.empty())
+            g = layoutPartitionGrid(part.box, std::max(1.0, part.cellCount / double(tetsPerCell)));
+        else
+            g.dims[0] = g.dims[1] = g.dims[2] = 1;
+        g.first = static_cast<std::uint32_t>(total);
+        total += std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2];
+        UVR_CHECK(total < 0xffffffffull, "macrocell grids exceed 32-bit indices");
+        out.grids[p] = g;
+    }
+    out.cells.assign(total, MacroCell{});
+    const bool cellData = mesh.association == Association::Cell;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {
+        const KdPartition& part = kd.partitions[p];
+        const PartitionGrid& g = out.grids[p];
+        if (part.cellCount == 0 || part.box.empty()) continue;
+        MacroCell* cells = out.cells.data() + g.first;
+        const std::size_t count = std::size_t(g.dims[0]) * g.dims[1] * g.dims[2];
+        std::vector<Bounds3f> gradients(count);  // bounding boxes of the gradients
+        for (std::uint32_t i = 0; i < part.cellCount; ++i) {
+            const std::uint32_t t = kd.cells[part.firstCell + i];
+            const Tet& tet = mesh.tets[t];
+            Bounds3f box;
+            for (int k = 0; k < 4; ++k) box.extend(mesh.points[tet.v[k]]);
+            float lo = INFINITY, hi = -INFINITY;
+            Vec3f grad(0.f);
+            bool gradOk = false;
+            if (cellData) {
+                lo = hi = mesh.values[t];
+            } else {
+                for (int k = 0; k < 4; ++k) {
+                    lo = std::fmin(lo, mesh.values[tet.v[k]]);  // NaN values are left out
+                    hi = std::fmax(hi, mesh.values[tet.v[k]]);
+                }
+                grad =
+                    tetGradient(mesh.points[tet.v[0]], mesh.points[tet.v[1]], mesh.points[tet.v[2]],
+                                mesh.points[tet.v[3]], mesh.values[tet.v[0]], mesh.values[tet.v[1]],
+                                mesh.values[tet.v[2]], mesh.values[tet.v[3]]);
+                gradOk = isFinite(grad);
+            }
+            bool boundary = false;
+            for (int f = 0; f < 4; ++f)
+                boundary = boundary || neighbors[4 * std::size_t(t) + f] == kNoTet;
+            std::uint32_t a[3], b[3];
+            macroCellOf(g, box.lo, a);
+            macroCellOf(g, box.hi, b);
+            for (std::uint32_t z = a[2]; z <= b[2]; ++z)
+                for (std::uint32_t y = a[1]; y <= b[1]; ++y)
+                    for (std::uint32_t x = a[0]; x <= b[0]; ++x) {
+                        const std::size_t c = (std::size_t(z) * g.dims[1] + y) * g.dims[0] + x;
+                        MacroCell& m = cells[c];
+                        // A tetrahedron whose values are all NaN adds no range: its samples
+                        // are transparent, so a macrocell of only such cells is skipped.
+                        m.valueMin = std::fmin(m.valueMin, lo);
+                        m.valueMax = std::fmax(m.valueMax, hi);
+                        if (cellData || boundary)
+                            m.gradientSpread = INFINITY;
+                        else if (gradOk)
+                            gradients[c].extend(grad);
+                    }
+        }
+        if (!cellData)
+            for (std::size_t c = 0; c < count; ++c)
+                if (!gradients[c].empty() && cells[c].gradientSpread < INFINITY)
+                    cells[c].gradientSpread = length(gradients[c].hi - gradients[c].lo);
+    }
+    out.buildSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+}  // namespace uvr

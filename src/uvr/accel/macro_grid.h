@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Macrocell grids (issue 11, beyond the paper): a coarse uniform grid over each k-d partition
+// whose cells record the field's value range and gradient spread over the tetrahedra that
+// overlap them. The partition integrator skips transparent macrocells and takes each macrocell's
+// own error-bounded step, so a partition of 65,536 tetrahedra is no longer one value range and
+// one step (docs/METHOD.md).
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/seed_grid.h"
+#include "uvr/mesh/tet_mesh.h"
+
+namespace uvr {
+
+/// Field statistics of one macrocell over the tetrahedra that overlap it (12 bytes).
+struct MacroCell {
+    /// Smallest vertex (or cell) value, NaN left out; above valueMax when no tetrahedron with a
+    /// value overlaps the macrocell.
+    float valueMin = INFINITY;
+    float valueMax = -INFINITY;  ///< largest
+    /// Diagonal of the bounding box of the tetrahedra's field gradients (see
+    /// partitionGradientSpread); infinite for a cell-centred field and where a tetrahedron's
+    /// face lies on the mesh's boundary: the integrand jumps there (to nothing), so such
+    /// macrocells take the shortest step, as the reference does (a long step would miss a ray's
+    /// short chords through the mesh near its silhouette).
+    float gradientSpread = 0.f;
+
+    /// True when no tetrahedron with a value overlaps the macrocell (it is transparent).
+    UVR_HOST_DEVICE bool empty() const { return !(valueMin <= valueMax); }
+};
+
+/// Tetrahedra per macrocell the builder aims for: about 6 sample steps s1 across on a uniform
+/// mesh (PERFORMANCE.md, "Macrocells").
+inline constexpr float kTetsPerMacroCell = 48.f;
+
+/// Macrocell grids of all partitions (the layout of seed grids: one PartitionGrid per partition,
+/// its cells from `first` in x-fastest order).
+struct MacroGrids {
+    std::vector<PartitionGrid> grids;
+    std::vector<MacroCell> cells;
+    double buildSeconds = 0.0;
+
+    /// Bytes held.
+    std::uint64_t bytes() const {
+        return grids.size() * sizeof(PartitionGrid) + cells.size() * sizeof(MacroCell);
+    }
+};
+
+/// Index of the macrocell of grid g holding p (clamped into the grid; idx receives the cell's
+/// coordinates).
+UVR_HOST_DEVICE inline std::uint32_t macroCellOf(const PartitionGrid& g, Vec3f p,
+                                                 std::uint32_t idx[3]) {
+    for (int a = 0; a < 3; ++a) idx[a] = SeedGridView::cellIndex(g, a, p[a]);
+    return g.first + (idx[2] * g.dims[1] + idx[1]) * g.dims[0] + idx[0];
+}
+
+/// Builds the macrocell grids of every partition of kd over mesh (in parallel over partitions;
+/// the result does not depend on the thread count). Each tetrahedron of a partition adds its
+/// values and gradient to every macrocell its bounding box overlaps; neighbors (4 per
+/// tetrahedron, kNoTet on the boundary) mark the boundary's macrocells.
+MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
+                           const std::vector<std::uint32_t>& neighbors,
+                           float tetsPerCell = kTetsPerMacroCell);
+
+}  // namespace uvr
