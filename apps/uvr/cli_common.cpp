@@ -217,9 +217,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
         ->check(CLI::PositiveNumber);
     if (oneFrame)
         app.add_option("--method", method,
-                       "Integrator: reference (fixed step s1 everywhere), adaptive (k-d "
-                       "partitions, space skipping, adaptive steps; Morrical et al. 2019) or "
-                       "exact (no sampling: every tetrahedron's segment integrated exactly)")
+                       "Integrator: adaptive (k-d partitions and macrocells: space skipping, "
+                       "error-bounded adaptive steps; Morrical et al. 2019 and beyond), "
+                       "reference (fixed step s1 everywhere) or exact (no sampling: every "
+                       "tetrahedron's segment integrated exactly)")
             ->check(CLI::IsMember({"reference", "adaptive", "exact"}))
             ->capture_default_str();
     app.add_option("--sampling", sampling,

@@ -74,7 +74,7 @@ struct RenderFlags {
     float azimuth = 0.f, elevation = 0.f;
     float step = 0.f;
     float opacityUnit = 0.f;
-    std::string method = "reference";
+    std::string method = "adaptive";
     std::string stepRule = "error";
     std::optional<float> quality;  ///< unset: kDefaultQuality
     std::string sampling = "preintegrated";

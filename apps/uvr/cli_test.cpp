@@ -303,11 +303,20 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
     const Image h = readPng(dir + "/h.png");
     EXPECT_EQ(h.height, 48);
     EXPECT_GT(h.width, 64);  // the colour bar and its scale
-    // Method-only flags without --method adaptive are refused.
-    EXPECT_EQ(
-        uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir + "/b.png --no-skip", dir)
-            .code,
-        2);
+    // Method-only flags with another method are refused.
+    EXPECT_EQ(uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
+                      "/b.png --method reference --no-skip",
+                  dir)
+                  .code,
+              2);
+    // Adaptive is the default method (issue 11: it meets the quality bar).
+    ASSERT_EQ(uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
+                      "/c.png --size 32x32 --stats " + dir + "/c.json",
+                  dir)
+                  .code,
+              0);
+    std::ifstream defaults(dir + "/c.json");
+    EXPECT_EQ(nlohmann::json::parse(defaults)["method"], "adaptive");
 }
 
 TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {

@@ -97,8 +97,8 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
 void addRenderCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "render",
-        "Render a mesh file to a PNG with the fixed-step reference (pre-integrated), the "
-        "adaptive partition method or the exact integrator (--method), on the CPU or a GPU");
+        "Render a mesh file to a PNG with the adaptive partition method (the default), the "
+        "fixed-step reference or the exact integrator (--method), on the CPU or a GPU");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();

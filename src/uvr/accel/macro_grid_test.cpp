@@ -109,7 +109,9 @@ TEST(MacroGrid, LinearFieldHasNoSpreadInsideAndCellDataHasNoBound) {
     spec.name = "id";
     const PreparedMesh pm = prepareMesh(m, selectScalarField(m, spec));
     for (const MacroCell& c : pm.macro->cells)
-        if (!c.empty()) EXPECT_EQ(c.gradientSpread, INFINITY);
+        if (!c.empty()) {
+            EXPECT_EQ(c.gradientSpread, INFINITY);
+        }
 }
 
 TEST(MacroGrid, RaysLeaveACellWhereGridCellExitSays) {

@@ -22,8 +22,10 @@ PreparedMesh jitteredGrid(std::uint32_t leafCells = 64) {
     return prepareMesh(m, selectScalarField(m, {}), o);
 }
 
+/// The reference marcher's settings (tests switch to the partition method).
 RenderSettings baseSettings() {
     RenderSettings s;
+    s.method = RenderMethod::Reference;
     s.width = 64;
     s.height = 48;
     s.tf.colors = {{0.f, {0, 0, 1}}, {0.5f, {1, 1, 1}}, {1.f, {1, 0, 0}}};
@@ -114,6 +116,7 @@ TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
                                                                                  : ""));
         const PreparedMesh pm = prepareMesh(mesh, field);
         RenderSettings s;
+        s.method = RenderMethod::Reference;
         s.width = s.height = 96;
         s.tf = transferFunctionPreset("viridis");
         applyOpacitySpec(s.tf, "0:0,1:0.5");

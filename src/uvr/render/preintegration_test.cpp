@@ -38,6 +38,7 @@ PreparedMesh cube(const std::function<float(Vec3f)>& f, std::uint32_t leafCells 
 /// normalised range.
 RenderSettings bandSettings(const char* opacity, float step) {
     RenderSettings s;
+    s.method = RenderMethod::Reference;
     s.width = s.height = 24;
     s.camera = Camera{};
     s.camera->position = Vec3f(0.5f, 0.5f, 3.f);
@@ -183,6 +184,7 @@ TEST(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
     const PreparedMesh pm =
         cube([](Vec3f p) { return std::sin(4.f * p.x) * std::cos(3.f * p.y) + p.z; }, 64, 10);
     RenderSettings s;
+    s.method = RenderMethod::Reference;
     s.width = s.height = 64;
     s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), 35.f, 25.f);
     s.tf = transferFunctionPreset("cool-to-warm");

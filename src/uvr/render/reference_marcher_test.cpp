@@ -101,6 +101,7 @@ TEST(ReferenceMarcher, CpuFrameMatchesPerRayMarching) {
         4, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.2f);
     const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}));
     RenderSettings s;
+    s.method = RenderMethod::Reference;
     s.width = 40;
     s.height = 30;
     s.tf.colors = {{0.f, {0, 0, 1}}, {1.f, {1, 0, 0}}};

@@ -125,7 +125,7 @@ float toleranceForQuality(float quality);
 
 /// What to render and how.
 struct RenderSettings {
-    RenderMethod method = RenderMethod::Reference;
+    RenderMethod method = RenderMethod::Partitions;
     StepRule stepRule = StepRule::ErrorBound;  ///< how the partition method picks steps
     /// The error-bound rule's target: the SSIM against the exact integrator that it aims at for
     /// typical data (toleranceForQuality), in [kMinQuality, kMaxQuality].
