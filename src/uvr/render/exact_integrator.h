@@ -32,24 +32,39 @@ inline constexpr std::uint32_t kExactMaxSteps = 1u << 22;
 namespace exact {
 
 /// The span [tIn, tOut] of a ray inside a tetrahedron and the face (opposite vertex exitFace)
-/// through which it leaves; empty when tIn > tOut.
+/// through which it leaves; empty when tIn > tOut. With values: the point field along the ray
+/// inside the tetrahedron, v(t) = value0 + valueSlope t, from the barycentric coordinates that
+/// the face planes give (each one affine in t), clamped to the tetrahedron's values.
 struct TetSpan {
     double tIn = -INFINITY, tOut = INFINITY;
     int exitFace = -1;
+    bool hasValue = false;  ///< value0, valueSlope, valueLo, valueHi are set
+    double value0 = 0.0, valueSlope = 0.0;
+    float valueLo = 0.f, valueHi = 0.f;
+
+    /// The field at parameter t (hasValue).
+    UVR_HOST_DEVICE float valueAt(double t) const {
+        const float v = static_cast<float>(value0 + valueSlope * t);
+        return v < valueLo ? valueLo : (v > valueHi ? valueHi : v);  // NaN stays NaN
+    }
 };
 
-/// Clips the ray against the four face planes of tetrahedron t (in double; either orientation).
-UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t, const Ray& ray) {
+/// Clips the ray against the four face planes of tetrahedron t (in double; either orientation);
+/// withValue: also the point field along the ray (TetSpan::valueAt; not for cell data).
+UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
+                                       bool withValue = false) {
     const Tet& tet = mesh.tets[t];
     Vec3d p[4];
     for (int i = 0; i < 4; ++i) p[i] = toDouble(mesh.points[tet.v[i]]);
     const Vec3d o = toDouble(ray.org), d = toDouble(ray.dir);
     TetSpan s;
+    bool degenerate = false;
     for (int i = 0; i < 4; ++i) {
         // Face opposite vertex i; its normal points away from vertex i.
         const Vec3d a = p[(i + 1) & 3], b = p[(i + 2) & 3], c = p[(i + 3) & 3];
         Vec3d n = cross(b - a, c - a);
-        if (dot(n, p[i] - a) > 0.0) n = {-n.x, -n.y, -n.z};
+        double height = dot(n, p[i] - a);  // vertex i's signed distance (times |n|)
+        if (height > 0.0) n = {-n.x, -n.y, -n.z}, height = -height;
         const double num = dot(n, a - o), den = dot(n, d);
         if (den > 0.0) {
             const double t1 = num / den;
@@ -60,6 +75,26 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
         } else if (num < 0.0) {  // parallel to the face and outside it
             s.tIn = INFINITY;
             s.tOut = -INFINITY;
+        }
+        if (withValue) {
+            // Barycentric i at o + t d: its distance to the face over vertex i's,
+            // (t den - num) / height.
+            if (!(height < 0.0)) {
+                degenerate = true;
+                continue;
+            }
+            const double v = mesh.values[tet.v[i]];
+            s.value0 -= v * num / height;
+            s.valueSlope += v * den / height;
+        }
+    }
+    if (withValue && !degenerate) {
+        s.hasValue = true;
+        s.valueLo = s.valueHi = mesh.values[tet.v[0]];
+        for (int i = 1; i < 4; ++i) {
+            const float v = mesh.values[tet.v[i]];
+            s.valueLo = v < s.valueLo ? v : s.valueLo;
+            s.valueHi = v > s.valueHi ? v : s.valueHi;
         }
     }
     return s;
@@ -107,11 +142,13 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
     return best;
 }
 
-/// Scalar at parameter t of the ray inside tetrahedron tet (barycentric, clamped to the cell).
-UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, const Ray& ray,
-                                      double t) {
+/// Scalar at parameter t of the ray inside tetrahedron tet: from the span's linear function
+/// when it has one, else barycentric at the point (clamped to the cell).
+UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, const TetSpan& span,
+                                      const Ray& ray, double t) {
     const TetMeshView& m = loc.mesh;
     if (m.cellCentered) return m.values[tet];
+    if (span.hasValue) return span.valueAt(t);
     const Tet& c = m.tets[tet];
     float bary[4];
     const Vec3f p = ray.at(static_cast<float>(t));
@@ -142,13 +179,16 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     double t = b0;
     exact::TetSpan span;
     std::uint32_t tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
-    if (tet != kNoTet && span.tIn > t) t = span.tIn;  // empty space before the mesh
+    const bool continuous = !loc.mesh.cellCentered;
+    if (tet != kNoTet) {
+        if (continuous) span = exact::clipTet(loc.mesh, tet, ray, true);  // with the field
+        if (span.tIn > t) t = span.tIn;  // empty space before the mesh
+    }
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
     // A point field is continuous across a shared face: the value where the ray leaves one
     // tetrahedron is where it enters the next (when it continues through that face).
-    const bool continuous = !loc.mesh.cellCentered;
     bool haveEntry = false;
     float sEntry = 0.f;
     for (std::uint32_t step = 0; tet != kNoTet && !opaque && step < kExactMaxSteps; ++step) {
@@ -156,8 +196,8 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         bool exitValue = false;
         if (tEnd > t) {
             ++counters.samples;  // one segment per tetrahedron crossed
-            const float s0 = haveEntry ? sEntry : exact::scalarAt(loc, tet, ray, t);
-            const float s1 = exact::scalarAt(loc, tet, ray, tEnd);
+            const float s0 = haveEntry ? sEntry : exact::scalarAt(loc, tet, span, ray, t);
+            const float s1 = exact::scalarAt(loc, tet, span, ray, tEnd);
             // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
             segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
             opaque = acc.w >= segment::kOpacityEnd;
@@ -172,7 +212,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         const std::uint32_t next =
             loc.neighbors && span.exitFace >= 0 ? loc.neighbors[4 * tet + span.exitFace] : kNoTet;
         if (next != kNoTet) {
-            const exact::TetSpan s = exact::clipTet(loc.mesh, next, ray);
+            const exact::TetSpan s = exact::clipTet(loc.mesh, next, ray, continuous);
             if (s.tOut > t + eps && s.tIn <= t + eps) {
                 tet = next;
                 span = s;
@@ -181,7 +221,10 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             }
         }
         tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
-        if (tet != kNoTet && span.tIn > t) t = span.tIn;  // empty space before it
+        if (tet != kNoTet) {
+            if (continuous) span = exact::clipTet(loc.mesh, tet, ray, true);
+            if (span.tIn > t) t = span.tIn;  // empty space before it
+        }
     }
     return acc;
 }
