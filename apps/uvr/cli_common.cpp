@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cfloat>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -65,6 +67,10 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
 
 void Context::step(const std::string& message) const {
     if (!quiet) std::fprintf(stderr, "uvr: %s\n", printable(message).c_str());
+}
+
+void Context::warn(const std::string& message) const {
+    std::fprintf(stderr, "uvr: warning: %s\n", printable(message).c_str());
 }
 
 void Context::done(const std::string& message, Clock::time_point start) const {
@@ -390,10 +396,33 @@ std::vector<NamedFile> RenderFlags::inputs() const {
     return in;
 }
 
+namespace {
+
+/// Refuses an output whose name does not say what is written (issue 15: `-o a.jpg` wrote PNG
+/// bytes): its extension must be `ext` (any case). Standard output ("-") and existing files that
+/// are not regular (/dev/null, FIFOs) are written whatever their names.
+void checkExtension(const std::string& flag, const std::string& path, const std::string& ext,
+                    const std::string& what) {
+    if (path.empty() || path == "-") return;
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) return;
+    std::string got = std::filesystem::path(path).extension().string();
+    for (char& c : got) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (got == ext) return;
+    throwError(ErrorKind::Argument, path,
+               flag + " writes " + what + ": name it *" + ext + " (or - for standard output)");
+}
+
+}  // namespace
+
 void RenderFlags::checkFiles(const std::string& meshFile) const {
     std::vector<NamedFile> in = inputs();
     if (!meshFile.empty()) in.push_back({"the input mesh", meshFile});
     checkOutputsDistinct(in, outputs());
+    checkExtension("-o", output, ".png", "a PNG image");
+    checkExtension("--heatmap", heatmapFile, ".png", "a PNG image");
+    checkExtension("--stats", statsFile, ".json", "JSON");
     for (const NamedFile& out : outputs()) resolveOutput(out.path);
 }
 
@@ -561,6 +590,8 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                       double(result.stats.partitionsSkipped) / (settings.width * settings.height));
         ctx.step(line);
     }
+    const std::string empty = explainEmptyFrame(prepared, settings, result);
+    if (!empty.empty()) ctx.warn(source + ": " + empty);
     // Every output is written first and committed after the last one succeeded: a failure (a
     // full disk) leaves none of them behind.
     std::vector<std::unique_ptr<OutputFile>> outputs;

@@ -20,6 +20,8 @@ public:
     std::uint64_t maxMemoryBytes = 0;  ///< a whole load, image buffers, meshes; 0 = no limit
     /// Prints a step message (control characters and invalid UTF-8 escaped: one line).
     void step(const std::string& message) const;
+    /// Prints "uvr: warning: MESSAGE", also when quiet: the command goes on and exits 0.
+    void warn(const std::string& message) const;
     /// Prints a message with the seconds since `start`.
     void done(const std::string& message, std::chrono::steady_clock::time_point start) const;
     /// Records what uvr is doing now and with which file ("" for none), for the message when

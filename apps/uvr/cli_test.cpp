@@ -319,6 +319,35 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
     EXPECT_EQ(nlohmann::json::parse(defaults)["method"], "adaptive");
 }
 
+TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {
+    // Issue 15: a transparent image with exit 0 and no word is a trap; each cause is named.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string spx = testing::sharedData("spx.vtk");
+    const std::string post = testing::sharedData("post_tets.vtk");
+    const struct {
+        std::string args, reason;
+    } cases[] = {
+        {post + " --field density", "the field is constant (1)"},
+        {spx + " --range 100,200", "--range 100,200 misses the field's values"},
+        {spx + " --camera-focal 100,100,100", "the mesh is not in view"},
+        {spx + " --view-angle 179", "smaller than a pixel"},
+        {spx + " --opacity constant:0", "opacity is 0 over all the field's values"},
+        {spx + " --method exact --opacity constant:0", "opacity is 0 over all the field's values"},
+    };
+    for (const auto& c : cases) {
+        const CliRun r = uvr("-q render " + c.args + " --size 32x32 -o " + dir + "/e.png", dir);
+        EXPECT_EQ(r.code, 0) << c.args << ": " << r.err;
+        EXPECT_NE(r.err.find("uvr: warning: "), std::string::npos) << c.args << ": " << r.err;
+        EXPECT_NE(r.err.find(c.reason), std::string::npos) << c.args << ": " << r.err;
+        EXPECT_EQ(readPng(dir + "/e.png").width, 32) << c.args;  // the image is still written
+    }
+    // A picture with something in it: no warning.
+    const CliRun ok = uvr("-q render " + spx + " --size 32x32 -o " + dir + "/f.png", dir);
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_EQ(ok.err.find("warning"), std::string::npos) << ok.err;
+}
+
 TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const std::string dir = testing::scratchDir();
@@ -614,6 +643,16 @@ TEST(Cli, OutputsNeverDestroyWhatTheirPathNames) {
                        {"--heatmap names the same file as -o"}, "two outputs");
     expectOneLineError(uvr("-q convert " + mesh + " " + mesh, dir), {"OUT names the input mesh"},
                        "convert onto itself");
+    // The name must say what is written (issue 15: `-o a.jpg` wrote PNG bytes).
+    expectOneLineError(uvr(render + "-o " + dir + "/a.jpg", dir),
+                       {"a.jpg", "-o writes a PNG image: name it *.png"}, "-o a.jpg");
+    expectOneLineError(uvr(render + "-o " + dir + "/a", dir), {"-o writes a PNG image"}, "-o a");
+    expectOneLineError(uvr(render + "-o " + dir + "/a.png --heatmap " + dir + "/h.jpeg", dir),
+                       {"--heatmap writes a PNG image"}, "--heatmap h.jpeg");
+    expectOneLineError(uvr(render + "-o " + dir + "/a.png --stats " + dir + "/s.txt", dir),
+                       {"--stats writes JSON: name it *.json"}, "--stats s.txt");
+    EXPECT_EQ(uvr(render + "-o " + dir + "/upper.PNG", dir).code, 0);
+    std::filesystem::remove(dir + "/upper.PNG");
     EXPECT_EQ(names(), (std::vector<std::string>{"alias.vtk", "m.vtk"}));
     EXPECT_EQ(readMesh(mesh).cellCount(), 5u);
     // A character device is written in place, never replaced.

@@ -16,6 +16,7 @@
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/mesh/validate.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/empty_frame.h"
 #include "uvr/render/heatmap.h"
 #include "uvr/render/image.h"
 #include "uvr/render/image_metrics.h"

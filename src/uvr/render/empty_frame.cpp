@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/render/empty_frame.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace uvr {
+namespace {
+
+std::string fmt(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+/// Largest opacity of the baked table over the values [lo, hi] (values beyond the table's range
+/// take its end entries).
+float maxOpacityOver(const FrameSetup& f, double lo, double hi) {
+    const int n = static_cast<int>(f.tfTable.size());
+    if (n == 0) return 0.f;
+    const double width = double(f.rangeHi) - double(f.rangeLo);
+    auto index = [&](double v) {
+        if (!(width > 0.0)) return 0;
+        const double g = (v - f.rangeLo) / width * (n - 1);
+        return g <= 0.0 ? 0 : (g >= n - 1 ? n - 1 : static_cast<int>(g));
+    };
+    const int a = index(lo), b = std::min(n - 1, index(hi) + 1);
+    float best = 0.f;
+    for (int i = a; i <= b; ++i) best = std::fmax(best, f.tfTable[i].w);
+    return best;
+}
+
+}  // namespace
+
+std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& settings,
+                              const RenderResult& result) {
+    for (const Vec4f& p : result.image.pixels)
+        if (p.w >= kEmptyPixelAlpha) return "";
+    const FrameSetup& f = result.setup;
+    // Does any pixel's ray meet the mesh's bounds?
+    bool inView = false;
+    const Bounds3f& box = mesh.tets.bounds;
+    for (int y = 0; y < result.image.height && !inView; ++y)
+        for (int x = 0; x < result.image.width && !inView; ++x) {
+            const Ray ray = f.rays.ray(x + 0.5f, y + 0.5f);
+            const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
+            float t0 = 0.f, t1 = INFINITY;
+            inView = intersectBox(box, ray.org, inv, t0, t1);
+        }
+    if (!inView)
+        return "the image is empty: the mesh is not in view, or smaller than a pixel (no "
+               "pixel's ray meets its bounds); check the camera (--camera, "
+               "--camera-position/--camera-focal, --azimuth, --elevation, --view-angle)";
+    double lo = INFINITY, hi = -INFINITY;
+    for (float v : mesh.tets.values)
+        if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);
+    if (!(lo <= hi)) return "the image is empty: the field has no finite value";
+    if (lo == hi)
+        return "the image is empty: the field is constant (" + fmt(lo) +
+               "), and the transfer function's opacity at that value is 0";
+    if (settings.range &&
+        (double(settings.range->second) < lo || double(settings.range->first) > hi))
+        return "the image is empty: --range " + fmt(settings.range->first) + "," +
+               fmt(settings.range->second) + " misses the field's values [" + fmt(lo) + ", " +
+               fmt(hi) +
+               "], which all take the transfer function's end opacity (0 here); use a range "
+               "inside the field's";
+    if (!(maxOpacityOver(f, lo, hi) > 0.f))
+        return "the image is empty: the transfer function's opacity is 0 over all the field's "
+               "values [" +
+               fmt(lo) + ", " + fmt(hi) + "]; check --opacity and --range";
+    return "the image is empty: every pixel's opacity is below half an 8-bit level; raise the "
+           "opacity (--opacity) or --opacity-unit";
+}
+
+}  // namespace uvr
