@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cfloat>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -161,7 +162,9 @@ std::uint64_t defaultMaxMemory() {
 }
 
 Vec3f parseVec3(const std::string& flag, const std::string& text) {
-    auto v = parseFloats(flag, text, 3, "three finite numbers x,y,z");
+    auto v = parseFloats(
+        flag, text, 3,
+        flag == "--background" ? "three finite numbers r,g,b" : "three finite numbers x,y,z");
     return {v[0], v[1], v[2]};
 }
 
@@ -184,6 +187,25 @@ std::pair<int, int> parseSize(const std::string& flag, const std::string& text) 
         badFlag(flag, text, "WIDTHxHEIGHT with each side between 1 and 16384, e.g. 1024x768");
     return {w, h};
 }
+
+namespace {
+
+/// A finite number above 0, with a plain message ("--step: must be a positive number, not 0")
+/// instead of CLI11's range of all doubles.
+CLI::Validator positiveNumber() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            double v = 0.0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v) ||
+                !(v > 0.0))
+                return "must be a positive number, not " + text;
+            return "";
+        },
+        "POSITIVE");
+}
+
+}  // namespace
 
 void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     if (oneFrame)
@@ -216,11 +238,11 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
         ->capture_default_str();
     app.add_option("--step", step,
                    "Sample spacing s1 (default: 0.5 * cube root of the mean tetrahedron volume)")
-        ->check(CLI::PositiveNumber);  // 0 means nothing: it is refused, not taken as the default
+        ->check(positiveNumber());  // 0 means nothing: it is refused, not taken as the default
     app.add_option("--opacity-unit", opacityUnit,
                    "Distance over which a TF opacity applies (default: ParaView's "
                    "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))")
-        ->check(CLI::PositiveNumber);
+        ->check(positiveNumber());
     if (oneFrame)
         app.add_option("--method", method,
                        "Integrator: adaptive (k-d partitions and macrocells: space skipping, "
@@ -254,7 +276,7 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--max-step", maxStep,
                    "Adaptive: largest step s2 (default: " +
                        std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)")
-        ->check(CLI::PositiveNumber);
+        ->check(positiveNumber());
     app.add_option("--power", power,
                    "Adaptive, --step-rule variance: power p >= 1 of the step formula (default "
                    "2)");
@@ -327,6 +349,9 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     if (stepRule == "error" && power)
         throwError(ErrorKind::Argument, "",
                    "--power shapes the variance rule's step: it needs --step-rule variance");
+    if (heatmapMax && heatmapFile.empty())
+        throwError(ErrorKind::Argument, "",
+                   "--heatmap-max sets the heat map's scale: it needs --heatmap FILE.png");
     if (s.method == RenderMethod::Exact && sampling != "preintegrated")
         throwError(ErrorKind::Argument, "",
                    "--sampling applies to the reference and adaptive methods; exact does not "
@@ -601,7 +626,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         ctx.setActivity(flags.heatmapFile, "writing the heat map");
         outputs.push_back(std::make_unique<OutputFile>(flags.heatmapFile));
         writePng(*outputs.back(), sampleHeatmap(result.sampleCounts, settings.width,
-                                                settings.height, flags.heatmapMax));
+                                                settings.height, flags.heatmapMax.value_or(0)));
     }
     if (!flags.statsFile.empty()) {
         nlohmann::json j;

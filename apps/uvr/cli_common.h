@@ -88,7 +88,7 @@ struct RenderFlags {
     std::string device = "auto";
     std::string buildDevice = "auto";
     std::string heatmapFile;
-    std::uint32_t heatmapMax = 0;
+    std::optional<std::uint32_t> heatmapMax;  ///< needs --heatmap; 0: the frame's maximum
     std::string background;
     std::string statsFile;
     int threads = 0;

@@ -319,6 +319,29 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
     EXPECT_EQ(nlohmann::json::parse(defaults)["method"], "adaptive");
 }
 
+TEST(Cli, FlagsThatWouldBeIgnoredOrMeanNothingAreRefused) {
+    // Issue 15: one rule for every flag; every bad combination gets its one-line error.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string render =
+        "-q render " + testing::sharedData("post_tets.vtk") + " --size 16x16 -o " + dir + "/a.png ";
+    expectOneLineError(uvr(render + "--heatmap-max 5", dir), {"--heatmap-max", "needs --heatmap"},
+                       "--heatmap-max alone");
+    expectOneLineError(uvr(render + "--field density:x", dir),
+                       {"--field 'density': a scalar field"}, "component of a scalar");
+    expectOneLineError(uvr(render + "--field density:magnitude", dir), {"a scalar field"},
+                       "magnitude of a scalar");
+    expectOneLineError(uvr(render + "--background 1,2", dir),
+                       {"--background '1,2'", "three finite numbers r,g,b"}, "--background");
+    expectOneLineError(uvr(render + "--step 0", dir), {"--step: must be a positive number, not 0"},
+                       "--step 0");
+    expectOneLineError(uvr(render + "--opacity-unit 0", dir),
+                       {"--opacity-unit: must be a positive number"}, "--opacity-unit 0");
+    // A vector's component and magnitude still work.
+    EXPECT_EQ(uvr(render + "--field momentum:x", dir).code, 0);
+    EXPECT_EQ(uvr(render + "--field momentum:magnitude", dir).code, 0);
+}
+
 TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {
     // Issue 15: a transparent image with exit 0 and no word is a trap; each cause is named.
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";

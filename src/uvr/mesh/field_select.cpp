@@ -35,11 +35,14 @@ FieldSpec parseFieldSpec(const std::string& text) {
             spec.association = Association::Cell;
         } else if (part == "magnitude") {
             spec.component = -1;
+            spec.selectsComponent = true;
         } else if (part == "x" || part == "y" || part == "z") {
             spec.component = part[0] - 'x';
+            spec.selectsComponent = true;
         } else if (!part.empty() && part.find_first_not_of("0123456789") == std::string::npos &&
                    part.size() < 6) {
             spec.component = std::stoi(part);
+            spec.selectsComponent = true;
         } else {
             throwError(ErrorKind::Argument, "",
                        "--field '" + text + "': unknown qualifier '" + part +
@@ -98,6 +101,11 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
                            "them in the file");
         }
     }
+    if (spec.selectsComponent && field->components == 1)
+        throwError(ErrorKind::Argument, "",
+                   "--field '" + spec.name +
+                       "': a scalar field; :x, :y, :z, :magnitude and a "
+                       "component number select from vector fields (leave the qualifier out)");
     return scalarFieldOf(mesh, *field, spec.component);
 }
 

@@ -15,6 +15,8 @@ struct FieldSpec {
     std::string name;
     std::optional<Association> association;
     int component = -1;  ///< -1: magnitude for vectors (the value itself for scalars)
+    /// A component or :magnitude was named (refused for a scalar field: nothing to select).
+    bool selectsComponent = false;
 };
 
 /// Parses a field spec; throws Error(Argument) on an unknown suffix.
