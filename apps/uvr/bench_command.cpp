@@ -20,6 +20,7 @@ namespace {
 /// One benchmarked configuration.
 struct Variant {
     std::string name;
+    std::string file;  ///< stem of its images under --images (fileName(name) unless set)
     RenderSettings settings;
     double s2Factor = 0.0;  ///< s2 / s1 (0 when not adaptive)
     // Results.
@@ -35,10 +36,18 @@ double median(std::vector<double> v) {
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/// A readable file stem for a configuration name: lower-case letters, digits and dots, other
+/// runs of characters as one '-' ("skipping + adaptive" -> "skipping-adaptive").
 std::string fileName(const std::string& name) {
-    std::string s = name;
-    for (char& c : s)
-        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    std::string s;
+    for (char c : name) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        if (std::isalnum(u) || c == '.')
+            s += static_cast<char>(std::tolower(u));
+        else if (!s.empty() && s.back() != '-')
+            s += '-';
+    }
+    while (!s.empty() && s.back() == '-') s.pop_back();
     return s;
 }
 
@@ -95,8 +104,14 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                             "--size " + flags->size + ": the frames of " +
                                 std::to_string(6 + sweep->size()) + " variants",
                             frameMemoryBytes(*flags, 6 + sweep->size()));
-        if (!images->empty() && !std::filesystem::is_directory(*images))
-            throwError(ErrorKind::Io, *images, "not a folder");
+        if (!images->empty()) {  // made when missing, before any heavy work
+            std::error_code ec;
+            std::filesystem::create_directories(*images, ec);
+            if (!std::filesystem::is_directory(*images))
+                throwError(ErrorKind::Io, *images,
+                           "--images: cannot make this folder" +
+                               (ec ? ": " + ec.message() : std::string(" (a file has its name)")));
+        }
         flags->method = "adaptive";  // partitions are needed; variants pick their integrator
         const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
@@ -117,6 +132,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                        float s2) -> Variant& {
             Variant v;
             v.name = name;
+            v.file = fileName(name);
             v.settings = base;
             v.settings.method = method;
             v.settings.skip = skip;
@@ -141,7 +157,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         for (double f : *sweep) {
             char name[64];
             std::snprintf(name, sizeof name, "both, s2 = %g s1", f);
-            add(name, RenderMethod::Partitions, true, true, static_cast<float>(f * s1));
+            Variant& v = add(name, RenderMethod::Partitions, true, true, float(f * s1));
+            std::snprintf(name, sizeof name, "adaptive_s2-%g", f);
+            v.file = name;
         }
         // The yardstick: one frame of the exact integrator (no sampling).
         ctx.step("rendering the exact image (the yardstick)");
@@ -175,7 +193,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             v.ssim = cmp.ssim;
             v.psnr = cmp.psnr;
             if (!images->empty()) {
-                const std::string stem = *images + "/" + fileName(v.name);
+                const std::string stem = *images + "/" + v.file;
                 writePng(stem + ".png", v.last.image, background);
                 writePng(stem + "_samples.png", sampleHeatmap(v.last.sampleCounts, v.settings.width,
                                                               v.settings.height, heatmapMax));

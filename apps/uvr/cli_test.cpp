@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "cli_test_support.h"
+#include "parse_errors.h"
 #include "test_support.h"
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/io/mesh_reader.h"
@@ -342,6 +343,26 @@ TEST(Cli, FlagsThatWouldBeIgnoredOrMeanNothingAreRefused) {
     EXPECT_EQ(uvr(render + "--field momentum:magnitude", dir).code, 0);
 }
 
+TEST(Cli, MisspeltCommandsAndOptionsGetASuggestion) {
+    // Issue 15: the unknown word named, the closest known one suggested (ParaView's names for
+    // uvr's options too), and the --help of the subcommand in use.
+    const std::string dir = testing::scratchDir();
+    expectOneLineError(uvr("rendr x.vtk", dir),
+                       {"unknown command 'rendr': did you mean 'render'?", "(see uvr --help)"},
+                       "rendr");
+    expectOneLineError(uvr("render x.vtk -o a.png --colormap viridis", dir),
+                       {"unknown option --colormap (did you mean --tf?)", "uvr render --help"},
+                       "--colormap");
+    expectOneLineError(uvr("render x.vtk -o a.png --azimth 30", dir),
+                       {"unknown option --azimth (did you mean --azimuth?)"}, "--azimth");
+    expectOneLineError(uvr("info x.vtk --zzzzzzzz", dir),
+                       {"unknown option --zzzzzzzz", "uvr info --help"}, "nothing close");
+    EXPECT_EQ(uvr("info x.vtk --zzzzzzzz", dir).err.find("did you mean"), std::string::npos);
+    EXPECT_EQ(cli::editDistance("rendr", "render"), 1);
+    EXPECT_EQ(cli::closest("--quailty", {"--quality", "--quiet"}), "--quality");
+    EXPECT_EQ(cli::closest("--x", {"--quality"}), "");
+}
+
 TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {
     // Issue 15: a transparent image with exit 0 and no word is a trap; each cause is named.
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
@@ -399,6 +420,16 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/exact.png"));
     EXPECT_EQ(readPng(dir + "/p.png").width, 800);
     EXPECT_TRUE(std::filesystem::exists(dir + "/reference_samples.png"));
+    // Names that read as names (issue 15; they were "both__s2___16_s1.png").
+    EXPECT_TRUE(std::filesystem::exists(dir + "/skipping-adaptive.png"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/adaptive_s2-4.png"));
+    // A missing --images folder is made (it was "not a folder").
+    ASSERT_EQ(uvr("-q bench " + testing::sharedData("spx.vtk") +
+                      " --size 16x16 --repeat 1 --sweep 2 --images " + dir + "/new/images",
+                  dir)
+                  .code,
+              0);
+    EXPECT_TRUE(std::filesystem::exists(dir + "/new/images/adaptive_s2-2.png"));
     EXPECT_TRUE(std::filesystem::exists(dir + "/b.csv"));
 }
 

@@ -4,6 +4,7 @@
 #include <new>
 
 #include "cli_common.h"
+#include "parse_errors.h"
 #include "uvr/core/text.h"
 
 int main(int argc, char** argv) {
@@ -49,7 +50,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::RuntimeError& e) {
         return e.get_exit_code();  // a completed command's own exit status (compare --min-ssim)
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "uvr: error: %s (see uvr --help)\n", printable(e.what()).c_str());
+        const std::vector<std::string> args(argv + 1, argv + argc);
+        std::fprintf(stderr, "uvr: error: %s\n",
+                     printable(cli::describeParseError(app, args, e)).c_str());
         return 2;
     } catch (const Error& e) {
         // Messages quote names from files: escaped, they stay one line.
