@@ -378,6 +378,7 @@ TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {
         {spx + " --view-angle 179", "smaller than a pixel"},
         {spx + " --opacity constant:0", "opacity is 0 over all the field's values"},
         {spx + " --method exact --opacity constant:0", "opacity is 0 over all the field's values"},
+        {spx + " --opacity constant:0.0000001", "below half an 8-bit level"},
     };
     for (const auto& c : cases) {
         const CliRun r = uvr("-q render " + c.args + " --size 32x32 -o " + dir + "/e.png", dir);

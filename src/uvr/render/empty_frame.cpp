@@ -55,6 +55,10 @@ std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& se
     for (float v : mesh.tets.values)
         if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);
     if (!(lo <= hi)) return "the image is empty: the field has no finite value";
+    if (maxOpacityOver(f, lo, hi) > 0.f)
+        return "the image is empty: every pixel's opacity is below half an 8-bit level; raise "
+               "the opacity (--opacity) or --opacity-unit";
+    // The transfer function is transparent over the field's values: say why.
     if (lo == hi)
         return "the image is empty: the field is constant (" + fmt(lo) +
                "), and the transfer function's opacity at that value is 0";
@@ -65,12 +69,9 @@ std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& se
                fmt(hi) +
                "], which all take the transfer function's end opacity (0 here); use a range "
                "inside the field's";
-    if (!(maxOpacityOver(f, lo, hi) > 0.f))
-        return "the image is empty: the transfer function's opacity is 0 over all the field's "
-               "values [" +
-               fmt(lo) + ", " + fmt(hi) + "]; check --opacity and --range";
-    return "the image is empty: every pixel's opacity is below half an 8-bit level; raise the "
-           "opacity (--opacity) or --opacity-unit";
+    return "the image is empty: the transfer function's opacity is 0 over all the field's "
+           "values [" +
+           fmt(lo) + ", " + fmt(hi) + "]; check --opacity and --range";
 }
 
 }  // namespace uvr

@@ -15,9 +15,9 @@ namespace uvr {
 inline constexpr float kEmptyPixelAlpha = 0.5f / 255.f;
 
 /// "" when some pixel of the frame reaches kEmptyPixelAlpha; else one sentence saying why the
-/// frame is empty, the likeliest cause first: no pixel's ray meets the mesh's bounds; a constant
-/// field; a --range that misses the field's values; a transfer function transparent over them;
-/// else opacity too low for the mesh's size.
+/// frame is empty: no pixel's ray meets the mesh's bounds; or the transfer function is
+/// transparent over the field's values, because the field is constant, because --range misses
+/// them, or as it is; else opacity too low for the mesh's size.
 std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& settings,
                               const RenderResult& result);
 
