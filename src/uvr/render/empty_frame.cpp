@@ -19,12 +19,15 @@ float maxOpacityOver(const FrameSetup& f, double lo, double hi) {
     const int n = static_cast<int>(f.tfTable.size());
     if (n == 0) return 0.f;
     const double width = double(f.rangeHi) - double(f.rangeLo);
-    auto index = [&](double v) {
-        if (!(width > 0.0)) return 0;
+    // Table position of a value, clamped to the table (a zero-width range maps to entry 0).
+    auto position = [&](double v) {
+        if (!(width > 0.0)) return 0.0;
         const double g = (v - f.rangeLo) / width * (n - 1);
-        return g <= 0.0 ? 0 : (g >= n - 1 ? n - 1 : static_cast<int>(g));
+        return g <= 0.0 ? 0.0 : (g >= n - 1 ? double(n - 1) : g);
     };
-    const int a = index(lo), b = std::min(n - 1, index(hi) + 1);
+    // The entries the values interpolate between.
+    const int a = static_cast<int>(std::floor(position(lo)));
+    const int b = static_cast<int>(std::ceil(position(hi)));
     float best = 0.f;
     for (int i = a; i <= b; ++i) best = std::fmax(best, f.tfTable[i].w);
     return best;
