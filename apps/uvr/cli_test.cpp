@@ -679,6 +679,22 @@ TEST(Cli, CameraAndMemoryErrorsNameTheFile) {
     }
 }
 
+TEST(Cli, ConvertAndGenerateRefuseAnUnwritableFormatBeforeAnyWork) {
+    // Issue 15: the output's format was refused only after reading or generating the mesh.
+    const std::string dir = testing::scratchDir();
+    const std::string mesh =
+        testing::writeFile(dir + "/m.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7"));
+    for (const std::string& cmd : {"convert " + mesh + " " + dir + "/x.abc",
+                                   "generate box --cells 1000 -o " + dir + "/x.abc",
+                                   "refine " + mesh + " " + dir + "/x.abc"}) {
+        const CliRun r = uvr(cmd, dir);
+        expectOneLineError(r, {"x.abc", "cannot write this format"}, cmd);
+        // Nothing was read or generated first.
+        EXPECT_EQ(r.err.find("uvr: read "), std::string::npos) << cmd << ": " << r.err;
+        EXPECT_EQ(r.err.find("generated"), std::string::npos) << cmd << ": " << r.err;
+    }
+}
+
 TEST(Cli, OutputsNeverDestroyWhatTheirPathNames) {
     const std::string dir = testing::scratchDir();
     const std::string mesh =

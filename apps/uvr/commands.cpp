@@ -165,6 +165,7 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
     cmd->callback([in, out, &ctx] {
         checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
         resolveOutput(*out);
+        checkMeshWritable(*out);  // before reading (minutes at 100M cells)
         const Mesh mesh = loadMesh(*in, ctx);
         auto start = Clock::now();
         ctx.setActivity(*out, "writing the mesh");
@@ -197,6 +198,7 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
         ->delimiter(',');
     cmd->callback([shape, out, spec, fields, &ctx] {
         resolveOutput(*out);
+        checkMeshWritable(*out);  // before generating
         spec->shape = parseProceduralShape(*shape);
         if (!fields->empty()) {
             spec->fields.clear();
@@ -248,12 +250,7 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
         applyThreads(*threads);
         checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
         resolveOutput(*out);
-        // Refuse an unwritable format before the (possibly long) refinement.
-        const std::string ext = fileExtension(*out);
-        if (ext != ".uvrm" && ext != ".vtu")
-            throwError(ErrorKind::Argument, *out,
-                       "cannot write this format: the output name must end in .uvrm (native) or "
-                       ".vtu");
+        checkMeshWritable(*out);  // before the (possibly long) refinement
         const Mesh mesh = loadMesh(*in, ctx);
         // The output's largest array (4 point indices per tetrahedron) must fit --max-memory;
         // the estimate splits hexahedra into 6 tetrahedra, wedges and pyramids into 3.

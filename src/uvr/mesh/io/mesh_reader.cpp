@@ -55,12 +55,17 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
                "VTK XML (.vtu/.pvtu) or a native uvr mesh (.uvrm)");
 }
 
-void writeMesh(const Mesh& mesh, const std::string& path) {
+void checkMeshWritable(const std::string& path) {
     const std::string ext = fileExtension(path);
-    if (ext == ".uvrm") return writeNative(mesh, path);
-    if (ext == ".vtu") return writeVtu(mesh, path);
-    throwError(ErrorKind::Argument, path,
-               "cannot write this format: the output name must end in .uvrm (native) or .vtu");
+    if (ext != ".uvrm" && ext != ".vtu")
+        throwError(ErrorKind::Argument, path,
+                   "cannot write this format: the output name must end in .uvrm (native) or .vtu");
+}
+
+void writeMesh(const Mesh& mesh, const std::string& path) {
+    checkMeshWritable(path);
+    if (fileExtension(path) == ".uvrm") return writeNative(mesh, path);
+    writeVtu(mesh, path);
 }
 
 }  // namespace uvr

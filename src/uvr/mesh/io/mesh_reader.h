@@ -15,5 +15,8 @@ Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 /// Writes a mesh in the format its extension names (.uvrm native or .vtu); throws
 /// Error(Argument) for other extensions. The file is written atomically.
 void writeMesh(const Mesh& mesh, const std::string& path);
+/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm or .vtu):
+/// commands call it before any heavy work.
+void checkMeshWritable(const std::string& path);
 
 }  // namespace uvr
