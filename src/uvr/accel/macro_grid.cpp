@@ -16,21 +16,8 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
     UVR_CHECK(neighbors.size() == 4 * mesh.tets.size(), "macrocells need the face neighbours");
     MacroGrids out;
     const std::size_t n = kd.partitions.size();
-    out.grids.resize(n);
-    std::uint64_t total = 0;
-    for (std::size_t p = 0; p < n; ++p) {
-        const KdPartition& part = kd.partitions[p];
-        PartitionGrid g;
-        if (part.cellCount > 0 && !part.box.empty())
-            g = layoutPartitionGrid(part.box, std::max(1.0, part.cellCount / double(tetsPerCell)));
-        else
-            g.dims[0] = g.dims[1] = g.dims[2] = 1;
-        g.first = static_cast<std::uint32_t>(total);
-        total += std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2];
-        UVR_CHECK(total < 0xffffffffull, "macrocell grids exceed 32-bit indices");
-        out.grids[p] = g;
-    }
-    out.cells.assign(total, MacroCell{});
+    out.grids = layoutPartitionGrids(kd, tetsPerCell, "macrocell grids");
+    out.cells.assign(gridCellCount(out.grids), MacroCell{});
     const bool cellData = mesh.association == Association::Cell;
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {

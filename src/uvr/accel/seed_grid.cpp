@@ -34,15 +34,12 @@ PartitionGrid layoutPartitionGrid(const Bounds3f& box, double target) {
     return g;
 }
 
-SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell) {
-    const auto start = std::chrono::steady_clock::now();
-    UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
-    SeedGrids out;
-    const std::size_t n = kd.partitions.size();
-    out.grids.resize(n);
-    // Layouts and offsets (sequential: a few operations per partition).
+std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float tetsPerCell,
+                                                const char* what) {
+    // Sequential: a few operations per partition.
+    std::vector<PartitionGrid> grids(kd.partitions.size());
     std::uint64_t total = 0;
-    for (std::size_t p = 0; p < n; ++p) {
+    for (std::size_t p = 0; p < grids.size(); ++p) {
         const KdPartition& part = kd.partitions[p];
         PartitionGrid g;
         if (part.cellCount > 0 && !part.box.empty())
@@ -51,10 +48,19 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
             g.dims[0] = g.dims[1] = g.dims[2] = 1;
         g.first = static_cast<std::uint32_t>(total);
         total += std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2];
-        UVR_CHECK(total < 0xffffffffull, "seed grids exceed 32-bit indices");
-        out.grids[p] = g;
+        UVR_CHECK(total < 0xffffffffull, what << " exceed 32-bit indices");
+        grids[p] = g;
     }
-    out.seeds.assign(total, kNoTet);
+    return grids;
+}
+
+SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell) {
+    const auto start = std::chrono::steady_clock::now();
+    UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
+    SeedGrids out;
+    const std::size_t n = kd.partitions.size();
+    out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids");
+    out.seeds.assign(gridCellCount(out.grids), kNoTet);
     // Seeds: per cell the smallest key (squared distance of a tetrahedron's centroid to the cell
     // centre, 0 when the tetrahedron contains the centre; ties to the smaller id). Partitions are
     // independent, each filled by one thread in cell order: the result is deterministic.

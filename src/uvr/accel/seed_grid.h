@@ -52,6 +52,20 @@ inline constexpr std::uint32_t kMaxGridSide = 1024;
 /// kMaxGridSide; flat boxes get one cell across their flat axis). `first` is left 0.
 PartitionGrid layoutPartitionGrid(const Bounds3f& box, double target);
 
+/// One grid per partition of kd (layoutPartitionGrid for about cellCount / tetsPerCell cells;
+/// one cell for an empty partition), with `first` set to consecutive offsets; `what` names the
+/// grids in the error when their cells exceed 32-bit indices. Shared by the seed and macrocell
+/// grids.
+std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float tetsPerCell,
+                                                const char* what);
+
+/// Cells of all grids laid out by layoutPartitionGrids.
+inline std::uint64_t gridCellCount(const std::vector<PartitionGrid>& grids) {
+    if (grids.empty()) return 0;
+    const PartitionGrid& g = grids.back();
+    return std::uint64_t(g.first) + std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2];
+}
+
 /// Where a ray leaves grid cell idx of g: the smallest t at which it crosses one of the cell's
 /// faces ahead (inv: 1 / the ray's direction). The grid's outer cells reach to infinity outward,
 /// as SeedGridView::cellIndex clamps positions outside the grid into them.

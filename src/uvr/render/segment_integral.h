@@ -142,8 +142,8 @@ inline constexpr int kFastMaxParts = 16;
 
 /// compositePiece in float for the sample-based methods: the optical depth in closed form (as
 /// compositePiece), the mean transmittance by composite 3-point Gauss-Legendre quadrature over
-/// sub-intervals of at most about 0.5 optical depth (at most 16). Within 1e-3 of compositePiece; pieces deeper than
-/// kFastMaxDepth call it.
+/// sub-intervals of at most about 0.5 optical depth (at most 16). Within 1e-3 of compositePiece;
+/// pieces deeper than kFastMaxDepth call it.
 UVR_HOST_DEVICE inline void compositePieceFast(Vec3f c0, float a0, Vec3f c1, float a1, float len,
                                                float unit, Vec4f& acc) {
     a0 = a0 > 0.f ? (a0 < 1.f ? a0 : 1.f) : 0.f;
