@@ -115,6 +115,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         flags->method = "adaptive";  // partitions are needed; variants pick their integrator
         const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
+        ctx.step("field " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice));
         const RenderSettings base = flags->settings(mesh.bounds(), *file);
         ctx.setActivity(*file, "preparing the mesh and rendering it");
         const std::optional<Vec3f> background = flags->backgroundColor();
@@ -272,6 +273,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 nlohmann::json j;
                 j["file"] = *file;
                 j["field"] = field.name;
+                j["field_association"] = associationName(field.association);
                 j["tetrahedra"] = prepared.tets.tets.size();
                 j["partitions"] = prepared.kd->partitions.size();
                 j["partition_build_seconds"] = prepared.kd->buildSeconds;

@@ -591,8 +591,8 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     PreparedMesh prepared = prepareMesh(mesh, field, flags.prepareOptions(),
                                         [&](const std::string& s) { ctx.step(s); });
     ctx.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
-    ctx.step("rendering '" + field.name + "' at " + std::to_string(settings.width) + "x" +
-             std::to_string(settings.height));
+    ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
+             " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height));
     ctx.setActivity(source, "rendering it at " + std::to_string(settings.width) + "x" +
                                 std::to_string(settings.height));
     FrameRenderer renderer(prepared, flags.useCuda(), ctx);
@@ -632,6 +632,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         nlohmann::json j;
         j["source"] = source;
         j["field"] = field.name;
+        j["field_association"] = associationName(field.association);
         j["device"] = renderer.deviceName();
         if (renderer.gpu()) {
             j["gpu"] = {

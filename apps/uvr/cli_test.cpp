@@ -481,7 +481,7 @@ TEST(Cli, InterruptedRenderLeavesThePreviousOutputUntouched) {
     testing::writeFile(out, "previous image");
     const int status = interruptWhenLogged(
         {"demo", "--cells", "20000", "--size", "4096x4096", "--threads", "1", "-o", out},
-        dir + "/log.txt", "rendering '");
+        dir + "/log.txt", "uvr: rendering jet (point data)");
     ASSERT_TRUE(WIFSIGNALED(status)) << "the render finished before it could be interrupted";
     EXPECT_EQ(WTERMSIG(status), SIGTERM);
     std::ifstream in(out);
@@ -580,7 +580,10 @@ TEST(Cli, SameNamedFieldsAreListedByInfoAndNamedRightByRender) {
     ASSERT_EQ(j["fields"].size(), 2u);
     EXPECT_EQ(j["fields"][1]["range"][1].get<double>(), 9.0);
     ASSERT_EQ(j["validation"].size(), 1u);
-    EXPECT_NE(j["validation"][0].get<std::string>().find("2 point fields are named 'f'"),
+    EXPECT_EQ(j["validation"][0]["code"], "duplicate_field_names");
+    EXPECT_EQ(j["validation"][0]["count"], 2);
+    EXPECT_EQ(j["validation"][0]["field"], "f");
+    EXPECT_NE(j["validation"][0]["message"].get<std::string>().find("2 point fields are named 'f'"),
               std::string::npos);
     const CliRun render = uvr("-q render " + two + " -o " + dir + "/t.png --field f", dir);
     expectOneLineError(render, {"--field 'f'", "2 point fields", "cannot tell them apart"},

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string_view>
 
 #include "uvr/core/error.h"
 
@@ -53,22 +54,69 @@ FieldSpec parseFieldSpec(const std::string& text) {
     return spec;
 }
 
+bool isIdFieldName(const std::string& name) {
+    static const char* const kExact[] = {"vtkGhostType", "vtkGhostLevels", "vtkValidPointMask",
+                                         "vtkProcessId", "ProcessId"};
+    for (const char* n : kExact)
+        if (name == n) return true;
+    auto endsWith = [&](std::string_view suffix) {
+        return name.size() > suffix.size() &&
+               std::string_view(name).substr(name.size() - suffix.size()) == suffix;
+    };
+    // Case matters: "Id" after a word ("GlobalNodeId"), not "fluid" or "void".
+    return endsWith("Id") || endsWith("ID") || endsWith("Ids") || endsWith("IDs") ||
+           endsWith("_id") || endsWith("_ids");
+}
+
+std::optional<std::size_t> defaultFieldIndex(const std::vector<FieldInfo>& fields) {
+    for (const bool ids : {false, true})
+        for (const bool vectors : {false, true})
+            for (const Association a : {Association::Point, Association::Cell})
+                for (std::size_t i = 0; i < fields.size(); ++i) {
+                    const FieldInfo& f = fields[i];
+                    if (f.association == a && (f.components > 1) == vectors &&
+                        isIdFieldName(f.name) == ids)
+                        return i;
+                }
+    return std::nullopt;
+}
+
+std::optional<std::size_t> defaultFieldIndex(const Mesh& mesh) {
+    std::vector<FieldInfo> infos;
+    infos.reserve(mesh.fields.size());
+    for (const Field& f : mesh.fields) infos.push_back({f.name, f.association, f.components});
+    return defaultFieldIndex(infos);
+}
+
+std::string ScalarField::describe() const {
+    return name + " (" + associationName(association) + " data)";
+}
+
 ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
     const Field* field = nullptr;
+    std::string choice;
     if (spec.name.empty()) {
-        for (const Field& f : mesh.fields)
-            if (f.components == 1 && (!spec.association || f.association == *spec.association)) {
-                field = &f;
-                break;
-            }
-        if (!field)
-            for (const Field& f : mesh.fields)
-                if (!spec.association || f.association == *spec.association) {
-                    field = &f;
-                    break;
+        if (spec.association) {  // ":cell" alone: the default among the cell fields
+            std::vector<FieldInfo> infos;
+            std::vector<std::size_t> index;
+            for (std::size_t i = 0; i < mesh.fields.size(); ++i)
+                if (mesh.fields[i].association == *spec.association) {
+                    infos.push_back({mesh.fields[i].name, mesh.fields[i].association,
+                                     mesh.fields[i].components});
+                    index.push_back(i);
                 }
+            if (const auto i = defaultFieldIndex(infos)) field = &mesh.fields[index[*i]];
+        } else if (const auto i = defaultFieldIndex(mesh)) {
+            field = &mesh.fields[*i];
+        }
         if (!field)
             throwError(ErrorKind::Argument, "", "no field to render: " + describeFields(mesh));
+        choice = isIdFieldName(field->name)
+                     ? "the default: the file holds only id arrays"
+                     : std::string("the default: the first ") +
+                           associationName(field->association) +
+                           (field->components == 1 ? "-data scalar field"
+                                                   : "-data field (no scalar field exists)");
     } else {
         int matches = 0, pointMatches = 0;
         for (const Field& f : mesh.fields) {
@@ -84,11 +132,13 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
                            (spec.association ? std::string(":") + associationName(*spec.association)
                                              : "") +
                            "' not found; " + describeFields(mesh));
-        if (matches == 2 && pointMatches == 1)
-            throwError(ErrorKind::Argument, "",
-                       "--field '" + spec.name +
-                           "' exists as point and cell data: add ':point' or ':cell'");
-        if (matches > 1) {
+        if (matches == 2 && pointMatches == 1) {
+            // The name exists as point and cell data: the point data, as ParaView prefers it.
+            for (const Field& f : mesh.fields)
+                if (f.name == spec.name && f.association == Association::Point) field = &f;
+            choice = "point data; the file also has cell data of this name: --field " + spec.name +
+                     ":cell selects it";
+        } else if (matches > 1) {
             const int cellMatches = matches - pointMatches;
             const std::string points = std::to_string(pointMatches) + " point";
             const std::string cells = std::to_string(cellMatches) + " cell";
@@ -106,7 +156,9 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
                    "--field '" + spec.name +
                        "': a scalar field; :x, :y, :z, :magnitude and a "
                        "component number select from vector fields (leave the qualifier out)");
-    return scalarFieldOf(mesh, *field, spec.component);
+    ScalarField out = scalarFieldOf(mesh, *field, spec.component);
+    out.choice = std::move(choice);
+    return out;
 }
 
 ScalarField scalarFieldOf(const Mesh& mesh, const Field& fieldRef, int component) {

@@ -10,7 +10,8 @@
 namespace uvr {
 
 /// Which field to render: "NAME[:point|:cell][:magnitude|:x|:y|:z|:N]"; an empty name means the
-/// default (the first field with one component, else the first field's magnitude).
+/// default (defaultFieldIndex). A name that exists as point and cell data means the point data,
+/// as ParaView prefers it; ":cell" selects the other.
 struct FieldSpec {
     std::string name;
     std::optional<Association> association;
@@ -27,7 +28,35 @@ struct ScalarField {
     std::string name;  ///< the field's name plus its component suffix when one was chosen
     Association association = Association::Point;
     std::vector<float> values;
+    /// How the field was chosen when the spec did not say everything, for the log: "the
+    /// default: ..." or "point data; pressure:cell selects the cell data" ("" otherwise).
+    std::string choice = {};
+
+    /// "pressure (point data)", for messages, logs and statistics.
+    std::string describe() const;
 };
+
+/// What choosing the default field needs to know of a field (a .uvrm header has it without
+/// reading any values).
+struct FieldInfo {
+    std::string name;
+    Association association = Association::Point;
+    int components = 1;
+};
+
+/// True for the names of id and bookkeeping arrays that writers add beside physical fields
+/// (GlobalNodeId, GlobalElementId, PedigreeIds, vtkOriginalCellIds, ObjectId, vtkGhostType, ...):
+/// a name ending in "Id", "ID", "Ids", "IDs", "_id" or "_ids", or a VTK ghost/mask array. Such a
+/// field is rendered when named, never chosen as the default while a physical field exists.
+bool isIdFieldName(const std::string& name);
+
+/// The field rendered when --field is not given, the same whatever the file format lists first
+/// (ParaView's preference): the first point-data scalar field, else the first cell-data scalar
+/// field, else the first point-data vector (its magnitude), else the first cell-data vector; id
+/// arrays (isIdFieldName) only when no other field exists. Empty for no fields.
+std::optional<std::size_t> defaultFieldIndex(const std::vector<FieldInfo>& fields);
+/// The same for a mesh's fields.
+std::optional<std::size_t> defaultFieldIndex(const Mesh& mesh);
 
 /// Resolves a spec against the mesh and extracts the scalar values; throws Error(Argument) naming
 /// the available fields when the name, association or component does not exist, or when a name

@@ -40,17 +40,58 @@ TEST(FieldSelect, VectorMagnitudeAndComponents) {
     EXPECT_EQ(finiteRange(mag.values), (std::pair<float, float>{0.f, 5.f}));
 }
 
-TEST(FieldSelect, PointAndCellOfTheSameNameNeedAQualifier) {
+TEST(FieldSelect, ANameOfPointAndCellDataMeansThePointData) {
     const Mesh m = meshWithFields();
     EXPECT_EQ(selectScalarField(m, parseFieldSpec("p:cell")).values, std::vector<float>{7});
     EXPECT_EQ(selectScalarField(m, parseFieldSpec("p:point")).values.size(), 4u);
-    try {
-        selectScalarField(m, parseFieldSpec("p"));
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_EQ(e.kind(), ErrorKind::Argument);
-        EXPECT_NE(std::string(e.what()).find(":cell"), std::string::npos);
-    }
+    EXPECT_EQ(selectScalarField(m, parseFieldSpec("p:point")).choice, "");
+    const ScalarField p = selectScalarField(m, parseFieldSpec("p"));
+    EXPECT_EQ(p.association, Association::Point);
+    EXPECT_EQ(p.values, (std::vector<float>{1, 2, 3, 4}));
+    EXPECT_NE(p.choice.find("--field p:cell"), std::string::npos) << p.choice;
+    EXPECT_EQ(p.describe(), "p (point data)");
+}
+
+TEST(FieldSelect, IdArrayNames) {
+    for (const char* id : {"GlobalNodeId", "GlobalElementId", "PedigreeIds", "vtkOriginalCellIds",
+                           "vtkOriginalPointIds", "ObjectId", "BlockId", "ElementID", "node_id",
+                           "cell_ids", "vtkGhostType", "vtkValidPointMask", "vtkProcessId"})
+        EXPECT_TRUE(isIdFieldName(id)) << id;
+    for (const char* physical : {"fluid", "void", "Id", "pressure", "VEL", "Acid", "rigid",
+                                 "temperature_idx", "density", "EQPS"})
+        EXPECT_FALSE(isIdFieldName(physical)) << physical;
+}
+
+TEST(FieldSelect, DefaultPrefersPhysicalPointScalarsWhateverTheOrder) {
+    using A = Association;
+    auto pick = [](std::vector<FieldInfo> f) {
+        const auto i = defaultFieldIndex(f);
+        return i ? f[*i].name : std::string("none");
+    };
+    EXPECT_EQ(pick({}), "none");
+    // Cell data listed first (as legacy VTK files write it) does not win over point data.
+    EXPECT_EQ(pick({{"pressure", A::Cell, 1}, {"pressure", A::Point, 1}}), "pressure");
+    EXPECT_EQ(defaultFieldIndex(std::vector<FieldInfo>{{"p", A::Cell, 1}, {"p", A::Point, 1}}),
+              std::optional<std::size_t>(1));
+    EXPECT_EQ(pick({{"GlobalNodeId", A::Point, 1}, {"EQPS", A::Cell, 1}, {"VEL", A::Point, 3}}),
+              "EQPS");
+    EXPECT_EQ(pick({{"GlobalNodeId", A::Point, 1}, {"VEL", A::Point, 3}, {"s", A::Cell, 3}}),
+              "VEL");
+    EXPECT_EQ(pick({{"v", A::Cell, 3}, {"w", A::Point, 3}}), "w");
+    EXPECT_EQ(pick({{"GlobalElementId", A::Cell, 1}, {"GlobalNodeId", A::Point, 1}}),
+              "GlobalNodeId");
+    EXPECT_EQ(pick({{"a", A::Point, 1}, {"b", A::Point, 1}}), "a");
+}
+
+TEST(FieldSelect, DefaultSaysWhyAndKeepsAnAssociation) {
+    Mesh m = meshWithFields();
+    m.fields.insert(m.fields.begin(), Field{"GlobalNodeId", Association::Point, 1, {0, 1, 2, 3}});
+    m.fields.insert(m.fields.begin(), Field{"c", Association::Cell, 1, {9}});
+    const ScalarField d = selectScalarField(m, parseFieldSpec(""));
+    EXPECT_EQ(d.describe(), "p (point data)");
+    EXPECT_NE(d.choice.find("the default"), std::string::npos) << d.choice;
+    EXPECT_EQ(selectScalarField(m, parseFieldSpec(":cell")).describe(), "c (cell data)");
+    EXPECT_EQ(selectScalarField(m, parseFieldSpec("GlobalNodeId")).values.size(), 4u);
 }
 
 TEST(FieldSelect, TwoPointFieldsOfTheSameNameAreNotCalledPointAndCell) {

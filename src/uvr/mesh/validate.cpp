@@ -113,32 +113,48 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
     return r;
 }
 
+std::vector<ValidationFinding> ValidationReport::structuredFindings() const {
+    std::vector<ValidationFinding> out;
+    auto cells = [&](const char* code, std::uint64_t n, const char* what, std::uint64_t first,
+                     const char* action) {
+        if (n)
+            out.push_back({code, n, "cell", first, "", action,
+                           std::to_string(n) + " " + what + " cell(s) (first: cell " +
+                               std::to_string(first) + "): " + action});
+    };
+    cells("inverted_cells", invertedCells, "inverted", firstInvertedCell,
+          "re-oriented for rendering");
+    cells("zero_volume_cells", zeroVolumeCells, "zero-volume", firstZeroVolumeCell,
+          "they contribute nothing");
+    cells("distorted_cells", distortedCells, "distorted (twisted or non-convex)",
+          firstDistortedCell, "split tetrahedra re-oriented individually");
+    if (coincidentPoints)
+        out.push_back({"coincident_points", coincidentPoints, "", 0, "", "",
+                       std::to_string(coincidentPoints) +
+                           " coincident point(s) (same position as an earlier point)"});
+    if (nonFinitePoints)
+        out.push_back({"non_finite_points", nonFinitePoints, "", 0, "",
+                       "cells using them are dropped (the bounds leave them out)",
+                       std::to_string(nonFinitePoints) +
+                           " point(s) with NaN/Inf coordinates: cells using them are dropped (the "
+                           "bounds leave them out)"});
+    if (unusedPoints)
+        out.push_back({"unused_points", unusedPoints, "", 0, "", "the bounds leave them out",
+                       std::to_string(unusedPoints) +
+                           " point(s) used by no cell (the bounds leave them out)"});
+    for (const NonFiniteField& f : nonFiniteFields)
+        out.push_back({"non_finite_field_values", f.count, associationName(f.association),
+                       f.firstTuple, f.name, "rendered transparent",
+                       std::string(associationName(f.association)) + " field '" + f.name +
+                           "': " + std::to_string(f.count) + " NaN/Inf value(s) (first at " +
+                           associationName(f.association) + " " + std::to_string(f.firstTuple) +
+                           "): rendered transparent"});
+    return out;
+}
+
 std::vector<std::string> ValidationReport::findings() const {
     std::vector<std::string> out;
-    auto cells = [&](std::uint64_t n, const char* what, std::uint64_t first, const char* action) {
-        if (n)
-            out.push_back(std::to_string(n) + " " + what + " cell(s) (first: cell " +
-                          std::to_string(first) + "): " + action);
-    };
-    cells(invertedCells, "inverted", firstInvertedCell, "re-oriented for rendering");
-    cells(zeroVolumeCells, "zero-volume", firstZeroVolumeCell, "they contribute nothing");
-    cells(distortedCells, "distorted (twisted or non-convex)", firstDistortedCell,
-          "split tetrahedra re-oriented individually");
-    if (coincidentPoints)
-        out.push_back(std::to_string(coincidentPoints) +
-                      " coincident point(s) (same position as an earlier point)");
-    if (nonFinitePoints)
-        out.push_back(std::to_string(nonFinitePoints) +
-                      " point(s) with NaN/Inf coordinates: cells using them are dropped (the "
-                      "bounds leave them out)");
-    if (unusedPoints)
-        out.push_back(std::to_string(unusedPoints) +
-                      " point(s) used by no cell (the bounds leave them out)");
-    for (const NonFiniteField& f : nonFiniteFields)
-        out.push_back(std::string(associationName(f.association)) + " field '" + f.name +
-                      "': " + std::to_string(f.count) + " NaN/Inf value(s) (first at " +
-                      associationName(f.association) + " " + std::to_string(f.firstTuple) +
-                      "): rendered transparent");
+    for (const ValidationFinding& f : structuredFindings()) out.push_back(f.message);
     return out;
 }
 

@@ -17,6 +17,21 @@ struct NonFiniteField {
     std::uint64_t firstTuple = 0;  ///< first point/cell index holding a NaN or Inf
 };
 
+/// One finding of validation, for machines (`uvr info --json`) and people (message).
+struct ValidationFinding {
+    /// What was found: inverted_cells, zero_volume_cells, distorted_cells, coincident_points,
+    /// non_finite_points, unused_points, non_finite_field_values.
+    std::string code;
+    std::uint64_t count = 0;
+    /// "cell", "point" or, for field values, the field's association; with `first`, the index
+    /// of the first cell/point concerned ("" when the finding names none).
+    std::string firstKind;
+    std::uint64_t first = 0;
+    std::string field;    ///< the field, for non_finite_field_values
+    std::string action;   ///< what uvr does about it ("re-oriented for rendering")
+    std::string message;  ///< the whole finding as one line
+};
+
 /// What validation found in a mesh; structural errors throw instead.
 struct ValidationReport {
     std::uint64_t invertedCells = 0;     ///< re-oriented when rendering
@@ -31,6 +46,8 @@ struct ValidationReport {
     /// non-zero volume); empty when nothing renders. Unused and NaN/Inf points lie outside it.
     Bounds3f bounds;
 
+    /// The findings, in the order findings() lists them.
+    std::vector<ValidationFinding> structuredFindings() const;
     /// Human-readable findings, one per line ("77 zero-volume cells (first: cell 1234)"); empty
     /// when the mesh is clean.
     std::vector<std::string> findings() const;

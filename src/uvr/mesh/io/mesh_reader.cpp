@@ -55,6 +55,11 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
                "VTK XML (.vtu/.pvtu) or a native uvr mesh (.uvrm)");
 }
 
+std::optional<MeshSummary> readMeshSummary(const std::string& path) {
+    if (sniffFormat(path) == Format::Native) return readNativeSummary(path);
+    return std::nullopt;
+}
+
 void checkMeshWritable(const std::string& path) {
     const std::string ext = fileExtension(path);
     if (ext != ".uvrm" && ext != ".vtu")

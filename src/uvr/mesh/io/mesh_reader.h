@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <optional>
 #include <string>
 
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
 #include "uvr/mesh/mesh.h"
 
@@ -11,6 +13,10 @@ namespace uvr {
 /// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .uvrm native), chosen by magic
 /// bytes first and extension second; throws Error naming the file on failure.
 Mesh readMesh(const std::string& path, const ReadOptions& options = {});
+
+/// The counts, cell types and fields of a file whose format has a header that holds them (.uvrm),
+/// without reading its arrays; empty for formats that must be read whole to know them.
+std::optional<MeshSummary> readMeshSummary(const std::string& path);
 
 /// Writes a mesh in the format its extension names (.uvrm native or .vtu); throws
 /// Error(Argument) for other extensions. The file is written atomically.

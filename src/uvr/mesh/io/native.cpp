@@ -134,6 +134,13 @@ public:
         }
         offset_ += bytes;
     }
+    /// Moves to byte `offset` (within the file).
+    void seek(std::uint64_t offset) {
+        if (::fseeko(file_.get(), static_cast<off_t>(offset), SEEK_SET) != 0)
+            throwError(ErrorKind::Io, path_,
+                       "cannot seek to " + atByte(offset) + ": " + std::strerror(errno));
+        offset_ = offset;
+    }
     /// Skips zero padding up to the next multiple of 8.
     void alignTo8(const std::string& what) {
         unsigned char pad[8];
@@ -147,12 +154,16 @@ private:
     FilePtr file_{nullptr, &std::fclose};
 };
 
-}  // namespace
+/// What the header and descriptors say, checked against the file size: the counts, the fields
+/// and where every array lies (points, cellTypes, cellOffsets, cellIndices, then the fields').
+struct NativeLayout {
+    std::uint64_t pointCount = 0, cellCount = 0, indexCount = 0;
+    std::vector<FieldDescriptor> descriptors;
+    std::vector<ArraySpan> arrays;
+};
 
-Mesh readNative(const std::string& path, const ReadOptions& options) {
-    const std::uint64_t size = fileSize(path);
-    Reader in(path, size);
-
+/// Reads and checks the header and the field descriptors (the reader is left after them).
+NativeLayout readLayout(Reader& in, const std::string& path, std::uint64_t size) {
     // Header.
     if (size < kHeaderBytes)
         throwParseError(path, atByte(size),
@@ -244,6 +255,10 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
     }
 
     // Array layout: the exact size the counts imply must be the file size.
+    NativeLayout layout;
+    layout.pointCount = pointCount;
+    layout.cellCount = cellCount;
+    layout.indexCount = indexCount;
     std::vector<ArraySpan> arrays = {{"points", pointCount, 12},
                                      {"cellTypes", cellCount, 1},
                                      {"cellOffsets", addSat(cellCount, 1), 8},
@@ -269,6 +284,22 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
         throwParseError(path, atByte(cursor),
                         "expected the file to end after the last array at " + atByte(cursor) +
                             ", but it has " + std::to_string(size) + " bytes");
+    layout.descriptors = std::move(descriptors);
+    layout.arrays = std::move(arrays);
+    return layout;
+}
+
+}  // namespace
+
+Mesh readNative(const std::string& path, const ReadOptions& options) {
+    const std::uint64_t size = fileSize(path);
+    Reader in(path, size);
+    NativeLayout layout = readLayout(in, path, size);
+    const std::vector<ArraySpan>& arrays = layout.arrays;
+    std::vector<FieldDescriptor>& descriptors = layout.descriptors;
+    const std::uint64_t pointCount = layout.pointCount, cellCount = layout.cellCount,
+                        indexCount = layout.indexCount;
+    const auto fieldCount = static_cast<std::uint32_t>(descriptors.size());
     for (const ArraySpan& a : arrays)
         checkAllocation(path, a.what, a.count, a.elementBytes, options.maxMemoryBytes);
     const BudgetedOptions budgeted(options);
@@ -303,6 +334,41 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
 
     validateStructure(mesh, path);
     return mesh;
+}
+
+MeshSummary readNativeSummary(const std::string& path) {
+    const std::uint64_t size = fileSize(path);
+    Reader in(path, size);
+    const NativeLayout layout = readLayout(in, path, size);
+    MeshSummary summary;
+    summary.pointCount = layout.pointCount;
+    summary.cellCount = layout.cellCount;
+    summary.fileBytes = size;
+    for (const FieldDescriptor& d : layout.descriptors)
+        summary.fields.push_back({d.name,
+                                  d.association == 0 ? Association::Point : Association::Cell,
+                                  static_cast<int>(d.components)});
+    // The cell types (one byte per cell) are counted in chunks: nothing else is read.
+    const ArraySpan& types = layout.arrays[1];
+    in.seek(types.start);
+    std::vector<unsigned char> chunk(std::min<std::uint64_t>(types.count, 1u << 20));
+    for (std::uint64_t done = 0; done < types.count;) {
+        const std::uint64_t n = std::min<std::uint64_t>(chunk.size(), types.count - done);
+        in.read(chunk.data(), n, types.what);
+        for (std::uint64_t i = 0; i < n; ++i) {
+            const auto t = static_cast<CellType>(chunk[i]);
+            if (t != CellType::Tetra && t != CellType::Hexahedron && t != CellType::Wedge &&
+                t != CellType::Pyramid)
+                throwParseError(path, atByte(types.start + done + i),
+                                "cell " + std::to_string(done + i) + ": cell type " +
+                                    std::to_string(chunk[i]) +
+                                    ", expected 10 (tetra), 12 (hexahedron), 13 (wedge) or 14 "
+                                    "(pyramid)");
+            ++summary.cellTypes[t];
+        }
+        done += n;
+    }
+    return summary;
 }
 
 void writeNative(const Mesh& mesh, const std::string& path) {

@@ -17,7 +17,8 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
     const std::uint64_t pointCount = mesh.pointCount();
     std::vector<std::uint64_t> kept;
     kept.reserve(n);
-    std::map<std::string, std::uint64_t> dropped;
+    std::map<std::string, std::uint64_t> dropped, reduced;
+    std::uint64_t voxels = 0;
     std::uint32_t ids[8];
     const std::uint64_t firstNewCell = mesh.cellCount();
     for (std::uint64_t c = 0; c < n; ++c) {
@@ -59,6 +60,9 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
         if (cells.types[c] == 11) {  // voxel order 0,1,3,2,4,5,7,6 -> hexahedron order
             std::swap(ids[2], ids[3]);
             std::swap(ids[6], ids[7]);
+            ++voxels;
+        } else if (cells.types[c] != static_cast<int>(info.linear)) {
+            ++reduced[info.name];  // quadratic or Lagrange: its corners only
         }
         mesh.addCell(info.linear, {ids, static_cast<std::size_t>(corners)});
         kept.push_back(c);
@@ -66,6 +70,14 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
     for (const auto& [name, count] : dropped)
         mesh.notes.push_back("dropped " + std::to_string(count) + " non-volumetric " + name +
                              " cell(s)");
+    if (voxels)
+        mesh.notes.push_back("read " + std::to_string(voxels) +
+                             " voxel cell(s) as hexahedra (the same cells, corners reordered)");
+    for (const auto& [name, count] : reduced)
+        mesh.notes.push_back(
+            "reduced " + std::to_string(count) + " " + name +
+            " cell(s) to their corner nodes: their mid-edge and higher-order nodes are used by "
+            "no cell, and fields are interpolated between the corners");
     // Filter cell data of this batch to the kept cells (tuples beyond firstNewCell belong to it).
     if (kept.size() != n) {
         for (Field& f : mesh.fields) {
