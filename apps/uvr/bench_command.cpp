@@ -116,7 +116,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
         ctx.step("field " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice));
-        const RenderSettings base = flags->settings(mesh.bounds(), *file);
+        std::vector<std::string> notes;
+        const RenderSettings base = flags->settings(mesh.bounds(), *file, &notes);
+        for (const std::string& note : notes) ctx.step("note: " + note);
         ctx.setActivity(*file, "preparing the mesh and rendering it");
         const std::optional<Vec3f> background = flags->backgroundColor();
         const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
@@ -280,6 +282,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["mesh_bvh_seconds"] = prepared.bvhSeconds;
                 j["bvh_build_device"] = prepared.builtElsewhere ? "cuda" : "cpu";
                 j["image"] = {base.width, base.height};
+                j["supersample"] = base.supersample;  // samples per pixel sum its rays
                 j["s1"] = s1;
                 j["step_rule"] = base.stepRule == StepRule::ErrorBound ? "error" : "variance";
                 j["quality"] = base.quality;

@@ -231,7 +231,16 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--camera-position", cameraPosition, "Camera position x,y,z");
     app.add_option("--camera-focal", cameraFocal, "Camera focal point x,y,z");
     app.add_option("--camera-up", cameraUp, "Camera view up x,y,z");
-    app.add_option("--view-angle", viewAngle, "Vertical view angle in degrees (default 30)");
+    app.add_option("--view-angle", viewAngle,
+                   "Vertical view angle in degrees (default 30; perspective projection only)");
+    app.add_flag("--parallel", parallel,
+                 "Parallel (orthographic) projection, as ParaView's CameraParallelProjection: "
+                 "every ray along the view direction, starting on the plane through the camera");
+    app.add_option("--parallel-scale", parallelScale,
+                   "With --parallel (or a parallel .pvcc): half the image height in world units, "
+                   "as ParaView's CameraParallelScale (default: the camera file's, else the "
+                   "bounding sphere's radius as ParaView's reset camera sets it)")
+        ->check(positiveNumber());
     app.add_option("--azimuth", azimuth, "Rotate the camera about view up, degrees")
         ->capture_default_str();
     app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees")
@@ -301,6 +310,18 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                        "Sample count at the top of the heat map scale (default: the frame's "
                        "maximum)");
     }
+    {
+        char help[240];
+        std::snprintf(help, sizeof help,
+                      "Anti-aliasing: N x N rays per pixel (1 to %d), their premultiplied colours "
+                      "averaged; a pixel's sample count (--heatmap, --stats) sums its rays "
+                      "(default 1: one ray through the pixel's centre)",
+                      kMaxSupersample);
+        app.add_option("--supersample", supersample, help)->capture_default_str();
+    }
+    app.add_flag("--jitter", jitter,
+                 "With --supersample N: each ray at a fixed pseudo-random place in its cell of "
+                 "the N x N grid instead of its centre (the same rays every run and device)");
     app.add_option("--background", background,
                    "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
         ->capture_default_str();
@@ -318,7 +339,8 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--threads", threads, threadsHelp())->capture_default_str();
 }
 
-RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& source) const {
+RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& source,
+                                     std::vector<std::string>* notes) const {
     RenderSettings s;
     std::tie(s.width, s.height) = parseSize("--size", size);
     s.tf = loadTransferFunction(tf);
@@ -356,6 +378,16 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
         throwError(ErrorKind::Argument, "",
                    "--sampling applies to the reference and adaptive methods; exact does not "
                    "sample");
+    if (!(supersample >= 1 && supersample <= kMaxSupersample))
+        throwError(ErrorKind::Argument, "",
+                   "--supersample " + std::to_string(supersample) + ": expected 1 to " +
+                       std::to_string(kMaxSupersample) + " (N x N rays per pixel)");
+    if (jitter && supersample < 2)
+        throwError(ErrorKind::Argument, "",
+                   "--jitter moves the rays of --supersample N inside the pixel: it needs "
+                   "--supersample 2 or more");
+    s.supersample = supersample;
+    s.jitter = jitter;
     // The camera file, else the default camera fitted to the bounds (its error names the mesh)
     // where camera flags leave its position or focal point to it; with no camera flag the
     // renderer resets the camera itself.
@@ -363,22 +395,84 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     bool custom = false;
     const bool placed = !cameraPosition.empty() && !cameraFocal.empty();
     const bool adjusted = !cameraPosition.empty() || !cameraFocal.empty() || !cameraUp.empty() ||
-                          viewAngle || azimuth != 0.f || elevation != 0.f;
-    if (!cameraFile.empty()) {
-        cam = loadPvcc(cameraFile), custom = true;
-    } else if (adjusted && !placed) {
+                          viewAngle || azimuth != 0.f || elevation != 0.f || parallel ||
+                          parallelScale;
+    const float aspect = float(s.width) / float(s.height);
+    const auto reset = [&] {
         try {
-            cam = resetCamera(bounds, float(s.width) / float(s.height));
+            return resetCamera(bounds, aspect);
         } catch (const Error& e) {
             if (source.empty()) throw;
             throwError(e.kind(), source, e.what());
         }
+    };
+    bool fileScale = false;
+    if (!cameraFile.empty()) {
+        cam = loadPvcc(cameraFile, &fileScale), custom = true;
+    } else if (adjusted && !placed) {
+        cam = reset();
     }
+    // Parallel projection: --parallel, or the camera file's. Its scale: --parallel-scale, else
+    // the camera file's, else ParaView's reset value (the bounding sphere's radius).
+    const std::string parallelSource = parallel ? "--parallel" : "the camera file " + cameraFile;
+    if (parallel) {
+        if (!cam.parallelProjection && !fileScale && !parallelScale &&
+            (placed || !cameraFile.empty()))
+            cam.parallelScale = reset().parallelScale;
+        cam.parallelProjection = true, custom = true;
+    }
+    if (parallelScale) {
+        if (!cam.parallelProjection)
+            throwError(ErrorKind::Argument, "",
+                       "--parallel-scale sets the half height of a parallel projection: it needs "
+                       "--parallel (or a .pvcc with CameraParallelProjection 1)");
+        cam.parallelScale = *parallelScale, custom = true;
+    }
+    if (viewAngle && cam.parallelProjection)
+        throwError(ErrorKind::Argument, "",
+                   "--view-angle sets the perspective view angle, which parallel projection (" +
+                       parallelSource +
+                       ") does not have: use --parallel-scale for the half height of the view");
+    const bool fileUp = !cameraFile.empty() && cameraUp.empty();
     if (!cameraPosition.empty())
         cam.position = parseVec3("--camera-position", cameraPosition), custom = true;
     if (!cameraFocal.empty())
         cam.focalPoint = parseVec3("--camera-focal", cameraFocal), custom = true;
     if (!cameraUp.empty()) cam.viewUp = parseVec3("--camera-up", cameraUp), custom = true;
+    // A view up parallel to the view direction cannot orient the image. The default one (+Y) is
+    // replaced as ParaView's view-direction buttons do (+Z up when looking along Y); one the
+    // user gave is refused with how to fix it.
+    if (isFinite(cam.position) && isFinite(cam.focalPoint) && isFinite(cam.viewUp) &&
+        cam.position != cam.focalPoint &&
+        viewUpParallel(cam.position, cam.focalPoint, cam.viewUp)) {
+        const Vec3f dir = normalize(cam.focalPoint - cam.position);
+        std::ostringstream d;
+        d << dir.x << "," << dir.y << "," << dir.z;
+        if (cameraUp.empty() && !fileUp) {
+            const Vec3f up = defaultViewUp(cam.position, cam.focalPoint);
+            std::ostringstream u;
+            u << up.x << "," << up.y << "," << up.z;
+            if (notes)
+                notes->push_back("the default view up 0,1,0 is parallel to the view direction " +
+                                 d.str() + ": using --camera-up " + u.str() +
+                                 " (give --camera-up to choose another)");
+            cam.viewUp = up;
+        } else {
+            // Suggest the axis most across the view direction.
+            const Vec3f axes[3] = {{0.f, 1.f, 0.f}, {0.f, 0.f, 1.f}, {1.f, 0.f, 0.f}};
+            const char* names[3] = {"0,1,0", "0,0,1", "1,0,0"};
+            int best = 0;
+            for (int k = 1; k < 3; ++k)
+                if (std::fabs(dot(dir, axes[k])) < std::fabs(dot(dir, axes[best]))) best = k;
+            std::ostringstream u;
+            u << cam.viewUp.x << "," << cam.viewUp.y << "," << cam.viewUp.z;
+            throwError(
+                ErrorKind::Argument, fileUp ? cameraFile : "",
+                (fileUp ? "view up " + u.str() + " (CameraViewUp)" : "--camera-up " + cameraUp) +
+                    " is zero or parallel to the view direction " + d.str() +
+                    ": pass a --camera-up across it, e.g. --camera-up " + names[best]);
+        }
+    }
     if (viewAngle) {
         if (!(*viewAngle >= kMinViewAngle && *viewAngle <= kMaxViewAngle)) {
             std::ostringstream os;
@@ -584,7 +678,9 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                              "NaN/Inf points; nothing to render");
     // Every flag is parsed before the expensive preparation, so a bad flag fails fast. The
     // camera fits the rendered cells (unused and NaN/Inf points and flat cells left out).
-    RenderSettings settings = flags.settings(report.bounds, source);
+    std::vector<std::string> notes;
+    RenderSettings settings = flags.settings(report.bounds, source, &notes);
+    for (const std::string& note : notes) ctx.step("note: " + note);
     validateSettings(settings);
     settings.progress = progressPrinter(ctx, "rendering");
     ctx.setActivity(source, "preparing the mesh for rendering");
@@ -592,7 +688,12 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                                         [&](const std::string& s) { ctx.step(s); });
     ctx.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
     ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
-             " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height));
+             " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
+             (settings.supersample > 1
+                  ? " with " + std::to_string(settings.supersample) + "x" +
+                        std::to_string(settings.supersample) + " rays per pixel" +
+                        (settings.jitter ? " (jittered)" : "")
+                  : std::string()));
     ctx.setActivity(source, "rendering it at " + std::to_string(settings.width) + "x" +
                                 std::to_string(settings.height));
     FrameRenderer renderer(prepared, flags.useCuda(), ctx);
@@ -677,6 +778,10 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
             j["partitions_skipped"] = result.stats.partitionsSkipped;
         }
         j["image"] = {{"width", settings.width}, {"height", settings.height}};
+        // Anti-aliasing: a pixel's samples are summed over its supersample^2 rays.
+        j["supersample"] = settings.supersample;
+        if (settings.supersample > 1) j["jitter"] = settings.jitter;
+        j["rays"] = result.stats.rays();
         j["mesh"] = {{"points", mesh.pointCount()},
                      {"cells", mesh.cellCount()},
                      {"tetrahedra", prepared.tets.tets.size()}};
@@ -686,6 +791,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["render_seconds"] = result.stats.seconds;
         j["samples"] = result.stats.samples;
         j["mean_samples_per_pixel"] = result.stats.meanSamplesPerPixel();
+        j["mean_samples_per_ray"] = result.stats.meanSamplesPerRay();
         j["max_samples_per_pixel"] =
             *std::max_element(result.sampleCounts.begin(), result.sampleCounts.end());
         j["samples_per_second"] =
@@ -706,7 +812,10 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
             {"position", {number(position[0]), number(position[1]), number(position[2])}},
             {"focal_point", {number(focal[0]), number(focal[1]), number(focal[2])}},
             {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
-            {"view_angle", c.viewAngle}};
+            {"view_angle", c.viewAngle},
+            {"parallel_projection", c.parallelProjection}};
+        if (c.parallelProjection)
+            j["camera"]["parallel_scale"] = number(c.parallelScale / frame.scale);
         outputs.push_back(std::make_unique<OutputFile>(flags.statsFile));
         outputs.back()->write(jsonText(j) + "\n");
     }

@@ -73,7 +73,11 @@ struct RenderFlags {
     std::string size = "1024x1024";
     std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
     std::optional<float> viewAngle;
+    bool parallel = false;               ///< --parallel: parallel projection
+    std::optional<float> parallelScale;  ///< unset: the camera file's, else the reset camera's
     float azimuth = 0.f, elevation = 0.f;
+    int supersample = 1;  ///< N x N rays per pixel
+    bool jitter = false;  ///< jittered sub-pixel rays (needs supersample > 1)
     float step = 0.f;
     float opacityUnit = 0.f;
     std::string method = "adaptive";
@@ -97,8 +101,11 @@ struct RenderFlags {
     /// heat map, stats), which `bench` chooses itself.
     void registerOn(CLI::App& app, bool oneFrame = true);
     /// Parses the flags into render settings; the default camera fits the bounds (of the mesh
-    /// named source, which an error resetting the camera names).
-    RenderSettings settings(const Bounds3f& bounds, const std::string& source = "") const;
+    /// named source, which an error resetting the camera names). Choices made for the user (a
+    /// view up picked because the default one is parallel to the view direction) are appended
+    /// to notes when given, for the caller to print.
+    RenderSettings settings(const Bounds3f& bounds, const std::string& source = "",
+                            std::vector<std::string>* notes = nullptr) const;
     /// The --background colour, if given (checked to lie in [0, 1]).
     std::optional<Vec3f> backgroundColor() const;
     /// The files a single render writes (-o, --heatmap, --stats), for checks before any work.

@@ -8,7 +8,8 @@ integrated in closed form by vtkUnstructuredGridLinearRayIntegrator, Williams, M
   vtk_oracle.py MESH -o OUT.png --tf MAP.json [--field NAME] [--range LO,HI]
                 [--opacity-unit U] [--camera FILE.pvcc | --camera-position X,Y,Z
                 --camera-focal X,Y,Z] [--camera-up X,Y,Z] [--view-angle DEG]
-                [--azimuth DEG] [--elevation DEG] [--size WxH] [--background R,G,B]
+                [--parallel] [--parallel-scale S] [--azimuth DEG] [--elevation DEG]
+                [--size WxH] [--background R,G,B]
 
 Run it with Debian's /usr/bin/python3 (python3-vtk9, numpy). VTK 9.1's X11 render window needs
 an X display even off-screen: where there is none, run it under `xvfb-run -a`.
@@ -29,9 +30,9 @@ integration", src/uvr/render/camera.cpp, src/uvr/tf/paraview_json.cpp):
   control points and read the opacity function only there (see resample).
 - mesh: other cells are split into tetrahedra; zero-volume tetrahedra are dropped, as uvr does
   (the Bunyk caster loses the rays that meet one).
-- camera: a .pvcc file (position, focal point, view up, vertical view angle), or position and
-  focal point, or VTK's ResetCamera (ParaView's, which uvr mimics); then vtkCamera's Azimuth
-  and Elevation. uvr casts one ray through each pixel centre; the mapper's rays and the texture
+- camera: a .pvcc file (position, focal point, view up, vertical view angle, and its parallel
+  projection and scale), or position and focal point, or VTK's ResetCamera (ParaView's, which
+  uvr mimics); then vtkCamera's Azimuth and Elevation. uvr casts one ray through each pixel centre; the mapper's rays and the texture
   that shows them are laid out differently, so VTK's projection is adapted (see ray_grid and
   set_camera) to cast exactly uvr's rays.
 - image: premultiplied colour composited over --background (default black) into 8-bit RGB,
@@ -295,7 +296,8 @@ def resample(colour, opacity, knots, lo, hi, model, tolerance):
 
 
 def load_pvcc(path):
-    """Position, focal point, view up and view angle of a ParaView camera file (.pvcc)."""
+    """Position, focal point, view up, view angle, parallel projection and parallel scale (None
+    when absent) of a ParaView camera file (.pvcc)."""
     try:
         root = ElementTree.parse(path).getroot()
     except (OSError, ElementTree.ParseError) as e:
@@ -308,10 +310,12 @@ def load_pvcc(path):
     for name, count in need.items():
         if len(props.get(name, [])) != count:
             fail(f"{path}: expected property {name} with {count} element(s)")
-    if props.get("CameraParallelProjection", [0])[0] != 0:
-        fail(f"{path}: parallel projection is not supported")
+    parallel = props.get("CameraParallelProjection", [0])[0] != 0
+    scale = props.get("CameraParallelScale", [None])[0]
+    if parallel and not (scale and scale > 0):
+        fail(f"{path}: parallel projection needs a positive CameraParallelScale")
     return (props["CameraPosition"], props["CameraFocalPoint"], props["CameraViewUp"],
-            props["CameraViewAngle"][0])
+            props["CameraViewAngle"][0], parallel, scale)
 
 
 def ray_grid(width, height):
@@ -344,12 +348,14 @@ def set_camera(renderer, args, grid_size):
       centre at (1 / mx, 1 / my) (vtkCamera's frustum shift: ndc = tan / tan(half) - centre).
     Returns the camera as uvr sees it."""
     camera = renderer.GetActiveCamera()
+    parallel, scale = args.parallel, None
     if args.camera:
-        position, focal, up, angle = load_pvcc(args.camera)
+        position, focal, up, angle, file_parallel, scale = load_pvcc(args.camera)
         camera.SetPosition(*position)
         camera.SetFocalPoint(*focal)
         camera.SetViewUp(*up)
         camera.SetViewAngle(angle)
+        parallel = parallel or file_parallel
     elif args.camera_position or args.camera_focal:
         if not (args.camera_position and args.camera_focal):
             fail("--camera-position and --camera-focal go together")
@@ -357,8 +363,18 @@ def set_camera(renderer, args, grid_size):
         camera.SetFocalPoint(*parse_floats(args.camera_focal, 3, "--camera-focal"))
     else:
         # ParaView's reset camera: a fresh vtkCamera looks down -Z with +Y up, view angle 30
-        # degrees, and ResetCamera fits the bounding sphere into the view.
+        # degrees, and ResetCamera fits the bounding sphere into the view (and sets the parallel
+        # scale to its radius).
         renderer.ResetCamera()
+        scale = camera.GetParallelScale()
+    if args.parallel_scale is not None:
+        scale = args.parallel_scale
+    if parallel:
+        if scale is None:
+            fail("--parallel with a camera file without CameraParallelScale needs "
+                 "--parallel-scale")
+        camera.ParallelProjectionOn()
+        camera.SetParallelScale(scale)
     if args.camera_up:
         camera.SetViewUp(*parse_floats(args.camera_up, 3, "--camera-up"))
     if args.view_angle is not None:
@@ -369,11 +385,17 @@ def set_camera(renderer, args, grid_size):
         camera.Elevation(args.elevation)
         camera.OrthogonalizeViewUp()
     seen = {"position": camera.GetPosition(), "focal": camera.GetFocalPoint(),
-            "up": camera.GetViewUp(), "angle": camera.GetViewAngle()}
+            "up": camera.GetViewUp(), "angle": camera.GetViewAngle(),
+            "parallel_scale": camera.GetParallelScale() if parallel else None}
 
     mx, my = grid_size
-    half = math.radians(0.5 * camera.GetViewAngle())
-    camera.SetViewAngle(math.degrees(2.0 * math.atan(math.tan(half) * my / (my - 1))))
+    if parallel:
+        # uvr's parallel rays sit at offsets scale * ((2p + 1) / height - 1) from the centre, as
+        # its perspective rays sit at those tangents: the same adaptation.
+        camera.SetParallelScale(camera.GetParallelScale() * my / (my - 1))
+    else:
+        half = math.radians(0.5 * camera.GetViewAngle())
+        camera.SetViewAngle(math.degrees(2.0 * math.atan(math.tan(half) * my / (my - 1))))
     camera.SetUseExplicitAspectRatio(True)
     camera.SetExplicitAspectRatio(mx / my)
     camera.SetWindowCenter(1.0 / mx, 1.0 / my)
@@ -536,6 +558,11 @@ def make_parser():
     parser.add_argument("--camera-focal", help="camera focal point x,y,z")
     parser.add_argument("--camera-up", help="camera view up x,y,z")
     parser.add_argument("--view-angle", type=float, help="vertical view angle, degrees")
+    parser.add_argument("--parallel", action="store_true",
+                        help="parallel projection (as the .pvcc's CameraParallelProjection)")
+    parser.add_argument("--parallel-scale", type=float,
+                        help="half the view height with --parallel (default: the .pvcc's, else "
+                             "ResetCamera's, the bounding sphere's radius)")
     parser.add_argument("--azimuth", type=float, default=0.0,
                         help="rotate the camera about view up, degrees (vtkCamera::Azimuth)")
     parser.add_argument("--elevation", type=float, default=0.0,

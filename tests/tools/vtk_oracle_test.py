@@ -12,8 +12,9 @@ Usage: vtk_oracle_test.py --uvr PATH/TO/uvr --data SHARED_DATA_DIR
 
 Cases: Blunt Fin (density) and the Oxygen Post (speed), each with two transfer functions
 (tests/data/oracle/*.json: a cool-to-warm Diverging map with an opacity ramp, a black-body Lab
-map with two opacity bands) and two views (ParaView's reset camera orbited with --azimuth 35
---elevation 25, each tool doing its own orbit; a ParaView .pvcc camera). uvr renders each case
+map with two opacity bands) and three views (ParaView's reset camera orbited with --azimuth 35
+--elevation 25, each tool doing its own orbit; a ParaView .pvcc camera; the orbit in parallel
+projection, --parallel, with the reset camera's parallel scale). uvr renders each case
 with every method in --methods; those in --assert-methods must reach --min-ssim, the others
 are reported. Images go to a temporary folder removed at the end (unless --keep).
 
@@ -41,9 +42,10 @@ TRANSFER_FUNCTIONS = ["ramp_cool_to_warm.json", "bands_lab.json"]
 
 
 def views(pvcc):
-    """The two views: (name, flags shared by uvr and the oracle)."""
+    """The three views: (name, flags shared by uvr and the oracle)."""
     return [("orbit", ["--azimuth", "35", "--elevation", "25"]),
-            ("pvcc", ["--camera", os.path.join(ORACLE_DATA, pvcc)])]
+            ("pvcc", ["--camera", os.path.join(ORACLE_DATA, pvcc)]),
+            ("parallel", ["--azimuth", "35", "--elevation", "25", "--parallel"])]
 
 
 def skip(message):

@@ -60,8 +60,13 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     result.setup = makeFrameSetup(mesh, settings);
     result.image = Image(settings.width, settings.height);
     result.sampleCounts.assign(result.image.pixels.size(), 0);
-    const FrameView frame{result.image.pixels.data(), result.sampleCounts.data(), settings.width,
-                          settings.height, result.setup.rays};
+    const FrameView frame{result.image.pixels.data(),
+                          result.sampleCounts.data(),
+                          settings.width,
+                          settings.height,
+                          result.setup.rays,
+                          settings.supersample,
+                          settings.jitter && settings.supersample > 1};
     const auto start = std::chrono::steady_clock::now();
     if (settings.method == RenderMethod::Reference)
         launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)},
@@ -76,6 +81,7 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;
     result.stats.height = settings.height;
+    result.stats.supersample = settings.supersample;
     return result;
 }
 

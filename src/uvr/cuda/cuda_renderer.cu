@@ -287,8 +287,13 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     d.pixels.reserve(pixelCount, "the image");
     d.sampleCounts.reserve(pixelCount, "the sample counts");
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
-    const FrameView frame{d.pixels.data(), d.sampleCounts.data(), settings.width, settings.height,
-                          result.setup.rays};
+    const FrameView frame{d.pixels.data(),
+                          d.sampleCounts.data(),
+                          settings.width,
+                          settings.height,
+                          result.setup.rays,
+                          settings.supersample,
+                          settings.jitter && settings.supersample > 1};
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);
@@ -343,6 +348,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     result.stats.seconds = ms * 1e-3;
     result.stats.width = settings.width;
     result.stats.height = settings.height;
+    result.stats.supersample = settings.supersample;
     result.stats.samples = totals[0];
     result.stats.walkSteps = totals[1];
     result.stats.bvhQueries = totals[2];

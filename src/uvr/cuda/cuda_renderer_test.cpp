@@ -82,6 +82,34 @@ TEST(Cuda, ProceduralMeshMatchesCpuForEveryMethod) {
     expectSameAsCpu(pm, s, "skipping only");
 }
 
+TEST(Cuda, ParallelProjectionAndSupersamplingMatchCpuForEveryMethod) {
+    // The shared pixel kernel's N x N rays (stratified and jittered) and the parallel camera's
+    // per-pixel origins, on both devices.
+    UVR_REQUIRE_GPU();
+    Mesh m = testing::makeHexGrid(
+        12, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+    PrepareOptions o;
+    o.kd.leafCells = 128;
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
+    for (RenderMethod method :
+         {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
+        RenderSettings s = settingsFor(pm, method);
+        s.camera->parallelProjection = true;
+        s.camera->parallelScale = 1.2f;
+        s.supersample = 3;
+        expectSameAsCpu(pm, s, "parallel, supersample 3");
+        s.jitter = true;
+        s.camera->parallelProjection = false;
+        expectSameAsCpu(pm, s, "perspective, supersample 3, jittered");
+        CudaScene gpu(pm);
+        const RenderResult g = gpu.render(s);
+        EXPECT_EQ(g.stats.supersample, 3);
+        std::uint64_t sum = 0;
+        for (std::uint32_t c : g.sampleCounts) sum += c;
+        EXPECT_EQ(sum, g.stats.samples);
+    }
+}
+
 TEST(Cuda, RealMeshesMatchCpu) {
     UVR_REQUIRE_GPU();
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";

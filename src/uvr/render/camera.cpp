@@ -210,7 +210,56 @@ Camera resetCamera(const Bounds3f& bounds, float aspect) {
     cam.focalPoint = toFloat(focal, "the reset camera's focal point");
     cam.position = toFloat(focal + Vec3d{0.0, 0.0, distance}, "the reset camera");
     cam.viewUp = Vec3f(0.f, 1.f, 0.f);
+    // vtkRenderer::ResetCamera: the parallel scale shows the sphere's diameter vertically, or
+    // horizontally when the image is taller than wide.
+    const double scale = aspect < 1.f ? radius / aspect : radius;
+    cam.parallelScale = static_cast<float>(std::fmin(scale, double(FLT_MAX)));
     return cam;
+}
+
+namespace {
+
+/// Sine of the angle between the view direction from position to focal point and `up` (0 for a
+/// zero up), in double; the points must be distinct.
+double viewUpSine(Vec3f position, Vec3f focalPoint, Vec3f upF) {
+    const Vec3d offset = toDouble(focalPoint) - toDouble(position);
+    const Vec3d dir = offset * (1.0 / std::sqrt(dot(offset, offset)));
+    const Vec3d up = toDouble(upF);
+    const double upLen = std::sqrt(dot(up, up));
+    if (!(upLen > 0.0)) return 0.0;
+    const Vec3d sine = cross(dir, up * (1.0 / upLen));
+    return std::sqrt(dot(sine, sine));
+}
+
+/// Smallest sine between view up and view direction that orients an image.
+constexpr double kMinViewUpSine = 1e-4;
+
+/// Whether two finite points are far enough apart to define a view direction: more than two
+/// float spacings of their coordinates (in double: the offset of float points near 1e38
+/// overflows float and that of points 1e-30 apart underflows its square).
+bool pointsDistinct(Vec3f position, Vec3f focalPoint) {
+    const Vec3d offset = toDouble(focalPoint) - toDouble(position);
+    const double dist = std::sqrt(dot(offset, offset));
+    const double scale = std::max(maxComponent(vmax(position, -position)),
+                                  maxComponent(vmax(focalPoint, -focalPoint)));
+    return dist > 0.0 && dist > 2.0 * FLT_EPSILON * scale;
+}
+
+/// Whether every component of v lies within float's range.
+bool fitsFloat(Vec3d v) {
+    return std::fabs(v.x) <= double(FLT_MAX) && std::fabs(v.y) <= double(FLT_MAX) &&
+           std::fabs(v.z) <= double(FLT_MAX);
+}
+
+}  // namespace
+
+bool viewUpParallel(Vec3f position, Vec3f focalPoint, Vec3f up) {
+    return !(viewUpSine(position, focalPoint, up) >= kMinViewUpSine);
+}
+
+Vec3f defaultViewUp(Vec3f position, Vec3f focalPoint) {
+    const Vec3f y(0.f, 1.f, 0.f);
+    return viewUpParallel(position, focalPoint, y) ? Vec3f(0.f, 0.f, 1.f) : y;
 }
 
 Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
@@ -235,7 +284,7 @@ Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
     return out;
 }
 
-Camera loadPvcc(const std::string& path) {
+Camera loadPvcc(const std::string& path, bool* hasParallelScale) {
     std::vector<char> bytes = readFileBytes(path, kMaxPvccBytes, "camera file");
     // XML processors read UTF-8 and UTF-16 (expat converts UTF-16 to UTF-8), not UTF-32.
     const char* wide = wideTextEncoding(bytes.data(), bytes.size());
@@ -277,13 +326,38 @@ Camera loadPvcc(const std::string& path) {
     cam.focalPoint = toVec3(propertyValues(state, "CameraFocalPoint", 3));
     cam.viewUp = toVec3(propertyValues(state, "CameraViewUp", 3));
     cam.viewAngle = static_cast<float>(propertyValues(state, "CameraViewAngle", 1)[0]);
-    if (state.properties.count("CameraParallelProjection") &&
-        propertyValues(state, "CameraParallelProjection", 1)[0] != 0.0) {
-        throwError(ErrorKind::Unsupported, path,
-                   atLine(state.properties["CameraParallelProjection"].line) +
-                       ": property CameraParallelProjection: parallel projection is not "
-                       "supported");
+    // ParaView writes CameraParallelScale always and CameraParallelProjection as 0 or 1; a file
+    // without them is a perspective camera.
+    cam.parallelProjection = state.properties.count("CameraParallelProjection") &&
+                             propertyValues(state, "CameraParallelProjection", 1)[0] != 0.0;
+    const bool hasScale = state.properties.count("CameraParallelScale") > 0;
+    if (hasParallelScale) *hasParallelScale = hasScale;
+    if (hasScale) {
+        const double scale = propertyValues(state, "CameraParallelScale", 1)[0];
+        if (cam.parallelProjection && !(scale > 0.0 && scale <= double(FLT_MAX)))
+            throwParseError(
+                path,
+                atLine(state.properties["CameraParallelScale"].line) +
+                    ": property CameraParallelScale",
+                "expected a positive parallel scale (half the view height), got " +
+                    printableShort(state.properties["CameraParallelScale"].elements[0]));
+        if (std::fabs(scale) <= double(FLT_MAX)) cam.parallelScale = static_cast<float>(scale);
+    } else if (cam.parallelProjection) {
+        throwParseError(path,
+                        atLine(state.properties["CameraParallelProjection"].line) +
+                            ": property CameraParallelProjection",
+                        "parallel projection needs a <Property name=\"CameraParallelScale\"> "
+                        "(half the view height), found none");
     }
+    // A view up parallel to the view direction is the file's: named with its property.
+    if (isFinite(cam.position) && isFinite(cam.focalPoint) && isFinite(cam.viewUp) &&
+        pointsDistinct(cam.position, cam.focalPoint) &&
+        viewUpParallel(cam.position, cam.focalPoint, cam.viewUp))
+        throwParseError(path,
+                        atLine(state.properties["CameraViewUp"].line) + ": property CameraViewUp",
+                        "view up " + formatVec(cam.viewUp) +
+                            " is zero or parallel to the view direction from CameraPosition to "
+                            "CameraFocalPoint; give a view up across it");
     try {
         validateCamera(cam);
     } catch (const Error& e) {
@@ -300,28 +374,28 @@ void validateCamera(const Camera& camera) {
                        ", focal point " + formatVec(camera.focalPoint) + ", view up " +
                        formatVec(camera.viewUp) + ", angle " + std::to_string(camera.viewAngle));
     }
-    // In double: the offset of float points near 1e38 overflows float and that of points 1e-30
-    // apart underflows its square. Distinct points must lie more than two float spacings of
-    // their coordinates apart, so the view direction means something.
-    const Vec3d offset = toDouble(camera.focalPoint) - toDouble(camera.position);
-    const double dist = std::sqrt(dot(offset, offset));
-    const double scale = std::max(maxComponent(vmax(camera.position, -camera.position)),
-                                  maxComponent(vmax(camera.focalPoint, -camera.focalPoint)));
-    if (!(dist > 0.0) || dist <= 2.0 * FLT_EPSILON * scale) {
+    if (!pointsDistinct(camera.position, camera.focalPoint)) {
         throwError(ErrorKind::Argument, "",
                    "camera position " + formatVec(camera.position) +
                        " equals the focal point; expected distinct points");
     }
-    const Vec3d up = toDouble(camera.viewUp), dir = offset * (1.0 / dist);
-    const double upLen = std::sqrt(dot(up, up));
-    const Vec3d sine = cross(dir, up * (1.0 / upLen));
-    if (!(upLen > 0.0) || std::sqrt(dot(sine, sine)) < 1e-4) {
+    if (viewUpParallel(camera.position, camera.focalPoint, camera.viewUp)) {
+        const Vec3d offset = toDouble(camera.focalPoint) - toDouble(camera.position);
+        const Vec3d dir = offset * (1.0 / std::sqrt(dot(offset, offset)));
         throwError(ErrorKind::Argument, "",
                    "camera view up " + formatVec(camera.viewUp) +
                        " is zero or parallel to the view direction " +
-                       formatVec({float(dir.x), float(dir.y), float(dir.z)}));
+                       formatVec({float(dir.x), float(dir.y), float(dir.z)}) +
+                       "; give a view up across it");
     }
-    if (!(camera.viewAngle >= kMinViewAngle && camera.viewAngle <= kMaxViewAngle)) {
+    if (camera.parallelProjection) {
+        if (!std::isfinite(camera.parallelScale) || !(camera.parallelScale > 0.f)) {
+            std::ostringstream os;
+            os << "camera parallel scale (half the view height) must be positive, got "
+               << camera.parallelScale;
+            throwError(ErrorKind::Argument, "", os.str());
+        }
+    } else if (!(camera.viewAngle >= kMinViewAngle && camera.viewAngle <= kMaxViewAngle)) {
         std::ostringstream os;
         os << "camera view angle must be in [" << kMinViewAngle << ", " << kMaxViewAngle
            << "] degrees, got " << camera.viewAngle;
@@ -329,7 +403,7 @@ void validateCamera(const Camera& camera) {
     }
 }
 
-CameraRays makeCameraRays(const Camera& camera, int width, int height) {
+CameraRays makeCameraRays(const Camera& camera, int width, int height, double nearDistance) {
     validateCamera(camera);
     if (width <= 0 || height <= 0) {
         throwError(ErrorKind::Argument, "",
@@ -344,13 +418,42 @@ CameraRays makeCameraRays(const Camera& camera, int width, int height) {
     const Vec3f dir(float(dirD.x), float(dirD.y), float(dirD.z));
     const Vec3f right(float(rightD.x), float(rightD.y), float(rightD.z));
     const Vec3f up(float(upD.x), float(upD.y), float(upD.z));
+    CameraRays rays;
+    if (camera.parallelProjection) {
+        // Orthographic: the image plane spans 2 parallelScale vertically (VTK's convention),
+        // every ray along the view direction from the plane nearDistance in front of the camera.
+        // Its centre is placed from the focal point, which lies near the mesh where the camera
+        // may be far out and coarsely resolved (in double until the corner is known to fit).
+        const double halfH = camera.parallelScale;
+        const double halfW = halfH * double(width) / double(height);
+        const double nearD = nearDistance > 0.0 ? nearDistance : 0.0;
+        const Vec3d offset = toDouble(camera.focalPoint) - toDouble(camera.position);
+        const double distance = std::sqrt(dot(offset, offset));
+        const Vec3d corner =
+            toDouble(camera.focalPoint) + dirD * (nearD - distance) - rightD * halfW + upD * halfH;
+        const Vec3d stepU = rightD * (2.0 * halfW / double(width));
+        const Vec3d stepV = upD * (-2.0 * halfH / double(height));
+        const Vec3d far = corner + stepU * double(width) + stepV * double(height);
+        if (!fitsFloat(corner) || !fitsFloat(far)) {
+            std::ostringstream os;
+            os << "the parallel camera's image plane (parallel scale " << camera.parallelScale
+               << ") would reach beyond float32 range (3.4e38): use a smaller parallel scale";
+            throwError(ErrorKind::Argument, "", os.str());
+        }
+        rays.origin = Vec3f(float(corner.x), float(corner.y), float(corner.z));
+        rays.originDu = Vec3f(float(stepU.x), float(stepU.y), float(stepU.z));
+        rays.originDv = Vec3f(float(stepV.x), float(stepV.y), float(stepV.z));
+        rays.topLeft = dir;
+        rays.du = rays.dv = Vec3f(0.f);
+        return rays;
+    }
     float halfH = static_cast<float>(std::tan(0.5 * camera.viewAngle * kDegToRad));
     float halfW = halfH * static_cast<float>(width) / static_cast<float>(height);
-    CameraRays rays;
     rays.origin = camera.position;
     rays.topLeft = dir - right * halfW + up * halfH;
     rays.du = right * (2.f * halfW / static_cast<float>(width));
     rays.dv = up * (-2.f * halfH / static_cast<float>(height));
+    rays.originDu = rays.originDv = Vec3f(0.f);
     return rays;
 }
 

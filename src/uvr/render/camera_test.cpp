@@ -279,6 +279,16 @@ TEST(Camera, BadCameraFilesNameFileAndProperty) {
     missing.erase(from, to - from);
     std::string parallel = pvcc(kPosition);
     parallel.replace(parallel.find("value=\"0\"/>\n      <Domain"), 9, "value=\"1\"");
+    std::string badScale = parallel;
+    badScale.replace(badScale.find("  </Proxy>"), 0,
+                     "    <Property name=\"CameraParallelScale\" number_of_elements=\"1\">\n"
+                     "      <Element index=\"0\" value=\"-2\"/>\n    </Property>\n");
+    std::string alongUp = pvcc(R"(<Element index="0" value="-0.445446427868706"/>
+      <Element index="1" value="9"/>
+      <Element index="2" value="-0.440184037664585"/>)",
+                               "30",
+                               "0\" /><Element index=\"1\" value=\"1\"/><Element "
+                               "index=\"2\" value=\"0");
     std::string declared = pvcc(kPosition);
     declared.replace(declared.find("number_of_elements=\"3\""), 22, "number_of_elements=\"4\"");
     struct Case {
@@ -308,8 +318,12 @@ TEST(Camera, BadCameraFilesNameFileAndProperty) {
         {"unclosed", pvcc(kPosition).substr(0, 300), ErrorKind::Parse, "line ", "expected XML"},
         {"otherxml", "<?xml version=\"1.0\"?>\n<VTKFile/>\n", ErrorKind::Parse, "line 1",
          "PVCameraConfiguration"},
-        {"parallel", parallel, ErrorKind::Unsupported, "line 25: property CameraParallelProjection",
-         "parallel"},
+        {"parallel", parallel, ErrorKind::Parse, "line 25: property CameraParallelProjection",
+         "parallel projection needs a <Property name=\"CameraParallelScale\">"},
+        {"badscale", badScale, ErrorKind::Parse, "line 29: property CameraParallelScale",
+         "expected a positive parallel scale (half the view height), got -2"},
+        {"alongup", alongUp, ErrorKind::Parse, "line 14: property CameraViewUp",
+         "parallel to the view direction from CameraPosition to CameraFocalPoint"},
         {"utf32", std::string("\xFF\xFE\0\0<\0\0\0", 8), ErrorKind::Parse, "byte 0",
          "UTF-32 text is not supported; save the camera file as UTF-8"},
     };
@@ -325,6 +339,121 @@ TEST(Camera, BadCameraFilesNameFileAndProperty) {
     Error e = catchError([&] { loadPvcc(dir + "/absent.pvcc"); });
     EXPECT_EQ(e.kind(), ErrorKind::Io);
     EXPECT_THAT(e.what(), HasSubstr("absent.pvcc"));
+}
+
+TEST(Camera, ParallelCameraFilesLoadWithTheirScale) {
+    // As ParaView writes them: CameraParallelScale always, CameraParallelProjection 0 or 1.
+    std::string text = pvcc(kPosition);
+    text.replace(text.find("  </Proxy>"), 0,
+                 "    <Property name=\"CameraParallelScale\" number_of_elements=\"1\">\n"
+                 "      <Element index=\"0\" value=\"2.5\"/>\n    </Property>\n");
+    const std::string dir = scratchDir();
+    bool hasScale = false;
+    Camera perspective = loadPvcc(writeFile(dir + "/p.pvcc", text), &hasScale);
+    EXPECT_FALSE(perspective.parallelProjection);
+    EXPECT_TRUE(hasScale);
+    EXPECT_FLOAT_EQ(perspective.parallelScale, 2.5f);
+    text.replace(text.find("value=\"0\"/>\n      <Domain"), 9, "value=\"1\"");
+    Camera parallel = loadPvcc(writeFile(dir + "/o.pvcc", text), &hasScale);
+    EXPECT_TRUE(parallel.parallelProjection);
+    EXPECT_FLOAT_EQ(parallel.parallelScale, 2.5f);
+    expectVec(parallel.position, perspective.position, 0.f);
+    loadPvcc(writeFile(dir + "/n.pvcc", pvcc(kPosition)), &hasScale);
+    EXPECT_FALSE(hasScale);
+}
+
+TEST(Camera, ResetSetsTheParallelScaleAsVtkRendererDoes) {
+    // vtkRenderer::ResetCamera: the bounding sphere's radius, over the aspect for tall images.
+    const Bounds3f b = box({-1, -3, 0}, {2, 4, 1});
+    const float radius = 0.5f * std::sqrt(9.f + 49.f + 1.f);
+    EXPECT_FLOAT_EQ(resetCamera(b, 2.f).parallelScale, radius);
+    EXPECT_FLOAT_EQ(resetCamera(b, 0.5f).parallelScale, radius / 0.5f);
+    EXPECT_FALSE(resetCamera(b, 1.f).parallelProjection);
+    if (!pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk";
+    std::vector<double> v = runPython(scratchDir(), R"(
+import vtk
+for w, h in ((400, 200), (200, 400)):
+    r = vtk.vtkRenderer()
+    win = vtk.vtkRenderWindow()
+    win.SetOffScreenRendering(1)
+    win.AddRenderer(r)
+    win.SetSize(w, h)
+    r.GetActiveCamera().ParallelProjectionOn()
+    r.ResetCamera(-1, 2, -3, 4, 0, 1)
+    print(r.GetActiveCamera().GetParallelScale())
+)");
+    ASSERT_EQ(v.size(), 2u);
+    EXPECT_NEAR(resetCamera(b, 2.f).parallelScale, v[0], 1e-5 * v[0]);
+    EXPECT_NEAR(resetCamera(b, 0.5f).parallelScale, v[1], 1e-5 * v[1]);
+}
+
+TEST(Camera, ParallelRaysShareTheViewDirectionAndSpanTwiceTheScale) {
+    Camera cam;
+    cam.position = {1.f, 2.f, 3.f};
+    cam.focalPoint = {-2.f, 0.5f, 1.f};
+    cam.viewUp = {0.f, 0.f, 1.f};
+    cam.parallelProjection = true;
+    cam.parallelScale = 1.5f;
+    const int w = 64, h = 48;
+    const CameraRays rays = makeCameraRays(cam, w, h);
+    const Vec3f dir = normalize(cam.focalPoint - cam.position);
+    const Vec3f right = normalize(cross(dir, cam.viewUp));
+    const Vec3f up = cross(right, dir);
+    for (float px : {0.f, 0.5f, 31.f, 64.f})
+        for (float py : {0.f, 47.5f, 48.f}) expectVec(rays.ray(px, py).dir, dir, 1e-6f);
+    // The centre ray starts at the camera; the image plane is 2 scale high, 2 scale * aspect
+    // wide, pixel (0, 0) top-left; origins lie on the plane through the camera.
+    expectVec(rays.ray(w / 2.f, h / 2.f).org, cam.position, 1e-5f);
+    expectVec(rays.ray(w / 2.f, 0.f).org - rays.ray(w / 2.f, h).org, up * 3.f, 1e-5f);
+    expectVec(rays.ray(w, h / 2.f).org - rays.ray(0.f, h / 2.f).org, right * (3.f * w / h), 1e-5f);
+    EXPECT_NEAR(dot(rays.ray(3.5f, 40.5f).org - cam.position, dir), 0.f, 1e-6f);
+    // A near distance moves the plane forward along the view direction, nothing else.
+    const CameraRays moved = makeCameraRays(cam, w, h, 2.0);
+    expectVec(moved.ray(7.5f, 9.5f).org - rays.ray(7.5f, 9.5f).org, dir * 2.f, 1e-5f);
+    // Refused: a non-positive or non-finite scale; an image plane beyond float range.
+    for (float bad : {0.f, -1.f, std::numeric_limits<float>::infinity(), std::nanf("")}) {
+        Camera c = cam;
+        c.parallelScale = bad;
+        const Error e = catchError([&] { makeCameraRays(c, w, h); });
+        EXPECT_EQ(e.kind(), ErrorKind::Argument);
+        EXPECT_THAT(e.what(), HasSubstr("parallel scale"));
+    }
+    Camera huge = cam;
+    huge.parallelScale = 3e38f;
+    EXPECT_THAT(catchError([&] { makeCameraRays(huge, w, h); }).what(),
+                HasSubstr("beyond float32 range"));
+    // The view angle means nothing to a parallel camera.
+    Camera angle = cam;
+    angle.viewAngle = 0.f;
+    EXPECT_NO_THROW(validateCamera(angle));
+}
+
+TEST(Camera, PerspectiveRaysAllStartAtTheCamera) {
+    Camera cam;
+    cam.position = {1.f, 2.f, 3.f};
+    cam.focalPoint = {-2.f, 0.5f, 1.f};
+    const CameraRays rays = makeCameraRays(cam, 64, 48, 5.0);  // the near distance is ignored
+    expectVec(rays.originDu, Vec3f(0.f), 0.f);
+    expectVec(rays.originDv, Vec3f(0.f), 0.f);
+    for (float px : {0.5f, 17.5f, 63.5f}) expectVec(rays.ray(px, 30.5f).org, cam.position, 0.f);
+}
+
+TEST(Camera, DefaultViewUpIsPlusYUnlessLookingAlongY) {
+    const Vec3f y(0.f, 1.f, 0.f), z(0.f, 0.f, 1.f);
+    expectVec(defaultViewUp({0.f, 0.f, 5.f}, {0.f, 0.f, 0.f}), y, 0.f);
+    expectVec(defaultViewUp({3.f, 1.f, 0.f}, {0.f, 0.f, 0.f}), y, 0.f);
+    expectVec(defaultViewUp({0.f, 5.f, 0.f}, {0.f, 0.f, 0.f}), z, 0.f);
+    expectVec(defaultViewUp({1.f, -4.f, 1.f}, {1.f, 2.f, 1.f}), z, 0.f);
+    EXPECT_TRUE(viewUpParallel({0.f, 5.f, 0.f}, {0.f, 0.f, 0.f}, y));
+    EXPECT_TRUE(viewUpParallel({0.f, 5.f, 0.f}, {0.f, 0.f, 0.f}, Vec3f(0.f)));
+    EXPECT_FALSE(viewUpParallel({0.f, 5.f, 0.f}, {0.f, 0.f, 0.f}, z));
+    // The orbit keeps the projection and scale.
+    Camera c;
+    c.parallelProjection = true;
+    c.parallelScale = 4.f;
+    const Camera o = orbitCamera(c, 30.f, 20.f);
+    EXPECT_TRUE(o.parallelProjection);
+    EXPECT_EQ(o.parallelScale, 4.f);
 }
 
 }  // namespace

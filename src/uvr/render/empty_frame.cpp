@@ -51,9 +51,11 @@ std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& se
             inView = intersectBox(box, ray.org, inv, t0, t1);
         }
     if (!inView)
-        return "the image is empty: the mesh is not in view, or smaller than a pixel (no "
-               "pixel's ray meets its bounds); check the camera (--camera, "
-               "--camera-position/--camera-focal, --azimuth, --elevation, --view-angle)";
+        return std::string(
+                   "the image is empty: the mesh is not in view, or smaller than a pixel (no "
+                   "pixel's ray meets its bounds); check the camera (--camera, "
+                   "--camera-position/--camera-focal, --azimuth, --elevation, ") +
+               (f.camera.parallelProjection ? "--parallel-scale" : "--view-angle") + ")";
     double lo = INFINITY, hi = -INFINITY;
     for (float v : mesh.tets.values)
         if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);

@@ -14,23 +14,64 @@ namespace uvr {
 /// Output buffers of one frame, as plain data.
 struct FrameView {
     Vec4f* pixels = nullptr;                ///< width * height, premultiplied RGBA
-    std::uint32_t* sampleCounts = nullptr;  ///< width * height samples per pixel
+    std::uint32_t* sampleCounts = nullptr;  ///< width * height samples per pixel (all its rays)
     int width = 0;
     int height = 0;
     CameraRays rays;
+    int supersample = 1;  ///< N: N x N rays per pixel, in [1, kMaxSupersample]
+    bool jitter = false;  ///< each ray at a hashed position in its sub-pixel cell, not its centre
 };
 
-/// Kernel body for one pixel: traces the pixel's centre ray with `march(ray, counters)`, stores
-/// colour and sample count, returns the ray's counters. CPU and CUDA backends launch it.
+/// A 32-bit integer hash (lowbias32, Wellons 2018: a bijection with low bias).
+UVR_HOST_DEVICE inline std::uint32_t hashU32(std::uint32_t v) {
+    v ^= v >> 16;
+    v *= 0x7feb352dU;
+    v ^= v >> 15;
+    v *= 0x846ca68bU;
+    v ^= v >> 16;
+    return v;
+}
+
+/// Sub-pixel offsets in [0, 1)^2 of ray `s` of pixel (x, y) for jittered supersampling: a fixed
+/// hash of the three (no random state), so every frame and both devices take the same rays.
+UVR_HOST_DEVICE inline void jitterOffsets(int x, int y, int s, float& ox, float& oy) {
+    const std::uint32_t h =
+        hashU32(static_cast<std::uint32_t>(x) +
+                hashU32(static_cast<std::uint32_t>(y) + hashU32(static_cast<std::uint32_t>(s))));
+    // 16 bits each: exact in float and below 1.
+    ox = static_cast<float>(h & 0xffffU) * (1.f / 65536.f);
+    oy = static_cast<float>(h >> 16) * (1.f / 65536.f);
+}
+
+/// Kernel body for one pixel: traces its N x N rays (frame.supersample; one through the centre
+/// of each cell of an N x N grid over the pixel, or jittered within it) with
+/// `march(ray, counters)`, stores the mean premultiplied colour and the samples summed over the
+/// rays, and returns the counters summed over the rays. With N = 1 the one ray passes through
+/// the pixel's centre and the pixel is exactly that ray's colour. CPU and CUDA backends launch
+/// it. The rays run one after another in this thread, so no buffer grows with N.
 template <class March>
 UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int y, March&& march) {
-    const Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
-    RayCounters counters;
-    const Vec4f c = march(ray, counters);
+    const int n = frame.supersample;
+    const float cell = 1.f / static_cast<float>(n);
+    Vec4f sum(0.f, 0.f, 0.f, 0.f);
+    RayCounters total;
+    for (int s = 0; s < n * n; ++s) {
+        float ox = 0.5f, oy = 0.5f;
+        if (frame.jitter) jitterOffsets(x, y, s, ox, oy);
+        const float px = static_cast<float>(x) + (static_cast<float>(s % n) + ox) * cell;
+        const float py = static_cast<float>(y) + (static_cast<float>(s / n) + oy) * cell;
+        RayCounters counters;
+        sum = sum + march(frame.rays.ray(px, py), counters);
+        total.samples += counters.samples;
+        total.partitionsVisited += counters.partitionsVisited;
+        total.partitionsSkipped += counters.partitionsSkipped;
+        total.locate.walkSteps += counters.locate.walkSteps;
+        total.locate.bvhQueries += counters.locate.bvhQueries;
+    }
     const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
-    frame.pixels[i] = c;
-    frame.sampleCounts[i] = counters.samples;
-    return counters;
+    frame.pixels[i] = sum * (cell * cell);
+    frame.sampleCounts[i] = total.samples;
+    return total;
 }
 
 /// The reference marcher as a functor for shadePixel (lambdas do not cross to CUDA kernels).

@@ -159,6 +159,9 @@ void validateSettings(const RenderSettings& s) {
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
+    if (!(s.supersample >= 1 && s.supersample <= kMaxSupersample))
+        bad("--supersample " + std::to_string(s.supersample) + ": expected 1 to " +
+            std::to_string(kMaxSupersample) + " (N x N rays per pixel)");
     toleranceForQuality(s.quality);  // throws for a quality out of range
 }
 
@@ -236,9 +239,11 @@ std::string fmtG(double v) {
 /// kMaxSamplesPerRay or kMaxFrameSamples, naming the step that would be accepted.
 void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, float step) {
     const Bounds3f& bounds = mesh.tets.bounds;
-    const FrameWork w = estimateFrameWork(bounds, step, settings.width, settings.height);
+    const int raysPerPixel = settings.supersample * settings.supersample;
+    const FrameWork w =
+        estimateFrameWork(bounds, step, settings.width, settings.height, raysPerPixel);
     if (w.samplesPerRay <= kMaxSamplesPerRay && w.samples <= kMaxFrameSamples) return;
-    const double pixels = double(settings.width) * settings.height;
+    const double pixels = double(settings.width) * settings.height * raysPerPixel;
     // Lengths shown in the file's units (the mesh renders scaled by frame.scale).
     const double unit = 1.0 / mesh.tets.frame.scale;
     const double diagonal = bounds.diagonal() * unit;
@@ -253,7 +258,11 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
     throwError(ErrorKind::Argument, "",
                what + " would take up to " + fmtG(w.samples) + " samples (" +
                    std::to_string(settings.width) + "x" + std::to_string(settings.height) +
-                   " pixels x " + fmtG(w.samplesPerRay) + " per ray across the bounds' diagonal " +
+                   " pixels x " +
+                   (raysPerPixel > 1 ? std::to_string(raysPerPixel) + " rays (--supersample " +
+                                           std::to_string(settings.supersample) + ") x "
+                                     : std::string()) +
+                   fmtG(w.samplesPerRay) + " per ray across the bounds' diagonal " +
                    fmtG(diagonal) + "), more than the " +
                    (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
                                                         : "10^12 samples per frame") +
@@ -313,26 +322,59 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     double position[3], focal[3];
     cameraFrame.toLocal(given.position, position);
     cameraFrame.toLocal(given.focalPoint, focal);
-    // The integrators count sample grid points k = t / s1 from the camera in float: at 2^24 and
-    // beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
-    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
-    if (!empty) {
-        double farthest = 0.0;
+    // Parallel projection: the rays start on the plane through the camera perpendicular to the
+    // view direction (VTK's near clipping plane never lies behind the camera), moved forward to
+    // the mesh's nearest corner when the mesh lies wholly in front of it: nothing between is
+    // seen, and the sample grid then counts from the mesh, however far the camera is.
+    const bool parallel = given.parallelProjection;
+    double nearDistance = 0.0, farDepth = 0.0;
+    if (parallel && !empty) {
+        double dir[3], len2 = 0.0;
+        for (int a = 0; a < 3; ++a) dir[a] = focal[a] - position[a], len2 += dir[a] * dir[a];
+        const double len = std::sqrt(len2);
+        double nearest = INFINITY;
+        farDepth = -INFINITY;
         for (int c = 0; c < 8; ++c) {
             const Vec3f corner((c & 1) ? bounds.hi.x : bounds.lo.x,
                                (c & 2) ? bounds.hi.y : bounds.lo.y,
                                (c & 4) ? bounds.hi.z : bounds.lo.z);
-            double d2 = 0.0;
-            for (int a = 0; a < 3; ++a) d2 += (corner[a] - position[a]) * (corner[a] - position[a]);
-            farthest = std::max(farthest, std::sqrt(d2));
+            double depth = 0.0;
+            for (int a = 0; a < 3; ++a) depth += (corner[a] - position[a]) * dir[a] / len;
+            nearest = std::min(nearest, depth);
+            farDepth = std::max(farDepth, depth);
+        }
+        if (nearest > 0.0 && std::isfinite(nearest)) nearDistance = nearest;
+    }
+    // The integrators count sample grid points k = t / s1 from the ray origin in float: at 2^24
+    // and beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
+    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
+    if (!empty) {
+        double farthest = 0.0;
+        if (parallel) {
+            farthest = std::max(0.0, farDepth - nearDistance);
+        } else {
+            for (int c = 0; c < 8; ++c) {
+                const Vec3f corner((c & 1) ? bounds.hi.x : bounds.lo.x,
+                                   (c & 2) ? bounds.hi.y : bounds.lo.y,
+                                   (c & 4) ? bounds.hi.z : bounds.lo.z);
+                double d2 = 0.0;
+                for (int a = 0; a < 3; ++a)
+                    d2 += (corner[a] - position[a]) * (corner[a] - position[a]);
+                farthest = std::max(farthest, std::sqrt(d2));
+            }
         }
         const double steps = farthest / f.params.step;
         if (!(steps <= kMaxGridSteps))
             throwError(ErrorKind::Argument, "",
-                       "the camera is " + fmtG(steps) + " steps of " +
-                           fmtG(f.params.step / frame.scale) +
-                           " from the far side of the mesh (at most 16 million): move the camera "
-                           "closer (and widen --view-angle) or use a larger --step");
+                       parallel ? "the mesh is " + fmtG(steps) + " steps of " +
+                                      fmtG(f.params.step / frame.scale) +
+                                      " deep along the view direction (at most 16 million): use "
+                                      "a larger --step"
+                                : "the camera is " + fmtG(steps) + " steps of " +
+                                      fmtG(f.params.step / frame.scale) +
+                                      " from the far side of the mesh (at most 16 million): move "
+                                      "the camera closer (and widen --view-angle) or use a "
+                                      "larger --step");
     }
     f.camera = given;
     f.camera.position = Vec3f(float(position[0]), float(position[1]), float(position[2]));
@@ -341,8 +383,17 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         throwError(ErrorKind::Argument, "",
                    "the camera lies beyond float32 range from the mesh, which renders scaled by " +
                        fmtG(frame.scale) + ": move the camera closer");
+    if (parallel) {
+        const double scale = double(given.parallelScale) * cameraFrame.scale;
+        if (!(scale >= double(FLT_MIN) && scale <= double(FLT_MAX)))
+            throwError(ErrorKind::Argument, "",
+                       "parallel scale " + fmtG(given.parallelScale) +
+                           ": out of float32 range against the mesh, which renders scaled by " +
+                           fmtG(frame.scale));
+        f.camera.parallelScale = static_cast<float>(scale);
+    }
     validateCamera(f.camera);
-    f.rays = makeCameraRays(f.camera, settings.width, settings.height);
+    f.rays = makeCameraRays(f.camera, settings.width, settings.height, nearDistance);
     if (settings.method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
     if (settings.method != RenderMethod::Partitions && mesh.bvh.nodes.empty() &&
@@ -378,12 +429,14 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     return f;
 }
 
-FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height) {
+FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height,
+                            int raysPerPixel) {
     FrameWork w;
     const double diagonal = bounds.empty() ? 0.0 : bounds.diagonal();
     if (!(diagonal > 0.0)) return w;
     w.samplesPerRay = step > 0.f ? diagonal / step : INFINITY;
-    w.samples = w.samplesPerRay * std::max(width, 0) * std::max(height, 0);
+    w.samples =
+        w.samplesPerRay * std::max(width, 0) * std::max(height, 0) * std::max(raysPerPixel, 1);
     return w;
 }
 

@@ -146,14 +146,25 @@ struct RenderSettings {
     float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
     float terminationAlpha = 0.99f;
     int tfTableSize = 1024;  ///< entries of the baked transfer function
+    /// Anti-aliasing: N x N rays per pixel (N in [1, kMaxSupersample]), their premultiplied
+    /// colours averaged; a pixel's sample count is the sum over its rays. 1: one ray through
+    /// the pixel's centre.
+    int supersample = 1;
+    /// With supersample > 1: each ray at a fixed hashed position inside its cell of the N x N
+    /// grid instead of its centre (deterministic: the same rays every frame, on every device).
+    bool jitter = false;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)
     std::function<void(double)> progress;
 };
 
+/// Largest RenderSettings::supersample: 8 x 8 = 64 rays per pixel.
+inline constexpr int kMaxSupersample = 8;
+
 /// Throws Error(Argument) for settings that cannot render: image size outside [1, 16384] per
-/// side, non-finite or non-positive step or opacity unit, bad range, bad camera.
+/// side, non-finite or non-positive step or opacity unit, bad range, bad camera, supersample
+/// outside [1, kMaxSupersample].
 void validateSettings(const RenderSettings& settings);
 
 /// Most samples one ray may take across the mesh bounds' diagonal at the step s1: the default
@@ -164,14 +175,16 @@ inline constexpr double kMaxSamplesPerRay = 1e5;
 /// (2e7 samples per second each), minutes on a GPU.
 inline constexpr double kMaxFrameSamples = 1e12;
 
-/// Upper bound on the work of a frame: every pixel's ray crossing the bounds' whole diagonal.
+/// Upper bound on the work of a frame: every ray crossing the bounds' whole diagonal.
 struct FrameWork {
     double samplesPerRay = 0.0;  ///< bounds diagonal / step
-    double samples = 0.0;        ///< pixels x samplesPerRay
+    double samples = 0.0;        ///< pixels x rays per pixel x samplesPerRay
 };
 
-/// The work estimate of a width x height frame of the bounds at a step.
-FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height);
+/// The work estimate of a width x height frame of the bounds at a step, with raysPerPixel rays
+/// per pixel (supersample squared).
+FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height,
+                            int raysPerPixel = 1);
 
 /// Host bytes per pixel of a frame rendered and written as a PNG: the float image (16), the
 /// per-pixel sample counts (4) and the PNG's 8-bit rows (4).
@@ -267,6 +280,7 @@ struct RenderStats {
     std::uint64_t partitionsVisited = 0;  ///< partitions entered by rays (partition method)
     std::uint64_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
     int width = 0, height = 0;
+    int supersample = 1;  ///< N x N rays per pixel
 
     /// Adds another frame part's counters.
     void merge(const RenderStats& o) {
@@ -284,9 +298,20 @@ struct RenderStats {
         partitionsVisited += c.partitionsVisited;
         partitionsSkipped += c.partitionsSkipped;
     }
+    /// Samples per pixel (summed over its rays), averaged over the image.
     double meanSamplesPerPixel() const {
         return width > 0 && height > 0 ? static_cast<double>(samples) / (double(width) * height)
                                        : 0.0;
+    }
+    /// Rays traced: pixels x supersample^2.
+    std::uint64_t rays() const {
+        return static_cast<std::uint64_t>(width > 0 ? width : 0) *
+               static_cast<std::uint64_t>(height > 0 ? height : 0) *
+               static_cast<std::uint64_t>(supersample) * static_cast<std::uint64_t>(supersample);
+    }
+    /// Samples per ray, averaged over the rays.
+    double meanSamplesPerRay() const {
+        return rays() > 0 ? static_cast<double>(samples) / static_cast<double>(rays()) : 0.0;
     }
 };
 
