@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "progress.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 
@@ -67,17 +68,19 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
 }  // namespace
 
 void Context::step(const std::string& message) const {
-    if (!quiet) std::fprintf(stderr, "uvr: %s\n", printable(message).c_str());
+    if (!quiet) printStderrLine("uvr: " + printable(message));
 }
 
 void Context::warn(const std::string& message) const {
-    std::fprintf(stderr, "uvr: warning: %s\n", printable(message).c_str());
+    printStderrLine("uvr: warning: " + printable(message));
 }
 
 void Context::done(const std::string& message, Clock::time_point start) const {
-    if (!quiet)
-        std::fprintf(stderr, "uvr: %s (%.2f s)\n", printable(message).c_str(),
-                     std::chrono::duration<double>(Clock::now() - start).count());
+    if (quiet) return;
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, " (%.2f s)",
+                  std::chrono::duration<double>(Clock::now() - start).count());
+    printStderrLine("uvr: " + printable(message) + seconds);
 }
 
 void Context::setActivity(const std::string& file, const std::string& what) const {
@@ -622,42 +625,15 @@ void checkFrameMemory(const RenderFlags& flags, const Context& ctx) {
         frameMemoryBytes(flags));
 }
 
-std::function<void(double)> progressPrinter(const Context& ctx, const std::string& what) {
-    if (ctx.quiet) return {};
-    struct State {
-        Clock::time_point start = Clock::now();
-        double next = 2.0;  // seconds: the first report, then every 2 s
-    };
-    auto state = std::make_shared<State>();
-    return [&ctx, what, state](double fraction) {
-        const double t = std::chrono::duration<double>(Clock::now() - state->start).count();
-        if (t < state->next || !(fraction > 0.0 && fraction < 1.0)) return;
-        state->next = t + 2.0;
-        const double eta = t * (1.0 - fraction) / fraction;
-        char line[160];
-        if (eta < 120.0)
-            std::snprintf(line, sizeof line, "%s: %d%% (ETA %.0f s)", what.c_str(),
-                          static_cast<int>(fraction * 100.0), eta);
-        else if (eta < 7200.0)
-            std::snprintf(line, sizeof line, "%s: %d%% (ETA %.0f min)", what.c_str(),
-                          static_cast<int>(fraction * 100.0), eta / 60.0);
-        else
-            std::snprintf(line, sizeof line, "%s: %d%% (ETA %.1f h)", what.c_str(),
-                          static_cast<int>(fraction * 100.0), eta / 3600.0);
-        ctx.step(line);
-    };
-}
-
 Mesh loadMesh(const std::string& path, const Context& ctx) {
-    auto start = Clock::now();
-    ctx.step("reading " + path);
     ctx.setActivity(path, "reading the mesh");
+    Progress progress(ctx, "reading " + path);
     ReadOptions options;
     options.maxMemoryBytes = ctx.maxMemoryBytes;
+    options.progress = progress.callback();
     Mesh mesh = readMesh(path, options);  // every reader checks the structure it returns
-    ctx.done("read " + std::to_string(mesh.pointCount()) + " points, " +
-                 std::to_string(mesh.cellCount()) + " cells",
-             start);
+    progress.done("read " + path + ": " + std::to_string(mesh.pointCount()) + " points, " +
+                  std::to_string(mesh.cellCount()) + " cells");
     for (const std::string& note : mesh.notes) ctx.step("note: " + note);
     return mesh;
 }
@@ -682,7 +658,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     RenderSettings settings = flags.settings(report.bounds, source, &notes);
     for (const std::string& note : notes) ctx.step("note: " + note);
     validateSettings(settings);
-    settings.progress = progressPrinter(ctx, "rendering");
+
     ctx.setActivity(source, "preparing the mesh for rendering");
     PreparedMesh prepared = prepareMesh(mesh, field, flags.prepareOptions(),
                                         [&](const std::string& s) { ctx.step(s); });
@@ -697,7 +673,13 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     ctx.setActivity(source, "rendering it at " + std::to_string(settings.width) + "x" +
                                 std::to_string(settings.height));
     FrameRenderer renderer(prepared, flags.useCuda(), ctx);
-    RenderResult result = renderer.render(settings);
+    RenderResult result;
+    {
+        Progress progress(ctx, "rendering", double(settings.width) * settings.height, "pixels");
+        settings.progress = progress.callback();
+        result = renderer.render(settings);
+        settings.progress = {};
+    }
     ctx.setActivity(flags.output, "writing the image");
     char line[200];
     std::snprintf(

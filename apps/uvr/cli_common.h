@@ -162,10 +162,6 @@ std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames = 
 /// Checks before any work that the frame buffers of the flags' --size fit --max-memory.
 void checkFrameMemory(const RenderFlags& flags, const Context& ctx);
 
-/// A RenderSettings::progress that prints "uvr: rendering: 35% (ETA 12 s)" on stderr about every
-/// 2 s once a frame has taken 2 s; empty with --quiet.
-std::function<void(double)> progressPrinter(const Context& ctx, const std::string& what);
-
 /// Registers the subcommands.
 void addInfoCommand(CLI::App& app, Context& ctx);
 void addRenderCommand(CLI::App& app, Context& ctx);

@@ -4,14 +4,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "progress.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 
 namespace uvr::cli {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 std::string fmt(double v) {
     char buf[64];
@@ -72,6 +71,14 @@ void printFields(const nlohmann::json& fields) {
         if (f["default"].get<bool>()) line += "  (default)";
         std::printf("%s\n", line.c_str());
     }
+}
+
+/// Writes a mesh with a progress line; "wrote OUT" at the end.
+void writeMeshWithProgress(const Mesh& mesh, const std::string& out, const Context& ctx) {
+    ctx.setActivity(out, "writing the mesh");
+    Progress progress(ctx, "writing " + out);
+    writeMesh(mesh, out, progress.callback());
+    progress.done("wrote " + out);
 }
 
 }  // namespace
@@ -228,11 +235,12 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
                 std::to_string(kPrepareBytesPerTet) + " per tetrahedron to prepare it, " +
                 std::to_string(frameMemoryBytes(*flags)) + " for the image)",
             proceduralMeshBytes(spec) + tets * kPrepareBytesPerTet + frameMemoryBytes(*flags));
-        auto start = Clock::now();
-        ctx.step("generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)");
         ctx.setActivity("", "generating the demo mesh");
-        const Mesh mesh = generateMesh(spec);
-        ctx.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra", start);
+        Progress progress(ctx,
+                          "generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)",
+                          double(*cells), "tetrahedra");
+        const Mesh mesh = generateMesh(spec, progress.callback());
+        progress.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra");
         renderAndWrite(mesh, "demo", *flags, ctx);
     });
 }
@@ -249,10 +257,7 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
         resolveOutput(*out);
         checkMeshWritable(*out);  // before reading (minutes at 100M cells)
         const Mesh mesh = loadMesh(*in, ctx);
-        auto start = Clock::now();
-        ctx.setActivity(*out, "writing the mesh");
-        writeMesh(mesh, *out);
-        ctx.done("wrote " + *out, start);
+        writeMeshWithProgress(mesh, *out, ctx);
     });
 }
 
@@ -290,25 +295,15 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                             "--cells " + std::to_string(spec->targetCells) + ": the mesh of " +
                                 std::to_string(proceduralTetCount(*spec)) + " tetrahedra",
                             proceduralMeshBytes(*spec));
-        auto start = Clock::now();
-        ctx.step("generating " + std::string(proceduralShapeName(spec->shape)) + " with about " +
-                 std::to_string(spec->targetCells) + " tetrahedra");
-        int lastPercent = -10;
         ctx.setActivity(*out, "generating the mesh");
-        const Mesh mesh = generateMesh(*spec, [&](double f) {
-            const int percent = static_cast<int>(f * 100);
-            if (percent >= lastPercent + 10) {
-                lastPercent = percent;
-                ctx.step("  " + std::to_string(percent) + "%");
-            }
-        });
-        ctx.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
-                     std::to_string(mesh.cellCount()) + " tetrahedra",
-                 start);
-        start = Clock::now();
-        ctx.setActivity(*out, "writing the mesh");
-        writeMesh(mesh, *out);
-        ctx.done("wrote " + *out, start);
+        Progress progress(ctx,
+                          "generating " + std::string(proceduralShapeName(spec->shape)) +
+                              " with about " + std::to_string(spec->targetCells) + " tetrahedra",
+                          double(spec->targetCells), "tetrahedra");
+        const Mesh mesh = generateMesh(*spec, progress.callback());
+        progress.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
+                      std::to_string(mesh.cellCount()) + " tetrahedra");
+        writeMeshWithProgress(mesh, *out, ctx);
     });
 }
 
@@ -346,16 +341,13 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
                            std::to_string(*levels) + " times makes about " +
                            std::to_string(outTets) + " tetrahedra, whose " +
                            std::to_string(16 * outTets) + "-byte index array exceeds --max-memory");
-        auto start = Clock::now();
         ctx.setActivity(*in, "refining the mesh");
-        const Mesh refined = refineMesh(mesh, *levels, [&](const std::string& s) { ctx.step(s); });
-        ctx.done("refined to " + std::to_string(refined.pointCount()) + " points, " +
-                     std::to_string(refined.cellCount()) + " tetrahedra",
-                 start);
-        start = Clock::now();
-        ctx.setActivity(*out, "writing the mesh");
-        writeMesh(refined, *out);
-        ctx.done("wrote " + *out, start);
+        Progress progress(ctx, "refining", double(outTets), "tetrahedra");
+        const Mesh refined = refineMesh(
+            mesh, *levels, [&](const std::string& s) { ctx.step(s); }, progress.callback());
+        progress.done("refined to " + std::to_string(refined.pointCount()) + " points, " +
+                      std::to_string(refined.cellCount()) + " tetrahedra");
+        writeMeshWithProgress(refined, *out, ctx);
     });
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 
 #include "uvr/core/error.h"
 #include "uvr/core/scratch_vector.h"
@@ -174,7 +175,8 @@ void refineOnce(Work& w) {
 }  // namespace
 
 Mesh refineMesh(const Mesh& mesh, int levels,
-                const std::function<void(const std::string&)>& progress) {
+                const std::function<void(const std::string&)>& progress,
+                const std::function<void(double)>& fraction) {
     if (levels < 0 || levels > kMaxRefineLevels)
         throwError(ErrorKind::Argument, "",
                    "--levels " + std::to_string(levels) + ": expected 0 to " +
@@ -201,6 +203,16 @@ Mesh refineMesh(const Mesh& mesh, int levels,
         throwError(ErrorKind::Resource, "",
                    std::to_string(baseTets) + " tetrahedra refined " + std::to_string(levels) +
                        " times would exceed " + std::to_string(kMaxRefinedTets) + " tetrahedra");
+    // Work shares: the split makes baseTets, level L makes 8^(L+1) baseTets, assembling copies
+    // the last level's tetrahedra once more.
+    const double totalWork = double(baseTets) +
+                             double(outTets) * (8.0 / 7.0) * (1.0 - std::pow(8.0, -levels)) +
+                             double(outTets);
+    double doneWork = 0.0;
+    auto advance = [&](double work) {
+        doneWork += work;
+        if (fraction) fraction(std::min(1.0, doneWork / std::max(totalWork, 1.0)));
+    };
     Work w;
     w.points = mesh.points;
     w.tets.resize(baseTets);
@@ -218,12 +230,14 @@ Mesh refineMesh(const Mesh& mesh, int levels,
     }
     for (const Field& f : mesh.fields)
         if (f.association == Association::Point) w.pointFields.push_back(f);
+    advance(double(baseTets));
     // Step 2: the refinement levels.
     for (int level = 0; level < levels; ++level) {
         say("refinement level " + std::to_string(level + 1) + " of " + std::to_string(levels) +
             ": " + std::to_string(w.tets.size()) + " -> " + std::to_string(8 * w.tets.size()) +
             " tetrahedra");
         refineOnce(w);
+        advance(double(w.tets.size()));
     }
     // Step 3: the output mesh; cell fields follow the source cell of each tetrahedron.
     say("assembling " + std::to_string(w.tets.size()) + " tetrahedra");
@@ -256,6 +270,7 @@ Mesh refineMesh(const Mesh& mesh, int levels,
         out.fields.push_back(std::move(g));
     }
     out.notes = mesh.notes;
+    advance(double(n));
     return out;
 }
 

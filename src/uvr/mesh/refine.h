@@ -29,10 +29,12 @@ inline std::uint64_t refinedTetCount(std::uint64_t tets, int levels) {
 /// fields are interpolated linearly at midpoints (every component), cell fields are copied to the
 /// children. Parallel and deterministic: the same input gives the same output bit for bit
 /// whatever the thread count. Points keep their indices; new points follow. progress(message) is
-/// called at each step when given. Throws Error(Argument) for levels outside
+/// called at each step when given, fraction(done) after each step with the share of the work
+/// done (each step weighted by the tetrahedra it makes). Throws Error(Argument) for levels outside
 /// [0, kMaxRefineLevels] and Error(Resource) when the result would exceed kMaxRefinedTets
 /// tetrahedra or 32-bit point indices.
 Mesh refineMesh(const Mesh& mesh, int levels,
-                const std::function<void(const std::string&)>& progress = {});
+                const std::function<void(const std::string&)>& progress = {},
+                const std::function<void(double)>& fraction = {});
 
 }  // namespace uvr

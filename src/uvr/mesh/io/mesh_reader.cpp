@@ -67,10 +67,11 @@ void checkMeshWritable(const std::string& path) {
                    "cannot write this format: the output name must end in .uvrm (native) or .vtu");
 }
 
-void writeMesh(const Mesh& mesh, const std::string& path) {
+void writeMesh(const Mesh& mesh, const std::string& path,
+               const std::function<void(double)>& progress) {
     checkMeshWritable(path);
-    if (fileExtension(path) == ".uvrm") return writeNative(mesh, path);
-    writeVtu(mesh, path);
+    if (fileExtension(path) == ".uvrm") return writeNative(mesh, path, progress);
+    writeVtu(mesh, path, progress);
 }
 
 }  // namespace uvr

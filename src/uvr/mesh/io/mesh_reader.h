@@ -18,9 +18,11 @@ Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 /// without reading its arrays; empty for formats that must be read whole to know them.
 std::optional<MeshSummary> readMeshSummary(const std::string& path);
 
-/// Writes a mesh in the format its extension names (.uvrm native or .vtu); throws
+/// Writes a mesh in the format its extension names (.uvrm native or .vtu), reporting the
+/// fraction of bytes written to progress (when given) as it goes; throws
 /// Error(Argument) for other extensions. The file is written atomically.
-void writeMesh(const Mesh& mesh, const std::string& path);
+void writeMesh(const Mesh& mesh, const std::string& path,
+               const std::function<void(double)>& progress = {});
 /// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm or .vtu):
 /// commands call it before any heavy work.
 void checkMeshWritable(const std::string& path);

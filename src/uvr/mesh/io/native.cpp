@@ -310,7 +310,13 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
     Mesh mesh;
     auto readArray = [&](const ArraySpan& a, void* dst, size_t wordBytes) {
         in.alignTo8(a.what);
-        in.read(dst, a.bytes(), a.what);
+        // In 64 MiB pieces, so that progress moves while a large file is read.
+        constexpr std::uint64_t kPiece = 64ull << 20;
+        auto* p = static_cast<unsigned char*>(dst);
+        for (std::uint64_t done = 0; done < a.bytes(); done += kPiece) {
+            in.read(p + done, std::min(kPiece, a.bytes() - done), a.what);
+            if (options.progress) options.progress(double(in.offset()) / double(size));
+        }
         swapWordsIfBigEndian(dst, a.bytes() / wordBytes, wordBytes);
     };
     mesh.points.resize(pointCount);
@@ -371,7 +377,8 @@ MeshSummary readNativeSummary(const std::string& path) {
     return summary;
 }
 
-void writeNative(const Mesh& mesh, const std::string& path) {
+void writeNative(const Mesh& mesh, const std::string& path,
+                 const std::function<void(double)>& progress) {
     // Refuse meshes the reader would refuse, before creating any file.
     validateStructure(mesh, path);
     for (const Field& f : mesh.fields) {
@@ -401,10 +408,19 @@ void writeNative(const Mesh& mesh, const std::string& path) {
         storeLe<std::uint64_t>(head, f.values.size());
     }
 
+    std::uint64_t total = head.size() + 12 * mesh.points.size() + mesh.cellTypes.size() +
+                          8 * mesh.cellOffsets.size() + 4 * mesh.cellIndices.size();
+    for (const Field& f : mesh.fields) total += 4 * f.values.size();
     OutputFile file(path);
     std::uint64_t offset = 0;
+    // Large arrays go out in 64 MiB pieces so that progress moves while an 8 GB file is written.
     auto put = [&](const void* data, std::uint64_t bytes) {
-        file.write(data, bytes);
+        constexpr std::uint64_t kPiece = 64ull << 20;
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::uint64_t done = 0; done < bytes; done += kPiece) {
+            file.write(p + done, std::min(kPiece, bytes - done));
+            if (progress) progress(double(offset + std::min(bytes, done + kPiece)) / double(total));
+        }
         offset += bytes;
     };
     // Arrays in file order, each after zero padding to a multiple of 8; on big-endian hosts

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -30,6 +31,7 @@ Mesh readNative(const std::string& path, const ReadOptions& options = {});
 MeshSummary readNativeSummary(const std::string& path);
 
 /// Writes a mesh in the native format, atomically (temporary file, then rename).
-void writeNative(const Mesh& mesh, const std::string& path);
+void writeNative(const Mesh& mesh, const std::string& path,
+                 const std::function<void(double)>& progress = {});
 
 }  // namespace uvr

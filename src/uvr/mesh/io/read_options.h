@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "uvr/mesh/io/load_budget.h"
 
@@ -16,6 +17,8 @@ struct ReadOptions {
     /// The budget the load charges (shared by the pieces of a .pvtu); when null, the reader makes
     /// one of maxMemoryBytes.
     LoadBudget* budget = nullptr;
+    /// Called with the fraction of the file read so far, by readers that know it (.uvrm).
+    std::function<void(double)> progress;
 };
 
 /// A reader's options with a budget: the caller's, or a new one of maxMemoryBytes.

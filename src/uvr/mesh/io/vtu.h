@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "uvr/mesh/io/read_options.h"
@@ -23,6 +24,7 @@ namespace uvr {
 
 /// Writes a VTK XML UnstructuredGrid (.vtu) with raw appended little-endian data (Float32 points,
 /// Int64 connectivity/offsets, UInt8 types, Float32 fields), atomically; ParaView reads it.
-void writeVtu(const Mesh& mesh, const std::string& path);
+void writeVtu(const Mesh& mesh, const std::string& path,
+              const std::function<void(double)>& progress = {});
 
 }  // namespace uvr

@@ -50,9 +50,19 @@ std::string xmlEscape(const std::string& s) {
 /// Writes values converted to little-endian T, a chunk at a time, so that no array is copied whole.
 class LittleEndianWriter {
 public:
-    explicit LittleEndianWriter(OutputFile& file) : file_(file) {}
+    /// Writes to file, reporting the fraction of `total` bytes written to progress (if given).
+    LittleEndianWriter(OutputFile& file, std::uint64_t total,
+                       const std::function<void(double)>& progress)
+        : file_(file), total_(std::max<std::uint64_t>(total, 1)), progress_(progress) {}
 
-    void bytes(const void* data, std::uint64_t count) { file_.write(data, count); }
+    void bytes(const void* data, std::uint64_t count) {
+        file_.write(data, count);
+        written_ += count;
+        if (progress_ && written_ >= nextReport_) {
+            progress_(std::min(1.0, double(written_) / double(total_)));
+            nextReport_ = written_ + total_ / 200;
+        }
+    }
 
     /// Writes T(get(i)) for i in [0, count).
     template <typename T, typename Get>
@@ -75,11 +85,14 @@ public:
 
 private:
     OutputFile& file_;
+    std::uint64_t total_, written_ = 0, nextReport_ = 0;
+    const std::function<void(double)>& progress_;
 };
 
 }  // namespace
 
-void writeVtu(const Mesh& mesh, const std::string& path) {
+void writeVtu(const Mesh& mesh, const std::string& path,
+              const std::function<void(double)>& progress) {
     // Structure checks, so that VTK never reads past an array.
     validateStructure(mesh, path);
     const std::uint64_t cells = mesh.cellCount();
@@ -130,7 +143,7 @@ void writeVtu(const Mesh& mesh, const std::string& path) {
         "   _";
 
     OutputFile file(path);
-    LittleEndianWriter out(file);
+    LittleEndianWriter out(file, xml.size() + offset, progress);
     out.bytes(xml.data(), xml.size());
     auto blockHeader = [&](std::uint64_t bytes) {
         out.values<std::uint64_t>(1, [bytes](std::uint64_t) { return bytes; });

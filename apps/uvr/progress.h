@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace uvr::cli {
+
+class Context;
+
+/// Writes one line to stderr (a newline is added), first clearing a progress line a terminal
+/// shows; every message of the CLI goes through it so lines never mix.
+void printStderrLine(const std::string& text);
+
+/// How a progress line is shown: redrawn in place on a terminal, a plain line now and then
+/// otherwise (logs, pipes), nothing with --quiet.
+enum class ProgressStyle { Terminal, Lines, Off };
+
+/// The one progress reporter of every long phase (reading, generating, refining, rendering,
+/// writing). Nothing is shown for a phase shorter than about a second; after that a line
+/// "uvr: refining: 42% (3.1 M tetrahedra/s, ETA 8 s)" - or "uvr: reading x.vtk: 12 s" when the
+/// phase cannot say how far it is - is redrawn four times a second on a terminal, or printed
+/// every 5 seconds when stderr is not one. A ticker thread keeps the line alive while the work
+/// reports nothing. done() ends the phase with one line and its time.
+class Progress {
+public:
+    /// A phase named `what`; `total` units of `unit` (e.g. tetrahedra) make the rate, 0 for none.
+    Progress(const Context& ctx, std::string what, double total = 0.0, std::string unit = "");
+    /// Stops the ticker and clears the line (no message).
+    ~Progress();
+    Progress(const Progress&) = delete;
+    Progress& operator=(const Progress&) = delete;
+
+    /// The fraction done, in [0, 1] (thread-safe; decreasing values are ignored).
+    void set(double fraction);
+    /// A callback for the library's progress(fraction) parameters; valid while this lives.
+    std::function<void(double)> callback();
+    /// Ends the phase: "uvr: MESSAGE (1.23 s)" (not with --quiet).
+    void done(const std::string& message);
+
+    /// The line shown after `seconds` at `fraction` (negative: unknown), for tests.
+    static std::string line(const std::string& what, double seconds, double fraction, double total,
+                            const std::string& unit);
+    /// The style for stderr: Off when quiet, Terminal when stderr is a terminal, else Lines.
+    static ProgressStyle styleFor(bool quiet);
+
+private:
+    void run();
+    void stop();
+
+    const Context& ctx_;
+    std::string what_, unit_;
+    double total_;
+    ProgressStyle style_;
+    std::chrono::steady_clock::time_point start_;
+    std::atomic<double> fraction_{-1.0};
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    bool stopping_ = false;
+    bool shown_ = false;  ///< a terminal line is on screen
+    std::thread ticker_;
+};
+
+}  // namespace uvr::cli
