@@ -216,8 +216,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Field to render: NAME[:point|:cell][:magnitude|:x|:y|:z|:N] "
                    "(default: the first scalar field)");
     app.add_option("--tf", tf,
-                   "Colour map: a preset (cool-to-warm, viridis, black-body, grayscale, ...) or "
-                   "a ParaView colour-map JSON export")
+                   "Colour map: a ParaView preset by name (\"Cool to Warm\", viridis, Turbo, "
+                   "Jet, \"Rainbow Uniform\", \"X Ray\", ...; `uvr presets` lists them), a "
+                   "ParaView colour-map JSON export FILE.json, or one map of a presets file "
+                   "FILE.json:NAME")
         ->capture_default_str();
     app.add_option("--opacity", opacity,
                    "Opacity: ramp, ramp:A, constant:A, step:T[:A] (binary) or x0:a0,x1:a1,... "
@@ -416,7 +418,8 @@ std::vector<NamedFile> RenderFlags::outputs() const {
 }
 
 std::vector<NamedFile> RenderFlags::inputs() const {
-    std::vector<NamedFile> in{{"--tf", tf}};
+    const auto tfFile = splitColorMapFile(tf);  // FILE.json[:NAME]: the file
+    std::vector<NamedFile> in{{"--tf", tfFile ? tfFile->first : tf}};
     if (!cameraFile.empty()) in.push_back({"--camera", cameraFile});
     return in;
 }

@@ -168,5 +168,6 @@ void addGenerateCommand(CLI::App& app, Context& ctx);
 void addRefineCommand(CLI::App& app, Context& ctx);
 void addCompareCommand(CLI::App& app, Context& ctx);
 void addBenchCommand(CLI::App& app, Context& ctx);
+void addPresetsCommand(CLI::App& app, Context& ctx);
 
 }  // namespace uvr::cli
