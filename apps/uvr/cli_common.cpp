@@ -228,6 +228,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--range", range,
                    "Value range lo,hi the transfer function spans "
                    "(default: the field's range)");
+    app.add_flag("--log", logScale,
+                 "Map values to colours on a log scale, as ParaView's \"Use log scale when "
+                 "mapping data to colors\" (also set by a JSON's UseLogScale); a range from 0 or "
+                 "below starts at min(hi / 10^4, 1), as in ParaView");
     app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
     app.add_option("--camera", cameraFile, "ParaView camera file (.pvcc)");
     app.add_option("--camera-position", cameraPosition, "Camera position x,y,z");
@@ -325,6 +329,7 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     std::tie(s.width, s.height) = parseSize("--size", size);
     s.tf = loadTransferFunction(tf);
     if (opacity) applyOpacitySpec(s.tf, *opacity);  // an empty spec is refused, not ignored
+    if (logScale) s.tf.logScale = true;
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
@@ -618,6 +623,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                       double(result.stats.partitionsSkipped) / (settings.width * settings.height));
         ctx.step(line);
     }
+    for (const std::string& note : result.setup.notes) ctx.warn(source + ": " + note);
     const std::string empty = explainEmptyFrame(prepared, settings, result);
     if (!empty.empty()) ctx.warn(source + ": " + empty);
     // Every output is written first and committed after the last one succeeded: a failure (a
@@ -700,6 +706,8 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["step"] = number(result.setup.params.step / frame.scale);
         j["opacity_unit"] = number(result.setup.params.opacityUnit / frame.scale);
         j["range"] = {result.setup.rangeLo, result.setup.rangeHi};
+        j["log_scale"] = settings.tf.logScale;
+        j["tf_table_entries"] = result.setup.tfTable.size();
         const Camera& c = result.setup.camera;
         double position[3], focal[3];
         frame.toFile(c.position, position);

@@ -70,6 +70,7 @@ struct RenderFlags {
     std::string tf = "cool-to-warm";
     std::optional<std::string> opacity;  ///< unset: the JSON's Points, else ramp
     std::string range;
+    bool logScale = false;  ///< --log
     std::string size = "1024x1024";
     std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
     std::optional<float> viewAngle;

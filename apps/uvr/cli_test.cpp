@@ -415,6 +415,25 @@ TEST(Cli, PresetsListsParaViewNamesAndPresetsFiles) {
                        "unknown name");
 }
 
+TEST(Cli, LogScaleWarnsAboutARangeFromZeroAndRefusesOneWithNoPositiveValue) {
+    const std::string dir = testing::scratchDir();
+    const std::string demo = "-q demo --cells 3000 --size 24x16 -o " + dir + "/d.png ";
+    const CliRun ok = uvr(demo + "--log --range 0,1 --stats " + dir + "/s.json", dir);
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_NE(ok.err.find("uvr: warning: demo: --log: --range [0, 1] is not positive; mapping "
+                          "[0.0001, 1] as ParaView does"),
+              std::string::npos)
+        << ok.err;
+    std::ifstream in(dir + "/s.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["log_scale"], true);
+    EXPECT_GT(stats["tf_table_entries"].get<int>(), 1024);
+    EXPECT_FLOAT_EQ(stats["range"][0].get<float>(), 1e-4f);
+    expectOneLineError(uvr(demo + "--log --range -2,0", dir),
+                       {"--log needs positive values: --range [-2, 0] has none"}, "negative");
+    expectOneLineError(uvr(demo + "--log-scale", dir), {"did you mean --log?"}, "--log-scale");
+}
+
 TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {
     // Issue 15: a transparent image with exit 0 and no word is a trap; each cause is named.
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";

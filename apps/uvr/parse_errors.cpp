@@ -44,6 +44,11 @@ const std::map<std::string, std::string>& aliases() {
         {"--camera-file", "--camera"},
         {"--sample-distance", "--step"},
         {"--unit-distance", "--opacity-unit"},
+        {"--log-scale", "--log"},
+        {"--use-log-scale", "--log"},
+        {"--logscale", "--log"},
+        {"--nan-colour", "--nan-color"},
+        {"--nancolor", "--nan-color"},
     };
     return names;
 }

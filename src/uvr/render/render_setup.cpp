@@ -232,6 +232,13 @@ std::string fmtG(double v) {
     return buf;
 }
 
+/// A field value for a message (6 significant digits).
+std::string fmtValue(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
 /// Refuses a frame whose estimated work (every ray across the bounds' diagonal) exceeds
 /// kMaxSamplesPerRay or kMaxFrameSamples, naming the step that would be accepted.
 void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, float step) {
@@ -269,10 +276,38 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                           bool shadePartitions) {
     validateSettings(settings);
     FrameSetup f;
-    f.tfTable = settings.tf.bake(settings.tfTableSize);
-    f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
     f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
     f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
+    // The baked table: linear in the value over [rangeLo, rangeHi]; a log-scale function is
+    // evaluated at each entry's log position, on a table fine enough where log changes fastest.
+    int tableSize = settings.tfTableSize;
+    if (settings.tf.logScale) {
+        const std::string range = "[" + fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) + "]";
+        const std::string which = settings.range ? "--range " : "the field's range ";
+        if (!(f.rangeHi > 0.f))
+            throwError(ErrorKind::Argument, "",
+                       "--log needs positive values: " + which + range +
+                           " has none; give --range LO,HI with 0 < LO <= HI");
+        if (!(f.rangeLo > 0.f)) {
+            f.rangeLo = std::fmin(f.rangeHi * 1e-4f, 1.f);  // ParaView's AdjustRangeForLog
+            f.notes.push_back("--log: " + which + range + " is not positive; mapping [" +
+                              fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) +
+                              "] as ParaView does (values below take the lowest colour; "
+                              "set the range with --range LO,HI)");
+        }
+        tableSize = logTableSize(settings.tfTableSize, f.rangeLo, f.rangeHi);
+        // Below `resolved` one table step spans more than 1 / 255 of the log range: 8-bit
+        // colour bands may show there (said when that is more than the range's lowest octave).
+        const double resolved = logTableResolvedFrom(tableSize, 256, f.rangeLo, f.rangeHi);
+        if (resolved > 2.0 * f.rangeLo)
+            f.notes.push_back("--log over " + fmtG(std::log10(double(f.rangeHi) / f.rangeLo)) +
+                              " decades: the " + std::to_string(tableSize) +
+                              "-entry table steps by more than 1/255 of the log range below "
+                              "value " +
+                              fmtValue(resolved) + " (narrow the range with --range LO,HI)");
+    }
+    f.tfTable = settings.tf.bakeOverRange(tableSize, f.rangeLo, f.rangeHi);
+    f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
     const float aspect = float(settings.width) / float(settings.height);
     // Settings are in the file's units; the prepared mesh is in rendering units (mesh.tets.frame:
     // the identity unless the mesh is very large, very small or far from the origin).

@@ -145,7 +145,8 @@ struct RenderSettings {
     float step = 0.f;                              ///< s1; 0 = defaultStep
     float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
     float terminationAlpha = 0.99f;
-    int tfTableSize = 1024;  ///< entries of the baked transfer function
+    /// Entries of the baked transfer function (a log-scale one gets more: logTableSize).
+    int tfTableSize = 1024;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)
@@ -244,7 +245,13 @@ struct FrameSetup {
     Camera camera;
     CameraRays rays;
     MarchParams params;
+    /// The value range the table spans: the settings' or the field's; with a log-scale transfer
+    /// function one from 0 or below starts at min(hi / 10^4, 1) (ParaView's AdjustRangeForLog).
     float rangeLo = 0.f, rangeHi = 1.f;
+    /// What the setup changed or could not do as asked, one sentence each, for the user (the
+    /// CLI prints them as warnings): a log range moved off 0, a log table too coarse at its low
+    /// end.
+    std::vector<std::string> notes;
 
     /// Scene view over a prepared mesh; both must outlive it.
     SceneView scene(const PreparedMesh& mesh) const;

@@ -76,6 +76,40 @@ TEST(TransferFunction, BakeSamplesEvenlyIncludingEnds) {
     EXPECT_EQ(catchError([&] { tf.bake(1); }).kind(), ErrorKind::Argument);
 }
 
+TEST(TransferFunction, LogScaleBakesTheLogPositionOfEachValue) {
+    // Entry k of a table over [1, 1000] holds value v_k = 1 + 999 k / (n - 1) and gets the
+    // function at log10(v_k) / 3 (ParaView's volume mappers: a table linear in the value).
+    TransferFunction tf = transferFunctionPreset("grayscale");
+    tf.logScale = true;
+    const int n = 2001;
+    const std::vector<Vec4f> table = tf.bakeOverRange(n, 1.0, 1000.0);
+    ASSERT_EQ(table.size(), size_t(n));
+    for (int k = 0; k < n; k += 50) {
+        const double t = std::log10(1.0 + 999.0 * k / (n - 1)) / 3.0;
+        EXPECT_NEAR(table[k].x, t, 1e-6) << k;
+        EXPECT_NEAR(table[k].w, t, 1e-6) << k;
+    }
+    EXPECT_FLOAT_EQ(table.back().x, 1.f);
+    // Linear without logScale: the same as bake.
+    tf.logScale = false;
+    EXPECT_FLOAT_EQ(tf.bakeOverRange(5, 1.0, 1000.0)[1].x, 0.25f);
+    tf.logScale = true;
+    EXPECT_EQ(catchError([&] { tf.bakeOverRange(8, 0.0, 10.0); }).kind(), ErrorKind::Argument);
+
+    // Table size: the first step from lo spans 1 / 1023 of the log range, as a linear table's.
+    const int size = logTableSize(1024, 1.0, 1000.0);
+    const double first = 999.0 / (size - 1);
+    EXPECT_LE(std::log10(1.0 + first) / 3.0, 1.0 / 1023 * 1.0001);
+    EXPECT_GT(std::log10(1.0 + 999.0 / (size - 2)) / 3.0, 1.0 / 1023 * 0.999);
+    EXPECT_LE(logTableSize(1024, 1.0, 1.001), 1025);  // narrow ranges need hardly more
+    EXPECT_LT(logTableSize(1024, 1.0, 1.5), 1300);
+    EXPECT_EQ(logTableSize(1024, 1.0, 1e8), kMaxLogTableSize);
+    EXPECT_EQ(logTableResolvedFrom(size, 1024, 1.0, 1000.0), 1.0);
+    const double from = logTableResolvedFrom(kMaxLogTableSize, 1024, 1.0, 1e8);
+    EXPECT_GT(from, 1.0);
+    EXPECT_LT(from, 1e8);
+}
+
 TEST(TransferFunction, LabConversionMatchesPublishedValues) {
     // sRGB primaries in CIE L*a*b* (D65), e.g. from Bruce Lindbloom's calculator.
     Vec3f red = srgbToLab({1.f, 0.f, 0.f});
