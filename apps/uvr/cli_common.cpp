@@ -232,6 +232,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                  "Map values to colours on a log scale, as ParaView's \"Use log scale when "
                  "mapping data to colors\" (also set by a JSON's UseLogScale); a range from 0 or "
                  "below starts at min(hi / 10^4, 1), as in ParaView");
+    app.add_option("--nan-color", nanColor,
+                   "Colour of NaN values r,g,b[,a] in [0, 1]; a is the opacity (default 1, "
+                   "ParaView's NanOpacity). Without it NaN values take the colour map's NanColor "
+                   "at opacity 0: invisible, unless a JSON's NanOpacity says otherwise");
     app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
     app.add_option("--camera", cameraFile, "ParaView camera file (.pvcc)");
     app.add_option("--camera-position", cameraPosition, "Camera position x,y,z");
@@ -330,6 +334,16 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     s.tf = loadTransferFunction(tf);
     if (opacity) applyOpacitySpec(s.tf, *opacity);  // an empty spec is refused, not ignored
     if (logScale) s.tf.logScale = true;
+    if (!nanColor.empty()) {
+        const bool withAlpha = std::count(nanColor.begin(), nanColor.end(), ',') == 3;
+        const auto v = parseFloats("--nan-color", nanColor, withAlpha ? 4 : 3,
+                                   "r,g,b or r,g,b,a with numbers in [0, 1]");
+        for (float c : v)
+            if (!(c >= 0.f && c <= 1.f))
+                badFlag("--nan-color", nanColor, "r,g,b or r,g,b,a with numbers in [0, 1]");
+        s.tf.nanColor = Vec3f(v[0], v[1], v[2]);
+        s.tf.nanOpacity = withAlpha ? v[3] : 1.f;
+    }
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;

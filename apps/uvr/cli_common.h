@@ -71,6 +71,7 @@ struct RenderFlags {
     std::optional<std::string> opacity;  ///< unset: the JSON's Points, else ramp
     std::string range;
     bool logScale = false;  ///< --log
+    std::string nanColor;   ///< --nan-color r,g,b[,a]; empty: the colour map's
     std::string size = "1024x1024";
     std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
     std::optional<float> viewAngle;

@@ -415,7 +415,7 @@ TEST(Cli, PresetsListsParaViewNamesAndPresetsFiles) {
                        "unknown name");
 }
 
-TEST(Cli, LogScaleWarnsAboutARangeFromZeroAndRefusesOneWithNoPositiveValue) {
+TEST(Cli, LogScaleAndNanColorFlags) {
     const std::string dir = testing::scratchDir();
     const std::string demo = "-q demo --cells 3000 --size 24x16 -o " + dir + "/d.png ";
     const CliRun ok = uvr(demo + "--log --range 0,1 --stats " + dir + "/s.json", dir);
@@ -432,6 +432,15 @@ TEST(Cli, LogScaleWarnsAboutARangeFromZeroAndRefusesOneWithNoPositiveValue) {
     expectOneLineError(uvr(demo + "--log --range -2,0", dir),
                        {"--log needs positive values: --range [-2, 0] has none"}, "negative");
     expectOneLineError(uvr(demo + "--log-scale", dir), {"did you mean --log?"}, "--log-scale");
+    // --nan-color r,g,b[,a].
+    EXPECT_EQ(uvr(demo + "--nan-color 1,0,0", dir).code, 0);
+    EXPECT_EQ(uvr(demo + "--nan-color 1,0,0,0.5", dir).code, 0);
+    for (const char* bad : {"1,0", "2,0,0", "1,0,0,0,1", "red"})
+        expectOneLineError(uvr(demo + "--nan-color " + bad, dir),
+                           {"--nan-color '" + std::string(bad) + "': expected r,g,b or r,g,b,a"},
+                           bad);
+    expectOneLineError(uvr(demo + "--nan-colour 1,0,0", dir), {"did you mean --nan-color?"},
+                       "--nan-colour");
 }
 
 TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {

@@ -73,10 +73,34 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
             out.seeds = buildSeedGrids(out.tets, *out.kd);
         }
         out.gradientSpread = partitionGradientSpread(out.tets, *out.kd);
+        out.partitionNan = partitionNanFlags(out.tets, *out.kd);
         if (options.macroGrids) {
             if (progress) progress("building macrocell grids");
             out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors);
         }
+    }
+    return out;
+}
+
+std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartitions& kd) {
+    const auto isNan = [](float v) { return v != v; };
+    if (std::none_of(tets.values.begin(), tets.values.end(), isNan)) return {};
+    const bool cellData = tets.association == Association::Cell;
+    std::vector<std::uint8_t> out(kd.partitions.size(), 0);
+    const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::int64_t p = 0; p < n; ++p) {
+        const KdPartition& part = kd.partitions[p];
+        bool nan = false;
+        for (std::uint32_t i = 0; i < part.cellCount && !nan; ++i) {
+            const std::uint32_t t = kd.cells[part.firstCell + i];
+            if (cellData) {
+                nan = isNan(tets.values[t]);
+            } else {
+                for (std::uint32_t v : tets.tets[t].v) nan = nan || isNan(tets.values[v]);
+            }
+        }
+        out[p] = nan;
     }
     return out;
 }
@@ -198,6 +222,7 @@ SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     SceneView v;
     v.locator = mesh.locator();
     v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi, tfBreaks.data()};
+    v.tf.nan = tfNan;
     v.bounds = mesh.tets.bounds;
     v.params = params;
     return v;
@@ -308,6 +333,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     }
     f.tfTable = settings.tf.bakeOverRange(tableSize, f.rangeLo, f.rangeHi);
     f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
+    f.tfNan = Vec4f(settings.tf.nanColor.x, settings.tf.nanColor.y, settings.tf.nanColor.z,
+                    settings.tf.nanOpacity);
     const float aspect = float(settings.width) / float(settings.height);
     // Settings are in the file's units; the prepared mesh is in rendering units (mesh.tets.frame:
     // the identity unless the mesh is very large, very small or far from the origin).
@@ -401,8 +428,13 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         const TfRangeTables ranges(table);
         f.shading =
             computePartitionShading(*mesh.kd, mesh.gradientSpread, ranges.view(table), f.stepRule);
+        // Partitions and macrocells holding NaN values (their value ranges leave NaN out).
+        for (std::size_t p = 0; p < mesh.partitionNan.size(); ++p)
+            if (mesh.partitionNan[p]) shadeNan(f.shading[p], f.tfNan.w, f.stepRule.s1);
         if (usesMacroCells(mesh, f.stepRule)) {
             f.macroShading = computeMacroShading(*mesh.macro, ranges.view(table), f.stepRule);
+            for (std::size_t c = 0; c < mesh.macro->nanCells.size(); ++c)
+                if (mesh.macro->nanCells[c]) shadeNan(f.macroShading[c], f.tfNan.w, f.stepRule.s1);
             for (std::size_t p = 0; p < f.shading.size(); ++p)
                 f.shading[p].byMacroCells =
                     macroCellsPay(mesh.macro->grids[p], f.macroShading.data(), f.shading[p]);

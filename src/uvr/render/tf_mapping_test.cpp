@@ -1,16 +1,18 @@
 // SPDX-License-Identifier: MIT
 // Transfer-function mappings every integrator must honour (issue 15): a log scale (--log) baked
-// into the value-linear table, checked against where the log map puts an opacity band, with
-// partition skipping on.
+// into the value-linear table, checked against where the log map puts an opacity band, and the
+// NaN colour, checked against the chord through a NaN region; with partition skipping on.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "test_meshes.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/field_select.h"
+#include "uvr/render/camera.h"
 #include "uvr/render/render_setup.h"
 
 namespace uvr {
@@ -108,6 +110,78 @@ TEST(TfMapping, LogScaleRangeFromZeroStartsWhereParaViewStartsIt) {
                                              "none; give --range LO,HI with 0 < LO <= HI"),
                   std::string::npos)
             << e.what();
+    }
+}
+
+/// A 12^3 grid of hexahedra over [0, 1]^3 whose field is x, NaN at vertices with x > 0.5: every
+/// cell in x >= 0.5 has a NaN vertex, so the NaN region is the box [0.5, 1] x [0, 1]^2.
+PreparedMesh halfNanGrid() {
+    const Mesh m = testing::makeHexGrid(12, 0.f, 1.f, [](Vec3f p) {
+        return p.x > 0.51f ? std::numeric_limits<float>::quiet_NaN() : p.x;
+    });
+    PrepareOptions options;
+    options.kd.leafCells = 64;
+    return prepareMesh(m, selectScalarField(m, {}), options);
+}
+
+TEST(TfMapping, NanValuesTakeTheNanColourInEveryIntegrator) {
+    const PreparedMesh pm = halfNanGrid();
+    ASSERT_FALSE(pm.partitionNan.empty());
+    ASSERT_TRUE(pm.macro && !pm.macro->nanCells.empty());
+    Bounds3f nanBox, finiteBox;
+    nanBox.lo = Vec3f(0.5f, 0.f, 0.f), nanBox.hi = Vec3f(1.f, 1.f, 1.f);
+    finiteBox.lo = Vec3f(0.f, 0.f, 0.f), finiteBox.hi = Vec3f(0.5f, 1.f, 1.f);
+    RenderSettings s;
+    s.width = 40, s.height = 30;
+    s.camera = orbitCamera(resetCamera(pm.tets.bounds, 40.f / 30.f), 35.f, 20.f);
+    s.opacityUnit = 0.25f;
+    s.tf = transferFunctionPreset("Grayscale");
+    struct Case {
+        const char* what;
+        float opacity;  ///< of finite values (constant)
+        float nanOpacity;
+    };
+    // NaN visible over a transparent field; then NaN invisible (the default) in a visible one.
+    for (const Case c : {Case{"NaN visible", 0.f, 0.5f}, Case{"NaN invisible", 0.3f, 0.f}}) {
+        applyOpacitySpec(s.tf, "constant:" + std::to_string(c.opacity));
+        s.tf.nanColor = Vec3f(1.f, 0.f, 0.f);
+        s.tf.nanOpacity = c.nanOpacity;
+        const Bounds3f& seen = c.nanOpacity > 0.f ? nanBox : finiteBox;
+        const float alphaPerUnit = c.nanOpacity > 0.f ? c.nanOpacity : c.opacity;
+        for (const RenderMethod method :
+             {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
+            for (const bool pre : {true, false}) {
+                if (method == RenderMethod::Exact && !pre) continue;
+                s.method = method;
+                s.preintegrated = pre;
+                const RenderResult r = renderCpu(pm, s);
+                // Sample-based methods place the NaN region's edge to within a step s1.
+                const double tol = method == RenderMethod::Exact ? 2e-3 : 0.03;
+                double worst = 0.0;
+                int hit = 0;
+                for (int y = 0; y < s.height; ++y)
+                    for (int x = 0; x < s.width; ++x) {
+                        const Ray ray = r.setup.rays.ray(x + 0.5f, y + 0.5f);
+                        double t0, t1;
+                        const double chord = boxSpan(seen, ray, t0, t1) ? t1 - t0 : 0.0;
+                        const double want =
+                            1.0 - std::pow(1.0 - alphaPerUnit, chord / s.opacityUnit);
+                        const Vec4f px = r.image.pixels[y * s.width + x];
+                        worst = std::max(worst, std::fabs(px.w - want));
+                        if (c.nanOpacity > 0.f) {
+                            // Premultiplied NaN colour: red only.
+                            EXPECT_NEAR(px.x, px.w, 1e-4) << c.what;
+                            EXPECT_EQ(px.y, 0.f) << c.what;
+                        }
+                        hit += chord > 0.05;
+                    }
+                EXPECT_GT(hit, 100) << c.what;
+                EXPECT_LE(worst, tol) << c.what << " method " << int(method) << " pre " << pre;
+                if (method == RenderMethod::Partitions && c.nanOpacity > 0.f) {
+                    EXPECT_GT(r.stats.partitionsSkipped, 0u) << "the finite half is skipped";
+                }
+            }
+        }
     }
 }
 
