@@ -34,6 +34,11 @@ inline std::string testTool(const std::string& name) {
     return std::string(UVR_TEST_TOOLS_DIR) + "/" + name;
 }
 
+/// Path of a data file in tests/data (the repository's own small inputs).
+inline std::string testData(const std::string& name) {
+    return std::string(UVR_TEST_TOOLS_DIR) + "/../data/" + name;
+}
+
 /// A fresh, empty folder for this test's files under the system temp folder.
 inline std::string scratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

@@ -219,8 +219,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Field to render: NAME[:point|:cell][:magnitude|:x|:y|:z|:N] "
                    "(default: the first scalar field)");
     app.add_option("--tf", tf,
-                   "Colour map: a preset (cool-to-warm, viridis, black-body, grayscale, ...) or "
-                   "a ParaView colour-map JSON export")
+                   "Colour map: a ParaView preset by name (\"Cool to Warm\", viridis, Turbo, "
+                   "Jet, \"Rainbow Uniform\", \"X Ray\", ...; `uvr presets` lists them), a "
+                   "ParaView colour-map JSON export FILE.json, or one map of a presets file "
+                   "FILE.json:NAME")
         ->capture_default_str();
     app.add_option("--opacity", opacity,
                    "Opacity: ramp, ramp:A, constant:A, step:T[:A] (binary) or x0:a0,x1:a1,... "
@@ -229,6 +231,14 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--range", range,
                    "Value range lo,hi the transfer function spans "
                    "(default: the field's range)");
+    app.add_flag("--log", logScale,
+                 "Map values to colours on a log scale, as ParaView's \"Use log scale when "
+                 "mapping data to colors\" (also set by a JSON's UseLogScale); a range from 0 or "
+                 "below starts at min(hi / 10^4, 1), as in ParaView");
+    app.add_option("--nan-color", nanColor,
+                   "Colour of NaN values r,g,b[,a] in [0, 1]; a is the opacity (default 1, "
+                   "ParaView's NanOpacity). Without it NaN values take the colour map's NanColor "
+                   "at opacity 0: invisible, unless a JSON's NanOpacity says otherwise");
     app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
     app.add_option("--camera", cameraFile, "ParaView camera file (.pvcc)");
     app.add_option("--camera-position", cameraPosition, "Camera position x,y,z");
@@ -348,6 +358,17 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     std::tie(s.width, s.height) = parseSize("--size", size);
     s.tf = loadTransferFunction(tf);
     if (opacity) applyOpacitySpec(s.tf, *opacity);  // an empty spec is refused, not ignored
+    if (logScale) s.tf.logScale = true;
+    if (!nanColor.empty()) {
+        const bool withAlpha = std::count(nanColor.begin(), nanColor.end(), ',') == 3;
+        const auto v = parseFloats("--nan-color", nanColor, withAlpha ? 4 : 3,
+                                   "r,g,b or r,g,b,a with numbers in [0, 1]");
+        for (float c : v)
+            if (!(c >= 0.f && c <= 1.f))
+                badFlag("--nan-color", nanColor, "r,g,b or r,g,b,a with numbers in [0, 1]");
+        s.tf.nanColor = Vec3f(v[0], v[1], v[2]);
+        s.tf.nanOpacity = withAlpha ? v[3] : 1.f;
+    }
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
@@ -513,7 +534,8 @@ std::vector<NamedFile> RenderFlags::outputs() const {
 }
 
 std::vector<NamedFile> RenderFlags::inputs() const {
-    std::vector<NamedFile> in{{"--tf", tf}};
+    const auto tfFile = splitColorMapFile(tf);  // FILE.json[:NAME]: the file
+    std::vector<NamedFile> in{{"--tf", tfFile ? tfFile->first : tf}};
     if (!cameraFile.empty()) in.push_back({"--camera", cameraFile});
     return in;
 }
@@ -698,6 +720,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                       double(result.stats.partitionsSkipped) / (settings.width * settings.height));
         ctx.step(line);
     }
+    for (const std::string& note : result.setup.notes) ctx.warn(source + ": " + note);
     const std::string empty = explainEmptyFrame(prepared, settings, result);
     if (!empty.empty()) ctx.warn(source + ": " + empty);
     // Every output is written first and committed after the last one succeeded: a failure (a
@@ -786,6 +809,8 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["step"] = number(result.setup.params.step / frame.scale);
         j["opacity_unit"] = number(result.setup.params.opacityUnit / frame.scale);
         j["range"] = {result.setup.rangeLo, result.setup.rangeHi};
+        j["log_scale"] = settings.tf.logScale;
+        j["tf_table_entries"] = result.setup.tfTable.size();
         const Camera& c = result.setup.camera;
         double position[3], focal[3];
         frame.toFile(c.position, position);

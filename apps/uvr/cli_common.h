@@ -70,6 +70,8 @@ struct RenderFlags {
     std::string tf = "cool-to-warm";
     std::optional<std::string> opacity;  ///< unset: the JSON's Points, else ramp
     std::string range;
+    bool logScale = false;  ///< --log
+    std::string nanColor;   ///< --nan-color r,g,b[,a]; empty: the colour map's
     std::string size = "1024x1024";
     std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
     std::optional<float> viewAngle;
@@ -171,5 +173,6 @@ void addGenerateCommand(CLI::App& app, Context& ctx);
 void addRefineCommand(CLI::App& app, Context& ctx);
 void addCompareCommand(CLI::App& app, Context& ctx);
 void addBenchCommand(CLI::App& app, Context& ctx);
+void addPresetsCommand(CLI::App& app, Context& ctx);
 
 }  // namespace uvr::cli

@@ -37,7 +37,7 @@ TEST(Cli, HelpListsEverySubcommand) {
     const CliRun r = uvr("--help", dir);
     EXPECT_EQ(r.code, 0);
     for (const char* cmd :
-         {"info", "render", "demo", "convert", "generate", "refine", "compare", "bench"})
+         {"info", "render", "demo", "convert", "generate", "refine", "compare", "bench", "presets"})
         EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd;
     const CliRun rh = uvr("render --help", dir);
     EXPECT_EQ(rh.code, 0);
@@ -361,6 +361,86 @@ TEST(Cli, MisspeltCommandsAndOptionsGetASuggestion) {
     EXPECT_EQ(cli::editDistance("rendr", "render"), 1);
     EXPECT_EQ(cli::closest("--quailty", {"--quality", "--quiet"}), "--quality");
     EXPECT_EQ(cli::closest("--x", {"--quality"}), "");
+}
+
+TEST(Cli, PresetsListsParaViewNamesAndPresetsFiles) {
+    // Issue 15: ParaView's preset names work with --tf, `uvr presets` lists them, and a presets
+    // file of many maps gives one by name.
+    const std::string dir = testing::scratchDir();
+    const CliRun list = uvr("presets", dir);
+    EXPECT_EQ(list.code, 0) << list.err;
+    for (const char* name : {"Cool to Warm", "Viridis (matplotlib)", "Turbo", "Jet",
+                             "Rainbow Uniform", "X Ray", "Blue Orange (divergent)"})
+        EXPECT_NE(list.out.find(name), std::string::npos) << name;
+    EXPECT_NE(list.out.find("Cool to Warm (Extended)  Lab        35 points"), std::string::npos)
+        << list.out;
+    const CliRun js = uvr("presets --json", dir);
+    ASSERT_EQ(js.code, 0) << js.err;
+    const nlohmann::json j = nlohmann::json::parse(js.out);
+    EXPECT_EQ(j["source"], "built-in");
+    ASSERT_GE(j["colormaps"].size(), 28u);
+    EXPECT_EQ(j["colormaps"][0]["name"], "Cool to Warm");
+    EXPECT_EQ(j["colormaps"][0]["color_space"], "Diverging");
+    EXPECT_EQ(j["colormaps"][0]["points"], 3);
+
+    const std::string file = testing::testData("presets/several_maps.json");
+    const CliRun maps = uvr("presets " + file, dir);
+    EXPECT_EQ(maps.code, 0) << maps.err;
+    EXPECT_NE(maps.out.find("Ember Ramp    RGB        2 points"), std::string::npos) << maps.out;
+    EXPECT_NE(maps.out.find("Site Classes  indexed    (not supported)"), std::string::npos)
+        << maps.out;
+    EXPECT_NE(maps.out.find("4 colour maps: --tf " + file + ":NAME"), std::string::npos);
+    expectOneLineError(uvr("presets " + dir + "/missing.json", dir),
+                       {dir + "/missing.json: cannot open"}, "missing file");
+    expectOneLineError(uvr("presetz", dir), {"did you mean 'presets'?"}, "presetz");
+
+    // Render with ParaView names and with a map of the presets file; refusals in one line.
+    const std::string demo = "-q demo --cells 3000 --size 24x16 -o " + dir + "/d.png ";
+    for (const std::string& tf :
+         {std::string("Turbo"), std::string("'Rainbow Uniform'"), std::string("x-ray"),
+          std::string("'Blue Orange'"), "'" + file + ":Ember Ramp'"}) {
+        const CliRun r = uvr(demo + "--tf " + tf, dir);
+        EXPECT_EQ(r.code, 0) << tf << ": " << r.err;
+    }
+    expectOneLineError(
+        uvr(demo + "--tf jett", dir),
+        {"unknown transfer function preset \"jett\"; did you mean \"Jet\"?", "`uvr presets` lists"},
+        "jett");
+    expectOneLineError(uvr(demo + "--tf " + file, dir),
+                       {file + ": holds 4 colour maps: pick one with --tf " + file + ":NAME",
+                        "\"Deep Sea\", \"Ember Ramp\""},
+                       "no name");
+    expectOneLineError(uvr(demo + "--tf '" + file + ":Amber Ramp'", dir),
+                       {"no colour map named \"Amber Ramp\"; did you mean \"Ember Ramp\"?"},
+                       "unknown name");
+}
+
+TEST(Cli, LogScaleAndNanColorFlags) {
+    const std::string dir = testing::scratchDir();
+    const std::string demo = "-q demo --cells 3000 --size 24x16 -o " + dir + "/d.png ";
+    const CliRun ok = uvr(demo + "--log --range 0,1 --stats " + dir + "/s.json", dir);
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_NE(ok.err.find("uvr: warning: demo: --log: --range [0, 1] is not positive; mapping "
+                          "[0.0001, 1] as ParaView does"),
+              std::string::npos)
+        << ok.err;
+    std::ifstream in(dir + "/s.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["log_scale"], true);
+    EXPECT_GT(stats["tf_table_entries"].get<int>(), 1024);
+    EXPECT_FLOAT_EQ(stats["range"][0].get<float>(), 1e-4f);
+    expectOneLineError(uvr(demo + "--log --range -2,0", dir),
+                       {"--log needs positive values: --range [-2, 0] has none"}, "negative");
+    expectOneLineError(uvr(demo + "--log-scale", dir), {"did you mean --log?"}, "--log-scale");
+    // --nan-color r,g,b[,a].
+    EXPECT_EQ(uvr(demo + "--nan-color 1,0,0", dir).code, 0);
+    EXPECT_EQ(uvr(demo + "--nan-color 1,0,0,0.5", dir).code, 0);
+    for (const char* bad : {"1,0", "2,0,0", "1,0,0,0,1", "red"})
+        expectOneLineError(uvr(demo + "--nan-color " + bad, dir),
+                           {"--nan-color '" + std::string(bad) + "': expected r,g,b or r,g,b,a"},
+                           bad);
+    expectOneLineError(uvr(demo + "--nan-colour 1,0,0", dir), {"did you mean --nan-color?"},
+                       "--nan-colour");
 }
 
 TEST(Cli, EmptyImagesWarnWithTheReasonAndExitZero) {

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: MIT
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -348,6 +349,49 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
         progress.done("refined to " + std::to_string(refined.pointCount()) + " points, " +
                       std::to_string(refined.cellCount()) + " tetrahedra");
         writeMeshWithProgress(refined, *out, ctx);
+    });
+}
+
+void addPresetsCommand(CLI::App& app, Context& /*ctx*/) {
+    auto* cmd = app.add_subcommand(
+        "presets",
+        "List the built-in colour maps (ParaView's presets, for --tf NAME) or the maps of a "
+        "ParaView presets file (for --tf FILE.json:NAME): name, colour space, control points");
+    auto file = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    cmd->add_option("FILE", *file,
+                    "ParaView colour-map JSON (an export of one map or a presets file of many)");
+    cmd->add_flag("--json", *json, "Print JSON instead of text");
+    cmd->callback([file, json] {
+        const std::vector<ColorMapInfo> maps =
+            file->empty() ? transferFunctionPresets() : listParaViewColorMaps(*file);
+        if (*json) {
+            nlohmann::json j;
+            j["source"] = file->empty() ? "built-in" : *file;
+            j["colormaps"] = nlohmann::json::array();
+            for (const ColorMapInfo& m : maps)
+                j["colormaps"].push_back(
+                    {{"name", m.name}, {"color_space", m.colorSpace}, {"points", m.points}});
+            std::printf("%s\n", jsonText(j).c_str());
+            return;
+        }
+        std::size_t width = 4;
+        for (const ColorMapInfo& m : maps) width = std::max(width, printable(m.name).size());
+        for (const ColorMapInfo& m : maps) {
+            const std::string name = m.name.empty() ? "(unnamed)" : printable(m.name);
+            const std::string points =
+                m.points > 0 ? std::to_string(m.points) + " points" : "(not supported)";
+            std::printf("%-*s  %-10s %s\n", static_cast<int>(width), name.c_str(),
+                        printable(m.colorSpace).c_str(), points.c_str());
+        }
+        if (file->empty())
+            std::printf(
+                "%zu presets: --tf NAME (case, spaces, '-' and '_' do not matter; "
+                "\"viridis\" for \"Viridis (matplotlib)\")\n",
+                maps.size());
+        else
+            std::printf("%zu colour map%s: --tf %s:NAME\n", maps.size(),
+                        maps.size() == 1 ? "" : "s", printable(*file).c_str());
     });
 }
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The uvr command-line tool: info, render, demo, convert, generate, refine, compare, bench.
+// The uvr command-line tool: info, render, demo, convert, generate, refine, compare, bench,
+// presets.
 #include <cstdio>
 #include <new>
 
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
     cli::addRefineCommand(app, ctx);
     cli::addCompareCommand(app, ctx);
     cli::addBenchCommand(app, ctx);
+    cli::addPresetsCommand(app, ctx);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,24 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "parse_errors.h"
 
+#include "uvr/core/text.h"
+
 #include <algorithm>
 #include <map>
 
 namespace uvr::cli {
 
 int editDistance(const std::string& a, const std::string& b) {
-    std::vector<int> row(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        int diagonal = row[0];
-        row[0] = static_cast<int>(i);
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const int up = row[j];
-            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-            diagonal = up;
-        }
-    }
-    return row[b.size()];
+    return uvr::editDistance(a, b);
 }
 
 std::string closest(const std::string& word, const std::vector<std::string>& candidates) {
@@ -53,6 +44,11 @@ const std::map<std::string, std::string>& aliases() {
         {"--camera-file", "--camera"},
         {"--sample-distance", "--step"},
         {"--unit-distance", "--opacity-unit"},
+        {"--log-scale", "--log"},
+        {"--use-log-scale", "--log"},
+        {"--logscale", "--log"},
+        {"--nan-colour", "--nan-color"},
+        {"--nancolor", "--nan-color"},
     };
     return names;
 }

@@ -19,6 +19,9 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "macrocell grids");
     out.cells.assign(gridCellCount(out.grids), MacroCell{});
     const bool cellData = mesh.association == Association::Cell;
+    const bool anyNan =
+        std::any_of(mesh.values.begin(), mesh.values.end(), [](float v) { return v != v; });
+    if (anyNan) out.nanCells.assign(out.cells.size(), 0);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {
         const KdPartition& part = kd.partitions[p];
@@ -35,9 +38,13 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
             float lo = INFINITY, hi = -INFINITY;
             Vec3f grad(0.f);
             bool gradOk = false;
+            bool nan = false;
             if (cellData) {
                 lo = hi = mesh.values[t];
+                nan = anyNan && lo != lo;
             } else {
+                for (int k = 0; k < 4 && anyNan; ++k)
+                    nan = nan || mesh.values[tet.v[k]] != mesh.values[tet.v[k]];
                 for (int k = 0; k < 4; ++k) {
                     lo = std::fmin(lo, mesh.values[tet.v[k]]);  // NaN values are left out
                     hi = std::fmax(hi, mesh.values[tet.v[k]]);
@@ -59,10 +66,11 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
                     for (std::uint32_t x = a[0]; x <= b[0]; ++x) {
                         const std::size_t c = (std::size_t(z) * g.dims[1] + y) * g.dims[0] + x;
                         MacroCell& m = cells[c];
-                        // A tetrahedron whose values are all NaN adds no range: its samples
-                        // are transparent, so a macrocell of only such cells is skipped.
+                        // A tetrahedron whose values are all NaN adds no range; nanCells
+                        // records it (shadeNan keeps the macrocell while NaN is visible).
                         m.valueMin = std::fmin(m.valueMin, lo);
                         m.valueMax = std::fmax(m.valueMax, hi);
+                        if (nan) out.nanCells[g.first + c] = 1;
                         if (cellData || boundary)
                             m.gradientSpread = INFINITY;
                         else if (gradOk)

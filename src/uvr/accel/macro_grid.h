@@ -44,11 +44,15 @@ inline constexpr float kTetsPerMacroCell = 48.f;
 struct MacroGrids {
     std::vector<PartitionGrid> grids;
     std::vector<MacroCell> cells;
+    /// Per macrocell: 1 where a tetrahedron with a NaN value overlaps it (its value range leaves
+    /// NaN out); empty when the field has no NaN value.
+    std::vector<std::uint8_t> nanCells;
     double buildSeconds = 0.0;
 
     /// Bytes held.
     std::uint64_t bytes() const {
-        return grids.size() * sizeof(PartitionGrid) + cells.size() * sizeof(MacroCell);
+        return grids.size() * sizeof(PartitionGrid) + cells.size() * sizeof(MacroCell) +
+               nanCells.size();
     }
 };
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/core/text.h"
 
+#include <algorithm>
 #include <cstdint>
 
 namespace uvr {
@@ -110,6 +111,44 @@ const char* wideTextEncoding(const void* data, std::size_t size) {
     if ((!z0 && z1 && z2 && z3) || (z0 && z1 && z2 && !z3)) return "UTF-32";
     if ((!z0 && z1 && !z2 && z3) || (z0 && !z1 && z2 && !z3)) return "UTF-16";
     return nullptr;
+}
+
+int editDistance(std::string_view a, std::string_view b) {
+    std::vector<int> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        int diagonal = row[0];
+        row[0] = static_cast<int>(i);
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const int up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+            diagonal = up;
+        }
+    }
+    return row[b.size()];
+}
+
+std::vector<std::string> closeMatches(const std::string& word,
+                                      const std::vector<std::string>& candidates,
+                                      std::size_t maxCount) {
+    const int limit = std::max(2, static_cast<int>(word.size()) / 3);
+    std::vector<std::pair<int, std::string>> scored;
+    for (const std::string& c : candidates) {
+        int d = editDistance(word, c);
+        const bool contains =
+            word.size() >= 3 && c.size() >= 3 &&
+            (c.find(word) != std::string::npos || word.find(c) != std::string::npos);
+        if (contains) d = std::min(d, limit);
+        if (d <= limit) scored.emplace_back(d, c);
+    }
+    std::stable_sort(scored.begin(), scored.end(),
+                     [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::vector<std::string> out;
+    for (const auto& s : scored) {
+        if (out.size() >= maxCount) break;
+        if (std::find(out.begin(), out.end(), s.second) == out.end()) out.push_back(s.second);
+    }
+    return out;
 }
 
 }  // namespace uvr

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace uvr {
 
@@ -25,5 +26,15 @@ bool isValidUtf8(std::string_view text);
 /// mark, or NUL bytes among the first four, which UTF-8 text never has), else nullptr. Readers of
 /// UTF-8 formats use it to refuse such files with a clear message.
 const char* wideTextEncoding(const void* data, std::size_t size);
+
+/// Edit distance (insertions, deletions, substitutions of bytes) between two words.
+int editDistance(std::string_view a, std::string_view b);
+
+/// Up to maxCount of the candidates close to `word`: within a third of its length in edits (at
+/// least 2), or containing it, or contained in it (3 bytes or more), closest first; for "did you
+/// mean" lists of names.
+std::vector<std::string> closeMatches(const std::string& word,
+                                      const std::vector<std::string>& candidates,
+                                      std::size_t maxCount = 5);
 
 }  // namespace uvr

@@ -98,6 +98,15 @@ __global__ void macroShadeKernel(TfRangeView range, const MacroCell* cells, std:
     shading[c] = shadeMacroCell(cells[c], range, rule);
 }
 
+/// Transfer-function update, NaN values (one thread per partition or macrocell): the shading of
+/// those holding visible NaN values (shadeNan).
+__global__ void nanShadeKernel(const std::uint8_t* flags, std::uint32_t count, float nanAlpha,
+                               float s1, PartitionShading* shading) {
+    const std::uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= count || !flags[i]) return;
+    shadeNan(shading[i], nanAlpha, s1);
+}
+
 /// Transfer-function update, last pass (one thread per partition): whether each partition
 /// marches by its macrocells.
 __global__ void macroChoiceKernel(const PartitionGrid* grids, const PartitionShading* cells,
@@ -141,12 +150,14 @@ struct CudaScene::Impl {
     cuda::DeviceArray<KdNode> kdNodes;
     cuda::DeviceArray<KdPartition> partitions;
     cuda::DeviceArray<float> gradientSpread;
+    cuda::DeviceArray<std::uint8_t> partitionNan;  ///< empty when the field has no NaN
     cuda::DeviceArray<BvhNode> partitionBvhNodes;
     cuda::DeviceArray<std::uint32_t> partitionCells;
     cuda::DeviceArray<PartitionGrid> seedGrids;
     cuda::DeviceArray<std::uint32_t> seeds;
     cuda::DeviceArray<PartitionGrid> macroGrids;
     cuda::DeviceArray<MacroCell> macroCells;
+    cuda::DeviceArray<std::uint8_t> macroNan;  ///< empty when the field has no NaN
     // Per frame / transfer function.
     cuda::DeviceArray<Vec4f> tfTable;
     cuda::DeviceArray<std::int32_t> tfBreaks;
@@ -195,6 +206,8 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
         d.kdNodes.upload(mesh.kd->nodes, "the k-d nodes");
         d.partitions.upload(mesh.kd->partitions, "the partitions");
         d.gradientSpread.upload(mesh.gradientSpread, "the partition gradient spreads");
+        if (!mesh.partitionNan.empty())
+            d.partitionNan.upload(mesh.partitionNan, "the partitions' NaN flags");
         d.partitionBvhNodes.upload(mesh.kd->bvhNodes, "the partition BVH nodes");
         d.partitionCells.upload(mesh.kd->cells, "the partition cell lists");
     }
@@ -205,6 +218,8 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
     if (mesh.macro) {
         d.macroGrids.upload(mesh.macro->grids, "the macrocell grids");
         d.macroCells.upload(mesh.macro->cells, "the macrocells");
+        if (!mesh.macro->nanCells.empty())
+            d.macroNan.upload(mesh.macro->nanCells, "the macrocells' NaN flags");
     }
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
@@ -219,7 +234,8 @@ std::uint64_t CudaScene::geometryBytes() const {
     return d.points.bytes() + d.tets.bytes() + d.values.bytes() + d.neighbors.bytes() +
            d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
            d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() + d.partitionCells.bytes() +
-           d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes();
+           d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes() +
+           d.partitionNan.bytes() + d.macroNan.bytes();
 }
 
 double CudaScene::uploadSeconds() const {
@@ -256,6 +272,11 @@ void CudaScene::updateShading(RenderResult& result) {
                                                 d.varianceBounds.data(), f.stepRule,
                                                 d.shading.data());
     UVR_CUDA_CHECK(cudaGetLastError());
+    if (!d.mesh.partitionNan.empty()) {
+        cuda::nanShadeKernel<<<grid, block>>>(d.partitionNan.data(), n, f.tfNan.w, f.stepRule.s1,
+                                              d.shading.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+    }
     // The macrocells' shading stays on the GPU.
     d.macroActive = false;
     if (usesMacroCells(d.mesh, f.stepRule)) {
@@ -264,6 +285,11 @@ void CudaScene::updateShading(RenderResult& result) {
         cuda::macroShadeKernel<<<(m + block - 1) / block, block>>>(
             range, d.macroCells.data(), m, f.stepRule, d.macroShading.data());
         UVR_CUDA_CHECK(cudaGetLastError());
+        if (!d.mesh.macro->nanCells.empty()) {
+            cuda::nanShadeKernel<<<(m + block - 1) / block, block>>>(
+                d.macroNan.data(), m, f.tfNan.w, f.stepRule.s1, d.macroShading.data());
+            UVR_CUDA_CHECK(cudaGetLastError());
+        }
         cuda::macroChoiceKernel<<<grid, block>>>(d.macroGrids.data(), d.macroShading.data(), n,
                                                  d.shading.data());
         UVR_CUDA_CHECK(cudaGetLastError());

@@ -94,6 +94,15 @@ UVR_HOST_DEVICE inline PartitionShading shadeMacroCell(const MacroCell& cell,
                           r);
 }
 
+/// Shading of a partition or macrocell holding NaN values: at least the NaN opacity nanAlpha, so
+/// visible NaN is never skipped (value ranges leave NaN out); and, when anything in it is
+/// visible, the smallest step s1, as at the mesh's boundary: the NaN region's edge is a jump
+/// (to the NaN colour, or to nothing) that neither the value range nor the gradient spread shows.
+UVR_HOST_DEVICE inline void shadeNan(PartitionShading& s, float nanAlpha, float s1) {
+    if (nanAlpha > s.maxOpacity) s.maxOpacity = nanAlpha;
+    if (s.maxOpacity > 0.f) s.step = s1;
+}
+
 /// The macrocells' layout and their shading for the current transfer function.
 struct MacroShadingView {
     const PartitionGrid* grids = nullptr;       ///< per partition; null: no macrocells

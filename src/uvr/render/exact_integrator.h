@@ -204,7 +204,9 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             if (opaque) continue;
             t = tEnd;
             sEntry = s1;
-            exitValue = continuous;
+            // A NaN tetrahedron's exit value is not the next one's entry value (that one's
+            // field is its own, finite where its vertices are).
+            exitValue = continuous && s1 == s1;
         }
         haveEntry = false;
         // Across the exit face; located again where there is no neighbour or the crossing is

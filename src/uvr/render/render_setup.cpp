@@ -73,10 +73,34 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
             out.seeds = buildSeedGrids(out.tets, *out.kd);
         }
         out.gradientSpread = partitionGradientSpread(out.tets, *out.kd);
+        out.partitionNan = partitionNanFlags(out.tets, *out.kd);
         if (options.macroGrids) {
             if (progress) progress("building macrocell grids");
             out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors);
         }
+    }
+    return out;
+}
+
+std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartitions& kd) {
+    const auto isNan = [](float v) { return v != v; };
+    if (std::none_of(tets.values.begin(), tets.values.end(), isNan)) return {};
+    const bool cellData = tets.association == Association::Cell;
+    std::vector<std::uint8_t> out(kd.partitions.size(), 0);
+    const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::int64_t p = 0; p < n; ++p) {
+        const KdPartition& part = kd.partitions[p];
+        bool nan = false;
+        for (std::uint32_t i = 0; i < part.cellCount && !nan; ++i) {
+            const std::uint32_t t = kd.cells[part.firstCell + i];
+            if (cellData) {
+                nan = isNan(tets.values[t]);
+            } else {
+                for (std::uint32_t v : tets.tets[t].v) nan = nan || isNan(tets.values[v]);
+            }
+        }
+        out[p] = nan;
     }
     return out;
 }
@@ -201,6 +225,7 @@ SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     SceneView v;
     v.locator = mesh.locator();
     v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi, tfBreaks.data()};
+    v.tf.nan = tfNan;
     v.bounds = mesh.tets.bounds;
     v.params = params;
     return v;
@@ -232,6 +257,13 @@ constexpr double kMaxGridSteps = 16e6;
 std::string fmtG(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g", v);
+    return buf;
+}
+
+/// A field value for a message (6 significant digits).
+std::string fmtValue(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
     return buf;
 }
 
@@ -278,10 +310,40 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                           bool shadePartitions) {
     validateSettings(settings);
     FrameSetup f;
-    f.tfTable = settings.tf.bake(settings.tfTableSize);
-    f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
     f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
     f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
+    // The baked table: linear in the value over [rangeLo, rangeHi]; a log-scale function is
+    // evaluated at each entry's log position, on a table fine enough where log changes fastest.
+    int tableSize = settings.tfTableSize;
+    if (settings.tf.logScale) {
+        const std::string range = "[" + fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) + "]";
+        const std::string which = settings.range ? "--range " : "the field's range ";
+        if (!(f.rangeHi > 0.f))
+            throwError(ErrorKind::Argument, "",
+                       "--log needs positive values: " + which + range +
+                           " has none; give --range LO,HI with 0 < LO <= HI");
+        if (!(f.rangeLo > 0.f)) {
+            f.rangeLo = std::fmin(f.rangeHi * 1e-4f, 1.f);  // ParaView's AdjustRangeForLog
+            f.notes.push_back("--log: " + which + range + " is not positive; mapping [" +
+                              fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) +
+                              "] as ParaView does (values below take the lowest colour; "
+                              "set the range with --range LO,HI)");
+        }
+        tableSize = logTableSize(settings.tfTableSize, f.rangeLo, f.rangeHi);
+        // Below `resolved` one table step spans more than 1 / 255 of the log range: 8-bit
+        // colour bands may show there (said when that is more than the range's lowest octave).
+        const double resolved = logTableResolvedFrom(tableSize, 256, f.rangeLo, f.rangeHi);
+        if (resolved > 2.0 * f.rangeLo)
+            f.notes.push_back("--log over " + fmtG(std::log10(double(f.rangeHi) / f.rangeLo)) +
+                              " decades: the " + std::to_string(tableSize) +
+                              "-entry table steps by more than 1/255 of the log range below "
+                              "value " +
+                              fmtValue(resolved) + " (narrow the range with --range LO,HI)");
+    }
+    f.tfTable = settings.tf.bakeOverRange(tableSize, f.rangeLo, f.rangeHi);
+    f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
+    f.tfNan = Vec4f(settings.tf.nanColor.x, settings.tf.nanColor.y, settings.tf.nanColor.z,
+                    settings.tf.nanOpacity);
     const float aspect = float(settings.width) / float(settings.height);
     // Settings are in the file's units; the prepared mesh is in rendering units (mesh.tets.frame:
     // the identity unless the mesh is very large, very small or far from the origin).
@@ -417,8 +479,13 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         const TfRangeTables ranges(table);
         f.shading =
             computePartitionShading(*mesh.kd, mesh.gradientSpread, ranges.view(table), f.stepRule);
+        // Partitions and macrocells holding NaN values (their value ranges leave NaN out).
+        for (std::size_t p = 0; p < mesh.partitionNan.size(); ++p)
+            if (mesh.partitionNan[p]) shadeNan(f.shading[p], f.tfNan.w, f.stepRule.s1);
         if (usesMacroCells(mesh, f.stepRule)) {
             f.macroShading = computeMacroShading(*mesh.macro, ranges.view(table), f.stepRule);
+            for (std::size_t c = 0; c < mesh.macro->nanCells.size(); ++c)
+                if (mesh.macro->nanCells[c]) shadeNan(f.macroShading[c], f.tfNan.w, f.stepRule.s1);
             for (std::size_t p = 0; p < f.shading.size(); ++p)
                 f.shading[p].byMacroCells =
                     macroCellsPay(mesh.macro->grids[p], f.macroShading.data(), f.shading[p]);

@@ -57,6 +57,9 @@ struct PreparedMesh {
     /// Per partition (with partitions): the spread of its cells' field gradients, the diagonal
     /// of their bounding box (partitionGradientSpread), for the error-bound step rule.
     std::vector<float> gradientSpread;
+    /// Per partition (with partitions): 1 where a cell has a NaN value (partitionNanFlags);
+    /// empty when the field has none.
+    std::vector<std::uint8_t> partitionNan;
     std::uint64_t sourceCells = 0;  ///< cells of the mesh before splitting
     double splitSeconds = 0.0;      ///< time to split cells into tetrahedra
     double bvhSeconds = 0.0;        ///< time to build the BVH
@@ -82,6 +85,11 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field);
 /// infinite for a cell-centred field (piecewise constant: its jumps have no gradient bound).
 /// Cells with non-finite gradients (degenerate, or NaN values) are left out.
 std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd);
+
+/// Per partition, 1 where one of its cells has a NaN value (a vertex's, or the cell's own for
+/// cell data); empty when no cell has one. Partition value ranges leave NaN out, so skipping
+/// needs these to keep NaN regions of non-zero NaN opacity (shadeNan).
+std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartitions& kd);
 
 /// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume,
 /// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray;
@@ -145,7 +153,8 @@ struct RenderSettings {
     float step = 0.f;                              ///< s1; 0 = defaultStep
     float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
     float terminationAlpha = 0.99f;
-    int tfTableSize = 1024;  ///< entries of the baked transfer function
+    /// Entries of the baked transfer function (a log-scale one gets more: logTableSize).
+    int tfTableSize = 1024;
     /// Anti-aliasing: N x N rays per pixel (N in [1, kMaxSupersample]), their premultiplied
     /// colours averaged; a pixel's sample count is the sum over its rays. 1: one ray through
     /// the pixel's centre.
@@ -244,6 +253,7 @@ bool usesMacroCells(const PreparedMesh& mesh, const StepRuleParams& rule);
 /// Host-side frame state built from settings: the baked table, the camera and the parameters.
 struct FrameSetup {
     std::vector<Vec4f> tfTable;
+    Vec4f tfNan;                            ///< colour and opacity of NaN values (TfTableView::nan)
     std::vector<std::int32_t> tfBreaks;     ///< tfTableBreaks of tfTable
     StepRuleParams stepRule;                ///< the partition method's step rule and its inputs
     std::vector<PartitionShading> shading;  ///< per partition (partition method only)
@@ -257,7 +267,13 @@ struct FrameSetup {
     Camera camera;
     CameraRays rays;
     MarchParams params;
+    /// The value range the table spans: the settings' or the field's; with a log-scale transfer
+    /// function one from 0 or below starts at min(hi / 10^4, 1) (ParaView's AdjustRangeForLog).
     float rangeLo = 0.f, rangeHi = 1.f;
+    /// What the setup changed or could not do as asked, one sentence each, for the user (the
+    /// CLI prints them as warnings): a log range moved off 0, a log table too coarse at its low
+    /// end.
+    std::vector<std::string> notes;
 
     /// Scene view over a prepared mesh; both must outlive it.
     SceneView scene(const PreparedMesh& mesh) const;

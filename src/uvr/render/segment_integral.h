@@ -204,11 +204,21 @@ UVR_HOST_DEVICE inline Vec4f tableAt(const TfTableView& tf, double g) {
 /// Integrates a segment of length len along which the scalar runs linearly from s0 to s1
 /// through the transfer function, split at the table's breakpoints it crosses (every entry when
 /// the table has none), into acc; fast: each piece by compositePieceFast (in float, what the
-/// renderers use), else by compositePiece (in double). A NaN end
-/// makes the segment transparent (as a NaN sample is).
+/// renderers use), else by compositePiece (in double). A NaN end makes the whole segment take
+/// the NaN entry tf.nan (constant; transparent at NaN opacity 0): inside a linear tetrahedron
+/// with a NaN vertex the field is NaN everywhere, and between samples the NaN region's edge is
+/// placed at the segment's near end, as a point sample there would be.
 UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s1, double len,
                                       double unit, Vec4f& acc, bool fast = false) {
-    if (!(len > 0.0) || !(s0 == s0) || !(s1 == s1) || tf.count < 1) return;
+    if (!(len > 0.0) || tf.count < 1) return;
+    if (!(s0 == s0) || !(s1 == s1)) {
+        if (fast)
+            compositePieceFast(tf.nan.xyz(), tf.nan.w, tf.nan.xyz(), tf.nan.w, float(len),
+                               float(unit), acc);
+        else
+            compositePiece(tf.nan.xyz(), tf.nan.w, tf.nan.xyz(), tf.nan.w, len, unit, acc);
+        return;
+    }
     // An infinite end is a float overflow of a value near the largest float (interpolating a
     // field that spans the float range): take the largest float.
     s0 = s0 < DBL_MAX ? (s0 > -DBL_MAX ? s0 : -FLT_MAX) : FLT_MAX;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <algorithm>
 #include <cctype>
+#include <cfloat>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -154,16 +155,16 @@ void rgbToHsv(Vec3f c, double& h, double& s, double& v) {
     if (h < 0) h += 1.0;
 }
 
-/// Resamples HSV interpolation (hue taking the shorter way round, as VTK's HSVWrap default)
-/// into RGB control points.
-std::vector<ColorPoint> expandHsv(const std::vector<ColorPoint>& in) {
+}  // namespace
+
+std::vector<ColorPoint> resampleHsv(const std::vector<ColorPoint>& in, bool wrap) {
     std::vector<ColorPoint> out;
     for (size_t i = 0; i + 1 < in.size(); ++i) {
         double h0, s0, v0, h1, s1, v1;
         rgbToHsv(in[i].rgb, h0, s0, v0);
         rgbToHsv(in[i + 1].rgb, h1, s1, v1);
-        if (h1 - h0 > 0.5) h0 += 1.0;
-        if (h0 - h1 > 0.5) h1 += 1.0;
+        if (wrap && h1 - h0 > 0.5) h0 += 1.0;
+        if (wrap && h0 - h1 > 0.5) h1 += 1.0;
         for (int k = 0; k < kHsvSubdivisions; ++k) {
             double f = static_cast<double>(k) / kHsvSubdivisions;
             float x = in[i].x + static_cast<float>(f) * (in[i + 1].x - in[i].x);
@@ -176,9 +177,10 @@ std::vector<ColorPoint> expandHsv(const std::vector<ColorPoint>& in) {
     return out;
 }
 
-}  // namespace
+namespace {
 
-TransferFunction loadParaViewColorMap(const std::string& path) {
+/// Reads and parses a colour-map JSON file; Error(Parse) naming the byte for invalid JSON.
+Json readColorMapDocument(const std::string& path) {
     std::vector<char> bytes = readFileBytes(path, kMaxJsonBytes, "colour-map file");
     checkJsonShape(path, bytes);
     Json doc;
@@ -209,8 +211,110 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
                         "hold, got " +
                             printableShort(msg, 160));
     }
+    return doc;
+}
 
-    // Step 1: the colour-map object (ParaView exports an array of them; the first is used).
+/// Lower case without spaces, tabs, '-' and '_': how names in a presets file are matched when
+/// no name matches exactly.
+std::string looseName(const std::string& name) {
+    std::string out;
+    for (char c : name)
+        if (c != ' ' && c != '\t' && c != '-' && c != '_')
+            out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+}
+
+/// The "Name" of a colour-map object, or "" when it has none.
+std::string mapName(const Json& map) {
+    if (!map.is_object()) return "";
+    const auto it = map.find("Name");
+    return it != map.end() && it->is_string() ? it->get<std::string>() : "";
+}
+
+/// Up to `count` names quoted and comma-separated, with "and N more" for the rest.
+std::string quotedNames(const std::vector<std::string>& names, std::size_t count) {
+    std::string out;
+    for (std::size_t i = 0; i < names.size() && i < count; ++i)
+        out += (i ? ", \"" : "\"") + printableShort(names[i], 48) + "\"";
+    if (names.size() > count) out += " and " + std::to_string(names.size() - count) + " more";
+    return out;
+}
+
+/// The index of the map to load from an array of maps: the only one when `name` is empty (a file
+/// of several is refused, naming them), else the first whose Name is `name`, or failing that
+/// the first that matches it ignoring case, spaces, '-' and '_' (an unknown name is refused,
+/// naming the close ones).
+std::size_t selectMap(const std::string& path, const Json& maps, const std::string& name) {
+    std::vector<std::string> names;
+    for (const Json& m : maps) names.push_back(mapName(m));
+    const std::string listing = "`uvr presets " + path + "` lists them";
+    if (name.empty()) {
+        if (maps.size() == 1) return 0;
+        throwError(ErrorKind::Argument, path,
+                   "holds " + std::to_string(maps.size()) + " colour maps: pick one with --tf " +
+                       path + ":NAME, one of " + quotedNames(names, 10) + " (" + listing + ")");
+    }
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (names[i] == name) return i;
+    const std::string key = looseName(name);
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (!names[i].empty() && looseName(names[i]) == key) return i;
+    std::vector<std::string> keys;
+    for (const std::string& n : names) keys.push_back(looseName(n));
+    std::vector<std::string> close;
+    for (const std::string& k : closeMatches(key, keys))
+        for (const std::string& n : names)
+            if (looseName(n) == k && std::find(close.begin(), close.end(), n) == close.end()) {
+                close.push_back(n);
+                break;
+            }
+    throwError(ErrorKind::Argument, path,
+               "no colour map named \"" + printableShort(name, 60) + "\"" +
+                   (close.empty() ? "; it holds " + quotedNames(names, 10)
+                                  : "; did you mean " + quotedNames(close, 5) + "?") +
+                   " (" + std::to_string(maps.size()) + " maps; " + listing + ")");
+}
+
+/// A flag that ParaView writes as true/false or 1/0.
+bool jsonFlag(const Json& map, const char* key) {
+    const auto it = map.find(key);
+    if (it == map.end()) return false;
+    if (it->is_boolean()) return it->get<bool>();
+    return it->is_number() && it->get<double>() != 0.0;
+}
+
+}  // namespace
+
+std::vector<ColorMapInfo> listParaViewColorMaps(const std::string& path) {
+    const Json doc = readColorMapDocument(path);
+    std::vector<ColorMapInfo> out;
+    auto add = [&](const Json& m, const std::string& where) {
+        if (!m.is_object())
+            throwParseError(path, where, "expected a colour-map object, got " + describe(m));
+        ColorMapInfo info;
+        info.name = mapName(m);
+        const auto space = m.find("ColorSpace");
+        info.colorSpace =
+            space != m.end() && space->is_string() ? space->get<std::string>() : "RGB";
+        const auto rgb = m.find("RGBPoints");
+        if (rgb != m.end() && rgb->is_array())
+            info.points = static_cast<int>(rgb->size() / 4);
+        else if (m.contains("IndexedColors"))
+            info.colorSpace = "indexed";
+        out.push_back(info);
+    };
+    if (doc.is_array()) {
+        for (std::size_t i = 0; i < doc.size(); ++i) add(doc[i], "colour map " + std::to_string(i));
+    } else {
+        add(doc, "colour map");
+    }
+    return out;
+}
+
+TransferFunction loadParaViewColorMap(const std::string& path, const std::string& name) {
+    const Json doc = readColorMapDocument(path);
+    // Step 1: the colour-map object: a file's only one, or the one named (ParaView's exports
+    // and presets files are arrays of them).
     std::string where = "colour map";
     const Json* map = &doc;
     if (doc.is_array()) {
@@ -218,8 +322,14 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
             throwParseError(path, "top level",
                             "expected an array of colour-map objects, got an empty array");
         }
-        map = &doc[0];
-        where = "colour map 0";
+        const std::size_t index = selectMap(path, doc, name);
+        map = &doc[index];
+        where = "colour map " + std::to_string(index);
+    } else if (!name.empty() && mapName(doc) != name &&
+               looseName(mapName(doc)) != looseName(name)) {
+        throwError(ErrorKind::Argument, path,
+                   "no colour map named \"" + printableShort(name, 60) + "\"; it holds one, \"" +
+                       printableShort(mapName(doc), 48) + "\"");
     }
     if (!map->is_object()) {
         throwParseError(path, where, "expected a colour-map object, got " + describe(*map));
@@ -264,9 +374,18 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
     for (size_t i = 0; i < rgb.size(); ++i) {
         if (i % 4 != 0) checkUnit(path, rgbWhere, i, rgb[i], "a colour component");
     }
+    // "UseLogScale": positions are data values on a log scale (ParaView's vtkNormalize; as
+    // there, a range that is not positive is taken linearly).
     double lo = rgb.front(), hi = rgb[rgb.size() - 4];
+    tf.logScale = jsonFlag(*map, "UseLogScale");
+    const bool logPositions = tf.logScale && lo > 0.0;
+    auto position = [&](double x) {
+        return logPositions ? std::log10(x > DBL_MIN ? x : DBL_MIN) : x;
+    };
+    const double pLoRgb = position(lo), pHiRgb = position(hi);
     auto normalise = [&](double x) {
-        return hi > lo ? static_cast<float>((x - lo) / (hi - lo)) : 0.f;
+        return pHiRgb > pLoRgb ? static_cast<float>((position(x) - pLoRgb) / (pHiRgb - pLoRgb))
+                               : 0.f;
     };
     for (size_t i = 0; i < rgb.size(); i += 4) {
         tf.colors.push_back({normalise(rgb[i]),
@@ -274,12 +393,37 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
                                    static_cast<float>(rgb[i + 3]))});
     }
     if (hsv) {
-        tf.colors = expandHsv(tf.colors);
+        tf.colors = resampleHsv(tf.colors, jsonFlag(*map, "HSVWrap"));
         tf.colorSpace = ColorSpace::RGB;
     }
     tf.sourceRange = std::make_pair(static_cast<float>(lo), static_cast<float>(hi));
 
-    // Step 4: opacity points over the same range; a midpoint other than 0.5 becomes an extra
+    // Step 4: the colour and opacity of NaN values.
+    if (auto it = map->find("NanColor"); it != map->end()) {
+        const std::string nanWhere = where + " \"NanColor\"";
+        if (!it->is_array() || it->size() < 3 || it->size() > 4)
+            throwParseError(path, nanWhere, "expected 3 numbers (r, g, b), got " + describe(*it));
+        for (std::size_t i = 0; i < 3; ++i) {
+            const Json& c = (*it)[i];
+            if (!c.is_number())
+                throwParseError(path, nanWhere + "[" + std::to_string(i) + "]",
+                                "expected a number, got " + describe(c));
+            checkUnit(path, nanWhere, i, c.get<double>(), "a colour component");
+            tf.nanColor[static_cast<int>(i)] = static_cast<float>(c.get<double>());
+        }
+    }
+    if (auto it = map->find("NanOpacity"); it != map->end()) {
+        const std::string nanWhere = where + " \"NanOpacity\"";
+        if (!it->is_number())
+            throwParseError(path, nanWhere, "expected a number in [0, 1], got " + describe(*it));
+        const double a = it->get<double>();
+        if (!(a >= 0.0 && a <= 1.0))
+            throwParseError(path, nanWhere,
+                            "expected an opacity in [0, 1], got " + std::to_string(a));
+        tf.nanOpacity = static_cast<float>(a);
+    }
+
+    // Step 5: opacity points over the same range; a midpoint other than 0.5 becomes an extra
     // knot (vtkPiecewiseFunction's linear midpoint shift), sharpness is treated as 0.
     auto ptsIt = map->find("Points");
     if (ptsIt == map->end()) {
@@ -293,10 +437,10 @@ TransferFunction loadParaViewColorMap(const std::string& path) {
         checkUnit(path, ptsWhere, i + 2, pts[i + 2], "a midpoint");
         checkUnit(path, ptsWhere, i + 3, pts[i + 3], "a sharpness");
     }
-    double pLo = lo, pHi = hi;
-    if (!(hi > lo)) pLo = pts.front(), pHi = pts[pts.size() - 4];
+    double pLo = pLoRgb, pHi = pHiRgb;
+    if (!(pHi > pLo)) pLo = position(pts.front()), pHi = position(pts[pts.size() - 4]);
     auto normaliseOpacity = [&](double x) {
-        return pHi > pLo ? static_cast<float>((x - pLo) / (pHi - pLo)) : 0.f;
+        return pHi > pLo ? static_cast<float>((position(x) - pLo) / (pHi - pLo)) : 0.f;
     };
     TransferFunction raw;
     for (size_t i = 0; i < pts.size(); i += 4) {

@@ -38,6 +38,9 @@ struct TfTableView {
     /// breakpoints the table is linear to within kTfBreakTolerance, so the integrators need not
     /// split a segment at the entries in between. Null: every entry is a breakpoint.
     const std::int32_t* breaks = nullptr;
+    /// Colour and opacity of NaN values (TransferFunction::nanColor, nanOpacity); opacity 0
+    /// keeps NaN regions invisible.
+    Vec4f nan = Vec4f(0.f, 0.f, 0.f, 0.f);
 
     /// The first breakpoint (a table position) above position g in [0, count - 1).
     UVR_HOST_DEVICE int breakAbove(double g) const {
@@ -51,9 +54,10 @@ struct TfTableView {
     }
 
     /// Linearly interpolated RGBA at value v (clamped to the range; a zero-width range maps
-    /// everything to the first entry; NaN maps to fully transparent).
+    /// everything to the first entry; NaN takes the NaN entry).
     UVR_HOST_DEVICE Vec4f sample(float v) const {
-        if (!(v == v) || count < 1) return Vec4f(0.f, 0.f, 0.f, 0.f);
+        if (!(v == v)) return nan;
+        if (count < 1) return Vec4f(0.f, 0.f, 0.f, 0.f);
         const float f = tfTablePosition(v, lo, hi, count);
         const int i = static_cast<int>(f);  // f in [0, count - 1]: the conversion is defined
         if (i >= count - 1) return entries[count - 1];

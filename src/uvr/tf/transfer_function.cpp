@@ -2,6 +2,7 @@
 #include "uvr/tf/transfer_function.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -225,6 +226,45 @@ std::vector<Vec4f> TransferFunction::bake(int n) const {
     return table;
 }
 
+std::vector<Vec4f> TransferFunction::bakeOverRange(int n, double lo, double hi) const {
+    if (!logScale) return bake(n);
+    if (n < 2) {
+        throwError(ErrorKind::Argument, "",
+                   "transfer function table size must be at least 2, got " + std::to_string(n));
+    }
+    if (!(lo > 0.0) || !(hi >= lo) || !std::isfinite(hi))
+        throwError(ErrorKind::Argument, "",
+                   "--log needs a positive value range, got [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    std::vector<Vec4f> table(static_cast<size_t>(n));
+    const double logLo = std::log10(lo), logWidth = std::log10(hi) - logLo;
+    for (int k = 0; k < n; ++k) {
+        const double v = lo + (hi - lo) * (static_cast<double>(k) / (n - 1));
+        const float t =
+            logWidth > 0.0 ? static_cast<float>((std::log10(v) - logLo) / logWidth) : 0.f;
+        const Vec3f c = colorAt(t);
+        table[k] = Vec4f(c.x, c.y, c.z, opacityAt(t));
+    }
+    return table;
+}
+
+int logTableSize(int linearSize, double lo, double hi) {
+    if (!(lo > 0.0) || !(hi > lo) || !std::isfinite(hi)) return linearSize;
+    // The first step h from lo spans log10(1 + h / lo) / log10(hi / lo) of the log range.
+    const double span = std::log10(hi / lo) / (linearSize - 1);
+    const double h = lo * (std::pow(10.0, span) - 1.0);
+    const double n = std::ceil((hi - lo) / h) + 1.0;
+    return static_cast<int>(std::clamp(n, double(linearSize), double(kMaxLogTableSize)));
+}
+
+double logTableResolvedFrom(int n, int linearSize, double lo, double hi) {
+    if (!(lo > 0.0) || !(hi > lo) || n < 2) return lo;
+    // The value v whose step h = (hi - lo) / (n - 1) spans 1 / (linearSize - 1) of the range.
+    const double h = (hi - lo) / (n - 1);
+    const double span = std::log10(hi / lo) / (linearSize - 1);
+    return std::max(lo, h / (std::pow(10.0, span) - 1.0));
+}
+
 void applyOpacitySpec(TransferFunction& tf, const std::string& spec) {
     if (spec.empty()) badSpec(spec, "empty spec");
     std::vector<OpacityPoint> points;
@@ -257,20 +297,29 @@ void applyOpacitySpec(TransferFunction& tf, const std::string& spec) {
     tf.opacities = std::move(points);
 }
 
+std::optional<std::pair<std::string, std::string>> splitColorMapFile(const std::string& spec) {
+    std::string low = spec;
+    for (char& c : low) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const size_t colon = low.find(".json:");
+    if (colon != std::string::npos)
+        return std::make_pair(spec.substr(0, colon + 5), spec.substr(colon + 6));
+    if (fileExtension(spec) == ".json") return std::make_pair(spec, std::string());
+    return std::nullopt;
+}
+
 TransferFunction loadTransferFunction(const std::string& presetOrPath) {
-    if (fileExtension(presetOrPath) == ".json") {
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(presetOrPath, ec)) {
-            std::string names;
-            for (const std::string& n : transferFunctionPresetNames())
-                names += (names.empty() ? "" : ", ") + n;
-            throwError(ErrorKind::Io, presetOrPath,
-                       "no such file (expected a ParaView colour-map JSON export or a preset: " +
-                           names + ")");
-        }
-        return loadParaViewColorMap(presetOrPath);
-    }
-    return transferFunctionPreset(presetOrPath);
+    const auto file = splitColorMapFile(presetOrPath);
+    if (!file) return transferFunctionPreset(presetOrPath);
+    const auto& [path, name] = *file;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throwError(ErrorKind::Io, path,
+                   "no such file (expected a ParaView colour-map JSON export; `uvr presets` "
+                   "lists the built-in presets)");
+    if (file->second.empty() && presetOrPath.size() > path.size())
+        throwError(ErrorKind::Argument, path,
+                   "empty colour-map name after ':' in --tf " + presetOrPath);
+    return loadParaViewColorMap(path, name);
 }
 
 }  // namespace uvr

@@ -35,6 +35,15 @@ struct TransferFunction {
     std::vector<OpacityPoint> opacities;  ///< sorted by x, at least one point
     /// Data range the points were defined over when imported from ParaView JSON (informational).
     std::optional<std::pair<float, float>> sourceRange;
+    /// Colour of NaN values (ParaView's NanColor; Cool to Warm's yellow unless a preset or file
+    /// gives one).
+    Vec3f nanColor{1.f, 1.f, 0.f};
+    /// Opacity of NaN values per opacity unit (ParaView's NanOpacity); 0 keeps NaN regions
+    /// invisible.
+    float nanOpacity = 0.f;
+    /// Map values on a log scale (ParaView's UseLogScale): position t of value v in [lo, hi] is
+    /// (log10 v - log10 lo) / (log10 hi - log10 lo); the range must be positive.
+    bool logScale = false;
 
     /// Colour at normalised position t (clamped to [0, 1]), interpolated in colorSpace.
     Vec3f colorAt(float t) const;
@@ -42,29 +51,82 @@ struct TransferFunction {
     float opacityAt(float t) const;
     /// Samples colour and opacity at n evenly spaced positions over [0, 1] (n >= 2).
     std::vector<Vec4f> bake(int n) const;
+    /// The table the renderer reads (TfTableView): colour and opacity at n values evenly spaced
+    /// over [lo, hi], each at its normalised position: bake(n) for a linear scale; with logScale
+    /// the position of value v is (log10 v - log10 lo) / (log10 hi - log10 lo), so the table
+    /// stays linear in the value and every integrator reads it unchanged (ParaView's volume
+    /// mappers do the same). With logScale lo must be positive (Error(Argument) otherwise).
+    std::vector<Vec4f> bakeOverRange(int n, double lo, double hi) const;
 };
 
-/// Names of the built-in colour presets ("cool-to-warm", "viridis", "black-body", "grayscale",
-/// ...).
+/// What a listing of colour maps shows of one map.
+struct ColorMapInfo {
+    std::string name;        ///< ParaView's name ("Cool to Warm", "Viridis (matplotlib)")
+    std::string colorSpace;  ///< as ParaView writes it: "RGB", "Lab", "Diverging", "HSV", ...
+    int points = 0;          ///< colour control points (0: an indexed, categorical map)
+};
+
+/// The built-in colour presets, under ParaView's names and in ParaView's order of its
+/// "default" presets.
+std::vector<ColorMapInfo> transferFunctionPresets();
+
+/// Most entries logTableSize gives a log-scale table (4 MiB of entries; its range statistics
+/// take about 40 bytes per entry more).
+inline constexpr int kMaxLogTableSize = 1 << 18;
+
+/// Entries of a table over [lo, hi] (0 < lo < hi) for a log-scale transfer function: enough that
+/// the step from lo to the next entry spans at most 1 / (linearSize - 1) of the log range (the
+/// linear table's resolution, where the log map changes fastest per value), at least
+/// linearSize, at most kMaxLogTableSize.
+int logTableSize(int linearSize, double lo, double hi);
+
+/// The lowest value above which a log-scale table of n entries over [lo, hi] resolves the map as
+/// finely as a linear table of linearSize entries (lo itself when n suffices).
+double logTableResolvedFrom(int n, int linearSize, double lo, double hi);
+
+/// Names of the built-in colour presets (ParaView's: "Cool to Warm", "Viridis (matplotlib)", ...).
 std::vector<std::string> transferFunctionPresetNames();
 
-/// A built-in colour preset with a linear 0 -> 1 opacity ramp; throws Error(Argument) naming the
-/// valid presets for an unknown name. Matching ignores case, spaces, '-' and '_', so ParaView's
-/// names ("Cool to Warm", "Black-Body Radiation", "Viridis (matplotlib)") work too.
+/// A built-in colour preset (ParaView's control points, colour space and NanColor) with a linear
+/// 0 -> 1 opacity ramp; its name is ParaView's. Matching ignores case, spaces, ',', '-', '_' and
+/// parentheses ("cool-to-warm", "black_body_radiation"), and a name that matches no preset whole
+/// may leave out a trailing parenthesised suffix ("Viridis" for "Viridis (matplotlib)", "Blue
+/// Orange" for "Blue Orange (divergent)"); "black-body", "greyscale", "gray" and "grey" are
+/// aliases. Throws Error(Argument) naming close matches for an unknown name.
 TransferFunction transferFunctionPreset(const std::string& name);
 
-/// Loads a ParaView colour-map JSON export (an array of objects, or one object) with RGBPoints
-/// (x, r, g, b, ...) and optional Points (x, opacity, midpoint, sharpness, ...) and ColorSpace;
-/// positions are normalised to [0, 1] over the RGBPoints range. Throws Error(Parse) naming the
-/// file and the offending key on malformed input.
-TransferFunction loadParaViewColorMap(const std::string& path);
+/// Control points resampled from HSV interpolation into RGB points, 32 per segment; the hue runs
+/// linearly from one point's to the next, or with `wrap` the shorter way round the hue circle
+/// (vtkColorTransferFunction's HSVWrap; ParaView applies presets without it unless they say
+/// "HSVWrap": 1).
+std::vector<ColorPoint> resampleHsv(const std::vector<ColorPoint>& points, bool wrap = false);
+
+/// The colour maps of a ParaView colour-map JSON file (an export of one map, or a presets file of
+/// many), in file order; a map without RGBPoints but with IndexedColors is listed with colour
+/// space "indexed" and 0 points. Throws Error(Parse) for a file that is not such JSON.
+std::vector<ColorMapInfo> listParaViewColorMaps(const std::string& path);
+
+/// Loads a map from a ParaView colour-map JSON file (an array of objects, or one object) with
+/// RGBPoints (x, r, g, b, ...), optional Points (x, opacity, midpoint, sharpness, ...),
+/// ColorSpace, NanColor, NanOpacity, UseLogScale and HSVWrap; positions are normalised to
+/// [0, 1] over the RGBPoints range (of log10 x with UseLogScale). `name` picks the map whose
+/// Name it is (else the first matching it ignoring case, spaces, '-' and '_'); without a name the
+/// file must hold one map. Throws Error(Argument) for a missing or unknown name, naming the maps
+/// (close ones first), and Error(Parse) naming the file and the offending key on malformed input.
+TransferFunction loadParaViewColorMap(const std::string& path, const std::string& name = "");
 
 /// Replaces the opacity points from a spec: "ramp" (0 -> 1), "ramp:A" (0 -> A), "constant:A",
 /// "step:T[:A]" (0 below normalised T, A (default 1) at and above: a "binary" transfer function),
 /// or a list "x0:a0,x1:a1,..." of normalised positions. Throws Error(Argument) on a bad spec.
 void applyOpacitySpec(TransferFunction& tf, const std::string& spec);
 
-/// Loads a preset name or, when the string names an existing .json file, a ParaView export.
+/// A --tf value split into a ParaView colour-map file and a map name: "FILE.json" -> (FILE.json,
+/// ""), "FILE.json:NAME" -> (FILE.json, NAME) (the first ".json:", any case, ends the path);
+/// std::nullopt for a preset name.
+std::optional<std::pair<std::string, std::string>> splitColorMapFile(const std::string& spec);
+
+/// Loads a preset name, a ParaView colour-map file "FILE.json" (holding one map) or a map of a
+/// presets file "FILE.json:NAME" (loadParaViewColorMap).
 TransferFunction loadTransferFunction(const std::string& presetOrPath);
 
 /// CIE L*a*b* (D65 white, via linear sRGB and XYZ) of an sRGB colour with components in [0, 1].

@@ -3,6 +3,8 @@
 
 #include <gmock/gmock.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -74,6 +76,40 @@ TEST(TransferFunction, BakeSamplesEvenlyIncludingEnds) {
     EXPECT_EQ(catchError([&] { tf.bake(1); }).kind(), ErrorKind::Argument);
 }
 
+TEST(TransferFunction, LogScaleBakesTheLogPositionOfEachValue) {
+    // Entry k of a table over [1, 1000] holds value v_k = 1 + 999 k / (n - 1) and gets the
+    // function at log10(v_k) / 3 (ParaView's volume mappers: a table linear in the value).
+    TransferFunction tf = transferFunctionPreset("grayscale");
+    tf.logScale = true;
+    const int n = 2001;
+    const std::vector<Vec4f> table = tf.bakeOverRange(n, 1.0, 1000.0);
+    ASSERT_EQ(table.size(), size_t(n));
+    for (int k = 0; k < n; k += 50) {
+        const double t = std::log10(1.0 + 999.0 * k / (n - 1)) / 3.0;
+        EXPECT_NEAR(table[k].x, t, 1e-6) << k;
+        EXPECT_NEAR(table[k].w, t, 1e-6) << k;
+    }
+    EXPECT_FLOAT_EQ(table.back().x, 1.f);
+    // Linear without logScale: the same as bake.
+    tf.logScale = false;
+    EXPECT_FLOAT_EQ(tf.bakeOverRange(5, 1.0, 1000.0)[1].x, 0.25f);
+    tf.logScale = true;
+    EXPECT_EQ(catchError([&] { tf.bakeOverRange(8, 0.0, 10.0); }).kind(), ErrorKind::Argument);
+
+    // Table size: the first step from lo spans 1 / 1023 of the log range, as a linear table's.
+    const int size = logTableSize(1024, 1.0, 1000.0);
+    const double first = 999.0 / (size - 1);
+    EXPECT_LE(std::log10(1.0 + first) / 3.0, 1.0 / 1023 * 1.0001);
+    EXPECT_GT(std::log10(1.0 + 999.0 / (size - 2)) / 3.0, 1.0 / 1023 * 0.999);
+    EXPECT_LE(logTableSize(1024, 1.0, 1.001), 1025);  // narrow ranges need hardly more
+    EXPECT_LT(logTableSize(1024, 1.0, 1.5), 1300);
+    EXPECT_EQ(logTableSize(1024, 1.0, 1e8), kMaxLogTableSize);
+    EXPECT_EQ(logTableResolvedFrom(size, 1024, 1.0, 1000.0), 1.0);
+    const double from = logTableResolvedFrom(kMaxLogTableSize, 1024, 1.0, 1e8);
+    EXPECT_GT(from, 1.0);
+    EXPECT_LT(from, 1e8);
+}
+
 TEST(TransferFunction, LabConversionMatchesPublishedValues) {
     // sRGB primaries in CIE L*a*b* (D65), e.g. from Bruce Lindbloom's calculator.
     Vec3f red = srgbToLab({1.f, 0.f, 0.f});
@@ -131,44 +167,151 @@ table('Lab', [(0, 0, 0.6, 0.75), (0.3, 0.1, 0.1, 0.1), (1, 0.77, 0.47, 0.34)])
     }
 }
 
-TEST(TransferFunction, ViridisAndInfernoMatchMatplotlib) {
+TEST(TransferFunction, MatplotlibPresetsMatchMatplotlib) {
     if (!pythonHas("matplotlib")) GTEST_SKIP() << "system Python has no matplotlib";
     std::string dir = scratchDir();
+    const char* names[] = {"viridis", "inferno", "magma", "plasma"};
     std::vector<double> v = runPython(dir, R"(
-from matplotlib import cm
-for name in ('viridis', 'inferno'):
-    for c in cm.get_cmap(name).colors: print(*c)
+from matplotlib import colormaps
+for name in ('viridis', 'inferno', 'magma', 'plasma'):
+    for c in colormaps[name].colors: print(*c)
 )");
-    ASSERT_EQ(v.size(), 2u * 256 * 3);
-    TransferFunction maps[2] = {transferFunctionPreset("viridis"),
-                                transferFunctionPreset("Inferno (matplotlib)")};
-    for (int m = 0; m < 2; ++m) {
+    ASSERT_EQ(v.size(), 4u * 256 * 3);
+    for (int m = 0; m < 4; ++m) {
+        const TransferFunction tf = transferFunctionPreset(names[m]);
         for (int i = 0; i < 256; ++i) {
             const double* c = &v[3 * (256 * m + i)];
-            // Every 5th of the 256 entries is embedded; interpolation stays within one 8-bit step.
-            expectVec(maps[m].colorAt(i / 255.f), Vec3f(c[0], c[1], c[2]), 1.f / 255.f,
-                      maps[m].name + " entry " + std::to_string(i));
+            // ParaView's map puts entry i at i / 255; uvr keeps a subset of its points, within
+            // 0.45 / 255 of the full map (presets.cpp), plus float rounding.
+            expectVec(tf.colorAt(i / 255.f), Vec3f(c[0], c[1], c[2]), 0.5f / 255.f + 1e-5f,
+                      tf.name + " entry " + std::to_string(i));
         }
     }
 }
 
-TEST(TransferFunction, PresetsResolveParaViewNames) {
-    for (const char* name : {"Cool to Warm", "cool_to_warm", "COOL-TO-WARM"})
-        EXPECT_EQ(transferFunctionPreset(name).name, "cool-to-warm") << name;
-    EXPECT_EQ(transferFunctionPreset("Black-Body Radiation").name, "black-body");
-    EXPECT_EQ(transferFunctionPreset("Viridis (matplotlib)").name, "viridis");
-    EXPECT_EQ(transferFunctionPreset("Grayscale").name, "grayscale");
-    for (const std::string& name : transferFunctionPresetNames()) {
-        TransferFunction tf = transferFunctionPreset(name);
-        EXPECT_EQ(tf.name, name);
-        EXPECT_FLOAT_EQ(tf.opacityAt(0.f), 0.f);
-        EXPECT_FLOAT_EQ(tf.opacityAt(0.3f), 0.3f);
-        EXPECT_FLOAT_EQ(tf.opacityAt(1.f), 1.f);
+TEST(TransferFunction, PresetsMatchPublishedReferenceColours) {
+    // 8-bit hex colours as matplotlib's documentation and the BIDS colormap repository list
+    // them (entry 0, 128 = viridis(0.5), 255); Turbo's ends from Google's published table.
+    struct Ref {
+        const char* preset;
+        int entry;  ///< of 256, at position entry / 255
+        unsigned hex;
+    };
+    const Ref refs[] = {
+        {"Viridis (matplotlib)", 0, 0x440154},
+        {"viridis", 128, 0x21918c},
+        {"viridis", 255, 0xfde725},
+        {"Inferno (matplotlib)", 0, 0x000004},
+        {"inferno", 255, 0xfcffa4},
+        {"Magma (matplotlib)", 0, 0x000004},
+        {"magma", 255, 0xfcfdbf},
+        {"Plasma (matplotlib)", 0, 0x0d0887},
+        {"plasma", 255, 0xf0f921},
+        {"Turbo", 0, 0x30123b},
+        {"turbo", 255, 0x7a0403},
+    };
+    for (const Ref& r : refs) {
+        const Vec3f want((r.hex >> 16) / 255.f, ((r.hex >> 8) & 0xff) / 255.f,
+                         (r.hex & 0xff) / 255.f);
+        // Half an 8-bit level of rounding in the hex, half of subsampling (presets.cpp).
+        expectVec(transferFunctionPreset(r.preset).colorAt(r.entry / 255.f), want, 1.f / 255.f,
+                  std::string(r.preset) + " entry " + std::to_string(r.entry));
     }
-    Error e = catchError([] { transferFunctionPreset("jet"); });
+}
+
+TEST(TransferFunction, EveryPresetNameRoundTrips) {
+    const std::vector<ColorMapInfo> presets = transferFunctionPresets();
+    ASSERT_GE(presets.size(), 28u);
+    for (const char* name : {"Cool to Warm",
+                             "Cool to Warm (Extended)",
+                             "Warm to Cool",
+                             "Black-Body Radiation",
+                             "Inferno (matplotlib)",
+                             "Magma (matplotlib)",
+                             "Plasma (matplotlib)",
+                             "Viridis (matplotlib)",
+                             "Turbo",
+                             "Jet",
+                             "Rainbow Uniform",
+                             "Rainbow Desaturated",
+                             "Blue Orange (divergent)",
+                             "X Ray",
+                             "Grayscale",
+                             "Blue - Green - Orange",
+                             "Cold and Hot",
+                             "Blue to Red Rainbow",
+                             "Yellow - Gray - Blue",
+                             "Linear Green (Gr4L)",
+                             "erdc_rainbow_bright",
+                             "Spectral_lowBlue",
+                             "gist_earth",
+                             "Haze",
+                             "Black, Blue and White"}) {
+        const auto it = std::find_if(presets.begin(), presets.end(),
+                                     [&](const ColorMapInfo& p) { return p.name == name; });
+        EXPECT_NE(it, presets.end()) << name;
+    }
+    for (const ColorMapInfo& p : presets) {
+        // The name itself, in other cases and with '-' or '_' for spaces.
+        std::string lower, dashed, snake;
+        for (char c : p.name) {
+            lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            dashed += c == ' ' ? '-' : c;
+            snake += c == ' ' ? '_' : c;
+        }
+        for (const std::string& query : {p.name, lower, dashed, snake}) {
+            const TransferFunction tf = transferFunctionPreset(query);
+            EXPECT_EQ(tf.name, p.name) << query;
+            EXPECT_FLOAT_EQ(tf.opacityAt(0.f), 0.f) << query;
+            EXPECT_FLOAT_EQ(tf.opacityAt(0.3f), 0.3f) << query;
+            EXPECT_FLOAT_EQ(tf.opacityAt(1.f), 1.f) << query;
+        }
+        EXPECT_GE(p.points, 2) << p.name;
+        // Positions span [0, 1]; HSV maps are resampled into more points.
+        const TransferFunction tf = transferFunctionPreset(p.name);
+        EXPECT_FLOAT_EQ(tf.colors.front().x, 0.f) << p.name;
+        EXPECT_FLOAT_EQ(tf.colors.back().x, 1.f) << p.name;
+        if (p.colorSpace != "HSV") {
+            EXPECT_EQ(static_cast<int>(tf.colors.size()), p.points) << p.name;
+        }
+    }
+}
+
+TEST(TransferFunction, PresetsResolveAliasesAndSuffixes) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"cool-to-warm", "Cool to Warm"},
+        {"COOL_TO_WARM", "Cool to Warm"},
+        {"cool to warm (extended)", "Cool to Warm (Extended)"},
+        {"black-body", "Black-Body Radiation"},
+        {"Black-Body Radiation", "Black-Body Radiation"},
+        {"viridis", "Viridis (matplotlib)"},
+        {"Inferno", "Inferno (matplotlib)"},
+        {"grayscale", "Grayscale"},
+        {"greyscale", "Grayscale"},
+        {"gray", "Grayscale"},
+        {"xray", "X Ray"},
+        {"x-ray", "X Ray"},
+        {"Blue Orange", "Blue Orange (divergent)"},
+        {"linear green", "Linear Green (Gr4L)"},
+        {"black blue and white", "Black, Blue and White"},
+        {"rainbow-uniform", "Rainbow Uniform"},
+    };
+    for (const auto& [query, name] : cases) EXPECT_EQ(transferFunctionPreset(query).name, name);
+    expectVec(transferFunctionPreset("X Ray").nanColor, {1.f, 0.f, 0.f}, 0.f, "X Ray NanColor");
+    // ParaView applies presets without HSVWrap: blue to red through green, not magenta.
+    expectVec(transferFunctionPreset("Blue to Red Rainbow").colorAt(0.5f), {0.f, 1.f, 0.f}, 1e-5f,
+              "green in the middle");
+
+    Error e = catchError([] { transferFunctionPreset("jett"); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
-    EXPECT_THAT(e.what(), HasSubstr("\"jet\""));
-    EXPECT_THAT(e.what(), HasSubstr("cool-to-warm, viridis"));
+    EXPECT_THAT(e.what(), HasSubstr("\"jett\"; did you mean \"Jet\"?"));
+    EXPECT_THAT(e.what(), HasSubstr("`uvr presets` lists"));
+    e = catchError([] { transferFunctionPreset("rainbow"); });
+    EXPECT_THAT(e.what(), HasSubstr("\"Rainbow Uniform\""));
+    EXPECT_THAT(e.what(), HasSubstr("\"Rainbow Desaturated\""));
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    EXPECT_THAT(catchError([] { transferFunctionPreset("zzzzzzzzzz"); }).what(),
+                ::testing::Not(HasSubstr("did you mean")));
 }
 
 TEST(TransferFunction, BlackBodyMatchesParaViewPreset) {
@@ -251,15 +394,22 @@ TEST(TransferFunction, ParaViewCoolToWarmExportEqualsPreset) {
     }
 }
 
-TEST(TransferFunction, HsvExportIsResampledTheShortWayRound) {
+TEST(TransferFunction, HsvExportIsResampledAsParaViewAppliesIt) {
     std::string dir = scratchDir();
+    // ParaView applies a preset with HSVWrap off unless it says "HSVWrap": 1
+    // (vtkSMTransferFunctionProxy::ApplyPreset): red to blue through green; wrapped, the
+    // shorter way round through magenta.
     std::string path = writeFile(dir + "/hsv.json", R"([{"ColorSpace": "HSV",
         "RGBPoints": [0, 1, 0, 0, 1, 0, 0, 1]}])");
     TransferFunction tf = loadParaViewColorMap(path);
     EXPECT_EQ(tf.colorSpace, ColorSpace::RGB);
     expectVec(tf.colorAt(0.f), {1.f, 0.f, 0.f}, 1e-6f, "red end");
-    expectVec(tf.colorAt(0.5f), {1.f, 0.f, 1.f}, 1e-5f, "magenta, not green, in the middle");
+    expectVec(tf.colorAt(0.5f), {0.f, 1.f, 0.f}, 1e-5f, "green in the middle");
     expectVec(tf.colorAt(1.f), {0.f, 0.f, 1.f}, 1e-6f, "blue end");
+    path = writeFile(dir + "/wrap.json", R"([{"ColorSpace": "HSV", "HSVWrap": 1,
+        "RGBPoints": [0, 1, 0, 0, 1, 0, 0, 1]}])");
+    expectVec(loadParaViewColorMap(path).colorAt(0.5f), {1.f, 0.f, 1.f}, 1e-5f,
+              "magenta in the middle when wrapped");
 }
 
 TEST(TransferFunction, MalformedParaViewExportsNameFileAndKey) {
@@ -326,8 +476,91 @@ TEST(TransferFunction, MalformedParaViewExportsNameFileAndKey) {
     }
 }
 
+TEST(TransferFunction, PresetsFilePicksMapsByName) {
+    const std::string path = uvr::testing::testData("presets/several_maps.json");
+    const std::vector<ColorMapInfo> maps = listParaViewColorMaps(path);
+    ASSERT_EQ(maps.size(), 4u);
+    EXPECT_EQ(maps[0].name, "Deep Sea");
+    EXPECT_EQ(maps[0].colorSpace, "Lab");
+    EXPECT_EQ(maps[0].points, 3);
+    EXPECT_EQ(maps[1].colorSpace, "RGB");
+    EXPECT_EQ(maps[3].colorSpace, "indexed");
+    EXPECT_EQ(maps[3].points, 0);
+
+    TransferFunction deep = loadParaViewColorMap(path, "Deep Sea");
+    EXPECT_EQ(deep.name, "Deep Sea");
+    EXPECT_EQ(deep.colorSpace, ColorSpace::Lab);
+    expectVec(deep.nanColor, {1.f, 0.f, 1.f}, 0.f, "NanColor");
+    EXPECT_EQ(deep.nanOpacity, 0.f);  // no NanOpacity: NaN stays invisible
+    // Loose matching, and the same through --tf's FILE.json:NAME.
+    EXPECT_EQ(loadParaViewColorMap(path, "deep-sea").name, "Deep Sea");
+    const TransferFunction ember = loadTransferFunction(path + ":Ember Ramp");
+    EXPECT_EQ(ember.name, "Ember Ramp");
+    EXPECT_FLOAT_EQ(ember.nanOpacity, 0.5f);
+    expectVec(ember.nanColor, {0.2f, 0.8f, 0.2f}, 0.f, "Ember NanColor");
+    EXPECT_NEAR(ember.opacityAt(0.5f), 0.4f, 1e-6f);
+    EXPECT_FALSE(ember.logScale);
+
+    // UseLogScale: positions 1, 10, 1000 lie at log10 0, 1/3 and 1 of the range.
+    const TransferFunction decades = loadTransferFunction(path + ":decades");
+    EXPECT_TRUE(decades.logScale);
+    ASSERT_EQ(decades.colors.size(), 3u);
+    EXPECT_NEAR(decades.colors[1].x, 1.f / 3.f, 1e-6f);
+    ASSERT_TRUE(decades.sourceRange.has_value());
+    EXPECT_FLOAT_EQ(decades.sourceRange->second, 1000.f);
+
+    // Without a name a file of several maps is refused, naming them.
+    Error e = catchError([&] { loadTransferFunction(path); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(), HasSubstr(path + ": holds 4 colour maps: pick one with --tf " + path +
+                                    ":NAME, one of \"Deep Sea\", \"Ember Ramp\", \"Decades\", "
+                                    "\"Site Classes\""));
+    EXPECT_THAT(e.what(), HasSubstr("`uvr presets " + path + "` lists them"));
+    // An unknown name: the close ones.
+    e = catchError([&] { loadTransferFunction(path + ":Deep See"); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(),
+                HasSubstr("no colour map named \"Deep See\"; did you mean \"Deep Sea\"?"));
+    e = catchError([&] { loadTransferFunction(path + ":zzzzzzzz"); });
+    EXPECT_THAT(e.what(), HasSubstr("; it holds \"Deep Sea\", \"Ember Ramp\""));
+    // A categorical map is named but cannot be loaded.
+    e = catchError([&] { loadTransferFunction(path + ":Site Classes"); });
+    EXPECT_EQ(e.kind(), ErrorKind::Parse);
+    EXPECT_THAT(e.what(), HasSubstr("colour map 3"));
+    EXPECT_THAT(e.what(), HasSubstr("indexed (categorical)"));
+    EXPECT_EQ(catchError([&] { loadTransferFunction(path + ":"); }).kind(), ErrorKind::Argument);
+}
+
+TEST(TransferFunction, PresetsFileListsTheFirstTenNames) {
+    std::string json = "[";
+    for (int i = 0; i < 12; ++i)
+        json += std::string(i ? ", " : "") + "{\"Name\": \"Map " + std::to_string(i) +
+                "\", \"RGBPoints\": [0, 0, 0, 0, 1, 1, 1, 1]}";
+    const std::string path = writeFile(scratchDir() + "/twelve.json", json + "]");
+    Error e = catchError([&] { loadParaViewColorMap(path); });
+    EXPECT_THAT(e.what(), HasSubstr("holds 12 colour maps"));
+    EXPECT_THAT(e.what(), HasSubstr("\"Map 9\" and 2 more"));
+    EXPECT_THAT(e.what(), ::testing::Not(HasSubstr("Map 10")));
+    // One map in an array needs no name; a name that is not its own is refused.
+    const std::string one =
+        writeFile(scratchDir() + "/one.json", R"([{"Name": "Only", "RGBPoints": [0, 0, 0, 0]}])");
+    EXPECT_EQ(loadTransferFunction(one).name, "Only");
+    EXPECT_EQ(loadTransferFunction(one + ":only").name, "Only");
+    EXPECT_THAT(catchError([&] { loadTransferFunction(one + ":Other"); }).what(),
+                HasSubstr("no colour map named \"Other\""));
+    // Malformed NanColor / NanOpacity name the key.
+    for (const char* bad : {R"([{"RGBPoints": [0, 0, 0, 0], "NanColor": [1, 2, 0]}])",
+                            R"([{"RGBPoints": [0, 0, 0, 0], "NanColor": "red"}])",
+                            R"([{"RGBPoints": [0, 0, 0, 0], "NanOpacity": 3}])"}) {
+        const std::string p = writeFile(scratchDir() + "/bad.json", bad);
+        Error b = catchError([&] { loadParaViewColorMap(p); });
+        EXPECT_EQ(b.kind(), ErrorKind::Parse) << bad;
+        EXPECT_THAT(b.what(), HasSubstr("colour map 0 \"Nan")) << bad;
+    }
+}
+
 TEST(TransferFunction, LoadTransferFunctionChoosesPresetOrFile) {
-    EXPECT_EQ(loadTransferFunction("Viridis").name, "viridis");
+    EXPECT_EQ(loadTransferFunction("Viridis").name, "Viridis (matplotlib)");
     std::string missing = scratchDir() + "/missing.json";
     Error e = catchError([&] { loadTransferFunction(missing); });
     EXPECT_EQ(e.kind(), ErrorKind::Io);
