@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Text with FreeType (glyph outlines rasterised with anti-aliasing) and fontconfig (finding a
-// system font); font_none.cpp stands in when the build has neither.
+// system font), both opened at run time (SharedLibrary: only their headers are needed to build,
+// and a binary carried to a machine without them still starts); font_none.cpp stands in when the
+// build has neither.
 #include "uvr/annotate/font.h"
 
 #include <fontconfig/fontconfig.h>
@@ -10,11 +12,61 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
+#include "uvr/annotate/shared_library.h"
 #include "uvr/core/error.h"
 #include "uvr/core/text.h"
 
 namespace uvr {
+
+namespace {
+
+// The functions used, each bound by the name of its declaration in the library's header.
+#define UVR_BIND(f) decltype(&::f) f = lib.function<std::remove_pointer_t<decltype(&::f)>>(#f);
+
+/// FreeType's functions, loaded on first use (a failure is retried at the next use).
+struct FreeTypeApi {
+    SharedLibrary lib{"libfreetype.so.6", "libfreetype6"};
+    UVR_BIND(FT_Init_FreeType)
+    UVR_BIND(FT_Done_FreeType)
+    UVR_BIND(FT_New_Face)
+    UVR_BIND(FT_Done_Face)
+    UVR_BIND(FT_Select_Charmap)
+    UVR_BIND(FT_Set_Char_Size)
+    UVR_BIND(FT_Get_Char_Index)
+    UVR_BIND(FT_Get_Kerning)
+    UVR_BIND(FT_Load_Glyph)
+};
+
+/// fontconfig's functions, loaded on first use.
+struct FontconfigApi {
+    SharedLibrary lib{"libfontconfig.so.1", "libfontconfig1"};
+    UVR_BIND(FcInitLoadConfigAndFonts)
+    UVR_BIND(FcConfigDestroy)
+    UVR_BIND(FcNameParse)
+    UVR_BIND(FcPatternAddBool)
+    UVR_BIND(FcConfigSubstitute)
+    UVR_BIND(FcDefaultSubstitute)
+    UVR_BIND(FcFontMatch)
+    UVR_BIND(FcPatternGetString)
+    UVR_BIND(FcPatternGetBool)
+    UVR_BIND(FcPatternDestroy)
+};
+
+#undef UVR_BIND
+
+const FreeTypeApi& freetype() {
+    static const FreeTypeApi api;
+    return api;
+}
+
+const FontconfigApi& fontconfig() {
+    static const FontconfigApi api;
+    return api;
+}
+
+}  // namespace
 
 bool textEngineAvailable() {
     return true;
@@ -24,29 +76,30 @@ std::string findFontFile(const std::string& pattern) {
     const std::string missing = "no scalable font found through fontconfig for '" +
                                 printableShort(pattern) +
                                 "': install the Debian package fonts-dejavu-core (DejaVu Sans)";
+    const FontconfigApi& fc = fontconfig();
     // A configuration of its own (not the process-wide one FcInit keeps), freed again.
-    FcConfig* config = FcInitLoadConfigAndFonts();
+    FcConfig* config = fc.FcInitLoadConfigAndFonts();
     if (!config)
         throwError(ErrorKind::Unsupported, "", missing + " (fontconfig has no configuration)");
     std::string file;
-    FcPattern* pat = FcNameParse(reinterpret_cast<const FcChar8*>(pattern.c_str()));
+    FcPattern* pat = fc.FcNameParse(reinterpret_cast<const FcChar8*>(pattern.c_str()));
     if (pat) {
-        FcPatternAddBool(pat, FC_SCALABLE, FcTrue);
-        FcConfigSubstitute(config, pat, FcMatchPattern);
-        FcDefaultSubstitute(pat);
+        fc.FcPatternAddBool(pat, FC_SCALABLE, FcTrue);
+        fc.FcConfigSubstitute(config, pat, FcMatchPattern);
+        fc.FcDefaultSubstitute(pat);
         FcResult result = FcResultNoMatch;
-        FcPattern* match = FcFontMatch(config, pat, &result);
+        FcPattern* match = fc.FcFontMatch(config, pat, &result);
         if (match) {
             FcChar8* path = nullptr;
             FcBool scalable = FcFalse;
-            if (FcPatternGetString(match, FC_FILE, 0, &path) == FcResultMatch && path &&
-                FcPatternGetBool(match, FC_SCALABLE, 0, &scalable) == FcResultMatch && scalable)
+            if (fc.FcPatternGetString(match, FC_FILE, 0, &path) == FcResultMatch && path &&
+                fc.FcPatternGetBool(match, FC_SCALABLE, 0, &scalable) == FcResultMatch && scalable)
                 file = reinterpret_cast<const char*>(path);
-            FcPatternDestroy(match);
+            fc.FcPatternDestroy(match);
         }
-        FcPatternDestroy(pat);
+        fc.FcPatternDestroy(pat);
     }
-    FcConfigDestroy(config);
+    fc.FcConfigDestroy(config);
     if (file.empty()) throwError(ErrorKind::Unsupported, "", missing);
     return file;
 }
@@ -65,14 +118,15 @@ char32_t drawable(char32_t cp) {
 }  // namespace
 
 struct Font::Impl {
+    const FreeTypeApi& ft = freetype();  // throws when FreeType cannot be loaded
     std::string path;
     FT_Library library = nullptr;
     FT_Face face = nullptr;
     float size = 0.f;  // the pixel size set on the face
 
     ~Impl() {
-        if (face) FT_Done_Face(face);
-        if (library) FT_Done_FreeType(library);
+        if (face) ft.FT_Done_Face(face);
+        if (library) ft.FT_Done_FreeType(library);
     }
 
     void setSize(float pixelSize) {
@@ -81,16 +135,16 @@ struct Font::Impl {
                        "text size " + std::to_string(pixelSize) + " px: expected 1 to 2048");
         if (pixelSize == size) return;
         // 26.6 fixed point at 72 dpi: one point is one pixel.
-        if (FT_Set_Char_Size(face, 0, static_cast<FT_F26Dot6>(std::lround(pixelSize * 64.f)), 72,
-                             72))
+        if (ft.FT_Set_Char_Size(face, 0, static_cast<FT_F26Dot6>(std::lround(pixelSize * 64.f)), 72,
+                                72))
             throwError(ErrorKind::Io, path,
                        "FreeType cannot scale the font to " + std::to_string(pixelSize) + " px");
         size = pixelSize;
     }
 
     FT_UInt glyphIndex(char32_t cp) const {
-        FT_UInt g = FT_Get_Char_Index(face, drawable(cp));
-        if (g == 0) g = FT_Get_Char_Index(face, 0xFFFD);  // else 0: the face's .notdef box
+        FT_UInt g = ft.FT_Get_Char_Index(face, drawable(cp));
+        if (g == 0) g = ft.FT_Get_Char_Index(face, 0xFFFD);  // else 0: the face's .notdef box
         return g;
     }
 
@@ -107,10 +161,10 @@ struct Font::Impl {
             const FT_UInt g = glyphIndex(cp);
             if (kern && previous && g) {
                 FT_Vector delta{0, 0};
-                if (FT_Get_Kerning(face, previous, g, FT_KERNING_DEFAULT, &delta) == 0)
+                if (ft.FT_Get_Kerning(face, previous, g, FT_KERNING_DEFAULT, &delta) == 0)
                     pen += delta.x;
             }
-            if (FT_Load_Glyph(face, g, flags) != 0) {  // a broken glyph: skip it
+            if (ft.FT_Load_Glyph(face, g, flags) != 0) {  // a broken glyph: skip it
                 previous = 0;
                 continue;
             }
@@ -124,13 +178,13 @@ struct Font::Impl {
 
 Font::Font(const std::string& path) : impl_(std::make_unique<Impl>()) {
     impl_->path = path;
-    if (FT_Init_FreeType(&impl_->library) != 0)
+    if (impl_->ft.FT_Init_FreeType(&impl_->library) != 0)
         throwError(ErrorKind::Internal, path, "FreeType failed to initialise");
-    if (FT_New_Face(impl_->library, path.c_str(), 0, &impl_->face) != 0)
+    if (impl_->ft.FT_New_Face(impl_->library, path.c_str(), 0, &impl_->face) != 0)
         throwError(ErrorKind::Io, path, "FreeType cannot open this file as a font");
     if (!FT_IS_SCALABLE(impl_->face))
         throwError(ErrorKind::Unsupported, path, "not a scalable (outline) font");
-    FT_Select_Charmap(impl_->face, FT_ENCODING_UNICODE);
+    impl_->ft.FT_Select_Charmap(impl_->face, FT_ENCODING_UNICODE);
 }
 
 Font::~Font() = default;
