@@ -52,23 +52,25 @@ std::vector<double> linearTicks(double lo, double hi, int target, int maxCount) 
 std::vector<double> logTicks(double lo, double hi, int target, int maxCount) {
     const int a = static_cast<int>(std::ceil(std::log10(lo) - 1e-9));
     const int b = static_cast<int>(std::floor(std::log10(hi) + 1e-9));
-    std::vector<double> out;
-    if (b - a + 1 >= 2) {  // decades: 10^k for k the multiples of a 1-2-5 stride
-        for (int stride : {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000}) {
-            const int first = static_cast<int>(std::ceil(double(a) / stride)) * stride;
-            if (first > b || (b - first) / stride + 1 > maxCount) continue;
-            for (int k = first; k <= b; k += stride) out.push_back(std::clamp(pow10(k), lo, hi));
-            if (out.size() >= 2) return out;
-            break;  // one decade of a wide stride: 1-2-5 ticks instead
-        }
-        out.clear();
+    std::vector<double> decades, oneTwoFive;
+    // Decades: 10^k for k the multiples of a 1-2-5 stride of exponents.
+    for (int stride : {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000}) {
+        const int first = static_cast<int>(std::ceil(double(a) / stride)) * stride;
+        if (first <= b && (b - first) / stride + 1 > maxCount) continue;
+        for (int k = first; k <= b; k += stride) decades.push_back(std::clamp(pow10(k), lo, hi));
+        break;
     }
-    for (int k = a - 1; k <= b; ++k)  // within one decade or two: 1, 2, 5 times 10^k
+    if (decades.size() >= 3) return decades;
+    // Two decades or less: 1, 2 and 5 times 10^k where they fit.
+    for (int k = a - 1; k <= b; ++k)
         for (double m : {1.0, 2.0, 5.0}) {
             const double v = scaled(m, k);
-            if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9)) out.push_back(std::clamp(v, lo, hi));
+            if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9))
+                oneTwoFive.push_back(std::clamp(v, lo, hi));
         }
-    if (out.size() >= 2 && static_cast<int>(out.size()) <= maxCount) return out;
+    if (oneTwoFive.size() >= 2 && static_cast<int>(oneTwoFive.size()) <= maxCount)
+        return oneTwoFive;
+    if (decades.size() >= 2) return decades;
     return linearTicks(lo, hi, target, maxCount);
 }
 
@@ -175,10 +177,13 @@ std::vector<std::string> formatTickLabels(const std::vector<double>& values, boo
     }
     const bool fixed = maxAbs == 0.0 || (maxAbs >= 1e-3 && maxAbs < 1e5);
     if (logScale) {  // each label its own shortest form, good to 1e-9 of itself
+        double minAbs = maxAbs;
+        for (double v : values) minAbs = std::min(minAbs, std::fabs(v));
+        const bool fixedAll = maxAbs < 1e5 && minAbs >= 1e-3;
         for (double v : values) {
             const std::vector<double> one{v};
             const double tol = std::fabs(v) * 1e-9;
-            const int fd = fixed ? fewestDigits(one, "%.*f", tol, 6) : -1;
+            const int fd = fixedAll ? fewestDigits(one, "%.*f", tol, 6) : -1;
             out.push_back(
                 fd >= 0 ? tidy(format("%.*f", fd, v), false)
                         : tidy(format("%.*e", std::max(0, fewestDigits(one, "%.*e", tol, 15)), v),

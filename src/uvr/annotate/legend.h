@@ -20,8 +20,9 @@ struct LegendTicks {
 
 /// "Nice" tick values within [lo, hi]. Linear: multiples of a step 1, 2 or 5 times a power of
 /// ten, the step whose tick count is closest to `target` within [2, maxCount] (the more ticks on
-/// a tie); log: the decades 10^k (every n-th when there are more than maxCount), else the 1-2-5
-/// multiples of powers of ten, else linear ticks. lo == hi gives that one value. Throws
+/// a tie); log: the decades 10^k when there are 3 or more (every n-th when more than maxCount),
+/// else the 1-2-5 multiples of powers of ten, else the two decades, else linear ticks. lo == hi
+/// gives that one value. Throws
 /// Error(Argument) for a non-finite lo or hi, lo > hi, maxCount < 2, or a log scale with lo <= 0.
 LegendTicks legendTicks(double lo, double hi, bool logScale, int target = 5, int maxCount = 8);
 
@@ -30,7 +31,8 @@ LegendTicks legendTicks(double lo, double hi, bool logScale, int target = 5, int
 /// in [1e-3, 1e5) ("0.0", "0.5", "1.0"), else scientific with a common mantissa precision
 /// ("1.0e-30", "1.5e-30"; a zero among them "0"), as ParaView's and matplotlib's labels keep one
 /// precision; negative numbers get the minus sign U+2212. With logScale each label takes its own
-/// shortest form, powers of ten beyond fixed point written 10 with a superscript exponent ("10⁶").
+/// shortest form: fixed point when all values lie in [1e-3, 1e5), else 10 with a superscript
+/// exponent ("10⁶", "2×10⁻⁷").
 std::vector<std::string> formatTickLabels(const std::vector<double>& values, bool logScale = false);
 
 /// Position in [0, 1] of value v along a legend of [lo, hi] (log: of log10 v), clamped; 0.5 when

@@ -79,6 +79,12 @@ TEST(LegendTicks, LogRangesGetDecades) {
     // Within a decade: 1-2-5 multiples, else linear ticks.
     t = legendTicks(2.0, 8.0, true);
     EXPECT_EQ(t.labels, (Labels{"2", "5"}));
+    t = legendTicks(0.5, 50.0, true);  // two decades: 1-2-5 ticks between them
+    EXPECT_EQ(t.labels, (Labels{"0.5", "1", "2", "5", "10", "20", "50"}));
+    t = legendTicks(0.5, 50.0, true, 5, 4);  // too many: the decades
+    EXPECT_EQ(t.labels, (Labels{"1", "10"}));
+    t = legendTicks(1e-5, 1e-3, true);
+    EXPECT_EQ(t.labels, (Labels{"10\u207B\u2075", "10\u207B\u2074", "10\u207B\u00B3"}));
     t = legendTicks(3.0, 4.0, true);
     EXPECT_EQ(t.values.front(), 3.0);
     EXPECT_EQ(t.values.back(), 4.0);
