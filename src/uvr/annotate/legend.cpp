@@ -127,17 +127,25 @@ void fillRect(Image& image, PixelRect r, Vec3f color, float alpha) {
         for (int x = r.x0; x < r.x1; ++x) blendOver(image, x, y, color, alpha);
 }
 
-/// The title cut to at most maxWidth pixels with a trailing ellipsis (invalid UTF-8 and control
-/// characters already replaced, as the font draws them).
+/// The title cut to at most maxWidth pixels with a trailing ellipsis. A name from a file may be
+/// megabytes long: a title is cut after kMaxTitleChars characters whatever the width, and the cut
+/// is found by bisection (advances only grow along a text), so it costs a few short layouts.
 std::string fitTitle(const Font& font, const std::string& title, float size, int maxWidth) {
-    if (font.advance(title, size) <= maxWidth) return title;
-    std::u32string cps = decodeUtf8Lossy(title);
-    while (!cps.empty()) {
-        cps.pop_back();
-        const std::string cut = encodeUtf8(cps) + "\u2026";
-        if (font.advance(cut, size) <= maxWidth) return cut;
+    constexpr size_t kMaxTitleChars = 512;
+    std::u32string cps = decodeUtf8Lossy(title.substr(0, 4 * kMaxTitleChars));
+    const bool cut = cps.size() > kMaxTitleChars || title.size() > 4 * kMaxTitleChars;
+    if (cps.size() > kMaxTitleChars) cps.resize(kMaxTitleChars);
+    if (!cut && font.advance(title, size) <= maxWidth) return title;
+    const auto shortened = [&](size_t n) { return encodeUtf8(cps.substr(0, n)) + "\u2026"; };
+    size_t lo = 0, hi = cps.size();  // shortened(lo) fits (or lo is 0); find the longest
+    while (lo < hi) {
+        const size_t mid = (lo + hi + 1) / 2;
+        if (font.advance(shortened(mid), size) <= maxWidth)
+            lo = mid;
+        else
+            hi = mid - 1;
     }
-    return "\u2026";
+    return shortened(lo);
 }
 
 }  // namespace

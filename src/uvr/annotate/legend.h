@@ -75,10 +75,10 @@ inline constexpr int kLegendMinHeight = 128;
 /// ParaView and matplotlib show it: opacity per unit length is not what the image shows), the
 /// title above it and ticks from legendTicks(lo, hi, logScale) beside it, all on an opaque-text,
 /// semi-transparent box so it reads over the rendering and on a transparent PNG. Its size scales
-/// with the image (labels about 1/40 of the height, at least 10 px). The title is any bytes
-/// (invalid UTF-8 drawn as U+FFFD) and is shortened with an ellipsis beyond 45% of the width.
-/// Throws Error(Argument) for an image below kLegendMinWidth x kLegendMinHeight or a bad range
-/// (as legendTicks).
+/// with the image (labels 1/40 of the height or 1/24 of the width, the smaller, at least 10 px).
+/// The title is any bytes (invalid UTF-8 drawn as U+FFFD), shortened with an ellipsis beyond 45%
+/// of the width or 512 characters. Throws Error(Argument) for an image below kLegendMinWidth x
+/// kLegendMinHeight or a bad range (as legendTicks).
 LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
                         double hi, const std::string& title, bool logScale,
                         const LegendStyle& style = {});

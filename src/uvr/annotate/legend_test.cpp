@@ -276,7 +276,13 @@ TEST(LegendDraw, AnyTitleIsDrawnAndLongOnesAreShortened) {
     Image image(400, 300);
     const LegendLayout L = drawLegend(image, font, tf, 0.0, 1.0, std::string(500, 'w'), false);
     EXPECT_LE(L.title.x1 - L.title.x0, static_cast<int>(0.45 * 400));
+    EXPECT_GE(L.title.x1 - L.title.x0, static_cast<int>(0.45 * 400) - 60);  // as long as fits
     EXPECT_GE(L.box.x0, 0);
+    // A name of megabytes (from a hostile file) is cut quickly, also on the widest image.
+    Image wide(16384, 200);
+    const LegendLayout W =
+        drawLegend(wide, font, tf, 0.0, 1.0, std::string(4 << 20, 'i') + "\xFF", false);
+    EXPECT_LE(W.title.x1 - W.title.x0, static_cast<int>(0.45 * 16384));
 }
 
 TEST(LegendDraw, LeftPositionAndTooSmallImages) {
