@@ -338,6 +338,12 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--background", background,
                    "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
         ->capture_default_str();
+    if (oneFrame)
+        app.add_flag("--legend", legend,
+                     "Draw a colour legend at the right edge: the field's name, the colour map "
+                     "and tick values over the value range (needs --size of at least " +
+                         std::to_string(kLegendMinWidth) + "x" + std::to_string(kLegendMinHeight) +
+                         ")");
     if (oneFrame) app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
     app.add_option("--device", device,
                    "Where to render: cpu, cuda, or auto (CUDA when a device is present)")
@@ -515,6 +521,21 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     return s;
 }
 
+std::optional<Font> RenderFlags::legendFont() const {
+    if (!legend) return std::nullopt;
+    const auto [width, height] = parseSize("--size", size);
+    if (width < kLegendMinWidth || height < kLegendMinHeight)
+        throwError(ErrorKind::Argument, "",
+                   "--legend needs an image of at least " + std::to_string(kLegendMinWidth) + "x" +
+                       std::to_string(kLegendMinHeight) + " pixels to be readable, not --size " +
+                       size);
+    try {
+        return Font(findFontFile());
+    } catch (const Error& e) {
+        throwError(e.kind(), "", std::string("--legend: ") + e.what());
+    }
+}
+
 std::optional<Vec3f> RenderFlags::backgroundColor() const {
     if (background.empty()) return std::nullopt;
     const Vec3f c = parseVec3("--background", background);
@@ -663,6 +684,7 @@ Mesh loadMesh(const std::string& path, const Context& ctx) {
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx) {
     const std::optional<Vec3f> background = flags.backgroundColor();
+    const std::optional<Font> legendFont = flags.legendFont();  // before the expensive work
     const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
     auto start = Clock::now();
     const ValidationReport report = validateMesh(mesh, source);
@@ -723,6 +745,14 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     for (const std::string& note : result.setup.notes) ctx.warn(source + ": " + note);
     const std::string empty = explainEmptyFrame(prepared, settings, result);
     if (!empty.empty()) ctx.warn(source + ": " + empty);
+    if (legendFont) {
+        LegendStyle style;
+        style.background = background;
+        drawLegend(result.image, *legendFont, settings.tf, result.setup.rangeLo,
+                   result.setup.rangeHi, field.name, settings.tf.logScale, style);
+        ctx.step("drew the legend in " + legendFont->familyName() + " (" + legendFont->path() +
+                 ")");
+    }
     // Every output is written first and committed after the last one succeeded: a failure (a
     // full disk) leaves none of them behind.
     std::vector<std::unique_ptr<OutputFile>> outputs;

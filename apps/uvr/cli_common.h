@@ -96,6 +96,7 @@ struct RenderFlags {
     std::string heatmapFile;
     std::optional<std::uint32_t> heatmapMax;  ///< needs --heatmap; 0: the frame's maximum
     std::string background;
+    bool legend = false;  ///< draw a colour legend (title, bar, ticks) at the right edge
     std::string statsFile;
     int threads = 0;
 
@@ -108,6 +109,10 @@ struct RenderFlags {
     /// to notes when given, for the caller to print.
     RenderSettings settings(const Bounds3f& bounds, const std::string& source = "",
                             std::vector<std::string>* notes = nullptr) const;
+    /// With --legend, the font it is drawn with (found through fontconfig), after checking that
+    /// --size leaves room for it; throws Error naming --legend and what is missing. Without
+    /// --legend, none.
+    std::optional<Font> legendFont() const;
     /// The --background colour, if given (checked to lie in [0, 1]).
     std::optional<Vec3f> backgroundColor() const;
     /// The files a single render writes (-o, --heatmap, --stats), for checks before any work.
@@ -149,7 +154,8 @@ private:
 /// Loads a mesh with progress messages and validation; prints findings.
 Mesh loadMesh(const std::string& path, const Context& ctx);
 
-/// Prepares, renders and writes the PNG (and stats JSON); returns the result.
+/// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its
+/// image carries the legend).
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx);
 

@@ -197,6 +197,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         applyThreads(flags->threads);
         flags->checkFiles(*file);
         checkFrameMemory(*flags, ctx);
+        flags->legendFont();  // --legend's size and font checked before reading
         const Mesh mesh = loadMesh(*file, ctx);
         renderAndWrite(mesh, *file, *flags, ctx);
     });
@@ -223,6 +224,7 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
     cmd->callback([flags, cells, &ctx] {
         applyThreads(flags->threads);
         flags->checkFiles("");
+        flags->legendFont();  // --legend's size and font checked before generating
         ProceduralSpec spec;
         spec.shape = ProceduralShape::Box;
         spec.targetCells = *cells;

@@ -2,6 +2,8 @@
 #pragma once
 
 /// The uvr library facade: everything an application needs to read, render and write.
+#include "uvr/annotate/font.h"
+#include "uvr/annotate/legend.h"
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
 #include "uvr/core/output_file.h"

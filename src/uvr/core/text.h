@@ -18,6 +18,14 @@ std::string printable(std::string_view text);
 /// with "..." appended to at most maxBytes (maxBytes >= 4).
 std::string printableShort(std::string_view text, std::size_t maxBytes = 40);
 
+/// The code points of a UTF-8 text for drawing it: valid sequences decode as they are, and every
+/// byte of invalid UTF-8 becomes U+FFFD (the replacement character), so any bytes decode.
+std::u32string decodeUtf8Lossy(std::string_view text);
+
+/// The UTF-8 encoding of code points (one outside U+0000..U+10FFFF or a surrogate becomes
+/// U+FFFD): decodeUtf8Lossy's inverse for valid text.
+std::string encodeUtf8(std::u32string_view text);
+
 /// True when text is well-formed UTF-8 (no overlong forms, surrogates or code points past
 /// U+10FFFF).
 bool isValidUtf8(std::string_view text);

@@ -51,6 +51,23 @@ TEST(Text, IsValidUtf8) {
     EXPECT_FALSE(isValidUtf8("bad \xFF name"));
 }
 
+TEST(Text, DecodeUtf8LossyReplacesEachBadByte) {
+    EXPECT_EQ(decodeUtf8Lossy(""), U"");
+    EXPECT_EQ(decodeUtf8Lossy("a\xC3\xA9\xE2\x82\xAC\xF0\x9F\x98\x80"), U"a\u00E9\u20AC\U0001F600");
+    EXPECT_EQ(decodeUtf8Lossy("x\xFFy"), U"x\uFFFDy");
+    EXPECT_EQ(decodeUtf8Lossy("\xE2\x82"), U"\uFFFD\uFFFD");  // truncated: each byte replaced
+    EXPECT_EQ(decodeUtf8Lossy("\xC1\xBF"), U"\uFFFD\uFFFD");  // overlong
+    EXPECT_EQ(decodeUtf8Lossy("\xED\xA0\x80"), U"\uFFFD\uFFFD\uFFFD");  // a surrogate
+}
+
+TEST(Text, EncodeUtf8InvertsDecodingAndReplacesNonCharacters) {
+    const std::string text = "a\xC3\xA9\xE2\x82\xAC\xF0\x9F\x98\x80";
+    EXPECT_EQ(encodeUtf8(decodeUtf8Lossy(text)), text);
+    EXPECT_EQ(encodeUtf8(decodeUtf8Lossy("x\xFF")), "x\xEF\xBF\xBD");
+    EXPECT_EQ(encodeUtf8(std::u32string(1, char32_t(0xD800))), "\xEF\xBF\xBD");
+    EXPECT_EQ(encodeUtf8(std::u32string(1, char32_t(0x110000))), "\xEF\xBF\xBD");
+}
+
 TEST(Text, WideTextEncodingSeesByteOrderMarksAndNulPatterns) {
     const auto enc = [](const std::string& s) {
         const char* e = wideTextEncoding(s.data(), s.size());

@@ -1,0 +1,309 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/annotate/legend.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "uvr/core/error.h"
+#include "uvr/core/text.h"
+
+namespace uvr {
+
+namespace {
+
+/// 10^e as exactly as doubles allow (a division by an exact power for small numbers).
+double pow10(int e) {
+    return e >= 0 ? std::pow(10.0, e) : 1.0 / std::pow(10.0, -e);
+}
+
+/// m * 10^e, correctly rounded where 10^|e| is exact (|e| <= 22).
+double scaled(double m, int e) {
+    return e >= 0 ? m * std::pow(10.0, e) : m / std::pow(10.0, -e);
+}
+
+/// Linear ticks: multiples of 1, 2 or 5 times a power of ten (Heckbert's nice numbers, tight to
+/// the range), the count closest to target within [2, maxCount]; {lo, hi} when none fits.
+std::vector<double> linearTicks(double lo, double hi, int target, int maxCount) {
+    const double span = hi - lo;
+    if (!std::isfinite(span)) return {lo, hi};
+    const int e0 = static_cast<int>(std::floor(std::log10(span / std::max(target - 1, 1))));
+    double bestM = 0.0, bestScore = 1e300;
+    int bestE = 0;
+    double bestLo = 0.0, bestHi = -1.0;
+    for (int e = e0 - 1; e <= e0 + 1; ++e)
+        for (double m : {1.0, 2.0, 5.0}) {
+            const double step = m * pow10(e);
+            const double kLo = std::ceil(lo / step - 1e-9), kHi = std::floor(hi / step + 1e-9);
+            const double count = kHi - kLo + 1.0;
+            if (count < 2.0 || count > maxCount) continue;
+            const double score = std::fabs(count - target);
+            if (score < bestScore)  // steps grow along the loop: a tie keeps the smaller step
+                bestScore = score, bestM = m, bestE = e, bestLo = kLo, bestHi = kHi;
+        }
+    if (bestM == 0.0) return {lo, hi};
+    std::vector<double> out;
+    for (double k = bestLo; k <= bestHi; k += 1.0)
+        out.push_back(std::clamp(scaled(k * bestM, bestE), lo, hi));
+    return out;
+}
+
+std::vector<double> logTicks(double lo, double hi, int target, int maxCount) {
+    const int a = static_cast<int>(std::ceil(std::log10(lo) - 1e-9));
+    const int b = static_cast<int>(std::floor(std::log10(hi) + 1e-9));
+    std::vector<double> decades, oneTwoFive;
+    // Decades: 10^k for k the multiples of a 1-2-5 stride of exponents.
+    for (int stride : {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000}) {
+        const int first = static_cast<int>(std::ceil(double(a) / stride)) * stride;
+        if (first <= b && (b - first) / stride + 1 > maxCount) continue;
+        for (int k = first; k <= b; k += stride) decades.push_back(std::clamp(pow10(k), lo, hi));
+        break;
+    }
+    if (decades.size() >= 3) return decades;
+    // Two decades or less: 1, 2 and 5 times 10^k where they fit.
+    for (int k = a - 1; k <= b; ++k)
+        for (double m : {1.0, 2.0, 5.0}) {
+            const double v = scaled(m, k);
+            if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9))
+                oneTwoFive.push_back(std::clamp(v, lo, hi));
+        }
+    if (oneTwoFive.size() >= 2 && static_cast<int>(oneTwoFive.size()) <= maxCount)
+        return oneTwoFive;
+    if (decades.size() >= 2) return decades;
+    return linearTicks(lo, hi, target, maxCount);
+}
+
+std::string format(const char* fmt, int digits, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, fmt, digits, v);
+    return buf;
+}
+
+/// The fewest digits (0..maxDigits) for which fmt gives every value within tol; -1 if none.
+int fewestDigits(const std::vector<double>& values, const char* fmt, double tol, int maxDigits) {
+    for (int d = 0; d <= maxDigits; ++d) {
+        bool ok = true;
+        for (double v : values)
+            ok = ok && std::fabs(std::strtod(format(fmt, d, v).c_str(), nullptr) - v) <= tol;
+        if (ok) return d;
+    }
+    return -1;
+}
+
+const char* const kSuperscript[] = {"\u2070", "\u00B9", "\u00B2", "\u00B3", "\u2074",
+                                    "\u2075", "\u2076", "\u2077", "\u2078", "\u2079"};
+
+/// A number from printf's %f or %e, in the legend's style: "1.5e-30" (no '+', no leading zeros
+/// in the exponent) or with superscripts "10⁶" / "2×10⁻³"; zero unsigned ("0.0" in fixed point,
+/// "0" in scientific); U+2212 for minus.
+std::string tidy(const std::string& printed, bool superscript) {
+    std::string mant = printed, exp;
+    const size_t e = printed.find('e');
+    if (e != std::string::npos) {
+        mant = printed.substr(0, e);
+        exp = std::to_string(std::atoi(printed.c_str() + e + 1));
+    }
+    if (mant.find_first_of("123456789") == std::string::npos)  // zero, also "-0.0"
+        return exp.empty() ? mant.substr(mant[0] == '-' ? 1 : 0) : "0";
+    std::string out;
+    if (mant[0] == '-') out = "\u2212", mant.erase(0, 1);
+    if (!superscript && (exp.empty() || exp == "0")) {
+        out += mant;
+    } else if (!superscript) {
+        out += mant + "e" + (exp[0] == '-' ? "\u2212" + exp.substr(1) : exp);
+    } else {
+        if (mant != "1") out += mant + "\u00D7";
+        out += "10";
+        for (char c : exp) out += c == '-' ? "\u207B" : kSuperscript[c - '0'];
+    }
+    return out;
+}
+
+void fillRect(Image& image, PixelRect r, Vec3f color, float alpha) {
+    r.x0 = std::max(r.x0, 0), r.y0 = std::max(r.y0, 0);
+    r.x1 = std::min(r.x1, image.width), r.y1 = std::min(r.y1, image.height);
+    for (int y = r.y0; y < r.y1; ++y)
+        for (int x = r.x0; x < r.x1; ++x) blendOver(image, x, y, color, alpha);
+}
+
+/// The title cut to at most maxWidth pixels with a trailing ellipsis. A name from a file may be
+/// megabytes long: a title is cut after kMaxTitleChars characters whatever the width, and the cut
+/// is found by bisection (advances only grow along a text), so it costs a few short layouts.
+std::string fitTitle(const Font& font, const std::string& title, float size, int maxWidth) {
+    constexpr size_t kMaxTitleChars = 512;
+    std::u32string cps = decodeUtf8Lossy(title.substr(0, 4 * kMaxTitleChars));
+    const bool cut = cps.size() > kMaxTitleChars || title.size() > 4 * kMaxTitleChars;
+    if (cps.size() > kMaxTitleChars) cps.resize(kMaxTitleChars);
+    if (!cut && font.advance(title, size) <= maxWidth) return title;
+    const auto shortened = [&](size_t n) { return encodeUtf8(cps.substr(0, n)) + "\u2026"; };
+    size_t lo = 0, hi = cps.size();  // shortened(lo) fits (or lo is 0); find the longest
+    while (lo < hi) {
+        const size_t mid = (lo + hi + 1) / 2;
+        if (font.advance(shortened(mid), size) <= maxWidth)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return shortened(lo);
+}
+
+}  // namespace
+
+LegendTicks legendTicks(double lo, double hi, bool logScale, int target, int maxCount) {
+    if (!std::isfinite(lo) || !std::isfinite(hi) || lo > hi)
+        throwError(ErrorKind::Argument, "",
+                   "legend range " + std::to_string(lo) + ".." + std::to_string(hi) +
+                       ": expected finite lo <= hi");
+    if (maxCount < 2)
+        throwError(ErrorKind::Argument, "", "legend ticks: at least 2 must be allowed");
+    if (logScale && !(lo > 0.0))
+        throwError(ErrorKind::Argument, "",
+                   "legend range " + std::to_string(lo) + ".." + std::to_string(hi) +
+                       ": a log scale needs lo > 0");
+    target = std::clamp(target, 2, maxCount);
+    LegendTicks t;
+    if (lo == hi)
+        t.values = {lo};
+    else
+        t.values =
+            logScale ? logTicks(lo, hi, target, maxCount) : linearTicks(lo, hi, target, maxCount);
+    t.labels = formatTickLabels(t.values, logScale);
+    return t;
+}
+
+std::vector<std::string> formatTickLabels(const std::vector<double>& values, bool logScale) {
+    std::vector<std::string> out;
+    if (values.empty()) return out;
+    double maxAbs = 0.0, gap = 0.0;
+    for (size_t i = 0; i < values.size(); ++i) {
+        maxAbs = std::max(maxAbs, std::fabs(values[i]));
+        if (i > 0 && values[i] != values[i - 1]) {
+            const double g = std::fabs(values[i] - values[i - 1]);
+            gap = gap == 0.0 ? g : std::min(gap, g);
+        }
+    }
+    const bool fixed = maxAbs == 0.0 || (maxAbs >= 1e-3 && maxAbs < 1e5);
+    if (logScale) {  // each label its own shortest form, good to 1e-9 of itself
+        double minAbs = maxAbs;
+        for (double v : values) minAbs = std::min(minAbs, std::fabs(v));
+        const bool fixedAll = maxAbs < 1e5 && minAbs >= 1e-3;
+        for (double v : values) {
+            const std::vector<double> one{v};
+            const double tol = std::fabs(v) * 1e-9;
+            const int fd = fixedAll ? fewestDigits(one, "%.*f", tol, 6) : -1;
+            out.push_back(
+                fd >= 0 ? tidy(format("%.*f", fd, v), false)
+                        : tidy(format("%.*e", std::max(0, fewestDigits(one, "%.*e", tol, 15)), v),
+                               true));
+        }
+        return out;
+    }
+    // One format for all: good to 1e-6 of the smallest gap (of the value itself for one value).
+    const double tol = gap > 0.0 ? gap * 1e-6 : maxAbs * 1e-9;
+    int digits = fixed ? fewestDigits(values, "%.*f", tol, 6) : -1;
+    const char* fmt = "%.*f";
+    if (digits < 0) {
+        fmt = "%.*e";
+        digits = std::max(0, fewestDigits(values, fmt, tol, 15));
+    }
+    for (double v : values) out.push_back(tidy(format(fmt, digits, v), false));
+    return out;
+}
+
+double legendPosition(double v, double lo, double hi, bool logScale) {
+    if (!(hi > lo)) return 0.5;
+    const double t = logScale && lo > 0.0 && v > 0.0 ? std::log(v / lo) / std::log(hi / lo)
+                                                     : (v - lo) / (hi - lo);
+    return std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0);
+}
+
+LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
+                        double hi, const std::string& title, bool logScale,
+                        const LegendStyle& style) {
+    const int W = image.width, H = image.height;
+    if (W < kLegendMinWidth || H < kLegendMinHeight)
+        throwError(ErrorKind::Argument, "",
+                   "a legend needs an image of at least " + std::to_string(kLegendMinWidth) + "x" +
+                       std::to_string(kLegendMinHeight) + " pixels, not " + std::to_string(W) +
+                       "x" + std::to_string(H));
+    legendTicks(lo, hi, logScale);  // a bad range fails before anything is drawn
+
+    // Sizes: everything in units of the label size u, about 1/40 of the height.
+    LegendLayout L;
+    const float u = std::max(10.f, std::round(std::min(H / 40.f, W / 24.f)));
+    const float titleSize = std::round(u * 1.15f);
+    L.fontSize = u;
+    const auto px = [&](float f) { return std::max(1, static_cast<int>(std::lround(f * u))); };
+    const int margin = px(0.8f), pad = px(0.6f), barWidth = px(1.1f), tickLength = px(0.35f),
+              labelGap = px(0.3f), titleGap = px(0.7f), line = std::max(1, px(1.f / 14.f));
+    const TextBox digit = font.inkBox("0", u);
+    const int digitHeight = std::max(1, digit.y1 - digit.y0);
+    const FontMetrics tm = font.metrics(titleSize);
+    const int titleAscent = static_cast<int>(std::ceil(tm.ascender)),
+              titleHeight = static_cast<int>(std::ceil(tm.ascender + tm.descender));
+
+    // The bar: half the height, less where the title and the box would not fit.
+    const int frame = titleHeight + titleGap + digitHeight + 2 * (pad + margin);
+    const int barHeight = std::max(digitHeight * 2, std::min(H / 2, H - frame));
+    // Labels at least 1.8 digit heights apart.
+    const int maxTicks = std::clamp(barHeight / (digitHeight * 9 / 5) + 1, 2, 8);
+    L.ticks = legendTicks(lo, hi, logScale, std::min(5, maxTicks), maxTicks);
+    int labelWidth = 0;
+    for (const std::string& s : L.ticks.labels)
+        labelWidth = std::max(labelWidth, font.advance(s, u));
+    const int scaleWidth = line + barWidth + line + tickLength + labelGap + labelWidth;
+    const std::string shownTitle =
+        fitTitle(font, title, titleSize,
+                 std::max(scaleWidth, static_cast<int>(0.45f * W) - 2 * (pad + margin)));
+    const int titleWidth = font.advance(shownTitle, titleSize);
+    const int contentWidth = std::max(scaleWidth, titleWidth);
+    const int contentHeight =
+        titleHeight + titleGap + digitHeight / 2 + barHeight + digitHeight / 2 + line;
+
+    // Placement: at the chosen edge, vertically centred.
+    L.box.x0 =
+        style.position == LegendPosition::Right ? W - margin - contentWidth - 2 * pad : margin;
+    L.box.x1 = L.box.x0 + contentWidth + 2 * pad;
+    L.box.y0 = (H - contentHeight - 2 * pad) / 2;
+    L.box.y1 = L.box.y0 + contentHeight + 2 * pad;
+    const int left = L.box.x0 + pad, top = L.box.y0 + pad;
+    L.title = {left, top, left + titleWidth, top + titleHeight};
+    L.bar.x0 = left + line;
+    L.bar.x1 = L.bar.x0 + barWidth;
+    L.bar.y0 = top + titleHeight + titleGap + digitHeight / 2;
+    L.bar.y1 = L.bar.y0 + barHeight;
+
+    // Colours: the box as the background (white on a transparent image), text contrasting.
+    const Vec3f boxColor = style.background.value_or(Vec3f{1.f, 1.f, 1.f});
+    const float luminance = 0.2126f * boxColor.x + 0.7152f * boxColor.y + 0.0722f * boxColor.z;
+    const Vec3f ink = luminance > 0.45f ? Vec3f{0.08f, 0.08f, 0.08f} : Vec3f{0.95f, 0.95f, 0.95f};
+
+    // Drawing: box, title, bar with its frame, tick marks and labels.
+    fillRect(image, L.box, boxColor, 0.8f);
+    font.draw(image, shownTitle, titleSize, L.title.x0, top + titleAscent, ink);
+    for (int y = L.bar.y0; y < L.bar.y1; ++y) {
+        const float t = (L.bar.y1 - y - 0.5f) / barHeight;
+        fillRect(image, {L.bar.x0, y, L.bar.x1, y + 1}, tf.colorAt(t), 1.f);
+    }
+    fillRect(image, {L.bar.x0 - line, L.bar.y0 - line, L.bar.x1 + line, L.bar.y0}, ink, 1.f);
+    fillRect(image, {L.bar.x0 - line, L.bar.y1, L.bar.x1 + line, L.bar.y1 + line}, ink, 1.f);
+    fillRect(image, {L.bar.x0 - line, L.bar.y0, L.bar.x0, L.bar.y1}, ink, 1.f);
+    fillRect(image, {L.bar.x1, L.bar.y0, L.bar.x1 + line, L.bar.y1}, ink, 1.f);
+    const int labelX = L.bar.x1 + line + tickLength + labelGap;
+    for (size_t i = 0; i < L.ticks.values.size(); ++i) {
+        const double t = legendPosition(L.ticks.values[i], lo, hi, logScale);
+        const int row = std::clamp(static_cast<int>(std::floor(L.bar.y1 - t * barHeight)), L.bar.y0,
+                                   L.bar.y1 - 1);
+        L.tickRows.push_back(row);
+        const int y0 = row - (line - 1) / 2;
+        fillRect(image, {L.bar.x1, y0, L.bar.x1 + line + tickLength, y0 + line}, ink, 1.f);
+        // Digits centred on the tick: their ink box runs from digit.y0 to digit.y1 about the
+        // baseline.
+        const int baseline = row - (digit.y0 + digit.y1) / 2;
+        font.draw(image, L.ticks.labels[i], u, labelX, baseline, ink);
+    }
+    return L;
+}
+
+}  // namespace uvr
