@@ -113,6 +113,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                                (ec ? ": " + ec.message() : std::string(" (a file has its name)")));
         }
         flags->method = "adaptive";  // partitions are needed; variants pick their integrator
+        flags->checkBeforeLoading(*file);
         const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
         ctx.step("field " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice));

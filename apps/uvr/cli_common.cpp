@@ -358,8 +358,7 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_option("--threads", threads, threadsHelp())->capture_default_str();
 }
 
-RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& source,
-                                     std::vector<std::string>* notes) const {
+RenderSettings RenderFlags::baseSettings() const {
     RenderSettings s;
     std::tie(s.width, s.height) = parseSize("--size", size);
     s.tf = loadTransferFunction(tf);
@@ -418,6 +417,47 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
                    "--supersample 2 or more");
     s.supersample = supersample;
     s.jitter = jitter;
+    return s;
+}
+
+void RenderFlags::checkBeforeLoading(const std::string& meshFile) const {
+    validateSettings(baseSettings());
+    (void)backgroundColor();
+    // What the camera needs of the mesh (its bounds) waits; its flags and file are read now.
+    for (const auto& [flag, text] :
+         {std::pair<const char*, const std::string&>{"--camera-position", cameraPosition},
+          {"--camera-focal", cameraFocal},
+          {"--camera-up", cameraUp}})
+        if (!text.empty()) (void)parseVec3(flag, text);
+    bool fileParallel = false;
+    if (!cameraFile.empty()) fileParallel = loadPvcc(cameraFile).parallelProjection;
+    if (parallelScale && !parallel && !fileParallel)
+        throwError(ErrorKind::Argument, "",
+                   "--parallel-scale sets the half height of a parallel projection: it needs "
+                   "--parallel (or a .pvcc with CameraParallelProjection 1)");
+    if (viewAngle && (parallel || fileParallel))
+        throwError(ErrorKind::Argument, "",
+                   "--view-angle sets the perspective view angle, which parallel projection (" +
+                       (parallel ? std::string("--parallel") : "the camera file " + cameraFile) +
+                       ") does not have: use --parallel-scale for the half height of the view");
+    if (viewAngle && !(*viewAngle >= kMinViewAngle && *viewAngle <= kMaxViewAngle)) {
+        std::ostringstream os;
+        os << "--view-angle " << *viewAngle << ": expected degrees in [" << kMinViewAngle << ", "
+           << kMaxViewAngle << "]";
+        throwError(ErrorKind::Argument, "", os.str());
+    }
+    if (!std::isfinite(azimuth) || !std::isfinite(elevation))
+        throwError(ErrorKind::Argument, "", "--azimuth/--elevation must be finite");
+    const FieldSpec spec = parseFieldSpec(field);
+    // A .uvrm's header names its fields: a --field it lacks is refused before reading the arrays.
+    if (!meshFile.empty())
+        if (const std::optional<MeshSummary> header = readMeshSummary(meshFile))
+            (void)resolveField(header->fields, spec);
+}
+
+RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& source,
+                                     std::vector<std::string>* notes) const {
+    RenderSettings s = baseSettings();
     // The camera file, else the default camera fitted to the bounds (its error names the mesh)
     // where camera flags leave its position or focal point to it; with no camera flag the
     // renderer resets the camera itself.

@@ -113,8 +113,14 @@ struct RenderFlags {
     /// --size leaves room for it; throws Error naming --legend and what is missing. Without
     /// --legend, none.
     std::optional<Font> legendFont() const;
+    /// Checks every flag that does not need the mesh (and, for a .uvrm meshFile, that --field
+    /// names one of the fields its header lists), so that a bad flag fails before minutes of
+    /// reading; throws Error(Argument) as settings() would.
+    void checkBeforeLoading(const std::string& meshFile = "") const;
     /// The --background colour, if given (checked to lie in [0, 1]).
     std::optional<Vec3f> backgroundColor() const;
+    /// The settings the flags give that do not depend on the mesh (no camera).
+    RenderSettings baseSettings() const;
     /// The files a single render writes (-o, --heatmap, --stats), for checks before any work.
     std::vector<NamedFile> outputs() const;
     /// The files the flags read (--tf when it names a file, --camera).

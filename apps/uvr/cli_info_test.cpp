@@ -182,3 +182,66 @@ TEST(CliInfo, VoxelsAndQuadraticCellsAreNamedAndFindingsAreStructured) {
 
 }  // namespace
 }  // namespace uvr
+
+namespace uvr {
+namespace {
+
+TEST(CliChecks, EveryBadFlagFailsBeforeTheMeshIsRead) {
+    // Without -q a read prints "uvr: read ...": a one-line error means nothing was read.
+    const std::string dir = testing::scratchDir();
+    const std::string m = dir + "/m.uvrm";
+    ASSERT_EQ(uvr("-q generate box --cells 3000 --fields jet -o " + m, dir).code, 0);
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"--size 0x0", "--size"},
+        {"--range 2,1", "--range"},
+        {"--tf nosuch", "nosuch"},
+        {"--opacity bad", "--opacity"},
+        {"--camera-position a", "--camera-position"},
+        {"--camera-up 1,2", "--camera-up"},
+        {"--background 2,2,2", "--background"},
+        {"--field x:bad", "unknown qualifier"},
+        {"--field nosuch", "'nosuch' not found; available: jet:point"},
+        {"--field jet:x", "a scalar field"},
+        {"--field jet:cell", "'jet:cell' not found"},
+        {"--quality 5", "--quality"},
+        {"--view-angle 500", "--view-angle"},
+        {"--supersample 9", "--supersample"},
+        {"--nan-color bad", "--nan-color"},
+        {"--camera missing.pvcc", "missing.pvcc"},
+        {"--tf missing.json", "missing.json"},
+        {"--power 2", "--step-rule variance"},
+        {"--heatmap-max 5", "--heatmap"},
+        {"--log --range -5,-1", "--log needs positive values"},
+        {"--elevation nan", "--elevation"},
+        {"--parallel --view-angle 20", "--view-angle"},
+        {"--parallel-scale 2", "--parallel-scale"},
+        {"--stats s.txt", "*.json"},
+        {"-o " + dir + "/missing/x.png", "missing"},
+    };
+    for (const auto& [flags, piece] : cases) {
+        const std::string out = flags.rfind("-o ", 0) == 0 ? "" : " -o " + dir + "/x.png";
+        expectOneLineError(uvr("render " + m + out + " " + flags, dir), {piece}, flags);
+        EXPECT_FALSE(std::filesystem::exists(dir + "/x.png")) << flags;
+    }
+}
+
+TEST(CliChecks, RefineAndGenerateEstimateTheirMemoryFirst) {
+    const std::string dir = testing::scratchDir();
+    const std::string m = dir + "/m.uvrm";
+    ASSERT_EQ(uvr("-q generate box --cells 3000 -o " + m, dir).code, 0);
+    // 3 levels make about 1.5M tetrahedra: far more than 10M bytes.
+    expectOneLineError(
+        uvr("-q --max-memory 10M refine " + m + " " + dir + "/r.uvrm --levels 3", dir),
+        {"refining", "--max-memory"}, "refine");
+    expectOneLineError(
+        uvr("-q --max-memory 10M generate box --cells 4000000 -o " + dir + "/g.uvrm", dir),
+        {"--cells 4000000", "--max-memory"}, "generate");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/r.uvrm"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/g.uvrm"));
+    // The same commands within the limit work.
+    ASSERT_EQ(uvr("-q --max-memory 200M refine " + m + " " + dir + "/r.uvrm --levels 1", dir).code,
+              0);
+}
+
+}  // namespace
+}  // namespace uvr

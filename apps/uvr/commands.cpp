@@ -196,6 +196,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
     cmd->callback([file, flags, &ctx] {
         applyThreads(flags->threads);
         flags->checkFiles(*file);
+        flags->checkBeforeLoading(*file);
         checkFrameMemory(*flags, ctx);
         flags->legendFont();  // --legend's size and font checked before reading
         const Mesh mesh = loadMesh(*file, ctx);
@@ -224,6 +225,7 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
     cmd->callback([flags, cells, &ctx] {
         applyThreads(flags->threads);
         flags->checkFiles("");
+        flags->checkBeforeLoading();
         flags->legendFont();  // --legend's size and font checked before generating
         ProceduralSpec spec;
         spec.shape = ProceduralShape::Box;
@@ -332,18 +334,18 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
         resolveOutput(*out);
         checkMeshWritable(*out);  // before the (possibly long) refinement
         const Mesh mesh = loadMesh(*in, ctx);
-        // The output's largest array (4 point indices per tetrahedron) must fit --max-memory;
-        // the estimate splits hexahedra into 6 tetrahedra, wedges and pyramids into 3.
+        // The whole refinement must fit --max-memory: the input, the output mesh and the work
+        // arrays (estimate: hexahedra split into 6 tetrahedra, wedges and pyramids into 3).
         std::uint64_t tets = 0;
         for (CellType t : mesh.cellTypes)
             tets += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
         const std::uint64_t outTets = refinedTetCount(tets, *levels);
-        if (ctx.maxMemoryBytes > 0 && outTets > ctx.maxMemoryBytes / 16)
-            throwError(ErrorKind::Resource, *in,
-                       "refining " + std::to_string(tets) + " tetrahedra " +
-                           std::to_string(*levels) + " times makes about " +
-                           std::to_string(outTets) + " tetrahedra, whose " +
-                           std::to_string(16 * outTets) + "-byte index array exceeds --max-memory");
+        const std::uint64_t bytes = refineMemoryBytes(mesh, tets, *levels);
+        checkMemoryEstimate(ctx,
+                            *in + ": refining " + std::to_string(tets) + " tetrahedra " +
+                                std::to_string(*levels) + " times (about " +
+                                std::to_string(outTets) + " tetrahedra)",
+                            bytes);
         ctx.setActivity(*in, "refining the mesh");
         Progress progress(ctx, "refining", double(outTets), "tetrahedra");
         const Mesh refined = refineMesh(

@@ -9,19 +9,6 @@
 
 namespace uvr {
 
-namespace {
-
-std::string describeFields(const Mesh& mesh) {
-    if (mesh.fields.empty()) return "the mesh has no fields";
-    std::string s = "available:";
-    for (const Field& f : mesh.fields)
-        s += " " + f.name + ":" + associationName(f.association) +
-             (f.components > 1 ? "(" + std::to_string(f.components) + " components)" : "");
-    return s;
-}
-
-}  // namespace
-
 FieldSpec parseFieldSpec(const std::string& text) {
     FieldSpec spec;
     size_t pos = text.find(':');
@@ -92,50 +79,58 @@ std::string ScalarField::describe() const {
     return name + " (" + associationName(association) + " data)";
 }
 
-ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
-    const Field* field = nullptr;
+FieldChoice resolveField(const std::vector<FieldInfo>& fields, const FieldSpec& spec) {
+    auto describe = [&] {
+        if (fields.empty()) return std::string("the mesh has no fields");
+        std::string s = "available:";
+        for (const FieldInfo& f : fields)
+            s += " " + f.name + ":" + associationName(f.association) +
+                 (f.components > 1 ? "(" + std::to_string(f.components) + " components)" : "");
+        return s;
+    };
+    std::optional<std::size_t> index;
     std::string choice;
     if (spec.name.empty()) {
         if (spec.association) {  // ":cell" alone: the default among the cell fields
-            std::vector<FieldInfo> infos;
-            std::vector<std::size_t> index;
-            for (std::size_t i = 0; i < mesh.fields.size(); ++i)
-                if (mesh.fields[i].association == *spec.association) {
-                    infos.push_back({mesh.fields[i].name, mesh.fields[i].association,
-                                     mesh.fields[i].components});
-                    index.push_back(i);
+            std::vector<FieldInfo> some;
+            std::vector<std::size_t> where;
+            for (std::size_t i = 0; i < fields.size(); ++i)
+                if (fields[i].association == *spec.association) {
+                    some.push_back(fields[i]);
+                    where.push_back(i);
                 }
-            if (const auto i = defaultFieldIndex(infos)) field = &mesh.fields[index[*i]];
-        } else if (const auto i = defaultFieldIndex(mesh)) {
-            field = &mesh.fields[*i];
+            if (const auto i = defaultFieldIndex(some)) index = where[*i];
+        } else {
+            index = defaultFieldIndex(fields);
         }
-        if (!field)
-            throwError(ErrorKind::Argument, "", "no field to render: " + describeFields(mesh));
-        choice = isIdFieldName(field->name)
+        if (!index) throwError(ErrorKind::Argument, "", "no field to render: " + describe());
+        const FieldInfo& f = fields[*index];
+        choice = isIdFieldName(f.name)
                      ? "the default: the file holds only id arrays"
-                     : std::string("the default: the first ") +
-                           associationName(field->association) +
-                           (field->components == 1 ? "-data scalar field"
-                                                   : "-data field (no scalar field exists)");
+                     : std::string("the default: the first ") + associationName(f.association) +
+                           (f.components == 1 ? "-data scalar field"
+                                              : "-data field (no scalar field exists)");
     } else {
         int matches = 0, pointMatches = 0;
-        for (const Field& f : mesh.fields) {
+        for (std::size_t i = 0; i < fields.size(); ++i) {
+            const FieldInfo& f = fields[i];
             if (f.name != spec.name) continue;
             if (spec.association && f.association != *spec.association) continue;
-            if (!field) field = &f;
+            if (!index) index = i;
             ++matches;
             pointMatches += f.association == Association::Point;
         }
-        if (!field)
+        if (!index)
             throwError(ErrorKind::Argument, "",
                        "--field '" + spec.name +
                            (spec.association ? std::string(":") + associationName(*spec.association)
                                              : "") +
-                           "' not found; " + describeFields(mesh));
+                           "' not found; " + describe());
         if (matches == 2 && pointMatches == 1) {
             // The name exists as point and cell data: the point data, as ParaView prefers it.
-            for (const Field& f : mesh.fields)
-                if (f.name == spec.name && f.association == Association::Point) field = &f;
+            for (std::size_t i = 0; i < fields.size(); ++i)
+                if (fields[i].name == spec.name && fields[i].association == Association::Point)
+                    index = i;
             choice = "point data; the file also has cell data of this name: --field " + spec.name +
                      ":cell selects it";
         } else if (matches > 1) {
@@ -151,13 +146,26 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
                            "them in the file");
         }
     }
-    if (spec.selectsComponent && field->components == 1)
+    if (spec.selectsComponent && fields[*index].components == 1)
         throwError(ErrorKind::Argument, "",
                    "--field '" + spec.name +
                        "': a scalar field; :x, :y, :z, :magnitude and a "
                        "component number select from vector fields (leave the qualifier out)");
-    ScalarField out = scalarFieldOf(mesh, *field, spec.component);
-    out.choice = std::move(choice);
+    if (spec.component >= fields[*index].components)
+        throwError(ErrorKind::Argument, "",
+                   "--field '" + fields[*index].name + "': component " +
+                       std::to_string(spec.component) + " does not exist (the field has " +
+                       std::to_string(fields[*index].components) + ")");
+    return {*index, std::move(choice)};
+}
+
+ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
+    std::vector<FieldInfo> infos;
+    infos.reserve(mesh.fields.size());
+    for (const Field& f : mesh.fields) infos.push_back({f.name, f.association, f.components});
+    FieldChoice choice = resolveField(infos, spec);
+    ScalarField out = scalarFieldOf(mesh, mesh.fields[choice.index], spec.component);
+    out.choice = std::move(choice.choice);
     return out;
 }
 

@@ -58,6 +58,17 @@ std::optional<std::size_t> defaultFieldIndex(const std::vector<FieldInfo>& field
 /// The same for a mesh's fields.
 std::optional<std::size_t> defaultFieldIndex(const Mesh& mesh);
 
+/// The field a spec names among `fields` (its index) and, when the spec left something to
+/// choose, how it was chosen (ScalarField::choice).
+struct FieldChoice {
+    std::size_t index = 0;
+    std::string choice;
+};
+
+/// Resolves a spec against a list of fields (a mesh's, or a .uvrm header's before its values are
+/// read); throws Error(Argument) as selectScalarField does.
+FieldChoice resolveField(const std::vector<FieldInfo>& fields, const FieldSpec& spec);
+
 /// Resolves a spec against the mesh and extracts the scalar values; throws Error(Argument) naming
 /// the available fields when the name, association or component does not exist, or when a name
 /// exists as both point and cell data and the spec does not say which.

@@ -174,6 +174,19 @@ void refineOnce(Work& w) {
 
 }  // namespace
 
+std::uint64_t refineMemoryBytes(const Mesh& mesh, std::uint64_t tets, int levels) {
+    const std::uint64_t outTets = refinedTetCount(tets, levels);
+    std::uint64_t inBytes =
+        12 * mesh.pointCount() + 9 * mesh.cellCount() + 4 * mesh.cellIndices.size();
+    std::uint64_t pointComps = 0, cellComps = 0;
+    for (const Field& f : mesh.fields) {
+        inBytes += 4 * f.values.size();
+        (f.association == Association::Point ? pointComps : cellComps) += f.components;
+    }
+    const std::uint64_t outPoints = mesh.pointCount() + outTets / 4;
+    return inBytes + outTets * (41 + 4 * cellComps) + outPoints * (12 + 4 * pointComps) + 8 * tets;
+}
+
 Mesh refineMesh(const Mesh& mesh, int levels,
                 const std::function<void(const std::string&)>& progress,
                 const std::function<void(double)>& fraction) {

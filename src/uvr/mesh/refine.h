@@ -21,6 +21,12 @@ inline std::uint64_t refinedTetCount(std::uint64_t tets, int levels) {
     return levels >= 0 && levels <= kMaxRefineLevels ? tets << (3 * levels) : 0;
 }
 
+/// Host bytes refineMesh needs at its peak for `mesh` split into `tets` tetrahedra, refined
+/// `levels` times: the input, the output mesh (41 bytes per tetrahedron with the work copy still
+/// held, its cell fields, about a quarter point per tetrahedron with the point fields) and the
+/// source-cell table; an upper estimate for --max-memory.
+std::uint64_t refineMemoryBytes(const Mesh& mesh, std::uint64_t tets, int levels);
+
 /// Uniform red refinement (Bey 1995, "Tetrahedral grid refinement"): every cell is first split
 /// into positively oriented tetrahedra (splitCell: the conforming split of `uvr render`,
 /// zero-volume tetrahedra dropped), then `levels` times every tetrahedron is split into 8 at its

@@ -157,6 +157,17 @@ float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount) {
     return static_cast<float>(d / std::cbrt(double(cellCount)));
 }
 
+namespace {
+
+/// A field value for a message (6 significant digits).
+std::string fmtValue(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+}  // namespace
+
 void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;
@@ -187,6 +198,11 @@ void validateSettings(const RenderSettings& s) {
         bad("--supersample " + std::to_string(s.supersample) + ": expected 1 to " +
             std::to_string(kMaxSupersample) + " (N x N rays per pixel)");
     toleranceForQuality(s.quality);  // throws for a quality out of range
+    if (s.tf.logScale && s.range && !(s.range->second > 0.f))  // the field's range: at setup
+        throwError(ErrorKind::Argument, "",
+                   "--log needs positive values: --range [" + fmtValue(s.range->first) + ", " +
+                       fmtValue(s.range->second) +
+                       "] has none; give --range LO,HI with 0 < LO <= HI");
 }
 
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
@@ -257,13 +273,6 @@ constexpr double kMaxGridSteps = 16e6;
 std::string fmtG(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g", v);
-    return buf;
-}
-
-/// A field value for a message (6 significant digits).
-std::string fmtValue(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
     return buf;
 }
 
