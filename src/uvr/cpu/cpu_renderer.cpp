@@ -46,7 +46,8 @@ void launchFrame(const FrameView& frame, RenderStats& stats, const March& march,
         RenderStats& s = perThread[thread];
         for (int y = y0; y < y0 + kTile && y < frame.height; ++y)
             for (int x = x0; x < x0 + kTile && x < frame.width; ++x)
-                s.add(shadePixel(frame, x, y, march));
+                s.add(frame.supersample == 1 ? shadePixel<false>(frame, x, y, march)
+                                             : shadePixel<true>(frame, x, y, march));
         progress.partDone();
     });
     progress.finish();

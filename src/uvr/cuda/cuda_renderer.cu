@@ -47,13 +47,13 @@ constexpr int kFrameBlock = 128;
 constexpr int kFrameBlocksPerSm = 4;
 
 /// Kernel: one thread per pixel runs the shared pixel body, then the warp sums its counters.
-template <class March>
+template <bool Supersampled, class March>
 __global__ void __launch_bounds__(kFrameBlock, kFrameBlocksPerSm)
     frameKernel(FrameView frame, March march, unsigned long long* totals) {
     const int x = blockIdx.x * blockDim.x + threadIdx.x;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     RayCounters c;
-    if (x < frame.width && y < frame.height) c = shadePixel(frame, x, y, march);
+    if (x < frame.width && y < frame.height) c = shadePixel<Supersampled>(frame, x, y, march);
     unsigned long long v[kCounters] = {c.samples, c.locate.walkSteps, c.locate.bvhQueries,
                                        c.partitionsVisited, c.partitionsSkipped};
     const unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) % 32u;
@@ -62,6 +62,16 @@ __global__ void __launch_bounds__(kFrameBlock, kFrameBlocksPerSm)
             v[k] += __shfl_down_sync(0xffffffffu, v[k], offset);
         if (lane == 0 && v[k]) atomicAdd(&totals[k], v[k]);
     }
+}
+
+/// Launches the frame kernel for the frame's rays per pixel: the one-ray body when it has one.
+template <class March>
+void launchFrame(dim3 grid, dim3 block, const FrameView& frame, const March& march,
+                 unsigned long long* totals) {
+    if (frame.supersample == 1)
+        frameKernel<false><<<grid, block>>>(frame, march, totals);
+    else
+        frameKernel<true><<<grid, block>>>(frame, march, totals);
 }
 
 /// Transfer-function update, pass 1 (one thread per partition): range statistics, and the
@@ -334,11 +344,11 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaEventCreate(&end));
     UVR_CUDA_CHECK(cudaEventRecord(begin));
     if (settings.method == RenderMethod::Reference) {
-        cuda::frameKernel<<<grid, block>>>(frame, ReferenceMarch{d.deviceScene(result.setup)},
-                                           d.totals.data());
+        cuda::launchFrame(grid, block, frame, ReferenceMarch{d.deviceScene(result.setup)},
+                          d.totals.data());
     } else if (settings.method == RenderMethod::Exact) {
-        cuda::frameKernel<<<grid, block>>>(frame, ExactMarch{d.deviceScene(result.setup)},
-                                           d.totals.data());
+        cuda::launchFrame(grid, block, frame, ExactMarch{d.deviceScene(result.setup)},
+                          d.totals.data());
     } else {
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
         scene.base = d.deviceScene(result.setup);
@@ -353,7 +363,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         else
             scene.longStep = INFINITY;  // without seeds, walking beats divergent BVH searches
         scene.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;
-        cuda::frameKernel<<<grid, block>>>(frame, PartitionMarch{scene}, d.totals.data());
+        cuda::launchFrame(grid, block, frame, PartitionMarch{scene}, d.totals.data());
     }
     UVR_CUDA_CHECK(cudaGetLastError());
     UVR_CUDA_CHECK(cudaEventRecord(end));

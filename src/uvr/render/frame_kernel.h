@@ -48,9 +48,20 @@ UVR_HOST_DEVICE inline void jitterOffsets(int x, int y, int s, float& ox, float&
 /// `march(ray, counters)`, stores the mean premultiplied colour and the samples summed over the
 /// rays, and returns the counters summed over the rays. With N = 1 the one ray passes through
 /// the pixel's centre and the pixel is exactly that ray's colour. CPU and CUDA backends launch
-/// it. The rays run one after another in this thread, so no buffer grows with N.
-template <class March>
+/// it. The rays run one after another in this thread, so no buffer grows with N. Supersampled
+/// false is the one-ray body (frame.supersample must be 1): without the loop's sums live across
+/// the integrator, the GPU kernels keep their registers (the loop cost the partition kernel 7%).
+template <bool Supersampled = true, class March>
 UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int y, March&& march) {
+    if constexpr (!Supersampled) {
+        const Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        RayCounters counters;
+        const Vec4f c = march(ray, counters);
+        const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
+        frame.pixels[i] = c;
+        frame.sampleCounts[i] = counters.samples;
+        return counters;
+    }
     const int n = frame.supersample;
     const float cell = 1.f / static_cast<float>(n);
     Vec4f sum(0.f, 0.f, 0.f, 0.f);

@@ -211,14 +211,10 @@ UVR_HOST_DEVICE inline Vec4f tableAt(const TfTableView& tf, double g) {
 UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s1, double len,
                                       double unit, Vec4f& acc, bool fast = false) {
     if (!(len > 0.0) || tf.count < 1) return;
-    if (!(s0 == s0) || !(s1 == s1)) {
-        if (fast)
-            compositePieceFast(tf.nan.xyz(), tf.nan.w, tf.nan.xyz(), tf.nan.w, float(len),
-                               float(unit), acc);
-        else
-            compositePiece(tf.nan.xyz(), tf.nan.w, tf.nan.xyz(), tf.nan.w, len, unit, acc);
-        return;
-    }
+    // A NaN end: one constant piece (dg 0) of the NaN entry through the same piece code below
+    // (a separate branch with its own inlined piece made the GPU kernels spill registers).
+    const bool nanEnd = !(s0 == s0) || !(s1 == s1);
+    if (nanEnd) s0 = s1 = 0.0;
     // An infinite end is a float overflow of a value near the largest float (interpolating a
     // field that spans the float range): take the largest float.
     s0 = s0 < DBL_MAX ? (s0 > -DBL_MAX ? s0 : -FLT_MAX) : FLT_MAX;
@@ -238,7 +234,7 @@ UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s
     const double last = tf.count - 1;
     const double dg = g1 - g0;
     double u = 0.0;  // fraction of the segment done
-    Vec4f e0 = tableAt(tf, g0);
+    Vec4f e0 = nanEnd ? tf.nan : tableAt(tf, g0);
     for (int guard = 0; guard <= 2 * tf.count + 4 && u < 1.0; ++guard) {
         if (acc.w >= kOpacityEnd) return;
         // Next breakpoint: the next whole table position (or range end) in the direction of g.
@@ -253,7 +249,9 @@ UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s
         }
         if (!(uNext > u)) uNext = u + 1e-12;  // rounding at a breakpoint: always advance
         if (uNext > 1.0) uNext = 1.0;
-        const Vec4f e1 = tableAt(tf, g0 + dg * uNext);
+        // A constant value (dg 0, also a NaN end) keeps its entry: no second lookup, and no
+        // flag live across the loop.
+        const Vec4f e1 = dg == 0.0 ? e0 : tableAt(tf, g0 + dg * uNext);
         if (fast)
             compositePieceFast(e0.xyz(), e0.w, e1.xyz(), e1.w, float((uNext - u) * len),
                                float(unit), acc);
