@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "test_meshes.h"
 #include "test_support.h"
@@ -107,6 +108,28 @@ TEST(Cuda, ParallelProjectionAndSupersamplingMatchCpuForEveryMethod) {
         std::uint64_t sum = 0;
         for (std::uint32_t c : g.sampleCounts) sum += c;
         EXPECT_EQ(sum, g.stats.samples);
+    }
+}
+
+TEST(Cuda, NanColourAndLogScaleMatchCpuForEveryMethod) {
+    // The NaN flags of partitions and macrocells (shaded by their own kernel on the GPU), the
+    // NaN entry of the table, and a log-scale table of many entries, on both devices.
+    UVR_REQUIRE_GPU();
+    Mesh m = testing::makeHexGrid(12, 0.f, 1.f, [](Vec3f p) {
+        return p.x > 0.51f ? std::numeric_limits<float>::quiet_NaN() : 0.001f + p.x * p.y;
+    });
+    PrepareOptions o;
+    o.kd.leafCells = 64;
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), o);
+    ASSERT_FALSE(pm.partitionNan.empty());
+    for (RenderMethod method :
+         {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
+        RenderSettings s = settingsFor(pm, method);
+        s.tf.nanColor = Vec3f(1.f, 0.f, 0.f);
+        s.tf.nanOpacity = 0.6f;
+        expectSameAsCpu(pm, s, "NaN colour");
+        s.tf.logScale = true;
+        expectSameAsCpu(pm, s, "NaN colour, log scale");
     }
 }
 
