@@ -19,10 +19,6 @@ std::string fmt(double v) {
     return buf;
 }
 
-}  // namespace
-
-namespace {
-
 void printCellCounts(std::uint64_t cells, const std::map<std::string, std::uint64_t>& byType) {
     std::printf("cells:   %llu", static_cast<unsigned long long>(cells));
     const char* sep = " (";

@@ -61,13 +61,8 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     result.setup = makeFrameSetup(mesh, settings);
     result.image = Image(settings.width, settings.height);
     result.sampleCounts.assign(result.image.pixels.size(), 0);
-    const FrameView frame{result.image.pixels.data(),
-                          result.sampleCounts.data(),
-                          settings.width,
-                          settings.height,
-                          result.setup.rays,
-                          settings.supersample,
-                          settings.jitter && settings.supersample > 1};
+    const FrameView frame = makeFrameView(settings, result.setup, result.image.pixels.data(),
+                                          result.sampleCounts.data());
     const auto start = std::chrono::steady_clock::now();
     if (settings.method == RenderMethod::Reference)
         launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)},

@@ -323,13 +323,8 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     d.pixels.reserve(pixelCount, "the image");
     d.sampleCounts.reserve(pixelCount, "the sample counts");
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
-    const FrameView frame{d.pixels.data(),
-                          d.sampleCounts.data(),
-                          settings.width,
-                          settings.height,
-                          result.setup.rays,
-                          settings.supersample,
-                          settings.jitter && settings.supersample > 1};
+    const FrameView frame =
+        makeFrameView(settings, result.setup, d.pixels.data(), d.sampleCounts.data());
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);

@@ -19,6 +19,7 @@
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/frame_kernel.h"
 #include "uvr/render/image.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/transfer_function.h"
@@ -280,6 +281,19 @@ struct FrameSetup {
     /// Partition scene view (the mesh must have partitions); both must outlive it.
     PartitionSceneView partitionScene(const PreparedMesh& mesh, bool skip) const;
 };
+
+/// The frame's output buffers and rays for the shared pixel kernel (both backends): pixels and
+/// counts hold width * height entries on the device that renders.
+inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup& setup,
+                               Vec4f* pixels, std::uint32_t* sampleCounts) {
+    return FrameView{pixels,
+                     sampleCounts,
+                     settings.width,
+                     settings.height,
+                     setup.rays,
+                     settings.supersample,
+                     settings.jitter && settings.supersample > 1};
+}
 
 /// Resolves defaults and validates; throws Error(Argument) on bad settings. For the partition
 /// method it also computes the per-partition shading on the host unless shadePartitions is false
