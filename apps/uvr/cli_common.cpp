@@ -451,7 +451,7 @@ void RenderFlags::checkBeforeLoading(const std::string& meshFile) const {
     const FieldSpec spec = parseFieldSpec(field);
     // A .uvrm's header names its fields: a --field it lacks is refused before reading the arrays.
     if (!meshFile.empty())
-        if (const std::optional<MeshSummary> header = readMeshSummary(meshFile))
+        if (const std::optional<MeshSummary> header = readMeshSummary(meshFile, false))
             (void)resolveField(header->fields, spec);
 }
 

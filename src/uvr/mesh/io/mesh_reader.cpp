@@ -55,8 +55,8 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
                "VTK XML (.vtu/.pvtu) or a native uvr mesh (.uvrm)");
 }
 
-std::optional<MeshSummary> readMeshSummary(const std::string& path) {
-    if (sniffFormat(path) == Format::Native) return readNativeSummary(path);
+std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes) {
+    if (sniffFormat(path) == Format::Native) return readNativeSummary(path, cellTypes);
     return std::nullopt;
 }
 

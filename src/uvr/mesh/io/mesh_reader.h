@@ -15,8 +15,9 @@ namespace uvr {
 Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 
 /// The counts, cell types and fields of a file whose format has a header that holds them (.uvrm),
-/// without reading its arrays; empty for formats that must be read whole to know them.
-std::optional<MeshSummary> readMeshSummary(const std::string& path);
+/// without reading its arrays (the cell types, one byte per cell, only with cellTypes); empty for
+/// formats that must be read whole to know them.
+std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes = true);
 
 /// Writes a mesh in the format its extension names (.uvrm native or .vtu), reporting the
 /// fraction of bytes written to progress (when given) as it goes; throws

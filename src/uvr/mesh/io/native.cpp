@@ -342,7 +342,7 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
     return mesh;
 }
 
-MeshSummary readNativeSummary(const std::string& path) {
+MeshSummary readNativeSummary(const std::string& path, bool cellTypes) {
     const std::uint64_t size = fileSize(path);
     Reader in(path, size);
     const NativeLayout layout = readLayout(in, path, size);
@@ -354,6 +354,7 @@ MeshSummary readNativeSummary(const std::string& path) {
         summary.fields.push_back({d.name,
                                   d.association == 0 ? Association::Point : Association::Cell,
                                   static_cast<int>(d.components)});
+    if (!cellTypes) return summary;
     // The cell types (one byte per cell) are counted in chunks: nothing else is read.
     const ArraySpan& types = layout.arrays[1];
     in.seek(types.start);

@@ -27,8 +27,9 @@ struct MeshSummary {
 Mesh readNative(const std::string& path, const ReadOptions& options = {});
 
 /// What `uvr info` prints of a .uvrm without reading its arrays: the header's counts and fields
-/// and the cell types (one byte per cell, read in chunks); checked as readNative checks them.
-MeshSummary readNativeSummary(const std::string& path);
+/// and, with cellTypes, the cell types (one byte per cell, read in chunks); checked as
+/// readNative checks them.
+MeshSummary readNativeSummary(const std::string& path, bool cellTypes = true);
 
 /// Writes a mesh in the native format, atomically (temporary file, then rename).
 void writeNative(const Mesh& mesh, const std::string& path,
