@@ -1,11 +1,27 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 
+#include "uvr/core/bounds.h"
+#include "uvr/core/ray.h"
 #include "uvr/mesh/mesh.h"
 
 namespace uvr::testing {
+
+/// The span [t0, t1] of a ray inside a box, in double; false when it misses.
+inline bool boxSpan(const Bounds3f& b, const Ray& ray, double& t0, double& t1) {
+    t0 = 0.0, t1 = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        const double lo = (double(b.lo[a]) - ray.org[a]) / ray.dir[a];
+        const double hi = (double(b.hi[a]) - ray.org[a]) / ray.dir[a];
+        t0 = std::max(t0, std::min(lo, hi));
+        t1 = std::min(t1, std::max(lo, hi));
+    }
+    return t0 < t1;
+}
 
 /// An n x n x n grid of hexahedra over the box [lo, hi]^3 with a point field f(x, y, z) named
 /// "f"; optional point jitter (fraction of the spacing, deterministic).

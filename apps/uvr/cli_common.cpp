@@ -429,8 +429,16 @@ void RenderFlags::checkBeforeLoading(const std::string& meshFile) const {
           {"--camera-focal", cameraFocal},
           {"--camera-up", cameraUp}})
         if (!text.empty()) (void)parseVec3(flag, text);
-    bool fileParallel = false;
-    if (!cameraFile.empty()) fileParallel = loadPvcc(cameraFile).parallelProjection;
+    checkCameraFlags(!cameraFile.empty() && loadPvcc(cameraFile).parallelProjection);
+    (void)legendFont();
+    const FieldSpec spec = parseFieldSpec(field);
+    // A .uvrm's header names its fields: a --field it lacks is refused before reading the arrays.
+    if (!meshFile.empty())
+        if (const std::optional<MeshSummary> header = readMeshSummary(meshFile, false))
+            (void)resolveField(header->fields, spec);
+}
+
+void RenderFlags::checkCameraFlags(bool fileParallel) const {
     if (parallelScale && !parallel && !fileParallel)
         throwError(ErrorKind::Argument, "",
                    "--parallel-scale sets the half height of a parallel projection: it needs "
@@ -448,11 +456,6 @@ void RenderFlags::checkBeforeLoading(const std::string& meshFile) const {
     }
     if (!std::isfinite(azimuth) || !std::isfinite(elevation))
         throwError(ErrorKind::Argument, "", "--azimuth/--elevation must be finite");
-    const FieldSpec spec = parseFieldSpec(field);
-    // A .uvrm's header names its fields: a --field it lacks is refused before reading the arrays.
-    if (!meshFile.empty())
-        if (const std::optional<MeshSummary> header = readMeshSummary(meshFile, false))
-            (void)resolveField(header->fields, spec);
 }
 
 RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& source,
@@ -482,27 +485,16 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
     } else if (adjusted && !placed) {
         cam = reset();
     }
+    checkCameraFlags(!cameraFile.empty() && cam.parallelProjection);
     // Parallel projection: --parallel, or the camera file's. Its scale: --parallel-scale, else
     // the camera file's, else ParaView's reset value (the bounding sphere's radius).
-    const std::string parallelSource = parallel ? "--parallel" : "the camera file " + cameraFile;
     if (parallel) {
         if (!cam.parallelProjection && !fileScale && !parallelScale &&
             (placed || !cameraFile.empty()))
             cam.parallelScale = reset().parallelScale;
         cam.parallelProjection = true, custom = true;
     }
-    if (parallelScale) {
-        if (!cam.parallelProjection)
-            throwError(ErrorKind::Argument, "",
-                       "--parallel-scale sets the half height of a parallel projection: it needs "
-                       "--parallel (or a .pvcc with CameraParallelProjection 1)");
-        cam.parallelScale = *parallelScale, custom = true;
-    }
-    if (viewAngle && cam.parallelProjection)
-        throwError(ErrorKind::Argument, "",
-                   "--view-angle sets the perspective view angle, which parallel projection (" +
-                       parallelSource +
-                       ") does not have: use --parallel-scale for the half height of the view");
+    if (parallelScale) cam.parallelScale = *parallelScale, custom = true;
     const bool fileUp = !cameraFile.empty() && cameraUp.empty();
     if (!cameraPosition.empty())
         cam.position = parseVec3("--camera-position", cameraPosition), custom = true;
@@ -543,17 +535,7 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
                     ": pass a --camera-up across it, e.g. --camera-up " + names[best]);
         }
     }
-    if (viewAngle) {
-        if (!(*viewAngle >= kMinViewAngle && *viewAngle <= kMaxViewAngle)) {
-            std::ostringstream os;
-            os << "--view-angle " << *viewAngle << ": expected degrees in [" << kMinViewAngle
-               << ", " << kMaxViewAngle << "]";
-            throwError(ErrorKind::Argument, "", os.str());
-        }
-        cam.viewAngle = *viewAngle, custom = true;
-    }
-    if (!std::isfinite(azimuth) || !std::isfinite(elevation))
-        throwError(ErrorKind::Argument, "", "--azimuth/--elevation must be finite");
+    if (viewAngle) cam.viewAngle = *viewAngle, custom = true;
     validateCamera(cam);
     if (azimuth != 0.f || elevation != 0.f)
         cam = orbitCamera(cam, azimuth, elevation), custom = true;

@@ -114,11 +114,15 @@ struct RenderFlags {
     /// --legend, none.
     std::optional<Font> legendFont() const;
     /// Checks every flag that does not need the mesh (and, for a .uvrm meshFile, that --field
-    /// names one of the fields its header lists), so that a bad flag fails before minutes of
-    /// reading; throws Error(Argument) as settings() would.
+    /// names one of the fields its header lists; with --legend, that a font is found), so that a
+    /// bad flag fails before minutes of reading; throws Error(Argument) as settings() would.
     void checkBeforeLoading(const std::string& meshFile = "") const;
     /// The --background colour, if given (checked to lie in [0, 1]).
     std::optional<Vec3f> backgroundColor() const;
+    /// The camera flags' own checks (--parallel-scale without a parallel camera, --view-angle
+    /// with one or out of range, non-finite --azimuth/--elevation); fileParallel: the --camera
+    /// file is parallel. Run before loading and again by settings().
+    void checkCameraFlags(bool fileParallel) const;
     /// The settings the flags give that do not depend on the mesh (no camera).
     RenderSettings baseSettings() const;
     /// The files a single render writes (-o, --heatmap, --stats), for checks before any work.

@@ -19,6 +19,7 @@
 #include "cli_test_support.h"
 #include "parse_errors.h"
 #include "test_support.h"
+#include "uvr/core/text.h"
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/render/image.h"
@@ -358,7 +359,7 @@ TEST(Cli, MisspeltCommandsAndOptionsGetASuggestion) {
     expectOneLineError(uvr("info x.vtk --zzzzzzzz", dir),
                        {"unknown option --zzzzzzzz", "uvr info --help"}, "nothing close");
     EXPECT_EQ(uvr("info x.vtk --zzzzzzzz", dir).err.find("did you mean"), std::string::npos);
-    EXPECT_EQ(cli::editDistance("rendr", "render"), 1);
+    EXPECT_EQ(editDistance("rendr", "render"), 1);
     EXPECT_EQ(cli::closest("--quailty", {"--quality", "--quiet"}), "--quality");
     EXPECT_EQ(cli::closest("--x", {"--quality"}), "");
 }

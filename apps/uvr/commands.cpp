@@ -194,7 +194,6 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         flags->checkFiles(*file);
         flags->checkBeforeLoading(*file);
         checkFrameMemory(*flags, ctx);
-        flags->legendFont();  // --legend's size and font checked before reading
         const Mesh mesh = loadMesh(*file, ctx);
         renderAndWrite(mesh, *file, *flags, ctx);
     });
@@ -222,7 +221,6 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
         applyThreads(flags->threads);
         flags->checkFiles("");
         flags->checkBeforeLoading();
-        flags->legendFont();  // --legend's size and font checked before generating
         ProceduralSpec spec;
         spec.shape = ProceduralShape::Box;
         spec.targetCells = *cells;

@@ -8,16 +8,12 @@
 
 namespace uvr::cli {
 
-int editDistance(const std::string& a, const std::string& b) {
-    return uvr::editDistance(a, b);
-}
-
 std::string closest(const std::string& word, const std::vector<std::string>& candidates) {
     const int limit = std::max(2, static_cast<int>(word.size()) / 3);
     std::string best;
     int bestDistance = limit + 1;
     for (const std::string& c : candidates) {
-        const int d = editDistance(word, c);
+        const int d = uvr::editDistance(word, c);
         if (d < bestDistance) best = c, bestDistance = d;
     }
     return best;

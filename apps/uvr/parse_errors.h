@@ -11,9 +11,6 @@
 
 namespace uvr::cli {
 
-/// Edit distance (insertions, deletions, substitutions) between two words.
-int editDistance(const std::string& a, const std::string& b);
-
 /// The candidate closest to `word` within a few edits (about a third of its length, at least
 /// 2), or "" when none is that close.
 std::string closest(const std::string& word, const std::vector<std::string>& candidates);

@@ -16,6 +16,8 @@
 namespace uvr {
 namespace {
 
+using testing::boxSpan;
+
 /// The model by brute force: a fine front-to-back composition over n steps of the marchers'
 /// corrected opacity 1 - (1 - alpha)^(h / unit), in double (in float, 1 - (1 - alpha)^1e-5 is
 /// mostly rounding); its error falls as 1 / n.
@@ -109,18 +111,6 @@ RenderSettings exactSettings(const Bounds3f& box, int size) {
     applyOpacitySpec(s.tf, "constant:0.2");
     s.opacityUnit = 0.5f;
     return s;
-}
-
-/// The ray's span inside a box, in double.
-bool boxSpan(const Bounds3f& b, const Ray& ray, double& t0, double& t1) {
-    t0 = 0.0, t1 = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-        const double lo = (double(b.lo[a]) - ray.org[a]) / ray.dir[a];
-        const double hi = (double(b.hi[a]) - ray.org[a]) / ray.dir[a];
-        t0 = std::max(t0, std::min(lo, hi));
-        t1 = std::min(t1, std::max(lo, hi));
-    }
-    return t0 < t1;
 }
 
 /// For a constant field under constant opacity 0.2 per unit 0.5 filling the boxes: the largest

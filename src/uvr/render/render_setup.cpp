@@ -166,6 +166,14 @@ std::string fmtValue(double v) {
     return buf;
 }
 
+/// Refuses a log-scale mapping over a range with no positive value (`which`: "--range " or "the
+/// field's range ").
+[[noreturn]] void refuseLogRange(const std::string& which, double lo, double hi) {
+    throwError(ErrorKind::Argument, "",
+               "--log needs positive values: " + which + "[" + fmtValue(lo) + ", " + fmtValue(hi) +
+                   "] has none; give --range LO,HI with 0 < LO <= HI");
+}
+
 }  // namespace
 
 void validateSettings(const RenderSettings& s) {
@@ -197,12 +205,9 @@ void validateSettings(const RenderSettings& s) {
     if (!(s.supersample >= 1 && s.supersample <= kMaxSupersample))
         bad("--supersample " + std::to_string(s.supersample) + ": expected 1 to " +
             std::to_string(kMaxSupersample) + " (N x N rays per pixel)");
-    toleranceForQuality(s.quality);  // throws for a quality out of range
+    toleranceForQuality(s.quality);                            // throws for a quality out of range
     if (s.tf.logScale && s.range && !(s.range->second > 0.f))  // the field's range: at setup
-        throwError(ErrorKind::Argument, "",
-                   "--log needs positive values: --range [" + fmtValue(s.range->first) + ", " +
-                       fmtValue(s.range->second) +
-                       "] has none; give --range LO,HI with 0 < LO <= HI");
+        refuseLogRange("--range ", s.range->first, s.range->second);
 }
 
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
@@ -327,10 +332,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     if (settings.tf.logScale) {
         const std::string range = "[" + fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) + "]";
         const std::string which = settings.range ? "--range " : "the field's range ";
-        if (!(f.rangeHi > 0.f))
-            throwError(ErrorKind::Argument, "",
-                       "--log needs positive values: " + which + range +
-                           " has none; give --range LO,HI with 0 < LO <= HI");
+        if (!(f.rangeHi > 0.f)) refuseLogRange(which, f.rangeLo, f.rangeHi);
         if (!(f.rangeLo > 0.f)) {
             f.rangeLo = std::fmin(f.rangeHi * 1e-4f, 1.f);  // ParaView's AdjustRangeForLog
             f.notes.push_back("--log: " + which + range + " is not positive; mapping [" +
@@ -398,42 +400,33 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     // the mesh's nearest corner when the mesh lies wholly in front of it: nothing between is
     // seen, and the sample grid then counts from the mesh, however far the camera is.
     const bool parallel = given.parallelProjection;
-    double nearDistance = 0.0, farDepth = 0.0;
-    if (parallel && !empty) {
-        double dir[3], len2 = 0.0;
-        for (int a = 0; a < 3; ++a) dir[a] = focal[a] - position[a], len2 += dir[a] * dir[a];
-        const double len = std::sqrt(len2);
-        double nearest = INFINITY;
-        farDepth = -INFINITY;
-        for (int c = 0; c < 8; ++c) {
-            const Vec3f corner((c & 1) ? bounds.hi.x : bounds.lo.x,
-                               (c & 2) ? bounds.hi.y : bounds.lo.y,
-                               (c & 4) ? bounds.hi.z : bounds.lo.z);
-            double depth = 0.0;
-            for (int a = 0; a < 3; ++a) depth += (corner[a] - position[a]) * dir[a] / len;
-            nearest = std::min(nearest, depth);
-            farDepth = std::max(farDepth, depth);
-        }
-        if (nearest > 0.0 && std::isfinite(nearest)) nearDistance = nearest;
-    }
+    double nearDistance = 0.0;
     // The integrators count sample grid points k = t / s1 from the ray origin in float: at 2^24
     // and beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
     // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
     if (!empty) {
-        double farthest = 0.0;
-        if (parallel) {
-            farthest = std::max(0.0, farDepth - nearDistance);
-        } else {
-            for (int c = 0; c < 8; ++c) {
-                const Vec3f corner((c & 1) ? bounds.hi.x : bounds.lo.x,
-                                   (c & 2) ? bounds.hi.y : bounds.lo.y,
-                                   (c & 4) ? bounds.hi.z : bounds.lo.z);
-                double d2 = 0.0;
-                for (int a = 0; a < 3; ++a)
-                    d2 += (corner[a] - position[a]) * (corner[a] - position[a]);
-                farthest = std::max(farthest, std::sqrt(d2));
+        // One pass over the bounds' corners: their depths along the view direction (parallel)
+        // and their distances from the camera (perspective).
+        double dir[3], len2 = 0.0;
+        for (int a = 0; a < 3; ++a) dir[a] = focal[a] - position[a], len2 += dir[a] * dir[a];
+        const double len = std::sqrt(len2);
+        double nearest = INFINITY, farDepth = -INFINITY, farthestCorner = 0.0;
+        for (int c = 0; c < 8; ++c) {
+            const Vec3f corner((c & 1) ? bounds.hi.x : bounds.lo.x,
+                               (c & 2) ? bounds.hi.y : bounds.lo.y,
+                               (c & 4) ? bounds.hi.z : bounds.lo.z);
+            double depth = 0.0, d2 = 0.0;
+            for (int a = 0; a < 3; ++a) {
+                const double d = corner[a] - position[a];
+                depth += d * dir[a] / len;
+                d2 += d * d;
             }
+            nearest = std::min(nearest, depth);
+            farDepth = std::max(farDepth, depth);
+            farthestCorner = std::max(farthestCorner, std::sqrt(d2));
         }
+        if (parallel && nearest > 0.0 && std::isfinite(nearest)) nearDistance = nearest;
+        const double farthest = parallel ? std::max(0.0, farDepth - nearDistance) : farthestCorner;
         const double steps = farthest / f.params.step;
         if (!(steps <= kMaxGridSteps))
             throwError(ErrorKind::Argument, "",

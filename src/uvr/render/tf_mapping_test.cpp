@@ -18,17 +18,7 @@
 namespace uvr {
 namespace {
 
-/// The ray's span inside a box, in double.
-bool boxSpan(const Bounds3f& b, const Ray& ray, double& t0, double& t1) {
-    t0 = 0.0, t1 = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-        const double lo = (double(b.lo[a]) - ray.org[a]) / ray.dir[a];
-        const double hi = (double(b.hi[a]) - ray.org[a]) / ray.dir[a];
-        t0 = std::max(t0, std::min(lo, hi));
-        t1 = std::min(t1, std::max(lo, hi));
-    }
-    return t0 < t1;
-}
+using testing::boxSpan;
 
 /// A 12^3 grid of hexahedra over [0, 1]^3 with the field 1 + 999 x (1 to 1000, exactly linear),
 /// prepared with small partitions so that skipping has partitions to skip.
