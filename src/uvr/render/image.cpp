@@ -55,9 +55,11 @@ std::uint8_t toByte(float v) {
     return static_cast<std::uint8_t>(std::lround(v * 255.f));
 }
 
-/// Where encodePng's bytes go: an output file, with the first failure kept for rethrowing.
+/// Where encodePng's bytes go: an output file or memory, with the first failure kept for
+/// rethrowing.
 struct PngSink {
     OutputFile* out = nullptr;
+    std::string* memory = nullptr;  ///< used when out is null
     std::exception_ptr failure;
 };
 
@@ -66,7 +68,10 @@ void writeToSink(png_structp png, png_bytep data, png_size_t count) {
     auto* sink = static_cast<PngSink*>(png_get_io_ptr(png));
     bool failed = false;
     try {
-        sink->out->write(data, count);
+        if (sink->out)
+            sink->out->write(data, count);
+        else
+            sink->memory->append(reinterpret_cast<const char*>(data), count);
     } catch (...) {
         sink->failure = std::current_exception();
         failed = true;
@@ -163,16 +168,7 @@ void writePng(const std::string& path, const Image& image, const std::optional<V
     out.commit();
 }
 
-void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& background) {
-    const std::string& path = out.path();
-    if (image.width <= 0 || image.height <= 0 ||
-        image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
-        throwError(ErrorKind::Argument, path,
-                   "cannot write a " + std::to_string(image.width) + " x " +
-                       std::to_string(image.height) + " image with " +
-                       std::to_string(image.pixels.size()) + " pixels as PNG");
-    }
-    // Convert to 8-bit rows: straight RGBA, or RGB composited over the background.
+std::vector<std::uint8_t> toPngBytes(const Image& image, const std::optional<Vec3f>& background) {
     const bool alpha = !background.has_value();
     const size_t channels = alpha ? 4 : 3;
     std::vector<std::uint8_t> bytes(image.pixels.size() * channels);
@@ -189,15 +185,46 @@ void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& b
             compositeToRgb8(p, *background, px);
         }
     }
+    return bytes;
+}
+
+namespace {
+
+/// Encodes the image into an output file or memory (writePng, encodePng).
+void encodeImage(PngSink& sink, const std::string& path, const Image& image,
+                 const std::optional<Vec3f>& background) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
+        throwError(ErrorKind::Argument, path,
+                   "cannot write a " + std::to_string(image.width) + " x " +
+                       std::to_string(image.height) + " image with " +
+                       std::to_string(image.pixels.size()) + " pixels as PNG");
+    }
+    // Convert to 8-bit rows: straight RGBA, or RGB composited over the background.
+    const bool alpha = !background.has_value();
+    const size_t channels = alpha ? 4 : 3;
+    std::vector<std::uint8_t> bytes = toPngBytes(image, background);
     std::vector<png_bytep> rows(static_cast<size_t>(image.height));
     for (int y = 0; y < image.height; ++y)
         rows[y] = &bytes[static_cast<size_t>(y) * image.width * channels];
-
-    PngSink sink{&out, nullptr};
     PngErrorState state;
     const bool ok = encodePng(sink, image.width, image.height, alpha, rows.data(), state);
     if (sink.failure) std::rethrow_exception(sink.failure);
     if (!ok) throwError(ErrorKind::Io, path, std::string("PNG write failed: ") + state.message);
+}
+
+}  // namespace
+
+void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& background) {
+    PngSink sink{&out, nullptr, nullptr};
+    encodeImage(sink, out.path(), image, background);
+}
+
+std::string encodePng(const Image& image, const std::optional<Vec3f>& background) {
+    std::string bytes;
+    PngSink sink{nullptr, &bytes, nullptr};
+    encodeImage(sink, "", image, background);
+    return bytes;
 }
 
 Image readPng(const std::string& path) {

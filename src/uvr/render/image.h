@@ -42,6 +42,16 @@ void writePng(const std::string& path, const Image& image,
 void writePng(OutputFile& out, const Image& image,
               const std::optional<Vec3f>& background = std::nullopt);
 
+/// The PNG file's 8-bit pixels as writePng makes them, row-major from the top: straight
+/// (un-premultiplied) RGBA, 4 bytes a pixel, when background is empty, else RGB composited over
+/// the background, 3 bytes a pixel.
+std::vector<std::uint8_t> toPngBytes(const Image& image,
+                                     const std::optional<Vec3f>& background = std::nullopt);
+
+/// The PNG file writePng writes, in memory (for a notebook's inline display); throws
+/// Error(Argument) for an image of no pixels.
+std::string encodePng(const Image& image, const std::optional<Vec3f>& background = std::nullopt);
+
 /// Reads an 8-bit or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette) into a premultiplied
 /// Image; throws Error(Io/Parse) naming the file.
 Image readPng(const std::string& path);
