@@ -178,8 +178,8 @@ std::unique_ptr<MeshData> convertMesh(const py::handle& points, const py::handle
     cells.offsets.assign(o.data(), o.data() + o.shape(0));
     cells.connectivity.assign(c.data(), c.data() + c.shape(0));
     if (!cells.offsets.empty() && cells.offsets[0] != 0)
-        raise(ErrorKind::Validation, "cell 0: offset " + std::to_string(cells.offsets[0]) +
-                                         ", expected 0");
+        raise(ErrorKind::Validation,
+              "cell 0: offset " + std::to_string(cells.offsets[0]) + ", expected 0");
     appendVtkCells(cells, *mesh, "");
     auto out = std::make_unique<MeshData>();
     out->view = *mesh;
@@ -229,14 +229,13 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
         const std::string name = t[0].cast<std::string>();
         const Association assoc = parseAssociation(t[1].cast<std::string>(), "association");
         auto a = exactArray<float>(t[2], "field '" + name + "'");
-        const std::uint64_t tuples = assoc == Association::Point ? mesh.view.pointCount()
-                                                                 : mesh.view.cellCount();
+        const std::uint64_t tuples =
+            assoc == Association::Point ? mesh.view.pointCount() : mesh.view.cellCount();
         if (a.ndim() < 1 || a.ndim() > 2 || static_cast<std::uint64_t>(a.shape(0)) != tuples)
-            raise(ErrorKind::Argument, std::string(associationName(assoc)) + " field '" + name +
-                                           "': expected " + std::to_string(tuples) +
-                                           " tuples (one per " + associationName(assoc) +
-                                           "), got an array of shape " +
-                                           std::string(py::str(a.attr("shape"))));
+            raise(ErrorKind::Argument,
+                  std::string(associationName(assoc)) + " field '" + name + "': expected " +
+                      std::to_string(tuples) + " tuples (one per " + associationName(assoc) +
+                      "), got an array of shape " + std::string(py::str(a.attr("shape"))));
         infos.push_back({name, assoc, a.ndim() == 2 ? static_cast<int>(a.shape(1)) : 1});
         arrays.push_back(a);
     }
@@ -244,8 +243,7 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
     const FieldChoice choice = resolveField(infos, parsed);
     const auto& a = arrays[choice.index];
     Field f{infos[choice.index].name, infos[choice.index].association,
-            infos[choice.index].components,
-            std::vector<float>(a.data(), a.data() + a.size())};
+            infos[choice.index].components, std::vector<float>(a.data(), a.data() + a.size())};
     ScalarField s = scalarFieldOf(mesh.view, f, parsed.component);
     const auto n = static_cast<py::ssize_t>(s.values.size());
     return py::make_tuple(s.name, associationName(s.association),
@@ -258,8 +256,8 @@ RenderMethod parseMethod(const std::string& s) {
     if (s == "adaptive") return RenderMethod::Partitions;
     if (s == "reference") return RenderMethod::Reference;
     if (s == "exact") return RenderMethod::Exact;
-    raise(ErrorKind::Argument, "method: expected 'adaptive', 'reference' or 'exact', got '" + s +
-                                   "'");
+    raise(ErrorKind::Argument,
+          "method: expected 'adaptive', 'reference' or 'exact', got '" + s + "'");
 }
 
 /// The renderer object of the library with the GIL released around its long calls.
@@ -270,10 +268,10 @@ struct PyRenderer {
 /// One frame: (pixels (h, w, 4) float32 premultiplied, sample counts (h, w) uint32, stats).
 py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
-                      int width, int height, const std::string& method,
-                      const std::string& sampling, const std::string& stepRule, float quality,
-                      float step, float maxStep, float opacityUnit, float power, bool skip,
-                      bool adaptive, int supersample, bool jitter) {
+                      int width, int height, const std::string& method, const std::string& sampling,
+                      const std::string& stepRule, float quality, float step, float maxStep,
+                      float opacityUnit, float power, bool skip, bool adaptive, int supersample,
+                      bool jitter) {
     RenderSettings s;
     s.method = parseMethod(method);
     if (sampling != "preintegrated" && sampling != "point")
@@ -363,16 +361,16 @@ PYBIND11_MODULE(_uvr, m) {
     // Exceptions.
     gExceptions.base = addException(m, "Error", nullptr, "Base of every error uvr raises.");
     auto& k = gExceptions.byKind;
-    k[int(ErrorKind::Io)] = addException(m, "FileError", PyExc_OSError,
-                                         "A file could not be opened, read or written.");
+    k[int(ErrorKind::Io)] =
+        addException(m, "FileError", PyExc_OSError, "A file could not be opened, read or written.");
     k[int(ErrorKind::Parse)] = addException(m, "ParseError", PyExc_ValueError,
                                             "A file is malformed (names file and place).");
-    k[int(ErrorKind::Validation)] = addException(
-        m, "ValidationError", PyExc_ValueError, "A mesh is invalid (names the cell or index).");
-    k[int(ErrorKind::Argument)] = addException(
-        m, "ArgumentError", PyExc_ValueError, "An argument is out of range or malformed.");
-    k[int(ErrorKind::Unsupported)] = addException(
-        m, "UnsupportedError", PyExc_NotImplementedError, "Valid input uvr does not handle.");
+    k[int(ErrorKind::Validation)] = addException(m, "ValidationError", PyExc_ValueError,
+                                                 "A mesh is invalid (names the cell or index).");
+    k[int(ErrorKind::Argument)] = addException(m, "ArgumentError", PyExc_ValueError,
+                                               "An argument is out of range or malformed.");
+    k[int(ErrorKind::Unsupported)] = addException(m, "UnsupportedError", PyExc_NotImplementedError,
+                                                  "Valid input uvr does not handle.");
     k[int(ErrorKind::Resource)] = addException(m, "ResourceError", PyExc_MemoryError,
                                                "Not enough memory (host or GPU) or over a limit.");
     k[int(ErrorKind::Internal)] = addException(m, "InternalError", PyExc_RuntimeError,
@@ -401,8 +399,8 @@ PYBIND11_MODULE(_uvr, m) {
                 return out;
             },
             py::arg("path"), py::arg("max_memory") = 0)
-        .def_static("borrow", &borrowMesh, py::arg("points"), py::arg("types"),
-                    py::arg("offsets"), py::arg("connectivity"))
+        .def_static("borrow", &borrowMesh, py::arg("points"), py::arg("types"), py::arg("offsets"),
+                    py::arg("connectivity"))
         .def_static("convert", &convertMesh, py::arg("points"), py::arg("types"),
                     py::arg("offsets"), py::arg("connectivity"))
         .def_property_readonly("borrowed", [](const MeshData& d) { return !d.owned; })
@@ -412,9 +410,9 @@ PYBIND11_MODULE(_uvr, m) {
                                [](py::object self) -> py::object {
                                    const auto& d = self.cast<const MeshData&>();
                                    if (!d.owned) return d.arrays[0];
-                                   return viewArray(reinterpret_cast<const float*>(
-                                                        d.view.points.data()),
-                                                    {py::ssize_t(d.view.pointCount()), 3}, self);
+                                   return viewArray(
+                                       reinterpret_cast<const float*>(d.view.points.data()),
+                                       {py::ssize_t(d.view.pointCount()), 3}, self);
                                })
         .def_property_readonly(
             "types",
@@ -429,25 +427,21 @@ PYBIND11_MODULE(_uvr, m) {
                                    const auto& d = self.cast<const MeshData&>();
                                    if (!d.owned) return d.arrays[2];
                                    return viewArray(d.view.cellOffsets.data(),
-                                                    {py::ssize_t(d.view.cellOffsets.size())},
-                                                    self);
+                                                    {py::ssize_t(d.view.cellOffsets.size())}, self);
                                })
         .def_property_readonly("connectivity",
                                [](py::object self) -> py::object {
                                    const auto& d = self.cast<const MeshData&>();
                                    if (!d.owned) return d.arrays[3];
                                    return viewArray(d.view.cellIndices.data(),
-                                                    {py::ssize_t(d.view.cellIndices.size())},
-                                                    self);
+                                                    {py::ssize_t(d.view.cellIndices.size())}, self);
                                })
-        .def_property_readonly("fields",
-                               [](py::object self) {
-                                   return ownedFields(self, self.cast<const MeshData&>());
-                               })
-        .def_property_readonly("notes",
-                               [](const MeshData& d) {
-                                   return d.owned ? d.owned->notes : std::vector<std::string>{};
-                               })
+        .def_property_readonly(
+            "fields",
+            [](py::object self) { return ownedFields(self, self.cast<const MeshData&>()); })
+        .def_property_readonly(
+            "notes",
+            [](const MeshData& d) { return d.owned ? d.owned->notes : std::vector<std::string>{}; })
         .def("bounds", [](const MeshData& d) {
             const Bounds3f b = d.view.bounds();
             return py::make_tuple(arr3(b.lo), arr3(b.hi));
@@ -478,9 +472,8 @@ PYBIND11_MODULE(_uvr, m) {
             py::arg("text"), py::arg("name") = "", py::arg("source") = "<json>")
         .def("to_json", &paraViewColorMapJson, py::arg("lo"), py::arg("hi"))
         .def(
-            "set_opacity", [](TransferFunction& tf, const std::string& spec) {
-                applyOpacitySpec(tf, spec);
-            },
+            "set_opacity",
+            [](TransferFunction& tf, const std::string& spec) { applyOpacitySpec(tf, spec); },
             py::arg("spec"))
         .def_readwrite("name", &TransferFunction::name)
         .def_readwrite("log_scale", &TransferFunction::logScale)
@@ -527,8 +520,8 @@ PYBIND11_MODULE(_uvr, m) {
                             raise(ErrorKind::Argument, "colors: row " + std::to_string(i) +
                                                            " has a value outside [0, 1]");
                     if (i && r[0] < pts.back().x)
-                        raise(ErrorKind::Argument, "colors: x must not decrease (row " +
-                                                       std::to_string(i) + ")");
+                        raise(ErrorKind::Argument,
+                              "colors: x must not decrease (row " + std::to_string(i) + ")");
                     pts.push_back({r[0], {r[1], r[2], r[3]}});
                 }
                 tf.colors = std::move(pts);
@@ -552,8 +545,8 @@ PYBIND11_MODULE(_uvr, m) {
                         raise(ErrorKind::Argument, "opacities: row " + std::to_string(i) +
                                                        " has a value outside [0, 1]");
                     if (i && x < pts.back().x)
-                        raise(ErrorKind::Argument, "opacities: x must not decrease (row " +
-                                                       std::to_string(i) + ")");
+                        raise(ErrorKind::Argument,
+                              "opacities: x must not decrease (row " + std::to_string(i) + ")");
                     pts.push_back({x, alpha});
                 }
                 tf.opacities = std::move(pts);
@@ -588,9 +581,8 @@ PYBIND11_MODULE(_uvr, m) {
              }),
              py::arg("position") = std::array<float, 3>{0.f, 0.f, 1.f},
              py::arg("focal_point") = std::array<float, 3>{0.f, 0.f, 0.f},
-             py::arg("view_up") = std::array<float, 3>{0.f, 1.f, 0.f},
-             py::arg("view_angle") = 30.f, py::arg("parallel_projection") = false,
-             py::arg("parallel_scale") = 1.f)
+             py::arg("view_up") = std::array<float, 3>{0.f, 1.f, 0.f}, py::arg("view_angle") = 30.f,
+             py::arg("parallel_projection") = false, py::arg("parallel_scale") = 1.f)
         .def_property(
             "position", [](const Camera& c) { return arr3(c.position); },
             [](Camera& c, const std::array<float, 3>& v) { c.position = vec3(v); })
@@ -646,10 +638,10 @@ PYBIND11_MODULE(_uvr, m) {
                                                     ? mesh.view.pointCount()
                                                     : mesh.view.cellCount();
                  if (field.values.size() != expected)
-                     raise(ErrorKind::Argument,
-                           "values: " + std::to_string(field.values.size()) + " " +
-                               associationName(field.association) + " values, expected " +
-                               std::to_string(expected));
+                     raise(ErrorKind::Argument, "values: " + std::to_string(field.values.size()) +
+                                                    " " + associationName(field.association) +
+                                                    " values, expected " +
+                                                    std::to_string(expected));
                  auto r = std::make_unique<PyRenderer>();
                  py::gil_scoped_release release;
                  r->renderer = std::make_unique<Renderer>(mesh.view, field, o);
@@ -670,16 +662,15 @@ PYBIND11_MODULE(_uvr, m) {
         .def("render", &renderFrame, py::arg("tf"), py::arg("range"), py::arg("camera"),
              py::arg("width"), py::arg("height"), py::arg("method") = "adaptive",
              py::arg("sampling") = "preintegrated", py::arg("step_rule") = "error",
-             py::arg("quality") = kDefaultQuality, py::arg("step") = 0.f,
-             py::arg("max_step") = 0.f, py::arg("opacity_unit") = 0.f, py::arg("power") = 2.f,
-             py::arg("skip") = true, py::arg("adaptive") = true, py::arg("supersample") = 1,
-             py::arg("jitter") = false)
+             py::arg("quality") = kDefaultQuality, py::arg("step") = 0.f, py::arg("max_step") = 0.f,
+             py::arg("opacity_unit") = 0.f, py::arg("power") = 2.f, py::arg("skip") = true,
+             py::arg("adaptive") = true, py::arg("supersample") = 1, py::arg("jitter") = false)
         .def_property_readonly("device",
                                [](const PyRenderer& r) { return r.renderer->deviceName(); })
         .def_property_readonly("device_description",
                                [](const PyRenderer& r) { return r.renderer->deviceDescription(); })
-        .def_property_readonly("bounds",
-                               [](const PyRenderer& r) { return fileBounds(r.renderer->prepared()); })
+        .def_property_readonly(
+            "bounds", [](const PyRenderer& r) { return fileBounds(r.renderer->prepared()); })
         .def_property_readonly("info", [](const PyRenderer& r) {
             const PreparedMesh& p = r.renderer->prepared();
             py::dict d;

@@ -57,6 +57,16 @@ def _tf_repr_png(self):
     return _uvr.png_bytes(bar, None)
 
 
+def _with_path(load):
+    """A loader taking any path-like (the compiled one takes str)."""
+    def wrapped(path, *args, **kwargs):
+        return load(_os.fspath(path), *args, **kwargs)
+    wrapped.__doc__ = load.__doc__
+    return staticmethod(wrapped)
+
+
+TransferFunction.load = _with_path(TransferFunction.load)
+TransferFunction.load_paraview = _with_path(TransferFunction.load_paraview)
 TransferFunction.save = _tf_save
 TransferFunction.__repr__ = _tf_repr
 TransferFunction._repr_png_ = _tf_repr_png
@@ -112,6 +122,7 @@ def _camera_repr(self):
 
 
 Camera.reset = staticmethod(_camera_reset_any)
+Camera.load = _with_path(Camera.load)
 Camera.azimuth = _camera_azimuth
 Camera.elevation = _camera_elevation
 Camera.zoom = _camera_zoom
