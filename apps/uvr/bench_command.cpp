@@ -154,7 +154,6 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             add("paper: variance, point", RenderMethod::Partitions, true, true, defaultS2);
         paper.settings.preintegrated = false;
         paper.settings.stepRule = StepRule::Variance;
-        const std::size_t kSweepStart = variants.size();
         for (double f : *sweep) {
             char name[64];
             std::snprintf(name, sizeof name, "both, s2 = %g s1", f);
