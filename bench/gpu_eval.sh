@@ -14,6 +14,9 @@ out=$3
 shift 3
 mkdir -p "$out"
 uvr="$build/uvr"
+here=$(dirname "$0")
+python=python3
+[ -x /usr/bin/python3 ] && python=/usr/bin/python3
 # OPACITY replaces the semi-transparent transfer function of the box, graded and refine stages
 # (e.g. OPACITY=step:0.5:0.5 for a binary one; TAG then names their outputs).
 semi="0:0,1:0.1"
@@ -29,6 +32,12 @@ bench() {  # bench NAME MESH OPACITY [extra flags]
   "$uvr" -q bench "$mesh" $view $mem --device cuda --build-device "${BUILD:-auto}" \
     --opacity "$spec" --repeat "${REPEAT:-10}" --sweep "${SWEEP:-8,16,32,64}" \
     --json "$out/$name.json" "$@" 2>&1 | tee "$out/$name.txt"
+  # The figure (time and SSIM against s2) where matplotlib is installed (bench/plot_bench.py).
+  if "$python" -c "import matplotlib" 2>/dev/null; then
+    "$python" "$here/plot_bench.py" "$out/$name.json" --out "$out/$name.png"
+  else
+    echo "(no matplotlib for $python: $name.png not drawn; run bench/plot_bench.py elsewhere)"
+  fi
 }
 for stage in "$@"; do
   case $stage in

@@ -65,7 +65,6 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
     auto sweep = std::make_shared<std::vector<double>>(std::vector<double>{2, 4, 8, 16, 32});
     auto csv = std::make_shared<std::string>();
     auto json = std::make_shared<std::string>();
-    auto plot = std::make_shared<std::string>();
     auto images = std::make_shared<std::string>();
     cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
     flags->registerOn(*cmd, false);
@@ -78,15 +77,13 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         ->check(CLI::Range(1.0, 1e4));
     cmd->add_option("--csv", *csv, "Write the table as CSV");
     cmd->add_option("--json", *json, "Write the table and settings as JSON");
-    cmd->add_option("--plot", *plot, "Write a PNG plot of time and SSIM against s2 / s1");
     cmd->add_option("--images", *images,
                     "Write each configuration's image and sample heat map (all on the reference's "
                     "scale) into this folder");
     cmd->callback([=, &ctx] {
         applyThreads(flags->threads);
         std::vector<NamedFile> outputs;
-        for (auto [flag, out] : {std::pair{"--csv", csv.get()}, std::pair{"--json", json.get()},
-                                 std::pair{"--plot", plot.get()}}) {
+        for (auto [flag, out] : {std::pair{"--csv", csv.get()}, std::pair{"--json", json.get()}}) {
             if (out->empty()) continue;
             if (*out == "-")
                 throwError(ErrorKind::Argument, "-",
@@ -157,7 +154,6 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             add("paper: variance, point", RenderMethod::Partitions, true, true, defaultS2);
         paper.settings.preintegrated = false;
         paper.settings.stepRule = StepRule::Variance;
-        const std::size_t kSweepStart = variants.size();
         for (double f : *sweep) {
             char name[64];
             std::snprintf(name, sizeof name, "both, s2 = %g s1", f);
@@ -296,38 +292,27 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["ssim_against"] = "exact";
                 j["exact"] = {{"seconds_per_frame", exact.medianSeconds},
                               {"tetrahedra_crossed", exact.samples}};
-                for (const Variant& v : variants)
-                    j["rows"].push_back({{"configuration", v.name},
-                                         {"s2_over_s1", v.s2Factor},
-                                         {"seconds_per_frame", v.medianSeconds},
-                                         {"samples", v.samples},
-                                         {"speedup", refTime / v.medianSeconds},
-                                         {"ssim", v.ssim},
-                                         {"psnr", v.psnr}});
+                for (const Variant& v : variants) {
+                    nlohmann::json row = {{"configuration", v.name},
+                                          {"s2_over_s1", v.s2Factor},
+                                          {"seconds_per_frame", v.medianSeconds},
+                                          {"samples", v.samples},
+                                          {"speedup", refTime / v.medianSeconds},
+                                          {"ssim", v.ssim},
+                                          {"psnr", v.psnr}};
+                    if (!images->empty()) row["image"] = v.file;  // <file>.png, <file>_samples.png
+                    j["rows"].push_back(row);
+                }
+                // The heat maps' common scale and colours, for bench/plot_bench.py's legend.
+                nlohmann::json ramp = nlohmann::json::array();
+                for (int i = 0; i < 64; ++i) {
+                    const Vec3f c = heatmapColor(float(i) / 63.f);
+                    ramp.push_back({c.x, c.y, c.z});
+                }
+                j["heatmap"] = {{"max_samples", heatmapMax}, {"colors", ramp}};
+                if (!images->empty()) j["images"] = *images;
                 out.write(jsonText(j) + "\n");
             });
-        if (!plot->empty()) {
-            PlotSpec spec;
-            spec.title = std::filesystem::path(*file).filename().string() +
-                         ": time and SSIM against s2 (skipping + adaptive)";
-            spec.xLabel = "s2 / s1";
-            spec.yLabel = "ms per frame";
-            spec.yRightLabel = "SSIM vs exact";
-            PlotSeries time{"ms per frame", {}, {}, Vec3f(0.1f, 0.3f, 0.8f), false};
-            PlotSeries ssim{"SSIM", {}, {}, Vec3f(0.8f, 0.2f, 0.1f), true};
-            time.x.push_back(1.0);  // s2 = s1: skipping only
-            time.y.push_back(variants[1].medianSeconds * 1e3);
-            ssim.x.push_back(1.0);
-            ssim.y.push_back(variants[1].ssim);
-            for (std::size_t i = kSweepStart; i < variants.size(); ++i) {
-                time.x.push_back(variants[i].s2Factor);
-                time.y.push_back(variants[i].medianSeconds * 1e3);
-                ssim.x.push_back(variants[i].s2Factor);
-                ssim.y.push_back(variants[i].ssim);
-            }
-            spec.series = {time, ssim};
-            writePng(*plot, renderPlot(spec));
-        }
     });
 }
 

@@ -764,11 +764,18 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     std::vector<std::unique_ptr<OutputFile>> outputs;
     outputs.push_back(std::make_unique<OutputFile>(flags.output));
     writePng(*outputs.back(), result.image, background);
+    // The heat map's scale: --heatmap-max, else the frame's largest count (at least 1).
+    std::uint32_t heatmapTop = flags.heatmapMax.value_or(0);
+    if (heatmapTop == 0)
+        for (std::uint32_t c : result.sampleCounts) heatmapTop = std::max(heatmapTop, c);
+    heatmapTop = std::max<std::uint32_t>(heatmapTop, 1);
     if (!flags.heatmapFile.empty()) {
         ctx.setActivity(flags.heatmapFile, "writing the heat map");
         outputs.push_back(std::make_unique<OutputFile>(flags.heatmapFile));
-        writePng(*outputs.back(), sampleHeatmap(result.sampleCounts, settings.width,
-                                                settings.height, flags.heatmapMax.value_or(0)));
+        writePng(*outputs.back(),
+                 sampleHeatmap(result.sampleCounts, settings.width, settings.height, heatmapTop));
+        ctx.step("heat map: the bar runs from 0 samples per pixel (black, bottom) to " +
+                 std::to_string(heatmapTop) + " (top)");
     }
     if (!flags.statsFile.empty()) {
         nlohmann::json j;
@@ -785,6 +792,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                 {"upload_seconds", renderer->gpu()->uploadSeconds()}};
         }
         j["threads"] = cpu::threadCount();
+        if (!flags.heatmapFile.empty()) j["heatmap_max"] = heatmapTop;
         j["method"] = flags.method;
         if (settings.method != RenderMethod::Exact) j["sampling"] = flags.sampling;
         if (prepared.kd) {

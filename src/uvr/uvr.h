@@ -23,6 +23,5 @@
 #include "uvr/render/heatmap.h"
 #include "uvr/render/image.h"
 #include "uvr/render/image_metrics.h"
-#include "uvr/render/plot.h"
 #include "uvr/render/render_setup.h"
 #include "uvr/tf/transfer_function.h"

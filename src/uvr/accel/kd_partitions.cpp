@@ -24,11 +24,10 @@ constexpr std::size_t kSubtreeCells = 1u << 18;
 /// Cells per chunk of a data-parallel pass.
 constexpr std::int64_t kChunk = 1 << 14;
 
-/// Per-cell boxes, centres and finite value ranges.
+/// Per-cell boxes and centres.
 struct CellData {
     std::vector<Bounds3f> boxes;
     std::vector<Vec3f> centers;
-    std::vector<float> vmin, vmax;
 };
 
 /// A node to split: its k-d node index, region, cells and depth.
@@ -68,17 +67,14 @@ void splitNode(std::vector<KdNode>& nodes, std::vector<Task>& stack, const Task&
     stack.push_back({child, below, std::move(left), task.depth + 1});
 }
 
-/// A partition's padded shrunk box, whole-cell value range and cell count.
-void describePartition(const CellData& data, const Bounds3f& shrunk,
-                       std::span<const std::uint32_t> cells, Vec3f pad, KdPartition& part) {
+/// A partition's padded shrunk box and cell count (its value range comes later, from
+/// computePartitionValueRanges).
+void describePartition(const Bounds3f& shrunk, std::span<const std::uint32_t> cells, Vec3f pad,
+                       KdPartition& part) {
     // Widened by a hair so that samples exactly on a cell face bounding the box are not lost to
     // rounding in the ray-box clip (it only admits samples that then find no cell).
     part.box = shrunk;
     if (!shrunk.empty()) part.box.lo = part.box.lo - pad, part.box.hi = part.box.hi + pad;
-    float lo = INFINITY, hi = -INFINITY;
-    for (std::uint32_t c : cells) lo = std::min(lo, data.vmin[c]), hi = std::max(hi, data.vmax[c]);
-    part.valueMin = lo <= hi ? lo : 0.f;
-    part.valueMax = lo <= hi ? hi : 0.f;
     part.cellCount = static_cast<std::uint32_t>(cells.size());
 }
 
@@ -229,29 +225,17 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     KdPartitions kd;
     kd.bounds = mesh.bounds;
     kd.leafCells = options.leafCells;
-    // Step 1: per-cell boxes, centres and finite value ranges.
+    // Step 1: per-cell boxes and centres (the geometry alone decides the partitions).
     CellData data;
     const bool needBoxes = !options.splitter || !options.lbvh;  // for the CPU's splits or SAH
-    if (needBoxes) data.boxes.resize(n), data.centers.resize(n);
-    data.vmin.resize(n);
-    data.vmax.resize(n);
-    const bool cellData = mesh.association == Association::Cell;
     const std::int64_t tetCount = static_cast<std::int64_t>(n);
+    if (needBoxes) {
+        data.boxes.resize(n), data.centers.resize(n);
 #pragma omp parallel for schedule(static)
-    for (std::int64_t t = 0; t < tetCount; ++t) {
-        Bounds3f box;
-        float lo = INFINITY, hi = -INFINITY;
-        for (std::uint32_t v : mesh.tets[t].v) {
-            box.extend(mesh.points[v]);
-            if (!cellData && std::isfinite(mesh.values[v])) {
-                lo = std::min(lo, mesh.values[v]);
-                hi = std::max(hi, mesh.values[v]);
-            }
+        for (std::int64_t t = 0; t < tetCount; ++t) {
+            const Bounds3f box = tetBounds(mesh.points.data(), mesh.tets[t]);
+            data.boxes[t] = box, data.centers[t] = box.center();
         }
-        if (cellData && std::isfinite(mesh.values[t])) lo = hi = mesh.values[t];
-        if (needBoxes) data.boxes[t] = box, data.centers[t] = box.center();
-        data.vmin[t] = lo;
-        data.vmax[t] = hi;
     }
     std::vector<Leaf> leaves;  // the CPU's leaves; or, from a splitter, `tree`
     std::optional<KdTree> tree;
@@ -337,7 +321,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         if (!tree) kd.cells.resize(cells);
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::int64_t p = 0; p < leafCount; ++p) {
-            describePartition(data, shrunkOf(p), cellsOf(p), pad, kd.partitions[p]);
+            describePartition(shrunkOf(p), cellsOf(p), pad, kd.partitions[p]);
             if (tree) continue;
             std::copy(leaves[p].cells.begin(), leaves[p].cells.end(),
                       kd.cells.begin() + kd.partitions[p].firstCell);
@@ -363,6 +347,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         kd.cells = std::move(sorted);
         kd.bvhNodes = std::move(r.nodes);
         for (std::int64_t p = 0; p < leafCount; ++p) kd.partitions[p].bvhRoot = r.roots[p];
+        computePartitionValueRanges(mesh, kd);
         kd.buildSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return kd;
@@ -383,7 +368,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         for (std::int64_t p = b0; p < b1; ++p) {
             const std::span<const std::uint32_t> leafCells = cellsOf(p);
             KdPartition& part = kd.partitions[p];
-            describePartition(data, shrunkOf(p), leafCells, pad, part);
+            describePartition(shrunkOf(p), leafCells, pad, part);
             const std::size_t count = leafCells.size();
             std::vector<Bounds3f> leafBoxes(count);
             std::vector<Vec3f> leafCenters(count);
@@ -418,9 +403,34 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         }
         b0 = b1;
     }
+    computePartitionValueRanges(mesh, kd);
     kd.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return kd;
+}
+
+void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd) {
+    const bool cellData = mesh.association == Association::Cell;
+    const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::int64_t p = 0; p < n; ++p) {
+        KdPartition& part = kd.partitions[p];
+        float lo = INFINITY, hi = -INFINITY;
+        for (std::uint32_t i = 0; i < part.cellCount; ++i) {
+            const std::uint32_t t = kd.cells[part.firstCell + i];
+            if (cellData) {
+                const float v = mesh.values[t];
+                if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+                continue;
+            }
+            for (std::uint32_t k : mesh.tets[t].v) {
+                const float v = mesh.values[k];
+                if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+            }
+        }
+        part.valueMin = lo <= hi ? lo : 0.f;
+        part.valueMax = lo <= hi ? hi : 0.f;
+    }
 }
 
 }  // namespace uvr

@@ -243,4 +243,10 @@ struct KdPartitions {
 /// thread) and bit-identical for any thread count.
 KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options = {});
 
+/// Sets every partition's value range: the finite minimum and maximum over its cells' values
+/// (whole cells: all four vertices, or the cell's own value for cell data; {0, 0} when none is
+/// finite). The only value-dependent part of the partitions: buildKdPartitions ends with it, and
+/// new values of the same mesh (a time step) need only this, not a rebuild.
+void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd);
+
 }  // namespace uvr

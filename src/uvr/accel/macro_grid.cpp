@@ -13,11 +13,21 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
                            const std::vector<std::uint32_t>& neighbors, float tetsPerCell) {
     const auto start = std::chrono::steady_clock::now();
     UVR_CHECK(tetsPerCell > 0.f, "macrocell density must be positive");
-    UVR_CHECK(neighbors.size() == 4 * mesh.tets.size(), "macrocells need the face neighbours");
     MacroGrids out;
-    const std::size_t n = kd.partitions.size();
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "macrocell grids");
+    fillMacroCells(mesh, kd, neighbors, out);
+    out.buildSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
+                    const std::vector<std::uint32_t>& neighbors, MacroGrids& out) {
+    UVR_CHECK(neighbors.size() == 4 * mesh.tets.size(), "macrocells need the face neighbours");
+    UVR_CHECK(out.grids.size() == kd.partitions.size(), "one macrocell grid per partition");
+    const std::size_t n = kd.partitions.size();
     out.cells.assign(gridCellCount(out.grids), MacroCell{});
+    out.nanCells.clear();
     const bool cellData = mesh.association == Association::Cell;
     const bool anyNan =
         std::any_of(mesh.values.begin(), mesh.values.end(), [](float v) { return v != v; });
@@ -82,9 +92,6 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
                 if (!gradients[c].empty() && cells[c].gradientSpread < INFINITY)
                     cells[c].gradientSpread = length(gradients[c].hi - gradients[c].lo);
     }
-    out.buildSeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return out;
 }
 
 }  // namespace uvr

@@ -72,4 +72,11 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
                            const std::vector<std::uint32_t>& neighbors,
                            float tetsPerCell = kTetsPerMacroCell);
 
+/// The value-dependent part of the macrocell grids: recomputes every macrocell (value range,
+/// gradient spread) and the NaN flags over the grids' existing layout (out.grids, which only the
+/// geometry decides). buildMacroGrids ends with it; new values of the same mesh (a time step)
+/// need only this. The capacity of out.cells is reused.
+void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
+                    const std::vector<std::uint32_t>& neighbors, MacroGrids& out);
+
 }  // namespace uvr

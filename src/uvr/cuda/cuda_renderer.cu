@@ -183,8 +183,30 @@ struct CudaScene::Impl {
     cuda::DeviceArray<std::uint32_t> sampleCounts;
     cuda::DeviceArray<unsigned long long> totals;
     double uploadSeconds = 0.0;
+    double valueUploadSeconds = 0.0;
 
     explicit Impl(const PreparedMesh& m) : mesh(m) {}
+
+    /// Uploads the arrays that depend on the field's values (the constructor's and
+    /// updateValues' one code path); a NaN flag array the field no longer needs is freed.
+    void uploadValues() {
+        values.upload(mesh.tets.values, "the field values");
+        if (mesh.kd) {
+            partitions.upload(mesh.kd->partitions, "the partitions");
+            gradientSpread.upload(mesh.gradientSpread, "the partition gradient spreads");
+            if (!mesh.partitionNan.empty())
+                partitionNan.upload(mesh.partitionNan, "the partitions' NaN flags");
+            else
+                partitionNan.clear();
+        }
+        if (mesh.macro) {
+            macroCells.upload(mesh.macro->cells, "the macrocells");
+            if (!mesh.macro->nanCells.empty())
+                macroNan.upload(mesh.macro->nanCells, "the macrocells' NaN flags");
+            else
+                macroNan.clear();
+        }
+    }
 
     /// The host scene view with every pointer replaced by its device copy.
     SceneView deviceScene(const FrameSetup& setup) const {
@@ -208,16 +230,11 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
     Impl& d = *impl_;
     d.points.upload(mesh.tets.points, "the mesh points");
     d.tets.upload(mesh.tets.tets, "the tetrahedra");
-    d.values.upload(mesh.tets.values, "the field values");
     d.neighbors.upload(mesh.neighbors, "the face neighbours");
     d.bvhNodes.upload(mesh.bvh.nodes, "the BVH nodes");
     d.bvhPrims.upload(mesh.bvh.primIds, "the BVH primitive ids");
     if (mesh.kd) {
         d.kdNodes.upload(mesh.kd->nodes, "the k-d nodes");
-        d.partitions.upload(mesh.kd->partitions, "the partitions");
-        d.gradientSpread.upload(mesh.gradientSpread, "the partition gradient spreads");
-        if (!mesh.partitionNan.empty())
-            d.partitionNan.upload(mesh.partitionNan, "the partitions' NaN flags");
         d.partitionBvhNodes.upload(mesh.kd->bvhNodes, "the partition BVH nodes");
         d.partitionCells.upload(mesh.kd->cells, "the partition cell lists");
     }
@@ -225,12 +242,8 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
         d.seedGrids.upload(mesh.seeds->grids, "the seed grids");
         d.seeds.upload(mesh.seeds->seeds, "the seeds");
     }
-    if (mesh.macro) {
-        d.macroGrids.upload(mesh.macro->grids, "the macrocell grids");
-        d.macroCells.upload(mesh.macro->cells, "the macrocells");
-        if (!mesh.macro->nanCells.empty())
-            d.macroNan.upload(mesh.macro->nanCells, "the macrocells' NaN flags");
-    }
+    if (mesh.macro) d.macroGrids.upload(mesh.macro->grids, "the macrocell grids");
+    d.uploadValues();
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     d.uploadSeconds =
@@ -250,6 +263,18 @@ std::uint64_t CudaScene::geometryBytes() const {
 
 double CudaScene::uploadSeconds() const {
     return impl_->uploadSeconds;
+}
+
+void CudaScene::updateValues() {
+    const auto start = std::chrono::steady_clock::now();
+    impl_->uploadValues();
+    UVR_CUDA_CHECK(cudaDeviceSynchronize());
+    impl_->valueUploadSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double CudaScene::valueUploadSeconds() const {
+    return impl_->valueUploadSeconds;
 }
 
 void CudaScene::updateShading(RenderResult& result) {

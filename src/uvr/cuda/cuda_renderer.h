@@ -37,6 +37,15 @@ public:
     /// renderCpu up to floating-point rounding).
     RenderResult render(const RenderSettings& settings);
 
+    /// Re-uploads what depends on the field's values after updateFieldValues gave the
+    /// PreparedMesh new ones (a time step): the values, the partition records (their value
+    /// ranges), gradient spreads, NaN flags and macrocells. Points, tetrahedra, neighbours, BVHs,
+    /// k-d nodes, cell lists and seed grids stay on the device untouched; buffers of unchanged
+    /// size are reused. Throws Error(Resource) when the GPU lacks memory.
+    void updateValues();
+    /// Seconds the last updateValues took (0 before the first).
+    double valueUploadSeconds() const;
+
     /// Bytes of device memory holding the mesh, BVH, neighbours and partitions.
     std::uint64_t geometryBytes() const;
     /// Seconds the upload took.

@@ -28,6 +28,12 @@ RenderResult CudaScene::render(const RenderSettings&) {
     return {};
 }
 
+void CudaScene::updateValues() {}
+
+double CudaScene::valueUploadSeconds() const {
+    return 0.0;
+}
+
 std::uint64_t CudaScene::geometryBytes() const {
     return 0;
 }

@@ -59,7 +59,7 @@ std::unique_ptr<CudaScene> uploadIf(Device device, const PreparedMesh& prepared)
 
 }  // namespace
 
-Renderer::Renderer(const Mesh& mesh, const ScalarField& field, const RendererOptions& options,
+Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const RendererOptions& options,
                    const ProgressFn& progress) {
     checkDeviceUsable(options.device);
     const auto start = std::chrono::steady_clock::now();
@@ -80,6 +80,11 @@ Renderer::~Renderer() = default;
 
 RenderResult Renderer::render(const RenderSettings& settings) {
     return gpu_ ? gpu_->render(settings) : renderCpu(*prepared_, settings);
+}
+
+void Renderer::setFieldValues(const ScalarField& field) {
+    updateFieldValues(*prepared_, field);
+    if (gpu_) gpu_->updateValues();
 }
 
 std::string Renderer::deviceDescription() const {

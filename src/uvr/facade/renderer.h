@@ -50,10 +50,11 @@ struct RendererOptions {
 /// module all render through it. One frame at a time (render is not reentrant).
 class Renderer {
 public:
-    /// Prepares `field` of `mesh` (which need not outlive the renderer) as `options` ask and
-    /// uploads it when rendering on the GPU. Throws Error(Unsupported) for Device::Cuda without
-    /// a usable CUDA device, Error(Resource) when the GPU lacks memory.
-    Renderer(const Mesh& mesh, const ScalarField& field, const RendererOptions& options = {},
+    /// Prepares `field` of `mesh` (a Mesh or a view of arrays held elsewhere; neither need
+    /// outlive the renderer) as `options` ask and uploads it when rendering on the GPU. Throws
+    /// Error(Unsupported) for Device::Cuda without a usable CUDA device, Error(Resource) when
+    /// the GPU lacks memory.
+    Renderer(const MeshView& mesh, const ScalarField& field, const RendererOptions& options = {},
              const ProgressFn& progress = {});
     /// Renders an already prepared mesh, taking it over, on `device`.
     Renderer(PreparedMesh prepared, Device device);
@@ -64,6 +65,13 @@ public:
     /// Renders one frame; throws Error(Argument) for settings validateSettings refuses and for a
     /// method whose structures were not prepared.
     RenderResult render(const RenderSettings& settings);
+
+    /// Gives the prepared mesh new values of a field of the same mesh (a time step, or another
+    /// field) without rebuilding anything geometric (updateFieldValues), and on the GPU
+    /// re-uploads only the value-dependent arrays (CudaScene::updateValues). Frames then equal
+    /// those of a renderer prepared with these values. Throws Error(Argument) when the field
+    /// does not hold one value per point (or cell) of the mesh; the renderer is unchanged then.
+    void setFieldValues(const ScalarField& field);
 
     /// The prepared mesh.
     const PreparedMesh& prepared() const { return *prepared_; }

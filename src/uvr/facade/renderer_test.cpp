@@ -3,6 +3,9 @@
 
 #include <gmock/gmock.h>
 
+#include <cmath>
+#include <cstring>
+
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -117,6 +120,143 @@ TEST(Renderer, OnTheGpuFramesMatchTheCpu) {
         const double ssim =
             compareImages(toRgb8(cpu.render(s).image), toRgb8(gpu.render(s).image)).ssim;
         EXPECT_GE(ssim, 0.99) << int(method);
+    }
+}
+
+/// A jittered grid with a point field "f" and a cell field "c" at time t, and one flat tetrahedron
+/// (no tetrahedra kept) between the hexahedra, so a cell field's values must skip it.
+Mesh timeStep(float t) {
+    Mesh m = testing::makeHexGrid(
+        8, -1.f, 1.f, [t](Vec3f p) { return std::sin(3.f * p.x + t) * p.y + t * p.z; }, 0.3f);
+    const std::uint32_t flat[4] = {0, 0, 1, 2};
+    m.addCell(CellType::Tetra, flat);
+    Field c{"c", Association::Cell, 1, {}};
+    for (std::uint64_t i = 0; i < m.cellCount(); ++i)
+        c.values.push_back(std::cos(0.1f * float(i) + t));
+    m.fields.push_back(c);
+    return m;
+}
+
+/// Bitwise equality of two float arrays (NaN equal to NaN, -0 unequal to +0).
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+/// Every pixel of two frames equal, bit for bit.
+void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::string& what) {
+    ASSERT_EQ(a.image.pixels.size(), b.image.pixels.size()) << what;
+    EXPECT_EQ(a.stats.samples, b.stats.samples) << what;
+    EXPECT_TRUE(sameBits(a.image.pixels, b.image.pixels)) << what;
+    EXPECT_TRUE(sameBits(a.sampleCounts, b.sampleCounts)) << what;
+}
+
+TEST(Renderer, SetFieldValuesGivesTheFramesOfAFreshPreparationWithoutRebuilding) {
+    for (const char* spec : {"f", "c"}) {
+        const Mesh m0 = timeStep(0.f);
+        Mesh m1 = timeStep(0.7f);
+        // A NaN in the new values (NaN flags appear) for the point field.
+        if (spec[0] == 'f') m1.fields[0].values[100] = NAN;
+        const ScalarField f0 = selectScalarField(m0, parseFieldSpec(spec));
+        const ScalarField f1 = selectScalarField(m1, parseFieldSpec(spec));
+        RendererOptions o;
+        o.device = Device::Cpu;
+        o.leafCells = 64;
+        Renderer r(m0, f0, o);
+        const PreparedMesh& p = r.prepared();
+        ASSERT_TRUE(p.kd && p.seeds && p.macro);
+        // The geometric structures: their contents and their memory, before the update.
+        const PreparedMesh before = prepareMesh(m0, f0, o.prepareOptions());
+        const void* addresses[] = {p.tets.tets.data(),    p.tets.points.data(),
+                                   p.bvh.nodes.data(),    p.neighbors.data(),
+                                   p.kd->nodes.data(),    p.kd->cells.data(),
+                                   p.kd->bvhNodes.data(), p.seeds->seeds.data(),
+                                   p.macro->grids.data(), p.macro->cells.data()};
+        const double buildSeconds = p.kd->buildSeconds;
+        r.setFieldValues(f1);
+        EXPECT_EQ(p.valueUpdates, 1u);
+        EXPECT_GE(p.valueUpdateSeconds, 0.0);
+        const void* after[] = {p.tets.tets.data(),    p.tets.points.data(),  p.bvh.nodes.data(),
+                               p.neighbors.data(),    p.kd->nodes.data(),    p.kd->cells.data(),
+                               p.kd->bvhNodes.data(), p.seeds->seeds.data(), p.macro->grids.data(),
+                               p.macro->cells.data()};
+        for (std::size_t i = 0; i < std::size(addresses); ++i)
+            EXPECT_EQ(addresses[i], after[i]) << spec << ": array " << i << " was reallocated";
+        EXPECT_EQ(p.kd->buildSeconds, buildSeconds);
+        EXPECT_TRUE(sameBits(p.tets.tets, before.tets.tets));
+        EXPECT_TRUE(sameBits(p.bvh.nodes, before.bvh.nodes));
+        EXPECT_TRUE(sameBits(p.kd->cells, before.kd->cells));
+        EXPECT_TRUE(sameBits(p.kd->bvhNodes, before.kd->bvhNodes));
+        EXPECT_TRUE(sameBits(p.seeds->seeds, before.seeds->seeds));
+        // The value-dependent structures equal a fresh preparation's, bit for bit.
+        const PreparedMesh fresh = prepareMesh(m1, f1, o.prepareOptions());
+        EXPECT_TRUE(sameBits(p.tets.values, fresh.tets.values)) << spec;
+        EXPECT_EQ(p.tets.valueMin, fresh.tets.valueMin) << spec;
+        EXPECT_EQ(p.tets.valueMax, fresh.tets.valueMax) << spec;
+        EXPECT_TRUE(sameBits(p.kd->partitions, fresh.kd->partitions)) << spec;
+        EXPECT_TRUE(sameBits(p.gradientSpread, fresh.gradientSpread)) << spec;
+        EXPECT_TRUE(sameBits(p.partitionNan, fresh.partitionNan)) << spec;
+        EXPECT_TRUE(sameBits(p.macro->cells, fresh.macro->cells)) << spec;
+        EXPECT_TRUE(sameBits(p.macro->nanCells, fresh.macro->nanCells)) << spec;
+        EXPECT_EQ(p.partitionNan.empty(), spec[0] == 'c') << spec;
+        EXPECT_FALSE(sameBits(p.tets.values, before.tets.values)) << spec;
+        for (RenderMethod method :
+             {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
+            RenderSettings s = frameOf(m0.bounds(), method);
+            s.tf.nanOpacity = 0.5f;  // NaN regions visible: the NaN flags matter
+            expectSameFrames(r.render(s), renderCpu(fresh, s),
+                             std::string(spec) + ", method " + std::to_string(int(method)));
+        }
+    }
+}
+
+TEST(Renderer, SetFieldValuesRefusesTheWrongCountAndChangesNothing) {
+    const Mesh m = timeStep(0.f);
+    RendererOptions o;
+    o.device = Device::Cpu;
+    Renderer r(m, selectScalarField(m, parseFieldSpec("f")), o);
+    const std::vector<float> values = r.prepared().tets.values;
+    ScalarField bad{"f", Association::Point, std::vector<float>(m.pointCount() - 1, 1.f)};
+    const Error e = catchError([&] { r.setFieldValues(bad); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(), HasSubstr(std::to_string(m.pointCount() - 1) +
+                                    " point values, "
+                                    "expected " +
+                                    std::to_string(m.pointCount())));
+    bad.association = Association::Cell;
+    bad.values.assign(m.cellCount() + 1, 0.f);
+    EXPECT_THAT(catchError([&] { r.setFieldValues(bad); }).what(),
+                HasSubstr("expected " + std::to_string(m.cellCount())));
+    EXPECT_EQ(r.prepared().valueUpdates, 0u);
+    EXPECT_TRUE(sameBits(r.prepared().tets.values, values));
+    // Another field of the same mesh, of the other association, is fine.
+    r.setFieldValues(selectScalarField(m, parseFieldSpec("c")));
+    EXPECT_EQ(r.prepared().tets.association, Association::Cell);
+    EXPECT_EQ(r.prepared().tets.values.size(), r.prepared().tets.tets.size());
+}
+
+TEST(Renderer, OnTheGpuSetFieldValuesGivesTheFramesOfAFreshUpload) {
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
+    const Mesh m0 = timeStep(0.f), m1 = timeStep(0.7f);
+    const ScalarField f0 = selectScalarField(m0, parseFieldSpec("f"));
+    ScalarField f1 = selectScalarField(m1, parseFieldSpec("f"));
+    f1.values[100] = NAN;
+    RendererOptions o;
+    o.device = Device::Cuda;
+    o.leafCells = 64;
+    Renderer updated(m0, f0, o);
+    const std::uint64_t bytes = updated.gpu()->geometryBytes();
+    updated.setFieldValues(f1);
+    EXPECT_EQ(updated.gpu()->geometryBytes(), bytes + updated.prepared().partitionNan.size() +
+                                                  updated.prepared().macro->nanCells.size());
+    EXPECT_GT(updated.gpu()->valueUploadSeconds(), 0.0);
+    Renderer fresh(m1, f1, o);
+    for (RenderMethod method :
+         {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
+        RenderSettings s = frameOf(m0.bounds(), method);
+        s.tf.nanOpacity = 0.5f;
+        expectSameFrames(updated.render(s), fresh.render(s),
+                         "method " + std::to_string(int(method)));
     }
 }
 

@@ -169,7 +169,7 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
     return out;
 }
 
-ScalarField scalarFieldOf(const Mesh& mesh, const Field& fieldRef, int component) {
+ScalarField scalarFieldOf(const MeshView& mesh, const Field& fieldRef, int component) {
     const Field* field = &fieldRef;
     const std::uint64_t tuples =
         field->association == Association::Point ? mesh.pointCount() : mesh.cellCount();

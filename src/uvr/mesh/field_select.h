@@ -77,7 +77,7 @@ ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec);
 /// The scalar values of one field of the mesh: component `component`, or for component -1 the
 /// magnitude of a vector (the value itself for scalars); throws Error(Argument) when the component
 /// does not exist. Unlike selectScalarField it does not look the field up by name.
-ScalarField scalarFieldOf(const Mesh& mesh, const Field& field, int component = -1);
+ScalarField scalarFieldOf(const MeshView& mesh, const Field& field, int component = -1);
 
 /// Finite minimum and maximum of values (NaN/Inf skipped); {0, 0} when none is finite.
 std::pair<float, float> finiteRange(const std::vector<float>& values);

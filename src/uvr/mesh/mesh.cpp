@@ -18,6 +18,10 @@ void Mesh::addCell(CellType type, std::span<const std::uint32_t> ids) {
 }
 
 Bounds3f Mesh::bounds() const {
+    return MeshView(*this).bounds();
+}
+
+Bounds3f MeshView::bounds() const {
     Bounds3f b;
     for (std::uint64_t c = 0; c < cellCount(); ++c) {
         const auto ids = cell(c);

@@ -57,4 +57,33 @@ struct Mesh {
     const Field* findField(const std::string& name, Association association) const;
 };
 
+/// A non-owning view of a mesh's points and cells in Mesh's layout (float32 points, VTK cell
+/// types, cellCount + 1 offsets, uint32 corner indices): what splitting into tetrahedra reads.
+/// It lets arrays owned elsewhere (a Python caller's numpy arrays) be rendered without copying
+/// them into a Mesh. The same invariants as Mesh (validateStructure checks them).
+struct MeshView {
+    std::span<const Vec3f> points;
+    std::span<const CellType> cellTypes;
+    std::span<const std::uint64_t> cellOffsets;
+    std::span<const std::uint32_t> cellIndices;
+
+    MeshView() = default;
+    /// A view of a Mesh's arrays (implicit: every function taking a view takes a Mesh).
+    MeshView(const Mesh& mesh)  // NOLINT(google-explicit-constructor)
+        : points(mesh.points),
+          cellTypes(mesh.cellTypes),
+          cellOffsets(mesh.cellOffsets),
+          cellIndices(mesh.cellIndices) {}
+
+    std::uint64_t pointCount() const { return points.size(); }
+    /// Cells: one fewer than the offsets (0 for an empty view).
+    std::uint64_t cellCount() const { return cellTypes.size(); }
+    /// Corner indices of cell c.
+    std::span<const std::uint32_t> cell(std::uint64_t c) const {
+        return cellIndices.subspan(cellOffsets[c], cellOffsets[c + 1] - cellOffsets[c]);
+    }
+    /// Bounds of the points used by cells without NaN/Inf corners (as Mesh::bounds).
+    Bounds3f bounds() const;
+};
+
 }  // namespace uvr

@@ -93,6 +93,9 @@ struct TetMesh {
     float valueMin = 0.f;  ///< finite range of the field over the tets' values
     float valueMax = 0.f;
     double totalVolume = 0.0;  ///< sum of tetrahedron volumes
+    /// Per cell of the source mesh, how many tetrahedra it kept (0 to 6); tets lists them cell
+    /// after cell, so this maps a cell field onto the tetrahedra (assignTetValues).
+    std::vector<std::uint8_t> cellTets;
 
     /// View for kernels; the TetMesh must outlive it.
     TetMeshView view() const {
@@ -111,7 +114,14 @@ int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[
 /// Splits every cell of the mesh into tetrahedra and attaches the field; inverted cells are
 /// re-oriented, zero-volume tetrahedra (also those with a NaN/Inf corner) dropped (validateMesh
 /// reports both); points are mapped by frameForBounds of the kept tetrahedra's bounds.
-TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field);
+TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field);
+
+/// Attaches a field of the source mesh to the tetrahedra: values (a point field's as they are, a
+/// cell field's copied onto each of its cell's tetrahedra through cellTets), association, name
+/// and the finite value range over the tetrahedra's values. tetrahedralize ends with it, and a
+/// time step of the same mesh is attached with it without splitting again. Throws
+/// Error(Argument) when the field does not hold one value per point (or per source cell).
+void assignTetValues(TetMesh& mesh, const ScalarField& field);
 
 }  // namespace uvr
 
@@ -135,6 +145,6 @@ struct CellSplit {
 };
 
 /// Splits and classifies cell c of the mesh (indices must be in range).
-CellSplit splitCell(const Mesh& mesh, std::uint64_t c);
+CellSplit splitCell(const MeshView& mesh, std::uint64_t c);
 
 }  // namespace uvr

@@ -48,6 +48,10 @@ double det6(const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& d) {
 /// A tetrahedron whose |6V| is below this fraction of (longest edge)^3 counts as zero-volume.
 constexpr double kZeroVolumeRelative = 1e-7;
 
+/// Cells (or tetrahedra) per chunk of the parallel loops: fixed, so results do not depend on the
+/// thread count.
+constexpr std::int64_t kCellChunk = 1 << 14;
+
 }  // namespace
 
 int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[6][4]) {
@@ -94,7 +98,7 @@ int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[
     return count;
 }
 
-CellSplit splitCell(const Mesh& mesh, std::uint64_t c) {
+CellSplit splitCell(const MeshView& mesh, std::uint64_t c) {
     const auto ids = mesh.cell(c);
     const CellType type = mesh.cellTypes[c];
     std::uint8_t local[6][4];
@@ -137,50 +141,36 @@ CellSplit splitCell(const Mesh& mesh, std::uint64_t c) {
     return split;
 }
 
-TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
+TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field) {
     TetMesh out;
-    out.points = mesh.points;
-    out.association = field.association;
-    out.fieldName = field.name;
+    out.points.assign(mesh.points.begin(), mesh.points.end());
     const bool cellData = field.association == Association::Cell;
     UVR_CHECK(field.values.size() == (cellData ? mesh.cellCount() : mesh.pointCount()),
               "field '" << field.name << "' has " << field.values.size() << " values");
     // Fixed chunks of cells (so the result does not depend on the thread count), each split
-    // into its own list with its volume, bounds and value range; then the lists are moved into
-    // place in chunk order (each freed as soon as it is copied).
-    constexpr std::int64_t kChunk = 1 << 14;
+    // into its own list with its volume and bounds; then the lists are moved into place in
+    // chunk order (each freed as soon as it is copied).
     const std::int64_t cellCount = static_cast<std::int64_t>(mesh.cellCount());
-    const std::int64_t chunks = (cellCount + kChunk - 1) / kChunk;
+    const std::int64_t chunks = (cellCount + kCellChunk - 1) / kCellChunk;
     struct Chunk {
         std::vector<Tet> tets;
-        std::vector<std::uint32_t> cells;  ///< source cell of each (cell data only)
         double volume = 0.0;
         Bounds3f bounds;
-        float lo = INFINITY, hi = -INFINITY;
     };
     std::vector<Chunk> parts(chunks);
+    out.cellTets.assign(mesh.cellCount(), 0);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
         Chunk& s = parts[c];
-        const std::int64_t end = std::min(cellCount, (c + 1) * kChunk);
-        s.tets.reserve(static_cast<std::size_t>(end - c * kChunk));
-        for (std::int64_t i = c * kChunk; i < end; ++i) {
+        const std::int64_t end = std::min(cellCount, (c + 1) * kCellChunk);
+        s.tets.reserve(static_cast<std::size_t>(end - c * kCellChunk));
+        for (std::int64_t i = c * kCellChunk; i < end; ++i) {
             const CellSplit split = splitCell(mesh, i);
+            out.cellTets[i] = static_cast<std::uint8_t>(split.count);
             for (int t = 0; t < split.count; ++t) {
                 s.tets.push_back(split.tets[t]);
                 s.volume += split.volume6[t] / 6.0;
-                for (std::uint32_t v : split.tets[t].v) {
-                    s.bounds.extend(out.points[v]);
-                    if (!cellData && std::isfinite(field.values[v]))
-                        s.lo = std::fmin(s.lo, field.values[v]),
-                        s.hi = std::fmax(s.hi, field.values[v]);
-                }
-                if (cellData) {
-                    s.cells.push_back(static_cast<std::uint32_t>(i - c * kChunk));
-                    if (std::isfinite(field.values[i]))
-                        s.lo = std::fmin(s.lo, field.values[i]),
-                        s.hi = std::fmax(s.hi, field.values[i]);
-                }
+                for (std::uint32_t v : split.tets[t].v) s.bounds.extend(out.points[v]);
             }
         }
     }
@@ -188,24 +178,17 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
     for (std::int64_t c = 0; c < chunks; ++c)
         chunkStart[c + 1] = chunkStart[c] + parts[c].tets.size();
     out.tets.resize(chunkStart[chunks]);
-    if (cellData) out.values.resize(chunkStart[chunks]);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
         Chunk& s = parts[c];
         std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
-        for (std::size_t t = 0; t < s.cells.size(); ++t)
-            out.values[chunkStart[c] + t] = field.values[c * kChunk + s.cells[t]];
         s.tets = {};
-        s.cells = {};
     }
-    if (!cellData) out.values = field.values;
-    float lo = INFINITY, hi = -INFINITY;
     for (const Chunk& s : parts) {
         out.totalVolume += s.volume;
         out.bounds.extend(s.bounds);
-        lo = std::fmin(lo, s.lo), hi = std::fmax(hi, s.hi);
     }
-    if (lo <= hi) out.valueMin = lo, out.valueMax = hi;
+    assignTetValues(out, field);
     out.frame = frameForBounds(out.bounds);
     if (!out.frame.identity()) {
         const MeshFrame& f = out.frame;
@@ -224,6 +207,73 @@ TetMesh tetrahedralize(const Mesh& mesh, const ScalarField& field) {
         out.totalVolume *= f.scale * f.scale * f.scale;
     }
     return out;
+}
+
+void assignTetValues(TetMesh& mesh, const ScalarField& field) {
+    const bool cellData = field.association == Association::Cell;
+    const std::uint64_t expected = cellData ? mesh.cellTets.size() : mesh.points.size();
+    if (field.values.size() != expected)
+        throwError(ErrorKind::Argument, "",
+                   "field '" + field.name + "' has " + std::to_string(field.values.size()) + " " +
+                       associationName(field.association) + " values, expected " +
+                       std::to_string(expected) + " (one per " + (cellData ? "cell" : "point") +
+                       " of the prepared mesh)");
+    mesh.association = field.association;
+    mesh.fieldName = field.name;
+    const std::int64_t tetCount = static_cast<std::int64_t>(mesh.tets.size());
+    if (cellData) {
+        // Each cell's value onto its tetrahedra, which follow in cell order: per chunk of cells
+        // the first tetrahedron, then the chunks in parallel.
+        const std::int64_t cellCount = static_cast<std::int64_t>(mesh.cellTets.size());
+        const std::int64_t chunks = (cellCount + kCellChunk - 1) / kCellChunk;
+        std::vector<std::uint64_t> first(chunks + 1, 0);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t c = 0; c < chunks; ++c) {
+            std::uint64_t n = 0;
+            const std::int64_t end = std::min(cellCount, (c + 1) * kCellChunk);
+            for (std::int64_t i = c * kCellChunk; i < end; ++i) n += mesh.cellTets[i];
+            first[c + 1] = n;
+        }
+        for (std::int64_t c = 0; c < chunks; ++c) first[c + 1] += first[c];
+        UVR_CHECK(
+            first[chunks] == mesh.tets.size(),
+            "cellTets lists " << first[chunks] << " tetrahedra, the mesh has " << mesh.tets.size());
+        mesh.values.resize(mesh.tets.size());
+#pragma omp parallel for schedule(static)
+        for (std::int64_t c = 0; c < chunks; ++c) {
+            std::uint64_t t = first[c];
+            const std::int64_t end = std::min(cellCount, (c + 1) * kCellChunk);
+            for (std::int64_t i = c * kCellChunk; i < end; ++i)
+                for (int k = 0; k < mesh.cellTets[i]; ++k) mesh.values[t++] = field.values[i];
+        }
+    } else {
+        mesh.values.assign(field.values.begin(), field.values.end());
+    }
+    // The finite range over the tetrahedra's values (points no tetrahedron uses left out), per
+    // fixed chunk and then in chunk order: the same for any thread count.
+    const std::int64_t chunks = (tetCount + kCellChunk - 1) / kCellChunk;
+    std::vector<float> lo(chunks, INFINITY), hi(chunks, -INFINITY);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t c = 0; c < chunks; ++c) {
+        float l = INFINITY, h = -INFINITY;
+        const std::int64_t end = std::min(tetCount, (c + 1) * kCellChunk);
+        for (std::int64_t t = c * kCellChunk; t < end; ++t) {
+            if (cellData) {
+                const float v = mesh.values[t];
+                if (std::isfinite(v)) l = std::fmin(l, v), h = std::fmax(h, v);
+                continue;
+            }
+            for (std::uint32_t p : mesh.tets[t].v) {
+                const float v = mesh.values[p];
+                if (std::isfinite(v)) l = std::fmin(l, v), h = std::fmax(h, v);
+            }
+        }
+        lo[c] = l, hi[c] = h;
+    }
+    float l = INFINITY, h = -INFINITY;
+    for (std::int64_t c = 0; c < chunks; ++c) l = std::fmin(l, lo[c]), h = std::fmax(h, hi[c]);
+    mesh.valueMin = l <= h ? l : 0.f;
+    mesh.valueMax = l <= h ? h : 0.f;
 }
 
 MeshFrame frameForBounds(const Bounds3f& bounds) {

@@ -12,7 +12,7 @@
 
 namespace uvr {
 
-void validateStructure(const Mesh& mesh, const std::string& file) {
+void validateCells(const MeshView& mesh, const std::string& file) {
     const std::uint64_t cells = mesh.cellCount();
     const std::uint64_t points = mesh.pointCount();
     const std::uint64_t indices = mesh.cellIndices.size();
@@ -49,6 +49,15 @@ void validateStructure(const Mesh& mesh, const std::string& file) {
     if (mesh.cellOffsets[cells] != indices)
         fail("last cell offset " + std::to_string(mesh.cellOffsets[cells]) +
              ", expected indexCount " + std::to_string(indices));
+}
+
+void validateStructure(const Mesh& mesh, const std::string& file) {
+    validateCells(mesh, file);
+    const std::uint64_t cells = mesh.cellCount();
+    const std::uint64_t points = mesh.pointCount();
+    auto fail = [&](const std::string& message) {
+        throwError(ErrorKind::Validation, file, message);
+    };
     for (const Field& f : mesh.fields) {
         const std::uint64_t tuples = f.association == Association::Point ? points : cells;
         if (f.components < 1 ||

@@ -61,4 +61,11 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file = "");
 /// Only the structural checks of validateMesh (cheap; run by every load).
 void validateStructure(const Mesh& mesh, const std::string& file = "");
 
+/// The structural checks of the cells alone (validateStructure without the fields): at most
+/// 2^32 - 1 points, cellCount + 1 offsets from 0 to the index count, each cell of a rendered
+/// type with its corner count, every index below the point count. Throws Error(Validation)
+/// naming the cell (Error(Unsupported) for too many points). Splitting cells (splitCell,
+/// tetrahedralize) may read out of bounds on a view that fails these checks.
+void validateCells(const MeshView& mesh, const std::string& file = "");
+
 }  // namespace uvr

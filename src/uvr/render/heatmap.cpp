@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "uvr/core/error.h"
-#include "uvr/render/plot.h"
 
 namespace uvr {
 
@@ -25,11 +24,10 @@ const RampPoint kRamp[] = {
 /// Legend layout inside the kHeatmapLegendWidth margin.
 constexpr int kBarGap = 8;
 constexpr int kBarWidth = 20;
-constexpr int kTickLength = 3;
-constexpr int kLabelGap = 3;
+constexpr int kTickLength = 4;
 constexpr int kBarMarginY = 8;
 
-const Vec3f kLegendText(1.f, 1.f, 1.f);
+const Vec3f kTickColor(1.f, 1.f, 1.f);
 const Vec3f kBarBorder(0.5f, 0.5f, 0.5f);
 
 void fill(Image& image, int x0, int y0, int x1, int y1, Vec3f c) {
@@ -87,16 +85,15 @@ Image sampleHeatmap(const std::vector<std::uint32_t>& counts, int width, int hei
         fill(image, barLeft, y, barRight, y, color);
     }
 
-    // Step 3: ticks and numbers for 0, the middle and the top of the scale.
+    // Step 3: tick marks at 0, the middle and the top of the scale (numbers are left to the
+    // caller: the CLI logs the scale, bench/plot_bench.py draws a labelled colour bar).
     std::vector<std::uint32_t> ticks = {0};
     if (top / 2 > 0 && top / 2 < top) ticks.push_back(top / 2);
     ticks.push_back(top);
     for (std::uint32_t v : ticks) {
         const int y =
             barBottom - static_cast<int>(std::lround(static_cast<double>(v) / top * span));
-        fill(image, barRight + 1, y, barRight + kTickLength, y, kLegendText);
-        drawText(image, barRight + kTickLength + kLabelGap, y - kGlyphHeight / 2, std::to_string(v),
-                 kLegendText);
+        fill(image, barRight + 1, y, barRight + kTickLength, y, kTickColor);
     }
     return image;
 }

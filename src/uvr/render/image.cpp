@@ -170,20 +170,7 @@ void writePng(const std::string& path, const Image& image, const std::optional<V
     out.commit();
 }
 
-namespace {
-
-/// Encodes the image as 8-bit PNG rows into the sink: straight RGBA, or RGB composited over the
-/// background. `what` names the destination in errors.
-void encodeImage(PngSink& sink, const std::string& what, const Image& image,
-                 const std::optional<Vec3f>& background) {
-    if (image.width <= 0 || image.height <= 0 ||
-        image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
-        throwError(ErrorKind::Argument, what,
-                   "cannot write a " + std::to_string(image.width) + " x " +
-                       std::to_string(image.height) + " image with " +
-                       std::to_string(image.pixels.size()) + " pixels as PNG");
-    }
-    // Convert to 8-bit rows: straight RGBA, or RGB composited over the background.
+std::vector<std::uint8_t> toPngBytes(const Image& image, const std::optional<Vec3f>& background) {
     const bool alpha = !background.has_value();
     const size_t channels = alpha ? 4 : 3;
     std::vector<std::uint8_t> bytes(image.pixels.size() * channels);
@@ -200,6 +187,26 @@ void encodeImage(PngSink& sink, const std::string& what, const Image& image,
             compositeToRgb8(p, *background, px);
         }
     }
+    return bytes;
+}
+
+namespace {
+
+/// Encodes the image as 8-bit PNG rows into the sink: straight RGBA, or RGB composited over the
+/// background. `what` names the destination in errors.
+void encodeImage(PngSink& sink, const std::string& what, const Image& image,
+                 const std::optional<Vec3f>& background) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
+        throwError(ErrorKind::Argument, what,
+                   "cannot write a " + std::to_string(image.width) + " x " +
+                       std::to_string(image.height) + " image with " +
+                       std::to_string(image.pixels.size()) + " pixels as PNG");
+    }
+    // Convert to 8-bit rows: straight RGBA, or RGB composited over the background.
+    const bool alpha = !background.has_value();
+    const size_t channels = alpha ? 4 : 3;
+    std::vector<std::uint8_t> bytes = toPngBytes(image, background);
     std::vector<png_bytep> rows(static_cast<size_t>(image.height));
     for (int y = 0; y < image.height; ++y)
         rows[y] = &bytes[static_cast<size_t>(y) * image.width * channels];

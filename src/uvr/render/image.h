@@ -42,6 +42,12 @@ void writePng(const std::string& path, const Image& image,
 void writePng(OutputFile& out, const Image& image,
               const std::optional<Vec3f>& background = std::nullopt);
 
+/// The PNG file's 8-bit pixels as writePng makes them, row-major from the top: straight
+/// (un-premultiplied) RGBA, 4 bytes a pixel, when background is empty, else RGB composited over
+/// the background, 3 bytes a pixel.
+std::vector<std::uint8_t> toPngBytes(const Image& image,
+                                     const std::optional<Vec3f>& background = std::nullopt);
+
 /// The PNG writePng writes, encoded in memory; level is zlib's compression level 0 (fastest) to
 /// 9 (smallest), -1 libpng's default.
 std::vector<std::uint8_t> encodePng(const Image& image,

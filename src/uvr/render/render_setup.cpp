@@ -23,8 +23,8 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const PrepareOptions& options,
-                         const ProgressFn& progress) {
+PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
+                         const PrepareOptions& options, const ProgressFn& progress) {
     PreparedMesh out;
     out.sourceCells = mesh.cellCount();
     auto start = std::chrono::steady_clock::now();
@@ -82,6 +82,29 @@ PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const Prepa
     return out;
 }
 
+void updateFieldValues(PreparedMesh& mesh, const ScalarField& field) {
+    const auto start = std::chrono::steady_clock::now();
+    // Checked before anything changes (assignTetValues checks it too).
+    const bool cellData = field.association == Association::Cell;
+    const std::uint64_t expected = cellData ? mesh.sourceCells : mesh.tets.points.size();
+    if (field.values.size() != expected)
+        throwError(ErrorKind::Argument, "",
+                   "new values of field '" + field.name +
+                       "': " + std::to_string(field.values.size()) + " " +
+                       associationName(field.association) + " values, expected " +
+                       std::to_string(expected) + " (one per " + (cellData ? "cell" : "point") +
+                       " of the prepared mesh)");
+    assignTetValues(mesh.tets, field);
+    if (mesh.kd) {
+        computePartitionValueRanges(mesh.tets, *mesh.kd);
+        mesh.gradientSpread = partitionGradientSpread(mesh.tets, *mesh.kd);
+        mesh.partitionNan = partitionNanFlags(mesh.tets, *mesh.kd);
+        if (mesh.macro) fillMacroCells(mesh.tets, *mesh.kd, mesh.neighbors, *mesh.macro);
+    }
+    ++mesh.valueUpdates;
+    mesh.valueUpdateSeconds = secondsSince(start);
+}
+
 std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartitions& kd) {
     const auto isNan = [](float v) { return v != v; };
     if (std::none_of(tets.values.begin(), tets.values.end(), isNan)) return {};
@@ -137,7 +160,7 @@ float toleranceForQuality(float quality) {
     return kToleranceScale * (1.f - quality);
 }
 
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field) {
+PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field) {
     const PrepareOptions defaults;
     return prepareMesh(mesh, field, defaults);
 }

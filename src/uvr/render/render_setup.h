@@ -66,6 +66,8 @@ struct PreparedMesh {
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
     bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
+    std::uint64_t valueUpdates = 0;   ///< times updateFieldValues gave it new values
+    double valueUpdateSeconds = 0.0;  ///< time the last updateFieldValues took
 
     /// Point locator over this mesh.
     TetLocator locator() const { return {tets.view(), bvh.view(), neighbors.data()}; }
@@ -75,10 +77,21 @@ struct PreparedMesh {
 using ProgressFn = std::function<void(const std::string&)>;
 
 /// Splits cells, builds the BVH over the tetrahedra and the face-neighbour table.
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field, const PrepareOptions& options,
-                         const ProgressFn& progress = {});
+PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
+                         const PrepareOptions& options, const ProgressFn& progress = {});
 /// prepareMesh with the default options.
-PreparedMesh prepareMesh(const Mesh& mesh, const ScalarField& field);
+PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field);
+
+/// Gives a prepared mesh new values of a field of the same source mesh (a time step, or another
+/// field), rebuilding nothing geometric: tetrahedra, BVHs, neighbours, k-d tree, partition cell
+/// lists, seed grids and macrocell layouts stay as they are (not reallocated); the values, the
+/// value range, the partitions' value ranges, gradient spreads and NaN flags and the macrocells
+/// are recomputed by the same functions prepareMesh uses (assignTetValues,
+/// computePartitionValueRanges, partitionGradientSpread, partitionNanFlags, fillMacroCells), so
+/// frames equal those of a fresh prepareMesh of the new values bit for bit. Throws
+/// Error(Argument) when the field does not hold one value per point (or cell) of the source
+/// mesh; the prepared mesh is unchanged then.
+void updateFieldValues(PreparedMesh& mesh, const ScalarField& field);
 
 /// Per partition, the diagonal of the bounding box of the field gradients of its cells (each
 /// linear tetrahedron's constant gradient): it bounds how much the derivative of the field along

@@ -1,0 +1,142 @@
+# SPDX-License-Identifier: MIT
+"""Rendering: the CLI's pixels, time steps without rebuilding, the GIL, bad arguments."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import uvr
+
+VIEW = ["--size", "64x48", "--azimuth", "30", "--elevation", "20", "--device", "cpu", "-q"]
+
+
+def python_frame(renderer, **kw):
+    return renderer.render(size=(64, 48), azimuth=30, elevation=20, **kw)
+
+
+@pytest.mark.parametrize("case", [
+    ("spx.vtk", [], {}),
+    ("post_tets.vtk", ["--tf", "viridis", "--opacity", "0:0,1:0.4"],
+     dict(tf="viridis", opacity="0:0,1:0.4")),
+    ("bluntfin_tets.vtk", ["--field", "momentum:magnitude", "--range", "0,3", "--method",
+                           "reference"],
+     dict(field="momentum:magnitude", range=(0, 3), method="reference")),
+    ("cylinder_quadratic_as_tets.vtk", ["--field", "pressure:cell", "--method", "exact",
+                                        "--tf", "Turbo"],
+     dict(field="pressure:cell", method="exact", tf="Turbo")),
+    ("fire_ug.vtu", ["--opacity", "step:0.5:0.8", "--background", "1,1,1", "--quality", "0.999"],
+     dict(opacity="step:0.5:0.8", background=(1, 1, 1), quality=0.999)),
+], ids=lambda c: c[0])
+def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
+    name, flags, kwargs = case
+    out = tmp_path / "cli.png"
+    cli("render", data_dir / name, "-o", out, *VIEW, *flags)
+    r = uvr.Renderer(data_dir / name, field=kwargs.pop("field", None), device="cpu")
+    img = python_frame(r, **kwargs)
+    assert img.png_bytes() == out.read_bytes()
+    from matplotlib.image import imread
+
+    assert np.array_equal(img.to_uint8(), np.round(imread(out) * 255).astype(np.uint8))
+    assert img.stats["samples"] > 0
+
+
+def test_a_pvcc_camera_and_a_paraview_json_give_the_clis_pixels(data_dir, cli, tmp_path):
+    import pathlib
+    oracle = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "oracle"
+    out = tmp_path / "cli.png"
+    cli("render", data_dir / "post_tets.vtk", "-o", out, "--size", "64x48", "--device", "cpu",
+        "-q", "--camera", oracle / "post_oblique.pvcc", "--tf", oracle / "bands_lab.json")
+    r = uvr.Renderer(data_dir / "post_tets.vtk", device="cpu")
+    img = r.render(size=(64, 48), camera=uvr.Camera.load(oracle / "post_oblique.pvcc"),
+                   tf=str(oracle / "bands_lab.json"))
+    assert img.png_bytes() == out.read_bytes()
+
+
+def test_new_field_values_rebuild_nothing_and_match_a_fresh_renderer(data_dir):
+    mesh = uvr.read(data_dir / "spx.vtk")
+    x = np.asarray(mesh.points)[:, 0]
+    r = uvr.Renderer(mesh, device="cpu")
+    before = r.info
+    for t in (0.0, 0.5):
+        values = np.sin(2 * x + t).astype(np.float32)
+        a = r.render(field=values, size=(48, 40), range=(-1, 1), azimuth=10)
+        b = uvr.Renderer(mesh, field=values, device="cpu").render(size=(48, 40), range=(-1, 1),
+                                                                  azimuth=10)
+        assert np.array_equal(a, b)
+    after = r.info
+    assert after["value_updates"] == 2
+    assert after["partition_build_seconds"] == before["partition_build_seconds"]
+    assert after["prepare_seconds"] == before["prepare_seconds"]
+    # Back to the file's field by name, and a cell field of the same mesh.
+    r.render(field="scalars", size=(8, 8))
+    r.set_field(np.arange(mesh.n_cells, dtype=np.float64), association="cell")
+    assert r.info["field_association"] == "cell" and r.info["value_updates"] == 4
+
+
+def test_the_gil_is_released_while_rendering(data_dir):
+    r = uvr.Renderer(data_dir / "bluntfin_tets.vtk", device="cpu", methods=("reference",))
+    done = threading.Event()
+    ticks = 0
+
+    def work():
+        r.render(size=(256, 256), method="reference", step=0.02)
+        done.set()
+
+    thread = threading.Thread(target=work)
+    start = time.perf_counter()
+    thread.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    thread.join()
+    elapsed = time.perf_counter() - start
+    assert elapsed > 0.05, "the frame was too quick to tell"
+    assert ticks >= 10, f"the main thread ran {ticks} times in {elapsed:.2f} s"
+
+
+def test_images_are_arrays_that_display_themselves(data_dir):
+    img = uvr.render(data_dir / "tetraMesh.vtk", size=(20, 10))
+    assert isinstance(img, np.ndarray) and img.shape == (10, 20, 4) and img.dtype == np.float32
+    assert img._repr_png_()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert img.to_uint8().shape == (10, 20, 4) and img.to_uint8((0, 0, 0)).shape == (10, 20, 3)
+    assert img.sample_counts.shape == (10, 20)
+    assert {"seconds", "samples", "samples_per_pixel", "partitions_visited"} <= set(img.stats)
+    crop = img[2:5]
+    assert crop.stats is img.stats
+
+
+def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
+    r = uvr.Renderer(data_dir / "tetraMesh.vtk", device="cpu")
+    with pytest.raises(uvr.ArgumentError, match="--size 0x10"):
+        r.render(size=(0, 10))
+    with pytest.raises(uvr.ArgumentError, match="size: expected"):
+        r.render(size=5)
+    with pytest.raises(uvr.ArgumentError, match="methods: unknown"):
+        uvr.Renderer(data_dir / "tetraMesh.vtk", methods=("fast",))
+    with pytest.raises(uvr.ArgumentError, match="--quality"):
+        r.render(quality=2.0)
+    with pytest.raises(uvr.ArgumentError, match="'nope' not found; available: scalars"):
+        r.render(field="nope")
+    with pytest.raises(uvr.ArgumentError, match="field: expected 55 point values or 160 cell"):
+        r.render(field=np.zeros(7))
+    with pytest.raises(uvr.ArgumentError, match="--range"):
+        r.render(range=(2, 1))
+    with pytest.raises(uvr.ArgumentError, match="unknown"):
+        r.render(tf="no such map")
+    with pytest.raises(uvr.FileError):
+        r.render(tf="/nonexistent/map.json")
+    with pytest.raises(TypeError, match="camera: expected a uvr.Camera"):
+        r.render(camera="front")
+    with pytest.raises(uvr.ArgumentError, match="opacity"):
+        r.render(opacity="wobbly")
+    with pytest.raises(uvr.ArgumentError, match="position equal|focal"):
+        r.render(camera=uvr.Camera(position=(0, 0, 0), focal_point=(0, 0, 0)))
+    with pytest.raises(uvr.ArgumentError, match="device: expected auto, cpu or cuda"):
+        uvr.Renderer(data_dir / "tetraMesh.vtk", device="tpu")
+    if not uvr.cuda_available():
+        with pytest.raises(uvr.UnsupportedError):
+            uvr.Renderer(data_dir / "tetraMesh.vtk", device="cuda")
+    # Still usable after every refusal.
+    assert r.render(size=(8, 8)).stats["samples"] > 0

@@ -1,0 +1,191 @@
+# SPDX-License-Identifier: MIT
+"""The renderer: prepare a mesh once, render any number of frames."""
+
+import numpy as np
+
+from . import _uvr
+from ._image import Image, _background
+from ._mesh import as_mesh
+
+
+def transfer_function(tf=None, opacity=None):
+    """A TransferFunction from a preset name, a ParaView JSON path ("FILE.json[:NAME]") or a
+    TransferFunction (copied), with ``opacity`` (an ``--opacity`` spec such as "ramp",
+    "step:0.5", "0:0,1:0.3", or (x, alpha) pairs) applied."""
+    if tf is None:
+        t = _uvr.TransferFunction("Cool to Warm")
+    elif isinstance(tf, _uvr.TransferFunction):
+        t = tf.__copy__()
+    elif isinstance(tf, str):
+        t = _uvr.TransferFunction.load(tf)
+    else:
+        raise TypeError(f"tf: expected a preset name, a .json path or a uvr.TransferFunction, "
+                        f"got {type(tf).__name__}")
+    if opacity is not None:
+        if isinstance(opacity, str):
+            t.set_opacity(opacity)
+        else:
+            a = np.asarray(opacity, dtype=np.float32)
+            if a.ndim != 2 or a.shape[1] != 2:
+                raise _uvr.ArgumentError(f"opacity: expected (x, alpha) pairs of shape (k, 2), "
+                                         f"got shape {a.shape}")
+            t.opacities = np.ascontiguousarray(a)
+    return t
+
+
+class Renderer:
+    """A mesh prepared once for rendering (tetrahedra, BVHs, k-d partitions; resident on the GPU
+    when it renders there), rendering any number of frames.
+
+    ``Renderer(mesh, field=None, device="auto")``: `mesh` is anything ``uvr.as_mesh`` takes;
+    `field` a field spec as ``uvr render --field`` takes ("pressure", "velocity:magnitude",
+    "T:cell"; None: the default field) or an array of values (one per point or cell). `device`:
+    "auto" (CUDA when built with it and a GPU is present), "cpu" or "cuda".
+    ``methods`` names the integrators to prepare for ("reference" and "exact" need the mesh
+    BVH). Changing the transfer function, camera, range, method or quality rebuilds nothing;
+    new field values of the same mesh (``set_field``; ``render(field=...)``) rebuild nothing
+    geometric either. The GIL is released while preparing and rendering.
+    """
+
+    def __init__(self, mesh, field=None, device="auto", *, build_device="auto", leaf_cells=0,
+                 methods=("adaptive", "reference", "exact"), seed_grids=True, association=None):
+        self.mesh = as_mesh(mesh)
+        name, assoc, values = self._field(field, association)
+        unknown = set(methods) - {"adaptive", "reference", "exact"}
+        if unknown:
+            raise _uvr.ArgumentError(f"methods: unknown {sorted(unknown)}; expected "
+                                     "'adaptive', 'reference' or 'exact'")
+        self._methods = tuple(methods)
+        self._core = _uvr.Renderer(self.mesh._data, name, assoc, values, device, build_device,
+                                   int(leaf_cells),
+                                   mesh_bvh="reference" in methods or "exact" in methods,
+                                   seed_grids=bool(seed_grids))
+        self._field_key = field if isinstance(field, str) or field is None else None
+
+    def _field(self, field, association=None):
+        """(name, association, float32 values) of a field spec or an array of values."""
+        if field is None or isinstance(field, str):
+            if not self.mesh.fields:
+                raise _uvr.ArgumentError("the mesh has no fields: pass field=values (one per "
+                                         "point or cell)")
+            name, assoc, values, _ = _uvr.select_field(self.mesh._data, self.mesh.fields,
+                                                       field or "")
+            return name, assoc, values
+        a = np.asarray(field)
+        if a.dtype.kind not in "fiub":
+            raise TypeError(f"field: expected real values, got dtype {a.dtype}")
+        n_points, n_cells = self.mesh.n_points, self.mesh.n_cells
+        if association is None:
+            if a.ndim == 1 and a.shape[0] == n_points:
+                association = "point"
+            elif a.ndim == 1 and a.shape[0] == n_cells:
+                association = "cell"
+        if a.ndim != 1 or association not in ("point", "cell") or \
+                a.shape[0] != (n_points if association == "point" else n_cells):
+            raise _uvr.ArgumentError(f"field: expected {n_points} point values or {n_cells} cell "
+                                     f"values (shape (n,)), got shape {a.shape}")
+        return "values", association, np.ascontiguousarray(a, dtype=np.float32)
+
+    def set_field(self, field, association=None):
+        """New values of the same mesh (a time step; one per point or cell), or another field
+        by its spec: the values, value ranges and macrocells are refreshed, nothing geometric is
+        rebuilt (on the GPU only the value arrays are uploaded)."""
+        name, assoc, values = self._field(field, association)
+        self._core.set_field_values(name, assoc, values)
+        self._field_key = field if isinstance(field, str) else None
+
+    @property
+    def bounds(self):
+        """Bounds of the rendered tetrahedra, ((xmin, ymin, zmin), (xmax, ymax, zmax))."""
+        return self._core.bounds
+
+    @property
+    def device(self):
+        """"cpu" or "cuda"."""
+        return self._core.device
+
+    @property
+    def info(self):
+        """The preparation: tetrahedra, partitions, times, value updates, the field."""
+        return self._core.info
+
+    def camera(self, size=(512, 512), azimuth=0.0, elevation=0.0, zoom=1.0):
+        """ParaView's reset camera for the mesh and the image size, orbited and zoomed."""
+        w, h = size
+        cam = _uvr.Camera.reset(self.bounds, float(w) / float(h))
+        if azimuth or elevation:
+            cam = cam.orbit(azimuth, elevation)
+        return cam.zoom(zoom) if zoom != 1.0 else cam
+
+    def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
+               size=(512, 512), method="adaptive", quality=None, *, azimuth=0.0,
+               elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
+               sampling="preintegrated", step_rule="error", step=None, max_step=None,
+               opacity_unit=None, power=None, skip=True, adaptive=True, supersample=1,
+               jitter=False):
+        """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
+        ``.stats`` and ``.sample_counts``.
+
+        The arguments are ``uvr render``'s flags: `tf` a preset, ParaView JSON or
+        TransferFunction; `opacity` an opacity spec or (x, alpha) pairs; `range` (lo, hi) the
+        values the transfer function spans (default: the field's); `camera` a uvr.Camera
+        (default: ParaView's reset camera), then `azimuth`/`elevation`/`zoom`; `size` (w, h);
+        `method` "adaptive", "reference" or "exact"; `quality` the adaptive method's SSIM target
+        (0.99); `field` switches to another field or new values first (set_field). The same
+        settings give the CLI's pixels.
+        """
+        if field is not None and (not isinstance(field, str) or field != self._field_key):
+            self.set_field(field)
+        t = transfer_function(tf, opacity)
+        if log_scale is not None:
+            t.log_scale = bool(log_scale)
+        if nan_color is not None:
+            c = [float(x) for x in nan_color]
+            if len(c) not in (3, 4):
+                raise _uvr.ArgumentError("nan_color: expected (r, g, b) or (r, g, b, a)")
+            t.nan_color = c[:3]
+            t.nan_opacity = c[3] if len(c) == 4 else 1.0
+        try:
+            w, h = (int(size[0]), int(size[1]))
+        except (TypeError, ValueError, IndexError):
+            raise _uvr.ArgumentError(f"size: expected (width, height), got {size!r}") from None
+        if range is not None:
+            try:
+                lo, hi = (float(range[0]), float(range[1]))
+            except (TypeError, ValueError, IndexError):
+                raise _uvr.ArgumentError(f"range: expected (lo, hi), got {range!r}") from None
+            range = (lo, hi)
+        if camera is None and (azimuth or elevation or zoom != 1.0):
+            camera = self.camera((w, h), azimuth, elevation, zoom)
+        elif camera is not None:
+            if not isinstance(camera, _uvr.Camera):
+                raise TypeError(f"camera: expected a uvr.Camera, got {type(camera).__name__}")
+            if azimuth or elevation:
+                camera = camera.orbit(azimuth, elevation)
+            if zoom != 1.0:
+                camera = camera.zoom(zoom)
+        if method not in self._methods:
+            raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
+                                     f"{self._methods!r} when the Renderer was made)")
+        pixels, counts, stats = self._core.render(
+            t, range, camera, w, h, method=method, sampling=sampling, step_rule=step_rule,
+            quality=0.99 if quality is None else float(quality), step=float(step or 0.0),
+            max_step=float(max_step or 0.0), opacity_unit=float(opacity_unit or 0.0),
+            power=2.0 if power is None else float(power), skip=bool(skip),
+            adaptive=bool(adaptive), supersample=int(supersample), jitter=bool(jitter))
+        return Image(pixels, stats=stats, sample_counts=counts,
+                     background=_background(background))
+
+    def __repr__(self):
+        i = self.info
+        return (f"uvr.Renderer({i['tetrahedra']} tetrahedra, {i['partitions']} partitions, "
+                f"field {i['field']} ({i['field_association']}), on {self.device})")
+
+
+def render(mesh, **kwargs):
+    """One frame of a mesh: Renderer(mesh, field, device).render(**kwargs) (prepares only what
+    the method needs)."""
+    field = kwargs.pop("field", None)
+    device = kwargs.pop("device", "auto")
+    method = kwargs.get("method", "adaptive")
+    return Renderer(mesh, field, device, methods=(method,)).render(**kwargs)
