@@ -872,6 +872,9 @@ void ViewServer::Impl::acceptLoop() {
             if (ec == net::error::operation_aborted) return;
             say("view: accept failed: " + ec.message());
         } else {
+            // Frames go out as two messages (description, image): no Nagle delay between them.
+            beast::error_code ignored;
+            socket.set_option(tcp::no_delay(true), ignored);
             std::make_shared<HttpConnection>(*this, std::move(socket))->start();
         }
         acceptLoop();
