@@ -3,7 +3,9 @@
 # Installs every build and test dependency of uvr from Debian 12's packages (run as root); clang
 # with libFuzzer (libclang-rt-14-dev) and its OpenMP (libomp-dev) build the fuzz targets; xvfb
 # (xvfb-run) gives VTK the X display the oracle test (tests/tools/vtk_oracle_test.py) needs;
-# FreeType, fontconfig and the DejaVu fonts draw the colour legend (`--legend`).
+# FreeType, fontconfig and the DejaVu fonts draw the colour legend (`--legend`); chromium,
+# chromium-driver and python3-selenium run the browser test of `uvr view`'s page
+# (tests/web/view_page_test.py).
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
@@ -12,7 +14,8 @@ PACKAGES="g++ cmake make pkg-config
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev libomp-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage
-  xvfb xauth"
+  xvfb xauth
+  chromium chromium-driver python3-selenium"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
