@@ -348,14 +348,13 @@ function fieldEntries(fields) {
     for (const f of fields) {
         const shared = fields.filter((g) => g.name === f.name).length > 1;
         const base = shared ? `${f.name}:${f.association}` : f.name;
-        const where = `${f.association}${f.components > 1 ? `, ${f.components} components` : ""}`;
         if (!(f.components > 1)) {
-            entries.push({spec: base, label: `${f.name} (${where})`, field: f});
+            entries.push({spec: base, label: `${f.name} (${f.association})`, field: f});
             continue;
         }
         const comps = f.components === 3 ? ["x", "y", "z"] : [...Array(f.components).keys()].map(String);
         for (const c of ["magnitude", ...comps]) {
-            entries.push({spec: `${base}:${c}`, label: `${f.name} · ${c} (${where})`, field: f});
+            entries.push({spec: `${base}:${c}`, label: `${f.name} · ${c} (${f.association})`, field: f});
         }
     }
     return entries;
@@ -432,8 +431,11 @@ function updateControls() {
     }
     preset.value = name || "";
     $("log-scale").checked = !!(s.tf && s.tf.log);
-    if (document.activeElement !== $("range-lo")) $("range-lo").value = fmt(s.range[0]);
-    if (document.activeElement !== $("range-hi")) $("range-hi").value = fmt(s.range[1]);
+    ["range-lo", "range-hi"].forEach((id, i) => {
+        const input = $(id);
+        input.dataset.shown = fmt(s.range[i]);
+        if (document.activeElement !== input) input.value = input.dataset.shown;
+    });
     tfEditor.update({tf: s.tf, range: s.range});
 }
 
@@ -518,8 +520,15 @@ $("log-scale").addEventListener("change", (e) => {
     sendSet({tf: {...session.state.tf, log: e.target.checked}});
 });
 
+/// The value a range input stands for: the state's exact value while the input still shows its
+/// rounded text, else what was typed.
+function rangeInputValue(id, index) {
+    const input = $(id);
+    return input.value === input.dataset.shown ? session.state.range[index] : Number(input.value);
+}
+
 function applyRange() {
-    const lo = Number($("range-lo").value), hi = Number($("range-hi").value);
+    const lo = rangeInputValue("range-lo", 0), hi = rangeInputValue("range-hi", 1);
     if (!Number.isFinite(lo) || !Number.isFinite(hi) || !(lo < hi)) {
         showError("range: lo must be below hi");
         updateControls();

@@ -404,6 +404,21 @@ def load_colormap(page, tmp):
           f"the image is not green after loading a green map: mean RGB {rgb1} (before {rgb0})")
     check(difference(px0, px1) > 1.0, "the image hardly changed with the uploaded map")
     page.screenshot("colormap")
+    # The same through a drop on the editor (a synthetic drop event: WebDriver cannot drag files
+    # from outside the browser): a red map turns the image red.
+    reds = dict(cmap[0], Name="Test Reds", RGBPoints=[lo, 0.3, 0.0, 0.0, hi, 1.0, 0.3, 0.2])
+    page.js("""
+        const dt = new DataTransfer();
+        dt.items.add(new File([arguments[0]], 'reds.json', {type: 'application/json'}));
+        document.getElementById('tf-drop').dispatchEvent(
+            new DragEvent('drop', {dataTransfer: dt, bubbles: true, cancelable: true}));""",
+            json.dumps([reds]))
+    page.wait("v.state.tf.name === 'Test Reds'", 20, "the state with the dropped map")
+    page.wait_settled(page.hook("lastSeq"), what="the frame of the dropped map")
+    page.quiet()
+    rgb2, _ = mean_rgb(page.pixels())
+    check(rgb2[0] > rgb2[1] + 10 and rgb2[0] > rgb2[2] + 10,
+          f"the image is not red after dropping a red map: mean RGB {rgb2}")
 
 
 def bad_messages(page):
