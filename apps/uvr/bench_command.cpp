@@ -123,10 +123,10 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         ctx.setActivity(*file, "preparing the mesh and rendering it");
         const std::optional<Vec3f> background = flags->backgroundColor();
         const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
-        const PreparedMesh prepared =
-            prepareMesh(mesh, field, flags->prepareOptions(/*withReference=*/true),
-                        [&](const std::string& s) { ctx.step(s); });
-        FrameRenderer renderer(prepared, flags->useCuda(), ctx);
+        const std::unique_ptr<Renderer> rendererOwner =
+            makeRenderer(mesh, field, flags->rendererOptions(/*withReference=*/true), ctx);
+        Renderer& renderer = *rendererOwner;
+        const PreparedMesh& prepared = renderer.prepared();
         const FrameSetup setup = makeFrameSetup(prepared, base);
         const float s1 = static_cast<float>(setup.params.step / setup.frame.scale);  // file units
         const float defaultS2 = base.maxStep > 0.f ? base.maxStep : kDefaultMaxStepFactor * s1;

@@ -613,52 +613,33 @@ void RenderFlags::checkFiles(const std::string& meshFile) const {
     for (const NamedFile& out : outputs()) resolveOutput(out.path);
 }
 
-bool RenderFlags::useCuda() const {
-    return device == "cuda" || (device == "auto" && cudaDeviceAvailable());
-}
-
-bool RenderFlags::buildOnCuda() const {
-    return buildDevice == "cuda" || (buildDevice == "auto" && useCuda());
-}
-
-PrepareOptions RenderFlags::prepareOptions(bool withReference) const {
-    PrepareOptions o;
-    if (buildOnCuda()) {
-        o.lbvh = buildLbvhCuda;
-        o.kdSplitter = buildKdTreeCuda;
-        o.builderDevice = "the GPU";
-        if (buildDevice == "auto") o.builderMinTets = kAutoGpuBuildTets;
-    }
+RendererOptions RenderFlags::rendererOptions(bool withReference) const {
+    RendererOptions o;
+    o.device = parseDevice(device, "--device");
+    o.buildDevice = parseDevice(buildDevice, "--build-device");
     o.partitions = method == "adaptive";
     o.meshBvh = !o.partitions || withReference;  // the partition integrator uses its own BVHs
     o.seedGrids = !noSeedGrid;
-    if (leafCells)
-        o.kd.leafCells = leafCells;
-    else if (useCuda())
-        o.kd.leafCells = kCudaDefaultLeafCells;
+    o.leafCells = leafCells;
     return o;
 }
 
-FrameRenderer::FrameRenderer(const PreparedMesh& mesh, bool cuda, const Context& ctx)
-    : mesh_(mesh) {
-    if (cuda) {
-        ctx.step("GPU: " + cudaDeviceDescription());
-        gpu_ = std::make_unique<CudaScene>(mesh);
+std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
+                                       const RendererOptions& options, const Context& ctx) {
+    if (resolvesToCuda(options.device)) ctx.step("GPU: " + cudaDeviceDescription());
+    auto renderer = std::make_unique<Renderer>(mesh, field, options,
+                                               [&](const std::string& s) { ctx.step(s); });
+    if (const CudaScene* gpu = renderer->gpu()) {
         char line[160];
-        std::snprintf(
-            line, sizeof line,
-            "uploaded %.1f MiB to the GPU (%.1f bytes per tetrahedron) in %.3f s",
-            gpu_->geometryBytes() / 1048576.0,
-            double(gpu_->geometryBytes()) / std::max<std::size_t>(1, mesh.tets.tets.size()),
-            gpu_->uploadSeconds());
+        std::snprintf(line, sizeof line,
+                      "uploaded %.1f MiB to the GPU (%.1f bytes per tetrahedron) in %.3f s",
+                      gpu->geometryBytes() / 1048576.0,
+                      double(gpu->geometryBytes()) /
+                          std::max<std::size_t>(1, renderer->prepared().tets.tets.size()),
+                      gpu->uploadSeconds());
         ctx.step(line);
     }
-}
-
-FrameRenderer::~FrameRenderer() = default;
-
-RenderResult FrameRenderer::render(const RenderSettings& settings) {
-    return gpu_ ? gpu_->render(settings) : renderCpu(mesh_, settings);
+    return renderer;
 }
 
 void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes) {
@@ -726,8 +707,9 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     validateSettings(settings);
 
     ctx.setActivity(source, "preparing the mesh for rendering");
-    PreparedMesh prepared = prepareMesh(mesh, field, flags.prepareOptions(),
-                                        [&](const std::string& s) { ctx.step(s); });
+    const std::unique_ptr<Renderer> renderer =
+        makeRenderer(mesh, field, flags.rendererOptions(), ctx);
+    const PreparedMesh& prepared = renderer->prepared();
     ctx.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
     ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
              " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
@@ -738,19 +720,18 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                   : std::string()));
     ctx.setActivity(source, "rendering it at " + std::to_string(settings.width) + "x" +
                                 std::to_string(settings.height));
-    FrameRenderer renderer(prepared, flags.useCuda(), ctx);
     RenderResult result;
     {
         Progress progress(ctx, "rendering", double(settings.width) * settings.height, "pixels");
         settings.progress = progress.callback();
-        result = renderer.render(settings);
+        result = renderer->render(settings);
         settings.progress = {};
     }
     ctx.setActivity(flags.output, "writing the image");
     char line[200];
     std::snprintf(
         line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
-        renderer.deviceName(), result.stats.seconds,
+        renderer->deviceName(), result.stats.seconds,
         static_cast<unsigned long long>(result.stats.samples), result.stats.meanSamplesPerPixel(),
         result.setup.params.step / result.setup.frame.scale);
     ctx.step(line);
@@ -791,14 +772,14 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["source"] = source;
         j["field"] = field.name;
         j["field_association"] = associationName(field.association);
-        j["device"] = renderer.deviceName();
-        if (renderer.gpu()) {
+        j["device"] = renderer->deviceName();
+        if (renderer->gpu()) {
             j["gpu"] = {
                 {"description", cudaDeviceDescription()},
-                {"geometry_bytes", renderer.gpu()->geometryBytes()},
-                {"bytes_per_tetrahedron", double(renderer.gpu()->geometryBytes()) /
+                {"geometry_bytes", renderer->gpu()->geometryBytes()},
+                {"bytes_per_tetrahedron", double(renderer->gpu()->geometryBytes()) /
                                               std::max<std::size_t>(1, prepared.tets.tets.size())},
-                {"upload_seconds", renderer.gpu()->uploadSeconds()}};
+                {"upload_seconds", renderer->gpu()->uploadSeconds()}};
         }
         j["threads"] = cpu::threadCount();
         j["method"] = flags.method;

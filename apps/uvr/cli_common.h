@@ -132,34 +132,16 @@ struct RenderFlags {
     /// Checks before any work that every output can be written and that none names an input
     /// (the mesh file, when not empty, or a file the flags read) or another output.
     void checkFiles(const std::string& meshFile) const;
-    /// True when --device asks for CUDA, or is auto and a CUDA device is present.
-    bool useCuda() const;
-    /// True when --build-device asks for CUDA, or is auto and the render is on CUDA.
-    bool buildOnCuda() const;
-    /// What mesh preparation the flags need (partitions only for the adaptive method, the mesh
-    /// BVH only for the reference marcher, or also with the adaptive method when withReference;
-    /// the device's default leaf size unless --leaf-cells is given).
-    PrepareOptions prepareOptions(bool withReference = false) const;
+    /// What the renderer prepares and where (--device, --build-device, --leaf-cells,
+    /// --no-seed-grid): partitions only for the adaptive method, the mesh BVH only for the
+    /// reference and exact methods, or also with the adaptive method when withReference.
+    RendererOptions rendererOptions(bool withReference = false) const;
 };
 
-/// Renders frames of one prepared mesh on the device the flags chose (auto: CUDA when a device
-/// is present), keeping the GPU copy of the mesh across frames.
-class FrameRenderer {
-public:
-    /// Renders on the CPU, or uploads the mesh and renders with CUDA.
-    FrameRenderer(const PreparedMesh& mesh, bool cuda, const Context& ctx);
-    ~FrameRenderer();
-    /// Renders one frame.
-    RenderResult render(const RenderSettings& settings);
-    /// "cpu" or "cuda".
-    const char* deviceName() const { return gpu_ ? "cuda" : "cpu"; }
-    /// The GPU copy, when rendering on CUDA.
-    const CudaScene* gpu() const { return gpu_.get(); }
-
-private:
-    const PreparedMesh& mesh_;
-    std::unique_ptr<CudaScene> gpu_;
-};
+/// Prepares `field` of a mesh into a Renderer as the flags ask, with progress messages, and
+/// prints where it renders (the GPU, what was uploaded).
+std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
+                                       const RendererOptions& options, const Context& ctx);
 
 /// Loads a mesh with progress messages and validation; prints findings.
 Mesh loadMesh(const std::string& path, const Context& ctx);

@@ -10,6 +10,7 @@
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/facade/renderer.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/mesh.h"

@@ -285,7 +285,14 @@ Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg) {
 }
 
 Camera loadPvcc(const std::string& path, bool* hasParallelScale) {
-    std::vector<char> bytes = readFileBytes(path, kMaxPvccBytes, "camera file");
+    return parsePvcc(readFileBytes(path, kMaxPvccBytes, "camera file"), path, hasParallelScale);
+}
+
+Camera parsePvcc(const std::vector<char>& bytes, const std::string& path, bool* hasParallelScale) {
+    if (bytes.size() > kMaxPvccBytes)
+        throwError(ErrorKind::Resource, path,
+                   "camera file of " + std::to_string(bytes.size()) + " bytes: more than " +
+                       std::to_string(kMaxPvccBytes));
     // XML processors read UTF-8 and UTF-16 (expat converts UTF-16 to UTF-8), not UTF-32.
     const char* wide = wideTextEncoding(bytes.data(), bytes.size());
     if (wide && std::string(wide) == "UTF-32")
@@ -455,6 +462,38 @@ CameraRays makeCameraRays(const Camera& camera, int width, int height, double ne
     rays.dv = up * (-2.f * halfH / static_cast<float>(height));
     rays.originDu = rays.originDv = Vec3f(0.f);
     return rays;
+}
+
+std::string pvccText(const Camera& camera) {
+    validateCamera(camera);
+    std::string out =
+        "<?xml version=\"1.0\"?>\n"
+        "<PVCameraConfiguration description=\"ParaView camera configuration\" version=\"1.0\">\n"
+        "  <Proxy group=\"views\" type=\"RenderView\" id=\"4531\" servers=\"21\">\n";
+    // %.9g: every float reads back to itself.
+    auto property = [&](const char* name, std::initializer_list<double> values) {
+        char line[200];
+        std::snprintf(line, sizeof line,
+                      "    <Property name=\"%s\" id=\"4531.%s\" number_of_elements=\"%zu\">\n",
+                      name, name, values.size());
+        out += line;
+        int i = 0;
+        for (double v : values) {
+            std::snprintf(line, sizeof line, "      <Element index=\"%d\" value=\"%.9g\"/>\n", i++,
+                          v);
+            out += line;
+        }
+        out += "    </Property>\n";
+    };
+    auto vec = [&](const char* name, Vec3f v) { property(name, {v.x, v.y, v.z}); };
+    vec("CameraPosition", camera.position);
+    vec("CameraFocalPoint", camera.focalPoint);
+    vec("CameraViewUp", camera.viewUp);
+    property("CameraViewAngle", {camera.viewAngle});
+    property("CameraParallelScale", {camera.parallelScale});
+    property("CameraParallelProjection", {camera.parallelProjection ? 1.0 : 0.0});
+    out += "  </Proxy>\n</PVCameraConfiguration>\n";
+    return out;
 }
 
 }  // namespace uvr

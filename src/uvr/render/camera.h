@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/ray.h"
@@ -55,6 +56,16 @@ Camera orbitCamera(const Camera& camera, float azimuthDeg, float elevationDeg);
 /// parallel projection needs); throws Error(Parse) naming the file and the missing or bad
 /// property. hasParallelScale (when given) says whether the file held CameraParallelScale.
 Camera loadPvcc(const std::string& path, bool* hasParallelScale = nullptr);
+
+/// loadPvcc of a camera file held in memory (an upload); `source` names it in errors.
+Camera parsePvcc(const std::vector<char>& bytes, const std::string& source,
+                 bool* hasParallelScale = nullptr);
+
+/// The camera as a ParaView camera file (.pvcc) that loadPvcc (and ParaView's "Load Camera
+/// Configuration") reads back to the same camera: position, focal point, view up, view angle,
+/// parallel scale and projection, each float written to read back exactly. Throws
+/// Error(Argument) for a camera validateCamera refuses.
+std::string pvccText(const Camera& camera);
 
 /// Throws Error(Argument) when the camera cannot produce an image: non-finite values, position
 /// equal to the focal point, view up parallel to the view direction, angle outside

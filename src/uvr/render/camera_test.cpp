@@ -241,6 +241,36 @@ TEST(Camera, LoadsParaViewCameraFile) {
     EXPECT_FLOAT_EQ(cam.viewAngle, 22.5f);
 }
 
+TEST(Camera, PvccTextReadsBackToTheSameCamera) {
+    Camera cam;
+    cam.position = {1.f / 3.f, -2.5e7f, 7.125f};
+    cam.focalPoint = {0.1f, 0.2f, -0.3f};
+    cam.viewUp = {0.f, 0.f, 1.f};
+    cam.viewAngle = 12.345f;
+    for (bool parallel : {false, true}) {
+        cam.parallelProjection = parallel;
+        cam.parallelScale = 3.0e-3f;
+        const std::string text = pvccText(cam);
+        bool hasScale = false;
+        const Camera back =
+            parsePvcc(std::vector<char>(text.begin(), text.end()), "upload", &hasScale);
+        EXPECT_TRUE(hasScale);
+        expectVec(back.position, cam.position, 0.f, "position");
+        expectVec(back.focalPoint, cam.focalPoint, 0.f, "focal point");
+        expectVec(back.viewUp, cam.viewUp, 0.f, "view up");
+        EXPECT_EQ(back.viewAngle, cam.viewAngle);
+        EXPECT_EQ(back.parallelProjection, parallel);
+        EXPECT_EQ(back.parallelScale, cam.parallelScale);
+    }
+    cam.viewUp = cam.focalPoint - cam.position;  // parallel to the view: no such file is written
+    EXPECT_EQ(catchError([&] { pvccText(cam); }).kind(), ErrorKind::Argument);
+    const std::string bad = "<PVCameraConfiguration>";
+    EXPECT_THAT(catchError([&] {
+                    parsePvcc({bad.begin(), bad.end()}, "the upload");
+                }).what(),
+                ::testing::HasSubstr("the upload"));
+}
+
 TEST(Camera, Utf16CameraFilesReadTheSameAndUtf32IsRefused) {
     // XML processors must read UTF-16 (XML 1.0, Sec. 4.3.3); expat does, with or without a
     // byte-order mark. A UTF-16 file that declares itself UTF-8 gets a hint.

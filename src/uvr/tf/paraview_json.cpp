@@ -179,9 +179,9 @@ std::vector<ColorPoint> resampleHsv(const std::vector<ColorPoint>& in, bool wrap
 
 namespace {
 
-/// Reads and parses a colour-map JSON file; Error(Parse) naming the byte for invalid JSON.
-Json readColorMapDocument(const std::string& path) {
-    std::vector<char> bytes = readFileBytes(path, kMaxJsonBytes, "colour-map file");
+/// Parses a colour-map JSON document (the bytes of `path`); Error(Parse) naming the byte for
+/// invalid JSON.
+Json parseColorMapDocument(const std::string& path, const std::vector<char>& bytes) {
     checkJsonShape(path, bytes);
     Json doc;
     try {
@@ -286,7 +286,8 @@ bool jsonFlag(const Json& map, const char* key) {
 }  // namespace
 
 std::vector<ColorMapInfo> listParaViewColorMaps(const std::string& path) {
-    const Json doc = readColorMapDocument(path);
+    const Json doc =
+        parseColorMapDocument(path, readFileBytes(path, kMaxJsonBytes, "colour-map file"));
     std::vector<ColorMapInfo> out;
     auto add = [&](const Json& m, const std::string& where) {
         if (!m.is_object())
@@ -312,7 +313,16 @@ std::vector<ColorMapInfo> listParaViewColorMaps(const std::string& path) {
 }
 
 TransferFunction loadParaViewColorMap(const std::string& path, const std::string& name) {
-    const Json doc = readColorMapDocument(path);
+    return parseParaViewColorMap(readFileBytes(path, kMaxJsonBytes, "colour-map file"), path, name);
+}
+
+TransferFunction parseParaViewColorMap(const std::vector<char>& bytes, const std::string& path,
+                                       const std::string& name) {
+    if (bytes.size() > kMaxJsonBytes)
+        throwError(ErrorKind::Resource, path,
+                   "colour map of " + std::to_string(bytes.size()) + " bytes: more than " +
+                       std::to_string(kMaxJsonBytes));
+    const Json doc = parseColorMapDocument(path, bytes);
     // Step 1: the colour-map object: a file's only one, or the one named (ParaView's exports
     // and presets files are arrays of them).
     std::string where = "colour map";
@@ -461,6 +471,49 @@ TransferFunction loadParaViewColorMap(const std::string& path, const std::string
     }
     tf.opacities.push_back({1.f, raw.opacityAt(1.f)});
     return tf;
+}
+
+std::string paraViewColorMapJson(const TransferFunction& tf, double lo, double hi) {
+    if (!(std::isfinite(lo) && std::isfinite(hi) && lo < hi))
+        throwError(ErrorKind::Argument, "",
+                   "a colour-map export needs a finite range lo < hi, got [" + std::to_string(lo) +
+                       ", " + std::to_string(hi) + "]");
+    if (tf.logScale && !(lo > 0.0))
+        throwError(ErrorKind::Argument, "",
+                   "a log-scale colour-map export needs a positive range, got [" +
+                       std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (tf.colors.empty() || tf.opacities.empty())
+        throwError(ErrorKind::Argument, "", "a colour-map export needs colour and opacity points");
+    // Data value of normalised position t (vtkNormalize's inverse).
+    const double pLo = tf.logScale ? std::log10(lo) : lo;
+    const double pHi = tf.logScale ? std::log10(hi) : hi;
+    auto value = [&](double t) {
+        if (t <= 0.0) return lo;
+        if (t >= 1.0) return hi;
+        const double p = pLo + t * (pHi - pLo);
+        return tf.logScale ? std::pow(10.0, p) : p;
+    };
+    Json rgb = Json::array();
+    auto addColor = [&](double t, Vec3f c) {
+        rgb.insert(rgb.end(), {value(t), double(c.x), double(c.y), double(c.z)});
+    };
+    if (tf.colors.front().x > 0.f) addColor(0.0, tf.colors.front().rgb);
+    for (const ColorPoint& c : tf.colors) addColor(c.x, c.rgb);
+    if (tf.colors.back().x < 1.f) addColor(1.0, tf.colors.back().rgb);
+    Json points = Json::array();
+    for (const OpacityPoint& o : tf.opacities)
+        points.insert(points.end(), {value(o.x), double(o.alpha), 0.5, 0.0});
+    const char* space = tf.colorSpace == ColorSpace::Lab         ? "Lab"
+                        : tf.colorSpace == ColorSpace::Diverging ? "Diverging"
+                                                                 : "RGB";
+    Json map = {{"Name", tf.name.empty() ? "uvr" : tf.name},
+                {"ColorSpace", space},
+                {"RGBPoints", rgb},
+                {"Points", points},
+                {"NanColor", {double(tf.nanColor.x), double(tf.nanColor.y), double(tf.nanColor.z)}},
+                {"NanOpacity", double(tf.nanOpacity)},
+                {"UseLogScale", tf.logScale ? 1 : 0}};
+    return Json::array({map}).dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace uvr

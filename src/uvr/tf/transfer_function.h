@@ -115,6 +115,18 @@ std::vector<ColorMapInfo> listParaViewColorMaps(const std::string& path);
 /// (close ones first), and Error(Parse) naming the file and the offending key on malformed input.
 TransferFunction loadParaViewColorMap(const std::string& path, const std::string& name = "");
 
+/// loadParaViewColorMap of a document held in memory (an upload); `source` names it in errors.
+TransferFunction parseParaViewColorMap(const std::vector<char>& bytes, const std::string& source,
+                                       const std::string& name = "");
+
+/// The transfer function as a ParaView colour-map JSON export (an array of one map) over the data
+/// range [lo, hi]: Name, ColorSpace, RGBPoints and Points (midpoint 0.5, sharpness 0) at data
+/// values (spaced on a log scale with logScale), NanColor, NanOpacity and UseLogScale. Colour
+/// points are written from 0 to 1 (the end colours repeated where the map starts later or ends
+/// earlier), so loadParaViewColorMap reads the same map back. Throws Error(Argument) unless
+/// lo < hi, both finite, and lo > 0 with logScale.
+std::string paraViewColorMapJson(const TransferFunction& tf, double lo, double hi);
+
 /// Replaces the opacity points from a spec: "ramp" (0 -> 1), "ramp:A" (0 -> A), "constant:A",
 /// "step:T[:A]" (0 below normalised T, A (default 1) at and above: a "binary" transfer function),
 /// or a list "x0:a0,x1:a1,..." of normalised positions. Throws Error(Argument) on a bad spec.

@@ -381,6 +381,55 @@ TEST(TransferFunction, LoadsParaViewExport) {
     EXPECT_NEAR(tf.opacityAt(1.f), 1.f, 1e-6f);
 }
 
+TEST(TransferFunction, ParaViewJsonExportReadsBackToTheSameMap) {
+    // Every preset with a shaped opacity, linear and log, over a range that is not [0, 1]; the
+    // export is parsed in memory as an upload would be.
+    for (const std::string& name : transferFunctionPresetNames()) {
+        for (bool log : {false, true}) {
+            TransferFunction tf = transferFunctionPreset(name);
+            applyOpacitySpec(tf, "0:0,0.3:0.8,0.31:0.1,1:0.5");
+            tf.logScale = log;
+            tf.nanColor = {0.25f, 0.5f, 0.75f};
+            tf.nanOpacity = 0.125f;
+            const double lo = log ? 0.01 : -3.5, hi = 420.0;
+            const std::string text = paraViewColorMapJson(tf, lo, hi);
+            const TransferFunction back =
+                parseParaViewColorMap(std::vector<char>(text.begin(), text.end()), "upload");
+            const std::string what = name + (log ? " (log)" : "");
+            EXPECT_EQ(back.name, tf.name) << what;
+            EXPECT_EQ(back.colorSpace, tf.colorSpace) << what;
+            EXPECT_EQ(back.logScale, log) << what;
+            ASSERT_TRUE(back.sourceRange) << what;
+            EXPECT_FLOAT_EQ(back.sourceRange->first, float(lo)) << what;
+            EXPECT_FLOAT_EQ(back.sourceRange->second, float(hi)) << what;
+            expectVec(back.nanColor, tf.nanColor, 0.f, what);
+            EXPECT_EQ(back.nanOpacity, tf.nanOpacity) << what;
+            for (int i = 0; i <= 200; ++i) {
+                const float t = i / 200.f;
+                expectVec(back.colorAt(t), tf.colorAt(t), 2e-5f, what + " at " + std::to_string(t));
+                EXPECT_NEAR(back.opacityAt(t), tf.opacityAt(t), 2e-5f) << what << " at " << t;
+            }
+        }
+    }
+}
+
+TEST(TransferFunction, ParaViewJsonExportRefusesBadRangesAndUploadsNameTheirSource) {
+    const TransferFunction tf = transferFunctionPreset("viridis");
+    EXPECT_EQ(catchError([&] { paraViewColorMapJson(tf, 1.0, 1.0); }).kind(), ErrorKind::Argument);
+    EXPECT_EQ(catchError([&] { paraViewColorMapJson(tf, 0.0, NAN); }).kind(), ErrorKind::Argument);
+    TransferFunction log = tf;
+    log.logScale = true;
+    EXPECT_THAT(catchError([&] { paraViewColorMapJson(log, 0.0, 1.0); }).what(),
+                HasSubstr("positive range"));
+    const std::string bad = R"([{"Name": "x", "RGBPoints": [0, 1, 2]}])";
+    const Error e = catchError([&] {
+        parseParaViewColorMap({bad.begin(), bad.end()}, "the upload");
+    });
+    EXPECT_EQ(e.kind(), ErrorKind::Parse);
+    EXPECT_THAT(e.what(), HasSubstr("the upload"));
+    EXPECT_THAT(e.what(), HasSubstr("RGBPoints"));
+}
+
 TEST(TransferFunction, ParaViewCoolToWarmExportEqualsPreset) {
     std::string dir = scratchDir();
     std::string path = writeFile(dir + "/ctw.json", R"({"ColorSpace": "Diverging",

@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/facade/renderer.h"
+
+#include <chrono>
+
+#include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/cpu/threads.h"
+#include "uvr/cuda/cuda_build.h"
+#include "uvr/cuda/cuda_renderer.h"
+
+namespace uvr {
+
+Device parseDevice(const std::string& text, const std::string& what) {
+    if (text == "auto") return Device::Auto;
+    if (text == "cpu") return Device::Cpu;
+    if (text == "cuda") return Device::Cuda;
+    throwError(ErrorKind::Argument, "",
+               what + ": expected auto, cpu or cuda, got \"" + text + "\"");
+}
+
+bool resolvesToCuda(Device device) {
+    return device == Device::Cuda || (device == Device::Auto && cudaDeviceAvailable());
+}
+
+PrepareOptions RendererOptions::prepareOptions() const {
+    const bool renderOnCuda = resolvesToCuda(device);
+    const bool buildOnCuda =
+        buildDevice == Device::Cuda || (buildDevice == Device::Auto && renderOnCuda);
+    PrepareOptions o;
+    if (buildOnCuda) {
+        o.lbvh = buildLbvhCuda;
+        o.kdSplitter = buildKdTreeCuda;
+        o.builderDevice = "the GPU";
+        if (buildDevice == Device::Auto) o.builderMinTets = kAutoGpuBuildTets;
+    }
+    o.partitions = partitions;
+    o.meshBvh = meshBvh;
+    o.seedGrids = seedGrids;
+    if (leafCells)
+        o.kd.leafCells = leafCells;
+    else if (renderOnCuda)
+        o.kd.leafCells = kCudaDefaultLeafCells;
+    return o;
+}
+
+namespace {
+
+/// Throws Error(Unsupported) for Device::Cuda without a usable CUDA device.
+void checkDeviceUsable(Device device) {
+    if (device == Device::Cuda && !cudaDeviceAvailable())
+        throwError(ErrorKind::Unsupported, "",
+                   "rendering on CUDA was asked for, but " + cudaDeviceDescription());
+}
+
+std::unique_ptr<CudaScene> uploadIf(Device device, const PreparedMesh& prepared) {
+    return resolvesToCuda(device) ? std::make_unique<CudaScene>(prepared) : nullptr;
+}
+
+}  // namespace
+
+Renderer::Renderer(const Mesh& mesh, const ScalarField& field, const RendererOptions& options,
+                   const ProgressFn& progress) {
+    checkDeviceUsable(options.device);
+    const auto start = std::chrono::steady_clock::now();
+    prepared_ = std::make_unique<PreparedMesh>(
+        prepareMesh(mesh, field, options.prepareOptions(), progress));
+    prepareSeconds_ =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    gpu_ = uploadIf(options.device, *prepared_);
+}
+
+Renderer::Renderer(PreparedMesh prepared, Device device)
+    : prepared_(std::make_unique<PreparedMesh>(std::move(prepared))) {
+    checkDeviceUsable(device);
+    gpu_ = uploadIf(device, *prepared_);
+}
+
+Renderer::~Renderer() = default;
+
+RenderResult Renderer::render(const RenderSettings& settings) {
+    return gpu_ ? gpu_->render(settings) : renderCpu(*prepared_, settings);
+}
+
+std::string Renderer::deviceDescription() const {
+    if (gpu_) return cudaDeviceDescription();
+    return "CPU, " + std::to_string(cpu::threadCount()) + " threads";
+}
+
+}  // namespace uvr

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "uvr/mesh/field_select.h"
+#include "uvr/mesh/mesh.h"
+#include "uvr/render/render_setup.h"
+
+namespace uvr {
+
+class CudaScene;
+
+/// Where frames render, or where acceleration structures build.
+enum class Device {
+    Auto,  ///< CUDA when a CUDA device can be used, else the CPU
+    Cpu,
+    Cuda,
+};
+
+/// Parses "auto", "cpu" or "cuda"; throws Error(Argument) naming `what` (a flag or argument)
+/// and the choices otherwise.
+Device parseDevice(const std::string& text, const std::string& what);
+
+/// True for Device::Cuda, or for Device::Auto when a CUDA device can be used.
+bool resolvesToCuda(Device device);
+
+/// What a Renderer prepares and where.
+struct RendererOptions {
+    Device device = Device::Auto;  ///< where frames render
+    /// Where the BVHs and the k-d tree build: Auto builds on the GPU when frames render there and
+    /// the mesh has kAutoGpuBuildTets tetrahedra or more.
+    Device buildDevice = Device::Auto;
+    bool partitions = true;       ///< the k-d partitions of RenderMethod::Partitions
+    bool meshBvh = true;          ///< the mesh BVH of RenderMethod::Reference and Exact
+    bool seedGrids = true;        ///< with partitions: seed grids for long steps
+    std::uint32_t leafCells = 0;  ///< cells per k-d partition; 0: the device's default
+
+    /// The preparation these options ask for (the builders of the GPU when buildDevice resolves
+    /// to it, the device's default leaf size).
+    PrepareOptions prepareOptions() const;
+};
+
+/// The one renderer object of the library: a mesh prepared once for one field (tetrahedra,
+/// BVHs, neighbours, partitions), resident on the GPU when it renders there, rendering any
+/// number of frames. Camera, transfer function, range, method and quality are per-frame
+/// settings: changing them rebuilds nothing geometric. The CLI, the server and the Python
+/// module all render through it. One frame at a time (render is not reentrant).
+class Renderer {
+public:
+    /// Prepares `field` of `mesh` (which need not outlive the renderer) as `options` ask and
+    /// uploads it when rendering on the GPU. Throws Error(Unsupported) for Device::Cuda without
+    /// a usable CUDA device, Error(Resource) when the GPU lacks memory.
+    Renderer(const Mesh& mesh, const ScalarField& field, const RendererOptions& options = {},
+             const ProgressFn& progress = {});
+    /// Renders an already prepared mesh, taking it over, on `device`.
+    Renderer(PreparedMesh prepared, Device device);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    /// Renders one frame; throws Error(Argument) for settings validateSettings refuses and for a
+    /// method whose structures were not prepared.
+    RenderResult render(const RenderSettings& settings);
+
+    /// The prepared mesh.
+    const PreparedMesh& prepared() const { return *prepared_; }
+    /// True when frames render on the GPU.
+    bool onGpu() const { return gpu_ != nullptr; }
+    /// "cpu" or "cuda".
+    const char* deviceName() const { return gpu_ ? "cuda" : "cpu"; }
+    /// One line naming the device: the GPU and its memory, or the CPU threads.
+    std::string deviceDescription() const;
+    /// The GPU copy of the mesh when rendering on the GPU, else null.
+    const CudaScene* gpu() const { return gpu_.get(); }
+    /// Seconds the preparation took (0 for a mesh prepared elsewhere).
+    double prepareSeconds() const { return prepareSeconds_; }
+
+private:
+    std::unique_ptr<PreparedMesh> prepared_;
+    std::unique_ptr<CudaScene> gpu_;
+    double prepareSeconds_ = 0.0;
+};
+
+}  // namespace uvr
