@@ -90,11 +90,18 @@ class Server:
                 lines.put(line)
                 self.log.write("[stdout] " + line)
                 self.log.flush()
+            lines.put(None)  # the server closed its output (it exited)
         threading.Thread(target=pump, daemon=True).start()
         try:
             first = lines.get(timeout=90)
         except queue.Empty:
             raise Failure("uvr view printed no URL within 90 s")
+        if first is None:
+            self.proc.wait()
+            self.log.flush()
+            with open(log_path) as f:
+                raise Failure(f"uvr view exited ({self.proc.returncode}) before serving: "
+                              f"{f.read().strip()}")
         m = re.match(r"uvr: serving (http://[^\s/]+)/\?token=([A-Za-z0-9_-]+)", first)
         check(m, f"uvr view's first line is not 'uvr: serving http://HOST:PORT/?token=T': {first!r}")
         self.origin, self.token = m.group(1), m.group(2)
@@ -233,7 +240,7 @@ class Page:
 
     def wait_settled(self, seq, timeout=30, what="the frame of the last change"):
         """Waits for the full-resolution frame of `seq` (or a later one), decoded and drawn."""
-        self.wait(f"v.lastFrame && v.lastFrame.full && v.lastFrame.seq >= {seq} && "
+        self.wait(f"v.lastFrame && v.lastFrame.full && (v.lastFrame.seq ?? 0) >= {seq} && "
                   "v.framesDecoded === v.frameCount", timeout, what)
         return self.hook("lastFrame")
 
@@ -639,8 +646,9 @@ def main():
     if not os.access(args.uvr, os.X_OK):
         print(f"FAILED: no uvr binary at {args.uvr}")
         return 1
-    has_view = subprocess.run([args.uvr, "view", "--help"], capture_output=True)
-    if has_view.returncode != 0:
+    # `uvr view --help` of a uvr without `view` prints the top-level help: look for --port.
+    has_view = subprocess.run([args.uvr, "view", "--help"], capture_output=True, text=True)
+    if has_view.returncode != 0 or "--port" not in has_view.stdout:
         skip("this uvr has no `view` subcommand (built without the server)")
 
     tmp = tempfile.mkdtemp(prefix="uvr-view-test-")
