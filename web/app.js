@@ -766,7 +766,8 @@ $("banner-reload").addEventListener("click", () => location.reload());
 // ---- Test hook -------------------------------------------------------------------------------
 
 /// Read-only view of the session for tests (tests/web/view_page_test.py), which wait on it
-/// instead of sleeping; `sendRaw` puts any text on the socket, as a misbehaving client would.
+/// instead of sleeping; `set` changes the state as the controls do, `sendRaw` puts any text on
+/// the socket, as a misbehaving client would.
 window.uvrView = Object.freeze({
     get connected() { return session.connected; },
     get info() { return structuredClone(session.info); },
@@ -781,6 +782,8 @@ window.uvrView = Object.freeze({
     get messageCounts() { return {...session.counts}; },
     get lastExport() { return session.lastExport ? {...session.lastExport} : null; },
     get lastPong() { return session.lastPong ? {...session.lastPong} : null; },
+    /// Sends a `set` as the controls do (the local state follows); returns its seq.
+    set(changes, interactive = false) { return sendSet(structuredClone(changes), interactive); },
     sendRaw(text) {
         if (!session.ws || session.ws.readyState !== WebSocket.OPEN) return false;
         session.ws.send(text);

@@ -584,37 +584,25 @@ def wrong_token_page(page):
 
 
 def docs_screenshot(page, path):
-    """Blunt Fin in an oblique view with two opacity bands: docs/images/viewer.png."""
+    """Blunt Fin in an oblique view with a few opacity bands: docs/images/viewer.png."""
     page.d.get(page.server.url)
     page.wait("v.info && v.state", 120, "the info message")
     page.wait_settled(0, 120, "the first frame")
-    state = page.hook("state")
-    page.js("window.uvrView.sendRaw(JSON.stringify({type: 'set', preset: 'Plasma (matplotlib)'}));")
+    page.js("window.uvrView.set({preset: 'Plasma (matplotlib)'});")
     page.wait("v.state.tf.name.startsWith('Plasma')", 30, "the preset")
-    camera = dict(state["camera"])
-    f, p = camera["focal_point"], camera["position"]
-    # ParaView's reset camera orbited by azimuth 35, elevation 25 (as the oracle's views).
-    page.js("""
-        const [f, p] = [arguments[0], arguments[1]];
-        const c = window.uvrView.state.camera;
-        const rot = (v, k, a) => { const s = Math.sin(a), co = Math.cos(a);
-            const kv = [k[1]*v[2]-k[2]*v[1], k[2]*v[0]-k[0]*v[2], k[0]*v[1]-k[1]*v[0]];
-            const d = k[0]*v[0]+k[1]*v[1]+k[2]*v[2];
-            return v.map((x, i) => x*co + kv[i]*s + k[i]*d*(1-co)); };
-        let off = p.map((x, i) => x - f[i]);
-        off = rot(off, [0, 1, 0], 35 * Math.PI / 180);
-        const dir = off.map((x) => -x); const n = Math.hypot(...dir);
-        const right = [dir[1]*0 - dir[2]*1, dir[2]*0 - dir[0]*0, dir[0]*1 - dir[1]*0].map((x) => x / n);
-        const rl = Math.hypot(...right);
-        off = rot(off, right.map((x) => x / rl), -25 * Math.PI / 180);
-        const pos = off.map((x, i) => f[i] + 0.8 * x);
-        const tf = window.uvrView.state.tf;
-        window.uvrView.sendRaw(JSON.stringify({type: 'set', seq: 900, camera: {...c, position: pos,
-            view_up: [0, 1, 0]}, tf: {...tf, opacity: [[0, 0], [0.18, 0], [0.3, 0.35], [0.42, 0.04],
-            [0.62, 0.06], [0.75, 0.7], [0.82, 0.1], [1, 0.9]]}}));""", f, p)
-    page.wait_settled(900, 120, "the docs view")
+    # ParaView's reset camera orbited by azimuth 35 and elevation 25 with the page's own
+    # trackball math, a little closer.
+    seq = page.d.execute_async_script("""
+        const done = arguments[arguments.length - 1];
+        import('./camera.js').then((cam) => {
+            const v = window.uvrView;
+            const camera = cam.dolly(cam.orbit(v.state.camera, 35, 25), 1.25);
+            const tf = {...v.state.tf, opacity: [[0, 0], [0.16, 0], [0.26, 0.25], [0.36, 0.02],
+                [0.55, 0.05], [0.68, 0.6], [0.76, 0.08], [0.9, 0.5], [1, 1]]};
+            done(v.set({camera, tf}));
+        });""")
+    page.wait_settled(seq, 120, "the docs view")
     page.quiet(1.0, 120)
-    page.js("document.getElementById('range-lo').blur();")
     page.d.save_screenshot(path)
     print(f"wrote {path}")
 
