@@ -54,8 +54,7 @@ const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heat
 /// `colormap_json`), applies the state keys locally and returns its seq.
 function sendSet(changes, interactive = false) {
     const seq = ++session.seq;
-    const message = {type: "set", seq, ...changes};
-    if (interactive) message.interactive = true;
+    const message = {type: "set", seq, interactive, ...changes};
     if (!send(message)) return seq;
     for (const k of kStateKeys) {
         if (k in changes && session.state) session.state[k] = structuredClone(changes[k]);
