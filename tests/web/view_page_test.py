@@ -587,22 +587,23 @@ def wrong_token_page(page):
 
 
 def docs_screenshot(page, path):
-    """Blunt Fin in an oblique view with a few opacity bands: docs/images/viewer.png."""
+    """Blunt Fin in an oblique view, Turbo over density 0.2-3 with a rising opacity:
+    docs/images/viewer.png."""
     page.d.get(page.server.url)
     page.wait("v.info && v.state", 120, "the info message")
     page.wait_settled(0, 120, "the first frame")
-    page.js("window.uvrView.set({preset: 'Plasma (matplotlib)'});")
-    page.wait("v.state.tf.name.startsWith('Plasma')", 30, "the preset")
+    page.js("window.uvrView.set({preset: 'Turbo'});")
+    page.wait("v.state.tf.name === 'Turbo'", 30, "the preset")
     # ParaView's reset camera orbited by azimuth 35 and elevation 25 with the page's own
-    # trackball math, a little closer.
+    # trackball math.
     seq = page.d.execute_async_script("""
         const done = arguments[arguments.length - 1];
         import('./camera.js').then((cam) => {
             const v = window.uvrView;
-            const camera = cam.dolly(cam.orbit(v.state.camera, 35, 25), 1.25);
-            const tf = {...v.state.tf, opacity: [[0, 0], [0.16, 0], [0.26, 0.25], [0.36, 0.02],
-                [0.55, 0.05], [0.68, 0.6], [0.76, 0.08], [0.9, 0.5], [1, 1]]};
-            done(v.set({camera, tf}));
+            const camera = cam.orbit(v.state.camera, 35, 25);
+            const tf = {...v.state.tf, opacity: [[0, 0], [0.12, 0], [0.3, 0.03], [0.5, 0.2],
+                                                 [0.75, 0.6], [1, 1]]};
+            done(v.set({camera, tf, range: [0.2, 3]}));
         });""")
     page.wait_settled(seq, 120, "the docs view")
     page.quiet(1.0, 120)
