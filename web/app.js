@@ -155,7 +155,7 @@ function onInfo(m) {
     $("title-file").title = m.file || "";
     fillMeshInfo(m);
     fillSelectors(m);
-    resizeCanvas();
+    resizeCanvas(session.state.size);
     updateControls();
     scheduleExportRefresh();
 }
@@ -166,7 +166,6 @@ function onState(state) {
     session.state = {...(session.state || {}), ...structuredClone(next)};
     session.exportFresh = false;
     hideProgress();
-    resizeCanvas();
     updateControls();
     scheduleExportRefresh();
 }
@@ -203,6 +202,7 @@ async function drawFrame(header, buffer) {
     drawnDecode = id;
     if (shownBitmap) shownBitmap.close();
     shownBitmap = bitmap;
+    resizeCanvas(fullSize(header));
     paint();
 }
 
@@ -216,9 +216,16 @@ function paint() {
     viewContext.drawImage(shownBitmap, 0, 0, view.width, view.height);
 }
 
-/// Gives the canvas the state's image size and fits it, with that aspect, into its area.
-function resizeCanvas() {
-    const size = session.state && session.state.size;
+/// The full-resolution size of a frame: a reduced frame's size times its reduction factor (a
+/// whole number, found from the heights). Not simply the state's size: a heat map may carry a
+/// legend that widens the image.
+function fullSize(header) {
+    const k = Math.max(1, Math.round(session.state.size[1] / header.height));
+    return [header.width * k, header.height * k];
+}
+
+/// Gives the canvas `size` (when given) and fits it, with that aspect, into its area.
+function resizeCanvas(size) {
     if (size && (view.width !== size[0] || view.height !== size[1])) {
         view.width = size[0];
         view.height = size[1];
@@ -508,7 +515,6 @@ function applySize([w, h]) {
     }
     $("size-custom").hidden = true;
     sendSet({size: [w, h]});
-    resizeCanvas();
 }
 
 $("preset").addEventListener("change", (e) => {
