@@ -3,14 +3,16 @@
 # Installs every build and test dependency of uvr from Debian 12's packages (run as root); clang
 # with libFuzzer (libclang-rt-14-dev) and its OpenMP (libomp-dev) build the fuzz targets; xvfb
 # (xvfb-run) gives VTK the X display the oracle test (tests/tools/vtk_oracle_test.py) needs;
-# FreeType, fontconfig and the DejaVu fonts draw the colour legend (`--legend`); chromium,
-# chromium-driver and python3-selenium run the browser test of `uvr view`'s page
+# FreeType, fontconfig and the DejaVu fonts draw the colour legend (`--legend`); Boost (Beast,
+# headers only) and libturbojpeg serve the browser viewer (`uvr view`); chromium,
+# chromium-driver and python3-selenium run the browser test of its page
 # (tests/web/view_page_test.py).
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
   zlib1g-dev libpng-dev libexpat1-dev libcli11-dev nlohmann-json3-dev
   libfreetype-dev libfontconfig-dev fonts-dejavu-core
+  libboost-dev libturbojpeg0-dev
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev libomp-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage

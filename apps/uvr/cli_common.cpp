@@ -210,6 +210,16 @@ CLI::Validator positiveNumber() {
 
 }  // namespace
 
+void addMethodOption(CLI::App& app, std::string& method) {
+    app.add_option("--method", method,
+                   "Integrator: adaptive (k-d partitions and macrocells: space skipping, "
+                   "error-bounded adaptive steps; Morrical et al. 2019 and beyond), "
+                   "reference (fixed step s1 everywhere) or exact (no sampling: every "
+                   "tetrahedron's segment integrated exactly)")
+        ->check(CLI::IsMember({"reference", "adaptive", "exact"}))
+        ->capture_default_str();
+}
+
 void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     if (oneFrame)
         app.add_option("-o,--output", output,
@@ -265,14 +275,7 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Distance over which a TF opacity applies (default: ParaView's "
                    "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))")
         ->check(positiveNumber());
-    if (oneFrame)
-        app.add_option("--method", method,
-                       "Integrator: adaptive (k-d partitions and macrocells: space skipping, "
-                       "error-bounded adaptive steps; Morrical et al. 2019 and beyond), "
-                       "reference (fixed step s1 everywhere) or exact (no sampling: every "
-                       "tetrahedron's segment integrated exactly)")
-            ->check(CLI::IsMember({"reference", "adaptive", "exact"}))
-            ->capture_default_str();
+    if (oneFrame) addMethodOption(app, method);
     app.add_option("--sampling", sampling,
                    "Reference and adaptive: preintegrated (integrate between consecutive samples, "
                    "the scalar linear from one to the next: no transfer-function feature is "

@@ -172,5 +172,9 @@ void addRefineCommand(CLI::App& app, Context& ctx);
 void addCompareCommand(CLI::App& app, Context& ctx);
 void addBenchCommand(CLI::App& app, Context& ctx);
 void addPresetsCommand(CLI::App& app, Context& ctx);
+void addViewCommand(CLI::App& app, Context& ctx);
+
+/// Adds --method (adaptive, reference or exact) bound to `method`.
+void addMethodOption(CLI::App& app, std::string& method);
 
 }  // namespace uvr::cli

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
     cli::addCompareCommand(app, ctx);
     cli::addBenchCommand(app, ctx);
     cli::addPresetsCommand(app, ctx);
+    cli::addViewCommand(app, ctx);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

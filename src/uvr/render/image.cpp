@@ -55,9 +55,12 @@ std::uint8_t toByte(float v) {
     return static_cast<std::uint8_t>(std::lround(v * 255.f));
 }
 
-/// Where encodePng's bytes go: an output file, with the first failure kept for rethrowing.
+/// Where encodePng's bytes go: an output file or memory, with the first failure kept for
+/// rethrowing; the zlib level (-1: libpng's default).
 struct PngSink {
     OutputFile* out = nullptr;
+    std::vector<std::uint8_t>* memory = nullptr;
+    int level = -1;
     std::exception_ptr failure;
 };
 
@@ -66,7 +69,10 @@ void writeToSink(png_structp png, png_bytep data, png_size_t count) {
     auto* sink = static_cast<PngSink*>(png_get_io_ptr(png));
     bool failed = false;
     try {
-        sink->out->write(data, count);
+        if (sink->out)
+            sink->out->write(data, count);
+        else
+            sink->memory->insert(sink->memory->end(), data, data + count);
     } catch (...) {
         sink->failure = std::current_exception();
         failed = true;
@@ -93,6 +99,7 @@ bool encodePng(PngSink& sink, int width, int height, bool alpha, png_bytep* rows
         return false;
     }
     png_set_write_fn(png, &sink, writeToSink, flushSink);
+    if (sink.level >= 0) png_set_compression_level(png, sink.level);
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                  alpha ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -163,11 +170,15 @@ void writePng(const std::string& path, const Image& image, const std::optional<V
     out.commit();
 }
 
-void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& background) {
-    const std::string& path = out.path();
+namespace {
+
+/// Encodes the image as 8-bit PNG rows into the sink: straight RGBA, or RGB composited over the
+/// background. `what` names the destination in errors.
+void encodeImage(PngSink& sink, const std::string& what, const Image& image,
+                 const std::optional<Vec3f>& background) {
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != static_cast<size_t>(image.width) * image.height) {
-        throwError(ErrorKind::Argument, path,
+        throwError(ErrorKind::Argument, what,
                    "cannot write a " + std::to_string(image.width) + " x " +
                        std::to_string(image.height) + " image with " +
                        std::to_string(image.pixels.size()) + " pixels as PNG");
@@ -193,11 +204,31 @@ void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& b
     for (int y = 0; y < image.height; ++y)
         rows[y] = &bytes[static_cast<size_t>(y) * image.width * channels];
 
-    PngSink sink{&out, nullptr};
     PngErrorState state;
     const bool ok = encodePng(sink, image.width, image.height, alpha, rows.data(), state);
     if (sink.failure) std::rethrow_exception(sink.failure);
-    if (!ok) throwError(ErrorKind::Io, path, std::string("PNG write failed: ") + state.message);
+    if (!ok) throwError(ErrorKind::Io, what, std::string("PNG write failed: ") + state.message);
+}
+
+}  // namespace
+
+void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& background) {
+    PngSink sink;
+    sink.out = &out;
+    encodeImage(sink, out.path(), image, background);
+}
+
+std::vector<std::uint8_t> encodePng(const Image& image, const std::optional<Vec3f>& background,
+                                    int level) {
+    if (level < -1 || level > 9)
+        throwError(ErrorKind::Argument, "",
+                   "PNG compression level " + std::to_string(level) + ": expected -1 to 9");
+    std::vector<std::uint8_t> bytes;
+    PngSink sink;
+    sink.memory = &bytes;
+    sink.level = level;
+    encodeImage(sink, "PNG in memory", image, background);
+    return bytes;
 }
 
 Image readPng(const std::string& path) {

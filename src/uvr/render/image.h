@@ -42,6 +42,12 @@ void writePng(const std::string& path, const Image& image,
 void writePng(OutputFile& out, const Image& image,
               const std::optional<Vec3f>& background = std::nullopt);
 
+/// The PNG writePng writes, encoded in memory; level is zlib's compression level 0 (fastest) to
+/// 9 (smallest), -1 libpng's default.
+std::vector<std::uint8_t> encodePng(const Image& image,
+                                    const std::optional<Vec3f>& background = std::nullopt,
+                                    int level = -1);
+
 /// Reads an 8-bit or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette) into a premultiplied
 /// Image; throws Error(Io/Parse) naming the file.
 Image readPng(const std::string& path);

@@ -85,6 +85,27 @@ TEST(Png, RoundTripWithinOneStep) {
     EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
 }
 
+TEST(Png, EncodedInMemoryAsTheFileIsAtEveryLevel) {
+    Image img(9, 4);
+    for (int i = 0; i < 36; ++i) img.pixels[i] = Vec4f(i / 70.f, 0.2f, 0.1f, 0.5f + i / 80.f);
+    const std::string path = scratchDir() + "/mem.png";
+    writePng(path, img, Vec3f(0.f, 0.f, 1.f));
+    const std::vector<char> file = readFileBytes(path);
+    const std::vector<std::uint8_t> mem = encodePng(img, Vec3f(0.f, 0.f, 1.f));
+    EXPECT_EQ(std::string(mem.begin(), mem.end()), std::string(file.begin(), file.end()));
+    for (int level : {0, 1, 9}) {
+        const std::vector<std::uint8_t> bytes = encodePng(img, std::nullopt, level);
+        const std::string p = scratchDir() + "/level" + std::to_string(level) + ".png";
+        std::ofstream(p, std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        const Image back = readPng(p);
+        for (int i = 0; i < 36; ++i)
+            expectPixel(back.pixels[i], img.pixels[i], kStep, std::to_string(i));
+    }
+    EXPECT_THROW(encodePng(img, std::nullopt, 10), Error);
+    EXPECT_THROW(encodePng(Image(), std::nullopt), Error);
+}
+
 TEST(Png, CompositesOverBackgroundAndClamps) {
     std::string path = scratchDir() + "/bg.png";
     Image img(4, 1);

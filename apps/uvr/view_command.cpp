@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: MIT
+// `uvr view`: reads and prepares a mesh once and serves it to browsers (src/uvr/server).
+#include <chrono>
+#include <cstdio>
+
+#include "cli_common.h"
+#include "progress.h"
+
+#ifdef UVR_HAS_SERVER
+#include "uvr/server/view_server.h"
+#endif
+
+namespace uvr::cli {
+
+namespace {
+
+#ifdef UVR_HAS_SERVER
+/// The flags that shape the image beyond what the page controls, for the page's exported
+/// `uvr render` command (each a separate argument).
+std::vector<std::string> imageFlags(const RenderFlags& f) {
+    std::vector<std::string> out;
+    auto add = [&](const char* flag, const std::string& value) {
+        out.push_back(flag);
+        if (!value.empty()) out.push_back(value);
+    };
+    auto num = [](double v) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.9g", v);
+        return std::string(buf);
+    };
+    if (f.step > 0.f) add("--step", num(f.step));
+    if (f.sampling != "preintegrated") add("--sampling", f.sampling);
+    if (f.stepRule != "error") add("--step-rule", f.stepRule);
+    if (f.maxStep > 0.f) add("--max-step", num(f.maxStep));
+    if (f.power) add("--power", num(*f.power));
+    if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
+    if (f.noSeedGrid) add("--no-seed-grid", "");
+    if (f.supersample > 1) add("--supersample", std::to_string(f.supersample));
+    if (f.jitter) add("--jitter", "");
+    if (!f.background.empty()) add("--background", f.background);
+    return out;
+}
+#endif
+
+}  // namespace
+
+void addViewCommand(CLI::App& app, Context& ctx) {
+    auto* cmd = app.add_subcommand(
+        "view",
+        "Explore a mesh in the browser: read and prepare it once, then serve a page (printed URL "
+        "with a token) to orbit, edit the transfer function and switch field, method and "
+        "quality, rendered on the GPU or the CPU (docs/VIEWER.md)");
+    auto file = std::make_shared<std::string>();
+    auto flags = std::make_shared<RenderFlags>();
+    auto options = std::make_shared<std::pair<std::string, int>>("127.0.0.1", 8080);
+    auto token = std::make_shared<std::string>();
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    flags->registerOn(*cmd, /*oneFrame=*/false);
+    addMethodOption(*cmd, flags->method);
+    cmd->add_option("--host", options->first,
+                    "Address to listen on (0.0.0.0: every interface; the token still applies)")
+        ->capture_default_str();
+    cmd->add_option("--port", options->second, "Port to listen on (0: any free port)")
+        ->check(CLI::Range(0, 65535))
+        ->capture_default_str();
+    cmd->add_option("--token", *token,
+                    "The secret in the URL (default: 32 random hex characters; at least 16 of "
+                    "A-Z a-z 0-9 _ -)");
+    cmd->callback([=, &ctx] {
+#ifndef UVR_HAS_SERVER
+        throwError(ErrorKind::Unsupported, "",
+                   "this uvr was built without the viewer's server (it needs libboost-dev and "
+                   "libturbojpeg0-dev; see scripts/install-deps.sh)");
+#else
+        applyThreads(flags->threads);
+        flags->checkBeforeLoading(*file);
+        server::ServerOptions so;
+        so.host = options->first;
+        so.port = static_cast<std::uint16_t>(options->second);
+        so.token = *token;
+        // Step 1: read, validate and prepare, as `uvr render` does.
+        const auto start = std::chrono::steady_clock::now();
+        auto mesh = std::make_shared<Mesh>(loadMesh(*file, ctx));
+        server::ViewScene scene;
+        scene.loadSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        scene.file = *file;
+        const ValidationReport report = validateMesh(*mesh, *file);
+        for (const std::string& f : report.findings()) {
+            ctx.step("validation: " + f);
+            scene.notes.push_back(f);
+        }
+        for (const std::string& n : mesh->notes) scene.notes.push_back(n);
+        if (report.bounds.empty())
+            throwError(ErrorKind::Validation, *file,
+                       "no cell has volume (or the mesh has no volumetric cells): nothing to view");
+        const ScalarField field = selectScalarField(*mesh, parseFieldSpec(flags->field));
+        std::vector<std::string> notes;
+        RenderSettings settings = flags->settings(report.bounds, *file, &notes);
+        for (const std::string& note : notes) {
+            ctx.step("note: " + note);
+            scene.notes.push_back(note);
+        }
+        validateSettings(settings);
+        ctx.setActivity(*file, "preparing the mesh for rendering");
+        const auto prepStart = std::chrono::steady_clock::now();
+        // Every method can be picked in the page: prepare for all of them.
+        scene.renderer = makeRenderer(*mesh, field, flags->rendererOptions(true), ctx);
+        ctx.done("prepared " + std::to_string(scene.renderer->prepared().tets.tets.size()) +
+                     " tetrahedra",
+                 prepStart);
+        // Step 2: the state every tab starts from, as `uvr render` would draw it.
+        const FrameSetup setup = makeFrameSetup(scene.renderer->prepared(), settings);
+        server::ViewState& s = scene.initial;
+        s.camera = settings.camera.value_or(
+            resetCamera(report.bounds, float(settings.width) / float(settings.height)));
+        s.tf = settings.tf;
+        s.range = {setup.rangeLo, setup.rangeHi};
+        s.field = flags->field;
+        s.method = settings.method;
+        s.quality = settings.quality;
+        s.width = settings.width;
+        s.height = settings.height;
+        s.opacityUnit = static_cast<float>(setup.params.opacityUnit / setup.frame.scale);
+        scene.mesh = mesh;
+        scene.bounds = report.bounds;
+        scene.rendererOptions = flags->rendererOptions(true);
+        scene.base = settings;
+        scene.background = flags->backgroundColor();
+        scene.commandFlags = imageFlags(*flags);
+        // Step 3: serve until Ctrl-C.
+        server::ViewServer server(std::move(scene), so, [&ctx](const std::string& line) {
+            ctx.step(line.rfind("view: ", 0) == 0 ? line.substr(6) : line);
+        });
+        server.start();
+        std::printf("uvr: serving %s (Ctrl-C stops)\n", server.url().c_str());
+        std::fflush(stdout);
+        server.run();
+        ctx.step("stopped");
+#endif
+    });
+}
+
+}  // namespace uvr::cli

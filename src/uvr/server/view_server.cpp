@@ -1,0 +1,1056 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/server/view_server.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <random>
+#include <thread>
+
+#include "uvr/core/error.h"
+#include "uvr/core/text.h"
+#include "uvr/mesh/cell_types.h"
+#include "uvr/render/heatmap.h"
+#include "uvr/render/image.h"
+#include "uvr/server/frame_codec.h"
+#include "uvr/server/web_assets.h"
+#include "uvr/tf/transfer_function.h"
+
+namespace uvr::server {
+
+namespace {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+/// Bins of the field histograms the page draws.
+constexpr int kHistogramBins = 256;
+/// Messages waiting to be written to one connection before it counts as not reading.
+constexpr std::size_t kMaxOutbox = 256;
+/// How long an HTTP request may take to arrive.
+constexpr auto kHttpTimeout = std::chrono::seconds(30);
+
+double secondsSince(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::string randomToken() {
+    std::random_device rd;  // /dev/urandom on Linux
+    static const char* hex = "0123456789abcdef";
+    std::string t;
+    for (int i = 0; i < 32; ++i) t += hex[rd() & 15];
+    return t;
+}
+
+/// Equal strings, in time independent of where they differ.
+bool sameSecret(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    unsigned char diff = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+    return diff == 0;
+}
+
+/// The value of `key` in a target's query string ("/ws?token=abc&x=1"), if present.
+std::optional<std::string> queryValue(std::string_view target, std::string_view key) {
+    const auto q = target.find('?');
+    if (q == std::string_view::npos) return std::nullopt;
+    std::string_view rest = target.substr(q + 1);
+    while (!rest.empty()) {
+        const auto amp = rest.find('&');
+        const std::string_view pair = rest.substr(0, amp);
+        const auto eq = pair.find('=');
+        if (pair.substr(0, eq) == key)
+            return std::string(eq == std::string_view::npos ? "" : pair.substr(eq + 1));
+        if (amp == std::string_view::npos) break;
+        rest = rest.substr(amp + 1);
+    }
+    return std::nullopt;
+}
+
+/// The value of cookie `name` in a Cookie header, if present.
+std::optional<std::string> cookieValue(std::string_view header, std::string_view name) {
+    while (!header.empty()) {
+        const auto semi = header.find(';');
+        std::string_view pair = header.substr(0, semi);
+        while (!pair.empty() && pair.front() == ' ') pair.remove_prefix(1);
+        const auto eq = pair.find('=');
+        if (eq != std::string_view::npos && pair.substr(0, eq) == name)
+            return std::string(pair.substr(eq + 1));
+        if (semi == std::string_view::npos) break;
+        header = header.substr(semi + 1);
+    }
+    return std::nullopt;
+}
+
+std::string_view pathOf(std::string_view target) {
+    return target.substr(0, target.find('?'));
+}
+
+/// "uvr render" arguments quoted for a POSIX shell where needed.
+std::string shellQuote(const std::string& arg) {
+    const bool plain = !arg.empty() && std::all_of(arg.begin(), arg.end(), [](unsigned char c) {
+        return std::isalnum(c) || std::string_view("_-./:,=+@%").find(c) != std::string_view::npos;
+    });
+    if (plain) return arg;
+    std::string out = "'";
+    for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+/// The shortest decimal that reads back as the same float.
+std::string fmtExact(float v) {
+    char buf[40];
+    for (int digits = 6; digits <= 9; ++digits) {
+        std::snprintf(buf, sizeof buf, "%.*g", digits, double(v));
+        if (std::strtof(buf, nullptr) == v) break;
+    }
+    return buf;
+}
+
+/// ParaView's "set view direction" buttons: the view direction and view up of each axis.
+std::optional<std::pair<Vec3f, Vec3f>> axisView(const std::string& axis) {
+    const Vec3f z(0.f, 0.f, 1.f), y(0.f, 1.f, 0.f);
+    if (axis == "+x") return std::make_pair(Vec3f(1.f, 0.f, 0.f), z);
+    if (axis == "-x") return std::make_pair(Vec3f(-1.f, 0.f, 0.f), z);
+    if (axis == "+y") return std::make_pair(Vec3f(0.f, 1.f, 0.f), z);
+    if (axis == "-y") return std::make_pair(Vec3f(0.f, -1.f, 0.f), z);
+    if (axis == "+z") return std::make_pair(Vec3f(0.f, 0.f, 1.f), y);
+    if (axis == "-z") return std::make_pair(Vec3f(0.f, 0.f, -1.f), y);
+    return std::nullopt;
+}
+
+Json histogramOf(const std::vector<float>& values, std::pair<float, float> range) {
+    std::vector<std::uint64_t> counts(kHistogramBins, 0);
+    const double lo = range.first, hi = range.second;
+    const double scale = hi > lo ? kHistogramBins / (hi - lo) : 0.0;
+    for (float v : values) {
+        if (!std::isfinite(v)) continue;
+        const int bin = std::clamp(static_cast<int>((v - lo) * scale), 0, kHistogramBins - 1);
+        ++counts[bin];
+    }
+    return {{"range", {range.first, range.second}}, {"counts", counts}};
+}
+
+/// What a field needs on the server: its renderer (prepared on demand), range and histogram.
+struct FieldEntry {
+    std::shared_ptr<Renderer> renderer;
+    std::pair<float, float> range{0.f, 1.f};
+    Json histogram;
+};
+
+class Session;
+
+}  // namespace
+
+struct ViewServer::Impl {
+    ViewScene scene;
+    ServerOptions opt;
+    LogFn log;
+    std::vector<FieldInfo> fieldInfos;
+    Json infoBase;  ///< the parts of `info` every connection gets
+
+    net::io_context ioc{1};
+    tcp::acceptor acceptor{ioc};
+    std::optional<net::signal_set> signals;
+    std::thread ioThread, renderThread;
+    std::uint16_t boundPort = 0;
+    bool started = false;
+
+    // Shared between the network thread and the render thread.
+    std::mutex m;
+    std::condition_variable cv;
+    bool stopping = false;
+    std::vector<std::weak_ptr<Session>> sessions;
+    std::size_t roundRobin = 0;
+    std::map<std::string, FieldEntry> fields;  ///< by fieldKey; touched by the render thread
+    std::mutex fieldsMutex;                    ///< guards `fields` against info's readers
+
+    void say(const std::string& line) const {
+        if (log) log(line);
+    }
+    /// Canonical key of a field spec (the field's index and component), or throws
+    /// Error(Argument) for a spec naming no field.
+    std::string fieldKey(const std::string& spec) const {
+        const FieldSpec fs = parseFieldSpec(spec);
+        const FieldChoice c = resolveField(fieldInfos, fs);
+        return std::to_string(c.index) + ":" + std::to_string(fs.component);
+    }
+    /// The field's entry, prepared when new (render thread). `progress` reports its steps.
+    FieldEntry& field(const std::string& spec, const ProgressFn& progress);
+    void acceptLoop();
+    void renderLoop();
+    void requestStop();
+    Json exportMessage(const ViewState& s) const;
+};
+
+namespace {
+
+/// One WebSocket connection: a browser tab's state and its outgoing messages. Lives on the
+/// network thread; the render thread reads and writes the fields under Impl::m.
+class Session : public std::enable_shared_from_this<Session> {
+public:
+    Session(ViewServer::Impl& server, tcp::socket&& socket)
+        : server_(server), ws_(std::move(socket)) {}
+
+    // State shared with the render thread, guarded by Impl::m.
+    ViewState state;
+    std::uint64_t seq = 0;
+    bool interactive = false;
+    Clock::time_point lastChange = Clock::now();
+    bool dirty = true;        ///< the state changed since the last frame started
+    bool inFlight = false;    ///< a frame is being rendered or sent
+    bool needsFull = false;   ///< the last frame was reduced: refine when still
+    bool snapshot = false;    ///< a snapshot was asked for
+    bool resetRange = false;  ///< the field changed without a range: use the field's
+    double msPerPixel = 0.0;  ///< render time per pixel of recent frames (0: none yet)
+    std::string peer;
+
+    void start(http::request<http::string_body> req) {
+        ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+        ws_.read_message_max(server_.opt.maxMessageBytes);
+        ws_.async_accept(req,
+                         [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
+    }
+
+    /// Queues a text message (network thread).
+    void sendText(std::string text) { queue(false, std::move(text), false); }
+    /// Queues a frame's description and image; the frame ends when its image is written
+    /// (network thread).
+    void sendImage(std::string meta, std::string bytes) {
+        queue(false, std::move(meta), false);
+        queue(true, std::move(bytes), true);
+    }
+    /// Ends the connection at once (the server shuts down; network thread): the page sees the
+    /// socket close and says the connection was lost.
+    void shutdown() {
+        closed_ = true;
+        beast::error_code ignored;
+        auto& socket = beast::get_lowest_layer(ws_).socket();
+        socket.shutdown(tcp::socket::shutdown_both, ignored);
+        socket.close(ignored);
+    }
+
+    void sendError(const std::string& message, const std::string& request) {
+        sendText(Json{{"type", "error"}, {"message", message}, {"request", request}}.dump(
+            -1, ' ', false, Json::error_handler_t::replace));
+    }
+
+private:
+    struct Out {
+        bool binary;
+        std::string data;
+        bool endsFrame;
+    };
+
+    void onAccept(beast::error_code ec) {
+        if (ec) return;
+        {
+            std::lock_guard lk(server_.m);
+            if (static_cast<int>(liveSessionsLocked()) >= server_.opt.maxSessions) {
+                // Checked again here: several upgrades may have raced past the HTTP check.
+                ws_.async_close(websocket::close_reason(websocket::close_code::try_again_later),
+                                [self = shared_from_this()](beast::error_code) {});
+                return;
+            }
+            state = server_.scene.initial;
+            server_.sessions.push_back(weak_from_this());
+        }
+        peer = endpointName();
+        server_.say("view: " + peer + " connected");
+        Json info = server_.infoBase;
+        info["state"] = toJson(state);
+        {
+            std::lock_guard lk(server_.fieldsMutex);
+            const auto it = server_.fields.find(server_.fieldKey(state.field));
+            if (it != server_.fields.end()) {
+                info["histogram"] = it->second.histogram;
+                info["histogram"]["field"] = state.field;
+            }
+        }
+        sendText(info.dump(-1, ' ', false, Json::error_handler_t::replace));
+        server_.cv.notify_all();
+        doRead();
+    }
+
+    std::size_t liveSessionsLocked() {
+        auto& v = server_.sessions;
+        v.erase(std::remove_if(v.begin(), v.end(), [](const auto& w) { return w.expired(); }),
+                v.end());
+        return v.size();
+    }
+
+    std::string endpointName() {
+        beast::error_code ec;
+        const auto ep = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
+        return ec ? "a client" : ep.address().to_string() + ":" + std::to_string(ep.port());
+    }
+
+    void doRead() {
+        ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+            self->onRead(ec);
+        });
+    }
+
+    void onRead(beast::error_code ec) {
+        if (ec) {
+            if (ec == websocket::error::message_too_big)
+                server_.say("view: " + peer + " sent a message over " +
+                            std::to_string(server_.opt.maxMessageBytes) +
+                            " bytes: connection closed");
+            else if (ec != websocket::error::closed && ec != net::error::operation_aborted &&
+                     ec != net::error::eof)
+                server_.say("view: " + peer + " disconnected (" + ec.message() + ")");
+            else
+                server_.say("view: " + peer + " disconnected");
+            closed_ = true;
+            return;  // the last reference goes with the pending operations
+        }
+        const bool binary = ws_.got_binary();
+        std::string text = beast::buffers_to_string(buffer_.data());
+        buffer_.consume(buffer_.size());
+        if (admit()) {
+            if (binary)
+                sendError("binary messages are not accepted: send JSON text", "");
+            else
+                handle(text);
+        }
+        doRead();
+    }
+
+    /// Token bucket of maxMessagesPerSecond: false (and one error a second) when over.
+    bool admit() {
+        const auto now = Clock::now();
+        const double rate = server_.opt.maxMessagesPerSecond;
+        tokens_ = std::min(
+            rate, tokens_ + rate * std::chrono::duration<double>(now - lastRefill_).count());
+        lastRefill_ = now;
+        if (tokens_ >= 1.0) {
+            tokens_ -= 1.0;
+            return true;
+        }
+        ++dropped_;
+        if (now - lastDropReport_ >= std::chrono::seconds(1)) {
+            lastDropReport_ = now;
+            sendError("too many messages: " + std::to_string(dropped_) + " dropped (at most " +
+                          std::to_string(server_.opt.maxMessagesPerSecond) + " a second)",
+                      "");
+        }
+        return false;
+    }
+
+    void handle(const std::string& text) {
+        Json msg;
+        std::string type;
+        try {
+            msg = Json::parse(text);
+            if (!msg.is_object() || !msg.contains("type") || !msg["type"].is_string())
+                throwError(ErrorKind::Argument, "",
+                           "expected a JSON object with a \"type\" string");
+            type = msg["type"].get<std::string>();
+            if (type == "set")
+                onSet(msg);
+            else if (type == "reset_camera")
+                onResetCamera(msg);
+            else if (type == "snapshot")
+                onSnapshot();
+            else if (type == "export")
+                onExport();
+            else if (type == "ping")
+                sendText(Json{{"type", "pong"}, {"seq", msg.value("seq", Json())}}.dump());
+            else
+                throwError(ErrorKind::Argument, "",
+                           "unknown message type \"" + printableShort(type, 40) +
+                               "\" (set, reset_camera, snapshot, export, ping)");
+        } catch (const Json::exception& e) {
+            sendError(std::string("malformed JSON: ") + e.what(), type);
+        } catch (const Error& e) {
+            sendError(e.what(), type);
+        } catch (const std::exception& e) {
+            sendError(std::string("failed: ") + e.what(), type);
+        }
+    }
+
+    /// Checks the keys every state change may carry (seq, interactive) before anything changes.
+    static void checkChangeKeys(const Json& msg) {
+        if (auto it = msg.find("seq"); it != msg.end() && !it->is_number_unsigned())
+            throwError(ErrorKind::Argument, "", "\"seq\": expected a non-negative integer");
+        if (auto it = msg.find("interactive"); it != msg.end() && !it->is_boolean())
+            throwError(ErrorKind::Argument, "", "\"interactive\": expected true or false");
+    }
+
+    /// Records a change of the state (under Impl::m; checkChangeKeys passed).
+    void markChanged(const Json& msg) {
+        if (auto it = msg.find("seq"); it != msg.end()) seq = it->get<std::uint64_t>();
+        interactive = msg.value("interactive", false);
+        lastChange = Clock::now();
+        dirty = true;
+    }
+
+    void onSet(const Json& msg) {
+        checkChangeKeys(msg);
+        SetResult r;
+        {
+            std::lock_guard lk(server_.m);
+            ViewState next = state;
+            r = applySet(next, msg);
+            if (r.fieldChanged) server_.fieldKey(next.field);  // names a field of the mesh?
+            state = std::move(next);
+            if (r.fieldChanged) resetRange = !r.rangeGiven;
+            markChanged(msg);
+        }
+        server_.cv.notify_all();
+        if (r.echoState) sendState();
+    }
+
+    void onResetCamera(const Json& msg) {
+        checkChangeKeys(msg);
+        std::string axis;
+        if (auto it = msg.find("axis"); it != msg.end() && !it->is_null()) {
+            if (!it->is_string() || !axisView(it->get<std::string>()))
+                throwError(ErrorKind::Argument, "",
+                           "\"axis\": expected \"+x\", \"-x\", \"+y\", \"-y\", \"+z\" or \"-z\"");
+            axis = it->get<std::string>();
+        }
+        {
+            std::lock_guard lk(server_.m);
+            Camera cam =
+                resetCamera(server_.scene.bounds, float(state.width) / float(state.height));
+            if (const auto view = axisView(axis)) {
+                const Vec3f offset = cam.position - cam.focalPoint;
+                const float distance = std::sqrt(dot(offset, offset));
+                cam.position = cam.focalPoint - view->first * distance;
+                cam.viewUp = view->second;
+            }
+            cam.parallelProjection = state.camera.parallelProjection;
+            state.camera = cam;
+            markChanged(msg);
+        }
+        server_.cv.notify_all();
+        sendState();
+    }
+
+    void onSnapshot() {
+        {
+            std::lock_guard lk(server_.m);
+            snapshot = true;
+        }
+        server_.cv.notify_all();
+    }
+
+    void onExport() {
+        ViewState s;
+        {
+            std::lock_guard lk(server_.m);
+            s = state;
+        }
+        sendText(server_.exportMessage(s).dump(-1, ' ', false, Json::error_handler_t::replace));
+    }
+
+    void sendState() {
+        Json j;
+        {
+            std::lock_guard lk(server_.m);
+            j = {{"type", "state"}, {"state", toJson(state)}};
+        }
+        sendText(j.dump(-1, ' ', false, Json::error_handler_t::replace));
+    }
+
+    void queue(bool binary, std::string data, bool endsFrame) {
+        if (closed_) {
+            if (endsFrame) frameDone();
+            return;
+        }
+        if (outbox_.size() >= kMaxOutbox) {
+            server_.say("view: " + peer + " does not read its messages: connection closed");
+            closed_ = true;
+            beast::get_lowest_layer(ws_).socket().close();
+            if (endsFrame) frameDone();
+            return;
+        }
+        outbox_.push_back({binary, std::move(data), endsFrame});
+        pump();
+    }
+
+    void pump() {
+        if (writing_ || outbox_.empty()) return;
+        writing_ = true;
+        ws_.binary(outbox_.front().binary);
+        ws_.async_write(
+            net::buffer(outbox_.front().data),
+            [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onWrite(ec); });
+    }
+
+    void onWrite(beast::error_code ec) {
+        writing_ = false;
+        const bool endsFrame = outbox_.front().endsFrame;
+        outbox_.pop_front();
+        if (endsFrame) frameDone();
+        if (ec) {
+            closed_ = true;
+            for (const Out& o : outbox_)
+                if (o.endsFrame) frameDone();
+            outbox_.clear();
+            return;
+        }
+        pump();
+    }
+
+    void frameDone() {
+        {
+            std::lock_guard lk(server_.m);
+            inFlight = false;
+        }
+        server_.cv.notify_all();
+    }
+
+    ViewServer::Impl& server_;
+    websocket::stream<beast::tcp_stream> ws_;
+    beast::flat_buffer buffer_;
+    std::deque<Out> outbox_;
+    bool writing_ = false;
+    bool closed_ = false;
+    double tokens_ = 1e9;  // capped at the rate on first use
+    Clock::time_point lastRefill_ = Clock::now();
+    Clock::time_point lastDropReport_{};
+    std::uint64_t dropped_ = 0;
+};
+
+/// One HTTP connection: serves the page and its files, or hands a WebSocket upgrade to a
+/// Session.
+class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
+public:
+    HttpConnection(ViewServer::Impl& server, tcp::socket&& socket)
+        : server_(server), stream_(std::move(socket)) {}
+
+    void start() { doRead(); }
+
+private:
+    void doRead() {
+        parser_.emplace();
+        parser_->header_limit(16 * 1024);
+        parser_->body_limit(64 * 1024);
+        stream_.expires_after(kHttpTimeout);
+        http::async_read(
+            stream_, buffer_, *parser_,
+            [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
+    }
+
+    bool tokenIn(const http::request<http::string_body>& req, bool allowCookie) const {
+        const std::string& token = server_.opt.token;
+        if (auto q = queryValue(req.target(), "token"); q && sameSecret(*q, token)) return true;
+        if (!allowCookie) return false;
+        const auto it = req.find(http::field::cookie);
+        if (it == req.end()) return false;
+        const auto c = cookieValue(it->value(), cookieName());
+        return c && sameSecret(*c, token);
+    }
+
+    std::string cookieName() const { return "uvr_token_" + std::to_string(server_.boundPort); }
+
+    void onRead(beast::error_code ec) {
+        if (ec) return;  // closed, timed out or malformed: drop the connection
+        http::request<http::string_body> req = parser_->release();
+        const std::string_view path = pathOf(req.target());
+        if (websocket::is_upgrade(req)) {
+            // The socket needs the token in its URL: a cookie alone would let another site's
+            // page open one.
+            if (path != "/ws") return respond(req, http::status::not_found, "no such socket\n");
+            if (!tokenIn(req, false))
+                return respond(req, http::status::forbidden,
+                               "uvr view: missing or wrong token in the socket URL\n");
+            {
+                std::lock_guard lk(server_.m);
+                auto& v = server_.sessions;
+                v.erase(
+                    std::remove_if(v.begin(), v.end(), [](const auto& w) { return w.expired(); }),
+                    v.end());
+                if (static_cast<int>(v.size()) >= server_.opt.maxSessions)
+                    return respond(req, http::status::service_unavailable,
+                                   "uvr view: too many connections\n");
+            }
+            stream_.expires_never();
+            std::make_shared<Session>(server_, stream_.release_socket())->start(std::move(req));
+            return;
+        }
+        if (req.method() != http::verb::get)
+            return respond(req, http::status::method_not_allowed, "GET only\n");
+        if (!tokenIn(req, path != "/"))
+            return respond(req, http::status::forbidden,
+                           "uvr view: missing or wrong token: open the URL that uvr view printed "
+                           "(with ?token=...)\n");
+        const std::string name = path == "/" ? "index.html" : std::string(path.substr(1));
+        const WebAsset* asset = findWebAsset(name);
+        if (!asset) return respond(req, http::status::not_found, "not found\n");
+        http::response<http::string_body> res{http::status::ok, req.version()};
+        res.set(http::field::content_type, asset->mime);
+        res.set(http::field::cache_control, "no-store");
+        res.set("X-Content-Type-Options", "nosniff");
+        res.set("Referrer-Policy", "no-referrer");
+        res.set("Content-Security-Policy",
+                "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'; "
+                "style-src 'self'; script-src 'self'; frame-ancestors 'none'");
+        if (path == "/")
+            res.set(http::field::set_cookie,
+                    cookieName() + "=" + server_.opt.token + "; Path=/; HttpOnly; SameSite=Strict");
+        res.body() = std::string(asset->content);
+        res.prepare_payload();
+        res.keep_alive(req.keep_alive());
+        write(std::move(res));
+    }
+
+    void respond(const http::request<http::string_body>& req, http::status status,
+                 std::string body) {
+        http::response<http::string_body> res{status, req.version()};
+        res.set(http::field::content_type, "text/plain; charset=utf-8");
+        res.set(http::field::cache_control, "no-store");
+        res.body() = std::move(body);
+        res.prepare_payload();
+        res.keep_alive(req.keep_alive());
+        write(std::move(res));
+    }
+
+    void write(http::response<http::string_body>&& res) {
+        auto sp = std::make_shared<http::response<http::string_body>>(std::move(res));
+        http::async_write(
+            stream_, *sp, [self = shared_from_this(), sp](beast::error_code ec, std::size_t) {
+                if (ec) return;
+                if (!sp->keep_alive()) {
+                    beast::error_code ignored;
+                    self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                    return;
+                }
+                self->doRead();
+            });
+    }
+
+    ViewServer::Impl& server_;
+    beast::tcp_stream stream_;
+    beast::flat_buffer buffer_;
+    std::optional<http::request_parser<http::string_body>> parser_;
+};
+
+}  // namespace
+
+FieldEntry& ViewServer::Impl::field(const std::string& spec, const ProgressFn& progress) {
+    const std::string key = fieldKey(spec);
+    {
+        std::lock_guard lk(fieldsMutex);
+        auto it = fields.find(key);
+        if (it != fields.end() && it->second.renderer) return it->second;
+    }
+    // Free the renderers no tab shows any more before preparing another.
+    std::vector<std::string> used;
+    {
+        std::lock_guard lk(m);
+        for (const auto& w : sessions)
+            if (auto s = w.lock()) used.push_back(fieldKey(s->state.field));
+    }
+    {
+        std::lock_guard lk(fieldsMutex);
+        for (auto& [k, e] : fields)
+            if (k != key && std::find(used.begin(), used.end(), k) == used.end())
+                e.renderer.reset();
+    }
+    const ScalarField values = selectScalarField(*scene.mesh, parseFieldSpec(spec));
+    FieldEntry entry;
+    entry.range = finiteRange(values.values);
+    entry.histogram = histogramOf(values.values, entry.range);
+    const auto start = Clock::now();
+    say("view: preparing " + values.describe());
+    entry.renderer =
+        std::make_shared<Renderer>(*scene.mesh, values, scene.rendererOptions, progress);
+    char line[160];
+    std::snprintf(line, sizeof line, "view: prepared %s in %.2f s", values.describe().c_str(),
+                  secondsSince(start));
+    say(line);
+    std::lock_guard lk(fieldsMutex);
+    return fields[key] = std::move(entry);
+}
+
+Json ViewServer::Impl::exportMessage(const ViewState& s) const {
+    std::vector<std::string> args = {"uvr", "render", scene.file};
+    if (!s.field.empty()) args.insert(args.end(), {"--field", s.field});
+    args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
+                             fmtExact(s.range.first) + "," + fmtExact(s.range.second), "--method",
+                             methodName(s.method)});
+    if (s.method == RenderMethod::Partitions)
+        args.insert(args.end(), {"--quality", fmtExact(s.quality)});
+    args.insert(args.end(), {"--size", std::to_string(s.width) + "x" + std::to_string(s.height),
+                             "--opacity-unit", fmtExact(s.opacityUnit)});
+    args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
+    args.insert(args.end(), {"-o", "uvr-view.png"});
+    std::string command;
+    for (const std::string& a : args) command += (command.empty() ? "" : " ") + shellQuote(a);
+    return {{"type", "export"},
+            {"tf_json", paraViewColorMapJson(s.tf, s.range.first, s.range.second)},
+            {"pvcc", pvccText(s.camera)},
+            {"tf_file", "uvr-tf.json"},
+            {"camera_file", "uvr-camera.pvcc"},
+            {"command", command}};
+}
+
+void ViewServer::Impl::renderLoop() {
+    std::unique_lock lk(m);
+    while (!stopping) {
+        // Step 1: the next connection with work, round robin: a snapshot, a changed state, or
+        // a reduced frame whose state has been still long enough to refine.
+        const auto now = Clock::now();
+        const auto refine = std::chrono::milliseconds(opt.refineDelayMs);
+        std::shared_ptr<Session> s;
+        enum class Kind { Reduced, Full, Snapshot } kind = Kind::Full;
+        auto next = Clock::time_point::max();
+        const std::size_t n = sessions.size();
+        for (std::size_t i = 0; i < n && !s; ++i) {
+            const std::size_t at = (roundRobin + i) % n;
+            auto c = sessions[at].lock();
+            if (!c || c->inFlight) continue;
+            if (c->snapshot)
+                s = c, kind = Kind::Snapshot;
+            else if (c->dirty)
+                s = c, kind = c->interactive ? Kind::Reduced : Kind::Full;
+            else if (c->needsFull && c->lastChange + refine <= now)
+                s = c, kind = Kind::Full;
+            else if (c->needsFull)
+                next = std::min(next, c->lastChange + refine);
+            if (s) roundRobin = at + 1;
+        }
+        if (!s) {
+            if (next == Clock::time_point::max())
+                cv.wait(lk);
+            else
+                cv.wait_until(lk, next);
+            continue;
+        }
+        // Step 2: take the state; newer changes wait for this frame to be sent.
+        ViewState state = s->state;
+        const std::uint64_t seq = s->seq;
+        if (kind == Kind::Snapshot) {
+            s->snapshot = false;
+        } else {
+            s->dirty = false;
+            s->needsFull = kind == Kind::Reduced;
+        }
+        s->inFlight = true;
+        const bool resetRange = s->resetRange;
+        s->resetRange = false;
+        int scale = 1;
+        if (kind == Kind::Reduced && s->msPerPixel > 0.0) {
+            const double pixels = double(state.width) * state.height;
+            while (scale < opt.maxScale &&
+                   s->msPerPixel * pixels / (double(scale) * scale) > opt.targetFrameMs)
+                ++scale;
+        } else if (kind == Kind::Reduced) {
+            scale = 2;  // no measurement yet
+        }
+        lk.unlock();
+
+        // Step 3: render and encode outside the lock.
+        std::weak_ptr<Session> weak = s;
+        auto post = [&](std::function<void(Session&)> f) {
+            net::post(ioc, [weak, f = std::move(f)] {
+                if (auto c = weak.lock()) f(*c);
+            });
+        };
+        bool sent = false;
+        try {
+            const bool known = [&] {
+                std::lock_guard flk(fieldsMutex);
+                auto it = fields.find(fieldKey(state.field));
+                return it != fields.end() && it->second.renderer;
+            }();
+            FieldEntry& entry = field(state.field, [&](const std::string& phase) {
+                post([phase](Session& c) {
+                    c.sendText(
+                        Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
+                });
+            });
+            if (resetRange) {
+                state.range = entry.range;
+                if (!(state.range.first < state.range.second))
+                    state.range.second = state.range.first + 1.f;
+                std::lock_guard slk(m);
+                s->state.range = state.range;
+            }
+            if (!known || resetRange) {
+                Json h = entry.histogram;
+                h["type"] = "histogram";
+                h["field"] = state.field;
+                Json st = {{"type", "state"}, {"state", toJson(state)}};
+                post([h = h.dump(), st = st.dump()](Session& c) {
+                    c.sendText(h);
+                    c.sendText(st);
+                });
+            }
+            const RenderSettings settings =
+                frameSettings(state, scene.base, kind == Kind::Snapshot ? 1 : scale);
+            const RenderResult result = entry.renderer->render(settings);
+            const double renderMs = result.stats.seconds * 1e3;
+            const auto encodeStart = Clock::now();
+            Image image =
+                state.heatmap && kind != Kind::Snapshot
+                    ? sampleHeatmap(result.sampleCounts, settings.width, settings.height, 0)
+                    : result.image;
+            const Vec3f bg = scene.background.value_or(Vec3f(0.f, 0.f, 0.f));
+            std::vector<std::uint8_t> bytes;
+            const char* format = "png";
+            if (kind == Kind::Snapshot)
+                bytes = encodePng(image, scene.background);
+            else if (kind == Kind::Reduced)
+                bytes = encodeJpeg(image, bg, opt.jpegQuality), format = "jpeg";
+            else
+                bytes = encodePng(image, bg, 1);
+            const double encodeMs = secondsSince(encodeStart) * 1e3;
+            const double pixels = double(settings.width) * settings.height;
+            Json meta;
+            if (kind == Kind::Snapshot) {
+                meta = {{"type", "snapshot"}, {"format", "png"}};
+            } else {
+                const double spp = result.stats.meanSamplesPerPixel();
+                meta = {{"type", "frame"},
+                        {"seq", seq},
+                        {"format", format},
+                        {"full", kind == Kind::Full},
+                        {"scale", scale},
+                        {"stats",
+                         {{"render_ms", renderMs},
+                          {"encode_ms", encodeMs},
+                          {"bytes", bytes.size()},
+                          {"samples_per_pixel", spp},
+                          {"partitions_visited_per_pixel",
+                           double(result.stats.partitionsVisited) / pixels},
+                          {"partitions_skipped_per_pixel",
+                           double(result.stats.partitionsSkipped) / pixels},
+                          {"method", methodName(state.method)},
+                          {"device", entry.renderer->deviceName()}}}};
+            }
+            meta["width"] = image.width;
+            meta["height"] = image.height;
+            {
+                std::lock_guard slk(m);
+                const double perPixel = renderMs / std::max(1.0, pixels);
+                s->msPerPixel = s->msPerPixel > 0.0 ? 0.5 * (s->msPerPixel + perPixel) : perPixel;
+            }
+            post([meta = meta.dump(), bytes = std::move(bytes)](Session& c) mutable {
+                c.sendImage(meta, std::string(bytes.begin(), bytes.end()));
+            });
+            sent = true;
+        } catch (const std::exception& e) {
+            const std::string message = e.what();
+            say("view: frame failed: " + message);
+            post([message](Session& c) { c.sendError(message, "frame"); });
+        }
+        lk.lock();
+        if (!sent) s->inFlight = false;
+        // The last reference to a closed connection goes on the network thread, which owns
+        // its socket.
+        net::post(ioc, [s = std::move(s)] {});
+    }
+}
+
+void ViewServer::Impl::acceptLoop() {
+    acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
+        if (ec) {
+            if (ec == net::error::operation_aborted) return;
+            say("view: accept failed: " + ec.message());
+        } else {
+            std::make_shared<HttpConnection>(*this, std::move(socket))->start();
+        }
+        acceptLoop();
+    });
+}
+
+void ViewServer::Impl::requestStop() {
+    {
+        std::lock_guard lk(m);
+        if (stopping) return;
+        stopping = true;
+    }
+    cv.notify_all();
+}
+
+ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
+    : impl_(std::make_unique<Impl>()) {
+    Impl& d = *impl_;
+    if (!scene.mesh) throwError(ErrorKind::Argument, "", "the viewer needs a mesh");
+    if (options.token.empty()) {
+        options.token = randomToken();
+    } else {
+        const bool ok =
+            options.token.size() >= kMinTokenLength &&
+            std::all_of(options.token.begin(), options.token.end(),
+                        [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; });
+        if (!ok)
+            throwError(ErrorKind::Argument, "",
+                       "--token: expected " + std::to_string(kMinTokenLength) +
+                           " or more characters from A-Z, a-z, 0-9, _ and -");
+    }
+    if (options.maxSessions < 1 || options.maxMessagesPerSecond < 1 || options.maxScale < 1)
+        throwError(ErrorKind::Argument, "", "server limits must be positive");
+    d.scene = std::move(scene);
+    d.opt = std::move(options);
+    d.log = std::move(log);
+    const Mesh& mesh = *d.scene.mesh;
+    // The fields as the page lists them, with their ranges.
+    Json fields = Json::array();
+    const std::optional<std::size_t> def = defaultFieldIndex(mesh);
+    for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
+        const Field& f = mesh.fields[i];
+        d.fieldInfos.push_back({f.name, f.association, f.components});
+        const auto range = finiteRange(scalarFieldOf(mesh, f).values);
+        fields.push_back({{"name", f.name},
+                          {"association", associationName(f.association)},
+                          {"components", f.components},
+                          {"range", {range.first, range.second}},
+                          {"default", def == i}});
+    }
+    d.fieldKey(d.scene.initial.field);  // the starting field exists
+    std::map<std::string, std::uint64_t> types;
+    for (CellType t : mesh.cellTypes) ++types[cellTypeName(t)];
+    const Bounds3f& b = d.scene.bounds;
+    std::vector<std::string> presets;
+    for (const ColorMapInfo& p : transferFunctionPresets()) presets.push_back(p.name);
+    // The command line's preparation serves the starting field.
+    std::uint64_t tets = 0;
+    double prepareSeconds = 0.0;
+    std::string device = resolvesToCuda(d.scene.rendererOptions.device) ? "cuda" : "cpu";
+    {
+        const ScalarField values = selectScalarField(mesh, parseFieldSpec(d.scene.initial.field));
+        FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field)];
+        entry.range = finiteRange(values.values);
+        entry.histogram = histogramOf(values.values, entry.range);
+    }
+    if (d.scene.renderer) {
+        FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field)];
+        tets = d.scene.renderer->prepared().tets.tets.size();
+        prepareSeconds = d.scene.renderer->prepareSeconds();
+        device = d.scene.renderer->deviceDescription();
+        entry.renderer = std::shared_ptr<Renderer>(std::move(d.scene.renderer));
+    }
+    d.infoBase = {{"type", "info"},
+                  {"file", d.scene.file},
+                  {"cells", mesh.cellCount()},
+                  {"points", mesh.pointCount()},
+                  {"tetrahedra", tets},
+                  {"cell_types", types},
+                  {"bounds", {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}}},
+                  {"fields", fields},
+                  {"presets", presets},
+                  {"methods", {"adaptive", "reference", "exact"}},
+                  {"device", device},
+                  {"load_seconds", d.scene.loadSeconds},
+                  {"prepare_seconds", prepareSeconds},
+                  {"notes", d.scene.notes},
+                  {"limits",
+                   {{"max_message_bytes", d.opt.maxMessageBytes},
+                    {"max_messages_per_second", d.opt.maxMessagesPerSecond},
+                    {"min_size", kMinViewSize},
+                    {"max_size", kMaxViewSize}}}};
+}
+
+ViewServer::~ViewServer() {
+    stop();
+    Impl& d = *impl_;
+    if (d.renderThread.joinable()) d.renderThread.join();
+    d.ioc.stop();
+    if (d.ioThread.joinable()) d.ioThread.join();
+}
+
+void ViewServer::start() {
+    Impl& d = *impl_;
+    if (d.started) return;
+    beast::error_code ec;
+    const auto address = net::ip::make_address(d.opt.host, ec);
+    if (ec)
+        throwError(ErrorKind::Argument, "",
+                   "--host " + printableShort(d.opt.host, 60) + ": not an IP address (" +
+                       ec.message() + ")");
+    const tcp::endpoint endpoint(address, d.opt.port);
+    const std::string where = d.opt.host + ":" + std::to_string(d.opt.port);
+    d.acceptor.open(endpoint.protocol(), ec);
+    if (!ec) d.acceptor.set_option(net::socket_base::reuse_address(true), ec);
+    if (!ec) d.acceptor.bind(endpoint, ec);
+    if (!ec) d.acceptor.listen(net::socket_base::max_listen_connections, ec);
+    if (ec) throwError(ErrorKind::Io, "", "cannot listen on " + where + ": " + ec.message());
+    d.boundPort = d.acceptor.local_endpoint().port();
+    d.acceptLoop();
+    d.started = true;
+    d.ioThread = std::thread([&d] { d.ioc.run(); });
+    d.renderThread = std::thread([&d] { d.renderLoop(); });
+}
+
+std::uint16_t ViewServer::port() const {
+    return impl_->boundPort;
+}
+
+const std::string& ViewServer::token() const {
+    return impl_->opt.token;
+}
+
+std::string ViewServer::url() const {
+    std::string host = impl_->opt.host;
+    if (host == "0.0.0.0" || host == "::") {
+        char name[256] = {};
+        host = gethostname(name, sizeof name - 1) == 0 && name[0] ? name : "localhost";
+    } else if (host.find(':') != std::string::npos) {
+        host = "[" + host + "]";
+    }
+    return "http://" + host + ":" + std::to_string(port()) + "/?token=" + token();
+}
+
+void ViewServer::run(bool handleSignals) {
+    Impl& d = *impl_;
+    if (handleSignals) {
+        // Before start: the network thread then owns the signals from its first moment.
+        d.signals.emplace(d.ioc, SIGINT, SIGTERM);
+        d.signals->async_wait([&d](beast::error_code ec, int signal) {
+            if (ec) return;
+            d.say(std::string("view: ") + (signal == SIGINT ? "interrupted" : "terminated") +
+                  ": shutting down");
+            d.requestStop();
+        });
+    }
+    start();
+    {
+        std::unique_lock lk(d.m);
+        d.cv.wait(lk, [&d] { return d.stopping; });
+    }
+    if (d.renderThread.joinable()) d.renderThread.join();
+    // Close the listening socket and every connection, then let the network thread finish.
+    net::post(d.ioc, [&d] {
+        beast::error_code ignored;
+        d.acceptor.close(ignored);
+        if (d.signals) d.signals->cancel(ignored);
+        std::lock_guard lk(d.m);
+        for (const auto& w : d.sessions)
+            if (auto s = w.lock()) s->shutdown();
+    });
+    // Let the network thread close them, then stop it.
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    d.ioc.stop();
+    if (d.ioThread.joinable()) d.ioThread.join();
+}
+
+void ViewServer::stop() {
+    impl_->requestStop();
+}
+
+}  // namespace uvr::server

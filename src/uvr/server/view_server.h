@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "uvr/facade/renderer.h"
+#include "uvr/mesh/mesh.h"
+#include "uvr/server/view_state.h"
+
+namespace uvr::server {
+
+/// How the viewer's server listens and what it allows (docs/VIEWER.md).
+struct ServerOptions {
+    std::string host = "127.0.0.1";  ///< address to listen on (localhost by default)
+    std::uint16_t port = 8080;       ///< 0: any free port (port() tells which)
+    /// The secret every request must carry; empty: 32 random hexadecimal characters. Given
+    /// tokens need kMinTokenLength or more characters from [A-Za-z0-9_-].
+    std::string token;
+    std::size_t maxMessageBytes = 4u << 20;  ///< larger WebSocket messages close the connection
+    int maxMessagesPerSecond = 200;          ///< per connection; more are dropped with an error
+    int maxSessions = 32;                    ///< WebSocket connections at once
+    double targetFrameMs = 30.0;             ///< reduced-resolution frames aim at this render time
+    int refineDelayMs = 150;  ///< full resolution once the state has been still this long
+    int maxScale = 8;         ///< coarsest reduced resolution: 1/maxScale of each side
+    int jpegQuality = 80;     ///< of reduced-resolution frames
+};
+
+/// Shortest token ServerOptions::token may be.
+inline constexpr std::size_t kMinTokenLength = 16;
+
+/// What the server shows: the mesh as read (kept for field changes), how to prepare it, the
+/// render settings the command line fixed and the state every new tab starts from.
+struct ViewScene {
+    std::string file;                  ///< as named on the command line
+    std::shared_ptr<const Mesh> mesh;  ///< the mesh as read
+    Bounds3f bounds;                   ///< of the rendered cells, in file coordinates
+    RendererOptions rendererOptions;   ///< how fields are prepared
+    RenderSettings base;               ///< steps, sampling and rules beyond the state
+    ViewState initial;                 ///< every tab's starting state
+    /// Prepared for initial.field (the command line's preparation, with its progress); null:
+    /// prepared before the first frame.
+    std::unique_ptr<Renderer> renderer;
+    std::vector<std::string> notes;   ///< validation findings and notes the page shows
+    double loadSeconds = 0.0;         ///< reading the file
+    std::optional<Vec3f> background;  ///< --background: snapshots composite over it
+    /// Flags of the command line that shape the image beyond the state (--step, --sampling, ...)
+    /// for the exported `uvr render` command, each a separate argument.
+    std::vector<std::string> commandFlags;
+};
+
+/// Log lines of the server (connections, preparations, failures), one line each.
+using LogFn = std::function<void(const std::string&)>;
+
+/// The viewer's HTTP + WebSocket server (Boost.Beast): serves the page embedded from web/,
+/// keeps one state per WebSocket connection over the one prepared mesh, and renders the newest
+/// state of each connection on one render thread (latest wins; docs/VIEWER.md).
+class ViewServer {
+public:
+    /// Checks the options (a given token's form) and takes the scene; throws Error(Argument).
+    ViewServer(ViewScene scene, ServerOptions options, LogFn log = {});
+    /// Stops the server if it runs.
+    ~ViewServer();
+    ViewServer(const ViewServer&) = delete;
+    ViewServer& operator=(const ViewServer&) = delete;
+
+    /// Binds and starts serving on background threads; throws Error(Io) naming the address
+    /// when it cannot listen there.
+    void start();
+    /// The port it listens on (after start).
+    std::uint16_t port() const;
+    /// The token.
+    const std::string& token() const;
+    /// The address to open: http://HOST:PORT/?token=TOKEN.
+    std::string url() const;
+    /// Serves until stop() or, with handleSignals, SIGINT or SIGTERM; then shuts down.
+    void run(bool handleSignals = true);
+    /// Asks a running server to stop (any thread).
+    void stop();
+
+    /// The server's inside (view_server.cpp); opaque.
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace uvr::server

@@ -1,0 +1,449 @@
+// SPDX-License-Identifier: MIT
+// The viewer's server in process, driven by a WebSocket client (Boost.Beast) as the page would.
+#include "uvr/server/view_server.h"
+
+#include <gmock/gmock.h>
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "test_meshes.h"
+#include "test_support.h"
+#include "uvr/core/error.h"
+#include "uvr/server/web_assets.h"
+
+namespace uvr::server {
+namespace {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using Json = nlohmann::json;
+using ::testing::HasSubstr;
+using namespace std::chrono_literals;
+
+/// A mesh with a point field "f" and a cell field "g" of other ranges.
+std::shared_ptr<Mesh> twoFieldMesh() {
+    auto m = std::make_shared<Mesh>(testing::makeHexGrid(
+        6, -1.f, 1.f, [](Vec3f p) { return p.x + 2.f * p.y; }, 0.2f));
+    Field g{"g", Association::Cell, 1, {}};
+    for (std::size_t c = 0; c < m->cellCount(); ++c) g.values.push_back(100.f + float(c));
+    m->fields.push_back(g);
+    return m;
+}
+
+/// A server on a free port of 127.0.0.1 over the two-field mesh, on the CPU, 64x48 frames.
+std::unique_ptr<ViewServer> startServer(ServerOptions o = {}) {
+    ViewScene scene;
+    scene.file = "grid.vtk";
+    scene.mesh = twoFieldMesh();
+    scene.bounds = scene.mesh->bounds();
+    scene.rendererOptions.device = Device::Cpu;
+    scene.rendererOptions.leafCells = 64;
+    ViewState& s = scene.initial;
+    s.camera = resetCamera(scene.bounds, 64.f / 48.f);
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "0:0,1:0.6");
+    s.range = {-3.f, 3.f};
+    s.width = 64;
+    s.height = 48;
+    s.opacityUnit = 0.5f;
+    scene.commandFlags = {"--step", "0.01"};
+    o.port = 0;
+    auto server = std::make_unique<ViewServer>(std::move(scene), o);
+    server->start();
+    return server;
+}
+
+/// A WebSocket client with timeouts on its own io_context.
+class Client {
+public:
+    /// Connects to /ws?token=TOKEN; throws beast::system_error when the handshake fails.
+    Client(std::uint16_t port, const std::string& token) : ws_(ioc_) {
+        tcp::resolver resolver(ioc_);
+        net::connect(ws_.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
+        ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
+    }
+
+    void send(const Json& j) { sendText(j.dump()); }
+    void sendText(const std::string& text) {
+        ws_.text(true);
+        ws_.write(net::buffer(text));
+    }
+    void sendBinary(const std::string& bytes) {
+        ws_.binary(true);
+        ws_.write(net::buffer(bytes));
+    }
+
+    /// The next message (text JSON or, for a binary one, {"binary": size}); null on timeout
+    /// (the read stays pending for the next call) or a closed connection (closed() says which).
+    Json next(std::chrono::milliseconds timeout = 10s) {
+        if (closed_) return nullptr;
+        if (!reading_) {
+            reading_ = true;
+            done_ = false;
+            buffer_.clear();
+            ws_.async_read(buffer_, [this](beast::error_code ec, std::size_t) {
+                done_ = true;
+                error_ = ec;
+            });
+        }
+        ioc_.restart();
+        ioc_.run_for(timeout);
+        if (!done_) return nullptr;
+        reading_ = false;
+        if (error_) {
+            closed_ = true;
+            return nullptr;
+        }
+        if (ws_.got_binary()) {
+            lastBinary_ = beast::buffers_to_string(buffer_.data());
+            return Json{{"binary", lastBinary_.size()}};
+        }
+        return Json::parse(beast::buffers_to_string(buffer_.data()));
+    }
+
+    /// Messages until one of `type` arrives (null on timeout).
+    Json until(const std::string& type, std::chrono::milliseconds timeout = 20s) {
+        const auto end = std::chrono::steady_clock::now() + timeout;
+        while (std::chrono::steady_clock::now() < end) {
+            Json j = next(std::chrono::duration_cast<std::chrono::milliseconds>(
+                end - std::chrono::steady_clock::now()));
+            if (j.is_null()) return nullptr;
+            if (j.contains("type") && j["type"] == type) return j;
+            seen_.push_back(j);
+        }
+        return nullptr;
+    }
+
+    /// The next frame's description, its image read (lastBinary()).
+    Json frame(std::chrono::milliseconds timeout = 20s) {
+        Json f = until("frame", timeout);
+        if (!f.is_null()) {
+            const Json image = next();
+            EXPECT_TRUE(image.contains("binary")) << image.dump();
+        }
+        return f;
+    }
+
+    const std::string& lastBinary() const { return lastBinary_; }
+    const std::vector<Json>& seen() const { return seen_; }
+    bool closed() const { return closed_; }
+
+private:
+    net::io_context ioc_;
+    websocket::stream<tcp::socket> ws_;
+    std::string lastBinary_;
+    std::vector<Json> seen_;
+    beast::flat_buffer buffer_;
+    bool reading_ = false, done_ = false, closed_ = false;
+    beast::error_code error_;
+};
+
+/// Status of a plain HTTP GET of target, with optional Cookie header.
+int httpGet(std::uint16_t port, const std::string& target, const std::string& cookie = "",
+            std::string* setCookie = nullptr, std::string* body = nullptr) {
+    net::io_context ioc;
+    tcp::socket socket(ioc);
+    tcp::resolver resolver(ioc);
+    net::connect(socket, resolver.resolve("127.0.0.1", std::to_string(port)));
+    http::request<http::empty_body> req{http::verb::get, target, 11};
+    req.set(http::field::host, "127.0.0.1");
+    if (!cookie.empty()) req.set(http::field::cookie, cookie);
+    http::write(socket, req);
+    beast::flat_buffer buffer;
+    http::response<http::string_body> res;
+    http::read(socket, buffer, res);
+    if (setCookie) setCookie->assign(res[http::field::set_cookie]);
+    if (body) *body = res.body();
+    return res.result_int();
+}
+
+bool isPng(const std::string& b) {
+    return b.size() > 8 && b.compare(1, 3, "PNG") == 0;
+}
+bool isJpeg(const std::string& b) {
+    return b.size() > 2 && static_cast<unsigned char>(b[0]) == 0xFF &&
+           static_cast<unsigned char>(b[1]) == 0xD8;
+}
+
+TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
+    auto server = startServer();
+    EXPECT_THAT(server->url(), HasSubstr("http://127.0.0.1:" + std::to_string(server->port()) +
+                                         "/?token=" + server->token()));
+    EXPECT_EQ(server->token().size(), 32u);
+    Client c(server->port(), server->token());
+    const Json info = c.next();
+    ASSERT_EQ(info["type"], "info") << info.dump();
+    EXPECT_EQ(info["file"], "grid.vtk");
+    EXPECT_EQ(info["cells"], 216);
+    ASSERT_EQ(info["fields"].size(), 2u);
+    EXPECT_EQ(info["fields"][0]["name"], "f");
+    EXPECT_TRUE(info["fields"][0]["default"].get<bool>());
+    EXPECT_EQ(info["fields"][1]["association"], "cell");
+    EXPECT_NEAR(info["fields"][1]["range"][1].get<double>(), 315.0, 1e-3);
+    EXPECT_EQ(info["state"]["size"], Json({64, 48}));
+    EXPECT_EQ(info["state"]["tf"]["name"], "Viridis (matplotlib)");
+    EXPECT_EQ(info["histogram"]["counts"].size(), 256u);
+    EXPECT_GT(info["presets"].size(), 20u);
+    const Json f = c.frame();
+    ASSERT_FALSE(f.is_null());
+    EXPECT_TRUE(f["full"].get<bool>());
+    EXPECT_EQ(f["format"], "png");
+    EXPECT_EQ(f["width"], 64);
+    EXPECT_GT(f["stats"]["samples_per_pixel"].get<double>(), 0.0);
+    EXPECT_EQ(f["stats"]["device"], "cpu");
+    EXPECT_TRUE(isPng(c.lastBinary()));
+}
+
+TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    Json cam = c.seen().front()["state"]["camera"];
+    cam["position"][0] = 4.0;
+    c.send({{"type", "set"}, {"seq", 5}, {"interactive", true}, {"camera", cam}});
+    const Json moving = c.frame();
+    ASSERT_FALSE(moving.is_null());
+    EXPECT_EQ(moving["seq"], 5);
+    EXPECT_FALSE(moving["full"].get<bool>());
+    EXPECT_EQ(moving["format"], "jpeg");
+    EXPECT_TRUE(isJpeg(c.lastBinary()));
+    EXPECT_GE(moving["scale"].get<int>(), 1);
+    EXPECT_EQ(moving["width"].get<int>(), 64 / moving["scale"].get<int>());
+    // No further change: the refinement comes by itself.
+    const Json still = c.frame();
+    ASSERT_FALSE(still.is_null());
+    EXPECT_EQ(still["seq"], 5);
+    EXPECT_TRUE(still["full"].get<bool>());
+    EXPECT_EQ(still["width"], 64);
+    EXPECT_TRUE(isPng(c.lastBinary()));
+    const std::string before = c.lastBinary();
+    // A TF change alone gives a different image.
+    c.send({{"type", "set"}, {"seq", 6}, {"tf", {{"opacity", {{0, 0.9}, {1, 0.9}}}}}});
+    const Json tf = c.frame();
+    ASSERT_FALSE(tf.is_null());
+    EXPECT_EQ(tf["seq"], 6);
+    EXPECT_NE(c.lastBinary(), before);
+}
+
+TEST(ViewServer, WrongTokensGetNoPageAndNoSocket) {
+    auto server = startServer();
+    const std::uint16_t port = server->port();
+    EXPECT_THROW(Client(port, "0123456789abcdef0123456789abcdef"), beast::system_error);
+    EXPECT_THROW(Client(port, ""), beast::system_error);
+    EXPECT_EQ(httpGet(port, "/?token=wrong"), 403);
+    EXPECT_EQ(httpGet(port, "/"), 403);
+    EXPECT_EQ(httpGet(port, "/app.js"), 403);
+    EXPECT_EQ(httpGet(port, "/no-such-file.js?token=" + server->token()), 404);
+    if (!findWebAsset("index.html")) GTEST_SKIP() << "the page (web/) is not built in";
+    std::string cookie, body;
+    EXPECT_EQ(httpGet(port, "/?token=" + server->token(), "", &cookie, &body), 200);
+    EXPECT_THAT(body, HasSubstr("<html"));
+    EXPECT_THAT(cookie, HasSubstr("HttpOnly"));
+    const std::string pair = cookie.substr(0, cookie.find(';'));
+    EXPECT_EQ(pair, "uvr_token_" + std::to_string(port) + "=" + server->token());
+    // The page's files come with the cookie, not without it or with another one.
+    const std::string other = pair.substr(0, pair.find('=') + 1) + "x";
+    for (std::string name : {"app.js", "style.css"}) {
+        if (!findWebAsset(name)) continue;
+        EXPECT_EQ(httpGet(port, "/" + name, pair), 200) << name;
+        EXPECT_EQ(httpGet(port, "/" + name), 403) << name;
+        EXPECT_EQ(httpGet(port, "/" + name, other), 403) << name;
+    }
+}
+
+TEST(ViewServer, BadMessagesGetErrorsAndTheConnectionKeepsServing) {
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"{not json", "malformed JSON"},
+        {"[1, 2]", "\"type\""},
+        {R"({"type": 7})", "\"type\""},
+        {R"({"type": "launch"})", "unknown message type \"launch\""},
+        {R"({"type": "set", "quality": 7})", "\"quality\""},
+        {R"({"type": "set", "seq": -1, "heatmap": true})", "\"seq\""},
+        {R"({"type": "set", "field": "nope"})", "nope"},
+        {R"({"type": "set", "interactive": "yes"})", "interactive"},
+        {R"({"type": "reset_camera", "axis": "+w"})", "axis"},
+    };
+    for (const auto& [text, want] : cases) {
+        c.sendText(text);
+        const Json e = c.until("error");
+        ASSERT_FALSE(e.is_null()) << text;
+        EXPECT_THAT(e["message"].get<std::string>(), HasSubstr(want)) << text;
+    }
+    c.sendBinary(std::string("\x89PNG", 4));
+    EXPECT_THAT(c.until("error")["message"].get<std::string>(), HasSubstr("binary"));
+    // The bad seq and heat map above changed nothing: the state still shows the volume.
+    c.send({{"type", "ping"}, {"seq", 3}});
+    const Json pong = c.until("pong");
+    ASSERT_FALSE(pong.is_null());
+    EXPECT_EQ(pong["seq"], 3);
+    c.send({{"type", "set"}, {"seq", 9}, {"method", "exact"}});
+    const Json f = c.frame();
+    ASSERT_FALSE(f.is_null());
+    EXPECT_EQ(f["seq"], 9);
+    EXPECT_EQ(f["stats"]["method"], "exact");
+}
+
+TEST(ViewServer, AFloodIsLimitedAndNeverQueuesFrames) {
+    ServerOptions o;
+    o.maxMessagesPerSecond = 100;
+    auto server = startServer(o);
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    Json cam = c.seen().front()["state"]["camera"];
+    for (int i = 1; i <= 2000; ++i) {
+        cam["position"][0] = 3.0 + i * 1e-3;
+        c.send({{"type", "set"}, {"seq", i}, {"interactive", true}, {"camera", cam}});
+    }
+    // Read everything the flood produced until the connection goes quiet.
+    int frames = 0, errors = 0;
+    std::uint64_t lastSeq = 0;
+    for (Json j = c.next(1500ms); !j.is_null(); j = c.next(1500ms)) {
+        if (j.value("type", "") == "frame") ++frames, lastSeq = j["seq"];
+        if (j.value("type", "") == "error") {
+            ++errors;
+            EXPECT_THAT(j["message"].get<std::string>(), HasSubstr("too many messages"));
+        }
+    }
+    EXPECT_FALSE(c.closed());
+    EXPECT_GE(errors, 1);
+    EXPECT_LT(frames, 100) << "frames were queued, not replaced";
+    EXPECT_GE(lastSeq, 100u);   // the burst's newest accepted state was shown
+    EXPECT_LT(lastSeq, 2000u);  // later ones were dropped
+    // Once the flood is over the connection is heard again.
+    std::this_thread::sleep_for(1100ms);
+    c.send({{"type", "set"}, {"seq", 5000}, {"camera", cam}});
+    const Json f = c.frame();
+    ASSERT_FALSE(f.is_null());
+    EXPECT_EQ(f["seq"], 5000);
+}
+
+TEST(ViewServer, SnapshotAndExportReproduceTheState) {
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    c.send({{"type", "set"}, {"preset", "Inferno (matplotlib)"}, {"range", {-2.5, 2.5}}});
+    const Json state = c.until("state");
+    ASSERT_FALSE(state.is_null());
+    EXPECT_EQ(state["state"]["tf"]["name"], "Inferno (matplotlib)");
+    c.send({{"type", "snapshot"}});
+    const Json snap = c.until("snapshot");
+    ASSERT_FALSE(snap.is_null());
+    EXPECT_EQ(snap["width"], 64);
+    EXPECT_EQ(snap["height"], 48);
+    EXPECT_TRUE(c.next().contains("binary"));
+    EXPECT_TRUE(isPng(c.lastBinary()));
+    c.send({{"type", "export"}});
+    const Json ex = c.until("export");
+    ASSERT_FALSE(ex.is_null());
+    const std::string tfText = ex["tf_json"], pvcc = ex["pvcc"];
+    const TransferFunction tf = parseParaViewColorMap({tfText.begin(), tfText.end()}, "export");
+    EXPECT_EQ(tf.name, "Inferno (matplotlib)");
+    EXPECT_FLOAT_EQ(tf.sourceRange->first, -2.5f);
+    const Camera cam = parsePvcc({pvcc.begin(), pvcc.end()}, "export");
+    EXPECT_NEAR(cam.position.z, state["state"]["camera"]["position"][2].get<double>(), 1e-4);
+    const std::string cmd = ex["command"];
+    EXPECT_THAT(cmd, HasSubstr("uvr render grid.vtk --tf uvr-tf.json --camera uvr-camera.pvcc "
+                               "--range -2.5,2.5 --method adaptive --quality 0.99"));
+    EXPECT_THAT(cmd, HasSubstr("--size 64x48 --opacity-unit 0.5 --step 0.01 -o uvr-view.png"));
+}
+
+TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogram) {
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    c.send({{"type", "set"}, {"seq", 2}, {"field", "g"}});
+    const Json h = c.until("histogram");
+    ASSERT_FALSE(h.is_null());
+    EXPECT_EQ(h["field"], "g");
+    const Json st = c.until("state");
+    ASSERT_FALSE(st.is_null());
+    EXPECT_EQ(st["state"]["range"], Json({100.0, 315.0}));
+    const Json f = c.frame();
+    ASSERT_FALSE(f.is_null());
+    EXPECT_EQ(f["seq"], 2);
+}
+
+TEST(ViewServer, TabsHaveTheirOwnStateAndResetCameraSnapsToAxes) {
+    auto server = startServer();
+    Client a(server->port(), server->token()), b(server->port(), server->token());
+    ASSERT_FALSE(a.frame().is_null());
+    ASSERT_FALSE(b.frame().is_null());
+    a.send({{"type", "reset_camera"}, {"seq", 1}, {"axis", "+x"}});
+    const Json st = a.until("state");
+    ASSERT_FALSE(st.is_null());
+    const Json cam = st["state"]["camera"];
+    EXPECT_LT(cam["position"][0].get<double>(), -1.0);  // looking along +x from -x
+    EXPECT_EQ(cam["view_up"], Json({0.0, 0.0, 1.0}));
+    ASSERT_FALSE(a.frame().is_null());
+    b.send({{"type", "export"}});
+    const std::string pvcc = b.until("export")["pvcc"];
+    const Camera bCam = parsePvcc({pvcc.begin(), pvcc.end()}, "b");
+    EXPECT_EQ(bCam.viewUp, Vec3f(0.f, 1.f, 0.f));  // b still has the starting camera
+}
+
+TEST(ViewServer, OversizedMessagesCloseTheConnectionAndLimitsCapSessions) {
+    ServerOptions o;
+    o.maxMessageBytes = 1024;
+    o.maxSessions = 1;
+    auto server = startServer(o);
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    EXPECT_THROW(Client(server->port(), server->token()), beast::system_error);  // one only
+    c.sendText(R"({"type": "set", "colormap_json": ")" + std::string(2000, 'x') + "\"}");
+    EXPECT_TRUE(c.until("never", 5s).is_null());
+    EXPECT_TRUE(c.closed());
+    // Its place is free again.
+    std::this_thread::sleep_for(100ms);
+    Client d(server->port(), server->token());
+    EXPECT_EQ(d.next()["type"], "info");
+}
+
+TEST(ViewServer, StopClosesConnectionsAndBadOptionsAreRefused) {
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    std::thread runner([&] { server->run(false); });
+    server->stop();
+    runner.join();
+    for (Json j = c.next(3s); !j.is_null(); j = c.next(3s)) {
+    }
+    EXPECT_TRUE(c.closed()) << "no close from the server";
+    auto refused = [](ServerOptions o) {
+        ViewScene scene;
+        scene.mesh = twoFieldMesh();
+        scene.initial.field = "f";
+        try {
+            ViewServer s(std::move(scene), o);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    ServerOptions shortToken;
+    shortToken.token = "abc";
+    EXPECT_THAT(refused(shortToken), HasSubstr("--token"));
+    ServerOptions oddToken;
+    oddToken.token = "0123456789abcdef;rm";
+    EXPECT_THAT(refused(oddToken), HasSubstr("--token"));
+    ServerOptions badHost;
+    badHost.host = "not-an-address";
+    ViewScene scene;
+    scene.mesh = twoFieldMesh();
+    ViewServer s(std::move(scene), badHost);
+    EXPECT_THROW(s.start(), Error);
+}
+
+}  // namespace
+}  // namespace uvr::server

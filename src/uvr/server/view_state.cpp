@@ -1,0 +1,320 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/server/view_state.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "uvr/core/error.h"
+#include "uvr/core/text.h"
+
+namespace uvr::server {
+
+namespace {
+
+using Json = nlohmann::json;
+
+std::string fmtG(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+[[noreturn]] void bad(const std::string& key, const std::string& expected, const Json& got) {
+    throwError(ErrorKind::Argument, "",
+               "\"" + key + "\": expected " + expected + ", got " +
+                   printableShort(got.dump(-1, ' ', false, Json::error_handler_t::replace), 80));
+}
+
+double number(const std::string& key, const Json& v) {
+    if (!v.is_number() || !std::isfinite(v.get<double>())) bad(key, "a finite number", v);
+    return v.get<double>();
+}
+
+float floatIn(const std::string& key, const Json& v, double lo, double hi) {
+    const double x = number(key, v);
+    if (x < lo || x > hi) bad(key, "a number in [" + fmtG(lo) + ", " + fmtG(hi) + "]", v);
+    return static_cast<float>(x);
+}
+
+float finiteFloat(const std::string& key, const Json& v) {
+    const double x = number(key, v);
+    if (std::fabs(x) > 3.0e38) bad(key, "a number within float range", v);
+    return static_cast<float>(x);
+}
+
+Vec3f vec3(const std::string& key, const Json& v) {
+    if (!v.is_array() || v.size() != 3) bad(key, "3 numbers [x, y, z]", v);
+    return {finiteFloat(key + "[0]", v[0]), finiteFloat(key + "[1]", v[1]),
+            finiteFloat(key + "[2]", v[2])};
+}
+
+bool boolean(const std::string& key, const Json& v) {
+    if (!v.is_boolean()) bad(key, "true or false", v);
+    return v.get<bool>();
+}
+
+const Json& object(const std::string& key, const Json& v) {
+    if (!v.is_object()) bad(key, "an object", v);
+    return v;
+}
+
+/// Rows [x, c...] of `width` numbers, x increasing in [0, 1], the rest in [0, 1].
+std::vector<std::vector<float>> rows(const std::string& key, const Json& v, std::size_t width) {
+    const std::string shape =
+        width == 4 ? "rows [x, r, g, b] of numbers in [0, 1]" : "rows [x, alpha] in [0, 1]";
+    if (!v.is_array() || v.empty()) bad(key, "a non-empty array of " + shape, v);
+    if (v.size() > kMaxTfPoints) bad(key, "at most " + std::to_string(kMaxTfPoints) + " rows", v);
+    std::vector<std::vector<float>> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string where = key + "[" + std::to_string(i) + "]";
+        if (!v[i].is_array() || v[i].size() != width) bad(where, shape, v[i]);
+        std::vector<float> row;
+        for (std::size_t k = 0; k < width; ++k)
+            row.push_back(floatIn(where + "[" + std::to_string(k) + "]", v[i][k], 0.0, 1.0));
+        if (!out.empty() && row[0] < out.back()[0])
+            bad(where, "x not below the previous row's", v[i]);
+        out.push_back(std::move(row));
+    }
+    return out;
+}
+
+const char* colorSpaceName(ColorSpace space) {
+    switch (space) {
+        case ColorSpace::Lab:
+            return "Lab";
+        case ColorSpace::Diverging:
+            return "Diverging";
+        default:
+            return "RGB";
+    }
+}
+
+void applyCamera(Camera& cam, const Json& v) {
+    for (const auto& [k, x] : object("camera", v).items()) {
+        const std::string key = "camera." + k;
+        if (k == "position")
+            cam.position = vec3(key, x);
+        else if (k == "focal_point")
+            cam.focalPoint = vec3(key, x);
+        else if (k == "view_up")
+            cam.viewUp = vec3(key, x);
+        else if (k == "view_angle")
+            cam.viewAngle = floatIn(key, x, kMinViewAngle, kMaxViewAngle);
+        else if (k == "parallel")
+            cam.parallelProjection = boolean(key, x);
+        else if (k == "parallel_scale") {
+            cam.parallelScale = finiteFloat(key, x);
+            if (!(cam.parallelScale > 0.f)) bad(key, "a positive number", x);
+        } else
+            bad("camera",
+                "keys position, focal_point, view_up, view_angle, parallel, "
+                "parallel_scale (not \"" +
+                    printableShort(k, 40) + "\")",
+                v);
+    }
+    validateCamera(cam);
+}
+
+void applyTf(TransferFunction& tf, const Json& v) {
+    for (const auto& [k, x] : object("tf", v).items()) {
+        const std::string key = "tf." + k;
+        if (k == "colors") {
+            tf.colors.clear();
+            for (const auto& r : rows(key, x, 4)) tf.colors.push_back({r[0], {r[1], r[2], r[3]}});
+        } else if (k == "opacity") {
+            tf.opacities.clear();
+            for (const auto& r : rows(key, x, 2)) tf.opacities.push_back({r[0], r[1]});
+        } else if (k == "log") {
+            tf.logScale = boolean(key, x);
+        } else if (k == "nan_color") {
+            const Vec3f c = vec3(key, x);
+            if (!(c.x >= 0.f && c.y >= 0.f && c.z >= 0.f && c.x <= 1.f && c.y <= 1.f && c.z <= 1.f))
+                bad(key, "3 numbers in [0, 1]", x);
+            tf.nanColor = c;
+        } else if (k == "nan_opacity") {
+            tf.nanOpacity = floatIn(key, x, 0.0, 1.0);
+        } else if (k == "name") {
+            if (!x.is_string() || x.get<std::string>().size() > 256)
+                bad(key, "a string of at most 256 bytes", x);
+            tf.name = x.get<std::string>();
+        } else if (k == "color_space") {
+            const std::string s = x.is_string() ? x.get<std::string>() : "";
+            if (s == "RGB")
+                tf.colorSpace = ColorSpace::RGB;
+            else if (s == "Lab")
+                tf.colorSpace = ColorSpace::Lab;
+            else if (s == "Diverging")
+                tf.colorSpace = ColorSpace::Diverging;
+            else
+                bad(key, "\"RGB\", \"Lab\" or \"Diverging\"", x);
+        } else {
+            bad("tf",
+                "keys colors, opacity, log, nan_color, nan_opacity, name, color_space (not \"" +
+                    printableShort(k, 40) + "\")",
+                v);
+        }
+    }
+}
+
+}  // namespace
+
+const char* methodName(RenderMethod method) {
+    switch (method) {
+        case RenderMethod::Reference:
+            return "reference";
+        case RenderMethod::Exact:
+            return "exact";
+        default:
+            return "adaptive";
+    }
+}
+
+Json toJson(const ViewState& s) {
+    auto vec = [](Vec3f v) { return Json::array({v.x, v.y, v.z}); };
+    Json colors = Json::array(), opacity = Json::array();
+    for (const ColorPoint& c : s.tf.colors) colors.push_back({c.x, c.rgb.x, c.rgb.y, c.rgb.z});
+    for (const OpacityPoint& o : s.tf.opacities) opacity.push_back({o.x, o.alpha});
+    return {{"camera",
+             {{"position", vec(s.camera.position)},
+              {"focal_point", vec(s.camera.focalPoint)},
+              {"view_up", vec(s.camera.viewUp)},
+              {"view_angle", s.camera.viewAngle},
+              {"parallel", s.camera.parallelProjection},
+              {"parallel_scale", s.camera.parallelScale}}},
+            {"tf",
+             {{"name", s.tf.name},
+              {"color_space", colorSpaceName(s.tf.colorSpace)},
+              {"colors", colors},
+              {"opacity", opacity},
+              {"log", s.tf.logScale},
+              {"nan_color", vec(s.tf.nanColor)},
+              {"nan_opacity", s.tf.nanOpacity}}},
+            {"range", {s.range.first, s.range.second}},
+            {"field", s.field},
+            {"method", methodName(s.method)},
+            {"quality", s.quality},
+            {"heatmap", s.heatmap},
+            {"size", {s.width, s.height}},
+            {"opacity_unit", s.opacityUnit}};
+}
+
+SetResult applySet(ViewState& state, const Json& message) {
+    if (!message.is_object()) bad("set", "a JSON object", message);
+    ViewState next = state;  // all or nothing
+    SetResult result;
+    // Colour maps first: explicit tf keys in the same message refine them.
+    if (auto it = message.find("preset"); it != message.end()) {
+        if (!it->is_string()) bad("preset", "a preset name", *it);
+        const TransferFunction preset = transferFunctionPreset(it->get<std::string>());
+        next.tf.name = preset.name;
+        next.tf.colorSpace = preset.colorSpace;
+        next.tf.colors = preset.colors;
+        next.tf.nanColor = preset.nanColor;
+        result.echoState = true;
+    }
+    if (auto it = message.find("colormap_json"); it != message.end()) {
+        if (!it->is_string()) bad("colormap_json", "the text of a ParaView colour-map JSON", *it);
+        std::string name;
+        if (auto n = message.find("colormap_name"); n != message.end()) {
+            if (!n->is_string()) bad("colormap_name", "a string", *n);
+            name = n->get<std::string>();
+        }
+        const std::string& text = it->get_ref<const std::string&>();
+        TransferFunction loaded =
+            parseParaViewColorMap({text.begin(), text.end()}, "the uploaded colour map", name);
+        // A map without opacity points (the loader's ramp) keeps the page's opacity.
+        const bool hasPoints = text.find("\"Points\"") != std::string::npos;
+        if (!hasPoints) loaded.opacities = next.tf.opacities;
+        if (loaded.sourceRange && loaded.sourceRange->first < loaded.sourceRange->second &&
+            !message.contains("range")) {
+            next.range = *loaded.sourceRange;
+            result.rangeGiven = true;
+        }
+        next.tf = loaded;
+        result.echoState = true;
+    } else if (message.contains("colormap_name")) {
+        bad("colormap_name", "to come with colormap_json", message["colormap_name"]);
+    }
+    for (const auto& [k, v] : message.items()) {
+        if (k == "type" || k == "seq" || k == "interactive" || k == "preset" ||
+            k == "colormap_json" || k == "colormap_name")
+            continue;
+        if (k == "camera") {
+            applyCamera(next.camera, v);
+        } else if (k == "tf") {
+            applyTf(next.tf, v);
+        } else if (k == "range") {
+            if (!v.is_array() || v.size() != 2) bad(k, "[lo, hi]", v);
+            const float lo = finiteFloat("range[0]", v[0]), hi = finiteFloat("range[1]", v[1]);
+            if (!(lo < hi)) bad(k, "lo < hi", v);
+            next.range = {lo, hi};
+            result.rangeGiven = true;
+        } else if (k == "field") {
+            if (!v.is_string() || v.get<std::string>().size() > 1024)
+                bad(k, "a field spec as --field takes it", v);
+            parseFieldSpec(v.get<std::string>());  // a malformed suffix fails here
+            result.fieldChanged = v.get<std::string>() != next.field;
+            next.field = v.get<std::string>();
+        } else if (k == "method") {
+            const std::string m = v.is_string() ? v.get<std::string>() : "";
+            if (m == "adaptive")
+                next.method = RenderMethod::Partitions;
+            else if (m == "reference")
+                next.method = RenderMethod::Reference;
+            else if (m == "exact")
+                next.method = RenderMethod::Exact;
+            else
+                bad(k, "\"adaptive\", \"reference\" or \"exact\"", v);
+        } else if (k == "quality") {
+            next.quality = floatIn(k, v, kMinQuality, kMaxQuality);
+        } else if (k == "heatmap") {
+            next.heatmap = boolean(k, v);
+        } else if (k == "size") {
+            if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() ||
+                !v[1].is_number_integer())
+                bad(k, "[width, height] in pixels", v);
+            const auto w = v[0].get<std::int64_t>(), h = v[1].get<std::int64_t>();
+            if (w < kMinViewSize || h < kMinViewSize || w > kMaxViewSize || h > kMaxViewSize)
+                bad(k,
+                    "[width, height], each in [" + std::to_string(kMinViewSize) + ", " +
+                        std::to_string(kMaxViewSize) + "]",
+                    v);
+            next.width = static_cast<int>(w);
+            next.height = static_cast<int>(h);
+        } else if (k == "opacity_unit") {
+            next.opacityUnit = finiteFloat(k, v);
+            if (!(next.opacityUnit > 0.f)) bad(k, "a positive length", v);
+        } else {
+            bad("set",
+                "state keys (camera, tf, range, field, method, quality, heatmap, size, "
+                "opacity_unit, preset, colormap_json), not \"" +
+                    printableShort(k, 40) + "\"",
+                message);
+        }
+    }
+    if (next.tf.logScale && !(next.range.first > 0.f) && result.rangeGiven)
+        throwError(ErrorKind::Argument, "",
+                   "\"range\": a log-scale transfer function needs a positive range, got [" +
+                       fmtG(next.range.first) + ", " + fmtG(next.range.second) + "]");
+    state = std::move(next);
+    return result;
+}
+
+RenderSettings frameSettings(const ViewState& state, const RenderSettings& base, int scale) {
+    RenderSettings s = base;
+    s.progress = {};
+    s.camera = state.camera;
+    s.tf = state.tf;
+    s.range = state.range;
+    s.method = state.method;
+    s.quality = state.quality;
+    s.opacityUnit = state.opacityUnit;
+    scale = std::max(scale, 1);
+    s.width = std::max(1, state.width / scale);
+    s.height = std::max(1, state.height / scale);
+    return s;
+}
+
+}  // namespace uvr::server

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <utility>
+
+#include "uvr/render/camera.h"
+#include "uvr/render/render_setup.h"
+#include "uvr/tf/transfer_function.h"
+
+namespace uvr::server {
+
+/// Smallest and largest side of a viewer image.
+inline constexpr int kMinViewSize = 16;
+inline constexpr int kMaxViewSize = 4096;
+/// Most colour or opacity points a transfer function sent by a page may have.
+inline constexpr std::size_t kMaxTfPoints = 4096;
+
+/// What one browser tab looks at (docs/VIEWER.md, "The session state"): everything a frame
+/// depends on that the page may change. Positions are in the file's coordinates.
+struct ViewState {
+    Camera camera;
+    TransferFunction tf;
+    std::pair<float, float> range{0.f, 1.f};  ///< the data range the transfer function spans
+    std::string field;                        ///< as --field takes it
+    RenderMethod method = RenderMethod::Partitions;
+    float quality = kDefaultQuality;
+    bool heatmap = false;  ///< show samples per pixel instead of the volume
+    int width = 1024, height = 1024;
+    float opacityUnit = 1.f;  ///< ParaView's ScalarOpacityUnitDistance, in file units
+};
+
+/// "adaptive", "reference" or "exact" (the --method names).
+const char* methodName(RenderMethod method);
+
+/// The state as the protocol's JSON object.
+nlohmann::json toJson(const ViewState& state);
+
+/// What applying a `set` message changed.
+struct SetResult {
+    bool fieldChanged = false;  ///< `field` names another field (the caller resolves it)
+    bool rangeGiven = false;    ///< the message set `range`
+    /// The server changed or completed the state beyond what the page sent (a preset, an
+    /// uploaded colour map): the page needs the whole state back.
+    bool echoState = false;
+};
+
+/// Applies the state keys of a `set` message (camera, tf, range, field, method, quality,
+/// heatmap, size, opacity_unit, preset, colormap_json and colormap_name) to `state`, all or
+/// nothing: on any bad value it throws Error(Argument) (Error(Parse) for a malformed uploaded
+/// colour map) naming the key and what was expected, and leaves `state` unchanged. Unknown keys
+/// are refused too (a misspelt key must not pass silently); `type`, `seq` and `interactive`
+/// are the caller's.
+SetResult applySet(ViewState& state, const nlohmann::json& message);
+
+/// The render settings of a frame of the state: `base` (what the command line set beyond the
+/// state: steps, sampling, rule) with the state's camera, transfer function, range, method,
+/// quality and opacity unit, at the state's size divided by `scale` (at least 1 pixel a side).
+RenderSettings frameSettings(const ViewState& state, const RenderSettings& base, int scale = 1);
+
+}  // namespace uvr::server

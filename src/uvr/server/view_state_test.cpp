@@ -1,0 +1,162 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/server/view_state.h"
+
+#include <gmock/gmock.h>
+
+#include "test_support.h"
+#include "uvr/core/error.h"
+
+namespace uvr::server {
+namespace {
+
+using ::testing::HasSubstr;
+using Json = nlohmann::json;
+
+ViewState startState() {
+    ViewState s;
+    s.camera = resetCamera(Bounds3f(Vec3f(0.f), Vec3f(1.f)), 1.f);
+    s.tf = transferFunctionPreset("cool-to-warm");
+    s.range = {0.f, 2.f};
+    s.field = "density";
+    s.opacityUnit = 0.5f;
+    return s;
+}
+
+/// The message the error of applying `message` carries; the state must be unchanged.
+std::string refusal(const Json& message) {
+    ViewState s = startState();
+    const Json before = toJson(s);
+    try {
+        applySet(s, message);
+    } catch (const Error& e) {
+        EXPECT_EQ(toJson(s), before) << "state changed by a refused message";
+        return e.what();
+    }
+    ADD_FAILURE() << "accepted " << message.dump();
+    return "";
+}
+
+TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
+    ViewState s = startState();
+    const Json msg = {{"type", "set"},
+                      {"seq", 4},
+                      {"interactive", true},
+                      {"camera",
+                       {{"position", {1, 2, 3}},
+                        {"focal_point", {0, 0, 0}},
+                        {"view_up", {0, 0, 1}},
+                        {"view_angle", 20},
+                        {"parallel", true},
+                        {"parallel_scale", 0.75}}},
+                      {"tf",
+                       {{"colors", {{0, 0, 0, 0}, {1, 1, 0.5, 0.25}}},
+                        {"opacity", {{0, 0}, {0.5, 1}, {1, 0}}},
+                        {"log", false},
+                        {"nan_color", {0.5, 0.5, 0.5}},
+                        {"nan_opacity", 0.2},
+                        {"name", "mine"},
+                        {"color_space", "Lab"}}},
+                      {"range", {-1, 4}},
+                      {"method", "exact"},
+                      {"quality", 0.95},
+                      {"heatmap", true},
+                      {"size", {320, 200}},
+                      {"opacity_unit", 0.25}};
+    const SetResult r = applySet(s, msg);
+    EXPECT_FALSE(r.fieldChanged);
+    EXPECT_TRUE(r.rangeGiven);
+    EXPECT_FALSE(r.echoState);
+    EXPECT_EQ(s.camera.position, Vec3f(1.f, 2.f, 3.f));
+    EXPECT_TRUE(s.camera.parallelProjection);
+    EXPECT_FLOAT_EQ(s.camera.parallelScale, 0.75f);
+    EXPECT_EQ(s.tf.colorSpace, ColorSpace::Lab);
+    ASSERT_EQ(s.tf.opacities.size(), 3u);
+    EXPECT_FLOAT_EQ(s.tf.opacityAt(0.25f), 0.5f);
+    EXPECT_EQ(s.method, RenderMethod::Exact);
+    EXPECT_TRUE(s.heatmap);
+    EXPECT_EQ(s.width, 320);
+    EXPECT_EQ(s.height, 200);
+    // The state's JSON is itself a valid set message that changes nothing.
+    ViewState again = startState();
+    Json asSet = toJson(s);
+    applySet(again, asSet);
+    EXPECT_EQ(toJson(again), toJson(s));
+    // The frame settings carry it, at a reduced size too.
+    RenderSettings base;
+    base.step = 0.01f;
+    const RenderSettings f = frameSettings(s, base, 3);
+    EXPECT_EQ(f.width, 106);
+    EXPECT_EQ(f.height, 66);
+    EXPECT_EQ(f.step, 0.01f);
+    EXPECT_EQ(f.method, RenderMethod::Exact);
+    ASSERT_TRUE(f.range);
+    EXPECT_EQ(f.range->second, 4.f);
+    EXPECT_EQ(f.opacityUnit, 0.25f);
+}
+
+TEST(ViewState, PresetsAndUploadedColourMapsReplaceColoursAndAskForTheStateBack) {
+    ViewState s = startState();
+    applySet(s, {{"tf", {{"opacity", {{0, 0}, {1, 0.3}}}}}});
+    SetResult r = applySet(s, {{"preset", "viridis"}});
+    EXPECT_TRUE(r.echoState);
+    EXPECT_EQ(s.tf.name, "Viridis (matplotlib)");
+    EXPECT_FLOAT_EQ(s.tf.opacityAt(1.f), 0.3f);  // the page's opacity stays
+    // An uploaded map with Points and a range brings both.
+    const std::string json = R"([{"Name": "up", "ColorSpace": "RGB",
+        "RGBPoints": [10, 1, 0, 0, 20, 0, 0, 1], "Points": [10, 0, 0.5, 0, 20, 0.8, 0.5, 0]}])";
+    r = applySet(s, {{"colormap_json", json}});
+    EXPECT_TRUE(r.echoState);
+    EXPECT_TRUE(r.rangeGiven);
+    EXPECT_EQ(s.tf.name, "up");
+    EXPECT_EQ(s.range, std::make_pair(10.f, 20.f));
+    EXPECT_FLOAT_EQ(s.tf.opacityAt(1.f), 0.8f);
+    // Without Points the opacity stays; a range in the same message wins.
+    const std::string noPoints = R"({"Name": "np", "RGBPoints": [0, 0, 0, 0, 1, 1, 1, 1]})";
+    applySet(s, {{"colormap_json", noPoints}, {"range", {1, 3}}});
+    EXPECT_FLOAT_EQ(s.tf.opacityAt(1.f), 0.8f);
+    EXPECT_EQ(s.range, std::make_pair(1.f, 3.f));
+}
+
+TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
+    EXPECT_THAT(refusal({{"camera", {{"position", {0, 0}}}}}), HasSubstr("camera.position"));
+    EXPECT_THAT(refusal({{"camera", {{"position", {0, 0, "x"}}}}}),
+                HasSubstr("camera.position[2]"));
+    EXPECT_THAT(refusal({{"camera", {{"view_up", {0, 0, 1e39}}}}}), HasSubstr("float range"));
+    EXPECT_THAT(refusal({{"camera", {{"view_up", {0, 0, -1}}}}}), HasSubstr("parallel"));
+    EXPECT_THAT(refusal({{"camera", {{"view_angle", 180}}}}), HasSubstr("camera.view_angle"));
+    EXPECT_THAT(refusal({{"camera", {{"zoom", 2}}}}), HasSubstr("zoom"));
+    EXPECT_THAT(refusal({{"tf", {{"colors", Json::array()}}}}), HasSubstr("tf.colors"));
+    EXPECT_THAT(refusal({{"tf", {{"colors", {{0.5, 0, 0, 0}, {0.2, 0, 0, 0}}}}}}),
+                HasSubstr("tf.colors[1]"));
+    EXPECT_THAT(refusal({{"tf", {{"opacity", {{0, 2}}}}}}), HasSubstr("tf.opacity[0][1]"));
+    EXPECT_THAT(refusal({{"tf", {{"color_space", "HSV"}}}}), HasSubstr("tf.color_space"));
+    EXPECT_THAT(refusal({{"range", {2, 1}}}), HasSubstr("lo < hi"));
+    EXPECT_THAT(refusal({{"range", {0, "1"}}}), HasSubstr("range[1]"));
+    EXPECT_THAT(refusal({{"method", "fast"}}), HasSubstr("\"method\""));
+    EXPECT_THAT(refusal({{"quality", 1.5}}), HasSubstr("\"quality\""));
+    EXPECT_THAT(refusal({{"size", {8, 100}}}), HasSubstr("\"size\""));
+    EXPECT_THAT(refusal({{"size", {100.5, 100}}}), HasSubstr("\"size\""));
+    EXPECT_THAT(refusal({{"opacity_unit", -1}}), HasSubstr("opacity_unit"));
+    EXPECT_THAT(refusal({{"field", "density:sideways"}}), HasSubstr("sideways"));
+    EXPECT_THAT(refusal({{"preset", "no-such-map"}}), HasSubstr("no-such-map"));
+    EXPECT_THAT(refusal({{"colormap_json", "{not json"}}), HasSubstr("the uploaded colour map"));
+    EXPECT_THAT(refusal({{"colormap_name", "x"}}), HasSubstr("colormap_json"));
+    EXPECT_THAT(refusal({{"tf", {{"log", true}}}, {"range", {-1, 1}}}),
+                HasSubstr("positive range"));
+    EXPECT_THAT(refusal({{"camrea", {}}}), HasSubstr("camrea"));
+    EXPECT_THAT(refusal(Json::array({1, 2})), HasSubstr("object"));
+    // A good key before a bad one changes nothing either.
+    EXPECT_THAT(refusal({{"heatmap", true}, {"quality", 7}}), HasSubstr("quality"));
+}
+
+TEST(ViewState, AFieldChangeIsReported) {
+    ViewState s = startState();
+    EXPECT_FALSE(applySet(s, {{"field", "density"}}).fieldChanged);
+    const SetResult r = applySet(s, {{"field", "velocity:x"}});
+    EXPECT_TRUE(r.fieldChanged);
+    EXPECT_FALSE(r.rangeGiven);
+    EXPECT_EQ(s.field, "velocity:x");
+}
+
+}  // namespace
+}  // namespace uvr::server
