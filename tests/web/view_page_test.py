@@ -635,6 +635,7 @@ def main():
     mesh = os.path.join(args.data, args.mesh)
     if not os.path.isfile(mesh):
         skip(f"no {mesh}")
+    args.uvr = os.path.abspath(args.uvr)  # the exported command runs in the downloads folder
     if not os.access(args.uvr, os.X_OK):
         print(f"FAILED: no uvr binary at {args.uvr}")
         return 1
