@@ -233,8 +233,9 @@ function resizeCanvas(size) {
     }
     const wrap = $("view-wrap");
     const style = getComputedStyle(wrap);
-    const availW = wrap.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
-    const availH = wrap.clientHeight - parseFloat(style.paddingTop) - parseFloat(style.paddingBottom);
+    const px = (v) => parseFloat(v) || 0;
+    const availW = wrap.clientWidth - px(style.paddingLeft) - px(style.paddingRight);
+    const availH = wrap.clientHeight - px(style.paddingTop) - px(style.paddingBottom);
     const s = Math.max(0, Math.min(availW / view.width, availH / view.height));
     view.style.width = `${Math.floor(view.width * s)}px`;
     view.style.height = `${Math.floor(view.height * s)}px`;
@@ -316,7 +317,9 @@ view.addEventListener("wheel", (e) => {
     if (!session.state) return;
     e.preventDefault();
     // Notches: Chrome and Firefox give 100 pixels or 3 lines per notch of a mouse wheel.
-    const notches = e.deltaMode === 1 ? e.deltaY / 3 : e.deltaMode === 2 ? e.deltaY * 10 : e.deltaY / 100;
+    const notches = e.deltaMode === 1 ? e.deltaY / 3
+                  : e.deltaMode === 2 ? e.deltaY * 10
+                  : e.deltaY / 100;
     session.state.camera = cam.dolly(session.state.camera, cam.wheelZoomFactor(notches));
     scheduleCameraSend();
     clearTimeout(wheelTimer);
@@ -358,9 +361,11 @@ function fieldEntries(fields) {
             entries.push({spec: base, label: `${f.name} (${f.association})`, field: f});
             continue;
         }
-        const comps = f.components === 3 ? ["x", "y", "z"] : [...Array(f.components).keys()].map(String);
+        const comps = f.components === 3 ? ["x", "y", "z"]
+                                         : [...Array(f.components).keys()].map(String);
         for (const c of ["magnitude", ...comps]) {
-            entries.push({spec: `${base}:${c}`, label: `${f.name} · ${c} (${f.association})`, field: f});
+            entries.push({spec: `${base}:${c}`, label: `${f.name} · ${c} (${f.association})`,
+                          field: f});
         }
     }
     return entries;
@@ -416,7 +421,9 @@ function updateControls() {
     if (entry) {
         field.value = entry.spec;
     } else if (s.field) {
-        if (![...field.options].some((o) => o.value === s.field)) field.add(new Option(s.field, s.field));
+        if (![...field.options].some((o) => o.value === s.field)) {
+            field.add(new Option(s.field, s.field));
+        }
         field.value = s.field;
     }
     $("method").value = s.method;
@@ -691,8 +698,10 @@ function updateFrameStats(header) {
     $("stat-render-ms").textContent = `${num(s.render_ms)} ms`;
     $("stat-spp").textContent = num(s.samples_per_pixel);
     $("stat-partitions").textContent =
-        `${num(s.partitions_visited_per_pixel)} visited / ${num(s.partitions_skipped_per_pixel)} skipped`;
-    $("stat-frame").textContent = `${header.full ? "full" : "reduced"} ${header.width}×${header.height} ${header.format}`;
+        `${num(s.partitions_visited_per_pixel)} visited / ` +
+        `${num(s.partitions_skipped_per_pixel)} skipped`;
+    $("stat-frame").textContent =
+        `${header.full ? "full" : "reduced"} ${header.width}×${header.height} ${header.format}`;
     const device = s.device || (session.info && session.info.device) || "–";
     $("stat-device").textContent = s.method ? `${device} · ${s.method}` : device;
 }
@@ -700,8 +709,9 @@ function updateFrameStats(header) {
 // Frames per second: frames received over the last second, refreshed 4 times a second.
 setInterval(() => {
     const now = performance.now();
-    while (session.frameTimes.length && now - session.frameTimes[0] > 1000) session.frameTimes.shift();
-    $("stat-fps").textContent = String(session.frameTimes.length);
+    const times = session.frameTimes;
+    while (times.length && now - times[0] > 1000) times.shift();
+    $("stat-fps").textContent = String(times.length);
 }, 250);
 
 function fillMeshInfo(m) {
@@ -711,8 +721,9 @@ function fillMeshInfo(m) {
     $("mesh-tets").textContent = n(m.tetrahedra);
     $("mesh-types").textContent = m.cell_types
         ? Object.entries(m.cell_types).map(([k, v]) => `${k} ${n(v)}`).join(", ") : "–";
-    $("mesh-bounds").textContent = m.bounds
-        ? ["x", "y", "z"].map((a, i) => `${a} [${fmt(m.bounds[0][i], 4)}, ${fmt(m.bounds[1][i], 4)}]`).join("  ")
+    const b = m.bounds;
+    $("mesh-bounds").textContent = b
+        ? ["x", "y", "z"].map((a, i) => `${a} [${fmt(b[0][i], 4)}, ${fmt(b[1][i], 4)}]`).join("  ")
         : "–";
     const sec = (v) => (Number.isFinite(v) ? `${v.toFixed(2)} s` : "–");
     $("stat-load").textContent = `${sec(m.load_seconds)} / ${sec(m.prepare_seconds)}`;

@@ -222,7 +222,9 @@ export class TfEditor {
         const columns = Math.max(2, Math.round(pw));
         const tAt = (i) => i / (columns - 1);
         const colors = [];
-        for (let i = 0; i < columns; i++) colors.push(colorAt(this.tf.colors, this.tf.color_space, tAt(i)));
+        for (let i = 0; i < columns; i++) {
+            colors.push(colorAt(this.tf.colors, this.tf.color_space, tAt(i)));
+        }
 
         // Histogram: log(1 + count) scaled to the largest bin.
         const counts = [];

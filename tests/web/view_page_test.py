@@ -10,8 +10,8 @@
 - a mouse drag on the image turns the camera (focal point kept, view up orthonormal) and changes
   the image;
 - dragging an opacity point of the transfer-function editor changes the opacity and the image;
-- a ParaView colour-map JSON loaded through the file input changes the colours (green map:
-  the image turns green);
+- a ParaView colour-map JSON loaded through the file input changes the colours (a green map:
+  the image turns green) and keeps the opacity; one dropped on the editor too (red);
 - a malformed message and one of an unknown type each get an `error` and the page keeps working
   (the +X view button still gives a new view);
 - a flood of 2000 camera `set`s from the page's socket is limited (an `error` for the excess,
@@ -103,7 +103,8 @@ class Server:
                 raise Failure(f"uvr view exited ({self.proc.returncode}) before serving: "
                               f"{f.read().strip()}")
         m = re.match(r"uvr: serving (http://[^\s/]+)/\?token=([A-Za-z0-9_-]+)", first)
-        check(m, f"uvr view's first line is not 'uvr: serving http://HOST:PORT/?token=T': {first!r}")
+        check(m, "uvr view's first line is not 'uvr: serving http://HOST:PORT/?token=T': "
+                 f"{first!r}")
         self.origin, self.token = m.group(1), m.group(2)
         check(not self.origin.endswith(":0"), f"--port 0: the line names port 0: {first!r}")
         self.url = f"{self.origin}/?token={self.token}"
@@ -169,7 +170,8 @@ def check_http(server):
     m = re.search(r"(uvr_token(?:_\d+)?)=([^;]+)", set_cookie)
     check(m, f"the page sets no uvr_token cookie (Set-Cookie: {set_cookie!r})")
     check("httponly" in set_cookie.lower(), f"the cookie is not HttpOnly: {set_cookie!r}")
-    check("samesite=strict" in set_cookie.lower(), f"the cookie is not SameSite=Strict: {set_cookie!r}")
+    check("samesite=strict" in set_cookie.lower(),
+          f"the cookie is not SameSite=Strict: {set_cookie!r}")
     cookie = f"{m.group(1)}={m.group(2)}"
     for name, kind in (("app.js", "javascript"), ("style.css", "css")):
         status, headers, _ = http_get(f"{server.origin}/{name}", cookie)
@@ -469,7 +471,8 @@ def flood(page):
         let sent = 0;
         for (let i = 0; i < 2000; i++) {
             const k = 1 + 0.5 * (i + 1) / 2000;  // the camera moves away step by step
-            const position = c.position.map((p, j) => c.focal_point[j] + k * (p - c.focal_point[j]));
+            const f = c.focal_point;
+            const position = c.position.map((p, j) => f[j] + k * (p - f[j]));
             sent += window.uvrView.sendRaw(JSON.stringify(
                 {type: 'set', seq: 100000 + i, interactive: true, camera: {...c, position}}));
         }
@@ -494,8 +497,8 @@ def flood(page):
     check(vec_close(page.hook("state")["camera"]["position"], camera0["position"], 1e-9),
           "the state's camera is not the final one")
     diff = difference(px0, page.pixels())
-    step(f"  final frame vs. before the flood: same bytes {page.hook('lastFrame')['hash'] == hash0}, "
-         f"mean pixel difference {diff:.3f}")
+    same = page.hook("lastFrame")["hash"] == hash0
+    step(f"  final frame vs. before the flood: same bytes {same}, mean pixel difference {diff:.3f}")
     check(diff < 1.0, f"the final frame does not show the final camera (difference {diff:.2f})")
 
 
