@@ -34,7 +34,7 @@ const session = {
     frameTimes: [],        // arrival times (ms) of recent frames, for the FPS figure
     lastExport: null,
     exportFresh: false,    // lastExport describes the current state
-    exportWaiters: [],     // callbacks for the next `export` replies, in order
+    exportWaiters: [],     // {then, quiet} for the next `export` replies, in order
     lastPong: null,
 };
 
@@ -634,24 +634,26 @@ function download(blob, name) {
     setTimeout(() => URL.revokeObjectURL(url), 10000);
 }
 
-/// Asks for an `export` and calls `then` with it (exports are answered in order).
-function requestExport(then) {
-    if (send({type: "export"})) session.exportWaiters.push(then);
+/// Asks for an `export` and calls `then` with it (exports are answered in order, by `export`
+/// or by an `error` for the request). A `quiet` request (the background refresh of the command
+/// field) shows its error in the field instead of on the error line.
+function requestExport(then, quiet = false) {
+    if (send({type: "export"})) session.exportWaiters.push({then, quiet});
 }
 
 function onExport(m) {
     session.lastExport = m;
     session.exportFresh = true;
     $("command").value = m.command || "";
-    const then = session.exportWaiters.shift();
-    if (then) then(m);
+    const waiter = session.exportWaiters.shift();
+    if (waiter) waiter.then(m);
 }
 
 // The command field follows the state: a fresh export a moment after each final change.
 let exportTimer = 0;
 function scheduleExportRefresh() {
     clearTimeout(exportTimer);
-    exportTimer = setTimeout(() => requestExport(() => {}), kExportRefreshMs);
+    exportTimer = setTimeout(() => requestExport(() => {}, true), kExportRefreshMs);
 }
 
 $("save-png").addEventListener("click", () => send({type: "snapshot"}));
@@ -747,6 +749,14 @@ function showError(text) {
 function onServerError(m) {
     session.errorCount++;
     session.lastError = {message: m.message, request: m.request ?? null};
+    if (m.request === "export") {
+        const waiter = session.exportWaiters.shift();
+        if (waiter && waiter.quiet) {
+            session.lastExport = null;
+            $("command").value = `(no command: ${m.message})`;
+            return;
+        }
+    }
     showError(m.request ? `${m.request}: ${m.message}` : m.message);
     hideProgress();
 }
