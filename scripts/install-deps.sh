@@ -4,10 +4,12 @@
 # with libFuzzer (libclang-rt-14-dev) and its OpenMP (libomp-dev) build the fuzz targets; xvfb
 # (xvfb-run) gives VTK the X display the oracle test (tests/tools/vtk_oracle_test.py) needs;
 # FreeType, fontconfig and the DejaVu fonts draw the colour legend (`--legend`); Boost (Beast,
-# headers only) and libturbojpeg serve the browser viewer (`uvr view`); python3-dev and
-# pybind11-dev build the Python module (python/), python3-pytest runs its tests (with meshio and
-# python3-vtk9 for the conversions), python3-matplotlib draws the benchmark figures
-# (bench/plot_bench.py) and reads PNGs in the Python tests.
+# headers only) and libturbojpeg serve the browser viewer (`uvr view`); chromium,
+# chromium-driver and python3-selenium run the browser test of its page
+# (tests/web/view_page_test.py); python3-dev and pybind11-dev build the Python module (python/),
+# python3-pytest runs its tests (with meshio and python3-vtk9 for the conversions),
+# python3-matplotlib draws the benchmark figures (bench/plot_bench.py) and reads PNGs in the
+# Python tests.
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
@@ -18,7 +20,8 @@ PACKAGES="g++ cmake make pkg-config
   clang libclang-rt-14-dev libomp-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage
   python3-dev pybind11-dev python3-pytest python3-matplotlib
-  xvfb xauth"
+  xvfb xauth
+  chromium chromium-driver python3-selenium"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
