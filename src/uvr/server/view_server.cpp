@@ -381,12 +381,21 @@ private:
                            "unknown message type \"" + printableShort(type, 40) +
                                "\" (set, reset_camera, snapshot, export, ping)");
         } catch (const Json::exception& e) {
-            sendError(std::string("malformed JSON: ") + e.what(), type);
+            refused(std::string("malformed JSON: ") + e.what(), type, msg);
         } catch (const Error& e) {
-            sendError(e.what(), type);
+            refused(e.what(), type, msg);
         } catch (const std::exception& e) {
-            sendError(std::string("failed: ") + e.what(), type);
+            refused(std::string("failed: ") + e.what(), type, msg);
         }
+    }
+
+    /// Answers a refused request: the error (with the request's seq, when it had one) and, for a
+    /// state change, the state as it stays, so that the page can show it again.
+    void refused(const std::string& message, const std::string& type, const Json& msg) {
+        Json e = {{"type", "error"}, {"message", message}, {"request", type}};
+        if (msg.is_object() && msg.contains("seq")) e["seq"] = msg["seq"];
+        sendText(e.dump(-1, ' ', false, Json::error_handler_t::replace));
+        if (type == "set" || type == "reset_camera") sendState();
     }
 
     /// Checks the keys every state change may carry (seq, interactive) before anything changes.
@@ -686,7 +695,12 @@ FieldEntry& ViewServer::Impl::field(const std::string& spec, const ProgressFn& p
     return fields[key] = std::move(entry);
 }
 
-Json ViewServer::Impl::exportMessage(const ViewState& s) const {
+Json ViewServer::Impl::exportMessage(const ViewState& state) const {
+    ViewState s = state;
+    // A log scale over a range from 0 or below maps as the frames do (ParaView's
+    // AdjustRangeForLog, makeFrameSetup): export the range they use.
+    if (s.tf.logScale && !(s.range.first > 0.f) && s.range.second > 0.f)
+        s.range.first = std::fmin(s.range.second * 1e-4f, 1.f);
     std::vector<std::string> args = {"uvr", "render", scene.file};
     if (!s.field.empty()) args.insert(args.end(), {"--field", s.field});
     args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
@@ -841,6 +855,7 @@ void ViewServer::Impl::renderLoop() {
                            double(result.stats.partitionsSkipped) / pixels},
                           {"method", methodName(state.method)},
                           {"device", entry.renderer->deviceName()}}}};
+                if (!result.setup.notes.empty()) meta["notes"] = result.setup.notes;
             }
             meta["width"] = image.width;
             meta["height"] = image.height;

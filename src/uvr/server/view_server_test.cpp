@@ -281,6 +281,15 @@ TEST(ViewServer, BadMessagesGetErrorsAndTheConnectionKeepsServing) {
         ASSERT_FALSE(e.is_null()) << text;
         EXPECT_THAT(e["message"].get<std::string>(), HasSubstr(want)) << text;
     }
+    // A refused change names its seq and is followed by the state as it stays.
+    c.send({{"type", "set"}, {"seq", 77}, {"quality", 2}});
+    const Json e77 = c.until("error");
+    ASSERT_FALSE(e77.is_null());
+    EXPECT_EQ(e77["seq"], 77);
+    EXPECT_EQ(e77["request"], "set");
+    const Json kept = c.until("state");
+    ASSERT_FALSE(kept.is_null());
+    EXPECT_NEAR(kept["state"]["quality"].get<double>(), 0.99, 1e-6);
     c.sendBinary(std::string("\x89PNG", 4));
     EXPECT_THAT(c.until("error")["message"].get<std::string>(), HasSubstr("binary"));
     // The bad seq and heat map above changed nothing: the state still shows the volume.
@@ -357,6 +366,16 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_THAT(cmd, HasSubstr("uvr render grid.vtk --tf uvr-tf.json --camera uvr-camera.pvcc "
                                "--range -2.5,2.5 --method adaptive --quality 0.99"));
     EXPECT_THAT(cmd, HasSubstr("--size 64x48 --opacity-unit 0.5 --step 0.01 -o uvr-view.png"));
+    // A log scale over a range from 0 exports the range the frames map (AdjustRangeForLog).
+    c.send({{"type", "set"}, {"range", {0, 2}}, {"tf", {{"log", true}}}});
+    c.send({{"type", "export"}});
+    const Json logEx = c.until("export");
+    ASSERT_FALSE(logEx.is_null());
+    EXPECT_THAT(logEx["command"].get<std::string>(), HasSubstr("--range 0.0002,2 "));
+    const Json logFrame = c.frame();
+    ASSERT_FALSE(logFrame.is_null());
+    ASSERT_TRUE(logFrame.contains("notes"));
+    EXPECT_THAT(logFrame["notes"][0].get<std::string>(), HasSubstr("not positive"));
 }
 
 TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogram) {

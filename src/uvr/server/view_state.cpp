@@ -294,9 +294,12 @@ SetResult applySet(ViewState& state, const Json& message) {
                 message);
         }
     }
-    if (next.tf.logScale && !(next.range.first > 0.f) && result.rangeGiven)
+    // A log scale over a range from 0 or below maps from min(hi / 10^4, 1), as ParaView does
+    // (the frame says so in its notes); one with nothing positive cannot map at all.
+    if (next.tf.logScale && !(next.range.second > 0.f))
         throwError(ErrorKind::Argument, "",
-                   "\"range\": a log-scale transfer function needs a positive range, got [" +
+                   "\"range\": a log-scale transfer function needs a range reaching above 0, "
+                   "got [" +
                        fmtG(next.range.first) + ", " + fmtG(next.range.second) + "]");
     state = std::move(next);
     return result;

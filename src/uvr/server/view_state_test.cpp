@@ -141,8 +141,8 @@ TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
     EXPECT_THAT(refusal({{"preset", "no-such-map"}}), HasSubstr("no-such-map"));
     EXPECT_THAT(refusal({{"colormap_json", "{not json"}}), HasSubstr("the uploaded colour map"));
     EXPECT_THAT(refusal({{"colormap_name", "x"}}), HasSubstr("colormap_json"));
-    EXPECT_THAT(refusal({{"tf", {{"log", true}}}, {"range", {-1, 1}}}),
-                HasSubstr("positive range"));
+    EXPECT_THAT(refusal({{"tf", {{"log", true}}}, {"range", {-2, -1}}}),
+                HasSubstr("reaching above 0"));
     EXPECT_THAT(refusal({{"camrea", {}}}), HasSubstr("camrea"));
     EXPECT_THAT(refusal(Json::array({1, 2})), HasSubstr("object"));
     // A good key before a bad one changes nothing either.
