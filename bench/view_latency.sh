@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 # Starts `uvr view MESH` on a free port, runs the scripted client against it and stops it.
 #   bench/view_latency.sh UVR UVR_VIEW_LATENCY MESH [client flags...] [-- view flags...]
-# Prints the client's JSON; exits non-zero when the server or the client fails.
+# Prints the client's JSON; exits non-zero when the server or the client fails. VIEW_LOG=FILE
+# keeps the server's log there.
 set -eu
 uvr=$1 client=$2 mesh=$3
 shift 3
@@ -13,7 +14,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 log=$(mktemp)
-trap 'kill "$pid" 2>/dev/null || true; rm -f "$log"' EXIT
+trap 'kill "$pid" 2>/dev/null || true; [ -z "${VIEW_LOG:-}" ] || cp "$log" "$VIEW_LOG"; rm -f "$log"' EXIT
 # shellcheck disable=SC2086
 "$uvr" view "$mesh" --port 0 $view_flags >"$log" 2>&1 &
 pid=$!
