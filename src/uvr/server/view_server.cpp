@@ -816,8 +816,10 @@ void ViewServer::Impl::renderLoop() {
             }
             const RenderSettings settings =
                 frameSettings(state, scene.base, kind == Kind::Snapshot ? 1 : scale);
+            const auto frameStart = Clock::now();
             const RenderResult result = entry.renderer->render(settings);
             const double renderMs = result.stats.seconds * 1e3;
+            const double frameMs = secondsSince(frameStart) * 1e3;
             const auto encodeStart = Clock::now();
             Image image =
                 state.heatmap && kind != Kind::Snapshot
@@ -846,6 +848,7 @@ void ViewServer::Impl::renderLoop() {
                         {"scale", scale},
                         {"stats",
                          {{"render_ms", renderMs},
+                          {"frame_ms", frameMs},
                           {"encode_ms", encodeMs},
                           {"bytes", bytes.size()},
                           {"samples_per_pixel", spp},
@@ -861,7 +864,9 @@ void ViewServer::Impl::renderLoop() {
             meta["height"] = image.height;
             {
                 std::lock_guard slk(m);
-                const double perPixel = renderMs / std::max(1.0, pixels);
+                // What a frame costs here: the render call (setup, kernel, read-back) and the
+                // encoding, per pixel.
+                const double perPixel = (frameMs + encodeMs) / std::max(1.0, pixels);
                 s->msPerPixel = s->msPerPixel > 0.0 ? 0.5 * (s->msPerPixel + perPixel) : perPixel;
             }
             post([meta = meta.dump(), bytes = std::move(bytes)](Session& c) mutable {
