@@ -31,6 +31,12 @@
 #include "uvr/render/render_setup.h"
 #include "uvr/tf/transfer_function.h"
 
+#ifdef UVR_HAS_SERVER
+#include <nlohmann/json.hpp>
+
+#include "uvr/server/view_state.h"
+#endif
+
 namespace uvr::fuzz {
 
 /// Memory limit every fuzzed load runs under (the CLI's --max-memory), well below libFuzzer's
@@ -275,6 +281,41 @@ inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
     });
 }
 
+#ifdef UVR_HAS_SERVER
+/// A browser's `set` message to the viewer (docs/VIEWER.md): parsed as JSON, applied to a state
+/// (all or nothing), then the state's frame settings validated and its exports written and read
+/// back, as the server does with every message and `export`.
+inline void fuzzViewMessage(const std::uint8_t* data, std::size_t size) {
+    server::ViewState state;
+    state.camera = resetCamera(Bounds3f(Vec3f(0.f), Vec3f(1.f)), 1.f);
+    state.tf = transferFunctionPreset("cool-to-warm");
+    state.range = {0.f, 1.f};
+    const server::ViewState before = state;
+    nlohmann::json message;
+    try {
+        message = nlohmann::json::parse(data, data + size);
+    } catch (const nlohmann::json::exception&) {
+        return;  // the server answers malformed JSON with an error
+    }
+    bool applied = false;
+    expectCleanError([&] {
+        server::applySet(state, message);
+        applied = true;
+    });
+    if (!applied && server::toJson(state) != server::toJson(before)) {
+        std::fprintf(stderr, "fuzzViewMessage: a refused message changed the state\n");
+        std::abort();
+    }
+    expectCleanError([&] {
+        validateSettings(server::frameSettings(state, RenderSettings{}, 3));
+        const std::string tf = paraViewColorMapJson(state.tf, state.range.first, state.range.second);
+        (void)parseParaViewColorMap({tf.begin(), tf.end()}, "export").bake(64);
+        const std::string pvcc = pvccText(state.camera);
+        (void)parsePvcc({pvcc.begin(), pvcc.end()}, "export");
+    });
+}
+#endif
+
 /// A fuzz target: its name (the folder of its seeds and kept inputs) and its body.
 struct FuzzTarget {
     const char* name;
@@ -289,6 +330,10 @@ inline constexpr FuzzTarget kFuzzTargets[] = {{"vtk_legacy", fuzzVtkLegacy},
                                               {"colormap_json", fuzzColormapJson},
                                               {"pvcc", fuzzPvcc},
                                               {"specs", fuzzSpecs},
-                                              {"render", fuzzRender}};
+                                              {"render", fuzzRender},
+#ifdef UVR_HAS_SERVER
+                                              {"view_message", fuzzViewMessage},
+#endif
+};
 
 }  // namespace uvr::fuzz

@@ -13,13 +13,13 @@
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs fuzz_render"
+ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs fuzz_render fuzz_view_message"
 ci=0
 if [ "${1:-}" = "--ci" ]; then
   ci=1
   total=${2:-60}
   set -- $ALL
-  per=$((total / 8))
+  per=$((total / 9))
 else
   per=${1:?usage: scripts/fuzz.sh SECONDS [TARGET...] | scripts/fuzz.sh --ci [SECONDS]}
   shift
@@ -60,6 +60,7 @@ for t in "$@"; do
     colormap_json) maxlen=262144 ;;
     pvtu|pvcc) maxlen=65536 ;;
     specs) maxlen=4096 ;;
+    view_message) maxlen=65536 ;;
     *) maxlen=2048 ;;
   esac
   [ $ci -eq 1 ] || keepgoing="-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"
