@@ -150,9 +150,8 @@ Json histogramOf(const std::vector<float>& values, std::pair<float, float> range
     return {{"range", {range.first, range.second}}, {"counts", counts}};
 }
 
-/// What a field needs on the server: its renderer (prepared on demand), range and histogram.
+/// What the server knows of a field once a tab has shown it: its finite range and histogram.
 struct FieldEntry {
-    std::shared_ptr<Renderer> renderer;
     std::pair<float, float> range{0.f, 1.f};
     Json histogram;
 };
@@ -181,8 +180,12 @@ struct ViewServer::Impl {
     bool stopping = false;
     std::vector<std::weak_ptr<Session>> sessions;
     std::size_t roundRobin = 0;
-    std::map<std::string, FieldEntry> fields;  ///< by fieldKey; touched by the render thread
+    std::map<std::string, FieldEntry> fields;  ///< by fieldKey; filled by the render thread
     std::mutex fieldsMutex;                    ///< guards `fields` against info's readers
+    /// The one prepared mesh (render thread): prepared for the field of rendererKey; another
+    /// field's values replace them without rebuilding geometry (Renderer::setFieldValues).
+    std::unique_ptr<Renderer> renderer;
+    std::string rendererKey;
 
     void say(const std::string& line) const {
         if (log) log(line);
@@ -194,8 +197,10 @@ struct ViewServer::Impl {
         const FieldChoice c = resolveField(fieldInfos, fs);
         return std::to_string(c.index) + ":" + std::to_string(fs.component);
     }
-    /// The field's entry, prepared when new (render thread). `progress` reports its steps.
-    FieldEntry& field(const std::string& spec, const ProgressFn& progress);
+    /// Makes the renderer hold the field's values (preparing the mesh the first time, else
+    /// replacing the values) and returns the field's entry (render thread). `progress` reports
+    /// the preparation's steps.
+    FieldEntry field(const std::string& spec, const ProgressFn& progress);
     void acceptLoop();
     void renderLoop();
     void requestStop();
@@ -216,12 +221,13 @@ public:
     std::uint64_t seq = 0;
     bool interactive = false;
     Clock::time_point lastChange = Clock::now();
-    bool dirty = true;        ///< the state changed since the last frame started
-    bool inFlight = false;    ///< a frame is being rendered or sent
-    bool needsFull = false;   ///< the last frame was reduced: refine when still
-    bool snapshot = false;    ///< a snapshot was asked for
-    bool resetRange = false;  ///< the field changed without a range: use the field's
-    double msPerPixel = 0.0;  ///< render time per pixel of recent frames (0: none yet)
+    bool dirty = true;         ///< the state changed since the last frame started
+    bool inFlight = false;     ///< a frame is being rendered or sent
+    bool needsFull = false;    ///< the last frame was reduced: refine when still
+    bool snapshot = false;     ///< a snapshot was asked for
+    bool resetRange = false;   ///< the field changed without a range: use the field's
+    double msPerPixel = 0.0;   ///< render time per pixel of recent frames (0: none yet)
+    std::string histogramKey;  ///< the field whose histogram the tab has (Impl::fieldKey)
     std::string peer;
 
     void start(http::request<http::string_body> req) {
@@ -272,6 +278,7 @@ private:
                 return;
             }
             state = server_.scene.initial;
+            histogramKey = server_.fieldKey(state.field);  // info carries its histogram
             server_.sessions.push_back(weak_from_this());
         }
         peer = endpointName();
@@ -659,37 +666,30 @@ private:
 
 }  // namespace
 
-FieldEntry& ViewServer::Impl::field(const std::string& spec, const ProgressFn& progress) {
+FieldEntry ViewServer::Impl::field(const std::string& spec, const ProgressFn& progress) {
     const std::string key = fieldKey(spec);
-    {
+    if (renderer && key == rendererKey) {
         std::lock_guard lk(fieldsMutex);
-        auto it = fields.find(key);
-        if (it != fields.end() && it->second.renderer) return it->second;
-    }
-    // Free the renderers no tab shows any more before preparing another.
-    std::vector<std::string> used;
-    {
-        std::lock_guard lk(m);
-        for (const auto& w : sessions)
-            if (auto s = w.lock()) used.push_back(fieldKey(s->state.field));
-    }
-    {
-        std::lock_guard lk(fieldsMutex);
-        for (auto& [k, e] : fields)
-            if (k != key && std::find(used.begin(), used.end(), k) == used.end())
-                e.renderer.reset();
+        return fields.at(key);
     }
     const ScalarField values = selectScalarField(*scene.mesh, parseFieldSpec(spec));
     FieldEntry entry;
     entry.range = finiteRange(values.values);
     entry.histogram = histogramOf(values.values, entry.range);
     const auto start = Clock::now();
-    say("view: preparing " + values.describe());
-    entry.renderer =
-        std::make_shared<Renderer>(*scene.mesh, values, scene.rendererOptions, progress);
-    char line[160];
-    std::snprintf(line, sizeof line, "view: prepared %s in %.2f s", values.describe().c_str(),
-                  secondsSince(start));
+    char line[200];
+    if (!renderer) {
+        say("view: preparing " + values.describe());
+        renderer = std::make_unique<Renderer>(*scene.mesh, values, scene.rendererOptions, progress);
+        std::snprintf(line, sizeof line, "view: prepared %s in %.2f s", values.describe().c_str(),
+                      secondsSince(start));
+    } else {
+        // The same mesh: only the values and what depends on them change.
+        renderer->setFieldValues(values);
+        std::snprintf(line, sizeof line, "view: switched to %s in %.3f s (no geometry rebuilt)",
+                      values.describe().c_str(), secondsSince(start));
+    }
+    rendererKey = key;
     say(line);
     std::lock_guard lk(fieldsMutex);
     return fields[key] = std::move(entry);
@@ -765,6 +765,7 @@ void ViewServer::Impl::renderLoop() {
         }
         s->inFlight = true;
         const bool resetRange = s->resetRange;
+        const std::string histogramKey = s->histogramKey;
         s->resetRange = false;
         int scale = 1;
         if (kind == Kind::Reduced && s->msPerPixel > 0.0) {
@@ -786,12 +787,8 @@ void ViewServer::Impl::renderLoop() {
         };
         bool sent = false;
         try {
-            const bool known = [&] {
-                std::lock_guard flk(fieldsMutex);
-                auto it = fields.find(fieldKey(state.field));
-                return it != fields.end() && it->second.renderer;
-            }();
-            FieldEntry& entry = field(state.field, [&](const std::string& phase) {
+            const std::string key = fieldKey(state.field);
+            const FieldEntry entry = field(state.field, [&](const std::string& phase) {
                 post([phase](Session& c) {
                     c.sendText(
                         Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
@@ -804,7 +801,11 @@ void ViewServer::Impl::renderLoop() {
                 std::lock_guard slk(m);
                 s->state.range = state.range;
             }
-            if (!known || resetRange) {
+            if (key != histogramKey || resetRange) {
+                {
+                    std::lock_guard slk(m);
+                    s->histogramKey = key;
+                }
                 Json h = entry.histogram;
                 h["type"] = "histogram";
                 h["field"] = state.field;
@@ -817,7 +818,7 @@ void ViewServer::Impl::renderLoop() {
             const RenderSettings settings =
                 frameSettings(state, scene.base, kind == Kind::Snapshot ? 1 : scale);
             const auto frameStart = Clock::now();
-            const RenderResult result = entry.renderer->render(settings);
+            const RenderResult result = renderer->render(settings);
             const double renderMs = result.stats.seconds * 1e3;
             const double frameMs = secondsSince(frameStart) * 1e3;
             const auto encodeStart = Clock::now();
@@ -857,7 +858,7 @@ void ViewServer::Impl::renderLoop() {
                           {"partitions_skipped_per_pixel",
                            double(result.stats.partitionsSkipped) / pixels},
                           {"method", methodName(state.method)},
-                          {"device", entry.renderer->deviceName()}}}};
+                          {"device", renderer->deviceName()}}}};
                 if (!result.setup.notes.empty()) meta["notes"] = result.setup.notes;
             }
             meta["width"] = image.width;
@@ -962,11 +963,11 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
         entry.histogram = histogramOf(values.values, entry.range);
     }
     if (d.scene.renderer) {
-        FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field)];
         tets = d.scene.renderer->prepared().tets.tets.size();
         prepareSeconds = d.scene.renderer->prepareSeconds();
         device = d.scene.renderer->deviceDescription();
-        entry.renderer = std::shared_ptr<Renderer>(std::move(d.scene.renderer));
+        d.renderer = std::move(d.scene.renderer);
+        d.rendererKey = d.fieldKey(d.scene.initial.field);
     }
     d.infoBase = {{"type", "info"},
                   {"file", d.scene.file},

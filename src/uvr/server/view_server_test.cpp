@@ -40,7 +40,7 @@ std::shared_ptr<Mesh> twoFieldMesh() {
 }
 
 /// A server on a free port of 127.0.0.1 over the two-field mesh, on the CPU, 64x48 frames.
-std::unique_ptr<ViewServer> startServer(ServerOptions o = {}) {
+std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
     ViewScene scene;
     scene.file = "grid.vtk";
     scene.mesh = twoFieldMesh();
@@ -57,7 +57,7 @@ std::unique_ptr<ViewServer> startServer(ServerOptions o = {}) {
     s.opacityUnit = 0.5f;
     scene.commandFlags = {"--step", "0.01"};
     o.port = 0;
-    auto server = std::make_unique<ViewServer>(std::move(scene), o);
+    auto server = std::make_unique<ViewServer>(std::move(scene), o, std::move(log));
     server->start();
     return server;
 }
@@ -378,10 +378,16 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_THAT(logFrame["notes"][0].get<std::string>(), HasSubstr("not positive"));
 }
 
-TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogram) {
-    auto server = startServer();
+TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogramAndRebuildsNoGeometry) {
+    std::mutex mu;
+    std::vector<std::string> log;
+    auto server = startServer({}, [&](const std::string& line) {
+        std::lock_guard lk(mu);
+        log.push_back(line);
+    });
     Client c(server->port(), server->token());
     ASSERT_FALSE(c.frame().is_null());
+    const std::string first = c.lastBinary();
     c.send({{"type", "set"}, {"seq", 2}, {"field", "g"}});
     const Json h = c.until("histogram");
     ASSERT_FALSE(h.is_null());
@@ -392,6 +398,24 @@ TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogram) {
     const Json f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_EQ(f["seq"], 2);
+    EXPECT_NE(c.lastBinary(), first);
+    // Back to f with its first range: the very first image again.
+    c.send({{"type", "set"}, {"seq", 3}, {"field", "f"}, {"range", {-3, 3}}});
+    const Json back = c.until("histogram");
+    ASSERT_FALSE(back.is_null());
+    EXPECT_EQ(back["field"], "f");
+    const Json g = c.frame();
+    ASSERT_FALSE(g.is_null());
+    EXPECT_EQ(g["seq"], 3);
+    EXPECT_EQ(c.lastBinary(), first);
+    std::lock_guard lk(mu);
+    int prepared = 0, switched = 0;
+    for (const std::string& line : log) {
+        prepared += line.find("prepared") != std::string::npos;
+        switched += line.find("no geometry rebuilt") != std::string::npos;
+    }
+    EXPECT_EQ(prepared, 1);  // the first frame's; the scene came without a renderer
+    EXPECT_EQ(switched, 2);
 }
 
 TEST(ViewServer, TabsHaveTheirOwnStateAndResetCameraSnapsToAxes) {
