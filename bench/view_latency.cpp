@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
         // Step 2: orbit. A reader thread records frames; this thread sends at the rate.
         std::map<std::uint64_t, Clock::time_point> sent;
         std::mutex mu;
-        std::vector<double> latency, renderMs, scale;
+        std::vector<double> latency, renderMs, scale, frameMs, encodeMs, bytes;
         std::atomic<bool> done{false};
         std::uint64_t frames = 0, reduced = 0;
         std::thread reader([&] {
@@ -152,6 +152,9 @@ int main(int argc, char** argv) {
                 if (auto it = sent.find(seq); it != sent.end() && seq >= 100) {
                     latency.push_back(ms(now - it->second));
                     renderMs.push_back(j["stats"]["render_ms"].get<double>());
+                    frameMs.push_back(j["stats"]["frame_ms"].get<double>());
+                    encodeMs.push_back(j["stats"]["encode_ms"].get<double>());
+                    bytes.push_back(j["stats"]["bytes"].get<double>());
                     scale.push_back(j["scale"].get<double>());
                     ++frames;
                     reduced += !j["full"].get<bool>();
@@ -177,11 +180,14 @@ int main(int argc, char** argv) {
         }
         const double orbitSeconds = std::chrono::duration<double>(Clock::now() - start).count();
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
-        std::vector<double> movingLatency, movingRender, movingScale;
+        std::vector<double> movingLatency, movingRender, movingScale, movingFrame, movingEncode,
+            movingBytes;
         std::uint64_t movingFrames, movingReduced;
         {
             std::lock_guard lk(mu);
             movingLatency = latency, movingRender = renderMs, movingScale = scale;
+            movingFrame = frameMs, movingEncode = encodeMs, movingBytes = bytes;
+            frameMs.clear(), encodeMs.clear(), bytes.clear();
             movingFrames = frames, movingReduced = reduced;
             latency.clear(), renderMs.clear(), frames = 0;
         }
@@ -225,11 +231,17 @@ int main(int argc, char** argv) {
                       {"latency_ms_median", percentile(movingLatency, 0.5)},
                       {"latency_ms_p95", percentile(movingLatency, 0.95)},
                       {"render_ms_median", percentile(movingRender, 0.5)},
+                      {"frame_ms_median", percentile(movingFrame, 0.5)},
+                      {"encode_ms_median", percentile(movingEncode, 0.5)},
+                      {"bytes_median", percentile(movingBytes, 0.5)},
                       {"scale_median", percentile(movingScale, 0.5)}}},
                     {"still",
                      {{"changes", stillLatency.size()},
                       {"latency_ms_median", percentile(stillLatency, 0.5)},
-                      {"latency_ms_p95", percentile(stillLatency, 0.95)}}}};
+                      {"latency_ms_p95", percentile(stillLatency, 0.95)},
+                      {"frame_ms_median", percentile(frameMs, 0.5)},
+                      {"encode_ms_median", percentile(encodeMs, 0.5)},
+                      {"bytes_median", percentile(bytes, 0.5)}}}};
         std::printf("%s\n", out.dump(2).c_str());
     } catch (const std::exception& e) {
         std::fprintf(stderr, "uvr_view_latency: %s\n", e.what());

@@ -482,22 +482,13 @@ PYBIND11_MODULE(_uvr, m) {
             "nan_color", [](const TransferFunction& tf) { return arr3(tf.nanColor); },
             [](TransferFunction& tf, const std::array<float, 3>& c) { tf.nanColor = vec3(c); })
         .def_property(
-            "color_space",
-            [](const TransferFunction& tf) {
-                return tf.colorSpace == ColorSpace::RGB   ? "RGB"
-                       : tf.colorSpace == ColorSpace::Lab ? "Lab"
-                                                          : "Diverging";
-            },
+            "color_space", [](const TransferFunction& tf) { return colorSpaceName(tf.colorSpace); },
             [](TransferFunction& tf, const std::string& s) {
-                if (s == "RGB")
-                    tf.colorSpace = ColorSpace::RGB;
-                else if (s == "Lab")
-                    tf.colorSpace = ColorSpace::Lab;
-                else if (s == "Diverging")
-                    tf.colorSpace = ColorSpace::Diverging;
-                else
+                const auto space = colorSpaceFromName(s);
+                if (!space)
                     raise(ErrorKind::Argument,
                           "color_space: expected 'RGB', 'Lab' or 'Diverging', got '" + s + "'");
+                tf.colorSpace = *space;
             })
         .def_property(
             "colors",

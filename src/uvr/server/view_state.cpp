@@ -80,17 +80,6 @@ std::vector<std::vector<float>> rows(const std::string& key, const Json& v, std:
     return out;
 }
 
-const char* colorSpaceName(ColorSpace space) {
-    switch (space) {
-        case ColorSpace::Lab:
-            return "Lab";
-        case ColorSpace::Diverging:
-            return "Diverging";
-        default:
-            return "RGB";
-    }
-}
-
 void applyCamera(Camera& cam, const Json& v) {
     for (const auto& [k, x] : object("camera", v).items()) {
         const std::string key = "camera." + k;
@@ -140,15 +129,9 @@ void applyTf(TransferFunction& tf, const Json& v) {
                 bad(key, "a string of at most 256 bytes", x);
             tf.name = x.get<std::string>();
         } else if (k == "color_space") {
-            const std::string s = x.is_string() ? x.get<std::string>() : "";
-            if (s == "RGB")
-                tf.colorSpace = ColorSpace::RGB;
-            else if (s == "Lab")
-                tf.colorSpace = ColorSpace::Lab;
-            else if (s == "Diverging")
-                tf.colorSpace = ColorSpace::Diverging;
-            else
-                bad(key, "\"RGB\", \"Lab\" or \"Diverging\"", x);
+            const auto space = colorSpaceFromName(x.is_string() ? x.get<std::string>() : "");
+            if (!space) bad(key, "\"RGB\", \"Lab\" or \"Diverging\"", x);
+            tf.colorSpace = *space;
         } else {
             bad("tf",
                 "keys colors, opacity, log, nan_color, nan_opacity, name, color_space (not \"" +

@@ -503,11 +503,8 @@ std::string paraViewColorMapJson(const TransferFunction& tf, double lo, double h
     Json points = Json::array();
     for (const OpacityPoint& o : tf.opacities)
         points.insert(points.end(), {value(o.x), double(o.alpha), 0.5, 0.0});
-    const char* space = tf.colorSpace == ColorSpace::Lab         ? "Lab"
-                        : tf.colorSpace == ColorSpace::Diverging ? "Diverging"
-                                                                 : "RGB";
     Json map = {{"Name", tf.name.empty() ? "uvr" : tf.name},
-                {"ColorSpace", space},
+                {"ColorSpace", colorSpaceName(tf.colorSpace)},
                 {"RGBPoints", rgb},
                 {"Points", points},
                 {"NanColor", {double(tf.nanColor.x), double(tf.nanColor.y), double(tf.nanColor.z)}},

@@ -322,4 +322,21 @@ TransferFunction loadTransferFunction(const std::string& presetOrPath) {
     return loadParaViewColorMap(path, name);
 }
 
+const char* colorSpaceName(ColorSpace space) {
+    switch (space) {
+        case ColorSpace::Lab:
+            return "Lab";
+        case ColorSpace::Diverging:
+            return "Diverging";
+        default:
+            return "RGB";
+    }
+}
+
+std::optional<ColorSpace> colorSpaceFromName(const std::string& name) {
+    for (ColorSpace c : {ColorSpace::RGB, ColorSpace::Lab, ColorSpace::Diverging})
+        if (name == colorSpaceName(c)) return c;
+    return std::nullopt;
+}
+
 }  // namespace uvr

@@ -26,6 +26,12 @@ struct OpacityPoint {
 /// Colour space in which colours between control points are interpolated (as ParaView does).
 enum class ColorSpace { RGB, Lab, Diverging };
 
+/// "RGB", "Lab" or "Diverging": the name ParaView's colour-map JSON gives the space.
+const char* colorSpaceName(ColorSpace space);
+
+/// The space of one of colorSpaceName's names (exact spelling), or none.
+std::optional<ColorSpace> colorSpaceFromName(const std::string& name);
+
 /// Colour map plus piecewise-linear opacity over a normalised [0, 1] domain. The data range it is
 /// applied to is chosen separately (default: the field's range).
 struct TransferFunction {
