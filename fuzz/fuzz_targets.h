@@ -287,7 +287,7 @@ inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
 /// back, as the server does with every message and `export`.
 inline void fuzzViewMessage(const std::uint8_t* data, std::size_t size) {
     server::ViewState state;
-    state.camera = resetCamera(Bounds3f(Vec3f(0.f), Vec3f(1.f)), 1.f);
+    state.camera = resetCamera(Bounds3f{Vec3f(0.f), Vec3f(1.f)}, 1.f);
     state.tf = transferFunctionPreset("cool-to-warm");
     state.range = {0.f, 1.f};
     const server::ViewState before = state;

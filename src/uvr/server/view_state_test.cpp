@@ -14,7 +14,7 @@ using Json = nlohmann::json;
 
 ViewState startState() {
     ViewState s;
-    s.camera = resetCamera(Bounds3f(Vec3f(0.f), Vec3f(1.f)), 1.f);
+    s.camera = resetCamera(Bounds3f{Vec3f(0.f), Vec3f(1.f)}, 1.f);
     s.tf = transferFunctionPreset("cool-to-warm");
     s.range = {0.f, 2.f};
     s.field = "density";
