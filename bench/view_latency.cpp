@@ -5,6 +5,7 @@
 // (final `set` messages) and the time to their full-resolution frame. Prints one JSON object.
 //
 //   uvr_view_latency URL [--seconds 10] [--rate 60] [--size 1024x1024] [--still 20]
+//                        [--switch-field NAME]  (also time a field change to its first frame)
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -104,6 +105,7 @@ int main(int argc, char** argv) {
     std::string url, size = "1024x1024";
     double seconds = 10.0, rate = 60.0, degrees = 1.0;
     int still = 20;
+    std::string switchField;
     app.add_option("URL", url, "The URL uvr view printed")->required();
     app.add_option("--seconds", seconds, "Orbiting time")->capture_default_str();
     app.add_option("--rate", rate, "Camera events per second while orbiting")
@@ -111,6 +113,8 @@ int main(int argc, char** argv) {
     app.add_option("--degrees", degrees, "Azimuth per event")->capture_default_str();
     app.add_option("--size", size, "Full-resolution image size WxH")->capture_default_str();
     app.add_option("--still", still, "Still changes to time")->capture_default_str();
+    app.add_option("--switch-field", switchField,
+                   "Finally switch to this field and time it until its frame arrives");
     CLI11_PARSE(app, argc, argv);
     int w = 0, h = 0;
     if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2) {
@@ -214,6 +218,25 @@ int main(int argc, char** argv) {
             }
             std::this_thread::sleep_for(std::chrono::milliseconds(200));
         }
+        // Step 4: a field change, timed to the frame that shows it.
+        double switchMs = -1.0;
+        if (!switchField.empty()) {
+            const auto t = Clock::now();
+            {
+                std::lock_guard lk(mu);
+                sent[2000000] = t;
+                latency.clear();
+            }
+            c.send({{"type", "set"}, {"seq", 2000000}, {"field", switchField}});
+            for (int k = 0; k < 600000; ++k) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                std::lock_guard lk(mu);
+                if (!latency.empty()) {
+                    switchMs = latency.back();
+                    break;
+                }
+            }
+        }
         done = true;
         c.ws().next_layer().shutdown(tcp::socket::shutdown_both);
         reader.join();
@@ -221,6 +244,7 @@ int main(int argc, char** argv) {
                     {"device", info["device"]},
                     {"tetrahedra", info["tetrahedra"]},
                     {"first_full_frame_ms", firstMs},
+                    {"field_switch_ms", switchMs},
                     {"orbit",
                      {{"seconds", orbitSeconds},
                       {"events", seq - 100},
