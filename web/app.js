@@ -109,6 +109,7 @@ function onMessage(data) {
         case "snapshot": session.header = m; break;
         case "export": onExport(m); break;
         case "progress": onProgress(m); break;
+        case "prepared": onPrepared(m); break;
         case "error": onServerError(m); break;
         case "pong": session.lastPong = m; break;
         default: console.warn("uvr view: unknown message type", m.type);
@@ -168,6 +169,15 @@ function onState(state) {
     hideProgress();
     updateControls();
     scheduleExportRefresh();
+}
+
+/// The server finished preparing the mesh after this page connected: the mesh panel's
+/// tetrahedra, preparation time and device.
+function onPrepared(m) {
+    if (!session.info) return;
+    for (const k of ["tetrahedra", "prepare_seconds", "device"]) if (k in m) session.info[k] = m[k];
+    fillMeshInfo(session.info);
+    hideProgress();
 }
 
 function onHistogram(m) {

@@ -2,6 +2,7 @@
 // `uvr view`: reads and prepares a mesh once and serves it to browsers (src/uvr/server).
 #include <chrono>
 #include <cstdio>
+#include <memory>
 
 #include "cli_common.h"
 #include "progress.h"
@@ -102,29 +103,28 @@ void addViewCommand(CLI::App& app, Context& ctx) {
             scene.notes.push_back(note);
         }
         validateSettings(settings);
-        ctx.setActivity(*file, "preparing the mesh for rendering");
-        const auto prepStart = std::chrono::steady_clock::now();
-        // Every method can be picked in the page: prepare for all of them.
-        scene.renderer = makeRenderer(*mesh, field, flags->rendererOptions(true), ctx);
-        ctx.done("prepared " + std::to_string(scene.renderer->prepared().tets.tets.size()) +
-                     " tetrahedra",
-                 prepStart);
-        // Step 2: the state every tab starts from, as `uvr render` would draw it.
-        const FrameSetup setup = makeFrameSetup(scene.renderer->prepared(), settings);
+        // Step 2: the state every tab starts from, as `uvr render` would draw it (the field's
+        // finite range, ParaView's opacity unit of the rendered cells' bounds).
         server::ViewState& s = scene.initial;
         s.camera = settings.camera.value_or(
             resetCamera(report.bounds, float(settings.width) / float(settings.height)));
         s.tf = settings.tf;
-        s.range = {setup.rangeLo, setup.rangeHi};
+        s.range = settings.range.value_or(finiteRange(field.values));
         s.field = flags->field;
         s.method = settings.method;
         s.quality = settings.quality;
         s.width = settings.width;
         s.height = settings.height;
-        s.opacityUnit = static_cast<float>(setup.params.opacityUnit / setup.frame.scale);
+        s.opacityUnit = settings.opacityUnit > 0.f
+                            ? settings.opacityUnit
+                            : defaultOpacityUnit(report.bounds, mesh->cellCount());
         scene.mesh = mesh;
         scene.bounds = report.bounds;
+        // Every method can be picked in the page: the server prepares for all of them, in the
+        // background once it listens, showing the steps in the log and the page.
         scene.rendererOptions = flags->rendererOptions(true);
+        if (resolvesToCuda(scene.rendererOptions.device))
+            ctx.step("GPU: " + cudaDeviceDescription());
         scene.base = settings;
         scene.background = flags->backgroundColor();
         scene.commandFlags = imageFlags(*flags);

@@ -165,7 +165,7 @@ struct ViewServer::Impl {
     ServerOptions opt;
     LogFn log;
     std::vector<FieldInfo> fieldInfos;
-    Json infoBase;  ///< the parts of `info` every connection gets
+    Json infoBase;  ///< the parts of `info` every connection gets (under m once serving)
 
     net::io_context ioc{1};
     tcp::acceptor acceptor{ioc};
@@ -203,6 +203,12 @@ struct ViewServer::Impl {
     FieldEntry field(const std::string& spec, const ProgressFn& progress);
     void acceptLoop();
     void renderLoop();
+    /// Sends a text message to every connection (any thread).
+    void broadcast(const std::string& text);
+    /// Prepares the starting field before the first frame when the scene came without a
+    /// renderer (render thread): every connection sees the steps as `progress` and the result
+    /// as `prepared`, and later connections get it in `info`.
+    void prepareAtStart();
     void requestStop();
     Json exportMessage(const ViewState& s) const;
 };
@@ -283,7 +289,11 @@ private:
         }
         peer = endpointName();
         server_.say("view: " + peer + " connected");
-        Json info = server_.infoBase;
+        Json info;
+        {
+            std::lock_guard lk(server_.m);
+            info = server_.infoBase;
+        }
         info["state"] = toJson(state);
         {
             std::lock_guard lk(server_.fieldsMutex);
@@ -722,7 +732,47 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
             {"command", command}};
 }
 
+void ViewServer::Impl::broadcast(const std::string& text) {
+    net::post(ioc, [this, text] {
+        std::vector<std::shared_ptr<Session>> live;
+        {
+            std::lock_guard lk(m);
+            for (const auto& w : sessions)
+                if (auto s = w.lock()) live.push_back(std::move(s));
+        }
+        for (const auto& s : live) s->sendText(text);
+    });
+}
+
+void ViewServer::Impl::prepareAtStart() {
+    if (renderer) return;
+    const auto start = Clock::now();
+    try {
+        field(scene.initial.field, [this](const std::string& phase) {
+            say("view: " + phase);
+            broadcast(Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
+        });
+    } catch (const std::exception& e) {
+        // Said to the log and the page; the first frame tries again and answers with the error.
+        say(std::string("view: preparation failed: ") + e.what());
+        broadcast(Json{{"type", "error"}, {"message", e.what()}, {"request", "prepare"}}.dump(
+            -1, ' ', false, Json::error_handler_t::replace));
+        return;
+    }
+    Json prepared = {{"type", "prepared"},
+                     {"tetrahedra", renderer->prepared().tets.tets.size()},
+                     {"prepare_seconds", secondsSince(start)},
+                     {"device", renderer->deviceDescription()}};
+    {
+        std::lock_guard lk(m);
+        for (const char* key : {"tetrahedra", "prepare_seconds", "device"})
+            infoBase[key] = prepared[key];
+    }
+    broadcast(prepared.dump());
+}
+
 void ViewServer::Impl::renderLoop() {
+    prepareAtStart();
     std::unique_lock lk(m);
     while (!stopping) {
         // Step 1: the next connection with work, round robin: a snapshot, a changed state, or
@@ -953,8 +1003,8 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     std::vector<std::string> presets;
     for (const ColorMapInfo& p : transferFunctionPresets()) presets.push_back(p.name);
     // The command line's preparation serves the starting field.
-    std::uint64_t tets = 0;
-    double prepareSeconds = 0.0;
+    // Unknown (null) until the server's own preparation is done (prepareAtStart).
+    Json tets = nullptr, prepareSeconds = nullptr;
     std::string device = resolvesToCuda(d.scene.rendererOptions.device) ? "cuda" : "cpu";
     {
         const ScalarField values = selectScalarField(mesh, parseFieldSpec(d.scene.initial.field));

@@ -201,6 +201,16 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
     EXPECT_GT(f["stats"]["samples_per_pixel"].get<double>(), 0.0);
     EXPECT_EQ(f["stats"]["device"], "cpu");
     EXPECT_TRUE(isPng(c.lastBinary()));
+    // The scene came unprepared: the server prepared it at start, and the tab knows the result
+    // from info or, when it connected during the preparation, from `prepared`.
+    Json tets = info["tetrahedra"];
+    if (tets.is_null()) {
+        bool seen = false;
+        for (const Json& j : c.seen())
+            if (j.value("type", "") == "prepared") tets = j["tetrahedra"], seen = true;
+        EXPECT_TRUE(seen) << "no prepared message";
+    }
+    EXPECT_EQ(tets, 1296);  // 216 hexahedra, 6 tetrahedra each
 }
 
 TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
