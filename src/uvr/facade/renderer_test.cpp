@@ -140,7 +140,8 @@ Mesh timeStep(float t) {
 /// Bitwise equality of two float arrays (NaN equal to NaN, -0 unequal to +0).
 template <class T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 /// Every pixel of two frames equal, bit for bit.

@@ -275,6 +275,7 @@ private:
 
     void onAccept(beast::error_code ec) {
         if (ec) return;
+        Json info;
         {
             std::lock_guard lk(server_.m);
             if (static_cast<int>(liveSessionsLocked()) >= server_.opt.maxSessions) {
@@ -286,15 +287,11 @@ private:
             state = server_.scene.initial;
             histogramKey = server_.fieldKey(state.field);  // info carries its histogram
             server_.sessions.push_back(weak_from_this());
+            info = server_.infoBase;
+            info["state"] = toJson(state);
         }
         peer = endpointName();
         server_.say("view: " + peer + " connected");
-        Json info;
-        {
-            std::lock_guard lk(server_.m);
-            info = server_.infoBase;
-        }
-        info["state"] = toJson(state);
         {
             std::lock_guard lk(server_.fieldsMutex);
             const auto it = server_.fields.find(server_.fieldKey(state.field));
