@@ -59,7 +59,8 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     flags->registerOn(*cmd, /*oneFrame=*/false);
     addMethodOption(*cmd, flags->method);
     cmd->add_option("--host", options->first,
-                    "Address to listen on (0.0.0.0: every interface; the token still applies)")
+                    "IP address to listen on (localhost is 127.0.0.1; 0.0.0.0: every interface, "
+                    "the token still applies)")
         ->capture_default_str();
     cmd->add_option("--port", options->second, "Port to listen on (0: any free port)")
         ->check(CLI::Range(0, 65535))
@@ -79,7 +80,8 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         so.host = options->first;
         so.port = static_cast<std::uint16_t>(options->second);
         so.token = *token;
-        // Step 1: read, validate and prepare, as `uvr render` does.
+        server::checkServerOptions(so, /*tryAddress=*/true);  // before minutes of reading
+        // Step 1: read and validate, as `uvr render` does.
         const auto start = std::chrono::steady_clock::now();
         auto mesh = std::make_shared<Mesh>(loadMesh(*file, ctx));
         server::ViewScene scene;

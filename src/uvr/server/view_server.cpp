@@ -958,24 +958,64 @@ void ViewServer::Impl::requestStop() {
     cv.notify_all();
 }
 
-ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
-    : impl_(std::make_unique<Impl>()) {
-    Impl& d = *impl_;
-    if (!scene.mesh) throwError(ErrorKind::Argument, "", "the viewer needs a mesh");
-    if (options.token.empty()) {
-        options.token = randomToken();
-    } else {
-        const bool ok =
-            options.token.size() >= kMinTokenLength &&
-            std::all_of(options.token.begin(), options.token.end(),
-                        [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; });
+namespace {
+
+/// The address of the options' host ("localhost" is 127.0.0.1); Error(Argument) when it is not
+/// an IP address.
+net::ip::address hostAddress(const ServerOptions& o) {
+    if (o.host == "localhost") return net::ip::address_v4::loopback();
+    beast::error_code ec;
+    const auto address = net::ip::make_address(o.host, ec);
+    if (ec)
+        throwError(
+            ErrorKind::Argument, "",
+            "--host " + printableShort(o.host, 60) + ": not an IP address (" + ec.message() + ")");
+    return address;
+}
+
+/// Opens, binds and (with `listen`) listens on the options' address; Error(Io) naming it.
+void bindTo(tcp::acceptor& acceptor, const ServerOptions& o, bool listen) {
+    const tcp::endpoint endpoint(hostAddress(o), o.port);
+    beast::error_code ec;
+    acceptor.open(endpoint.protocol(), ec);
+    if (!ec) acceptor.set_option(net::socket_base::reuse_address(true), ec);
+    if (!ec) acceptor.bind(endpoint, ec);
+    if (!ec && listen) acceptor.listen(net::socket_base::max_listen_connections, ec);
+    if (ec)
+        throwError(
+            ErrorKind::Io, "",
+            "cannot listen on " + o.host + ":" + std::to_string(o.port) + ": " + ec.message());
+}
+
+}  // namespace
+
+void checkServerOptions(const ServerOptions& o, bool tryAddress) {
+    if (!o.token.empty()) {
+        const bool ok = o.token.size() >= kMinTokenLength &&
+                        std::all_of(o.token.begin(), o.token.end(), [](unsigned char c) {
+                            return std::isalnum(c) || c == '_' || c == '-';
+                        });
         if (!ok)
             throwError(ErrorKind::Argument, "",
                        "--token: expected " + std::to_string(kMinTokenLength) +
                            " or more characters from A-Z, a-z, 0-9, _ and -");
     }
-    if (options.maxSessions < 1 || options.maxMessagesPerSecond < 1 || options.maxScale < 1)
+    if (o.maxSessions < 1 || o.maxMessagesPerSecond < 1 || o.maxScale < 1)
         throwError(ErrorKind::Argument, "", "server limits must be positive");
+    hostAddress(o);
+    if (tryAddress) {
+        net::io_context ioc;
+        tcp::acceptor probe(ioc);
+        bindTo(probe, o, false);
+    }
+}
+
+ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
+    : impl_(std::make_unique<Impl>()) {
+    Impl& d = *impl_;
+    if (!scene.mesh) throwError(ErrorKind::Argument, "", "the viewer needs a mesh");
+    checkServerOptions(options, false);
+    if (options.token.empty()) options.token = randomToken();
     d.scene = std::move(scene);
     d.opt = std::move(options);
     d.log = std::move(log);
@@ -1048,19 +1088,7 @@ ViewServer::~ViewServer() {
 void ViewServer::start() {
     Impl& d = *impl_;
     if (d.started) return;
-    beast::error_code ec;
-    const auto address = net::ip::make_address(d.opt.host, ec);
-    if (ec)
-        throwError(ErrorKind::Argument, "",
-                   "--host " + printableShort(d.opt.host, 60) + ": not an IP address (" +
-                       ec.message() + ")");
-    const tcp::endpoint endpoint(address, d.opt.port);
-    const std::string where = d.opt.host + ":" + std::to_string(d.opt.port);
-    d.acceptor.open(endpoint.protocol(), ec);
-    if (!ec) d.acceptor.set_option(net::socket_base::reuse_address(true), ec);
-    if (!ec) d.acceptor.bind(endpoint, ec);
-    if (!ec) d.acceptor.listen(net::socket_base::max_listen_connections, ec);
-    if (ec) throwError(ErrorKind::Io, "", "cannot listen on " + where + ": " + ec.message());
+    bindTo(d.acceptor, d.opt, true);
     d.boundPort = d.acceptor.local_endpoint().port();
     d.acceptLoop();
     d.started = true;

@@ -33,6 +33,11 @@ struct ServerOptions {
 /// Shortest token ServerOptions::token may be.
 inline constexpr std::size_t kMinTokenLength = 16;
 
+/// Checks the options before any work (a given token's form, the limits, the host's form) and,
+/// with tryAddress, that the address can be bound now (another server on the port fails here,
+/// not after minutes of reading); throws Error(Argument) or Error(Io) naming the flag or address.
+void checkServerOptions(const ServerOptions& options, bool tryAddress);
+
 /// What the server shows: the mesh as read (kept for field changes), how to prepare it, the
 /// render settings the command line fixed and the state every new tab starts from.
 struct ViewScene {

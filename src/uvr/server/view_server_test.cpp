@@ -492,10 +492,22 @@ TEST(ViewServer, StopClosesConnectionsAndBadOptionsAreRefused) {
     EXPECT_THAT(refused(oddToken), HasSubstr("--token"));
     ServerOptions badHost;
     badHost.host = "not-an-address";
-    ViewScene scene;
-    scene.mesh = twoFieldMesh();
-    ViewServer s(std::move(scene), badHost);
-    EXPECT_THROW(s.start(), Error);
+    EXPECT_THAT(refused(badHost), HasSubstr("--host not-an-address"));
+    // A port in use is found before any work, and by start.
+    auto busy = startServer();
+    ServerOptions same;
+    same.port = busy->port();
+    try {
+        checkServerOptions(same, true);
+        ADD_FAILURE() << "a busy port passed";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Io);
+        EXPECT_THAT(e.what(), HasSubstr("cannot listen on 127.0.0.1:" + std::to_string(same.port)));
+    }
+    EXPECT_NO_THROW(checkServerOptions(ServerOptions{}, false));
+    ServerOptions named;
+    named.host = "localhost";  // the one name taken: 127.0.0.1
+    EXPECT_NO_THROW(checkServerOptions(named, false));
 }
 
 }  // namespace

@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+// `uvr view`'s own flags fail before the mesh is read (the server itself: src/uvr/server).
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "cli_test_support.h"
+#include "test_support.h"
+
+namespace uvr {
+namespace {
+
+using cli_testing::expectOneLineError;
+using cli_testing::uvr;
+
+TEST(CliView, BadServerFlagsAndABusyPortFailBeforeTheMeshIsRead) {
+    const std::string dir = testing::scratchDir();
+    const std::string m = dir + "/m.uvrm";
+    ASSERT_EQ(uvr("-q generate box --cells 3000 --fields jet -o " + m, dir).code, 0);
+    // Without -q a read prints "uvr: read ...": a one-line error means nothing was read. A
+    // server that starts anyway is stopped by `timeout` (exit 124), and the case fails.
+    auto view = [&](const std::string& args) {
+        return uvr("view " + m + " " + args, dir, "timeout 60 ");
+    };
+    expectOneLineError(view("--token short"), {"--token"}, "--token");
+    expectOneLineError(view("--token '0123456789abcdef;x'"), {"--token"}, "--token ;");
+    expectOneLineError(view("--host not-an-address"), {"--host not-an-address"}, "--host");
+    expectOneLineError(view("--port 70000"), {"--port"}, "--port");
+    expectOneLineError(view("--tf nosuch"), {"nosuch"}, "--tf");
+    // A port another program listens on.
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    addr.sin_port = 0;
+    ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    ASSERT_EQ(::listen(fd, 1), 0);
+    socklen_t len = sizeof addr;
+    ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+    const std::string port = std::to_string(ntohs(addr.sin_port));
+    expectOneLineError(view("--port " + port), {"cannot listen on 127.0.0.1:" + port}, "busy port");
+    ::close(fd);
+}
+
+}  // namespace
+}  // namespace uvr
