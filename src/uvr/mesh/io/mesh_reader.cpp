@@ -7,6 +7,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
 #include "uvr/mesh/io/native.h"
+#include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/io/vtk_legacy.h"
 #include "uvr/mesh/io/vtu.h"
 
@@ -14,7 +15,7 @@ namespace uvr {
 
 namespace {
 
-enum class Format { Legacy, Vtu, Pvtu, Native, Unknown };
+enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Unknown };
 
 Format sniffFormat(const std::string& path) {
     checkRegularFile(path);
@@ -26,11 +27,13 @@ Format sniffFormat(const std::string& path) {
     if (text.size() >= 8 && std::memcmp(text.data(), kNativeMagic, 8) == 0) return Format::Native;
     if (text.rfind("# vtk DataFile", 0) == 0) return Format::Legacy;
     if (text.find("PUnstructuredGrid") != std::string::npos) return Format::Pvtu;
+    if (text.find("type=\"Collection\"") != std::string::npos) return Format::Pvd;
     if (text.find("<VTKFile") != std::string::npos) return Format::Vtu;
     const std::string ext = fileExtension(path);
     if (ext == ".vtk") return Format::Legacy;
     if (ext == ".vtu") return Format::Vtu;
     if (ext == ".pvtu") return Format::Pvtu;
+    if (ext == ".pvd") return Format::Pvd;
     if (ext == ".uvrm") return Format::Native;
     return Format::Unknown;
 }
@@ -45,6 +48,8 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
             return readVtu(path, options);
         case Format::Pvtu:
             return readPvtu(path, options);
+        case Format::Pvd:  // its first time step
+            return openMeshSeries(path, options)->readStep(0);
         case Format::Native:
             return readNative(path, options);
         case Format::Unknown:
@@ -52,7 +57,7 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
     }
     throwError(ErrorKind::Parse, path,
                "unrecognised file format: expected a legacy VTK file ('# vtk DataFile' header), "
-               "VTK XML (.vtu/.pvtu) or a native uvr mesh (.uvrm)");
+               "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd) or a native uvr mesh (.uvrm)");
 }
 
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes) {

@@ -21,6 +21,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
 #include "uvr/mesh/io/base64.h"
+#include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/scalar_type.h"
 #include "uvr/mesh/io/vtk_cells.h"
 
@@ -840,7 +841,6 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
     LoadBudget& budget = *options.budget;
     const std::uint64_t heldBefore = budget.used();
     Mesh mesh;
-    std::unordered_map<std::string, Field*> meshFields;
     for (std::size_t k = 0; k < doc.pieces.size(); ++k) {
         const PieceDesc& p = doc.pieces[k];
         const std::string& piecePath = piecePaths[k];
@@ -848,47 +848,7 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
         Mesh piece = readVtuFile(piecePath, options, false);
         budget.charge(path, label, meshBytes(piece), 1);  // its copy in the merged mesh
 
-        // Merge: points appended, indices offset, fields concatenated by name and association.
-        const std::uint64_t pointBase = mesh.points.size();
-        if (pointBase + piece.points.size() > std::numeric_limits<std::uint32_t>::max())
-            throwError(ErrorKind::Unsupported, path,
-                       label + ": more than 4294967295 points in all are not supported");
-        const std::uint64_t indexBase = mesh.cellIndices.size();
-        mesh.points.insert(mesh.points.end(), piece.points.begin(), piece.points.end());
-        mesh.cellTypes.insert(mesh.cellTypes.end(), piece.cellTypes.begin(), piece.cellTypes.end());
-        for (std::size_t c = 1; c < piece.cellOffsets.size(); ++c)
-            mesh.cellOffsets.push_back(indexBase + piece.cellOffsets[c]);
-        for (std::uint32_t id : piece.cellIndices)
-            mesh.cellIndices.push_back(id + static_cast<std::uint32_t>(pointBase));
-        for (const std::string& note : piece.notes)
-            mesh.notes.push_back("piece " + std::to_string(k) + ": " + note);
-        if (k == 0) {
-            mesh.fields = std::move(piece.fields);
-            meshFields = indexFields(mesh.fields);
-            budget.resetTo(heldBefore + meshBytes(mesh));
-            continue;
-        }
-        const auto pieceFields = indexFields(piece.fields);
-        for (const Field& f : mesh.fields) {
-            const auto found = pieceFields.find(fieldId(f));
-            const Field* g = found == pieceFields.end() ? nullptr : found->second;
-            if (!g)
-                throwParseError(path, atLine(p.line),
-                                label + " has no " + fieldKey(f) + ", which piece 0 has");
-            if (g->components != f.components)
-                throwParseError(path, atLine(p.line),
-                                label + ": " + fieldKey(f) + " has " +
-                                    std::to_string(g->components) + " components, piece 0 has " +
-                                    std::to_string(f.components));
-        }
-        for (const Field& g : piece.fields) {
-            const auto found = meshFields.find(fieldId(g));
-            if (found == meshFields.end())
-                throwParseError(path, atLine(p.line),
-                                label + " has " + fieldKey(g) + ", which piece 0 lacks");
-            Field* it = found->second;
-            it->values.insert(it->values.end(), g.values.begin(), g.values.end());
-        }
+        appendMeshPiece(mesh, piece, k == 0, path, atLine(p.line), label);
         budget.resetTo(heldBefore + meshBytes(mesh));  // the piece is freed next
     }
     return mesh;

@@ -1,0 +1,265 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/mesh/io/time_series.h"
+
+#include <expat.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
+#include "uvr/mesh/io/mesh_merge.h"
+#include "uvr/mesh/io/mesh_reader.h"
+
+namespace uvr {
+
+namespace fs = std::filesystem;
+
+MeshSeries::MeshSeries(std::string path, std::vector<double> times, ReadOptions options)
+    : path_(std::move(path)), times_(std::move(times)), options_(std::move(options)) {
+    UVR_CHECK(!times_.empty(), "a series has at least one step");
+}
+
+void MeshSeries::checkStep(std::size_t i) const {
+    if (i >= times_.size())
+        throwError(ErrorKind::Argument, path_,
+                   "no time step " + std::to_string(i) + ": the steps are 0 to " +
+                       std::to_string(times_.size() - 1));
+}
+
+std::optional<std::vector<Field>> MeshSeries::readFieldsIfSameGeometry(std::size_t i,
+                                                                       const MeshView& geometry) {
+    Mesh mesh = readStep(i);
+    if (!sameGeometry(mesh, geometry)) return std::nullopt;
+    return std::move(mesh.fields);
+}
+
+bool sameGeometry(const MeshView& a, const MeshView& b) {
+    auto same = [](auto x, auto y) {
+        return x.size() == y.size() &&
+               (x.empty() || std::memcmp(x.data(), y.data(), x.size_bytes()) == 0);
+    };
+    return same(a.points, b.points) && same(a.cellTypes, b.cellTypes) &&
+           same(a.cellOffsets, b.cellOffsets) && same(a.cellIndices, b.cellIndices);
+}
+
+std::size_t stepAtTime(const std::vector<double>& times, double t) {
+    if (!std::isfinite(t)) throwError(ErrorKind::Argument, "", "--time: expected a finite number");
+    std::size_t best = 0;
+    for (std::size_t i = 0; i < times.size(); ++i)
+        if (times[i] <= t && times[i] >= times[best]) best = i;
+    return best;
+}
+
+namespace {
+
+// ---- One file: a series of one step at time 0 ----
+
+class SingleFileSeries final : public MeshSeries {
+public:
+    SingleFileSeries(const std::string& path, const ReadOptions& options)
+        : MeshSeries(path, {0.0}, options) {}
+    Mesh readStep(std::size_t i) override {
+        checkStep(i);
+        return readMesh(path(), options());
+    }
+};
+
+// ---- Several files, one (or several parts) per step: .pvd and numbered series ----
+
+/// A step of a file-per-step series: its files (parts merged in order) and, for messages, where
+/// the step is listed.
+struct FileStep {
+    double time = 0;
+    std::vector<std::string> files;
+    std::string where;
+};
+
+class FileSeries final : public MeshSeries {
+public:
+    FileSeries(const std::string& path, std::vector<FileStep> steps, const ReadOptions& options)
+        : MeshSeries(path, timesOf(steps), options), steps_(std::move(steps)) {}
+
+    std::string stepSource(std::size_t i) const override {
+        checkStep(i);
+        std::string s;
+        for (const std::string& f : steps_[i].files) s += (s.empty() ? "" : ", ") + f;
+        return s;
+    }
+
+    Mesh readStep(std::size_t i) override {
+        checkStep(i);
+        const FileStep& step = steps_[i];
+        if (step.files.size() == 1) return readMesh(step.files[0], options());
+        Mesh mesh;
+        for (std::size_t k = 0; k < step.files.size(); ++k) {
+            Mesh part = readMesh(step.files[k], options());
+            appendMeshPiece(mesh, part, k == 0, path(), step.where,
+                            "part " + std::to_string(k) + " ('" + step.files[k] + "')");
+        }
+        return mesh;
+    }
+
+private:
+    static std::vector<double> timesOf(const std::vector<FileStep>& steps) {
+        std::vector<double> t;
+        for (const FileStep& s : steps) t.push_back(s.time);
+        return t;
+    }
+    std::vector<FileStep> steps_;
+};
+
+/// A number of an XML attribute, parsed as VTK parses it (leading '+' and spaces allowed).
+std::optional<double> parseNumber(std::string_view s) {
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
+    return v;
+}
+
+struct PvdParse {
+    XML_Parser parser = nullptr;
+    std::string path;
+    fs::path folder;
+    bool sawRoot = false, sawCollection = false;
+    std::map<double, FileStep> steps;  // by time, parts in listing order
+    std::string error;                 // the first error (expat callbacks must not throw)
+};
+
+void fail(PvdParse& st, const std::string& message) {
+    if (st.error.empty()) st.error = atLine(XML_GetCurrentLineNumber(st.parser)) + ": " + message;
+    XML_StopParser(st.parser, XML_FALSE);
+}
+
+const char* attr(const XML_Char** attrs, const char* name) {
+    for (int i = 0; attrs[i]; i += 2)
+        if (std::strcmp(attrs[i], name) == 0) return attrs[i + 1];
+    return nullptr;
+}
+
+void XMLCALL onPvdStart(void* data, const XML_Char* name, const XML_Char** attrs) {
+    auto& st = *static_cast<PvdParse*>(data);
+    if (!st.sawRoot) {
+        st.sawRoot = true;
+        const char* type = attr(attrs, "type");
+        if (std::strcmp(name, "VTKFile") != 0 || !type || std::strcmp(type, "Collection") != 0)
+            fail(st, "expected <VTKFile type=\"Collection\"> (a ParaView .pvd file)");
+        return;
+    }
+    if (std::strcmp(name, "Collection") == 0) st.sawCollection = true;
+    if (std::strcmp(name, "DataSet") != 0) return;
+    const char* file = attr(attrs, "file");
+    if (!file || !*file) return fail(st, "<DataSet> without a file attribute");
+    double time = static_cast<double>(st.steps.size());
+    if (const char* t = attr(attrs, "timestep")) {
+        const auto v = parseNumber(t);
+        if (!v || !std::isfinite(*v))
+            return fail(st, std::string("<DataSet timestep=\"") + t + "\">: expected a number");
+        time = *v;
+    }
+    const fs::path source(file);
+    FileStep& step = st.steps[time];
+    step.time = time;
+    if (step.where.empty()) step.where = atLine(XML_GetCurrentLineNumber(st.parser));
+    step.files.push_back((source.is_absolute() ? source : st.folder / source).string());
+}
+
+std::vector<FileStep> readPvd(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string text = ss.str();
+    PvdParse st;
+    st.path = path;
+    st.folder = fs::path(path).parent_path();
+    st.parser = XML_ParserCreate(nullptr);
+    UVR_CHECK(st.parser != nullptr, "expat could not create a parser");
+    XML_SetUserData(st.parser, &st);
+    XML_SetElementHandler(st.parser, onPvdStart, nullptr);
+    const bool ok =
+        XML_Parse(st.parser, text.data(), static_cast<int>(text.size()), XML_TRUE) == XML_STATUS_OK;
+    std::string error = st.error;
+    if (!ok && error.empty())
+        error = atLine(XML_GetCurrentLineNumber(st.parser)) + ": " +
+                XML_ErrorString(XML_GetErrorCode(st.parser));
+    XML_ParserFree(st.parser);
+    if (!error.empty()) throwError(ErrorKind::Parse, path, error);
+    if (!st.sawCollection || st.steps.empty())
+        throwError(ErrorKind::Parse, path, "the collection lists no <DataSet file=...>");
+    std::vector<FileStep> steps;
+    for (auto& [t, s] : st.steps) {
+        for (const std::string& f : s.files)
+            if (fs::path(f) == fs::path(path))
+                throwError(ErrorKind::Parse, path, s.where + ": a DataSet names the .pvd itself");
+        steps.push_back(std::move(s));
+    }
+    return steps;
+}
+
+/// The files a pattern with one '*' names: the '*' stands for one or more digits; sorted by
+/// that number, their times 0, 1, 2, ... (as ParaView's file series). Error(Io) when none exists.
+std::vector<FileStep> globNumbered(const std::string& pattern) {
+    const fs::path p(pattern);
+    const std::string name = p.filename().string();
+    const std::size_t star = name.find('*');
+    if (star == std::string::npos || name.find('*', star + 1) != std::string::npos ||
+        p.parent_path().string().find('*') != std::string::npos)
+        throwError(ErrorKind::Argument, pattern,
+                   "a file series pattern has one '*', in the file name (e.g. run_*.vtu)");
+    const std::string prefix = name.substr(0, star), suffix = name.substr(star + 1);
+    const fs::path folder = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    std::error_code ec;
+    std::vector<std::pair<std::uint64_t, std::string>> found;
+    for (const auto& entry : fs::directory_iterator(folder, ec)) {
+        const std::string n = entry.path().filename().string();
+        if (n.size() <= prefix.size() + suffix.size() || n.rfind(prefix, 0) != 0 ||
+            n.compare(n.size() - suffix.size(), suffix.size(), suffix) != 0)
+            continue;
+        const std::string digits =
+            n.substr(prefix.size(), n.size() - prefix.size() - suffix.size());
+        if (digits.size() > 18 || !std::all_of(digits.begin(), digits.end(),
+                                               [](unsigned char c) { return std::isdigit(c); }))
+            continue;
+        found.emplace_back(std::stoull(digits), (p.parent_path() / n).string());
+    }
+    if (ec)
+        throwError(ErrorKind::Io, pattern,
+                   "cannot list the folder " + folder.string() + ": " + ec.message());
+    if (found.empty())
+        throwError(ErrorKind::Io, pattern,
+                   "no file matches (the '*' stands for the step's number: one or more digits)");
+    std::sort(found.begin(), found.end());
+    std::vector<FileStep> steps;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+        if (i > 0 && found[i].first == found[i - 1].first)
+            throwError(ErrorKind::Argument, pattern,
+                       "two files have the number " + std::to_string(found[i].first) + ": " +
+                           found[i - 1].second + " and " + found[i].second);
+        steps.push_back(
+            FileStep{static_cast<double>(i), {found[i].second}, "file " + found[i].second});
+    }
+    return steps;
+}
+
+}  // namespace
+
+std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOptions& options) {
+    if (fs::path(path).filename().string().find('*') != std::string::npos)
+        return std::make_unique<FileSeries>(path, globNumbered(path), options);
+    checkRegularFile(path);
+    if (fileExtension(path) == ".pvd")
+        return std::make_unique<FileSeries>(path, readPvd(path), options);
+    return std::make_unique<SingleFileSeries>(path, options);
+}
+
+}  // namespace uvr
