@@ -257,6 +257,7 @@ std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOp
     if (fs::path(path).filename().string().find('*') != std::string::npos)
         return std::make_unique<FileSeries>(path, globNumbered(path), options);
     checkRegularFile(path);
+    fileSize(path);  // a missing or unreadable file is named now, not at the first step
     if (fileExtension(path) == ".pvd")
         return std::make_unique<FileSeries>(path, readPvd(path), options);
     return std::make_unique<SingleFileSeries>(path, options);

@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/facade/series_player.h"
+
+#include <chrono>
+#include <optional>
+#include <utility>
+
+#include "uvr/core/error.h"
+#include "uvr/cpu/background_task.h"
+
+namespace uvr {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+/// One step's read: its fields when the geometry is the current one, else its whole mesh.
+struct SeriesPlayer::Read {
+    std::optional<std::vector<Field>> fields;
+    std::optional<Mesh> mesh;
+    double seconds = 0.0;
+};
+
+/// A read started by prefetch.
+struct SeriesPlayer::Pending {
+    std::size_t step = 0;
+    cpu::BackgroundTask<Read> task;
+};
+
+SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
+                           const RendererOptions& options, std::size_t first,
+                           const ProgressFn& progress)
+    : series_(std::move(series)), spec_(std::move(spec)), options_(options), progress_(progress) {
+    UVR_CHECK(series_ != nullptr, "a player needs a series");
+    mesh_ = series_->readStep(first);
+    field_ = selectScalarField(mesh_, spec_);
+    renderer_ = std::make_unique<Renderer>(mesh_, field_, options_, progress_);
+    step_ = first;
+}
+
+SeriesPlayer::~SeriesPlayer() = default;
+
+SeriesPlayer::Read SeriesPlayer::readStep(std::size_t i) {
+    const auto start = std::chrono::steady_clock::now();
+    Read r;
+    r.fields = series_->readFieldsIfSameGeometry(i, mesh_);
+    if (!r.fields) r.mesh = series_->readStep(i);
+    r.seconds = secondsSince(start);
+    return r;
+}
+
+void SeriesPlayer::prefetch(std::size_t i) {
+    if (i >= series_->stepCount() || i == step_) return;
+    if (pending_ && pending_->step == i) return;
+    pending_.reset();  // waits for an earlier read: one reader at a time
+    auto p = std::make_unique<Pending>();
+    p->step = i;
+    p->task = cpu::BackgroundTask<Read>([this, i] { return readStep(i); });
+    pending_ = std::move(p);
+}
+
+StepUpdate SeriesPlayer::show(std::size_t i) {
+    StepUpdate u;
+    u.step = i;
+    u.time = series_->times().at(std::min(i, series_->stepCount() - 1));
+    // Step 1: the step's data, from the prefetch when it read this step.
+    const auto waitStart = std::chrono::steady_clock::now();
+    std::unique_ptr<Pending> pending = std::move(pending_);
+    Read r;
+    if (pending && pending->step == i) {
+        r = pending->task.take();
+        u.prefetched = true;
+        u.readSeconds = secondsSince(waitStart);
+    } else {
+        pending.reset();  // a read of another step is waited for and dropped
+        r = readStep(i);
+        u.readSeconds = r.seconds;
+    }
+    // Step 2: new values for the same geometry, or the new geometry prepared.
+    const auto updateStart = std::chrono::steady_clock::now();
+    if (r.fields) {
+        std::vector<Field> previous = std::exchange(mesh_.fields, std::move(*r.fields));
+        try {
+            ScalarField field = selectScalarField(mesh_, spec_);
+            renderer_->setFieldValues(field);
+            field_ = std::move(field);
+        } catch (...) {
+            mesh_.fields = std::move(previous);
+            throw;
+        }
+    } else {
+        ScalarField field = selectScalarField(*r.mesh, spec_);
+        auto renderer = std::make_unique<Renderer>(*r.mesh, field, options_, progress_);
+        mesh_ = std::move(*r.mesh);
+        field_ = std::move(field);
+        renderer_ = std::move(renderer);
+        u.rebuilt = true;
+    }
+    u.updateSeconds = secondsSince(updateStart);
+    step_ = i;
+    return u;
+}
+
+}  // namespace uvr

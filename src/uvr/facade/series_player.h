@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "uvr/facade/renderer.h"
+#include "uvr/mesh/field_select.h"
+#include "uvr/mesh/io/time_series.h"
+
+namespace uvr {
+
+/// What showing a time step did.
+struct StepUpdate {
+    std::size_t step = 0;
+    double time = 0.0;
+    bool rebuilt = false;        ///< the step's geometry differs: its mesh was prepared anew
+    bool prefetched = false;     ///< its read had been started by prefetch
+    double readSeconds = 0.0;    ///< reading the step (after a prefetch: only the wait for it)
+    double updateSeconds = 0.0;  ///< refreshing the values, or preparing the new geometry
+};
+
+/// Plays a mesh series through one Renderer: the first step is read and prepared once; a later
+/// step whose points and cells are the same gives the renderer only its new values
+/// (Renderer::setFieldValues, nothing geometric rebuilt), one whose geometry differs is
+/// prepared anew. prefetch(i) reads step i on a thread of its own while the caller renders.
+/// One caller at a time.
+class SeriesPlayer {
+public:
+    /// Reads step `first` of the series and prepares the field `spec` names for rendering;
+    /// throws reader errors, Error(Argument) for an unknown field or step.
+    SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec, const RendererOptions& options,
+                 std::size_t first = 0, const ProgressFn& progress = {});
+    ~SeriesPlayer();
+    SeriesPlayer(const SeriesPlayer&) = delete;
+    SeriesPlayer& operator=(const SeriesPlayer&) = delete;
+
+    /// Makes the renderer show step i (a prefetched read of i is taken, one of another step is
+    /// waited for and dropped). On an error (a bad file, the field missing at that step) the
+    /// player still shows the step it showed before.
+    StepUpdate show(std::size_t i);
+    /// Starts reading step i in the background (fields only when its geometry is the current
+    /// one); nothing when i is out of range or is the current step. Errors surface in show(i).
+    void prefetch(std::size_t i);
+
+    /// The renderer, prepared for the current step.
+    Renderer& renderer() { return *renderer_; }
+    /// The current step's mesh: the geometry and that step's fields.
+    const Mesh& mesh() const { return mesh_; }
+    /// The rendered field's values at the current step.
+    const ScalarField& field() const { return field_; }
+    /// The series.
+    const MeshSeries& series() const { return *series_; }
+    /// The step shown.
+    std::size_t step() const { return step_; }
+
+private:
+    struct Read;
+    Read readStep(std::size_t i);
+
+    std::unique_ptr<MeshSeries> series_;
+    FieldSpec spec_;
+    RendererOptions options_;
+    ProgressFn progress_;
+    Mesh mesh_;
+    ScalarField field_;
+    std::unique_ptr<Renderer> renderer_;
+    std::size_t step_ = 0;
+    struct Pending;
+    std::unique_ptr<Pending> pending_;
+};
+
+}  // namespace uvr

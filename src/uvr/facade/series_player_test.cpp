@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/facade/series_player.h"
+
+#include <gmock/gmock.h>
+
+#include <cmath>
+
+#include "test_meshes.h"
+#include "test_support.h"
+#include "uvr/core/error.h"
+#include "uvr/mesh/io/mesh_reader.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+using uvr::testing::catchError;
+
+/// A jittered hexahedral grid of n cells a side whose point field "f" moves with t.
+Mesh stepMesh(float t, int n = 6, const std::string& name = "f") {
+    Mesh m = testing::makeHexGrid(
+        n, -1.f, 1.f, [t](Vec3f p) { return std::sin(3.f * p.x + t) * p.y + p.z; }, 0.2f);
+    m.fields[0].name = name;
+    return m;
+}
+
+RenderSettings frameOf(const Bounds3f& bounds) {
+    RenderSettings s;
+    s.width = 64;
+    s.height = 48;
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "0:0,1:0.6");
+    s.range = std::pair{-2.f, 2.f};  // one range for every step
+    s.camera = orbitCamera(resetCamera(bounds, 64.f / 48.f), 30.f, 20.f);
+    return s;
+}
+
+/// The frame a renderer prepared from scratch gives for this mesh.
+RenderResult freshFrame(const Mesh& m, const RenderSettings& s, const RendererOptions& o) {
+    Renderer r(m, selectScalarField(m, parseFieldSpec("f")), o);
+    return r.render(s);
+}
+
+void expectSameImage(const RenderResult& a, const RenderResult& b, const std::string& what) {
+    ASSERT_EQ(a.image.pixels.size(), b.image.pixels.size()) << what;
+    for (std::size_t i = 0; i < a.image.pixels.size(); ++i) {
+        const Vec4f p = a.image.pixels[i], q = b.image.pixels[i];
+        ASSERT_TRUE(p.x == q.x && p.y == q.y && p.z == q.z && p.w == q.w)
+            << what << ": pixel " << i;
+    }
+}
+
+TEST(SeriesPlayer, StepsOfOneGeometryRefreshValuesAndFramesEqualAFreshPreparation) {
+    const std::string dir = testing::scratchDir();
+    for (int k = 0; k < 3; ++k)
+        writeMesh(stepMesh(float(k)), dir + "/s_" + std::to_string(k) + ".vtu");
+    writeMesh(stepMesh(3.f, 5), dir + "/s_3.vtu");       // another geometry
+    writeMesh(stepMesh(4.f, 6, "g"), dir + "/s_4.vtu");  // the field is missing
+    RendererOptions o;
+    o.device = Device::Cpu;
+    SeriesPlayer player(openMeshSeries(dir + "/s_*.vtu"), parseFieldSpec("f"), o);
+    ASSERT_EQ(player.series().stepCount(), 5u);
+    EXPECT_EQ(player.step(), 0u);
+    const RenderSettings s = frameOf(player.mesh().bounds());
+    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(0.f), s, o), "step 0");
+    const PreparedMesh* prepared = &player.renderer().prepared();
+
+    // Step 1, read in the background while step 0 rendered: values only.
+    player.prefetch(1);
+    const RenderResult during = player.renderer().render(s);
+    StepUpdate u = player.show(1);
+    EXPECT_TRUE(u.prefetched);
+    EXPECT_FALSE(u.rebuilt);
+    EXPECT_EQ(u.time, 1.0);
+    EXPECT_EQ(&player.renderer().prepared(), prepared);  // nothing prepared anew
+    const RenderResult one = player.renderer().render(s);
+    expectSameImage(one, freshFrame(stepMesh(1.f), s, o), "step 1");
+    double change = 0.0;
+    for (std::size_t i = 0; i < one.image.pixels.size(); ++i)
+        change += std::abs(one.image.pixels[i].x - during.image.pixels[i].x);
+    EXPECT_GT(change, 1.0);  // the new values show
+
+    // Step 2 without a prefetch, while a prefetch of another step is dropped.
+    player.prefetch(3);
+    u = player.show(2);
+    EXPECT_FALSE(u.prefetched);
+    EXPECT_FALSE(u.rebuilt);
+    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(2.f), s, o), "step 2");
+
+    // Step 3's geometry differs: prepared anew.
+    u = player.show(3);
+    EXPECT_TRUE(u.rebuilt);
+    EXPECT_EQ(player.mesh().cellCount(), 125u);
+    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(3.f, 5), s, o), "step 3");
+
+    // Step 4 lacks the field: an error naming it, and step 3 stays shown.
+    player.prefetch(4);
+    EXPECT_THAT(catchError([&] { player.show(4); }).what(), HasSubstr("'f'"));
+    EXPECT_EQ(player.step(), 3u);
+    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(3.f, 5), s, o),
+                    "step 3 after the refused step");
+    EXPECT_THAT(catchError([&] { player.show(5); }).what(), HasSubstr("no time step 5"));
+    EXPECT_EQ(player.step(), 3u);
+}
+
+}  // namespace
+}  // namespace uvr
