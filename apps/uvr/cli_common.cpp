@@ -436,7 +436,7 @@ void RenderFlags::checkBeforeLoading(const std::string& meshFile) const {
     (void)legendFont();
     const FieldSpec spec = parseFieldSpec(field);
     // A .uvrm's header names its fields: a --field it lacks is refused before reading the arrays.
-    if (!meshFile.empty())
+    if (!meshFile.empty() && !isSeriesPattern(meshFile))
         if (const std::optional<MeshSummary> header = readMeshSummary(meshFile, false))
             (void)resolveField(header->fields, spec);
 }
@@ -674,15 +674,53 @@ void checkFrameMemory(const RenderFlags& flags, const Context& ctx) {
         frameMemoryBytes(flags));
 }
 
-Mesh loadMesh(const std::string& path, const Context& ctx) {
-    ctx.setActivity(path, "reading the mesh");
-    Progress progress(ctx, "reading " + path);
+void StepFlags::registerOn(CLI::App& app) {
+    auto* t = app.add_option("--time", time,
+                             "Time step shown at this time (the last step at or before it, as "
+                             "ParaView snaps) of a file or series with time steps");
+    auto* i = app.add_option("--step-index", index,
+                             "Time step by its index (0 is the first) of a file or series with "
+                             "time steps");
+    t->excludes(i);
+}
+
+std::size_t StepFlags::pick(const MeshSeries& series) const {
+    if (time) return stepAtTime(series.times(), *time);
+    if (index && *index >= series.stepCount())
+        throwError(ErrorKind::Argument, series.path(),
+                   "--step-index " + std::to_string(*index) + ": the file has " +
+                       std::to_string(series.stepCount()) + " time step" +
+                       (series.stepCount() == 1 ? "" : "s") + " (0 to " +
+                       std::to_string(series.stepCount() - 1) + ")");
+    return index.value_or(0);
+}
+
+std::unique_ptr<MeshSeries> openSeries(const std::string& path, const Context& ctx,
+                                       std::function<void(double)> progress) {
     ReadOptions options;
     options.maxMemoryBytes = ctx.maxMemoryBytes;
-    options.progress = progress.callback();
-    Mesh mesh = readMesh(path, options);  // every reader checks the structure it returns
-    progress.done("read " + path + ": " + std::to_string(mesh.pointCount()) + " points, " +
+    options.progress = std::move(progress);
+    return openMeshSeries(path, options);
+}
+
+Mesh loadMesh(const std::string& path, const Context& ctx, const StepFlags& steps) {
+    ctx.setActivity(path, "reading the mesh");
+    Progress progress(ctx, "reading " + path);
+    const std::unique_ptr<MeshSeries> series = openSeries(path, ctx, progress.callback());
+    const std::size_t step = steps.pick(*series);
+    Mesh mesh = series->readStep(step);  // every reader checks the structure it returns
+    std::string which;
+    if (series->stepCount() > 1) {
+        char t[64];
+        std::snprintf(t, sizeof t, "%.9g", series->times()[step]);
+        which = ", time step " + std::to_string(step) + " of 0-" +
+                std::to_string(series->stepCount() - 1) + " (time " + t + ")";
+    }
+    progress.done("read " + path + which + ": " + std::to_string(mesh.pointCount()) + " points, " +
                   std::to_string(mesh.cellCount()) + " cells");
+    if (series->stepCount() > 1 && !steps.time && !steps.index)
+        ctx.step("note: " + path + " has " + std::to_string(series->stepCount()) +
+                 " time steps; --time or --step-index picks another, `uvr animate` renders all");
     for (const std::string& note : mesh.notes) ctx.step("note: " + note);
     return mesh;
 }

@@ -143,8 +143,26 @@ struct RenderFlags {
 std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
                                        const RendererOptions& options, const Context& ctx);
 
-/// Loads a mesh with progress messages and validation; prints findings.
-Mesh loadMesh(const std::string& path, const Context& ctx);
+/// Which time step of a series a command reads: --time T (the last step at or before T, as
+/// ParaView snaps) or --step-index I; neither: the first.
+struct StepFlags {
+    std::optional<double> time;
+    std::optional<std::size_t> index;
+
+    /// Adds --time and --step-index (exclusive) to a subcommand.
+    void registerOn(CLI::App& app);
+    /// The step of `series` the flags pick; Error(Argument) naming --step-index when out of range.
+    std::size_t pick(const MeshSeries& series) const;
+};
+
+/// Opens a mesh file or series (a .pvd, a quoted 'run_*.vtu' pattern, a file with time steps)
+/// with --max-memory applied to each step's read; progress, when given, hears each read.
+std::unique_ptr<MeshSeries> openSeries(const std::string& path, const Context& ctx,
+                                       std::function<void(double)> progress = {});
+
+/// Loads a mesh (the step `steps` picks of a series) with progress messages; prints the reader's
+/// notes, and which step of how many it read when the file has several.
+Mesh loadMesh(const std::string& path, const Context& ctx, const StepFlags& steps = {});
 
 /// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its
 /// image carries the legend).
@@ -173,6 +191,7 @@ void addCompareCommand(CLI::App& app, Context& ctx);
 void addBenchCommand(CLI::App& app, Context& ctx);
 void addPresetsCommand(CLI::App& app, Context& ctx);
 void addViewCommand(CLI::App& app, Context& ctx);
+void addAnimateCommand(CLI::App& app, Context& ctx);
 
 /// Adds --method (adaptive, reference or exact) bound to `method`.
 void addMethodOption(CLI::App& app, std::string& method);

@@ -70,6 +70,57 @@ void printFields(const nlohmann::json& fields) {
     }
 }
 
+/// Every time step of a file or series with more than one (none otherwise): index, time, its
+/// file where each step has its own, whether its geometry is that of `mesh`, and each field's
+/// finite range (of the magnitude for vectors).
+nlohmann::json timeStepsJson(const std::string& path, const Mesh& mesh, const Context& ctx) {
+    const std::unique_ptr<MeshSeries> series = openSeries(path, ctx);
+    nlohmann::json out = nlohmann::json::array();
+    if (series->stepCount() < 2) return out;
+    Progress progress(
+        ctx, "reading the ranges of " + std::to_string(series->stepCount()) + " time steps",
+        double(series->stepCount()), "steps");
+    for (std::size_t i = 0; i < series->stepCount(); ++i) {
+        ctx.setActivity(series->stepSource(i), "reading time step " + std::to_string(i));
+        std::optional<std::vector<Field>> fields = series->readFieldsIfSameGeometry(i, mesh);
+        std::optional<Mesh> other;
+        if (!fields) other = series->readStep(i);
+        const MeshView geometry = other ? MeshView(*other) : MeshView(mesh);
+        nlohmann::json ranges = nlohmann::json::array();
+        for (const Field& f : fields ? *fields : other->fields) {
+            const auto [lo, hi] = finiteRange(scalarFieldOf(geometry, f).values);
+            ranges.push_back({{"name", f.name},
+                              {"association", associationName(f.association)},
+                              {"range", {lo, hi}}});
+        }
+        nlohmann::json step = {{"index", i},
+                               {"time", series->times()[i]},
+                               {"same_geometry", fields.has_value()},
+                               {"fields", ranges}};
+        if (series->stepSource(i) != path) step["source"] = series->stepSource(i);
+        out.push_back(std::move(step));
+        progress.set(double(i + 1) / double(series->stepCount()));
+    }
+    return out;
+}
+
+void printTimeSteps(const nlohmann::json& steps) {
+    std::printf("time steps: %zu (time %s to %s)\n", steps.size(),
+                fmt(steps.front()["time"].get<double>()).c_str(),
+                fmt(steps.back()["time"].get<double>()).c_str());
+    for (const auto& s : steps) {
+        std::string line = "  " + std::to_string(s["index"].get<std::size_t>()) + "  time " +
+                           fmt(s["time"].get<double>());
+        if (!s["same_geometry"].get<bool>()) line += "  (other points or cells)";
+        for (const auto& f : s["fields"])
+            line += "  " + printable(f["name"].get<std::string>()) + " [" +
+                    fmt(f["range"][0].get<double>()) + ", " + fmt(f["range"][1].get<double>()) +
+                    "]";
+        if (s.contains("source")) line += "  " + printable(s["source"].get<std::string>());
+        std::printf("%s\n", line.c_str());
+    }
+}
+
 /// Writes a mesh with a progress line; "wrote OUT" at the end.
 void writeMeshWithProgress(const Mesh& mesh, const std::string& out, const Context& ctx) {
     ctx.setActivity(out, "writing the mesh");
@@ -88,16 +139,23 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     auto full = std::make_shared<bool>(false);
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    auto steps = std::make_shared<StepFlags>();
+    cmd->add_option("FILE", *file,
+                    "Mesh file (.vtk, .vtu, .pvtu, .pvd, .uvrm) or a quoted numbered series "
+                    "('run_*.vtu')")
+        ->required();
     cmd->add_flag("--json", *json, "Print JSON instead of text");
+    steps->registerOn(*cmd);
     cmd->add_flag("--full", *full,
                   "Of a .uvrm, also read the arrays for bounds, value ranges and validation "
                   "(other formats are always read whole)");
-    cmd->callback([file, json, full, &ctx] {
+    cmd->callback([file, json, full, steps, &ctx] {
         // Of a .uvrm the header and the cell-type bytes: a 262M-tetrahedron file in a fraction
         // of a second instead of reading 8 GB.
         if (const std::optional<MeshSummary> header =
-                *full ? std::nullopt : readMeshSummary(*file)) {
+                *full || isSeriesPattern(*file) || steps->time || steps->index
+                    ? std::nullopt
+                    : readMeshSummary(*file)) {
             const MeshSummary& summary = *header;
             std::map<std::string, std::uint64_t> byType;
             for (const auto& [type, count] : summary.cellTypes) byType[cellTypeName(type)] = count;
@@ -122,7 +180,8 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
                 static_cast<unsigned long long>(summary.fileBytes));
             return;
         }
-        const Mesh mesh = loadMesh(*file, ctx);
+        const Mesh mesh = loadMesh(*file, ctx, *steps);
+        const nlohmann::json timeSteps = timeStepsJson(*file, mesh, ctx);
         ctx.step("validating " + *file);
         const ValidationReport report = validateMesh(mesh, *file);
         std::map<std::string, std::uint64_t> byType;
@@ -158,6 +217,7 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
             j["validation"].push_back(std::move(o));
         }
         j["notes"] = mesh.notes;
+        if (!timeSteps.empty()) j["time_steps"] = timeSteps;
         j["read"] = "whole file";
         if (*json) {
             std::printf("%s\n", jsonText(j).c_str());
@@ -172,6 +232,7 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
                         fmt(b.hi.x).c_str(), fmt(b.lo.y).c_str(), fmt(b.hi.y).c_str(),
                         fmt(b.lo.z).c_str(), fmt(b.hi.z).c_str());
         printFields(j["fields"]);
+        if (!timeSteps.empty()) printTimeSteps(timeSteps);
         std::printf("validation:\n");
         if (findings.empty()) std::printf("  no problems found\n");
         for (const ValidationFinding& f : findings)
@@ -187,14 +248,19 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         "fixed-step reference or the exact integrator (--method), on the CPU or a GPU");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    auto steps = std::make_shared<StepFlags>();
+    cmd->add_option("FILE", *file,
+                    "Mesh file (.vtk, .vtu, .pvtu, .pvd, .uvrm) or a quoted numbered series "
+                    "('run_*.vtu')")
+        ->required();
     flags->registerOn(*cmd);
-    cmd->callback([file, flags, &ctx] {
+    steps->registerOn(*cmd);
+    cmd->callback([file, flags, steps, &ctx] {
         applyThreads(flags->threads);
         flags->checkFiles(*file);
         flags->checkBeforeLoading(*file);
         checkFrameMemory(*flags, ctx);
-        const Mesh mesh = loadMesh(*file, ctx);
+        const Mesh mesh = loadMesh(*file, ctx, *steps);
         renderAndWrite(mesh, *file, *flags, ctx);
     });
 }

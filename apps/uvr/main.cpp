@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
     cli::addBenchCommand(app, ctx);
     cli::addPresetsCommand(app, ctx);
     cli::addViewCommand(app, ctx);
+    cli::addAnimateCommand(app, ctx);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -253,8 +253,12 @@ std::vector<FileStep> globNumbered(const std::string& pattern) {
 
 }  // namespace
 
+bool isSeriesPattern(const std::string& path) {
+    return fs::path(path).filename().string().find('*') != std::string::npos;
+}
+
 std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOptions& options) {
-    if (fs::path(path).filename().string().find('*') != std::string::npos)
+    if (isSeriesPattern(path))
         return std::make_unique<FileSeries>(path, globNumbered(path), options);
     checkRegularFile(path);
     fileSize(path);  // a missing or unreadable file is named now, not at the first step

@@ -64,6 +64,9 @@ private:
 std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path,
                                            const ReadOptions& options = {});
 
+/// True when path names a numbered file series ('*' in its file name) rather than one file.
+bool isSeriesPattern(const std::string& path);
+
 /// The step shown at time t, as ParaView snaps: the last step whose time is <= t (the first
 /// step for t before it); Error(Argument) for a non-finite t.
 std::size_t stepAtTime(const std::vector<double>& times, double t);

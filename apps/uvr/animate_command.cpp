@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: MIT
+// `uvr animate`: every time step of a file or series to numbered PNGs, the mesh prepared once.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "cli_common.h"
+#include "progress.h"
+
+namespace uvr::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// --steps FIRST:LAST[:STRIDE] (inclusive; either end may be left out) over `count` steps.
+std::vector<std::size_t> parseSteps(const std::string& text, std::size_t count) {
+    std::size_t first = 0, last = count - 1, stride = 1;
+    if (!text.empty()) {
+        auto number = [&](const std::string& part, std::size_t fallback) -> std::size_t {
+            if (part.empty()) return fallback;
+            std::size_t used = 0;
+            unsigned long long v = 0;
+            try {
+                v = std::stoull(part, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used != part.size() || part[0] == '-')
+                throwError(ErrorKind::Argument, "",
+                           "--steps " + text + ": expected FIRST:LAST[:STRIDE] of step indices");
+            return static_cast<std::size_t>(v);
+        };
+        std::vector<std::string> parts;
+        std::size_t start = 0;
+        for (std::size_t colon; (colon = text.find(':', start)) != std::string::npos;
+             start = colon + 1)
+            parts.push_back(text.substr(start, colon - start));
+        parts.push_back(text.substr(start));
+        if (parts.size() < 2 || parts.size() > 3)
+            throwError(ErrorKind::Argument, "",
+                       "--steps " + text + ": expected FIRST:LAST[:STRIDE] of step indices");
+        first = number(parts[0], 0);
+        last = std::min(number(parts[1], count - 1), count - 1);
+        stride = parts.size() == 3 ? number(parts[2], 1) : 1;
+        if (stride == 0) throwError(ErrorKind::Argument, "", "--steps " + text + ": STRIDE is 0");
+        if (first >= count || first > last)
+            throwError(ErrorKind::Argument, "",
+                       "--steps " + text + ": no step in it (the steps are 0 to " +
+                           std::to_string(count - 1) + ")");
+    }
+    std::vector<std::size_t> steps;
+    for (std::size_t i = first; i <= last; i += stride) steps.push_back(i);
+    return steps;
+}
+
+/// The rendered field's values at a step whose fields are `fields` over `geometry`.
+std::vector<float> fieldValues(const MeshView& geometry, const std::vector<Field>& fields,
+                               const FieldSpec& spec) {
+    std::vector<FieldInfo> infos;
+    for (const Field& f : fields) infos.push_back({f.name, f.association, f.components});
+    const FieldChoice choice = resolveField(infos, spec);
+    return scalarFieldOf(geometry, fields[choice.index], spec.component).values;
+}
+
+std::string timeText(double t) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.9g", t);
+    return buf;
+}
+
+std::string secondsText(double s) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.3f s", s);
+    return buf;
+}
+
+}  // namespace
+
+void addAnimateCommand(CLI::App& app, Context& ctx) {
+    auto* cmd = app.add_subcommand(
+        "animate",
+        "Render every time step of a file or series (.pvd, a quoted 'run_*.vtu' pattern, files "
+        "with time steps) to numbered PNGs in a folder; the mesh is prepared once and a step with "
+        "the same points and cells only refreshes the values, while the next step is read in "
+        "the background");
+    auto file = std::make_shared<std::string>();
+    auto folder = std::make_shared<std::string>();
+    auto flags = std::make_shared<RenderFlags>();
+    auto steps = std::make_shared<std::string>();
+    auto prefix = std::make_shared<std::string>("frame_");
+    auto perStep = std::make_shared<bool>(false);
+    cmd->add_option("FILE", *file,
+                    "Mesh file or series: .pvd, a quoted numbered series ('run_*.vtu'), a file "
+                    "with time steps, or any mesh file (one frame)")
+        ->required();
+    cmd->add_option("-o,--output", *folder, "Folder for the frames (created when missing)")
+        ->required();
+    flags->registerOn(*cmd, /*oneFrame=*/false);
+    addMethodOption(*cmd, flags->method);
+    cmd->add_flag("--legend", flags->legend,
+                  "Draw a colour legend at the right edge of every frame (the field's name, the "
+                  "colour map, ticks over the value range)");
+    cmd->add_option("--steps", *steps,
+                    "Steps to render, FIRST:LAST[:STRIDE] by index, inclusive (default: all)");
+    cmd->add_option("--prefix", *prefix, "File name of the frames before the step's number")
+        ->capture_default_str();
+    cmd->add_flag("--range-per-step", *perStep,
+                  "Map each frame's own step's value range (default: one range for all frames, "
+                  "the union over the rendered steps, read before the first frame unless "
+                  "--range gives it)");
+    cmd->callback([=, &ctx] {
+        applyThreads(flags->threads);
+        flags->checkBeforeLoading(*file);
+        checkFrameMemory(*flags, ctx);
+        if (*perStep && !flags->range.empty())
+            throwError(ErrorKind::Argument, "",
+                       "--range-per-step and --range contradict: a given range is every "
+                       "frame's");
+        if (prefix->empty() || prefix->find('/') != std::string::npos)
+            throwError(ErrorKind::Argument, "",
+                       "--prefix '" + *prefix + "': expected a file name part without '/'");
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        if (fs::exists(*folder, ec) && !fs::is_directory(*folder, ec))
+            throwError(ErrorKind::Argument, *folder, "-o: exists and is not a folder");
+        const std::unique_ptr<MeshSeries> series = openSeries(*file, ctx);
+        const std::vector<std::size_t> chosen = parseSteps(*steps, series->stepCount());
+        fs::create_directories(*folder, ec);
+        if (ec) throwError(ErrorKind::Io, *folder, "cannot create the folder: " + ec.message());
+        const FieldSpec spec = parseFieldSpec(flags->field);
+
+        // Step 1: the first step read, validated and prepared.
+        const auto start = Clock::now();
+        ctx.setActivity(series->stepSource(chosen[0]), "reading and preparing the first step");
+        if (resolvesToCuda(flags->rendererOptions().device))
+            ctx.step("GPU: " + cudaDeviceDescription());
+        SeriesPlayer player(std::unique_ptr<MeshSeries>(openSeries(*file, ctx)), spec,
+                            flags->rendererOptions(), chosen[0],
+                            [&](const std::string& s) { ctx.step(s); });
+        for (const std::string& note : player.mesh().notes) ctx.step("note: " + note);
+        const ValidationReport report = validateMesh(player.mesh(), series->stepSource(chosen[0]));
+        for (const std::string& f : report.findings()) ctx.step("validation: " + f);
+        if (report.bounds.empty())
+            throwError(ErrorKind::Validation, series->stepSource(chosen[0]),
+                       "no cell has volume (or the mesh has no volumetric cells): nothing to "
+                       "render");
+        ctx.done("read and prepared step " + std::to_string(chosen[0]) + " (" +
+                     std::to_string(player.renderer().prepared().tets.tets.size()) +
+                     " tetrahedra) of " + std::to_string(series->stepCount()),
+                 start);
+        std::vector<std::string> notes;
+        RenderSettings settings = flags->settings(report.bounds, *file, &notes);
+        for (const std::string& note : notes) ctx.step("note: " + note);
+        validateSettings(settings);
+        const std::optional<Vec3f> background = flags->backgroundColor();
+        const std::optional<Font> legendFont = flags->legendFont();
+
+        // Step 2: one value range for every frame (the union over the rendered steps).
+        if (!settings.range && !*perStep) {
+            Progress progress(ctx,
+                              "reading the value range of " + std::to_string(chosen.size()) +
+                                  " time steps (--range skips this)",
+                              double(chosen.size()), "steps");
+            float lo = INFINITY, hi = -INFINITY;
+            for (std::size_t k = 0; k < chosen.size(); ++k) {
+                const std::size_t i = chosen[k];
+                ctx.setActivity(series->stepSource(i), "reading time step " + std::to_string(i));
+                std::optional<std::vector<Field>> fields =
+                    series->readFieldsIfSameGeometry(i, player.mesh());
+                std::vector<float> values;
+                if (fields) {
+                    values = fieldValues(player.mesh(), *fields, spec);
+                } else {
+                    const Mesh other = series->readStep(i);
+                    values = fieldValues(other, other.fields, spec);
+                }
+                const auto [a, b] = finiteRange(values);
+                if (a <= b && std::isfinite(a)) lo = std::min(lo, a), hi = std::max(hi, b);
+                progress.set(double(k + 1) / double(chosen.size()));
+            }
+            if (lo > hi) lo = hi = 0.f;
+            settings.range = std::pair{lo, hi};
+            progress.done("value range over the steps: [" + timeText(lo) + ", " + timeText(hi) +
+                          "] (--range sets another)");
+        }
+
+        // Step 3: every step: values refreshed (or the new geometry prepared), rendered, written;
+        // the next step read meanwhile.
+        const int digits = std::max<int>(4, int(std::to_string(series->stepCount() - 1).size()));
+        std::set<std::string> warned;
+        std::vector<double> reads, updates, frames;
+        Progress progress(ctx, "rendering " + std::to_string(chosen.size()) + " time steps",
+                          double(chosen.size()), "steps");
+        for (std::size_t k = 0; k < chosen.size(); ++k) {
+            const std::size_t i = chosen[k];
+            ctx.setActivity(series->stepSource(i), "reading time step " + std::to_string(i));
+            StepUpdate u;
+            if (k > 0) {
+                u = player.show(i);
+                reads.push_back(u.readSeconds);
+                updates.push_back(u.updateSeconds);
+            }
+            if (k + 1 < chosen.size()) player.prefetch(chosen[k + 1]);
+            ctx.setActivity(*folder, "rendering time step " + std::to_string(i));
+            const RenderResult result = player.renderer().render(settings);
+            frames.push_back(result.stats.seconds);
+            Image image = result.image;
+            if (legendFont) {
+                LegendStyle style;
+                style.background = background;
+                drawLegend(image, *legendFont, settings.tf, result.setup.rangeLo,
+                           result.setup.rangeHi, player.field().name, settings.tf.logScale, style);
+            }
+            char name[64];
+            std::snprintf(name, sizeof name, "%0*zu.png", digits, i);
+            const std::string path = (fs::path(*folder) / (*prefix + name)).string();
+            {
+                OutputFile out(path);
+                writePng(out, image, background);
+                out.finish();
+                out.commit();
+            }
+            for (const std::string& note : result.setup.notes)
+                if (warned.insert(note).second) ctx.warn(*file + ": " + note);
+            const std::string empty =
+                explainEmptyFrame(player.renderer().prepared(), settings, result);
+            if (!empty.empty() && warned.insert(empty).second)
+                ctx.warn(*file + ", step " + std::to_string(i) + ": " + empty);
+            std::string line = "step " + std::to_string(i) + " (time " +
+                               timeText(player.series().times()[i]) + "): ";
+            if (k == 0)
+                line += "prepared above";
+            else
+                line +=
+                    std::string(u.rebuilt ? "new geometry prepared in " : "values refreshed in ") +
+                    secondsText(u.updateSeconds) + ", read " + secondsText(u.readSeconds) +
+                    (u.prefetched ? " (waiting for the background read)" : "");
+            line += ", frame " + secondsText(result.stats.seconds) + " -> " + path;
+            ctx.step(line);
+            progress.set(double(k + 1) / double(chosen.size()));
+        }
+        auto median = [](std::vector<double> v) {
+            if (v.empty()) return 0.0;
+            std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+            return v[v.size() / 2];
+        };
+        char summary[256];
+        std::snprintf(summary, sizeof summary,
+                      "wrote %zu frames to %s; per step (median): read %.3f s, update %.3f s, "
+                      "frame %.3f s",
+                      chosen.size(), folder->c_str(), median(reads), median(updates),
+                      median(frames));
+        progress.done(summary);
+    });
+}
+
+}  // namespace uvr::cli

@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: MIT
+// Time series on the command line: `uvr animate`, `render --time/--step-index` and the time
+// steps `uvr info` lists (issue 14).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "cli_test_support.h"
+#include "test_support.h"
+#include "uvr/mesh/io/mesh_reader.h"
+
+namespace uvr {
+namespace {
+
+using cli_testing::CliRun;
+using cli_testing::expectOneLineError;
+using cli_testing::uvr;
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// Three steps of a generated box, a blob moving along x (point field "blob"), as step_K.vtu
+/// and run.pvd with times 0, 0.5 and 1.
+void writeSeries(const std::string& dir) {
+    ASSERT_EQ(uvr("-q generate box --cells 4000 --fields linear -o " + dir + "/base.vtu", dir).code,
+              0);
+    Mesh m = readMesh(dir + "/base.vtu");
+    std::string pvd = "<VTKFile type=\"Collection\"><Collection>\n";
+    for (int k = 0; k < 3; ++k) {
+        Field blob{"blob", Association::Point, 1, {}};
+        for (const Vec3f& p : m.points) {
+            const float dx = p.x - 0.2f - 0.3f * k, dy = p.y - 0.5f, dz = p.z - 0.5f;
+            blob.values.push_back(std::exp(-(dx * dx + dy * dy + dz * dz) / 0.03f));
+        }
+        Mesh step = m;
+        step.fields.push_back(std::move(blob));
+        writeMesh(step, dir + "/step_" + std::to_string(k) + ".vtu");
+        pvd += "<DataSet timestep=\"" + std::to_string(0.5 * k) + "\" file=\"step_" +
+               std::to_string(k) + ".vtu\"/>\n";
+    }
+    testing::writeFile(dir + "/run.pvd", pvd + "</Collection></VTKFile>\n");
+}
+
+const std::string kLook = " --field blob --size 64x48 --device cpu --opacity 0:0,1:0.8 --range 0,1";
+
+TEST(CliAnimate, EveryStepIsTheFrameRenderWouldDrawWithTheGeometryPreparedOnce) {
+    const std::string dir = testing::scratchDir();
+    writeSeries(dir);
+    const CliRun a = uvr("animate run.pvd -o frames" + kLook, dir);
+    ASSERT_EQ(a.code, 0) << a.err;
+    EXPECT_NE(a.err.find("step 1 (time 0.5): values refreshed"), std::string::npos) << a.err;
+    EXPECT_NE(a.err.find("step 2 (time 1): values refreshed"), std::string::npos) << a.err;
+    EXPECT_EQ(a.err.find("new geometry"), std::string::npos) << a.err;
+    EXPECT_NE(a.err.find("wrote 3 frames"), std::string::npos) << a.err;
+    std::string previous;
+    for (int k = 0; k < 3; ++k) {
+        SCOPED_TRACE(k);
+        const std::string frame = slurp(dir + "/frames/frame_000" + std::to_string(k) + ".png");
+        ASSERT_FALSE(frame.empty());
+        EXPECT_NE(frame, previous);  // the blob moves
+        previous = frame;
+        // The same PNG as one render of that step.
+        const std::string one = "one" + std::to_string(k) + ".png";
+        ASSERT_EQ(
+            uvr("-q render run.pvd --step-index " + std::to_string(k) + " -o " + one + kLook, dir)
+                .code,
+            0);
+        EXPECT_EQ(slurp(dir + "/" + one), frame);
+    }
+    // --time snaps to the last step at or before it; a numbered series is the same steps.
+    ASSERT_EQ(uvr("-q render run.pvd --time 0.9 -o t.png" + kLook, dir).code, 0);
+    EXPECT_EQ(slurp(dir + "/t.png"), slurp(dir + "/frames/frame_0001.png"));
+    const CliRun b = uvr("-q animate 'step_*.vtu' -o series --steps 1: --prefix s" + kLook, dir);
+    ASSERT_EQ(b.code, 0) << b.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/series/s0000.png"));
+    EXPECT_EQ(slurp(dir + "/series/s0002.png"), slurp(dir + "/frames/frame_0002.png"));
+    // Without --range, one range over the steps: the log says it.
+    const CliRun c = uvr("animate run.pvd -o auto --field blob --size 32x32 --device cpu", dir);
+    ASSERT_EQ(c.code, 0) << c.err;
+    EXPECT_NE(c.err.find("value range over the steps: [0"), std::string::npos) << c.err;
+}
+
+TEST(CliAnimate, InfoListsTheStepsWithTheirRanges) {
+    const std::string dir = testing::scratchDir();
+    writeSeries(dir);
+    const CliRun info = uvr("-q info --json run.pvd", dir);
+    ASSERT_EQ(info.code, 0) << info.err;
+    const nlohmann::json j = nlohmann::json::parse(info.out);
+    ASSERT_EQ(j["time_steps"].size(), 3u);
+    for (int k = 0; k < 3; ++k) {
+        const nlohmann::json& s = j["time_steps"][k];
+        EXPECT_EQ(s["index"], k);
+        EXPECT_DOUBLE_EQ(s["time"].get<double>(), 0.5 * k);
+        EXPECT_TRUE(s["same_geometry"].get<bool>());
+        EXPECT_EQ(s["source"], "step_" + std::to_string(k) + ".vtu");  // relative to the .pvd
+        const nlohmann::json& blob = s["fields"][1];
+        EXPECT_EQ(blob["name"], "blob");
+        EXPECT_GT(blob["range"][1].get<double>(), 0.5);  // the blob is inside the box
+    }
+    const CliRun text = uvr("-q info run.pvd --step-index 2", dir);
+    ASSERT_EQ(text.code, 0) << text.err;
+    EXPECT_NE(text.out.find("time steps: 3 (time 0 to 1)"), std::string::npos) << text.out;
+    // A file without time steps lists none.
+    const CliRun plain = uvr("-q info --json base.vtu", dir);
+    EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("time_steps"));
+}
+
+TEST(CliAnimate, BadStepsAndOutputsAreRefusedBeforeRendering) {
+    const std::string dir = testing::scratchDir();
+    writeSeries(dir);
+    expectOneLineError(uvr("animate run.pvd -o f --steps 5:9", dir), {"--steps 5:9", "0 to 2"});
+    expectOneLineError(uvr("animate run.pvd -o f --steps a:b", dir), {"--steps a:b"});
+    expectOneLineError(uvr("animate run.pvd -o f --steps 0:2:0", dir), {"STRIDE is 0"});
+    expectOneLineError(uvr("animate run.pvd -o f --range 0,1 --range-per-step", dir),
+                       {"--range-per-step"});
+    expectOneLineError(uvr("animate run.pvd -o base.vtu", dir), {"base.vtu", "not a folder"});
+    expectOneLineError(uvr("animate run.pvd -o f --prefix a/b", dir), {"--prefix"});
+    expectOneLineError(uvr("animate 'none_*.vtu' -o f", dir), {"no file matches"});
+    expectOneLineError(uvr("render run.pvd -o x.png --step-index 7", dir),
+                       {"--step-index 7", "3 time steps"});
+    const CliRun both = uvr("render run.pvd -o x.png --step-index 1 --time 0", dir);
+    EXPECT_EQ(both.code, 2);
+    EXPECT_NE(both.err.find("excludes"), std::string::npos) << both.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/f"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
+}
+
+}  // namespace
+}  // namespace uvr
