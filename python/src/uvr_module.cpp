@@ -200,6 +200,28 @@ py::list ownedFields(const py::object& self, const MeshData& m) {
     return out;
 }
 
+/// A time step's fields read for a mesh held elsewhere (its geometry is that mesh's).
+struct FieldSet {
+    std::vector<Field> fields;
+};
+
+/// The fields of a FieldSet as (name, association, read-only array) tuples viewing its memory.
+py::list fieldSetTuples(const py::object& self) {
+    py::list out;
+    for (const Field& f : self.cast<const FieldSet&>().fields) {
+        const auto n = static_cast<py::ssize_t>(f.tupleCount());
+        py::array a = f.components == 1 ? viewArray(f.values.data(), {n}, self)
+                                        : viewArray(f.values.data(), {n, f.components}, self);
+        out.append(py::make_tuple(f.name, associationName(f.association), a));
+    }
+    return out;
+}
+
+/// A mesh file or series opened for its time steps (see uvr.Series).
+struct PySeries {
+    std::unique_ptr<MeshSeries> series;
+};
+
 Association parseAssociation(const std::string& s, const std::string& what) {
     if (s == "point") return Association::Point;
     if (s == "cell") return Association::Cell;
@@ -446,6 +468,49 @@ PYBIND11_MODULE(_uvr, m) {
             const Bounds3f b = d.view.bounds();
             return py::make_tuple(arr3(b.lo), arr3(b.hi));
         });
+    py::class_<FieldSet>(m, "FieldSet", "A time step's fields (see uvr.Series).")
+        .def_property_readonly("fields", [](py::object self) { return fieldSetTuples(self); });
+    py::class_<PySeries>(m, "Series", "A mesh file or series opened for its time steps.")
+        .def(py::init([](const std::string& path, std::uint64_t maxMemory) {
+                 ReadOptions o;
+                 o.maxMemoryBytes = maxMemory;
+                 auto s = std::make_unique<PySeries>();
+                 py::gil_scoped_release release;
+                 s->series = openMeshSeries(path, o);
+                 return s;
+             }),
+             py::arg("path"), py::arg("max_memory") = 0)
+        .def_property_readonly("path", [](const PySeries& s) { return s.series->path(); })
+        .def_property_readonly("times", [](const PySeries& s) { return s.series->times(); })
+        .def("source", [](const PySeries& s, std::size_t i) { return s.series->stepSource(i); })
+        .def("step_at",
+             [](const PySeries& s, double t) { return stepAtTime(s.series->times(), t); })
+        .def(
+            "read",
+            [](PySeries& s, std::size_t i) {
+                auto out = std::make_unique<MeshData>();
+                {
+                    py::gil_scoped_release release;
+                    out->owned = std::make_shared<Mesh>(s.series->readStep(i));
+                }
+                out->view = *out->owned;
+                return out;
+            },
+            py::arg("step"))
+        .def(
+            "read_fields",
+            [](PySeries& s, std::size_t i, const MeshData& geometry) -> py::object {
+                std::optional<std::vector<Field>> fields;
+                {
+                    py::gil_scoped_release release;
+                    fields = s.series->readFieldsIfSameGeometry(i, geometry.view);
+                }
+                if (!fields) return py::none();
+                auto set = std::make_unique<FieldSet>();
+                set->fields = std::move(*fields);
+                return py::cast(std::move(set));
+            },
+            py::arg("step"), py::arg("geometry"));
     m.def("select_field", &selectField, py::arg("mesh"), py::arg("fields"), py::arg("spec"));
     m.def(
         "is_id_field_name", [](const std::string& n) { return isIdFieldName(n); }, py::arg("name"));

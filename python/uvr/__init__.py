@@ -11,14 +11,14 @@ import os as _os
 
 from . import _uvr
 from ._image import Image, compare, contact_sheet, read_png
-from ._mesh import Mesh, as_mesh, from_meshio, from_vtk, read
+from ._mesh import Mesh, Series, as_mesh, from_meshio, from_vtk, read
 from ._render import Renderer, render, transfer_function
 from ._uvr import (ArgumentError, Camera, Error, FileError, InternalError, ParseError,
                    ResourceError, TransferFunction, UnsupportedError, ValidationError)
 
 __all__ = ["ArgumentError", "Camera", "Error", "FileError", "Image", "InternalError", "Mesh",
-           "ParseError", "Renderer", "ResourceError", "TransferFunction", "UnsupportedError",
-           "ValidationError", "as_mesh", "compare", "contact_sheet", "cuda_available",
+           "ParseError", "Renderer", "ResourceError", "Series", "TransferFunction",
+           "UnsupportedError", "ValidationError", "as_mesh", "compare", "contact_sheet", "cuda_available",
            "from_meshio", "from_vtk", "presets", "read", "read_png", "render",
            "transfer_function"]
 

@@ -286,14 +286,87 @@ class Mesh:
                 + (f"; fields: {fields}" if fields else "") + ")")
 
 
-def read(path, max_memory=None):
-    """Reads a mesh file of any format ``uvr render`` reads (.vtk, .vtu, .pvtu, .uvrm).
+def read(path, max_memory=None, *, step=None, time=None):
+    """Reads a mesh file of any format ``uvr render`` reads (.vtk, .vtu, .pvtu, .pvd, .uvrm, a
+    quoted numbered series such as "run_*.vtu"); of a file or series with time steps, the step
+    `step` (an index) or the one shown at `time` (the last at or before it), else the first.
 
     The arrays are uvr's own; ``mesh.points`` and the fields are read-only numpy views of them
     (no copies). ``max_memory`` (bytes) refuses loads that would hold more.
     """
-    data = _uvr.MeshData.read(os.fspath(path), int(max_memory or 0))
-    return Mesh(None, _data=data, _fields=data.fields)
+    if step is None and time is None:
+        data = _uvr.MeshData.read(os.fspath(path), int(max_memory or 0))
+        return Mesh(None, _data=data, _fields=data.fields)
+    series = Series(path, max_memory)
+    return series.read(series._index(step, time))
+
+
+class Series:
+    """A mesh file or series opened for its time steps: a ParaView ``.pvd``, a numbered file
+    series named by a pattern with one ``*`` ("run_*.vtu"), or a file with time steps; any
+    other file is one step at time 0.
+
+    ``series.times`` lists the steps' times, ``len(series)`` counts them, ``series[i]`` (or
+    ``read(i)``) reads step i whole. ``uvr.Renderer(series, field)`` prepares the first step and
+    ``renderer.set_time(t)`` / ``set_step(i)`` shows another: when its points and cells are the
+    same only the values are read and refreshed, nothing geometric is rebuilt.
+    """
+
+    def __init__(self, path, max_memory=None):
+        self._core = _uvr.Series(os.fspath(path), int(max_memory or 0))
+
+    @property
+    def path(self):
+        """The path or pattern it was opened with."""
+        return self._core.path
+
+    @property
+    def times(self):
+        """The steps' times (0, 1, 2, ... for a numbered series)."""
+        return list(self._core.times)
+
+    def __len__(self):
+        return len(self._core.times)
+
+    def source(self, step):
+        """The file step `step` comes from."""
+        return self._core.source(self._index(step, None))
+
+    def step_at(self, time):
+        """The step shown at `time`: the last at or before it (the first for earlier times)."""
+        return int(self._core.step_at(float(time)))
+
+    def _index(self, step, time):
+        if step is not None and time is not None:
+            raise _argument_error("step and time: give one of them")
+        if time is not None:
+            return self.step_at(time)
+        i = int(step or 0)
+        n = len(self)
+        if not 0 <= i < n:
+            raise _argument_error(f"step {i}: {self.path} has {n} time step"
+                                  f"{'' if n == 1 else 's'} (0 to {n - 1})")
+        return i
+
+    def read(self, step=0):
+        """Step `step`, whole (points, cells and that step's fields) as a uvr.Mesh."""
+        data = self._core.read(self._index(step, None))
+        return Mesh(None, _data=data, _fields=data.fields)
+
+    def __getitem__(self, step):
+        return self.read(step)
+
+    def _same_geometry(self, step, mesh):
+        """Step `step`'s fields on `mesh`'s geometry as a new uvr.Mesh sharing its arrays, or
+        None when the step's points or cells differ."""
+        fields = self._core.read_fields(self._index(step, None), mesh._data)
+        if fields is None:
+            return None
+        return Mesh(None, _data=mesh._data, _fields=fields.fields, _keep=mesh._keep)
+
+    def __repr__(self):
+        t = self.times
+        return f"uvr.Series({self.path!r}, {len(t)} steps, time {t[0]:g} to {t[-1]:g})"
 
 
 def from_meshio(m):
@@ -372,6 +445,8 @@ def as_mesh(obj):
     ``cell_data`` mappings."""
     if isinstance(obj, Mesh):
         return obj
+    if isinstance(obj, Series):
+        return obj.read(0)
     if isinstance(obj, (str, os.PathLike)):
         return read(obj)
     if hasattr(obj, "GetCellTypesArray"):

@@ -5,7 +5,7 @@ import numpy as np
 
 from . import _uvr
 from ._image import Image, _background
-from ._mesh import as_mesh
+from ._mesh import Series, as_mesh
 
 
 def transfer_function(tf=None, opacity=None):
@@ -44,23 +44,81 @@ class Renderer:
     ``methods`` names the integrators to prepare for ("reference" and "exact" need the mesh
     BVH). Changing the transfer function, camera, range, method or quality rebuilds nothing;
     new field values of the same mesh (``set_field``; ``render(field=...)``) rebuild nothing
-    geometric either. The GIL is released while preparing and rendering.
+    geometric either. Made from a ``uvr.Series``, it shows the first step and ``set_time`` /
+    ``set_step`` show others (values only while the points and cells stay). The GIL is released
+    while preparing and rendering.
     """
 
     def __init__(self, mesh, field=None, device="auto", *, build_device="auto", leaf_cells=0,
                  methods=("adaptive", "reference", "exact"), seed_grids=True, association=None):
-        self.mesh = as_mesh(mesh)
-        name, assoc, values = self._field(field, association)
-        unknown = set(methods) - {"adaptive", "reference", "exact"}
-        if unknown:
-            raise _uvr.ArgumentError(f"methods: unknown {sorted(unknown)}; expected "
-                                     "'adaptive', 'reference' or 'exact'")
+        self.series = mesh if isinstance(mesh, Series) else None
+        self._step = 0
+        self._options = dict(device=device, build_device=build_device, leaf_cells=leaf_cells,
+                             methods=methods, seed_grids=seed_grids)
+        self._prepare(as_mesh(mesh), field, association)
+
+    def _prepare(self, mesh, field, association=None):
+        """Prepares `field` of `mesh` with the options given to the constructor."""
+        device, build_device = self._options["device"], self._options["build_device"]
+        leaf_cells, seed_grids = self._options["leaf_cells"], self._options["seed_grids"]
+        methods = self._options["methods"]
+        previous = getattr(self, "mesh", None)
+        self.mesh = mesh
+        try:
+            name, assoc, values = self._field(field, association)
+            unknown = set(methods) - {"adaptive", "reference", "exact"}
+            if unknown:
+                raise _uvr.ArgumentError(f"methods: unknown {sorted(unknown)}; expected "
+                                         "'adaptive', 'reference' or 'exact'")
+            self._core = _uvr.Renderer(self.mesh._data, name, assoc, values, device,
+                                       build_device, int(leaf_cells),
+                                       mesh_bvh="reference" in methods or "exact" in methods,
+                                       seed_grids=bool(seed_grids))
+        except BaseException:
+            self.mesh = previous  # a failed new step leaves the renderer as it was
+            raise
         self._methods = tuple(methods)
-        self._core = _uvr.Renderer(self.mesh._data, name, assoc, values, device, build_device,
-                                   int(leaf_cells),
-                                   mesh_bvh="reference" in methods or "exact" in methods,
-                                   seed_grids=bool(seed_grids))
         self._field_key = field if isinstance(field, str) or field is None else None
+        self._by_values = self._field_key is None and field is not None
+
+    @property
+    def step(self):
+        """The time step shown (0 for a mesh that is no series)."""
+        return self._step
+
+    @property
+    def time(self):
+        """The time of the step shown (0 for a mesh that is no series)."""
+        return self.series.times[self._step] if self.series is not None else 0.0
+
+    def set_step(self, step):
+        """Shows time step `step` of the series the renderer was made from: when its points and
+        cells equal the current ones only its values are read and refreshed (nothing geometric
+        rebuilt, as set_field); otherwise the step is prepared anew. Returns True when only
+        the values changed."""
+        if self.series is None:
+            raise _uvr.ArgumentError("set_step/set_time: the renderer was made from a mesh, not "
+                                     "a uvr.Series (uvr.Series(path) opens one)")
+        if self._by_values:
+            raise _uvr.ArgumentError("set_step/set_time: the field was given as values; name "
+                                     "it (field='pressure') to follow it through the steps")
+        same = self.series._same_geometry(step, self.mesh)
+        if same is not None:
+            name, assoc, values = _uvr.select_field(same._data, same.fields,
+                                                    self._field_key or "")[:3]
+            self._core.set_field_values(name, assoc, values)
+            self.mesh = same
+        else:
+            self._prepare(self.series.read(step), self._field_key)
+        self._step = self.series._index(step, None)
+        return same is not None
+
+    def set_time(self, time):
+        """Shows the step at `time` (the last step at or before it), as set_step. Returns True
+        when only the values changed."""
+        if self.series is None:
+            return self.set_step(0)  # refused with the message above
+        return self.set_step(self.series.step_at(time))
 
     def _field(self, field, association=None):
         """(name, association, float32 values) of a field spec or an array of values."""
