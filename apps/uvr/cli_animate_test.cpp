@@ -114,6 +114,29 @@ TEST(CliAnimate, InfoListsTheStepsWithTheirRanges) {
     EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("time_steps"));
 }
 
+TEST(CliAnimate, GenerateWritesATimeSeriesOfOneGeometry) {
+    const std::string dir = testing::scratchDir();
+    ASSERT_EQ(
+        uvr("-q generate box --cells 3000 --fields jet,linear --steps 3 --dt 0.5 -o t.uvrm", dir)
+            .code,
+        0);
+    ASSERT_EQ(uvr("-q generate box --cells 3000 --fields jet,linear -o one.uvrm", dir).code, 0);
+    EXPECT_EQ(slurp(dir + "/t_0000.uvrm"), slurp(dir + "/one.uvrm"));  // time 0: the plain mesh
+    const CliRun info = uvr("-q info --json t.pvd", dir);
+    ASSERT_EQ(info.code, 0) << info.err;
+    const nlohmann::json j = nlohmann::json::parse(info.out);
+    ASSERT_EQ(j["time_steps"].size(), 3u);
+    EXPECT_DOUBLE_EQ(j["time_steps"][2]["time"].get<double>(), 1.0);
+    for (const auto& s : j["time_steps"]) EXPECT_TRUE(s["same_geometry"].get<bool>());
+    // The fields turn: linear x + 2y - z at the point turned by -t about y.
+    const Mesh m0 = readMesh(dir + "/t_0000.uvrm"), m2 = readMesh(dir + "/t_0002.uvrm");
+    const Vec3f p = m2.points[7];
+    const float c = std::cos(1.f), s = std::sin(1.f);
+    const float x = c * p.x + s * p.z, z = -s * p.x + c * p.z;
+    EXPECT_NEAR(m2.fields[1].values[7], x + 2.f * p.y - z, 1e-5f);
+    EXPECT_NE(m0.fields[0].values, m2.fields[0].values);
+}
+
 TEST(CliAnimate, BadStepsAndOutputsAreRefusedBeforeRendering) {
     const std::string dir = testing::scratchDir();
     writeSeries(dir);

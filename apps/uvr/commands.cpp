@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -348,7 +349,18 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
            "Fields to write, first is the default: jet, marschner_lobb, multiscale, linear, "
            "constant")
         ->delimiter(',');
-    cmd->callback([shape, out, spec, fields, &ctx] {
+    auto steps = std::make_shared<int>(1);
+    auto dt = std::make_shared<double>(0.1);
+    cmd->add_option("--steps", *steps,
+                    "Time steps: more than 1 writes OUT's name with _0000, _0001, ... before its "
+                    "extension, one mesh a step (the same points and cells, the fields turning "
+                    "about the y axis by --dt radians a step), and a ParaView .pvd listing them")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100000));
+    cmd->add_option("--dt", *dt, "Time between steps (radians the fields turn)")
+        ->capture_default_str()
+        ->check(CLI::Range(-1e6, 1e6));
+    cmd->callback([shape, out, spec, fields, steps, dt, &ctx] {
         resolveOutput(*out);
         checkMeshWritable(*out);  // before generating
         spec->shape = parseProceduralShape(*shape);
@@ -365,10 +377,37 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                           "generating " + std::string(proceduralShapeName(spec->shape)) +
                               " with about " + std::to_string(spec->targetCells) + " tetrahedra",
                           double(spec->targetCells), "tetrahedra");
-        const Mesh mesh = generateMesh(*spec, progress.callback());
+        Mesh mesh = generateMesh(*spec, progress.callback());
         progress.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
                       std::to_string(mesh.cellCount()) + " tetrahedra");
-        writeMeshWithProgress(mesh, *out, ctx);
+        if (*steps == 1) return writeMeshWithProgress(mesh, *out, ctx);
+        // A time series: one file a step and the .pvd naming them (relative to its folder).
+        namespace fs = std::filesystem;
+        const fs::path path(*out);
+        const std::string stem = path.stem().string(), ext = path.extension().string();
+        std::string pvd =
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+            "version=\"0.1\">\n  <Collection>\n";
+        for (int k = 0; k < *steps; ++k) {
+            char name[32];
+            std::snprintf(name, sizeof name, "_%04d", k);
+            const std::string file = stem + name + ext;
+            ProceduralSpec at = *spec;
+            at.time = *dt * k;
+            if (k > 0) setProceduralFields(mesh, at);
+            writeMeshWithProgress(mesh, (path.parent_path() / file).string(), ctx);
+            char entry[64];
+            std::snprintf(entry, sizeof entry, "%.17g", at.time);
+            pvd += "    <DataSet timestep=\"" + std::string(entry) + "\" part=\"0\" file=\"" +
+                   file + "\"/>\n";
+        }
+        pvd += "  </Collection>\n</VTKFile>\n";
+        const std::string pvdPath = (path.parent_path() / (stem + ".pvd")).string();
+        OutputFile index(pvdPath);
+        index.write(pvd);
+        index.finish();
+        index.commit();
+        ctx.step("wrote " + pvdPath + " (" + std::to_string(*steps) + " time steps)");
     });
 }
 

@@ -405,6 +405,22 @@ Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>&
             break;
     }
 
+    const double fieldWork = double(spec.fields.size()) * double(mesh.points.size());
+    double reported = 0.0;
+    setProceduralFields(mesh, spec, [&](double fraction) {
+        reporter.advance(fraction * fieldWork - reported);
+        reported = fraction * fieldWork;
+    });
+    reporter.finish();
+    return mesh;
+}
+
+void setProceduralFields(Mesh& mesh, const ProceduralSpec& spec,
+                         const std::function<void(double)>& progress) {
+    const double total = double(mesh.points.size()) * double(spec.fields.size());
+    double done = 0.0;
+    const double c = std::cos(spec.time), s = std::sin(spec.time);
+    mesh.fields.clear();
     mesh.fields.reserve(spec.fields.size());
     const double cellSize = proceduralCellSize(spec);
     for (ProceduralField f : spec.fields) {
@@ -416,14 +432,17 @@ Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>&
         constexpr size_t kChunk = 65536;
         for (size_t begin = 0; begin < mesh.points.size(); begin += kChunk) {
             const size_t end = std::min(begin + kChunk, mesh.points.size());
-            for (size_t i = begin; i < end; ++i)
-                field.values[i] = proceduralFieldValue(f, mesh.points[i], cellSize);
-            reporter.advance(static_cast<double>(end - begin));
+            for (size_t i = begin; i < end; ++i) {
+                Vec3f p = mesh.points[i];
+                if (spec.time != 0.0)  // turned by -time about y
+                    p = Vec3f(float(c * p.x + s * p.z), p.y, float(-s * p.x + c * p.z));
+                field.values[i] = proceduralFieldValue(f, p, cellSize);
+            }
+            done += double(end - begin);
+            if (progress && total > 0) progress(done / total);
         }
         mesh.fields.push_back(std::move(field));
     }
-    reporter.finish();
-    return mesh;
 }
 
 double proceduralCellSize(const ProceduralSpec& spec) {

@@ -52,11 +52,19 @@ struct ProceduralSpec {
     /// Fields written, in this order (the first is the default render field).
     std::vector<ProceduralField> fields{ProceduralField::Jet, ProceduralField::MarschnerLobb,
                                         ProceduralField::Linear, ProceduralField::Constant};
+    /// Time of the fields: each is evaluated at the point turned by -time radians about the y
+    /// axis (the flow turns about y as time goes on; the points stay where they are).
+    double time = 0.0;
 };
 
 /// Generates a tetrahedral mesh with no inverted or zero-volume cells; progress(fraction in [0,1])
 /// is called now and then when given.
 Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>& progress = {});
+
+/// Replaces the mesh's fields by spec's fields at spec.time (what generateMesh(spec) stores); the
+/// mesh must be generateMesh's of a spec differing at most in time and fields.
+void setProceduralFields(Mesh& mesh, const ProceduralSpec& spec,
+                         const std::function<void(double)>& progress = {});
 
 /// Tetrahedra generateMesh(spec) makes (from the same grid it builds).
 std::uint64_t proceduralTetCount(const ProceduralSpec& spec);
