@@ -48,7 +48,7 @@ function send(message) {
 
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
-                    "opacity_unit"];
+                    "opacity_unit", "step"];
 
 /// Sends a `set` changing `changes` (state keys with full values, plus `preset` or
 /// `colormap_json`), applies the state keys locally and returns its seq.
@@ -442,6 +442,7 @@ function updateControls() {
     if (document.activeElement !== $("quality")) $("quality").value = sliderFromQuality(s.quality);
     $("quality-value").textContent = fmt(s.quality, 4);
     $("heatmap").checked = !!s.heatmap;
+    fillTime(s.step || 0);
     fillSizes(s.size);
     // Transfer function.
     const preset = $("preset");
@@ -502,6 +503,43 @@ $("quality").addEventListener("change", (e) => {
     sendSet({quality: qualityFromSlider(Number(e.target.value))});
 });
 $("heatmap").addEventListener("change", (e) => sendSet({heatmap: e.target.checked}));
+
+// ---- Time steps ------------------------------------------------------------------------------
+
+/// Shows the time row for a file with several time steps: the slider at `step`, its time.
+function fillTime(step) {
+    const times = (session.info && session.info.times) || [0];
+    $("time-row").hidden = times.length < 2;
+    const slider = $("time");
+    slider.max = String(times.length - 1);
+    if (document.activeElement !== slider) slider.value = String(step);
+    $("time-value").textContent =
+        `${fmt(times[Math.min(step, times.length - 1)], 6)} (${step + 1}/${times.length})`;
+}
+
+let playTimer = null;  // while playing: the interval that steps on
+
+function stopPlaying() {
+    if (playTimer !== null) clearInterval(playTimer);
+    playTimer = null;
+    $("time-play").textContent = "▶";
+}
+
+$("time").addEventListener("input", (e) => {
+    stopPlaying();
+    sendSet({step: Number(e.target.value)}, true);
+});
+$("time").addEventListener("change", (e) => sendSet({step: Number(e.target.value)}));
+$("time-play").addEventListener("click", () => {
+    if (playTimer !== null) return stopPlaying();
+    $("time-play").textContent = "⏸";
+    // One step every 250 ms, the newest wins: a slow frame drops steps rather than queueing.
+    playTimer = setInterval(() => {
+        const count = ((session.info && session.info.times) || [0]).length;
+        const next = ((session.state && session.state.step) || 0) + 1;
+        sendSet({step: next % count}, false);
+    }, 250);
+});
 
 $("size").addEventListener("change", (e) => {
     if (e.target.value === "custom") {

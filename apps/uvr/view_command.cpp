@@ -55,8 +55,13 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     auto flags = std::make_shared<RenderFlags>();
     auto options = std::make_shared<std::pair<std::string, int>>("127.0.0.1", 8080);
     auto token = std::make_shared<std::string>();
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    auto steps = std::make_shared<StepFlags>();
+    cmd->add_option("FILE", *file,
+                    "Mesh file (.vtk, .vtu, .pvtu, .pvd, .uvrm) or a quoted numbered series "
+                    "('run_*.vtu'): the page gets a time slider for a series")
+        ->required();
     flags->registerOn(*cmd, /*oneFrame=*/false);
+    steps->registerOn(*cmd);
     addMethodOption(*cmd, flags->method);
     cmd->add_option("--host", options->first,
                     "IP address to listen on (localhost is 127.0.0.1; 0.0.0.0: every interface, "
@@ -83,8 +88,11 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         server::checkServerOptions(so, /*tryAddress=*/true);  // before minutes of reading
         // Step 1: read and validate, as `uvr render` does.
         const auto start = std::chrono::steady_clock::now();
-        auto mesh = std::make_shared<Mesh>(loadMesh(*file, ctx));
+        auto mesh = std::make_shared<Mesh>(loadMesh(*file, ctx, *steps));
         server::ViewScene scene;
+        std::shared_ptr<MeshSeries> series = openSeries(*file, ctx);
+        scene.initial.step = steps->pick(*series);
+        if (series->stepCount() > 1) scene.series = std::move(series);
         scene.loadSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         scene.file = *file;

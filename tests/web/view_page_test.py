@@ -20,7 +20,9 @@
 - Save PNG downloads a PNG of the state's size; Export TF and Export camera download the files
   the exported `uvr render` command names; that command, run here, gives an image with SSIM >=
   0.99 against the saved PNG (`uvr compare --min-ssim 0.99`);
-- a page opened with a wrong token has no viewer.
+- a page opened with a wrong token has no viewer;
+- of a time series (a second server on `uvr generate --steps 3`), the time row shows, its slider
+  and play button change the step and the image, and the exported command names the step.
 
 Screenshots of the whole window go to --screenshots DIR when given. --docs-screenshot PATH instead
 only renders a good-looking view (Blunt Fin) for docs/images/viewer.png.
@@ -617,6 +619,54 @@ def docs_screenshot(page, path):
 # ---- Main ------------------------------------------------------------------------------------
 
 
+def time_series(uvr, driver, shots, work, tmp):
+    """A series (uvr generate --steps 3) in a second server: the time row, its slider and play
+    button change the step and the image, and the exported command names the step."""
+    step("a time series: the time slider and play")
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    series = os.path.join(tmp, "series")
+    os.makedirs(series, exist_ok=True)
+    subprocess.run([uvr, "-q", "generate", "box", "--cells", "20000", "--fields", "jet",
+                    "--steps", "3", "--dt", "0.8", "-o", os.path.join(series, "t.uvrm")],
+                   check=True)
+    server = Server(uvr, os.path.join(series, "t.pvd"),
+                    ["--size", "128x128", "--device", "cpu", "--opacity", "0:0,1:0.8"],
+                    os.path.join(work, "server-series.log"))
+    try:
+        page = Page(driver, shots)
+        page.server = server
+        page.d.get(server.url)
+        page.wait("v.info && v.state", 60, "the series' info message")
+        page.wait_settled(0, 60, "the first full frame of the series")
+        check(page.hook("info")["times"] == [0, 0.8, 1.6],
+              f"info's times: {page.hook('info')['times']}")
+        row = page.d.find_element(By.ID, "time-row")
+        check(row.is_displayed(), "no time row for a series of 3 steps")
+        before = page.pixels()
+        slider = page.d.find_element(By.ID, "time")
+        slider.send_keys(Keys.END)  # the last step, as a user's keyboard moves it
+        page.wait("v.state && v.state.step === 2", 10, "the state's step 2")
+        page.wait_settled(page.hook("lastSeq"), 60, "the frame of step 2")
+        text = page.js("return document.getElementById('time-value').textContent")
+        check("1.6" in text and "(3/3)" in text, f"the time label reads {text!r}")
+        check(difference(before, page.pixels()) > 0.5, "step 2 looks like step 0")
+        page.screenshot("time-step-2")
+        command = page.js("return document.getElementById('command').value")
+        page.wait("document.getElementById('command').value.includes('--step-index 2')", 10,
+                  f"the exported command naming --step-index 2 (it reads {command!r})")
+        # Play steps on from 2 and wraps to 0; pause stops it.
+        page.d.find_element(By.ID, "time-play").click()
+        page.wait("v.state && v.state.step === 0", 10, "play to wrap to step 0")
+        page.d.find_element(By.ID, "time-play").click()
+        shown = page.hook("state")["step"]
+        time.sleep(0.6)
+        check(page.hook("state")["step"] == shown, "pause did not stop the steps")
+        check(server.proc.poll() is None, f"uvr view exited ({server.proc.returncode})")
+    finally:
+        server.stop()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--uvr", required=True, help="the uvr binary")
@@ -676,6 +726,7 @@ def main():
             save_and_reproduce(page, args.uvr, downloads, tmp)
             page.screenshot("final")
             wrong_token_page(page)
+            time_series(args.uvr, driver, args.screenshots, work, tmp)
         check(server.proc.poll() is None, f"uvr view exited ({server.proc.returncode})")
         status = 0
         step("PASSED")

@@ -190,17 +190,22 @@ struct ViewServer::Impl {
     void say(const std::string& line) const {
         if (log) log(line);
     }
-    /// Canonical key of a field spec (the field's index and component), or throws
-    /// Error(Argument) for a spec naming no field.
-    std::string fieldKey(const std::string& spec) const {
+    /// Canonical key of a field spec at a time step (the field's index and component, the
+    /// step), or throws Error(Argument) for a spec naming no field.
+    std::string fieldKey(const std::string& spec, std::size_t step = 0) const {
         const FieldSpec fs = parseFieldSpec(spec);
         const FieldChoice c = resolveField(fieldInfos, fs);
-        return std::to_string(c.index) + ":" + std::to_string(fs.component);
+        return std::to_string(c.index) + ":" + std::to_string(fs.component) + "@" +
+               std::to_string(step);
     }
-    /// Makes the renderer hold the field's values (preparing the mesh the first time, else
-    /// replacing the values) and returns the field's entry (render thread). `progress` reports
-    /// the preparation's steps.
-    FieldEntry field(const std::string& spec, const ProgressFn& progress);
+    /// Time steps of the file (1 without a series).
+    std::size_t stepCount() const { return scene.series ? scene.series->stepCount() : 1; }
+    /// The time step whose fields scene.mesh holds (render thread).
+    std::size_t meshStep = 0;
+    /// Makes the renderer hold the field's values at a time step (preparing the mesh the first
+    /// time, else reading the step's fields when it is another and replacing the values) and
+    /// returns the field's entry (render thread). `progress` reports the preparation's steps.
+    FieldEntry field(const std::string& spec, std::size_t step, const ProgressFn& progress);
     void acceptLoop();
     void renderLoop();
     /// Sends a text message to every connection (any thread).
@@ -285,7 +290,7 @@ private:
                 return;
             }
             state = server_.scene.initial;
-            histogramKey = server_.fieldKey(state.field);  // info carries its histogram
+            histogramKey = server_.fieldKey(state.field, state.step);  // info carries its histogram
             server_.sessions.push_back(weak_from_this());
             info = server_.infoBase;
             info["state"] = toJson(state);
@@ -294,7 +299,7 @@ private:
         server_.say("view: " + peer + " connected");
         {
             std::lock_guard lk(server_.fieldsMutex);
-            const auto it = server_.fields.find(server_.fieldKey(state.field));
+            const auto it = server_.fields.find(server_.fieldKey(state.field, state.step));
             if (it != server_.fields.end()) {
                 info["histogram"] = it->second.histogram;
                 info["histogram"]["field"] = state.field;
@@ -434,7 +439,7 @@ private:
         {
             std::lock_guard lk(server_.m);
             ViewState next = state;
-            r = applySet(next, msg);
+            r = applySet(next, msg, server_.stepCount());
             if (r.fieldChanged) server_.fieldKey(next.field);  // names a field of the mesh?
             state = std::move(next);
             if (r.fieldChanged) resetRange = !r.rangeGiven;
@@ -673,11 +678,41 @@ private:
 
 }  // namespace
 
-FieldEntry ViewServer::Impl::field(const std::string& spec, const ProgressFn& progress) {
-    const std::string key = fieldKey(spec);
+FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
+                                   const ProgressFn& progress) {
+    const std::string key = fieldKey(spec, step);
     if (renderer && key == rendererKey) {
         std::lock_guard lk(fieldsMutex);
         return fields.at(key);
+    }
+    if (step != meshStep) {
+        // Another time step: its fields for the same points and cells, nothing geometric.
+        const auto start = Clock::now();
+        std::optional<std::vector<Field>> stepFields =
+            scene.series->readFieldsIfSameGeometry(step, *scene.mesh);
+        if (!stepFields)
+            throwError(ErrorKind::Unsupported, scene.series->stepSource(step),
+                       "time step " + std::to_string(step) +
+                           " has other points or cells than "
+                           "step " +
+                           std::to_string(meshStep) +
+                           ": the viewer shows the time steps of one geometry (uvr animate renders "
+                           "any)");
+        std::vector<FieldInfo> infos;
+        for (const Field& f : *stepFields) infos.push_back({f.name, f.association, f.components});
+        if (resolveField(infos, parseFieldSpec(spec)).index !=
+            resolveField(fieldInfos, parseFieldSpec(spec)).index)
+            throwError(ErrorKind::Unsupported, scene.series->stepSource(step),
+                       "time step " + std::to_string(step) +
+                           " lists its fields otherwise than "
+                           "step " +
+                           std::to_string(meshStep) + ": the viewer needs the same fields");
+        scene.mesh->fields = std::move(*stepFields);
+        meshStep = step;
+        char line[160];
+        std::snprintf(line, sizeof line, "view: read time step %zu (time %.9g) in %.3f s", step,
+                      scene.series->times()[step], secondsSince(start));
+        say(line);
     }
     const ScalarField values = selectScalarField(*scene.mesh, parseFieldSpec(spec));
     FieldEntry entry;
@@ -709,6 +744,7 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     if (s.tf.logScale && !(s.range.first > 0.f) && s.range.second > 0.f)
         s.range.first = std::fmin(s.range.second * 1e-4f, 1.f);
     std::vector<std::string> args = {"uvr", "render", scene.file};
+    if (stepCount() > 1) args.insert(args.end(), {"--step-index", std::to_string(s.step)});
     if (!s.field.empty()) args.insert(args.end(), {"--field", s.field});
     args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
                              fmtExact(s.range.first) + "," + fmtExact(s.range.second), "--method",
@@ -745,7 +781,7 @@ void ViewServer::Impl::prepareAtStart() {
     if (renderer) return;
     const auto start = Clock::now();
     try {
-        field(scene.initial.field, [this](const std::string& phase) {
+        field(scene.initial.field, scene.initial.step, [this](const std::string& phase) {
             say("view: " + phase);
             broadcast(Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
         });
@@ -834,8 +870,8 @@ void ViewServer::Impl::renderLoop() {
         };
         bool sent = false;
         try {
-            const std::string key = fieldKey(state.field);
-            const FieldEntry entry = field(state.field, [&](const std::string& phase) {
+            const std::string key = fieldKey(state.field, state.step);
+            const FieldEntry entry = field(state.field, state.step, [&](const std::string& phase) {
                 post([phase](Session& c) {
                     c.sendText(
                         Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
@@ -1043,9 +1079,14 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     // Unknown (null) until the server's own preparation is done (prepareAtStart).
     Json tets = nullptr, prepareSeconds = nullptr;
     std::string device = resolvesToCuda(d.scene.rendererOptions.device) ? "cuda" : "cpu";
+    d.meshStep = d.scene.initial.step;
+    if (d.meshStep >= d.stepCount())
+        throwError(
+            ErrorKind::Argument, d.scene.file,
+            "time step " + std::to_string(d.meshStep) + " of " + std::to_string(d.stepCount()));
     {
         const ScalarField values = selectScalarField(mesh, parseFieldSpec(d.scene.initial.field));
-        FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field)];
+        FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field, d.meshStep)];
         entry.range = finiteRange(values.values);
         entry.histogram = histogramOf(values.values, entry.range);
     }
@@ -1054,7 +1095,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
         prepareSeconds = d.scene.renderer->prepareSeconds();
         device = d.scene.renderer->deviceDescription();
         d.renderer = std::move(d.scene.renderer);
-        d.rendererKey = d.fieldKey(d.scene.initial.field);
+        d.rendererKey = d.fieldKey(d.scene.initial.field, d.meshStep);
     }
     d.infoBase = {{"type", "info"},
                   {"file", d.scene.file},
@@ -1070,6 +1111,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                   {"load_seconds", d.scene.loadSeconds},
                   {"prepare_seconds", prepareSeconds},
                   {"notes", d.scene.notes},
+                  {"times", d.scene.series ? d.scene.series->times() : std::vector<double>{0.0}},
                   {"limits",
                    {{"max_message_bytes", d.opt.maxMessageBytes},
                     {"max_messages_per_second", d.opt.maxMessagesPerSecond},

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "uvr/facade/renderer.h"
+#include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/server/view_state.h"
 
@@ -41,12 +42,16 @@ void checkServerOptions(const ServerOptions& options, bool tryAddress);
 /// What the server shows: the mesh as read (kept for field changes), how to prepare it, the
 /// render settings the command line fixed and the state every new tab starts from.
 struct ViewScene {
-    std::string file;                  ///< as named on the command line
-    std::shared_ptr<const Mesh> mesh;  ///< the mesh as read
-    Bounds3f bounds;                   ///< of the rendered cells, in file coordinates
-    RendererOptions rendererOptions;   ///< how fields are prepared
-    RenderSettings base;               ///< steps, sampling and rules beyond the state
-    ViewState initial;                 ///< every tab's starting state
+    std::string file;  ///< as named on the command line
+    /// The mesh as read (the server replaces its fields when a tab shows another time step).
+    std::shared_ptr<Mesh> mesh;
+    /// The time steps of `file` (a series opened on it) when it has more than one; `mesh` holds
+    /// step initial.step. Steps must share the mesh's points and cells.
+    std::shared_ptr<MeshSeries> series;
+    Bounds3f bounds;                  ///< of the rendered cells, in file coordinates
+    RendererOptions rendererOptions;  ///< how fields are prepared
+    RenderSettings base;              ///< steps, sampling and rules beyond the state
+    ViewState initial;                ///< every tab's starting state
     /// Prepared for initial.field (the command line's preparation, with its progress); null:
     /// prepared before the first frame.
     std::unique_ptr<Renderer> renderer;

@@ -15,6 +15,7 @@
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/server/web_assets.h"
 
 namespace uvr::server {
@@ -426,6 +427,87 @@ TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogramAndRebuildsNoGeometry) {
     }
     EXPECT_EQ(prepared, 1);  // the first frame's; the scene came without a renderer
     EXPECT_EQ(switched, 2);
+}
+
+TEST(ViewServer, TimeStepsOfASeriesAreShownWithoutRebuildingAndOtherGeometriesRefused) {
+    // Steps 0-2: the two-field mesh with f moved by the step; step 3: another grid.
+    const std::string dir = uvr::testing::scratchDir();
+    for (int k = 0; k < 3; ++k) {
+        Mesh m = *twoFieldMesh();
+        for (float& v : m.fields[0].values) v += float(k);
+        writeMesh(m, dir + "/s_" + std::to_string(k) + ".vtu");
+    }
+    Mesh other = testing::makeHexGrid(4, -1.f, 1.f);
+    other.fields.push_back({"g", Association::Cell, 1, std::vector<float>(64, 1.f)});
+    writeMesh(other, dir + "/s_3.vtu");
+    std::mutex mu;
+    std::vector<std::string> log;
+    ViewScene scene;
+    scene.file = dir + "/s_*.vtu";
+    scene.series = openMeshSeries(scene.file);
+    scene.mesh = std::make_shared<Mesh>(scene.series->readStep(0));
+    scene.bounds = scene.mesh->bounds();
+    scene.rendererOptions.device = Device::Cpu;
+    ViewState& st = scene.initial;
+    st.camera = resetCamera(scene.bounds, 64.f / 48.f);
+    st.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(st.tf, "0:0,1:0.6");
+    st.range = {-3.f, 5.f};
+    st.width = 64;
+    st.height = 48;
+    ServerOptions o;
+    o.port = 0;
+    ViewServer server(std::move(scene), o, [&](const std::string& line) {
+        std::lock_guard lk(mu);
+        log.push_back(line);
+    });
+    server.start();
+    Client c(server.port(), server.token());
+    const Json info = c.until("info");
+    ASSERT_FALSE(info.is_null());
+    EXPECT_EQ(info["times"], Json({0, 1, 2, 3}));
+    EXPECT_EQ(info["state"]["step"], 0);
+    ASSERT_FALSE(c.frame().is_null());
+    const std::string first = c.lastBinary();
+    // Step 2: its histogram, the tab's range kept, a new image.
+    c.send({{"type", "set"}, {"seq", 2}, {"step", 2}});
+    const Json h = c.until("histogram");
+    ASSERT_FALSE(h.is_null());
+    EXPECT_NEAR(h["range"][0].get<double>(), -3.0 + 2.0, 0.7);  // f moved by 2
+    const Json state = c.until("state");
+    EXPECT_EQ(state["state"]["step"], 2);
+    EXPECT_EQ(state["state"]["range"], Json({-3.0, 5.0}));
+    const Json f2 = c.frame();
+    ASSERT_FALSE(f2.is_null());
+    EXPECT_EQ(f2["seq"], 2);
+    EXPECT_NE(c.lastBinary(), first);
+    c.send({{"type", "export"}});
+    const Json ex = c.until("export");
+    ASSERT_FALSE(ex.is_null());
+    EXPECT_THAT(ex["command"].get<std::string>(), HasSubstr("--step-index 2 "));
+    // Out of range: refused by the state; another geometry: refused by the frame.
+    c.send({{"type", "set"}, {"seq", 3}, {"step", 4}});
+    Json e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("from 0 to 3"));
+    c.send({{"type", "set"}, {"seq", 4}, {"step", 3}});
+    e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("other points or cells"));
+    // Back to step 0: the first image again, and the server still serves.
+    c.send({{"type", "set"}, {"seq", 5}, {"step", 0}});
+    const Json f0 = c.frame();
+    ASSERT_FALSE(f0.is_null());
+    EXPECT_EQ(f0["seq"], 5);
+    EXPECT_EQ(c.lastBinary(), first);
+    std::lock_guard lk(mu);
+    int prepared = 0, steps = 0;
+    for (const std::string& line : log) {
+        prepared += line.find("prepared") != std::string::npos;
+        steps += line.find("read time step") != std::string::npos;
+    }
+    EXPECT_EQ(prepared, 1);
+    EXPECT_EQ(steps, 2);  // step 2, then step 0 again
 }
 
 TEST(ViewServer, TabsHaveTheirOwnStateAndResetCameraSnapsToAxes) {

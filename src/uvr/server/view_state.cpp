@@ -180,10 +180,11 @@ Json toJson(const ViewState& s) {
             {"quality", s.quality},
             {"heatmap", s.heatmap},
             {"size", {s.width, s.height}},
-            {"opacity_unit", s.opacityUnit}};
+            {"opacity_unit", s.opacityUnit},
+            {"step", s.step}};
 }
 
-SetResult applySet(ViewState& state, const Json& message) {
+SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount) {
     if (!message.is_object()) bad("set", "a JSON object", message);
     ViewState next = state;  // all or nothing
     SetResult result;
@@ -266,13 +267,22 @@ SetResult applySet(ViewState& state, const Json& message) {
                     v);
             next.width = static_cast<int>(w);
             next.height = static_cast<int>(h);
+        } else if (k == "step") {
+            const bool index = v.is_number_unsigned() ||
+                               (v.is_number_integer() && v.get<std::int64_t>() >= 0);
+            if (!index || v.get<std::uint64_t>() >= stepCount)
+                bad(k,
+                    stepCount == 1 ? "0: the file has no other time step"
+                                   : "a time step from 0 to " + std::to_string(stepCount - 1),
+                    v);
+            next.step = v.get<std::size_t>();
         } else if (k == "opacity_unit") {
             next.opacityUnit = finiteFloat(k, v);
             if (!(next.opacityUnit > 0.f)) bad(k, "a positive length", v);
         } else {
             bad("set",
                 "state keys (camera, tf, range, field, method, quality, heatmap, size, "
-                "opacity_unit, preset, colormap_json), not \"" +
+                "opacity_unit, step, preset, colormap_json), not \"" +
                     printableShort(k, 40) + "\"",
                 message);
         }

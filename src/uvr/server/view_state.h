@@ -30,6 +30,7 @@ struct ViewState {
     bool heatmap = false;  ///< show samples per pixel instead of the volume
     int width = 1024, height = 1024;
     float opacityUnit = 1.f;  ///< ParaView's ScalarOpacityUnitDistance, in file units
+    std::size_t step = 0;     ///< the time step shown (0 for a file without time steps)
 };
 
 /// "adaptive", "reference" or "exact" (the --method names).
@@ -48,12 +49,13 @@ struct SetResult {
 };
 
 /// Applies the state keys of a `set` message (camera, tf, range, field, method, quality,
-/// heatmap, size, opacity_unit, preset, colormap_json and colormap_name) to `state`, all or
+/// heatmap, size, opacity_unit, step (below stepCount), preset, colormap_json and
+/// colormap_name) to `state`, all or
 /// nothing: on any bad value it throws Error(Argument) (Error(Parse) for a malformed uploaded
 /// colour map) naming the key and what was expected, and leaves `state` unchanged. Unknown keys
 /// are refused too (a misspelt key must not pass silently); `type`, `seq` and `interactive`
 /// are the caller's.
-SetResult applySet(ViewState& state, const nlohmann::json& message);
+SetResult applySet(ViewState& state, const nlohmann::json& message, std::size_t stepCount = 1);
 
 /// The render settings of a frame of the state: `base` (what the command line set beyond the
 /// state: steps, sampling, rule) with the state's camera, transfer function, range, method,

@@ -158,5 +158,30 @@ TEST(ViewState, AFieldChangeIsReported) {
     EXPECT_EQ(s.field, "velocity:x");
 }
 
+TEST(ViewState, TheStepIsOneOfTheFilesTimeSteps) {
+    ViewState s = startState();
+    applySet(s, {{"step", 2}}, 3);
+    EXPECT_EQ(s.step, 2u);
+    EXPECT_EQ(toJson(s)["step"], 2);
+    for (const Json& bad : {Json(3), Json(-1), Json(1.5), Json("1")}) {
+        SCOPED_TRACE(bad.dump());
+        try {
+            applySet(s, {{"step", bad}, {"heatmap", true}}, 3);
+            ADD_FAILURE() << "accepted";
+        } catch (const Error& e) {
+            EXPECT_THAT(e.what(), ::testing::HasSubstr("\"step\": expected a time step from 0 to 2"));
+        }
+        EXPECT_EQ(s.step, 2u);
+        EXPECT_FALSE(s.heatmap);  // all or nothing
+    }
+    ViewState one = startState();
+    try {
+        applySet(one, {{"step", 1}});
+        ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+        EXPECT_THAT(e.what(), ::testing::HasSubstr("no other time step"));
+    }
+}
+
 }  // namespace
 }  // namespace uvr::server
