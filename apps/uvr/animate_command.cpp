@@ -198,13 +198,16 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         for (std::size_t k = 0; k < chosen.size(); ++k) {
             const std::size_t i = chosen[k];
             ctx.setActivity(series->stepSource(i), "reading time step " + std::to_string(i));
+            const std::optional<std::size_t> next =
+                k + 1 < chosen.size() ? std::optional(chosen[k + 1]) : std::nullopt;
             StepUpdate u;
             if (k > 0) {
-                u = player.show(i);
+                u = player.show(i, next);  // the next read overlaps this step's refresh
                 reads.push_back(u.readSeconds);
                 updates.push_back(u.updateSeconds);
+            } else if (next) {
+                player.prefetch(*next);
             }
-            if (k + 1 < chosen.size()) player.prefetch(chosen[k + 1]);
             ctx.setActivity(*folder, "rendering time step " + std::to_string(i));
             const RenderResult result = player.renderer().render(settings);
             frames.push_back(result.stats.seconds);

@@ -63,7 +63,7 @@ void SeriesPlayer::prefetch(std::size_t i) {
     pending_ = std::move(p);
 }
 
-StepUpdate SeriesPlayer::show(std::size_t i) {
+StepUpdate SeriesPlayer::show(std::size_t i, std::optional<std::size_t> next) {
     StepUpdate u;
     u.step = i;
     u.time = series_->times().at(std::min(i, series_->stepCount() - 1));
@@ -83,6 +83,8 @@ StepUpdate SeriesPlayer::show(std::size_t i) {
     // Step 2: new values for the same geometry, or the new geometry prepared.
     const auto updateStart = std::chrono::steady_clock::now();
     if (r.fields) {
+        // The geometry stays: the next read (it only reads the points and cells) can start now.
+        if (next) prefetch(*next);
         std::vector<Field> previous = std::exchange(mesh_.fields, std::move(*r.fields));
         try {
             ScalarField field = selectScalarField(mesh_, spec_);
@@ -102,6 +104,7 @@ StepUpdate SeriesPlayer::show(std::size_t i) {
     }
     u.updateSeconds = secondsSince(updateStart);
     step_ = i;
+    if (next) prefetch(*next);  // after a new geometry (nothing when already reading it)
     return u;
 }
 

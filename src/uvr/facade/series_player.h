@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 
 #include "uvr/facade/renderer.h"
 #include "uvr/mesh/field_select.h"
@@ -36,9 +37,11 @@ public:
     SeriesPlayer& operator=(const SeriesPlayer&) = delete;
 
     /// Makes the renderer show step i (a prefetched read of i is taken, one of another step is
-    /// waited for and dropped). On an error (a bad file, the field missing at that step) the
-    /// player still shows the step it showed before.
-    StepUpdate show(std::size_t i);
+    /// waited for and dropped). With `next`, the read of that step starts in the background as
+    /// soon as step i's data are in, so that it overlaps step i's value refresh and frames. On
+    /// an error (a bad file, the field missing at that step) the player still shows the step it
+    /// showed before.
+    StepUpdate show(std::size_t i, std::optional<std::size_t> next = std::nullopt);
     /// Starts reading step i in the background (fields only when its geometry is the current
     /// one); nothing when i is out of range or is the current step. Errors surface in show(i).
     void prefetch(std::size_t i);

@@ -80,16 +80,18 @@ TEST(SeriesPlayer, StepsOfOneGeometryRefreshValuesAndFramesEqualAFreshPreparatio
         change += std::abs(one.image.pixels[i].x - during.image.pixels[i].x);
     EXPECT_GT(change, 1.0);  // the new values show
 
-    // Step 2 without a prefetch, while a prefetch of another step is dropped.
-    player.prefetch(3);
-    u = player.show(2);
+    // Step 2 without a prefetch, while a prefetch of another step is dropped; step 3's read
+    // starts before step 2's values are refreshed.
+    player.prefetch(4);
+    u = player.show(2, 3);
     EXPECT_FALSE(u.prefetched);
     EXPECT_FALSE(u.rebuilt);
     expectSameImage(player.renderer().render(s), freshFrame(stepMesh(2.f), s, o), "step 2");
 
-    // Step 3's geometry differs: prepared anew.
+    // Step 3's geometry differs: prepared anew (its read was started by show(2, 3)).
     u = player.show(3);
     EXPECT_TRUE(u.rebuilt);
+    EXPECT_TRUE(u.prefetched);
     EXPECT_EQ(player.mesh().cellCount(), 125u);
     expectSameImage(player.renderer().render(s), freshFrame(stepMesh(3.f, 5), s, o), "step 3");
 
