@@ -536,7 +536,7 @@ TEST_F(VtuErrors, PvtuPieceMissingAFieldIsNamed) {
     const std::string path = write("three.pvtu", text);
     expectError([&] { readPvtu(path); }, ErrorKind::Parse,
                 {path + ": line " + std::to_string(lineOf(text, text.find("three_1.vtu"))),
-                 "Piece 1 ('three_1.vtu') has no point DataArray 'i16', which piece 0 has"});
+                 "Piece 1 ('three_1.vtu') has no point field 'i16', which the first piece has"});
 }
 
 TEST_F(VtuErrors, PvtuNamingItselfOrAMissingPieceIsRefused) {
