@@ -720,7 +720,8 @@ TEST(VtkLegacyNumbers, SignedCountsAndExponentsReadAsVtkReadsThem) {
     for (const Case& c : std::vector<Case>{
              {"POINTS +5 float", "POINTS 0x5 float", "expected a point count in"},
              {"+1.5E+00", "1.5d0", "expected a number (value 3 of 5"},
-             {"+10 +10", "+10 1e1x", "expected an integer (value 2 of 2 in cell types), got '1e1x'"},
+             {"+10 +10", "+10 1e1x",
+              "expected an integer (value 2 of 2 in cell types), got '1e1x'"},
          }) {
         SCOPED_TRACE(c.to);
         std::string edited = text;

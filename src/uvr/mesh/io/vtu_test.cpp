@@ -729,7 +729,8 @@ TEST(VtuNumbers, GarbageCountsAndValuesKeepTheirMessages) {
              {"+4 +8", "+4 +8.5", "DataArray 'offsets': expected an integer (Int64), got '+8.5'"},
          }) {
         SCOPED_TRACE(c.to);
-        const std::string path = testing::writeFile(dir + "/bad.vtu", replaceOnce(text, c.from, c.to));
+        const std::string path =
+            testing::writeFile(dir + "/bad.vtu", replaceOnce(text, c.from, c.to));
         expectError([&] { readVtu(path); }, ErrorKind::Parse, {path + ": line ", c.message});
     }
 }
@@ -764,7 +765,8 @@ TEST(VtuCompressors, CorruptLz4AndLzmaBlocksAreNamed) {
         const std::string good = dir + "/good.vtu";
         writeVtu(m, good, {}, options);
         EXPECT_EQ(readVtu(good).points, m.points);
-        const std::string bad = testing::writeFile(dir + "/bad.vtu", corruptThirdPointsBlock(readText(good)));
+        const std::string bad =
+            testing::writeFile(dir + "/bad.vtu", corruptThirdPointsBlock(readText(good)));
         expectError([&] { readVtu(bad); }, ErrorKind::Parse,
                     {bad + ": byte ", "Piece 0: DataArray 'Points': ",
                      std::string(name) + " block 2 of DataArray 'Points' is corrupt ("});
