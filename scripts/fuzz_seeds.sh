@@ -3,7 +3,7 @@
 # Builds the fuzzing seed corpora in OUTDIR/<target>/ from the real meshes in ../shared/data (the
 # small ones), meshes written by uvr itself (generate/convert), VTK's own writers (every VTU
 # encoding, legacy 4.2/5.1 ASCII/BINARY, when python3-vtk9 is installed) and the hand-made seeds
-# in fuzz/seeds/, and the hostile inputs of tests/tools/write_hostile_seeds.py (deep nesting, zlib
+# in fuzz/seeds/ and tests/data/vtk/, and the hostile inputs of tests/tools/write_hostile_seeds.py (deep nesting, zlib
 # header bombs, reused blocks and pieces, many fields, extreme values for the render target). Real data is copied into OUTDIR (a build folder), never into the repository.
 # Usage: scripts/fuzz_seeds.sh OUTDIR UVR_BINARY [SHARED_DATA_DIR]
 set -eu
@@ -15,6 +15,9 @@ data=${3:-$root/../shared/data}
 export ASAN_OPTIONS=detect_leaks=0
 for t in vtk_legacy vtu pvtu native colormap_json pvcc specs render view_message; do mkdir -p "$out/$t"; done
 for t in colormap_json pvcc specs pvtu render view_message; do cp "$root/fuzz/seeds/$t/"* "$out/$t/"; done
+# Hand-made files with signed counts, exponent forms and nan (tests/data/vtk/).
+cp "$root/tests/data/vtk/"*.vtu "$out/vtu/"
+cp "$root/tests/data/vtk/"*.vtk "$out/vtk_legacy/"
 
 # Real meshes (the large Blunt Fin and Oxygen Post files are left out: too slow per execution).
 if [ -d "$data" ]; then
@@ -27,6 +30,11 @@ if [ -d "$data" ]; then
     "$uvr" -q convert "$data/$f" "$out/native/real_${f%.vtk}.uvrm"
     "$uvr" -q convert "$data/$f" "$out/vtu/uvr_${f%.vtk}.vtu"
   done
+  # uvr's LZ4 and LZMA blocks and its legacy writer (4.2 binary).
+  for c in lz4 lzma; do
+    "$uvr" -q convert "$data/tetraMesh.vtk" "$out/vtu/uvr_tetraMesh_$c.vtu" --compress $c
+  done
+  [ -f "$data/fire_ug.vtu" ] && "$uvr" -q convert "$data/fire_ug.vtu" "$out/vtk_legacy/uvr_fire_ug.vtk"
 else
   echo "fuzz_seeds.sh: $data not found: no real meshes in the seeds" >&2
 fi

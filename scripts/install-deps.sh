@@ -9,11 +9,12 @@
 # (tests/web/view_page_test.py); python3-dev and pybind11-dev build the Python module (python/),
 # python3-pytest runs its tests (with meshio and python3-vtk9 for the conversions),
 # python3-matplotlib draws the benchmark figures (bench/plot_bench.py) and reads PNGs in the
-# Python tests.
+# Python tests; liblz4-dev and liblzma-dev read and write LZ4/LZMA-compressed .vtu (optional).
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
   zlib1g-dev libpng-dev libexpat1-dev libcli11-dev nlohmann-json3-dev
+  liblz4-dev liblzma-dev
   libfreetype-dev libfontconfig-dev fonts-dejavu-core
   libboost-dev libturbojpeg0-dev
   libgtest-dev libbenchmark-dev

@@ -123,10 +123,11 @@ void printTimeSteps(const nlohmann::json& steps) {
 }
 
 /// Writes a mesh with a progress line; "wrote OUT" at the end.
-void writeMeshWithProgress(const Mesh& mesh, const std::string& out, const Context& ctx) {
+void writeMeshWithProgress(const Mesh& mesh, const std::string& out, const Context& ctx,
+                           const MeshWriteOptions& options = {}) {
     ctx.setActivity(out, "writing the mesh");
     Progress progress(ctx, "writing " + out);
-    writeMesh(mesh, out, progress.callback());
+    writeMesh(mesh, out, progress.callback(), options);
     progress.done("wrote " + out);
 }
 
@@ -313,17 +314,29 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
 
 void addConvertCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
-        "convert", "Convert a mesh between formats (any readable format to .uvrm or .vtu)");
+        "convert",
+        "Convert a mesh between formats (any readable format to .uvrm, .vtu or legacy .vtk)");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
+    auto compress = std::make_shared<std::string>();
     cmd->add_option("IN", *in, "Input mesh")->required();
-    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
-    cmd->callback([in, out, &ctx] {
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu or .vtk legacy binary)")
+        ->required();
+    cmd->add_option("--compress", *compress,
+                    "Compression of a .vtu output: none, zlib (the default), lz4 (faster, larger) "
+                    "or lzma (smaller, slower)")
+        ->check(CLI::IsMember({"none", "zlib", "lz4", "lzma"}));
+    cmd->callback([in, out, compress, &ctx] {
         checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
         resolveOutput(*out);
-        checkMeshWritable(*out);  // before reading (minutes at 100M cells)
+        MeshWriteOptions options;
+        if (*compress == "none") options.compressor = VtuCompressor::None;
+        if (*compress == "zlib") options.compressor = VtuCompressor::Zlib;
+        if (*compress == "lz4") options.compressor = VtuCompressor::Lz4;
+        if (*compress == "lzma") options.compressor = VtuCompressor::Lzma;
+        checkMeshWritable(*out, options);  // before reading (minutes at 100M cells)
         const Mesh mesh = loadMesh(*in, ctx);
-        writeMeshWithProgress(mesh, *out, ctx);
+        writeMeshWithProgress(mesh, *out, ctx, options);
     });
 }
 
@@ -335,7 +348,7 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     auto fields = std::make_shared<std::vector<std::string>>();
     cmd->add_option("SHAPE", *shape, "box, shell (hollow, non-convex) or graded (100x cell sizes)")
         ->capture_default_str();
-    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm or .vtu)")->required();
+    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu or .vtk)")->required();
     cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
@@ -422,7 +435,7 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
     auto levels = std::make_shared<int>(1);
     auto threads = std::make_shared<int>(0);
     cmd->add_option("IN", *in, "Input mesh")->required();
-    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu or .vtk legacy)")->required();
     cmd->add_option("--levels", *levels, "Refinement levels (x8 tetrahedra each)")
         ->capture_default_str()
         ->check(CLI::Range(0, kMaxRefineLevels));

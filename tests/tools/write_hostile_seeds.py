@@ -5,6 +5,7 @@ sets -max_len per target). The render target's seeds are small and kept in fuzz/
 (written by `write_hostile_seeds.py fuzz/seeds render`), so that the test suite replays them.
 Usage: write_hostile_seeds.py OUTDIR [TARGET...]   (default: every target but render)
 """
+import lzma
 import os
 import struct
 import sys
@@ -74,6 +75,20 @@ def vtu_seeds(out):
     write(out, "many_fields.vtu",
           '<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1">\n'
           "<UnstructuredGrid>\n" + piece + piece + "</UnstructuredGrid>\n</VTKFile>\n")
+    # LZ4 and LZMA blocks: a valid LZ4 block of 4 points written as literals only (token 0xf0,
+    # literal length 15 + 33), one whose header declares 4 GiB from 1-byte blocks, and an LZMA
+    # (xz) block of 100 points of zeros.
+    lz4 = b"\xf0\x21" + bytes(48)
+    write(out, "lz4_literals.vtu",
+          appended_zlib_vtu(points_piece(4), le32(1) + le32(48) + le32(48) + le32(len(lz4)) + lz4)
+          .replace(b"vtkZLibDataCompressor", b"vtkLZ4DataCompressor"))
+    write(out, "lz4_header_bomb.vtu",
+          appended_zlib_vtu(points_piece(blocks * block // 12), data)
+          .replace(b"vtkZLibDataCompressor", b"vtkLZ4DataCompressor"))
+    xz = lzma.compress(bytes(1200), format=lzma.FORMAT_XZ, check=lzma.CHECK_CRC64)
+    write(out, "lzma_zeros.vtu",
+          appended_zlib_vtu(points_piece(100), le32(1) + le32(1200) + le32(1200) + le32(len(xz)) + xz)
+          .replace(b"vtkZLibDataCompressor", b"vtkLZMADataCompressor"))
 
 
 def pvtu_seeds(out):

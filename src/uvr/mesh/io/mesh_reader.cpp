@@ -8,6 +8,7 @@
 #include "uvr/core/file_util.h"
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/time_series.h"
+#include "uvr/mesh/io/vtk_compression.h"
 #include "uvr/mesh/io/vtk_legacy.h"
 #include "uvr/mesh/io/vtu.h"
 
@@ -65,18 +66,27 @@ std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTyp
     return std::nullopt;
 }
 
-void checkMeshWritable(const std::string& path) {
+void checkMeshWritable(const std::string& path, const MeshWriteOptions& options) {
     const std::string ext = fileExtension(path);
-    if (ext != ".uvrm" && ext != ".vtu")
+    if (ext != ".uvrm" && ext != ".vtu" && ext != ".vtk")
         throwError(ErrorKind::Argument, path,
-                   "cannot write this format: the output name must end in .uvrm (native) or .vtu");
+                   "cannot write this format: the output name must end in .uvrm (native), .vtu "
+                   "or .vtk (legacy)");
+    if (options.compressor && ext != ".vtu")
+        throwError(ErrorKind::Argument, path,
+                   "a compressor applies to .vtu output only, not to " + ext);
+    if (options.compressor) requireVtuCompressor(*options.compressor, path);
 }
 
 void writeMesh(const Mesh& mesh, const std::string& path,
-               const std::function<void(double)>& progress) {
-    checkMeshWritable(path);
-    if (fileExtension(path) == ".uvrm") return writeNative(mesh, path, progress);
-    writeVtu(mesh, path, progress);
+               const std::function<void(double)>& progress, const MeshWriteOptions& options) {
+    checkMeshWritable(path, options);
+    const std::string ext = fileExtension(path);
+    if (ext == ".uvrm") return writeNative(mesh, path, progress);
+    if (ext == ".vtk") return writeVtkLegacy(mesh, path, progress);
+    VtuWriteOptions vtu;
+    if (options.compressor) vtu.compressor = *options.compressor;
+    writeVtu(mesh, path, progress, vtu);
 }
 
 }  // namespace uvr

@@ -6,6 +6,7 @@
 
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
+#include "uvr/mesh/io/vtu.h"
 #include "uvr/mesh/mesh.h"
 
 namespace uvr {
@@ -19,13 +20,19 @@ Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 /// formats that must be read whole to know them.
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes = true);
 
-/// Writes a mesh in the format its extension names (.uvrm native or .vtu), reporting the
-/// fraction of bytes written to progress (when given) as it goes; throws
+/// How writeMesh writes: the .vtu compressor (unset: zlib; only .vtu outputs take one).
+struct MeshWriteOptions {
+    std::optional<VtuCompressor> compressor;
+};
+
+/// Writes a mesh in the format its extension names (.uvrm native, .vtu, .vtk legacy binary),
+/// reporting the fraction of bytes written to progress (when given) as it goes; throws
 /// Error(Argument) for other extensions. The file is written atomically.
 void writeMesh(const Mesh& mesh, const std::string& path,
-               const std::function<void(double)>& progress = {});
-/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm or .vtu):
-/// commands call it before any heavy work.
-void checkMeshWritable(const std::string& path);
+               const std::function<void(double)>& progress = {},
+               const MeshWriteOptions& options = {});
+/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm, .vtu or
+/// .vtk) with these options: commands call it before any heavy work.
+void checkMeshWritable(const std::string& path, const MeshWriteOptions& options = {});
 
 }  // namespace uvr

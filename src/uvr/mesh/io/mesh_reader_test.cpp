@@ -37,5 +37,38 @@ TEST(MeshReader, UnknownFormatsAndOutputsAreClearErrors) {
     EXPECT_THROW(writeMesh(Mesh{}, dir + "/out.obj"), Error);
 }
 
+TEST(MeshReader, WritesVtuAndLegacyVtkByExtensionWithTheirOptions) {
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const Mesh spx = readMesh(testing::sharedData("spx.vtk"));
+    for (const char* name : {"/spx.vtk", "/spx.vtu"}) {
+        writeMesh(spx, dir + name);
+        const Mesh back = readMesh(dir + name);
+        EXPECT_EQ(back.cellIndices, spx.cellIndices) << name;
+        ASSERT_EQ(back.fields.size(), spx.fields.size()) << name;
+        EXPECT_EQ(back.fields[0].values, spx.fields[0].values) << name;
+    }
+    MeshWriteOptions lz4;
+    lz4.compressor = VtuCompressor::Lz4;
+    try {
+        checkMeshWritable(dir + "/spx.vtk", lz4);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Argument);
+        EXPECT_NE(
+            std::string(e.what()).find("a compressor applies to .vtu output only, not to .vtk"),
+            std::string::npos)
+            << e.what();
+    }
+    try {
+        checkMeshWritable(dir + "/spx.obj");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("must end in .uvrm (native), .vtu or .vtk (legacy)"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace uvr

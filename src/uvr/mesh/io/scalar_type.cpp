@@ -5,19 +5,20 @@ namespace uvr {
 
 std::optional<ScalarType> parseLegacyTypeName(const std::string& name) {
     if (name == "bit") return std::nullopt;  // packed bits: not a numeric array uvr reads
-    if (name == "char") return ScalarType::Int8;
+    // The vtktype* names: VTK 9.1 knows only the 64-bit ones, meshio writes all of them.
+    if (name == "char" || name == "vtktypeint8") return ScalarType::Int8;
     if (name == "signed_char") return ScalarType::Int8;
-    if (name == "unsigned_char") return ScalarType::UInt8;
-    if (name == "short") return ScalarType::Int16;
-    if (name == "unsigned_short") return ScalarType::UInt16;
-    if (name == "int") return ScalarType::Int32;
-    if (name == "unsigned_int") return ScalarType::UInt32;
+    if (name == "unsigned_char" || name == "vtktypeuint8") return ScalarType::UInt8;
+    if (name == "short" || name == "vtktypeint16") return ScalarType::Int16;
+    if (name == "unsigned_short" || name == "vtktypeuint16") return ScalarType::UInt16;
+    if (name == "int" || name == "vtktypeint32") return ScalarType::Int32;
+    if (name == "unsigned_int" || name == "vtktypeuint32") return ScalarType::UInt32;
     if (name == "long" || name == "vtktypeint64" || name == "vtkIdType" || name == "long_long")
         return ScalarType::Int64;
     if (name == "unsigned_long" || name == "vtktypeuint64" || name == "unsigned_long_long")
         return ScalarType::UInt64;
-    if (name == "float") return ScalarType::Float32;
-    if (name == "double") return ScalarType::Float64;
+    if (name == "float" || name == "vtktypefloat32") return ScalarType::Float32;
+    if (name == "double" || name == "vtktypefloat64") return ScalarType::Float64;
     return std::nullopt;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "uvr/core/file_util.h"
 #include "uvr/mesh/io/scalar_type.h"
 #include "uvr/mesh/io/vtk_cells.h"
+#include "uvr/mesh/io/vtk_number.h"
 
 namespace uvr {
 
@@ -284,11 +286,11 @@ void LegacyParser::requireTokens(const KeywordLine& kw, std::size_t n, const cha
 std::uint64_t LegacyParser::parseCount(const KeywordLine& kw, std::size_t i,
                                        const char* what) const {
     const std::string_view t = kw.tokens[i];
-    std::int64_t v = 0;
-    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (r.ec != std::errc() || r.ptr != t.data() + t.size())
+    const std::optional<std::int64_t> parsed = parseVtkInteger(t);
+    if (!parsed)
         fail(where(kw),
              std::string("expected ") + what + " in " + quote(kw.text()) + ", got " + quote(t));
+    const std::int64_t v = *parsed;
     if (v < 0)
         fail(where(kw),
              std::string("negative ") + what + " " + std::to_string(v) + " in " + quote(kw.text()));
@@ -378,34 +380,25 @@ std::string_view LegacyParser::Values::token() {
 double LegacyParser::Values::nextDouble() {
     if (bin_) return loadAsDouble(bin_, type_, index_++, p_.swap_);
     const std::string_view t = token();
-    const char* b = t.data();
-    const char* e = b + t.size();
-    if (b != e && *b == '+' && b + 1 != e && b[1] != '-') ++b;  // from_chars rejects '+'
-    double v = 0.0;
-    const auto r = std::from_chars(b, e, v);
-    if (r.ec == std::errc::invalid_argument || r.ptr != e)
+    const std::optional<double> v = parseVtkReal(t);
+    if (!v)
         p_.fail(atLine(lastLine_), "expected a number (value " + std::to_string(index_ + 1) +
                                        " of " + std::to_string(total_) + " in " + desc_.unit +
                                        "), got " + quote(t));
-    if (r.ec == std::errc::result_out_of_range) v = std::strtod(std::string(t).c_str(), nullptr);
     ++index_;
-    return v;
+    return *v;
 }
 
 std::int64_t LegacyParser::Values::nextInt() {
     if (bin_) return loadAsInt64(bin_, type_, index_++, p_.swap_);
     const std::string_view t = token();
-    const char* b = t.data();
-    const char* e = b + t.size();
-    if (b != e && *b == '+' && b + 1 != e && b[1] != '-') ++b;
-    std::int64_t v = 0;
-    const auto r = std::from_chars(b, e, v);
-    if (r.ec != std::errc() || r.ptr != e)
+    const std::optional<std::int64_t> v = parseVtkInteger(t);
+    if (!v)
         p_.fail(atLine(lastLine_), "expected an integer (value " + std::to_string(index_ + 1) +
                                        " of " + std::to_string(total_) + " in " + desc_.unit +
                                        "), got " + quote(t));
     ++index_;
-    return v;
+    return *v;
 }
 
 std::string LegacyParser::Values::where() const {

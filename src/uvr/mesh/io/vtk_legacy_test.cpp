@@ -694,3 +694,57 @@ TEST(VtkLegacyLimits, TheLimitBoundsAllArraysTogether) {
 
 }  // namespace
 }  // namespace uvr
+
+namespace uvr {
+namespace {
+
+TEST(VtkLegacyNumbers, SignedCountsAndExponentsReadAsVtkReadsThem) {
+    // The same values VTK 9.1's vtkUnstructuredGridReader gets from the file.
+    const std::string path = testing::testData("vtk/signed_numbers.vtk");
+    const Mesh m = readVtkLegacy(path);
+    ASSERT_EQ(m.pointCount(), 5u);
+    EXPECT_EQ(m.points[1], Vec3f(1, 0, 0));
+    EXPECT_EQ(m.points[2], Vec3f(0, 1, 0));
+    EXPECT_EQ(m.points[4], Vec3f(1, 1, 1));
+    EXPECT_EQ(m.cellIndices, (std::vector<std::uint32_t>{0, 1, 2, 3, 1, 2, 3, 4}));
+    ASSERT_EQ(m.fields.size(), 2u);
+    EXPECT_EQ(m.fields[0].values, (std::vector<float>{1, 1, 1.5f, 0.25f, -300}));
+    EXPECT_EQ(m.fields[1].values, (std::vector<float>{1e-3f, -20.f, 0.5f, 5.f, 0.f, -0.f}));
+    // Garbage keeps its message: hexadecimal, Fortran exponents, trailing letters.
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string dir = testing::scratchDir();
+    struct Case {
+        std::string from, to, message;
+    };
+    for (const Case& c : std::vector<Case>{
+             {"POINTS +5 float", "POINTS 0x5 float", "expected a point count in"},
+             {"+1.5E+00", "1.5d0", "expected a number (value 3 of 5"},
+             {"+10 +10", "+10 1e1x",
+              "expected an integer (value 2 of 2 in cell types), got '1e1x'"},
+         }) {
+        SCOPED_TRACE(c.to);
+        std::string edited = text;
+        edited.replace(edited.find(c.from), c.from.size(), c.to);
+        const std::string bad = testing::writeFile(dir + "/bad.vtk", edited);
+        expectReadError(bad, ErrorKind::Parse, {c.message});
+    }
+}
+
+TEST(VtkLegacyNumbers, MeshioTypeNamesAndNanAreRead) {
+    // meshio writes 'vtktypeint32' (VTK 9.1 knows only the 64-bit vtktype names) and ASCII nan.
+    const std::string path = testing::writeFile(
+        testing::scratchDir() + "/meshio.vtk",
+        "# vtk DataFile Version 5.1\nmeshio\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+        "POINTS 4 double\n0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 2 4\nOFFSETS vtktypeint64\n0 4\n"
+        "CONNECTIVITY vtktypeint64\n0 1 2 3\nCELL_TYPES 1\n10\nPOINT_DATA 4\n"
+        "FIELD FieldData 2\nid 1 4 vtktypeint32\n0 1 2 3\nt 1 4 vtktypefloat64\n1 nan -inf 2\n");
+    const Mesh m = readVtkLegacy(path);
+    ASSERT_EQ(m.fields.size(), 2u);
+    EXPECT_EQ(m.fields[0].values, (std::vector<float>{0, 1, 2, 3}));
+    EXPECT_TRUE(std::isnan(m.fields[1].values[1]));
+    EXPECT_EQ(m.fields[1].values[2], -std::numeric_limits<float>::infinity());
+}
+
+}  // namespace
+}  // namespace uvr

@@ -2,11 +2,9 @@
 #include "uvr/mesh/io/vtu.h"
 
 #include <expat.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -24,13 +22,13 @@
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/scalar_type.h"
 #include "uvr/mesh/io/vtk_cells.h"
+#include "uvr/mesh/io/vtk_compression.h"
+#include "uvr/mesh/io/vtk_number.h"
 
 namespace uvr {
 
 namespace {
 
-// Deflate cannot expand data by more than 1032:1 (258-byte matches coded in ~2 bits).
-constexpr std::uint64_t kMaxZlibRatio = 1032;
 constexpr std::uint64_t kMaxComponents = 1u << 20;
 
 enum class Section { None, Points, Cells, PointData, CellData };
@@ -66,7 +64,7 @@ struct XmlDoc {
     std::string type;
     bool bigEndian = false;
     std::size_t headerSize = 4;
-    bool compressed = false;
+    VtuCompressor compressor = VtuCompressor::None;
     std::vector<PieceDesc> pieces;
     bool hasAppended = false;
     bool appendedBase64 = false;
@@ -112,13 +110,11 @@ std::uint64_t parseCount(ParseState& st, const XML_Char** attrs, const char* att
         if (!required) return fallback;
         failAtLine(st, element + ": missing attribute " + attr);
     }
-    const std::string s = trimmed(value);
-    std::uint64_t v = 0;
-    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || ptr != s.data() + s.size() || s.empty())
-        failAtLine(
-            st, element + ": expected " + attr + " to be a non-negative integer, got '" + s + "'");
-    return v;
+    const std::optional<std::uint64_t> v = parseVtkCount(value);
+    if (!v)
+        failAtLine(st, element + ": expected " + attr + " to be a non-negative integer, got '" +
+                           trimmed(value).substr(0, 40) + "'");
+    return *v;
 }
 
 void onRootElement(ParseState& st, const XML_Char** attrs) {
@@ -142,11 +138,16 @@ void onRootElement(ParseState& st, const XML_Char** attrs) {
     doc.headerSize = headerType == "UInt64" ? 8 : 4;
     const char* compressor = findAttr(attrs, "compressor");
     const std::string comp = compressor ? compressor : "";
-    if (!comp.empty() && comp != "vtkZLibDataCompressor")
+    if (comp.empty()) return;
+    const std::optional<VtuCompressor> known = parseVtuCompressorClass(comp);
+    const std::string where = atLine(XML_GetCurrentLineNumber(st.parser));
+    if (!known)
         throwError(ErrorKind::Unsupported, doc.file,
-                   atLine(XML_GetCurrentLineNumber(st.parser)) + ": compressor '" + comp +
-                       "' is not supported: expected vtkZLibDataCompressor or none");
-    doc.compressed = !comp.empty();
+                   where + ": compressor '" + comp +
+                       "' is not supported: expected vtkZLibDataCompressor, vtkLZ4DataCompressor, "
+                       "vtkLZMADataCompressor or none");
+    requireVtuCompressor(*known, doc.file + ": " + where);
+    doc.compressor = *known;
 }
 
 void onDataArray(ParseState& st, const XML_Char** attrs) {
@@ -394,7 +395,7 @@ std::string sizeMismatch(const ArrayDesc& a, std::uint64_t values, std::uint64_t
 }
 
 /// Reads an array's binary payload: [nbytes] + data, or, compressed, [nblocks, blockSize,
-/// lastBlockSize, compressed sizes...] + zlib blocks (VTK's vtkZLibDataCompressor layout).
+/// lastBlockSize, compressed sizes...] + blocks (VTK's layout for zlib, LZ4 and LZMA alike).
 std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, ByteSource& src,
                                        std::optional<std::uint64_t> expected,
                                        const ReadOptions& options) {
@@ -424,23 +425,31 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
         checkAllocation(doc.file, a.label, totalBytes / es, es, options.maxMemoryBytes);
     };
 
-    // All payloads of a file together must fit what it can hold at deflate's maximum ratio, so
-    // data reused by many arrays (or many Pieces) cannot expand without bound; then the load's
-    // memory budget.
+    // All payloads of a file together must fit what it can hold at the compressor's maximum
+    // ratio, so data reused by many arrays (or many Pieces) cannot expand without bound; then
+    // the load's memory budget.
+    const std::uint64_t maxRatio = maxCompressionRatio(doc.compressor);
+    const std::string ratioName = std::string(doc.compressor == VtuCompressor::Lz4    ? "LZ4"
+                                              : doc.compressor == VtuCompressor::Lzma ? "LZMA"
+                                                                                      : "deflate") +
+                                  "'s maximum ratio of " + std::to_string(maxRatio) + ":1";
+    const std::string blockName = doc.compressor == VtuCompressor::Lz4    ? "LZ4 block "
+                                  : doc.compressor == VtuCompressor::Lzma ? "LZMA block "
+                                                                          : "zlib block ";
     auto chargeDecoded = [&](std::uint64_t bytes) {
-        const std::uint64_t possible = doc.fileBytes * kMaxZlibRatio;
+        const std::uint64_t possible = doc.fileBytes * maxRatio;
         if (doc.decodedBytes > possible || bytes > possible - doc.decodedBytes)
             fail(std::to_string(bytes) + " bytes more make " +
                  std::to_string(doc.decodedBytes + bytes) +
                  " bytes decoded from the file's arrays, more than its " +
-                 std::to_string(doc.fileBytes) + " bytes can hold at deflate's maximum ratio of " +
-                 std::to_string(kMaxZlibRatio) + ":1 (data reused by many arrays?)");
+                 std::to_string(doc.fileBytes) + " bytes can hold at " + ratioName +
+                 " (data reused by many arrays?)");
         doc.decodedBytes += bytes;
         options.budget->charge(doc.file, a.label, bytes, 1);
     };
 
     std::vector<unsigned char> out;
-    if (!doc.compressed) {
+    if (doc.compressor == VtuCompressor::None) {
         const std::uint64_t nbytes = header(1, "size header")[0];
         checkTotal(nbytes);
         if (nbytes > src.remaining())
@@ -470,15 +479,15 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
     if (compressedTotal > src.remaining())
         fail("compressed blocks of " + std::to_string(compressedTotal) + " bytes run past the " +
              "end of the data (" + std::to_string(src.remaining()) + " bytes remain)");
-    // Checked block by block before allocating: a block of s bytes inflates to at most 1032 * s.
+    // Checked block by block before allocating: a block of s bytes expands to at most
+    // maxRatio * s.
     for (std::uint64_t b = 0; b < blocks; ++b) {
         const std::uint64_t expect = (b + 1 == blocks && lastSize != 0) ? lastSize : blockSize;
-        if (expect > sizes[b] * kMaxZlibRatio)  // sizes[b] <= remaining(): no overflow
-            fail("zlib block " + std::to_string(b) + " of " + std::to_string(blocks) + ": " +
+        if (expect > sizes[b] * maxRatio)  // sizes[b] <= remaining(): no overflow
+            fail(blockName + std::to_string(b) + " of " + std::to_string(blocks) + ": " +
                  std::to_string(sizes[b]) + " compressed bytes cannot inflate to the " +
                  std::to_string(expect) + " bytes the header declares (at most " +
-                 std::to_string(sizes[b] * kMaxZlibRatio) + " at deflate's maximum ratio of " +
-                 std::to_string(kMaxZlibRatio) + ":1)");
+                 std::to_string(sizes[b] * maxRatio) + " at " + ratioName + ")");
     }
     chargeDecoded(total);
     out.resize(static_cast<std::size_t>(total));
@@ -487,15 +496,12 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
         const std::uint64_t expect = (b + 1 == blocks && lastSize != 0) ? lastSize : blockSize;
         block.clear();
         src.read(static_cast<std::size_t>(sizes[b]), block);
-        uLongf produced = static_cast<uLongf>(expect);
-        const int rc = uncompress(out.data() + b * blockSize, &produced, block.data(),
-                                  static_cast<uLong>(sizes[b]));
-        if (rc != Z_OK || produced != expect)
-            fail("zlib block " + std::to_string(b) + " of DataArray '" + a.name + "' is corrupt (" +
-                 (rc != Z_OK ? std::string(zError(rc))
-                             : "inflated to " + std::to_string(produced) + " bytes, expected " +
-                                   std::to_string(expect)) +
-                 ")");
+        const std::string problem =
+            decompressBlock(doc.compressor, block.data(), block.size(), out.data() + b * blockSize,
+                            static_cast<std::size_t>(expect), doc.file);
+        if (!problem.empty())
+            fail(blockName + std::to_string(b) + " of DataArray '" + a.name + "' is corrupt (" +
+                 problem + ")");
     }
     return out;
 }
@@ -528,32 +534,24 @@ std::vector<T> parseAscii(const XmlDoc& doc, const ArrayDesc& a,
         if (i >= s.size()) break;
         std::size_t j = i;
         while (j < s.size() && !isSpace(s[j])) ++j;
-        const char* first = s.data() + i;
-        const char* last = s.data() + j;
-        if (*first == '+' && last - first > 1) ++first;
+        const std::string_view token(s.data() + i, j - i);
         bool ok = false;
         T value{};
         if (integer) {
-            std::int64_t v = 0;
-            auto r = std::from_chars(first, last, v);
-            if (r.ec == std::errc() && r.ptr == last) {
+            if (const std::optional<std::int64_t> v = parseVtkInteger(token)) {
                 ok = true;
-                value = static_cast<T>(v);
-            } else {
-                std::uint64_t u = 0;
-                auto ru = std::from_chars(first, last, u);
-                ok = ru.ec == std::errc() && ru.ptr == last;
-                value = static_cast<T>(u);
+                value = static_cast<T>(*v);
+            } else if (const std::optional<std::uint64_t> u = parseVtkCount(token)) {
+                ok = true;
+                value = static_cast<T>(*u);
             }
-        } else {
-            double d = 0;
-            auto r = std::from_chars(first, last, d);
-            ok = (r.ec == std::errc() || r.ec == std::errc::result_out_of_range) && r.ptr == last;
+        } else if (const std::optional<double> d = parseVtkReal(token)) {
+            ok = true;
             if constexpr (std::is_integral_v<T>) {
-                ok = ok && d >= -9.2e18 && d <= 9.2e18;
-                value = ok ? static_cast<T>(d) : T{};
+                ok = *d >= -9.2e18 && *d <= 9.2e18;
+                value = ok ? static_cast<T>(*d) : T{};
             } else {
-                value = static_cast<T>(d);
+                value = static_cast<T>(*d);
             }
         }
         if (!ok)

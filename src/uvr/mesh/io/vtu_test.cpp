@@ -8,6 +8,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -513,11 +514,12 @@ TEST_F(VtuErrors, DecreasingOffsetsAreRefused) {
 
 TEST_F(VtuErrors, UnsupportedCompressorAndDatasetTypeAreNamed) {
     const std::string text = readText(variant(kRawZlib));
-    const std::string lzma =
-        write("lzma.vtu", replaceOnce(text, "vtkZLibDataCompressor", "vtkLZMADataCompressor"));
-    expectError([&] { readVtu(lzma); }, ErrorKind::Unsupported,
-                {lzma + ": line " + std::to_string(lineOf(text, text.find("<VTKFile"))),
-                 "compressor 'vtkLZMADataCompressor'"});
+    const std::string other =
+        write("other.vtu", replaceOnce(text, "vtkZLibDataCompressor", "vtkBZip2DataCompressor"));
+    expectError([&] { readVtu(other); }, ErrorKind::Unsupported,
+                {other + ": line " + std::to_string(lineOf(text, text.find("<VTKFile"))),
+                 "compressor 'vtkBZip2DataCompressor' is not supported: expected "
+                 "vtkZLibDataCompressor, vtkLZ4DataCompressor, vtkLZMADataCompressor or none"});
     const std::string poly = write(
         "poly.vtu",
         replaceOnce(readText(variant(kAscii)), "type=\"UnstructuredGrid\"", "type=\"PolyData\""));
@@ -679,6 +681,108 @@ TEST(VtuAmplification, ManyFieldsInTwoPiecesMergeInLinearTime) {
     ASSERT_EQ(mesh.fields.size(), std::size_t(kFields));
     EXPECT_EQ(mesh.fields.back().name, "f" + std::to_string(kFields - 1));
     EXPECT_EQ(mesh.fields.back().values, (std::vector<float>{kFields - 1, kFields - 1}));
+}
+
+}  // namespace
+}  // namespace uvr
+
+namespace uvr {
+namespace {
+
+// ---- numbers and compressors as VTK writes them ----
+
+TEST(VtuNumbers, SignedCountsExponentsAndNanReadAsVtkReadsThem) {
+    // The same values VTK 9.1's vtkXMLUnstructuredGridReader gets from the file.
+    const Mesh m = readVtu(testing::testData("vtk/plus_counts.vtu"));
+    ASSERT_EQ(m.pointCount(), 5u);
+    ASSERT_EQ(m.cellCount(), 2u);
+    EXPECT_EQ(m.points[1], Vec3f(1, 0, 0));
+    EXPECT_EQ(m.points[2], Vec3f(0, 1, 0));
+    EXPECT_EQ(m.points[4], Vec3f(1, 1, 1));
+    EXPECT_EQ(m.cellIndices, (std::vector<std::uint32_t>{0, 1, 2, 3, 1, 2, 3, 4}));
+    ASSERT_EQ(m.fields.size(), 3u);
+    EXPECT_EQ(m.fields[0].name, "rho");
+    EXPECT_EQ(m.fields[0].values[0], 1.0f);
+    EXPECT_EQ(m.fields[0].values[1], 1.0f);
+    EXPECT_EQ(m.fields[0].values[2], 1.5f);
+    EXPECT_EQ(m.fields[0].values[3], 0.25f);
+    EXPECT_TRUE(std::isnan(m.fields[0].values[4]));
+    EXPECT_EQ(m.fields[1].values, (std::vector<float>{0, 1, -2, 3, 4}));
+    EXPECT_EQ(m.fields[2].values, (std::vector<float>{1e-3f, -20.f, 0.5f, 5.f, 0.f, -0.f}));
+}
+
+TEST(VtuNumbers, GarbageCountsAndValuesKeepTheirMessages) {
+    const std::string text = readText(testing::testData("vtk/plus_counts.vtu"));
+    const std::string dir = testing::scratchDir();
+    struct Case {
+        std::string from, to, message;
+    };
+    for (const Case& c : std::vector<Case>{
+             {"NumberOfPoints=\"+5\"", "NumberOfPoints=\"0x5\"",
+              "Piece 0: expected NumberOfPoints to be a non-negative integer, got '0x5'"},
+             {"NumberOfCells=\" +2 \"", "NumberOfCells=\"-2\"",
+              "Piece 0: expected NumberOfCells to be a non-negative integer, got '-2'"},
+             {"NumberOfComponents=\"+1\"", "NumberOfComponents=\"1abc\"",
+              "expected NumberOfComponents to be a non-negative integer, got '1abc'"},
+             {"+1.5E+00", "1.5d0", "DataArray 'rho': expected a number (Float64), got '1.5d0'"},
+             {"+0 +1 -2", "+0 +1 0x2", "DataArray 'flag': expected an integer (Int32), got '0x2'"},
+             {"+4 +8", "+4 +8.5", "DataArray 'offsets': expected an integer (Int64), got '+8.5'"},
+         }) {
+        SCOPED_TRACE(c.to);
+        const std::string path =
+            testing::writeFile(dir + "/bad.vtu", replaceOnce(text, c.from, c.to));
+        expectError([&] { readVtu(path); }, ErrorKind::Parse, {path + ": line ", c.message});
+    }
+}
+
+/// Overwrites the third block of the Points payload of a compressed .vtu written by writeVtu
+/// (UInt64 header) with 0xff bytes: an LZ4 token whose literal run passes the block's end, not
+/// an xz stream header.
+std::string corruptThirdPointsBlock(std::string text) {
+    const std::size_t start = appendedArrayStart(text, "Points");
+    auto u64 = [&](std::size_t pos) {
+        std::uint64_t v;
+        std::memcpy(&v, text.data() + pos, 8);
+        return v;
+    };
+    const std::uint64_t blocks = u64(start);
+    const std::size_t block2 = start + 8 * (3 + blocks) + u64(start + 24) + u64(start + 32);
+    for (std::size_t k = 0; k < u64(start + 40); ++k) text[block2 + k] = '\xff';
+    return text;
+}
+
+TEST(VtuCompressors, CorruptLz4AndLzmaBlocksAreNamed) {
+    Mesh m;
+    for (int i = 0; i < 40; ++i) m.points.push_back({0.25f * i, std::sin(float(i)), 1.f / (i + 1)});
+    const std::string dir = testing::scratchDir();
+    for (const auto& [compressor, name] :
+         {std::pair{VtuCompressor::Lz4, "LZ4"}, std::pair{VtuCompressor::Lzma, "LZMA"}}) {
+        if (!vtuCompressorAvailable(compressor)) continue;
+        SCOPED_TRACE(name);
+        VtuWriteOptions options;
+        options.compressor = compressor;
+        options.blockSize = 64;
+        const std::string good = dir + "/good.vtu";
+        writeVtu(m, good, {}, options);
+        EXPECT_EQ(readVtu(good).points, m.points);
+        const std::string bad =
+            testing::writeFile(dir + "/bad.vtu", corruptThirdPointsBlock(readText(good)));
+        expectError([&] { readVtu(bad); }, ErrorKind::Parse,
+                    {bad + ": byte ", "Piece 0: DataArray 'Points': ",
+                     std::string(name) + " block 2 of DataArray 'Points' is corrupt ("});
+    }
+}
+
+TEST(VtuCompressors, BlocksDeclaringMoreThanTheRatioAreRefused) {
+    // One LZ4 block of 1 compressed byte cannot stand for 4092 bytes (LZ4 expands at most 255:1).
+    const std::string data = le32(1) + le32(4092) + le32(4092) + le32(1) + "x";
+    const std::string text = replaceOnce(appendedZlibVtu(pointsPiece(341), data),
+                                         "vtkZLibDataCompressor", "vtkLZ4DataCompressor");
+    if (!vtuCompressorAvailable(VtuCompressor::Lz4)) GTEST_SKIP() << "built without LZ4";
+    const std::string path = testing::writeFile(testing::scratchDir() + "/lz4.vtu", text);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {"LZ4 block 0 of 1: 1 compressed bytes cannot inflate to the 4092 bytes the header "
+                 "declares (at most 255 at LZ4's maximum ratio of 255:1)"});
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/io/vtk_legacy.h"
 #include "uvr/mesh/io/vtu.h"
 #include "uvr/mesh/procedural.h"
 
@@ -25,10 +26,11 @@ constexpr const char* kVtkDumpScript = R"PY(
 import json, sys
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
-r = vtk.vtkXMLUnstructuredGridReader()
+legacy = sys.argv[1].endswith(".vtk")
+r = vtk.vtkUnstructuredGridReader() if legacy else vtk.vtkXMLUnstructuredGridReader()
 r.SetFileName(sys.argv[1])
 r.Update()
-if r.GetErrorCode() != 0:
+if (legacy and r.GetHeader() is None) or r.GetErrorCode() != 0:
     sys.exit("vtk reader error %d" % r.GetErrorCode())
 g = r.GetOutput()
 out = {"points": g.GetNumberOfPoints(), "cells": g.GetNumberOfCells(), "types": [], "conn": []}
@@ -57,10 +59,8 @@ out["volumes"] = [vol.GetValue(i) for i in range(vol.GetNumberOfTuples())]
 print(json.dumps(out))
 )PY";
 
-/// Writes the mesh as .vtu, reads it back with VTK in Debian's Python and returns the JSON dump.
-nlohmann::json writeAndReadWithVtk(const Mesh& mesh, const std::string& dir) {
-    const std::string vtu = dir + "/mesh.vtu";
-    writeVtu(mesh, vtu);
+/// Reads a .vtu or legacy .vtk with VTK in Debian's Python and returns the JSON dump.
+nlohmann::json readWithVtk(const std::string& vtu, const std::string& dir) {
     const std::string script = testing::writeFile(dir + "/dump.py", kVtkDumpScript);
     const std::string json = dir + "/dump.json";
     const int status = testing::runCommand(std::string(testing::systemPython()) + " " + script +
@@ -71,6 +71,13 @@ nlohmann::json writeAndReadWithVtk(const Mesh& mesh, const std::string& dir) {
     EXPECT_EQ(status, 0) << errText;
     EXPECT_EQ(errText.find("ERROR"), std::string::npos) << errText;
     return nlohmann::json::parse(in);
+}
+
+/// Writes the mesh as .vtu (zlib-compressed), reads it back with VTK and returns the JSON dump.
+nlohmann::json writeAndReadWithVtk(const Mesh& mesh, const std::string& dir) {
+    const std::string vtu = dir + "/mesh.vtu";
+    writeVtu(mesh, vtu);
+    return readWithVtk(vtu, dir);
 }
 
 /// One tetra, hexahedron, wedge and pyramid (positively oriented, sharing faces' points), with
@@ -113,10 +120,8 @@ void expectArray(const nlohmann::json& a, const Field& f) {
         EXPECT_EQ(static_cast<float>(values[i]), f.values[i]) << f.name << " value " << i;
 }
 
-TEST(VtuWriter, VtkReadsBackEveryCellPointAndField) {
-    if (!testing::pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk module";
-    const Mesh m = mixedMesh();
-    const nlohmann::json j = writeAndReadWithVtk(m, testing::scratchDir());
+/// Checks VTK's dump of a file written from mixedMesh() (m).
+void expectMixedMesh(const nlohmann::json& j, const Mesh& m) {
     ASSERT_EQ(j["points"], m.pointCount());
     ASSERT_EQ(j["cells"], m.cellCount());
     const auto coords = j["coords"].get<std::vector<double>>();
@@ -146,6 +151,117 @@ TEST(VtuWriter, VtkReadsBackEveryCellPointAndField) {
     EXPECT_NEAR(volumes[1], 0.5, 1e-6);
     EXPECT_NEAR(volumes[2], 1.0 / 3.0, 1e-6);
     EXPECT_NEAR(volumes[3], 1.0 / 6.0, 1e-6);
+}
+
+TEST(VtuWriter, VtkReadsBackEveryCellPointAndField) {
+    if (!testing::pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk module";
+    const Mesh m = mixedMesh();
+    expectMixedMesh(writeAndReadWithVtk(m, testing::scratchDir()), m);
+}
+
+/// Expects a and b to hold the same points, cells and fields, bit for bit.
+void expectSameMesh(const Mesh& a, const Mesh& b) {
+    ASSERT_EQ(a.points.size(), b.points.size());
+    for (size_t i = 0; i < a.points.size(); ++i)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(a.points[i][c], b.points[i][c]) << "point " << i;
+    EXPECT_EQ(a.cellTypes, b.cellTypes);
+    EXPECT_EQ(a.cellOffsets, b.cellOffsets);
+    EXPECT_EQ(a.cellIndices, b.cellIndices);
+    ASSERT_EQ(a.fields.size(), b.fields.size());
+    for (const Field& f : a.fields) {
+        const auto g = std::find_if(b.fields.begin(), b.fields.end(), [&](const Field& x) {
+            return x.name == f.name && x.association == f.association;
+        });
+        ASSERT_NE(g, b.fields.end()) << f.name;
+        EXPECT_EQ(g->components, f.components) << f.name;
+        EXPECT_EQ(g->values, f.values) << f.name;
+    }
+}
+
+TEST(VtuWriter, EveryCompressorIsReadBackByVtkAndUvr) {
+    const bool vtk = testing::pythonHas("vtk");
+    const Mesh m = mixedMesh();
+    for (VtuCompressor c :
+         {VtuCompressor::None, VtuCompressor::Zlib, VtuCompressor::Lz4, VtuCompressor::Lzma}) {
+        SCOPED_TRACE(static_cast<int>(c));
+        if (!vtuCompressorAvailable(c)) continue;
+        const std::string dir = testing::scratchDir();
+        const std::string path = dir + "/mesh.vtu";
+        VtuWriteOptions options;
+        options.compressor = c;
+        options.blockSize = 64;  // several blocks per array, a partial last one
+        writeVtu(m, path, {}, options);
+        expectSameMesh(m, readVtu(path));
+        const std::vector<char> bytes = readFileBytes(path);
+        const std::string text(bytes.begin(), bytes.end());
+        EXPECT_EQ(text.find("compressor=") != std::string::npos, c != VtuCompressor::None);
+        if (vtk) expectMixedMesh(readWithVtk(path, dir), m);
+    }
+}
+
+TEST(VtuWriter, CompressionShrinksAProceduralMeshAndKeepsItExact) {
+    ProceduralSpec spec;
+    spec.targetCells = 50000;
+    const Mesh m = generateMesh(spec);
+    const std::string dir = testing::scratchDir();
+    VtuWriteOptions plain;
+    plain.compressor = VtuCompressor::None;
+    writeVtu(m, dir + "/plain.vtu", {}, plain);
+    writeVtu(m, dir + "/zlib.vtu");  // the default: zlib, 64 KiB blocks
+    expectSameMesh(m, readVtu(dir + "/zlib.vtu"));
+    EXPECT_LT(std::filesystem::file_size(dir + "/zlib.vtu"),
+              std::filesystem::file_size(dir + "/plain.vtu") * 6 / 10);
+}
+
+TEST(VtuWriter, BadBlockSizeIsAnArgumentError) {
+    VtuWriteOptions options;
+    options.blockSize = 12;
+    const std::string path = testing::scratchDir() + "/mesh.vtu";
+    try {
+        writeVtu(mixedMesh(), path, {}, options);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Argument);
+        EXPECT_THAT(e.what(), HasSubstr("VTU block size 12 must be a positive multiple of 8"));
+    }
+}
+
+TEST(VtkLegacyWriter, VtkAndUvrReadBackBothVersions) {
+    const bool vtk = testing::pythonHas("vtk");
+    const Mesh m = mixedMesh();
+    for (VtkLegacyVersion v :
+         {VtkLegacyVersion::Auto, VtkLegacyVersion::V42, VtkLegacyVersion::V51}) {
+        SCOPED_TRACE(static_cast<int>(v));
+        const std::string dir = testing::scratchDir();
+        const std::string path = dir + "/mesh.vtk";
+        writeVtkLegacy(m, path, {}, v);
+        const std::vector<char> bytes = readFileBytes(path);
+        const std::string text(bytes.begin(), bytes.end());
+        EXPECT_EQ(text.rfind(v == VtkLegacyVersion::V51 ? "# vtk DataFile Version 5.1\n"
+                                                        : "# vtk DataFile Version 4.2\n",
+                             0),
+                  0u);
+        EXPECT_THAT(text, HasSubstr("SCALARS temperature float 1\nLOOKUP_TABLE default\n"));
+        EXPECT_THAT(text, HasSubstr("velocity%20<m/s> 3 14 float\n"));
+        expectSameMesh(m, readVtkLegacy(path));
+        if (!vtk) continue;
+        const nlohmann::json j = readWithVtk(path, dir);
+        expectMixedMesh(j, m);
+    }
+}
+
+TEST(VtkLegacyWriter, FailedWritesLeaveNoFile) {
+    Mesh bad = mixedMesh();
+    bad.cellIndices[3] = 99;
+    const std::string dir = testing::scratchDir();
+    try {
+        writeVtkLegacy(bad, dir + "/bad.vtk");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Validation);
+        EXPECT_THAT(e.what(), HasSubstr(dir + "/bad.vtk"));
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 
 TEST(VtuWriter, VtkSeesTheCountsRangesAndVolumeOfAProceduralMesh) {
