@@ -4,7 +4,6 @@
 #include <expat.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include "uvr/core/file_util.h"
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/io/vtk_number.h"
 
 namespace uvr {
 
@@ -115,17 +115,6 @@ private:
     std::vector<FileStep> steps_;
 };
 
-/// A number of an XML attribute, parsed as VTK parses it (leading '+' and spaces allowed).
-std::optional<double> parseNumber(std::string_view s) {
-    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-    double v = 0;
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
-    return v;
-}
-
 struct PvdParse {
     XML_Parser parser = nullptr;
     std::string path;
@@ -161,7 +150,7 @@ void XMLCALL onPvdStart(void* data, const XML_Char* name, const XML_Char** attrs
     if (!file || !*file) return fail(st, "<DataSet> without a file attribute");
     double time = static_cast<double>(st.steps.size());
     if (const char* t = attr(attrs, "timestep")) {
-        const auto v = parseNumber(t);
+        const auto v = parseVtkReal(t);
         if (!v || !std::isfinite(*v))
             return fail(st, std::string("<DataSet timestep=\"") + t + "\">: expected a number");
         time = *v;
