@@ -28,7 +28,9 @@ Format sniffFormat(const std::string& path) {
     if (text.size() >= 8 && std::memcmp(text.data(), kNativeMagic, 8) == 0) return Format::Native;
     if (text.rfind("# vtk DataFile", 0) == 0) return Format::Legacy;
     if (text.find("PUnstructuredGrid") != std::string::npos) return Format::Pvtu;
-    if (text.find("type=\"Collection\"") != std::string::npos) return Format::Pvd;
+    if (text.find("<VTKFile") != std::string::npos &&
+        text.find("type=\"Collection\"") != std::string::npos)
+        return Format::Pvd;
     if (text.find("<VTKFile") != std::string::npos) return Format::Vtu;
     const std::string ext = fileExtension(path);
     if (ext == ".vtk") return Format::Legacy;

@@ -242,6 +242,22 @@ std::vector<FileStep> globNumbered(const std::string& pattern) {
 
 }  // namespace
 
+namespace {
+
+/// True for a ParaView collection: a VTKFile of type Collection in the first bytes, or a .pvd
+/// name without a VTKFile in them (readMesh's rule: the two agree on what a collection is).
+bool isCollection(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char head[512] = {};
+    in.read(head, sizeof(head) - 1);
+    const std::string text(head, static_cast<std::size_t>(in.gcount()));
+    if (text.find("<VTKFile") != std::string::npos)  // the content decides, as in readMesh
+        return text.find("type=\"Collection\"") != std::string::npos;
+    return fileExtension(path) == ".pvd";
+}
+
+}  // namespace
+
 bool isSeriesPattern(const std::string& path) {
     return fs::path(path).filename().string().find('*') != std::string::npos;
 }
@@ -251,8 +267,7 @@ std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOp
         return std::make_unique<FileSeries>(path, globNumbered(path), options);
     checkRegularFile(path);
     fileSize(path);  // a missing or unreadable file is named now, not at the first step
-    if (fileExtension(path) == ".pvd")
-        return std::make_unique<FileSeries>(path, readPvd(path), options);
+    if (isCollection(path)) return std::make_unique<FileSeries>(path, readPvd(path), options);
     return std::make_unique<SingleFileSeries>(path, options);
 }
 
