@@ -124,7 +124,7 @@ public:
         };
         throwError(ErrorKind::Parse, path_,
                    "variable " + name + " has shape " + text(got) + ", expected " +
-                       text(expected) + " (" + what + ")");
+                       text(expected) + " " + what);
     }
     /// A text attribute of a variable, "" when absent or not text.
     std::string textAttribute(int varid, const char* name) const {
@@ -231,8 +231,9 @@ struct FieldGroup {
     std::vector<std::size_t> variables;  ///< indices into the variable names, one per component
 };
 
-/// Groups consecutive names ending in X, Y, Z (case-insensitive, same prefix, the prefix not
-/// empty once a trailing '_' is dropped) into vectors named by the prefix, as VTK's Exodus reader.
+/// Groups consecutive names ending in X, Y, Z (case-insensitive, the same non-empty prefix) into
+/// vectors named by the prefix, as VTK's Exodus reader: VX, VY, VZ is V; vel_x, vel_y, vel_z is
+/// vel_ (as ParaView names it).
 std::vector<FieldGroup> groupComponents(const std::vector<std::string>& names) {
     std::vector<FieldGroup> groups;
     for (std::size_t i = 0; i < names.size();) {
@@ -247,9 +248,8 @@ std::vector<FieldGroup> groupComponents(const std::vector<std::string>& names) {
                           last(names[i + 2]) == 'z' &&
                           names[i + 1].compare(0, n - 1, a, 0, n - 1) == 0 &&
                           names[i + 2].compare(0, n - 1, a, 0, n - 1) == 0;
-            std::string prefix = a.substr(0, n >= 1 ? n - 1 : 0);
-            if (!prefix.empty() && prefix.back() == '_') prefix.pop_back();
-            if (vector && !prefix.empty()) {
+            const std::string prefix = a.substr(0, n - 1);
+            if (vector && prefix != "_") {
                 groups.push_back({prefix, {i, i + 1, i + 2}});
                 i += 3;
                 continue;
@@ -332,7 +332,7 @@ private:
             for (int d = 0; d < 3; ++d) {
                 coordVars_[d] = f.var(names[d]);
                 if (coordVars_[d] >= 0)
-                    f.expectShape(coordVars_[d], names[d], {nodes_}, "num_nodes coordinates");
+                    f.expectShape(coordVars_[d], names[d], {nodes_}, "(num_nodes coordinates)");
             }
             if (coordVars_[0] < 0 || coordVars_[1] < 0 || coordVars_[2] < 0) {
                 coordVar_ = f.var("coord");
@@ -355,7 +355,7 @@ private:
                        "num_el_blk is " + std::to_string(count) + ": more than a million blocks");
         std::vector<long long> ids(count);
         if (const int v = f.var("eb_prop1"); v >= 0 && count) {
-            f.expectShape(v, "eb_prop1", {count}, "one id per element block");
+            f.expectShape(v, "eb_prop1", {count}, "(one id per element block)");
             readAll(f, v, ids, "eb_prop1");
         } else {
             for (std::size_t b = 0; b < count; ++b) ids[b] = static_cast<long long>(b + 1);
@@ -657,8 +657,50 @@ private:
 
 }  // namespace
 
+namespace {
+
+/// Error(Parse) when a classic-format file (CDF-1, -2, -5) is shorter than its variables' data:
+/// netCDF reads past the end of a truncated file as fill values without an error.
+void checkClassicSize(const NcFile& f) {
+    int format = 0;
+    ncCheck(nc_inq_format(f.id(), &format), f.path(), "the netCDF format");
+    if (format != NC_FORMAT_CLASSIC && format != NC_FORMAT_64BIT_OFFSET &&
+        format != NC_FORMAT_CDF5)
+        return;  // HDF5 checks its own
+    int nvars = 0, unlimited = -1;
+    ncCheck(nc_inq_nvars(f.id(), &nvars), f.path(), "the variables");
+    ncCheck(nc_inq_unlimdim(f.id(), &unlimited), f.path(), "the record dimension");
+    std::uint64_t needed = 32;  // the smallest header
+    for (int v = 0; v < nvars; ++v) {
+        nc_type type = NC_NAT;
+        int ndims = 0;
+        ncCheck(nc_inq_vartype(f.id(), v, &type), f.path(), "a variable's type");
+        ncCheck(nc_inq_varndims(f.id(), v, &ndims), f.path(), "a variable's dimensions");
+        std::size_t typeSize = 0;
+        ncCheck(nc_inq_type(f.id(), type, nullptr, &typeSize), f.path(), "a variable's type");
+        std::vector<int> dims(static_cast<std::size_t>(std::max(ndims, 0)));
+        if (ndims > 0) ncCheck(nc_inq_vardimid(f.id(), v, dims.data()), f.path(), "dimensions");
+        long double bytes = static_cast<long double>(typeSize);
+        for (int d : dims) {
+            std::size_t len = 0;
+            ncCheck(nc_inq_dimlen(f.id(), d, &len), f.path(), "a dimension's length");
+            bytes *= static_cast<long double>(len);
+        }
+        needed += static_cast<std::uint64_t>(std::min(bytes, 1e19L));
+        if (needed > (1ull << 62)) break;
+    }
+    const std::uint64_t size = fileSize(f.path());
+    if (size < needed)
+        throwError(ErrorKind::Parse, f.path(),
+                   "truncated: its variables hold at least " + std::to_string(needed) +
+                       " bytes of data, the file has " + std::to_string(size));
+}
+
+}  // namespace
+
 std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOptions& options) {
     auto file = std::make_unique<NcFile>(path);
+    checkClassicSize(*file);
     // Time steps: time_whole over the time_step records; none is one step at time 0.
     const std::size_t records = file->dim("time_step").value_or(0);
     std::vector<double> times{0.0};
@@ -668,7 +710,7 @@ std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOption
             throwError(ErrorKind::Parse, path,
                        "the file has " + std::to_string(records) +
                            " time_step records but no time_whole variable");
-        file->expectShape(v, "time_whole", {records}, "one time per time_step record");
+        file->expectShape(v, "time_whole", {records}, "(one per time_step record)");
         checkAllocation(path, "time_whole", records, sizeof(double), options.maxMemoryBytes);
         times.resize(records);
         ncCheck(nc_get_var_double(file->id(), v, times.data()), path, "variable time_whole");
