@@ -30,9 +30,9 @@ struct ExoBlock {
 /// What an Exodus II file holds, and how it is laid out.
 struct ExoFileSpec {
     int numDim = 3;
-    std::vector<double> x, y, z;   ///< node coordinates (num_nodes each)
-    bool writeCoordinates = true;  ///< false: no coordinate variable at all (a bad file)
-    bool combinedCoord = false;    ///< the old coord(num_dim, num_nodes) instead of coordx/y/z
+    std::vector<double> x, y, z;     ///< node coordinates (num_nodes each)
+    bool writeCoordinates = true;    ///< false: no coordinate variable at all (a bad file)
+    bool combinedCoord = false;      ///< the old coord(num_dim, num_nodes) instead of coordx/y/z
     bool combinedNodalVars = false;  ///< the old vals_nod_var(time_step, num_nod_var, num_nodes)
     bool netcdf4 = false;            ///< netCDF-4 (HDF5) instead of the 64-bit-offset format
     bool doubles = false;            ///< coordinates, times and values as NC_DOUBLE
@@ -113,7 +113,8 @@ inline void writeExodusFile(const std::string& path, const ExoFileSpec& spec) {
             vCoord = var("coord", real, {numDim, numNodes});
         } else {
             const char* names[3] = {"coordx", "coordy", "coordz"};
-            for (int d = 0; d < spec.numDim && d < 3; ++d) vXyz[d] = var(names[d], real, {numNodes});
+            for (int d = 0; d < spec.numDim && d < 3; ++d)
+                vXyz[d] = var(names[d], real, {numNodes});
         }
     }
     std::vector<int> vConnect(nb, -1), blockDim(nb, -1);
@@ -151,13 +152,14 @@ inline void writeExodusFile(const std::string& path, const ExoFileSpec& spec) {
     if (nev) {
         const int numElemVar = dim("num_elem_var", nev);
         vElemNames = var("name_elem_var", NC_CHAR, {numElemVar, lenName});
-        if (!spec.truthTable.empty() && nb) vTab = var("elem_var_tab", NC_INT, {numBlk, numElemVar});
+        if (!spec.truthTable.empty() && nb)
+            vTab = var("elem_var_tab", NC_INT, {numBlk, numElemVar});
         for (std::size_t v = 0; v < nev; ++v)
             for (std::size_t b = 0; b < nb; ++b)
                 if (blockDim[b] >= 0 && defined(b, v))
-                    vElem[v][b] = var("vals_elem_var" + std::to_string(v + 1) + "eb" +
-                                          std::to_string(b + 1),
-                                      real, {time, blockDim[b]});
+                    vElem[v][b] =
+                        var("vals_elem_var" + std::to_string(v + 1) + "eb" + std::to_string(b + 1),
+                            real, {time, blockDim[b]});
     }
     ncOk(nc_enddef(nc), "nc_enddef");
     // Data.
@@ -195,12 +197,14 @@ inline void writeExodusFile(const std::string& path, const ExoFileSpec& spec) {
         for (std::size_t v = 0; v < nnv; ++v) {
             std::size_t len = nodes;
             if (v == 0 && !spec.firstNodalVarDim.empty())
-                ncOk(nc_inq_dimlen(nc, [&] {
-                         int d = -1;
-                         nc_inq_dimid(nc, spec.firstNodalVarDim.c_str(), &d);
-                         return d;
-                     }(),
-                                   &len),
+                ncOk(nc_inq_dimlen(
+                         nc,
+                         [&] {
+                             int d = -1;
+                             nc_inq_dimid(nc, spec.firstNodalVarDim.c_str(), &d);
+                             return d;
+                         }(),
+                         &len),
                      "bad dimension length");
             std::vector<double> values(len);
             for (std::size_t n = 0; n < len; ++n) values[n] = spec.nodal ? spec.nodal(s, v, n) : 0;

@@ -73,9 +73,9 @@ public:
         const int status = nc_open(path.c_str(), NC_NOWRITE, &id_);
         if (status != NC_NOERR) {
             id_ = -1;
-            throwError(ErrorKind::Parse, path,
-                       std::string("not a readable netCDF (Exodus II) file: ") +
-                           nc_strerror(status));
+            throwError(
+                ErrorKind::Parse, path,
+                std::string("not a readable netCDF (Exodus II) file: ") + nc_strerror(status));
         }
     }
     ~NcFile() {
@@ -118,20 +118,18 @@ public:
         if (got == expected) return;
         auto text = [](const std::vector<std::size_t>& s) {
             std::string t = "(";
-            for (std::size_t k = 0; k < s.size(); ++k)
-                t += (k ? ", " : "") + std::to_string(s[k]);
+            for (std::size_t k = 0; k < s.size(); ++k) t += (k ? ", " : "") + std::to_string(s[k]);
             return t + ")";
         };
         throwError(ErrorKind::Parse, path_,
-                   "variable " + name + " has shape " + text(got) + ", expected " +
-                       text(expected) + " " + what);
+                   "variable " + name + " has shape " + text(got) + ", expected " + text(expected) +
+                       " " + what);
     }
     /// A text attribute of a variable, "" when absent or not text.
     std::string textAttribute(int varid, const char* name) const {
         nc_type type = NC_NAT;
         std::size_t len = 0;
-        if (nc_inq_att(id_, varid, name, &type, &len) != NC_NOERR || type != NC_CHAR ||
-            len > 4096)
+        if (nc_inq_att(id_, varid, name, &type, &len) != NC_NOERR || type != NC_CHAR || len > 4096)
             return "";
         std::string s(len, '\0');
         if (len) ncCheck(nc_get_att_text(id_, varid, name, s.data()), path_, name);
@@ -296,8 +294,8 @@ public:
         return mesh;
     }
 
-    std::optional<std::vector<Field>> readFieldsIfSameGeometry(std::size_t i,
-                                                               const MeshView& geometry) override {
+    std::optional<std::vector<Field> > readFieldsIfSameGeometry(std::size_t i,
+                                                                const MeshView& geometry) override {
         checkStep(i);
         if (geometry.pointCount() != nodes_ || geometry.cellCount() != keptCells_ ||
             geometry.cellIndices.size() != keptIndices_)
@@ -320,8 +318,7 @@ private:
                        "no num_dim dimension: not an Exodus II file (or not one uvr reads)");
         if (*numDim != 3)
             throwError(ErrorKind::Unsupported, file(),
-                       "num_dim is " + std::to_string(*numDim) +
-                           ": a " + std::to_string(*numDim) +
+                       "num_dim is " + std::to_string(*numDim) + ": a " + std::to_string(*numDim) +
                            "D mesh holds no volume cells (uvr renders 3D meshes)");
         nodes_ = f.dim("num_nodes").value_or(0);
         if (nodes_ > std::numeric_limits<std::uint32_t>::max())
@@ -416,14 +413,14 @@ private:
         const std::string n = std::to_string(block.index);
         std::string list;
         for (std::size_t a : allowed) list += (list.empty() ? "" : ", ") + std::to_string(a);
-        const bool suffixDisagrees = !digits.empty() && digits.size() < 4 &&
-                                     std::stoul(digits) != block.nodesPerElement;
+        const bool suffixDisagrees =
+            !digits.empty() && digits.size() < 4 && std::stoul(digits) != block.nodesPerElement;
         if (suffixDisagrees ||
             std::find(allowed.begin(), allowed.end(), block.nodesPerElement) == allowed.end())
             throwError(ErrorKind::Parse, file(),
                        block.label() + ": elem_type '" + block.elemType + "' with " +
-                           std::to_string(block.nodesPerElement) + " nodes per element (num_nod_per_el" +
-                           n + "), expected " +
+                           std::to_string(block.nodesPerElement) +
+                           " nodes per element (num_nod_per_el" + n + "), expected " +
                            (suffixDisagrees ? digits : "one of " + list) + " for a " +
                            block.type.family);
     }
@@ -477,8 +474,8 @@ private:
             for (std::size_t b = 0; b < blocks_.size(); ++b) {
                 const Block& block = blocks_[b];
                 if (!block.kept) continue;
-                const std::string name = "vals_elem_var" + std::to_string(v + 1) + "eb" +
-                                         std::to_string(block.index);
+                const std::string name =
+                    "vals_elem_var" + std::to_string(v + 1) + "eb" + std::to_string(block.index);
                 const int id = f.var(name);
                 const bool listed = table.empty() || table[b * elemVars + v] != 0;
                 if (listed && id >= 0) {
@@ -487,8 +484,10 @@ private:
                     elemVarIds_[v][b] = id;
                 } else if (listed && !table.empty()) {
                     throwError(ErrorKind::Parse, file(),
-                               "no variable " + name + ", which elem_var_tab lists for the element "
-                               "variable '" + elemVarNames_[v] + "' on " + block.label());
+                               "no variable " + name +
+                                   ", which elem_var_tab lists for the element "
+                                   "variable '" +
+                                   elemVarNames_[v] + "' on " + block.label());
                 }
             }
         }
@@ -497,8 +496,9 @@ private:
             for (const Block& block : blocks_) {
                 if (!block.kept) continue;
                 const std::size_t b = block.index - 1;
-                const bool missing = std::any_of(g.variables.begin(), g.variables.end(),
-                                                 [&](std::size_t v) { return elemVarIds_[v][b] < 0; });
+                const bool missing =
+                    std::any_of(g.variables.begin(), g.variables.end(),
+                                [&](std::size_t v) { return elemVarIds_[v][b] < 0; });
                 if (missing)
                     notes_.push_back("the element variable " + g.name + " is not defined on " +
                                      block.label() + ": its " + std::to_string(block.elements) +
@@ -530,8 +530,7 @@ private:
     }
 
     void readCells(Mesh& mesh, LoadBudget& budget) const {
-        budget.charge(file(), "the cells", keptCells_,
-                      sizeof(CellType) + sizeof(std::uint64_t));
+        budget.charge(file(), "the cells", keptCells_, sizeof(CellType) + sizeof(std::uint64_t));
         budget.charge(file(), "the cell connectivity", keptIndices_, sizeof(std::uint32_t));
         mesh.cellTypes.reserve(keptCells_);
         mesh.cellOffsets.reserve(keptCells_ + 1);
@@ -614,9 +613,9 @@ private:
         for (const FieldGroup& g : cellGroups_) {
             const int comps = static_cast<int>(g.variables.size());
             budget.charge(file(), "the cell field " + g.name, keptCells_ * comps, sizeof(float));
-            Field field{g.name, Association::Cell, comps,
-                        std::vector<float>(keptCells_ * comps,
-                                           std::numeric_limits<float>::quiet_NaN())};
+            Field field{
+                g.name, Association::Cell, comps,
+                std::vector<float>(keptCells_ * comps, std::numeric_limits<float>::quiet_NaN())};
             for (const Block& block : blocks_) {
                 if (!block.kept) continue;
                 const std::size_t b = block.index - 1;
@@ -650,7 +649,7 @@ private:
     std::vector<std::string> nodVarNames_, elemVarNames_;
     std::vector<int> nodVarIds_;
     int combinedNodVar_ = -1;
-    std::vector<std::vector<int>> elemVarIds_;  ///< [variable][block]: varid or -1
+    std::vector<std::vector<int> > elemVarIds_;  ///< [variable][block]: varid or -1
     std::vector<FieldGroup> pointGroups_, cellGroups_;
     std::vector<std::string> notes_;
 };
@@ -664,8 +663,7 @@ namespace {
 void checkClassicSize(const NcFile& f) {
     int format = 0;
     ncCheck(nc_inq_format(f.id(), &format), f.path(), "the netCDF format");
-    if (format != NC_FORMAT_CLASSIC && format != NC_FORMAT_64BIT_OFFSET &&
-        format != NC_FORMAT_CDF5)
+    if (format != NC_FORMAT_CLASSIC && format != NC_FORMAT_64BIT_OFFSET && format != NC_FORMAT_CDF5)
         return;  // HDF5 checks its own
     int nvars = 0, unlimited = -1;
     ncCheck(nc_inq_nvars(f.id(), &nvars), f.path(), "the variables");

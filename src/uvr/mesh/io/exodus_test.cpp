@@ -130,8 +130,8 @@ TEST(Exodus, VtkWrittenFileMatchesVtkAtEveryStep) {
     const std::string dir = testing::scratchDir();
     const std::string file = dir + "/vtk_written.e";
     ASSERT_EQ(testing::runCommand(std::string(testing::systemPython()) + " " +
-                                  testing::testTool("exodus_oracle.py") + " write " + file +
-                                  " > " + dir + "/write.log 2>&1"),
+                                  testing::testTool("exodus_oracle.py") + " write " + file + " > " +
+                                  dir + "/write.log 2>&1"),
               0);
     const nlohmann::json vtk = vtkReading(file, dir, {0, 1, 2});
     auto series = openMeshSeries(file);
@@ -177,11 +177,8 @@ testing::ExoFileSpec mixedSpec() {
         }
     // Corners in VTK order (which Exodus shares) of the cube's nodes (x, y, z) bits; a wedge's
     // first triangle has its normal away from the second, as VTK's wedge.
-    const std::vector<std::vector<int>> corners = {{0, 1, 2, 4},
-                                                   {0, 1, 3, 2, 4, 5, 7, 6},
-                                                   {0, 2, 1, 4, 6, 5},
-                                                   {0, 1, 3, 2, 4},
-                                                   {0, 1, 3, 2}};
+    const std::vector<std::vector<int>> corners = {
+        {0, 1, 2, 4}, {0, 1, 3, 2, 4, 5, 7, 6}, {0, 2, 1, 4, 6, 5}, {0, 1, 3, 2, 4}, {0, 1, 3, 2}};
     spec.blocks = {{100, "TETRA10", 10, {}, "tets"}, {200, "HEX8", 8, {}, "hexes"},
                    {300, "WEDGE", 6, {}, "wedges"},  {400, "PYRAMID5", 5, {}, ""},
                    {500, "SHELL4", 4, {}, "skin"},   {600, "NULL", 0, {}, "empty"}};
@@ -264,8 +261,10 @@ TEST(Exodus, NetcdfWrittenFilesMatchVtk) {
                     EXPECT_EQ(old.fields[k].name, reference[step].fields[k].name);
                     EXPECT_EQ(old.fields[k].values.size(), reference[step].fields[k].values.size());
                     for (std::size_t i = 0; i < old.fields[k].values.size(); ++i) {
-                        const float a = old.fields[k].values[i], b = reference[step].fields[k].values[i];
-                        EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << old.fields[k].name;
+                        const float a = old.fields[k].values[i],
+                                    b = reference[step].fields[k].values[i];
+                        EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b)))
+                            << old.fields[k].name;
                     }
                 }
             }
