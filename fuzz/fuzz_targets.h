@@ -31,6 +31,11 @@
 #include "uvr/render/render_setup.h"
 #include "uvr/tf/transfer_function.h"
 
+#ifdef UVR_HAVE_NETCDF
+#include "../tests/exodus_file_writer.h"
+#include "uvr/mesh/io/exodus.h"
+#endif
+
 #ifdef UVR_HAS_SERVER
 #include <nlohmann/json.hpp>
 
@@ -281,6 +286,83 @@ inline void fuzzRender(const std::uint8_t* data, std::size_t size) {
     });
 }
 
+#ifdef UVR_HAVE_NETCDF
+/// Exodus II, structured: the bytes choose an Exodus file (layout flags, 0 to 23 nodes of raw float
+/// coordinates, up to 4 blocks of any elem_type with any nodes per element and node numbers, nodal
+/// and element variables with vector-like names, a truth table, up to 3 steps of raw values),
+/// written through netCDF (so the reader, not netCDF's parser, is what is fuzzed) and read back
+/// step by step: each step must load with consistent fields, or fail with a uvr::Error.
+inline void fuzzExodus(const std::uint8_t* data, std::size_t size) {
+    ByteReader in(data, size);
+    testing::ExoFileSpec spec;
+    const std::uint8_t shape = in.byte(), flags = in.byte();
+    spec.combinedCoord = flags & 1;
+    spec.combinedNodalVars = flags & 2;
+    spec.doubles = flags & 4;
+    spec.writeCoordinates = !(flags & 8);
+    spec.numDim = (flags & 0x80) ? 2 : 3;
+    const std::size_t nodes = shape % 24;
+    for (std::size_t n = 0; n < nodes; ++n) {
+        spec.x.push_back(in.real());
+        spec.y.push_back(in.real());
+        spec.z.push_back(in.real());
+    }
+    static const char* const kTypes[] = {"TETRA",    "TET4",  "tetra10", "HEX8",    "HEX",
+                                         "HEX27",    "WEDGE", "WEDGE15", "PYRAMID", "PYRAMID13",
+                                         "SHELL4",   "QUAD4", "TRI3",    "BAR2",    "NSIDED",
+                                         "HEXSHELL", ""};
+    static const std::size_t kNodes[] = {4, 4, 10, 8, 8, 27, 6, 15, 5, 13, 4, 4, 3, 2, 5, 12, 4};
+    const int blocks = in.byte() % 5;
+    for (int b = 0; b < blocks; ++b) {
+        const std::uint8_t t = in.byte(), npe = in.byte(), elements = in.byte();
+        testing::ExoBlock block;
+        block.id = in.byte();
+        block.elemType = kTypes[t % std::size(kTypes)];
+        block.nodesPerElement = (npe & 0x80) ? npe % 30 : kNodes[t % std::size(kTypes)];
+        for (std::size_t k = 0; k < block.nodesPerElement * (elements % 6); ++k)
+            block.connect.push_back(in.byte() % (nodes + 3));  // 0 and past num_nodes too
+        spec.blocks.push_back(block);
+    }
+    static const char* const kNames[] = {"T",     "VX",     "VY",     "VZ",     "vel_x", "vel_y",
+                                         "vel_z", "DISPLX", "DISPLY", "DISPLZ", "",      "p"};
+    for (int v = in.byte() % 5; v > 0; --v) spec.nodalVars.push_back(kNames[in.byte() % 12]);
+    for (int v = in.byte() % 4; v > 0; --v) spec.elemVars.push_back(kNames[in.byte() % 12]);
+    if (flags & 0x10)
+        for (std::size_t k = 0; k < spec.blocks.size() * spec.elemVars.size(); ++k)
+            spec.truthTable.push_back(in.byte() & 1);
+    if (flags & 0x20) spec.firstNodalVarDim = "num_el_in_blk1";
+    for (int s = in.byte() % 4; s > 0; --s) spec.times.push_back(in.real());
+    spec.nodal = [&](std::size_t, std::size_t, std::size_t) { return in.real(); };
+    spec.element = [&](std::size_t, std::size_t, std::size_t, std::size_t) { return in.real(); };
+    const std::string path = scratchFolder() + "/input.e";
+    try {
+        testing::writeExodusFile(path, spec);
+    } catch (const std::runtime_error&) {
+        return;  // netCDF refused the layout (e.g. a variable on a dimension of no nodes)
+    }
+    expectCleanError([&] {
+        auto series = openExodus(path, fuzzReadOptions());
+        for (std::size_t s = 0; s < series->stepCount(); ++s) {
+            const Mesh mesh = series->readStep(s);
+            for (const Field& f : mesh.fields)
+                if (f.values.size() !=
+                    (f.association == Association::Point ? mesh.pointCount() : mesh.cellCount()) *
+                        static_cast<std::size_t>(f.components)) {
+                    std::fprintf(stderr, "fuzzExodus: field %s has %zu values\n", f.name.c_str(),
+                                 f.values.size());
+                    std::abort();
+                }
+            const auto fields = series->readFieldsIfSameGeometry(s, mesh);
+            if (!fields || fields->size() != mesh.fields.size()) {
+                std::fprintf(stderr, "fuzzExodus: the fields alone differ from the step's\n");
+                std::abort();
+            }
+            useMesh(mesh, path);
+        }
+    });
+}
+#endif
+
 #ifdef UVR_HAS_SERVER
 /// A browser's `set` message to the viewer (docs/VIEWER.md): parsed as JSON, applied to a state
 /// (all or nothing), then the state's frame settings validated and its exports written and read
@@ -331,6 +413,9 @@ inline constexpr FuzzTarget kFuzzTargets[] = {{"vtk_legacy", fuzzVtkLegacy},
                                               {"pvcc", fuzzPvcc},
                                               {"specs", fuzzSpecs},
                                               {"render", fuzzRender},
+#ifdef UVR_HAVE_NETCDF
+                                              {"exodus", fuzzExodus},
+#endif
 #ifdef UVR_HAS_SERVER
                                               {"view_message", fuzzViewMessage},
 #endif

@@ -9,7 +9,9 @@
 # (tests/web/view_page_test.py); python3-dev and pybind11-dev build the Python module (python/),
 # python3-pytest runs its tests (with meshio and python3-vtk9 for the conversions),
 # python3-matplotlib draws the benchmark figures (bench/plot_bench.py) and reads PNGs in the
-# Python tests; liblz4-dev and liblzma-dev read and write LZ4/LZMA-compressed .vtu (optional).
+# Python tests; liblz4-dev and liblzma-dev read and write LZ4/LZMA-compressed .vtu (optional);
+# libnetcdf-dev reads Exodus II files, and mayavi2 ships ParaView's disk_out_ref.ex2 the Exodus
+# tests read.
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
@@ -17,6 +19,7 @@ PACKAGES="g++ cmake make pkg-config
   liblz4-dev liblzma-dev
   libfreetype-dev libfontconfig-dev fonts-dejavu-core
   libboost-dev libturbojpeg0-dev
+  libnetcdf-dev mayavi2
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev libomp-dev
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage

@@ -6,6 +6,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/io/vtk_compression.h"
@@ -16,7 +17,7 @@ namespace uvr {
 
 namespace {
 
-enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Unknown };
+enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Exodus, Unknown };
 
 Format sniffFormat(const std::string& path) {
     checkRegularFile(path);
@@ -26,6 +27,7 @@ Format sniffFormat(const std::string& path) {
     in.read(head, sizeof(head) - 1);
     const std::string text(head, static_cast<size_t>(in.gcount()));
     if (text.size() >= 8 && std::memcmp(text.data(), kNativeMagic, 8) == 0) return Format::Native;
+    if (looksLikeExodus(text, path)) return Format::Exodus;
     if (text.rfind("# vtk DataFile", 0) == 0) return Format::Legacy;
     if (text.find("PUnstructuredGrid") != std::string::npos) return Format::Pvtu;
     if (text.find("<VTKFile") != std::string::npos &&
@@ -55,12 +57,15 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
             return openMeshSeries(path, options)->readStep(0);
         case Format::Native:
             return readNative(path, options);
+        case Format::Exodus:  // its first time step
+            return readExodus(path, options);
         case Format::Unknown:
             break;
     }
     throwError(ErrorKind::Parse, path,
                "unrecognised file format: expected a legacy VTK file ('# vtk DataFile' header), "
-               "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd) or a native uvr mesh (.uvrm)");
+               "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd), Exodus II (.e/.exo/.ex2/.g) or "
+               "a native uvr mesh (.uvrm)");
 }
 
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes) {

@@ -11,8 +11,9 @@
 
 namespace uvr {
 
-/// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd: its first step, .uvrm native),
-/// chosen by magic bytes first and extension second; throws Error naming the file on failure.
+/// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd and Exodus II: their first step,
+/// .uvrm native), chosen by magic bytes first and extension second; throws Error naming the file
+/// on failure.
 Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 
 /// The counts, cell types and fields of a file whose format has a header that holds them (.uvrm),

@@ -13,6 +13,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/vtk_number.h"
@@ -240,6 +241,14 @@ std::vector<FileStep> globNumbered(const std::string& pattern) {
     return steps;
 }
 
+/// The first bytes of a file (fewer when it is shorter; none when it cannot be opened).
+std::string fileHead(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char head[8] = {};
+    in.read(head, sizeof(head));
+    return std::string(head, static_cast<std::size_t>(in.gcount()));
+}
+
 }  // namespace
 
 namespace {
@@ -268,6 +277,7 @@ std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOp
     checkRegularFile(path);
     fileSize(path);  // a missing or unreadable file is named now, not at the first step
     if (isCollection(path)) return std::make_unique<FileSeries>(path, readPvd(path), options);
+    if (looksLikeExodus(fileHead(path), path)) return openExodus(path, options);
     return std::make_unique<SingleFileSeries>(path, options);
 }
 
