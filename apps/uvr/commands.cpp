@@ -88,7 +88,7 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
     auto file = std::make_shared<std::string>();
     auto json = std::make_shared<bool>(false);
     auto full = std::make_shared<bool>(false);
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .vtkhdf, .uvrm)")->required();
     cmd->add_flag("--json", *json, "Print JSON instead of text");
     cmd->add_flag("--full", *full,
                   "Of a .uvrm, also read the arrays for bounds, value ranges and validation "
@@ -187,7 +187,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         "fixed-step reference or the exact integrator (--method), on the CPU or a GPU");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .vtkhdf, .uvrm)")->required();
     flags->registerOn(*cmd);
     cmd->callback([file, flags, &ctx] {
         applyThreads(flags->threads);
@@ -246,11 +246,12 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
 
 void addConvertCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
-        "convert", "Convert a mesh between formats (any readable format to .uvrm or .vtu)");
+        "convert",
+        "Convert a mesh between formats (any readable format to .uvrm, .vtu or .vtkhdf)");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     cmd->add_option("IN", *in, "Input mesh")->required();
-    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu or .vtkhdf)")->required();
     cmd->callback([in, out, &ctx] {
         checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
         resolveOutput(*out);
@@ -268,7 +269,7 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     auto fields = std::make_shared<std::vector<std::string>>();
     cmd->add_option("SHAPE", *shape, "box, shell (hollow, non-convex) or graded (100x cell sizes)")
         ->capture_default_str();
-    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm or .vtu)")->required();
+    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu or .vtkhdf)")->required();
     cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
@@ -317,7 +318,7 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
     auto levels = std::make_shared<int>(1);
     auto threads = std::make_shared<int>(0);
     cmd->add_option("IN", *in, "Input mesh")->required();
-    cmd->add_option("OUT", *out, "Output mesh (.uvrm native or .vtu)")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu or .vtkhdf)")->required();
     cmd->add_option("--levels", *levels, "Refinement levels (x8 tetrahedra each)")
         ->capture_default_str()
         ->check(CLI::Range(0, kMaxRefineLevels));

@@ -55,7 +55,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     auto flags = std::make_shared<RenderFlags>();
     auto options = std::make_shared<std::pair<std::string, int>>("127.0.0.1", 8080);
     auto token = std::make_shared<std::string>();
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .vtkhdf, .uvrm)")->required();
     flags->registerOn(*cmd, /*oneFrame=*/false);
     addMethodOption(*cmd, flags->method);
     cmd->add_option("--host", options->first,

@@ -9,13 +9,14 @@
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/io/vtk_legacy.h"
+#include "uvr/mesh/io/vtkhdf.h"
 #include "uvr/mesh/io/vtu.h"
 
 namespace uvr {
 
 namespace {
 
-enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Unknown };
+enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, VtkHdf, Unknown };
 
 Format sniffFormat(const std::string& path) {
     checkRegularFile(path);
@@ -29,6 +30,8 @@ Format sniffFormat(const std::string& path) {
     if (text.find("PUnstructuredGrid") != std::string::npos) return Format::Pvtu;
     if (text.find("type=\"Collection\"") != std::string::npos) return Format::Pvd;
     if (text.find("<VTKFile") != std::string::npos) return Format::Vtu;
+    // VTKHDF: an .vtkhdf/.hdf name, or HDF5 with a /VTKHDF group (netCDF-4 files are HDF5 too).
+    if (looksLikeVtkHdf(path)) return Format::VtkHdf;
     const std::string ext = fileExtension(path);
     if (ext == ".vtk") return Format::Legacy;
     if (ext == ".vtu") return Format::Vtu;
@@ -52,12 +55,16 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
             return openMeshSeries(path, options)->readStep(0);
         case Format::Native:
             return readNative(path, options);
+        case Format::VtkHdf:
+            return readVtkHdf(path, options);
         case Format::Unknown:
             break;
     }
-    throwError(ErrorKind::Parse, path,
-               "unrecognised file format: expected a legacy VTK file ('# vtk DataFile' header), "
-               "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd) or a native uvr mesh (.uvrm)");
+    throwError(
+        ErrorKind::Parse, path,
+        "unrecognised file format: expected a legacy VTK file ('# vtk DataFile' header), "
+        "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd), VTKHDF (.vtkhdf/.hdf) or a native "
+        "uvr mesh (.uvrm)");
 }
 
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes) {
@@ -67,15 +74,21 @@ std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTyp
 
 void checkMeshWritable(const std::string& path) {
     const std::string ext = fileExtension(path);
-    if (ext != ".uvrm" && ext != ".vtu")
+    if (ext != ".uvrm" && ext != ".vtu" && ext != ".vtkhdf")
         throwError(ErrorKind::Argument, path,
-                   "cannot write this format: the output name must end in .uvrm (native) or .vtu");
+                   "cannot write this format: the output name must end in .uvrm (native), .vtu "
+                   "or .vtkhdf");
+    if (ext == ".vtkhdf" && !vtkHdfSupported())
+        throwError(ErrorKind::Unsupported, path,
+                   "this uvr was built without HDF5, which VTKHDF files need: install "
+                   "libhdf5-dev and rebuild");
 }
 
 void writeMesh(const Mesh& mesh, const std::string& path,
                const std::function<void(double)>& progress) {
     checkMeshWritable(path);
     if (fileExtension(path) == ".uvrm") return writeNative(mesh, path, progress);
+    if (fileExtension(path) == ".vtkhdf") return writeVtkHdf(mesh, path, progress);
     writeVtu(mesh, path, progress);
 }
 

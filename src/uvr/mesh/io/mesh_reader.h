@@ -10,7 +10,8 @@
 
 namespace uvr {
 
-/// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd: its first step, .uvrm native),
+/// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd and VTKHDF: their first step,
+/// .uvrm native),
 /// chosen by magic bytes first and extension second; throws Error naming the file on failure.
 Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 
@@ -19,12 +20,13 @@ Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 /// formats that must be read whole to know them.
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes = true);
 
-/// Writes a mesh in the format its extension names (.uvrm native or .vtu), reporting the
+/// Writes a mesh in the format its extension names (.uvrm native, .vtu or .vtkhdf), reporting the
 /// fraction of bytes written to progress (when given) as it goes; throws
 /// Error(Argument) for other extensions. The file is written atomically.
 void writeMesh(const Mesh& mesh, const std::string& path,
                const std::function<void(double)>& progress = {});
-/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm or .vtu):
+/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm, .vtu or
+/// .vtkhdf; Error(Unsupported) for .vtkhdf in a build without HDF5):
 /// commands call it before any heavy work.
 void checkMeshWritable(const std::string& path);
 

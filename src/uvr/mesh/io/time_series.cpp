@@ -16,6 +16,7 @@
 #include "uvr/core/file_util.h"
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/io/vtkhdf.h"
 
 namespace uvr {
 
@@ -259,6 +260,7 @@ std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOp
     checkRegularFile(path);
     if (fileExtension(path) == ".pvd")
         return std::make_unique<FileSeries>(path, readPvd(path), options);
+    if (looksLikeVtkHdf(path)) return openVtkHdfSeries(path, options);
     return std::make_unique<SingleFileSeries>(path, options);
 }
 
