@@ -31,9 +31,6 @@ namespace uvr {
 
 namespace {
 
-/// The 8 bytes every HDF5 file without a user block starts with.
-constexpr char kHdf5Signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
-
 bool hasVtkHdfExtension(const std::string& path) {
     const std::string ext = fileExtension(path);
     return ext == ".vtkhdf" || ext == ".hdf";
@@ -76,6 +73,9 @@ void writeVtkHdf(const Mesh&, const std::string& path, const std::function<void(
 #else  // UVR_HAS_HDF5
 
 namespace {
+
+/// The 8 bytes every HDF5 file without a user block starts with.
+constexpr char kHdf5Signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
 
 // Deflate cannot expand data by more than 1032:1; a filtered dataset declaring more than that
 // over its stored bytes is refused before anything is allocated.
