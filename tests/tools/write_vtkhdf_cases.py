@@ -11,7 +11,8 @@ cell index (int32), cell 'pair' = (c, -c) (float32). A partition shifted by dx h
 moved by dx and 'cellid' = base + c.
 
 Files: mixed.vtkhdf (1.0, one partition, float64 points), parts.vtkhdf (1.0, two partitions:
-dx 0 and 10, cellid bases 0 and 100), temporal_shared.vtkhdf (2.0, three steps sharing one
+dx 0 and 10, cellid bases 0 and 100), parts_flat.vtkhdf (a partition of one triangle at z = 5,
+then the mixed one), temporal_shared.vtkhdf (2.0, three steps sharing one
 geometry; temp + 10 s and cellid + 100 s per step), temporal_changing.vtkhdf (2.0, steps 0 and 1
 share the mixed partition, step 2 holds two partitions at dx 10 and 20), and bad_*.vtkhdf /
 bad_*.hdf: one defect each (the test names the message it expects).
@@ -51,6 +52,21 @@ def partition(dx, base):
         "vel": pts.astype(np.float32),
         "cellid": (base + np.arange(n)).astype(np.int32),
         "pair": np.stack([np.arange(n), -np.arange(n)], axis=1).astype(np.float32),
+    }
+
+
+def flat():
+    """A partition of one triangle (3 points), which uvr drops whole."""
+    pts = np.array([(0.0, 0.0, 5.0), (1.0, 0.0, 5.0), (0.0, 1.0, 5.0)])
+    return {
+        "points": pts,
+        "conn": np.array([0, 1, 2], dtype=np.int64),
+        "offsets": np.array([0, 3], dtype=np.int64),
+        "types": np.array([5], dtype=np.uint8),
+        "temp": pts[:, 0] + 2 * pts[:, 1] - pts[:, 2],
+        "vel": pts.astype(np.float32),
+        "cellid": np.array([7], dtype=np.int32),
+        "pair": np.array([[7, -7]], dtype=np.float32),
     }
 
 
@@ -152,6 +168,7 @@ def main():
     shifted = partition(10.0, 100)
     write_static(p("mixed.vtkhdf"), [mixed])
     write_static(p("parts.vtkhdf"), [mixed, shifted], points_dtype=np.float32)
+    write_static(p("parts_flat.vtkhdf"), [flat(), mixed])
 
     # Three steps on one geometry: temp + 10 s, cellid + 100 s.
     def fields(s, row, steps, geo):

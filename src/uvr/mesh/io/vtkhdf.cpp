@@ -20,6 +20,7 @@
 #include <hdf5.h>
 
 #include <atomic>
+#include <mutex>
 
 #include "uvr/core/output_file.h"
 #include "uvr/mesh/io/mesh_merge.h"
@@ -86,6 +87,13 @@ constexpr std::size_t kMaxStringAttribute = 4096;
 /// Turns off HDF5's printing of its error stack (its failures become uvr::Errors).
 void quietHdf5() {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+/// Serialises uvr's calls into HDF5 (several series may be read from several threads; an HDF5
+/// built without its thread-safe option allows one caller at a time).
+std::recursive_mutex& hdf5Mutex() {
+    static std::recursive_mutex mutex;
+    return mutex;
 }
 
 /// The innermost message of HDF5's error stack (what failed at the bottom), then clears it.
@@ -252,6 +260,8 @@ public:
         d.dims.resize(static_cast<std::size_t>(rank));
         check(H5Sget_simple_extent_dims(space.get(), d.dims.data(), nullptr), path_, d.name,
               "read the dimensions");
+        if (rank == 2 && d.dims[1] == 0)
+            throwParseError(path_, d.name, "expected at least one column, got none");
         H5Handle type(H5Dget_type(d.id.get()), H5Tclose);
         check(type.get(), path_, d.name, "read the type");
         d.typeClass = H5Tget_class(type.get());
@@ -463,6 +473,9 @@ struct Partition {
     std::uint64_t firstPoint = 0, firstCell = 0;  // within the step (fields add their own start)
 };
 
+/// The file's cells of a partition that were kept, when some (0D-2D cells) were dropped.
+using KeptCells = std::optional<std::vector<std::uint64_t> >;
+
 /// A point or cell field of the file.
 struct FieldDesc {
     std::string name;
@@ -492,15 +505,21 @@ public:
           fields_(std::move(fields)),
           notes_(std::move(notes)) {}
 
+    ~VtkHdfSeries() override {
+        const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
+        file_.reset();
+    }
+
     Mesh readStep(std::size_t i) override {
         checkStep(i);
+        const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
         quietHdf5();
         const BudgetedOptions budgeted(options());
         LoadBudget& budget = budgeted.budget();
         const std::uint64_t heldBefore = budget.used();
         const std::vector<Partition> parts = partitions(i, budget);
         Mesh mesh;
-        std::vector<std::vector<std::uint64_t> > kept(parts.size());
+        std::vector<KeptCells> kept(parts.size());
         for (std::size_t p = 0; p < parts.size(); ++p) {
             Mesh piece = readPartition(i, p, parts[p], budget, kept[p]);
             if (parts.size() == 1) {
@@ -521,6 +540,7 @@ public:
     std::optional<std::vector<Field> > readFieldsIfSameGeometry(std::size_t i,
                                                                 const MeshView& geometry) override {
         checkStep(i);
+        const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
         if (!lastGeometry_) return MeshSeries::readFieldsIfSameGeometry(i, geometry);
         if (!(steps_[i] == *lastGeometry_) || geometry.pointCount() != lastCounts_.first ||
             geometry.cellCount() != lastCounts_.second)
@@ -537,8 +557,8 @@ public:
             for (std::size_t k = 0; k < fields_.size(); ++k) {
                 Field& piece = pieceFields[k];
                 fields[k].components = piece.components;
-                if (piece.association == Association::Cell && !lastKept_[p].empty())
-                    keepCells(piece, lastKept_[p]);
+                if (piece.association == Association::Cell && lastKept_[p])
+                    keepCells(piece, *lastKept_[p]);
                 fields[k].values.insert(fields[k].values.end(), piece.values.begin(),
                                         piece.values.end());
             }
@@ -577,6 +597,7 @@ private:
         const std::vector<std::int64_t> points = counts("NumberOfPoints");
         const std::vector<std::int64_t> cells = counts("NumberOfCells");
         const std::vector<std::int64_t> conn = counts("NumberOfConnectivityIds");
+        budget.charge(path(), what, g.parts, sizeof(Partition));
         std::vector<Partition> parts(g.parts);
         std::uint64_t point = 0, cell = 0, id = 0;
         for (std::size_t p = 0; p < parts.size(); ++p) {
@@ -642,7 +663,7 @@ private:
     /// Partition p of step i as a mesh; kept receives the indices of the cells kept when some
     /// (0D-2D cells) are dropped, else stays empty.
     Mesh readPartition(std::size_t i, std::size_t p, const Partition& part, LoadBudget& budget,
-                       std::vector<std::uint64_t>& kept) const {
+                       KeptCells& kept) const {
         const std::string what = label(i, p);
         Mesh piece;
         // Points: read straight into the mesh's float triples.
@@ -713,9 +734,11 @@ private:
         // As in .vtu: corners of quadratic cells, voxels reordered, 0D-2D cells dropped (and
         // their cell-field tuples with them).
         appendVtkCells(cells, piece, path() + ": " + what);
-        if (piece.cellCount() != cells.types.size())
+        if (piece.cellCount() != cells.types.size()) {
+            kept.emplace();
             for (std::uint64_t c = 0; c < cells.types.size(); ++c)
-                if (vtkCellTypeInfo(cells.types[c]).volumetric) kept.push_back(c);
+                if (vtkCellTypeInfo(cells.types[c]).volumetric) kept->push_back(c);
+        }
         return piece;
     }
 
@@ -725,7 +748,7 @@ private:
     std::vector<FieldDesc> fields_;
     std::vector<std::string> notes_;
     std::optional<StepGeometry> lastGeometry_;
-    std::vector<std::vector<std::uint64_t> > lastKept_;
+    std::vector<KeptCells> lastKept_;
     std::pair<std::uint64_t, std::uint64_t> lastCounts_;
 };
 
@@ -758,6 +781,7 @@ std::vector<FieldDesc> listFields(const VtkHdfFile& file, std::vector<std::strin
 
 /// The step table of /VTKHDF/Steps, or one step covering the whole file.
 std::unique_ptr<MeshSeries> openSeries(const std::string& path, const ReadOptions& options) {
+    const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
     auto file = std::make_unique<VtkHdfFile>(path);
     const BudgetedOptions budgeted(options);
     LoadBudget& budget = budgeted.budget();
@@ -946,6 +970,7 @@ bool looksLikeVtkHdf(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     char head[8] = {};
     if (!in.read(head, sizeof head) || std::memcmp(head, kHdf5Signature, 8) != 0) return false;
+    const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
     quietHdf5();
     H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     const bool found = file.get() >= 0 && exists(file.get(), "VTKHDF");
@@ -974,6 +999,7 @@ void writeVtkHdf(const Mesh& mesh, const std::string& path,
     };
 
     // The file, in memory: /VTKHDF with Version 2.2 and Type, one partition, no Steps.
+    std::unique_lock<std::recursive_mutex> lock(hdf5Mutex());
     Hdf5Writer w(path, total + (1u << 16));
     H5Handle root = w.group(w.file(), "VTKHDF");
     {
@@ -1028,6 +1054,7 @@ void writeVtkHdf(const Mesh& mesh, const std::string& path,
 
     // The image, written atomically in chunks.
     const std::vector<char> bytes = w.image();
+    lock.unlock();
     writeOutput(path, [&](OutputFile& out) {
         constexpr std::size_t kChunk = 16u << 20;
         for (std::size_t begin = 0; begin < bytes.size(); begin += kChunk) {

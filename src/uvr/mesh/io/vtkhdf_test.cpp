@@ -51,9 +51,10 @@ std::string caseFile(const std::string& name) {
     return casesDir() + "/" + name;
 }
 
-#define REQUIRE_CASES()                                                             \
-    if (casesDir().empty()) GTEST_SKIP() << "no HDF5 in this build, or no h5py in " \
-                                            "/usr/bin/python3"
+#define REQUIRE_CASES()                                     \
+    if (casesDir().empty())                                 \
+    GTEST_SKIP() << "no HDF5 in this build, or no h5py in " \
+                    "/usr/bin/python3"
 
 // ---- The construction of write_vtkhdf_cases.py ----
 
@@ -153,6 +154,24 @@ TEST(VtkHdf, FileWithoutStepsIsOneStepAtTimeZero) {
     auto fields = series->readFieldsIfSameGeometry(0, mesh);
     ASSERT_TRUE(fields.has_value());
     EXPECT_EQ(fields->size(), 4u);
+    for (std::size_t k = 0; k < fields->size(); ++k)
+        EXPECT_EQ((*fields)[k].values, mesh.fields[k].values) << mesh.fields[k].name;
+}
+
+TEST(VtkHdf, PartitionOfDroppedCellsOnly) {
+    REQUIRE_CASES();
+    auto series = openMeshSeries(caseFile("parts_flat.vtkhdf"));
+    const Mesh mesh = series->readStep(0);
+    ASSERT_EQ(mesh.pointCount(), 17u);  // the triangle's 3 points stay, unused
+    ASSERT_EQ(mesh.cellCount(), 5u);
+    EXPECT_EQ(mesh.points[2].z, 5.f);
+    const Field& cellid = field(mesh, "cellid", Association::Cell);
+    ASSERT_EQ(cellid.values.size(), 5u);
+    EXPECT_EQ(cellid.values[0], 0.f);  // the triangle's 7 is dropped with it
+    EXPECT_EQ(mesh.cell(0)[0], 3u);    // the mixed partition's ids follow the 3 points
+    // The field-only path drops the same tuples.
+    auto fields = series->readFieldsIfSameGeometry(0, mesh);
+    ASSERT_TRUE(fields.has_value());
     for (std::size_t k = 0; k < fields->size(); ++k)
         EXPECT_EQ((*fields)[k].values, mesh.fields[k].values) << mesh.fields[k].name;
 }
