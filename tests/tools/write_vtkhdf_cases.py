@@ -213,6 +213,14 @@ def main():
                  edit=replace("NumberOfCells", np.array([12], dtype=np.int64)))
     write_static(p("bad_absurd_count.vtkhdf"), [mixed],
                  edit=replace("NumberOfPoints", np.array([10**15], dtype=np.int64)))
+    def sparse_points(root):
+        # A billion rows declared, one chunk stored: the rest would read as fill values.
+        del root["Points"], root["NumberOfPoints"]
+        d = root.create_dataset("Points", shape=(10**9, 3), dtype="f4", chunks=(1024, 3))
+        d[0:14] = mixed["points"]
+        root["NumberOfPoints"] = np.array([10**9], dtype=np.int64)
+
+    write_static(p("bad_sparse_points.vtkhdf"), [mixed], edit=sparse_points)
     write_static(p("bad_cell_type.vtkhdf"), [mixed],
                  edit=replace("Types", np.array([12, 13, 10, 14, 5, 200], dtype=np.uint8)))
     write_static(p("bad_points_shape.vtkhdf"), [mixed],

@@ -279,6 +279,9 @@ TEST(VtkHdf, BadInputsGetClearErrors) {
         {"bad_absurd_count.vtkhdf",
          ErrorKind::Parse,
          {"/VTKHDF/Points", "has 14 rows", "needs rows [0, 1000000000000000)"}},
+        {"bad_sparse_points.vtkhdf",
+         ErrorKind::Parse,
+         {"/VTKHDF/Points", "needs 1000000000 rows of 12 bytes", "stores only 12288 bytes"}},
         {"bad_cell_type.vtkhdf", ErrorKind::Parse, {"cell 5", "unknown VTK cell type 200"}},
         {"bad_points_shape.vtkhdf", ErrorKind::Parse, {"/VTKHDF/Points", "N x 3"}},
     };
