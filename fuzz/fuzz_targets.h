@@ -21,7 +21,9 @@
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
+#include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/io/vtk_legacy.h"
+#include "uvr/mesh/io/vtkhdf.h"
 #include "uvr/mesh/io/vtu.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/procedural.h"
@@ -34,6 +36,9 @@
 #ifdef UVR_HAVE_NETCDF
 #include "../tests/exodus_file_writer.h"
 #include "uvr/mesh/io/exodus.h"
+#endif
+#ifdef UVR_HAS_HDF5
+#include "fuzz_vtkhdf_input.h"
 #endif
 
 #ifdef UVR_HAS_SERVER
@@ -133,6 +138,26 @@ inline void fuzzNative(const std::uint8_t* data, std::size_t size) {
     const std::string path = writeInput("input.uvrm", data, size);
     expectCleanError([&] { useMesh(readNative(path, fuzzReadOptions()), path); });
 }
+
+#ifdef UVR_HAS_HDF5
+/// VTKHDF reader, structured: the bytes describe partitions, cells, offsets, fields and steps of
+/// a file written through HDF5 (fuzz_vtkhdf_input.h); every step is read and handed to the
+/// field-only path with the other steps.
+inline void fuzzVtkHdf(const std::uint8_t* data, std::size_t size) {
+    const std::vector<std::uint8_t> image = vtkHdfImage(data, size);
+    const std::string path = writeInput("input.vtkhdf", image.data(), image.size());
+    std::unique_ptr<MeshSeries> series;
+    expectCleanError([&] { series = openVtkHdfSeries(path, fuzzReadOptions()); });
+    for (std::size_t s = 0; series && s < series->stepCount() && s < 4; ++s) {
+        expectCleanError([&] {
+            const Mesh mesh = series->readStep(s);
+            useMesh(mesh, path);
+            for (std::size_t t = 0; t < series->stepCount() && t < 4; ++t)
+                expectCleanError([&] { (void)series->readFieldsIfSameGeometry(t, mesh); });
+        });
+    }
+}
+#endif
 
 /// ParaView colour-map JSON import, then the baked table.
 inline void fuzzColormapJson(const std::uint8_t* data, std::size_t size) {
@@ -390,7 +415,8 @@ inline void fuzzViewMessage(const std::uint8_t* data, std::size_t size) {
     }
     expectCleanError([&] {
         validateSettings(server::frameSettings(state, RenderSettings{}, 3));
-        const std::string tf = paraViewColorMapJson(state.tf, state.range.first, state.range.second);
+        const std::string tf =
+            paraViewColorMapJson(state.tf, state.range.first, state.range.second);
         (void)parseParaViewColorMap({tf.begin(), tf.end()}, "export").bake(64);
         const std::string pvcc = pvccText(state.camera);
         (void)parsePvcc({pvcc.begin(), pvcc.end()}, "export");
@@ -405,19 +431,23 @@ struct FuzzTarget {
 };
 
 /// Every fuzz target.
-inline constexpr FuzzTarget kFuzzTargets[] = {{"vtk_legacy", fuzzVtkLegacy},
-                                              {"vtu", fuzzVtu},
-                                              {"pvtu", fuzzPvtu},
-                                              {"native", fuzzNative},
-                                              {"colormap_json", fuzzColormapJson},
-                                              {"pvcc", fuzzPvcc},
-                                              {"specs", fuzzSpecs},
-                                              {"render", fuzzRender},
+inline constexpr FuzzTarget kFuzzTargets[] = {
+    {"vtk_legacy", fuzzVtkLegacy},
+    {"vtu", fuzzVtu},
+    {"pvtu", fuzzPvtu},
+    {"native", fuzzNative},
+    {"colormap_json", fuzzColormapJson},
+    {"pvcc", fuzzPvcc},
+    {"specs", fuzzSpecs},
+    {"render", fuzzRender},
 #ifdef UVR_HAVE_NETCDF
-                                              {"exodus", fuzzExodus},
+    {"exodus", fuzzExodus},
+#endif
+#ifdef UVR_HAS_HDF5
+    {"vtkhdf", fuzzVtkHdf},
 #endif
 #ifdef UVR_HAS_SERVER
-                                              {"view_message", fuzzViewMessage},
+    {"view_message", fuzzViewMessage},
 #endif
 };
 

@@ -14,12 +14,15 @@ set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs fuzz_render fuzz_view_message"
+# The VTKHDF target exists where HDF5 does (libhdf5-dev; CMake's UVR_ENABLE_HDF5).
+pkg-config --exists hdf5 2>/dev/null && ALL="$ALL fuzz_vtkhdf"
+pkg-config --exists netcdf 2>/dev/null && ALL="$ALL fuzz_exodus"
 ci=0
 if [ "${1:-}" = "--ci" ]; then
   ci=1
   total=${2:-60}
   set -- $ALL
-  per=$((total / 9))
+  per=$((total / $#))
 else
   per=${1:?usage: scripts/fuzz.sh SECONDS [TARGET...] | scripts/fuzz.sh --ci [SECONDS]}
   shift

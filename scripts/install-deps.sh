@@ -11,7 +11,8 @@
 # python3-matplotlib draws the benchmark figures (bench/plot_bench.py) and reads PNGs in the
 # Python tests; liblz4-dev and liblzma-dev read and write LZ4/LZMA-compressed .vtu (optional);
 # libnetcdf-dev reads Exodus II files, and mayavi2 ships ParaView's disk_out_ref.ex2 the Exodus
-# tests read.
+# tests read; libhdf5-dev reads and writes VTKHDF files (optional in CMake) and python3-h5py
+# writes their test files.
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
@@ -25,7 +26,8 @@ PACKAGES="g++ cmake make pkg-config
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage
   python3-dev pybind11-dev python3-pytest python3-matplotlib
   xvfb xauth
-  chromium chromium-driver python3-selenium"
+  chromium chromium-driver python3-selenium
+  libhdf5-dev python3-h5py"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -66,7 +66,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
     auto csv = std::make_shared<std::string>();
     auto json = std::make_shared<std::string>();
     auto images = std::make_shared<std::string>();
-    cmd->add_option("FILE", *file, "Mesh file (.vtk, .vtu, .pvtu, .uvrm)")->required();
+    cmd->add_option("FILE", *file, kMeshFileHelp)->required();
     flags->registerOn(*cmd, false);
     cmd->add_option("--repeat", *repeat, "Timed frames per configuration (median reported)")
         ->capture_default_str()

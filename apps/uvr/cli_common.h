@@ -143,6 +143,11 @@ struct RenderFlags {
 std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
                                        const RendererOptions& options, const Context& ctx);
 
+/// Help text of every command's mesh FILE argument.
+inline constexpr const char* kMeshFileHelp =
+    "Mesh file (.vtk, .vtu, .pvtu, .vtkhdf, .e/.exo/.ex2 Exodus II, .pvd, .uvrm) or a quoted "
+    "numbered series ('run_*.vtu')";
+
 /// Which time step of a series a command reads: --time T (the last step at or before T, as
 /// ParaView snaps) or --step-index I; neither: the first.
 struct StepFlags {

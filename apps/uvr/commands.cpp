@@ -142,10 +142,7 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
     auto json = std::make_shared<bool>(false);
     auto full = std::make_shared<bool>(false);
     auto steps = std::make_shared<StepFlags>();
-    cmd->add_option("FILE", *file,
-                    "Mesh file (.vtk, .vtu, .pvtu, .pvd, .uvrm) or a quoted numbered series "
-                    "('run_*.vtu')")
-        ->required();
+    cmd->add_option("FILE", *file, kMeshFileHelp)->required();
     cmd->add_flag("--json", *json, "Print JSON instead of text");
     steps->registerOn(*cmd);
     cmd->add_flag("--full", *full,
@@ -251,10 +248,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     auto steps = std::make_shared<StepFlags>();
-    cmd->add_option("FILE", *file,
-                    "Mesh file (.vtk, .vtu, .pvtu, .pvd, .uvrm) or a quoted numbered series "
-                    "('run_*.vtu')")
-        ->required();
+    cmd->add_option("FILE", *file, kMeshFileHelp)->required();
     flags->registerOn(*cmd);
     steps->registerOn(*cmd);
     cmd->callback([file, flags, steps, &ctx] {
@@ -315,12 +309,13 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
 void addConvertCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "convert",
-        "Convert a mesh between formats (any readable format to .uvrm, .vtu or legacy .vtk)");
+        "Convert a mesh between formats (any readable format to .uvrm, .vtu, legacy .vtk or "
+        ".vtkhdf)");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     auto compress = std::make_shared<std::string>();
     cmd->add_option("IN", *in, "Input mesh")->required();
-    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu or .vtk legacy binary)")
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu, .vtk legacy binary or .vtkhdf)")
         ->required();
     cmd->add_option("--compress", *compress,
                     "Compression of a .vtu output: none, zlib (the default), lz4 (faster, larger) "
@@ -348,7 +343,7 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     auto fields = std::make_shared<std::vector<std::string>>();
     cmd->add_option("SHAPE", *shape, "box, shell (hollow, non-convex) or graded (100x cell sizes)")
         ->capture_default_str();
-    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu or .vtk)")->required();
+    cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu, .vtk or .vtkhdf)")->required();
     cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
@@ -435,7 +430,8 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
     auto levels = std::make_shared<int>(1);
     auto threads = std::make_shared<int>(0);
     cmd->add_option("IN", *in, "Input mesh")->required();
-    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu or .vtk legacy)")->required();
+    cmd->add_option("OUT", *out, "Output mesh (.uvrm native, .vtu, .vtk legacy or .vtkhdf)")
+        ->required();
     cmd->add_option("--levels", *levels, "Refinement levels (x8 tetrahedra each)")
         ->capture_default_str()
         ->check(CLI::Range(0, kMaxRefineLevels));

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
     // Ctrl-C or a kill leaves no temporary output behind; a closed pipe is a write error.
     installOutputSignalHandlers();
     CLI::App app{
-        "uvr: GPU-ready renderer for unstructured volume meshes (VTK .vtk/.vtu/.pvtu, "
+        "uvr: GPU-ready renderer for unstructured volume meshes (VTK .vtk/.vtu/.pvtu/.vtkhdf, "
         "native .uvrm)",
         "uvr"};
     app.require_subcommand(1);

@@ -57,8 +57,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     auto token = std::make_shared<std::string>();
     auto steps = std::make_shared<StepFlags>();
     cmd->add_option("FILE", *file,
-                    "Mesh file (.vtk, .vtu, .pvtu, .pvd, .uvrm) or a quoted numbered series "
-                    "('run_*.vtu'): the page gets a time slider for a series")
+                    std::string(kMeshFileHelp) + ": the page gets a time slider for a series")
         ->required();
     flags->registerOn(*cmd, /*oneFrame=*/false);
     steps->registerOn(*cmd);

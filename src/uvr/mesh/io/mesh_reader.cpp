@@ -11,13 +11,14 @@
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/io/vtk_compression.h"
 #include "uvr/mesh/io/vtk_legacy.h"
+#include "uvr/mesh/io/vtkhdf.h"
 #include "uvr/mesh/io/vtu.h"
 
 namespace uvr {
 
 namespace {
 
-enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Exodus, Unknown };
+enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Exodus, VtkHdf, Unknown };
 
 Format sniffFormat(const std::string& path) {
     checkRegularFile(path);
@@ -34,6 +35,8 @@ Format sniffFormat(const std::string& path) {
         text.find("type=\"Collection\"") != std::string::npos)
         return Format::Pvd;
     if (text.find("<VTKFile") != std::string::npos) return Format::Vtu;
+    // VTKHDF: an .vtkhdf/.hdf name, or HDF5 with a /VTKHDF group (netCDF-4 files are HDF5 too).
+    if (looksLikeVtkHdf(path)) return Format::VtkHdf;
     const std::string ext = fileExtension(path);
     if (ext == ".vtk") return Format::Legacy;
     if (ext == ".vtu") return Format::Vtu;
@@ -59,13 +62,15 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
             return readNative(path, options);
         case Format::Exodus:  // its first time step
             return readExodus(path, options);
+        case Format::VtkHdf:
+            return readVtkHdf(path, options);
         case Format::Unknown:
             break;
     }
     throwError(ErrorKind::Parse, path,
                "unrecognised file format: expected a legacy VTK file ('# vtk DataFile' header), "
-               "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd), Exodus II (.e/.exo/.ex2/.g) or "
-               "a native uvr mesh (.uvrm)");
+               "VTK XML (.vtu/.pvtu), a ParaView collection (.pvd), Exodus II (.e/.exo/.ex2/.g), "
+               "VTKHDF (.vtkhdf/.hdf) or a native uvr mesh (.uvrm)");
 }
 
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes) {
@@ -75,10 +80,14 @@ std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTyp
 
 void checkMeshWritable(const std::string& path, const MeshWriteOptions& options) {
     const std::string ext = fileExtension(path);
-    if (ext != ".uvrm" && ext != ".vtu" && ext != ".vtk")
+    if (ext != ".uvrm" && ext != ".vtu" && ext != ".vtk" && ext != ".vtkhdf")
         throwError(ErrorKind::Argument, path,
-                   "cannot write this format: the output name must end in .uvrm (native), .vtu "
-                   "or .vtk (legacy)");
+                   "cannot write this format: the output name must end in .uvrm (native), .vtu, "
+                   ".vtk (legacy) or .vtkhdf");
+    if (ext == ".vtkhdf" && !vtkHdfSupported())
+        throwError(ErrorKind::Unsupported, path,
+                   "this uvr was built without HDF5, which VTKHDF files need: install "
+                   "libhdf5-dev and rebuild");
     if (options.compressor && ext != ".vtu")
         throwError(ErrorKind::Argument, path,
                    "a compressor applies to .vtu output only, not to " + ext);
@@ -91,6 +100,7 @@ void writeMesh(const Mesh& mesh, const std::string& path,
     const std::string ext = fileExtension(path);
     if (ext == ".uvrm") return writeNative(mesh, path, progress);
     if (ext == ".vtk") return writeVtkLegacy(mesh, path, progress);
+    if (ext == ".vtkhdf") return writeVtkHdf(mesh, path, progress);
     VtuWriteOptions vtu;
     if (options.compressor) vtu.compressor = *options.compressor;
     writeVtu(mesh, path, progress, vtu);

@@ -11,9 +11,9 @@
 
 namespace uvr {
 
-/// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd and Exodus II: their first step,
-/// .uvrm native), chosen by magic bytes first and extension second; throws Error naming the file
-/// on failure.
+/// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd, Exodus II and VTKHDF: their
+/// first step, .uvrm native), chosen by magic bytes first and extension second; throws Error
+/// naming the file on failure.
 Mesh readMesh(const std::string& path, const ReadOptions& options = {});
 
 /// The counts, cell types and fields of a file whose format has a header that holds them (.uvrm),
@@ -26,14 +26,15 @@ struct MeshWriteOptions {
     std::optional<VtuCompressor> compressor;
 };
 
-/// Writes a mesh in the format its extension names (.uvrm native, .vtu, .vtk legacy binary),
-/// reporting the fraction of bytes written to progress (when given) as it goes; throws
+/// Writes a mesh in the format its extension names (.uvrm native, .vtu, .vtk legacy binary or
+/// .vtkhdf), reporting the fraction of bytes written to progress (when given) as it goes; throws
 /// Error(Argument) for other extensions. The file is written atomically.
 void writeMesh(const Mesh& mesh, const std::string& path,
                const std::function<void(double)>& progress = {},
                const MeshWriteOptions& options = {});
-/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm, .vtu or
-/// .vtk) with these options: commands call it before any heavy work.
+/// Throws Error(Argument) naming path unless writeMesh can write its format (.uvrm, .vtu, .vtk or
+/// .vtkhdf; Error(Unsupported) for .vtkhdf in a build without HDF5) with these options: commands
+/// call it before any heavy work.
 void checkMeshWritable(const std::string& path, const MeshWriteOptions& options = {});
 
 }  // namespace uvr

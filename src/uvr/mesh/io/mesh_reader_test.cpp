@@ -64,7 +64,8 @@ TEST(MeshReader, WritesVtuAndLegacyVtkByExtensionWithTheirOptions) {
         checkMeshWritable(dir + "/spx.obj");
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("must end in .uvrm (native), .vtu or .vtk (legacy)"),
+        EXPECT_NE(std::string(e.what()).find(
+                      "must end in .uvrm (native), .vtu, .vtk (legacy) or .vtkhdf"),
                   std::string::npos)
             << e.what();
     }

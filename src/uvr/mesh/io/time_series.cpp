@@ -17,6 +17,7 @@
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/vtk_number.h"
+#include "uvr/mesh/io/vtkhdf.h"
 
 namespace uvr {
 
@@ -278,6 +279,7 @@ std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOp
     fileSize(path);  // a missing or unreadable file is named now, not at the first step
     if (isCollection(path)) return std::make_unique<FileSeries>(path, readPvd(path), options);
     if (looksLikeExodus(fileHead(path), path)) return openExodus(path, options);
+    if (looksLikeVtkHdf(path)) return openVtkHdfSeries(path, options);
     return std::make_unique<SingleFileSeries>(path, options);
 }
 
