@@ -19,7 +19,9 @@ constexpr int kPolyhedronType = 42;
 /// (longest edge)^3 comes from a degenerate face triangle and is left out (tetrahedralize's rule).
 constexpr double kZeroVolumeRelative = 1e-7;
 
-std::string cellLabel(std::uint64_t c) { return "cell " + std::to_string(c) + " (polyhedron)"; }
+std::string cellLabel(std::uint64_t c) {
+    return "cell " + std::to_string(c) + " (polyhedron)";
+}
 
 /// Checks one polyhedron's face stream [nFaces, n0, ids..., n1, ids...] and returns its number
 /// of face triangles (sum of n_i - 2); throws Error(Parse) for a malformed stream and
@@ -78,7 +80,7 @@ double det6(const double a[3], const double b[3], const double c[3], const doubl
 /// What decomposing the polyhedra of one appendVtkCells call produced.
 struct PolyhedraStats {
     std::uint64_t polyhedra = 0, tets = 0, inverted = 0, degenerate = 0;
-    std::vector<std::uint32_t> vertices;        ///< distinct vertices of each polyhedron
+    std::vector<std::uint32_t> vertices;          ///< distinct vertices of each polyhedron
     std::vector<std::uint64_t> vertexOffsets{0};  ///< polyhedra + 1 entries into vertices
 };
 
@@ -308,8 +310,8 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
                            " points added; point fields there are the mean of the vertex "
                            "values; docs/METHOD.md, Polyhedra)";
         if (poly.degenerate)
-            note += "; " + std::to_string(poly.degenerate) +
-                    " degenerate face triangle(s) left out";
+            note +=
+                "; " + std::to_string(poly.degenerate) + " degenerate face triangle(s) left out";
         mesh.notes.push_back(note);
         if (poly.inverted)
             mesh.notes.push_back(
