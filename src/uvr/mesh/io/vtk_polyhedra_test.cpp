@@ -183,6 +183,24 @@ TEST(VtkPolyhedra, PolyhedralGridRendersLikeHexahedra) {
     EXPECT_THAT(log, HasSubstr("27 polyhedra decomposed into 324 tetrahedra"));
 }
 
+TEST(VtkPolyhedra, SmallVtkWrittenFilesInTestData) {
+    // A cube and a pyramid as polyhedra sharing a square, a tetrahedron on a pyramid triangle
+    // (VTK 9.1's ascii writers; the fuzz targets' seeds too). VTK's volumes: 1, 1/6, 1/3.
+    for (const char* name : {"vtk/polyhedra.vtk", "vtk/polyhedra.vtu"}) {
+        SCOPED_TRACE(name);
+        const Mesh m = readMesh(testing::testData(name));
+        ASSERT_EQ(m.cellCount(), 12u + 1u + 6u);
+        const Field* c = m.findField("c", Association::Cell);
+        ASSERT_NE(c, nullptr);
+        std::map<float, double> volume;
+        for (std::uint64_t t = 0; t < m.cellCount(); ++t) volume[c->values[t]] += tetVolume(m, t);
+        EXPECT_NEAR(volume[1.f], 1.0, 1e-6);
+        EXPECT_NEAR(volume[11.f], 1.0 / 6.0, 1e-6);
+        EXPECT_NEAR(volume[21.f], 1.0 / 3.0, 1e-6);
+        EXPECT_EQ(boundaryFaces(m), 10u + 3u + 3u);
+    }
+}
+
 // ---- hand-made files ----
 
 /// A legacy file of 8 cube corners and the given CELLS lines (count, size, records).
