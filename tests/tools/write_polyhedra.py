@@ -12,7 +12,8 @@ Writes, each as VTU (ascii, binary, appended) and legacy VTK (5.1 and 4.2, ASCII
                 through each square's smallest point index), plus an octahedron polyhedron with
                 a tetrahedron on one face.
 Point field 'f' = x + 2y - z, cell field 'id' = the cell's index. For mixed, also
-mixed_volumes.txt: VTK's volume of each cell (vtkCellSizeFilter). Needs python3-vtk9.
+mixed_volumes.txt: VTK's volume of each cell (vtkCellSizeFilter), and
+mixed_pieces.vtu: three <Piece>s. Needs python3-vtk9.
 """
 import os
 import sys
@@ -137,6 +138,13 @@ def main():
     cell(vtk.VTK_TETRA, [xp, yp, zp, p(o[0] + 1, o[1] + 1, o[2] + 1)])
     add_fields(ug)
     write_all(ug, out, "mixed")
+    # Three <Piece>s in one file (VTK 9.1's writer repeats the whole grid in each).
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(os.path.join(out, "mixed_pieces.vtu"))
+    w.SetInputData(ug)
+    w.SetNumberOfPieces(3)
+    w.SetDataModeToBinary()
+    assert w.Write() == 1
     sizes = vtk.vtkCellSizeFilter()
     sizes.SetInputData(ug)
     sizes.ComputeVolumeOn()

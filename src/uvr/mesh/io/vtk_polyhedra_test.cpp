@@ -134,6 +134,19 @@ TEST(VtkPolyhedra, MixedMeshMatchesVtkVolumesFieldsAndNeighbours) {
     }
 }
 
+TEST(VtkPolyhedra, PiecesOffsetTheFaceStreamsPointIndices) {
+    REQUIRE_POLY_DIR();
+    // Each Piece holds the whole mixed mesh: its face streams must index its own points (the
+    // earlier Pieces' copies, at the same positions, would leave these unused).
+    const Mesh m = readMesh(polyDir() + "/mixed_pieces.vtu");
+    EXPECT_EQ(m.cellCount(), 3u * 207u);
+    EXPECT_EQ(m.pointCount(), 3u * 93u);
+    const ValidationReport report = validateMesh(m);
+    EXPECT_EQ(report.unusedPoints, 0u);
+    EXPECT_EQ(report.coincidentPoints, 2u * 93u);
+    EXPECT_EQ(report.invertedCells + report.zeroVolumeCells, 0u);
+}
+
 TEST(VtkPolyhedra, CubeGridAsPolyhedraEqualsHexahedra) {
     REQUIRE_POLY_DIR();
     const Mesh hex = readMesh(polyDir() + "/cubes_hex_binary.vtu");
