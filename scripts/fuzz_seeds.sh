@@ -15,7 +15,7 @@ data=${3:-$root/../shared/data}
 export ASAN_OPTIONS=detect_leaks=0
 for t in vtk_legacy vtu pvtu native colormap_json pvcc specs render view_message vtkhdf exodus; do mkdir -p "$out/$t"; done
 for t in colormap_json pvcc specs pvtu render view_message vtkhdf exodus; do cp "$root/fuzz/seeds/$t/"* "$out/$t/"; done
-# Hand-made files with signed counts, exponent forms and nan (tests/data/vtk/).
+# Hand-made files with signed counts, exponent forms and nan, and small polyhedra (tests/data/vtk/).
 cp "$root/tests/data/vtk/"*.vtu "$out/vtu/"
 cp "$root/tests/data/vtk/"*.vtk "$out/vtk_legacy/"
 
@@ -53,6 +53,10 @@ if /usr/bin/python3 -c 'import vtk, meshio' 2>/dev/null; then
   for f in "$tmp"/vtu/*.vtu; do cp "$f" "$out/vtu/"; done
   # The parallel file, pointed at the piece the pvtu target writes beside its input.
   sed 's/Source="[^"]*"/Source="piece0.vtu"/g' "$tmp/vtu/three.pvtu" > "$out/pvtu/vtk_three.pvtu"
+  # Polyhedra (VTK type 42) with hexahedra, wedges, pyramids and a tetrahedron.
+  /usr/bin/python3 "$root/tests/tools/write_polyhedra.py" "$tmp/poly" >/dev/null
+  for f in "$tmp"/poly/mixed_*.vtu; do cp "$f" "$out/vtu/poly_${f##*/}"; done
+  for f in "$tmp"/poly/mixed_*.vtk; do cp "$f" "$out/vtk_legacy/poly_${f##*/}"; done
   for v in 42 51; do
     for mode in ascii binary; do
       /usr/bin/python3 "$root/tests/tools/write_legacy_vtk.py" "$tmp/l.vtk" $v $mode >/dev/null

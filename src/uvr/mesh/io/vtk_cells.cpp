@@ -1,26 +1,207 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/mesh/io/vtk_cells.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
+#include <span>
 
 #include "uvr/core/error.h"
 
 namespace uvr {
 
-void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& file) {
+namespace {
+
+constexpr int kPolyhedronType = 42;
+
+/// A tetrahedron of a polyhedron's decomposition whose |6V| is below this fraction of its
+/// (longest edge)^3 comes from a degenerate face triangle and is left out (tetrahedralize's rule).
+constexpr double kZeroVolumeRelative = 1e-7;
+
+std::string cellLabel(std::uint64_t c) {
+    return "cell " + std::to_string(c) + " (polyhedron)";
+}
+
+/// Checks one polyhedron's face stream [nFaces, n0, ids..., n1, ids...] and returns its number
+/// of face triangles (sum of n_i - 2); throws Error(Parse) for a malformed stream and
+/// Error(Validation) for a point index outside [0, pointCount).
+std::uint64_t checkFaceStream(std::span<const std::int64_t> s, std::uint64_t c,
+                              std::uint64_t pointCount, const std::string& file) {
+    auto fail = [&](ErrorKind kind, const std::string& what) {
+        throwError(kind, file, cellLabel(c) + ": " + what);
+    };
+    if (s.empty()) fail(ErrorKind::Parse, "empty face stream, expected a face count first");
+    const std::int64_t faces = s[0];
+    if (faces < 4)
+        fail(ErrorKind::Parse, "face count " + std::to_string(faces) + ", expected at least 4");
+    // Each face needs at least 4 entries (its count and 3 points).
+    if (static_cast<std::uint64_t>(faces) > (s.size() - 1) / 4)
+        fail(ErrorKind::Parse, "face count " + std::to_string(faces) +
+                                   " does not fit its face stream of " + std::to_string(s.size()) +
+                                   " entries");
+    std::uint64_t k = 1, triangles = 0;
+    for (std::int64_t f = 0; f < faces; ++f) {
+        const std::string face = "face " + std::to_string(f) + " of " + std::to_string(faces);
+        if (k >= s.size())
+            fail(ErrorKind::Parse, face + " starts past the end of the face stream of " +
+                                       std::to_string(s.size()) + " entries");
+        const std::int64_t n = s[k];
+        if (n < 3)
+            fail(ErrorKind::Parse,
+                 face + " lists " + std::to_string(n) + " points, expected at least 3");
+        if (static_cast<std::uint64_t>(n) > s.size() - k - 1)
+            fail(ErrorKind::Parse, face + " lists " + std::to_string(n) +
+                                       " points, past the end of the face stream of " +
+                                       std::to_string(s.size()) + " entries");
+        for (std::int64_t j = 1; j <= n; ++j) {
+            const std::int64_t id = s[k + j];
+            if (id < 0 || static_cast<std::uint64_t>(id) >= pointCount)
+                fail(ErrorKind::Validation, face + ": point index " + std::to_string(id) +
+                                                " out of range [0, " + std::to_string(pointCount) +
+                                                ")");
+        }
+        triangles += static_cast<std::uint64_t>(n) - 2;
+        k += static_cast<std::uint64_t>(n) + 1;
+    }
+    if (k != s.size())
+        fail(ErrorKind::Parse, "its " + std::to_string(faces) + " faces use " + std::to_string(k) +
+                                   " entries of a face stream of " + std::to_string(s.size()));
+    return triangles;
+}
+
+double det6(const double a[3], const double b[3], const double c[3], const double d[3]) {
+    const double bx = b[0] - a[0], by = b[1] - a[1], bz = b[2] - a[2];
+    const double cx = c[0] - a[0], cy = c[1] - a[1], cz = c[2] - a[2];
+    const double dx = d[0] - a[0], dy = d[1] - a[1], dz = d[2] - a[2];
+    return bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx);
+}
+
+/// What decomposing the polyhedra of one appendVtkCells call produced.
+struct PolyhedraStats {
+    std::uint64_t polyhedra = 0, tets = 0, inverted = 0, degenerate = 0;
+    std::vector<std::uint32_t> vertices;          ///< distinct vertices of each polyhedron
+    std::vector<std::uint64_t> vertexOffsets{0};  ///< polyhedra + 1 entries into vertices
+};
+
+/// Decomposes one (checked) polyhedron: a new point at the mean of its distinct vertices, each
+/// face fanned from its smallest point index (for a quadrilateral the diagonal through it, as
+/// splitCellIntoTets splits hexahedron, wedge and pyramid faces, so neighbours agree), each
+/// triangle with the new point one tetrahedron, oriented positively when the faces wind
+/// counter-clockwise seen from outside (VTK's rule; a stream wound the other way throughout
+/// is turned). Tetrahedra of degenerate triangles are left out; those still negative (the
+/// polyhedron is not star-shaped from its centroid) are counted and kept as they are.
+void decomposePolyhedron(std::span<const std::int64_t> s, std::uint64_t c, Mesh& mesh,
+                         std::vector<std::uint64_t>& source, PolyhedraStats& stats) {
+    // Distinct vertices and their centroid.
+    const std::size_t first = stats.vertices.size();
+    const std::int64_t faces = s[0];
+    for (std::size_t k = 1; k < s.size();) {
+        const std::size_t n = static_cast<std::size_t>(s[k]);
+        for (std::size_t j = 1; j <= n; ++j)
+            stats.vertices.push_back(static_cast<std::uint32_t>(s[k + j]));
+        k += n + 1;
+    }
+    std::sort(stats.vertices.begin() + first, stats.vertices.end());
+    stats.vertices.erase(std::unique(stats.vertices.begin() + first, stats.vertices.end()),
+                         stats.vertices.end());
+    stats.vertexOffsets.push_back(stats.vertices.size());
+    double centre[3] = {0.0, 0.0, 0.0};
+    const std::size_t count = stats.vertices.size() - first;
+    for (std::size_t i = first; i < stats.vertices.size(); ++i)
+        for (int a = 0; a < 3; ++a) centre[a] += mesh.points[stats.vertices[i]][a];
+    for (double& x : centre) x /= double(count);
+    const std::uint32_t apex = static_cast<std::uint32_t>(mesh.points.size());
+    mesh.points.emplace_back(float(centre[0]), float(centre[1]), float(centre[2]));
+    const double apexPos[3] = {mesh.points[apex].x, mesh.points[apex].y, mesh.points[apex].z};
+
+    // Face fans: tetrahedron (a, c, b, apex) for a counter-clockwise triangle (a, b, c).
+    struct Candidate {
+        std::uint32_t v[4];
+        double det, eps;
+    };
+    std::vector<Candidate> tets;
+    double total = 0.0;
+    std::size_t k = 1;
+    for (std::int64_t f = 0; f < faces; ++f) {
+        const std::size_t n = static_cast<std::size_t>(s[k]);
+        const std::int64_t* v = s.data() + k + 1;
+        std::size_t m = 0;
+        for (std::size_t j = 1; j < n; ++j)
+            if (v[j] < v[m]) m = j;
+        for (std::size_t j = 1; j + 1 < n; ++j) {
+            const std::uint32_t a = static_cast<std::uint32_t>(v[m]);
+            const std::uint32_t b = static_cast<std::uint32_t>(v[(m + j) % n]);
+            const std::uint32_t d = static_cast<std::uint32_t>(v[(m + j + 1) % n]);
+            Candidate t{{a, d, b, apex}, 0.0, 0.0};
+            double p[4][3];
+            for (int i = 0; i < 4; ++i)
+                for (int x = 0; x < 3; ++x) p[i][x] = i == 3 ? apexPos[x] : mesh.points[t.v[i]][x];
+            t.det = det6(p[0], p[1], p[2], p[3]);
+            double longest = 0.0;
+            for (int i = 0; i < 4; ++i)
+                for (int j2 = i + 1; j2 < 4; ++j2) {
+                    double l = 0.0;
+                    for (int x = 0; x < 3; ++x) l += (p[i][x] - p[j2][x]) * (p[i][x] - p[j2][x]);
+                    longest = std::fmax(longest, l);
+                }
+            t.eps = kZeroVolumeRelative * longest * std::sqrt(longest);
+            total += t.det;
+            tets.push_back(t);
+        }
+        k += n + 1;
+    }
+
+    // A stream wound clockwise throughout has a negative total: turn every tetrahedron.
+    const bool turn = total < 0.0;
+    for (Candidate& t : tets) {
+        if (turn) std::swap(t.v[1], t.v[2]), t.det = -t.det;
+        if (!(std::fabs(t.det) > t.eps)) {
+            ++stats.degenerate;
+            continue;
+        }
+        if (t.det < 0.0) ++stats.inverted;
+        mesh.addCell(CellType::Tetra, t.v);
+        source.push_back(c);
+        ++stats.tets;
+    }
+    ++stats.polyhedra;
+}
+
+}  // namespace
+
+void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& file,
+                    LoadBudget* budget) {
     const std::uint64_t n = cells.types.size();
     if (cells.offsets.size() != n + 1)
         throwError(ErrorKind::Parse, file,
                    "cell offsets hold " + std::to_string(cells.offsets.size()) +
                        " entries, expected " + std::to_string(n + 1) + " for " + std::to_string(n) +
                        " cells");
+    const bool separateFaces = cells.polyhedronFaces == PolyhedronFaces::Separate;
+    if (separateFaces && cells.faceOffsets.size() != n + 1)
+        throwError(ErrorKind::Parse, file,
+                   "face offsets hold " + std::to_string(cells.faceOffsets.size()) +
+                       " entries, expected " + std::to_string(n + 1) + " for " + std::to_string(n) +
+                       " cells");
     const std::uint64_t pointCount = mesh.pointCount();
-    std::vector<std::uint64_t> kept;
-    kept.reserve(n);
-    std::map<std::string, std::uint64_t> dropped, reduced;
-    std::uint64_t voxels = 0;
-    std::uint32_t ids[8];
-    const std::uint64_t firstNewCell = mesh.cellCount();
+    // The face stream of polyhedron c (its node list in legacy files).
+    auto faceStream = [&](std::uint64_t c) -> std::span<const std::int64_t> {
+        if (!separateFaces)
+            return {cells.connectivity.data() + cells.offsets[c],
+                    cells.connectivity.data() + cells.offsets[c + 1]};
+        const std::int64_t b = cells.faceOffsets[c], e = cells.faceOffsets[c + 1];
+        if (b < 0 || e < b || static_cast<std::uint64_t>(e) > cells.faces.size())
+            throwError(ErrorKind::Parse, file,
+                       cellLabel(c) + ": face stream range [" + std::to_string(b) + ", " +
+                           std::to_string(e) + ") outside the faces array of " +
+                           std::to_string(cells.faces.size()) + " entries");
+        return {cells.faces.data() + b, cells.faces.data() + e};
+    };
+
+    // Check every cell's node range and every polyhedron's face stream first, and charge what
+    // the polyhedra add before adding it.
+    std::uint64_t polyhedra = 0, polyTriangles = 0;
     for (std::uint64_t c = 0; c < n; ++c) {
         const std::int64_t begin = cells.offsets[c], end = cells.offsets[c + 1];
         if (begin < 0 || end < begin || static_cast<std::uint64_t>(end) > cells.connectivity.size())
@@ -28,15 +209,58 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
                        "cell " + std::to_string(c) + ": node range [" + std::to_string(begin) +
                            ", " + std::to_string(end) + ") outside the connectivity array of " +
                            std::to_string(cells.connectivity.size()) + " entries");
+        if (cells.types[c] != kPolyhedronType) continue;
+        if (cells.polyhedronFaces == PolyhedronFaces::None)
+            throwError(ErrorKind::Unsupported, file,
+                       "cell " + std::to_string(c) +
+                           ": polyhedron cells (type 42) need their face streams, which these "
+                           "arrays do not carry (write them to a .vtu or .vtk file)");
+        polyTriangles += checkFaceStream(faceStream(c), c, pointCount, file);
+        ++polyhedra;
+    }
+    if (polyhedra > 0) {
+        if (pointCount + polyhedra > std::numeric_limits<std::uint32_t>::max())
+            throwError(ErrorKind::Unsupported, file,
+                       "more than 4294967295 points with the polyhedra's centroids are not "
+                       "supported");
+        if (budget) {
+            std::uint64_t pointBytes = sizeof(Vec3f), cellBytes = 0;
+            for (const Field& f : mesh.fields)
+                (f.association == Association::Point ? pointBytes : cellBytes) +=
+                    sizeof(float) * static_cast<std::uint64_t>(f.components);
+            budget->charge(file, "the polyhedra's centroids", polyhedra, pointBytes);
+            budget->charge(file, "the polyhedra's tetrahedra", polyTriangles,
+                           sizeof(CellType) + sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t) +
+                               sizeof(std::uint64_t) + cellBytes);
+        }
+    }
+
+    std::vector<std::uint64_t> source;  // per added cell, its cell in `cells`
+    source.reserve(n - polyhedra + polyTriangles);
+    std::map<std::string, std::uint64_t> dropped, reduced;
+    std::uint64_t voxels = 0;
+    PolyhedraStats poly;
+    std::uint32_t ids[8];
+    const std::uint64_t firstNewCell = mesh.cellCount();
+    for (std::uint64_t c = 0; c < n; ++c) {
+        const std::int64_t begin = cells.offsets[c], end = cells.offsets[c + 1];
         const VtkCellTypeInfo info = vtkCellTypeInfo(cells.types[c]);
         if (!info.known)
             throwError(ErrorKind::Parse, file,
                        "cell " + std::to_string(c) + ": unknown VTK cell type " +
                            std::to_string(cells.types[c]));
-        if (cells.types[c] == 42)
-            throwError(
-                ErrorKind::Unsupported, file,
-                "cell " + std::to_string(c) + ": polyhedron cells (type 42) are not supported");
+        if (cells.types[c] == kPolyhedronType) {
+            if (separateFaces)  // the node list beside the faces: indices checked, not used
+                for (std::int64_t k = begin; k < end; ++k)
+                    if (cells.connectivity[k] < 0 ||
+                        static_cast<std::uint64_t>(cells.connectivity[k]) >= pointCount)
+                        throwError(ErrorKind::Validation, file,
+                                   cellLabel(c) + ": point index " +
+                                       std::to_string(cells.connectivity[k]) +
+                                       " out of range [0, " + std::to_string(pointCount) + ")");
+            decomposePolyhedron(faceStream(c), c, mesh, source, poly);
+            continue;
+        }
         if (!info.volumetric) {
             ++dropped[info.name];
             continue;
@@ -65,7 +289,7 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
             ++reduced[info.name];  // quadratic or Lagrange: its corners only
         }
         mesh.addCell(info.linear, {ids, static_cast<std::size_t>(corners)});
-        kept.push_back(c);
+        source.push_back(c);
     }
     for (const auto& [name, count] : dropped)
         mesh.notes.push_back("dropped " + std::to_string(count) + " non-volumetric " + name +
@@ -78,17 +302,56 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
             "reduced " + std::to_string(count) + " " + name +
             " cell(s) to their corner nodes: their mid-edge and higher-order nodes are used by "
             "no cell, and fields are interpolated between the corners");
-    // Filter cell data of this batch to the kept cells (tuples beyond firstNewCell belong to it).
-    if (kept.size() != n) {
+    if (poly.polyhedra) {
+        std::string note = std::to_string(poly.polyhedra) + " polyhedra decomposed into " +
+                           std::to_string(poly.tets) +
+                           " tetrahedra around their vertex centroids (" +
+                           std::to_string(poly.polyhedra) +
+                           " points added; point fields there are the mean of the vertex "
+                           "values; docs/METHOD.md, Polyhedra)";
+        if (poly.degenerate)
+            note +=
+                "; " + std::to_string(poly.degenerate) + " degenerate face triangle(s) left out";
+        mesh.notes.push_back(note);
+        if (poly.inverted)
+            mesh.notes.push_back(
+                std::to_string(poly.inverted) +
+                " tetrahedra of polyhedra not star-shaped from their vertex centroid are "
+                "inverted: validation reports them and rendering re-orients them, so those "
+                "polyhedra render with overlapping tetrahedra");
+    }
+
+    // Point fields: each centroid gets the mean of its polyhedron's vertex values.
+    if (poly.polyhedra) {
+        for (Field& f : mesh.fields) {
+            if (f.association != Association::Point) continue;
+            const std::size_t comps = static_cast<std::size_t>(f.components);
+            if (f.values.size() != pointCount * comps) continue;  // size checked by the reader
+            f.values.resize((pointCount + poly.polyhedra) * comps);
+            for (std::uint64_t p = 0; p < poly.polyhedra; ++p) {
+                const std::uint64_t b = poly.vertexOffsets[p], e = poly.vertexOffsets[p + 1];
+                for (std::size_t k = 0; k < comps; ++k) {
+                    double sum = 0.0;
+                    for (std::uint64_t i = b; i < e; ++i)
+                        sum += f.values[poly.vertices[i] * comps + k];
+                    f.values[(pointCount + p) * comps + k] = float(sum / double(e - b));
+                }
+            }
+        }
+    }
+    // Cell fields of this batch (tuples beyond firstNewCell) onto the added cells.
+    if (source.size() != n || poly.polyhedra) {
         for (Field& f : mesh.fields) {
             if (f.association != Association::Cell) continue;
             const std::size_t comps = static_cast<std::size_t>(f.components);
-            std::size_t base = firstNewCell * comps;
+            const std::size_t base = firstNewCell * comps;
             if (f.values.size() != base + n * comps) continue;  // size checked by the reader
-            for (std::size_t i = 0; i < kept.size(); ++i)
+            std::vector<float> values(base + source.size() * comps);
+            std::copy(f.values.begin(), f.values.begin() + base, values.begin());
+            for (std::size_t i = 0; i < source.size(); ++i)
                 for (std::size_t k = 0; k < comps; ++k)
-                    f.values[base + i * comps + k] = f.values[base + kept[i] * comps + k];
-            f.values.resize(base + kept.size() * comps);
+                    values[base + i * comps + k] = f.values[base + source[i] * comps + k];
+            f.values = std::move(values);
         }
     }
 }

@@ -786,8 +786,10 @@ Mesh LegacyParser::parse() {
                             sizeof(CellType) + sizeof(std::uint64_t));
     options_.budget->charge(file_, "the cell connectivity", cells_.connectivity.size(),
                             sizeof(std::uint32_t));
-    // Cells last: appendVtkCells filters the cell fields read above to the kept cells.
-    appendVtkCells(cells_, mesh_, file_);
+    // Cells last: appendVtkCells filters the cell fields read above to the kept cells. A
+    // polyhedron's node list is its face stream (what VTK writes in every file version).
+    cells_.polyhedronFaces = PolyhedronFaces::Connectivity;
+    appendVtkCells(cells_, mesh_, file_, options_.budget);
     return std::move(mesh_);
 }
 

@@ -682,6 +682,70 @@ std::unordered_map<std::string, F*> indexFields(std::vector<F>& fields) {
     return index;
 }
 
+constexpr std::int64_t kVtkPolyhedron = 42;
+
+/// Appends a Piece's polyhedron face streams to out.faces and its cells' stream ranges to
+/// out.faceOffsets (padded for the cells of earlier Pieces). VTK 9.1's layout: `faces` holds the
+/// streams [nFaces, n0, ids..., n1, ids...] of the polyhedra one after another, `faceoffsets`
+/// per cell the end of its stream, or -1 for a cell other than a polyhedron (VTK's reader reads
+/// the streams in order and checks only where the last one ends; uvr checks each).
+void readFaceStreams(const std::vector<char>& bytes, const XmlDoc& doc, const PieceDesc& p,
+                     const std::string& label, const std::vector<std::int64_t>& types,
+                     std::uint64_t pointBase, const ReadOptions& options, VtkCellArrays& out) {
+    const ArrayDesc* facesA = findArray(p, Section::Cells, "faces");
+    const ArrayDesc* endsA = findArray(p, Section::Cells, "faceoffsets");
+    if (!facesA || !endsA || !facesA->type || !endsA->type)
+        throwParseError(doc.file, atLine(p.line),
+                        label +
+                            ": polyhedron cells (type 42) need numeric <Cells> DataArrays "
+                            "'faces' and 'faceoffsets' (VTK 9.1's layout; the later "
+                            "'face_connectivity' layout is not read)");
+    const std::vector<std::int64_t> ends =
+        readArray<std::int64_t>(bytes, doc, *endsA, p.cells, options);
+    while (out.faceOffsets.size() < out.types.size() + 1)
+        out.faceOffsets.push_back(static_cast<std::int64_t>(out.faces.size()));
+    const std::int64_t faceBase = static_cast<std::int64_t>(out.faces.size());
+    options.budget->charge(doc.file, label + ": face offsets", p.cells, sizeof(std::int64_t));
+    std::int64_t previous = 0;
+    for (std::size_t c = 0; c < ends.size(); ++c) {
+        const std::string cell = "cell " + std::to_string(c);
+        if (types[c] == kVtkPolyhedron) {
+            if (ends[c] < previous)
+                throwParseError(doc.file, atLine(endsA->line),
+                                endsA->label + ": " + cell + " (polyhedron): end offset " +
+                                    std::to_string(ends[c]) +
+                                    " lies before the end of the previous face stream, " +
+                                    std::to_string(previous));
+            previous = ends[c];
+        } else if (ends[c] != -1 && ends[c] != previous) {
+            throwParseError(doc.file, atLine(endsA->line),
+                            endsA->label + ": " + cell + " (VTK type " + std::to_string(types[c]) +
+                                ") is no polyhedron, expected -1, got " + std::to_string(ends[c]));
+        }
+        out.faceOffsets.push_back(faceBase + previous);
+    }
+    std::vector<std::int64_t> faces =
+        readArray<std::int64_t>(bytes, doc, *facesA, static_cast<std::uint64_t>(previous), options);
+    // Point indices of later Pieces are offset like the connectivity's (walking each stream
+    // by its face sizes; appendVtkCells checks the streams).
+    if (pointBase > 0)
+        for (std::size_t c = 0, b = 0; c < ends.size(); ++c) {
+            if (types[c] != kVtkPolyhedron) continue;
+            const std::size_t e = static_cast<std::size_t>(ends[c]);
+            for (std::size_t k = b + 1; k < e;) {
+                const std::int64_t n = faces[k];
+                if (n < 0 || static_cast<std::uint64_t>(n) >= e - k) break;
+                for (std::size_t j = k + 1; j <= k + static_cast<std::size_t>(n); ++j)
+                    if (faces[j] >= 0) faces[j] += static_cast<std::int64_t>(pointBase);
+                k += static_cast<std::size_t>(n) + 1;
+            }
+            b = e;
+        }
+    options.budget->charge(doc.file, label + ": faces", faces.size(), sizeof(std::int64_t));
+    out.faces.insert(out.faces.end(), faces.begin(), faces.end());
+    options.budget->release((ends.size() + faces.size()) * sizeof(std::int64_t));
+}
+
 void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t index,
                const ReadOptions& options, RawGrid& grid) {
     const PieceDesc& p = doc.pieces[index];
@@ -745,6 +809,8 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
                                sizeof(std::int64_t));
         const std::int64_t connBase = static_cast<std::int64_t>(out.connectivity.size());
         if (out.offsets.empty()) out.offsets.push_back(0);
+        if (std::find(types.begin(), types.end(), kVtkPolyhedron) != types.end())
+            readFaceStreams(bytes, doc, p, label, types, pointBase, options, out);
         for (std::size_t c = 0; c < types.size(); ++c) {
             if (types[c] < 0 || types[c] > 255)
                 throwParseError(doc.file, atLine(typeA.line),
@@ -879,11 +945,14 @@ Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allow
     mesh.points = std::move(grid.points);
     mesh.fields = std::move(grid.fields);
     if (grid.cells.offsets.empty()) grid.cells.offsets.push_back(0);
+    grid.cells.polyhedronFaces = PolyhedronFaces::Separate;
+    while (grid.cells.faceOffsets.size() < grid.cells.types.size() + 1)
+        grid.cells.faceOffsets.push_back(static_cast<std::int64_t>(grid.cells.faces.size()));
     budget.charge(path, "the cells", grid.cells.types.size(),
                   sizeof(CellType) + sizeof(std::uint64_t));
     budget.charge(path, "the cell connectivity", grid.cells.connectivity.size(),
                   sizeof(std::uint32_t));
-    appendVtkCells(grid.cells, mesh, path);
+    appendVtkCells(grid.cells, mesh, path, &budget);
     budget.resetTo(heldBefore + meshBytes(mesh));  // the file and the raw cells are freed next
     return mesh;
 }
