@@ -133,6 +133,29 @@ inline void fuzzPvtu(const std::uint8_t* data, std::size_t size) {
     expectCleanError([&] { useMesh(readPvtu(path, fuzzReadOptions()), path); });
 }
 
+/// Time series: the input as a ParaView collection (input.pvd) beside a small valid step file,
+/// step0.vtu (written once per process), so that inputs naming it reach the steps; every step
+/// (the first four) is read whole and, after the first, through readFieldsIfSameGeometry.
+inline void fuzzPvd(const std::uint8_t* data, std::size_t size) {
+    static const bool stepWritten = [] {
+        ProceduralSpec spec;
+        spec.targetCells = 200;
+        spec.fields = {ProceduralField::Linear};
+        writeVtu(generateMesh(spec), scratchFolder() + "/step0.vtu");
+        return true;
+    }();
+    (void)stepWritten;
+    const std::string path = writeInput("input.pvd", data, size);
+    expectCleanError([&] {
+        const std::unique_ptr<MeshSeries> series = openMeshSeries(path, fuzzReadOptions());
+        (void)stepAtTime(series->times(), 0.5);
+        const Mesh first = series->readStep(0);
+        useMesh(first, path);
+        for (std::size_t i = 1; i < std::min<std::size_t>(series->stepCount(), 4); ++i)
+            (void)series->readFieldsIfSameGeometry(i, first);
+    });
+}
+
 /// Native .uvrm reader.
 inline void fuzzNative(const std::uint8_t* data, std::size_t size) {
     const std::string path = writeInput("input.uvrm", data, size);
@@ -435,6 +458,7 @@ inline constexpr FuzzTarget kFuzzTargets[] = {
     {"vtk_legacy", fuzzVtkLegacy},
     {"vtu", fuzzVtu},
     {"pvtu", fuzzPvtu},
+    {"pvd", fuzzPvd},
     {"native", fuzzNative},
     {"colormap_json", fuzzColormapJson},
     {"pvcc", fuzzPvcc},

@@ -13,7 +13,7 @@
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs fuzz_render fuzz_view_message"
+ALL="fuzz_vtk_legacy fuzz_vtu fuzz_pvtu fuzz_pvd fuzz_native fuzz_colormap_json fuzz_pvcc fuzz_specs fuzz_render fuzz_view_message"
 # The VTKHDF target exists where HDF5 does (libhdf5-dev; CMake's UVR_ENABLE_HDF5).
 pkg-config --exists hdf5 2>/dev/null && ALL="$ALL fuzz_vtkhdf"
 pkg-config --exists netcdf 2>/dev/null && ALL="$ALL fuzz_exodus"
@@ -61,7 +61,7 @@ for t in "$@"; do
   case $name in
     vtk_legacy|vtu|native) maxlen=1048576 ;;
     colormap_json) maxlen=262144 ;;
-    pvtu|pvcc) maxlen=65536 ;;
+    pvtu|pvd|pvcc) maxlen=65536 ;;
     specs) maxlen=4096 ;;
     view_message) maxlen=65536 ;;
     *) maxlen=2048 ;;

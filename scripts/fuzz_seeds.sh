@@ -13,8 +13,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 data=${3:-$root/../shared/data}
 # The fuzz build's CLI is instrumented; its leak checker is not what this script is about.
 export ASAN_OPTIONS=detect_leaks=0
-for t in vtk_legacy vtu pvtu native colormap_json pvcc specs render view_message vtkhdf exodus; do mkdir -p "$out/$t"; done
-for t in colormap_json pvcc specs pvtu render view_message vtkhdf exodus; do cp "$root/fuzz/seeds/$t/"* "$out/$t/"; done
+for t in vtk_legacy vtu pvtu pvd native colormap_json pvcc specs render view_message vtkhdf exodus; do mkdir -p "$out/$t"; done
+for t in colormap_json pvcc specs pvtu pvd render view_message vtkhdf exodus; do cp "$root/fuzz/seeds/$t/"* "$out/$t/"; done
 # Hand-made files with signed counts, exponent forms and nan, and small polyhedra (tests/data/vtk/).
 cp "$root/tests/data/vtk/"*.vtu "$out/vtu/"
 cp "$root/tests/data/vtk/"*.vtk "$out/vtk_legacy/"
