@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "../apps/uvr/cli_common.h"
+#include "byte_reader.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cpu/threads.h"
@@ -233,25 +234,6 @@ inline void fuzzSpecs(const std::uint8_t* data, std::size_t size) {
         }
     });
 }
-
-/// Reads the render target's input: bytes in order, then zeros once they run out.
-class ByteReader {
-public:
-    ByteReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
-    std::uint8_t byte() { return pos_ < size_ ? data_[pos_++] : 0; }
-    /// Four bytes as a float, any bit pattern (NaN, infinities, denormals, 3e38).
-    float real() {
-        std::uint8_t b[4] = {byte(), byte(), byte(), byte()};
-        float v;
-        std::memcpy(&v, b, sizeof v);
-        return v;
-    }
-
-private:
-    const std::uint8_t* data_;
-    std::size_t size_;
-    std::size_t pos_ = 0;
-};
 
 /// Most samples per ray the render target renders (a frame of 8x6 pixels under the sanitizers
 /// stays well below a second); frames estimated above it are prepared and set up, not rendered.

@@ -9,6 +9,8 @@
 
 #include <hdf5.h>
 
+#include "byte_reader.h"
+
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -16,32 +18,6 @@
 #include <vector>
 
 namespace uvr::fuzz {
-
-/// Reads the input: bytes in order, then zeros once they run out.
-class VtkHdfBytes {
-public:
-    VtkHdfBytes(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
-    std::uint8_t byte() { return pos_ < size_ ? data_[pos_++] : 0; }
-    /// A small count, usually the intended one, sometimes off by a signed byte (or absurd).
-    std::int64_t count(std::int64_t intended) {
-        const std::uint8_t b = byte();
-        if (b < 224) return intended;
-        if (b == 255) return std::int64_t(1) << 40;
-        return intended + static_cast<std::int8_t>(byte());
-    }
-    /// Four bytes as a float, any bit pattern.
-    float real() {
-        std::uint8_t b[4] = {byte(), byte(), byte(), byte()};
-        float v;
-        std::memcpy(&v, b, sizeof v);
-        return v;
-    }
-
-private:
-    const std::uint8_t* data_;
-    std::size_t size_;
-    std::size_t pos_ = 0;
-};
 
 /// Builds the in-memory HDF5 file; every HDF5 failure aborts (the input builder must not fail).
 class VtkHdfImage {
@@ -129,7 +105,7 @@ private:
 /// point and cell fields of 1 to 4 components (rows possibly short), and optionally a Steps
 /// group of 1 to 4 steps with offsets from the bytes, a Version and Type that may be wrong.
 inline std::vector<std::uint8_t> vtkHdfImage(const std::uint8_t* data, std::size_t size) {
-    VtkHdfBytes in(data, size);
+    ByteReader in(data, size);
     const std::uint8_t flags = in.byte(), more = in.byte();
     VtkHdfImage h;
     const hid_t root = h.group(h.file(), "VTKHDF");
