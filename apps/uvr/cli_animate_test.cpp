@@ -13,6 +13,8 @@
 #include "cli_test_support.h"
 #include "test_support.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/io/time_series.h"
+#include "uvr/mesh/io/vtkhdf.h"
 
 namespace uvr {
 namespace {
@@ -135,6 +137,24 @@ TEST(CliAnimate, GenerateWritesATimeSeriesOfOneGeometry) {
     const float x = c * p.x + s * p.z, z = -s * p.x + c * p.z;
     EXPECT_NEAR(m2.fields[1].values[7], x + 2.f * p.y - z, 1e-5f);
     EXPECT_NE(m0.fields[0].values, m2.fields[0].values);
+    // The same series as one temporal VTKHDF file: the geometry once, the same values per step.
+    if (!vtkHdfSupported()) GTEST_SKIP() << "built without HDF5";
+    ASSERT_EQ(
+        uvr("-q generate box --cells 3000 --fields jet,linear --steps 3 --dt 0.5 -o t.vtkhdf", dir)
+            .code,
+        0);
+    auto series = openMeshSeries(dir + "/t.vtkhdf");
+    ASSERT_EQ(series->times(), (std::vector<double>{0.0, 0.5, 1.0}));
+    const Mesh h0 = series->readStep(0);
+    EXPECT_TRUE(sameGeometry(h0, m0));
+    EXPECT_EQ(h0.fields[0].values, m0.fields[0].values);
+    const auto fields2 = series->readFieldsIfSameGeometry(2, h0);  // the values alone
+    ASSERT_TRUE(fields2.has_value());
+    ASSERT_EQ(fields2->size(), 2u);
+    EXPECT_EQ((*fields2)[0].values, m2.fields[0].values);
+    EXPECT_EQ((*fields2)[1].values, m2.fields[1].values);
+    const std::uint64_t oneStep = std::filesystem::file_size(dir + "/t_0000.uvrm");
+    EXPECT_LT(std::filesystem::file_size(dir + "/t.vtkhdf"), 2 * oneStep);  // not 3 geometries
 }
 
 TEST(CliAnimate, BadStepsAndOutputsAreRefusedBeforeRendering) {

@@ -360,9 +360,10 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     auto steps = std::make_shared<int>(1);
     auto dt = std::make_shared<double>(0.1);
     cmd->add_option("--steps", *steps,
-                    "Time steps: more than 1 writes OUT's name with _0000, _0001, ... before its "
-                    "extension, one mesh a step (the same points and cells, the fields turning "
-                    "about the y axis by --dt radians a step), and a ParaView .pvd listing them")
+                    "Time steps of one geometry, the fields turning about the y axis by --dt "
+                    "radians a step: more than 1 writes one temporal file for a .vtkhdf OUT (the "
+                    "geometry once), else OUT's name with _0000, _0001, ... before its extension, "
+                    "a mesh a step, and a ParaView .pvd listing them")
         ->capture_default_str()
         ->check(CLI::Range(1, 100000));
     cmd->add_option("--dt", *dt, "Time between steps (radians the fields turn)")
@@ -389,6 +390,27 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
         progress.done("generated " + std::to_string(mesh.pointCount()) + " points, " +
                       std::to_string(mesh.cellCount()) + " tetrahedra");
         if (*steps == 1) return writeMeshWithProgress(mesh, *out, ctx);
+        if (fileExtension(*out) == ".vtkhdf") {
+            // One temporal file: the geometry once, every step's fields.
+            std::vector<double> times;
+            for (int k = 0; k < *steps; ++k) times.push_back(*dt * k);
+            ctx.setActivity(*out, "writing the time series");
+            Progress write(ctx, "writing " + *out);
+            writeVtkHdfSeries(
+                mesh, times,
+                [&](std::size_t k) {
+                    ProceduralSpec at = *spec;
+                    at.time = times[k];
+                    Mesh stepMesh;
+                    stepMesh.points = mesh.points;  // setProceduralFields reads the points only
+                    setProceduralFields(stepMesh, at);
+                    return std::move(stepMesh.fields);
+                },
+                *out, write.callback());
+            write.done("wrote " + *out + " (" + std::to_string(*steps) +
+                       " time steps of one geometry)");
+            return;
+        }
         // A time series: one file a step and the .pvd naming them (relative to its folder).
         namespace fs = std::filesystem;
         const fs::path path(*out);

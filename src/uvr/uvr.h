@@ -15,6 +15,7 @@
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/time_series.h"
+#include "uvr/mesh/io/vtkhdf.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/mesh/refine.h"

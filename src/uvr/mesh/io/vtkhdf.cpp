@@ -71,6 +71,12 @@ void writeVtkHdf(const Mesh&, const std::string& path, const std::function<void(
     throwNoHdf5(path);
 }
 
+void writeVtkHdfSeries(const Mesh&, const std::vector<double>&,
+                       const std::function<std::vector<Field>(std::size_t)>&,
+                       const std::string& path, const std::function<void(double)>&) {
+    throwNoHdf5(path);
+}
+
 #else  // UVR_HAS_HDF5
 
 namespace {
@@ -986,19 +992,26 @@ Mesh readVtkHdf(const std::string& path, const ReadOptions& options) {
     return openSeries(path, options)->readStep(0);
 }
 
-void writeVtkHdf(const Mesh& mesh, const std::string& path,
-                 const std::function<void(double)>& progress) {
+namespace {
+
+/// Writes the file of writeVtkHdf (times null: no steps, the mesh's fields) or of
+/// writeVtkHdfSeries (every step's fields after one another, a Steps group).
+void writeVtkHdfFile(const Mesh& mesh, const std::string& path,
+                     const std::function<void(double)>& progress, const std::vector<double>* times,
+                     const std::function<std::vector<Field>(std::size_t)>& stepFields) {
     validateStructure(mesh, path);
     checkFieldNames(mesh, path);
+    const std::uint64_t steps = times ? times->size() : 1;
+    if (steps == 0) throwError(ErrorKind::Argument, path, "a time series needs a time step");
     const std::uint64_t n = mesh.pointCount(), cells = mesh.cellCount();
     const std::uint64_t ids = mesh.cellIndices.size();
     std::uint64_t total = n * 12 + cells * 9 + 8 + ids * 8;
-    for (const Field& f : mesh.fields) total += f.values.size() * 4;
+    for (const Field& f : mesh.fields) total += f.values.size() * 4 * steps;
     auto report = [&](std::uint64_t done) {
         if (progress) progress(0.5 * double(done) / double(std::max<std::uint64_t>(total, 1)));
     };
 
-    // The file, in memory: /VTKHDF with Version 2.2 and Type, one partition, no Steps.
+    // The file, in memory: /VTKHDF with Version 2.2 and Type, one partition.
     std::unique_lock<std::recursive_mutex> lock(hdf5Mutex());
     Hdf5Writer w(path, total + (1u << 16));
     H5Handle root = w.group(w.file(), "VTKHDF");
@@ -1039,15 +1052,95 @@ void writeVtkHdf(const Mesh& mesh, const std::string& path,
     w.dataset(root.get(), "Connectivity", H5T_STD_I64LE, H5T_NATIVE_UINT32, ids, 0,
               mesh.cellIndices.data());
     report(done += ids * 8);
+
+    // Fields: one dataset each, every step's rows after one another.
+    std::vector<H5Handle> datasets;
     for (Association association : {Association::Point, Association::Cell}) {
         H5Handle group =
             w.group(root.get(), association == Association::Point ? "PointData" : "CellData");
         for (const Field& f : mesh.fields) {
             if (f.association != association) continue;
-            w.dataset(group.get(), f.name, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, f.tupleCount(),
-                      f.components == 1 ? 0 : static_cast<std::uint64_t>(f.components),
-                      f.values.data());
-            report(done += f.values.size() * 4);
+            const hsize_t dims[2] = {steps * f.tupleCount(), hsize_t(f.components)};
+            H5Handle space(H5Screate_simple(f.components == 1 ? 1 : 2, dims, nullptr), H5Sclose);
+            w.ok(space.get(), "make the dataspace of " + f.name);
+            datasets.emplace_back(H5Dcreate2(group.get(), f.name.c_str(), H5T_IEEE_F32LE,
+                                             space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                                  H5Dclose);
+            w.ok(datasets.back().get(), "create dataset " + f.name);
+        }
+    }
+    // The fields in the order of the datasets: point fields, then cell fields.
+    std::vector<const Field*> order;
+    for (Association association : {Association::Point, Association::Cell})
+        for (const Field& f : mesh.fields)
+            if (f.association == association) order.push_back(&f);
+    for (std::uint64_t k = 0; k < steps; ++k) {
+        std::vector<Field> given;
+        if (times) given = stepFields(k);
+        const std::vector<Field>& fields = times ? given : mesh.fields;
+        std::vector<const Field*> stepOrder;
+        for (Association association : {Association::Point, Association::Cell})
+            for (const Field& f : fields)
+                if (f.association == association) stepOrder.push_back(&f);
+        if (stepOrder.size() != order.size())
+            throwError(ErrorKind::Argument, path,
+                       "time step " + std::to_string(k) + " has " +
+                           std::to_string(stepOrder.size()) + " fields, the first " +
+                           std::to_string(order.size()));
+        for (std::size_t i = 0; i < order.size(); ++i) {
+            const Field& f = *order[i];
+            const Field& g = *stepOrder[i];
+            if (g.name != f.name || g.components != f.components ||
+                g.values.size() != f.values.size())
+                throwError(ErrorKind::Argument, path,
+                           "time step " + std::to_string(k) + ": field '" + g.name +
+                               "' differs from the first step's '" + f.name +
+                               "' (name, components or size)");
+            const hsize_t rows = f.tupleCount();
+            const hsize_t start[2] = {k * rows, 0}, count[2] = {rows, hsize_t(f.components)};
+            const int rank = f.components == 1 ? 1 : 2;
+            H5Handle fileSpace(H5Dget_space(datasets[i].get()), H5Sclose);
+            w.ok(fileSpace.get(), "read the dataspace of " + f.name);
+            w.ok(H5Sselect_hyperslab(fileSpace.get(), H5S_SELECT_SET, start, nullptr, count,
+                                     nullptr),
+                 "select step " + std::to_string(k) + " of " + f.name);
+            H5Handle memSpace(H5Screate_simple(rank, count, nullptr), H5Sclose);
+            w.ok(memSpace.get(), "make a memory dataspace");
+            if (rows > 0)
+                w.ok(H5Dwrite(datasets[i].get(), H5T_NATIVE_FLOAT, memSpace.get(), fileSpace.get(),
+                              H5P_DEFAULT, g.values.data()),
+                     "write step " + std::to_string(k) + " of " + f.name);
+            report(done += g.values.size() * 4);
+        }
+    }
+    datasets.clear();
+
+    // The step table: one partition, the geometry shared (offsets 0), fields by step.
+    if (times) {
+        H5Handle group = w.group(root.get(), "Steps");
+        const std::int64_t nSteps = static_cast<std::int64_t>(steps);
+        H5Handle scalar(H5Screate(H5S_SCALAR), H5Sclose);
+        H5Handle attr(H5Acreate2(group.get(), "NSteps", H5T_STD_I64LE, scalar.get(), H5P_DEFAULT,
+                                 H5P_DEFAULT),
+                      H5Aclose);
+        w.ok(attr.get(), "create attribute NSteps");
+        w.ok(H5Awrite(attr.get(), H5T_NATIVE_INT64, &nSteps), "write attribute NSteps");
+        w.dataset(group.get(), "Values", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, steps, 0,
+                  times->data());
+        const std::vector<std::int64_t> zeros(steps, 0), ones(steps, 1);
+        for (const char* name :
+             {"PartOffsets", "PointOffsets", "CellOffsets", "ConnectivityIdOffsets"})
+            w.dataset(group.get(), name, H5T_STD_I64LE, H5T_NATIVE_INT64, steps, 0, zeros.data());
+        w.dataset(group.get(), "NumberOfParts", H5T_STD_I64LE, H5T_NATIVE_INT64, steps, 0,
+                  ones.data());
+        H5Handle pointOffsets = w.group(group.get(), "PointDataOffsets");
+        H5Handle cellOffsets = w.group(group.get(), "CellDataOffsets");
+        for (const Field* f : order) {
+            std::vector<std::int64_t> offsets(steps);
+            for (std::uint64_t k = 0; k < steps; ++k)
+                offsets[k] = static_cast<std::int64_t>(k * f->tupleCount());
+            w.dataset(f->association == Association::Point ? pointOffsets.get() : cellOffsets.get(),
+                      f->name, H5T_STD_I64LE, H5T_NATIVE_INT64, steps, 0, offsets.data());
         }
     }
     root.reset();
@@ -1063,6 +1156,19 @@ void writeVtkHdf(const Mesh& mesh, const std::string& path,
             if (progress) progress(0.5 + 0.5 * double(begin + size) / double(bytes.size()));
         }
     });
+}
+
+}  // namespace
+
+void writeVtkHdf(const Mesh& mesh, const std::string& path,
+                 const std::function<void(double)>& progress) {
+    writeVtkHdfFile(mesh, path, progress, nullptr, {});
+}
+
+void writeVtkHdfSeries(const Mesh& mesh, const std::vector<double>& times,
+                       const std::function<std::vector<Field>(std::size_t)>& stepFields,
+                       const std::string& path, const std::function<void(double)>& progress) {
+    writeVtkHdfFile(mesh, path, progress, &times, stepFields);
 }
 
 #endif  // UVR_HAS_HDF5

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "uvr/mesh/io/read_options.h"
 #include "uvr/mesh/io/time_series.h"
@@ -39,5 +40,15 @@ Mesh readVtkHdf(const std::string& path, const ReadOptions& options = {});
 /// Error(Argument) for field names HDF5 cannot hold ('/' or empty) or repeated.
 void writeVtkHdf(const Mesh& mesh, const std::string& path,
                  const std::function<void(double)>& progress = {});
+
+/// Writes a time series of one geometry as a temporal VTKHDF file (version 2.2, one partition):
+/// the points and cells stored once (every step's geometry offsets 0), each field one dataset
+/// holding every step's values in turn with Steps/PointDataOffsets or CellDataOffsets. mesh gives
+/// the geometry and the fields' names, associations and components (its own values are not
+/// written); stepFields(k) gives step k's fields, which must match them. Written atomically;
+/// throws Error(Argument) for mismatched or unnamable fields, or no steps.
+void writeVtkHdfSeries(const Mesh& mesh, const std::vector<double>& times,
+                       const std::function<std::vector<Field>(std::size_t)>& stepFields,
+                       const std::string& path, const std::function<void(double)>& progress = {});
 
 }  // namespace uvr
