@@ -178,14 +178,17 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                     const Mesh other = series->readStep(i);
                     values = fieldValues(other, other.fields, spec);
                 }
-                const auto [a, b] = finiteRange(values);
-                if (a <= b && std::isfinite(a)) lo = std::min(lo, a), hi = std::max(hi, b);
+                for (float v : values)  // finite values only (finiteRange gives 0, 0 for none)
+                    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
                 progress.set(double(k + 1) / double(chosen.size()));
             }
-            if (lo > hi) lo = hi = 0.f;
-            settings.range = std::pair{lo, hi};
-            progress.done("value range over the steps: [" + timeText(lo) + ", " + timeText(hi) +
-                          "] (--range sets another)");
+            if (lo < hi) {
+                settings.range = std::pair{lo, hi};
+                progress.done("value range over the steps: [" + timeText(lo) + ", " + timeText(hi) +
+                              "] (--range sets another)");
+            } else {  // constant or no finite value: each frame as `uvr render` would draw it
+                progress.done("the field has one value or none over the steps: no common range");
+            }
         }
 
         // Step 3: every step: values refreshed (or the new geometry prepared), rendered, written;

@@ -137,6 +137,13 @@ TEST(CliAnimate, GenerateWritesATimeSeriesOfOneGeometry) {
     const float x = c * p.x + s * p.z, z = -s * p.x + c * p.z;
     EXPECT_NEAR(m2.fields[1].values[7], x + 2.f * p.y - z, 1e-5f);
     EXPECT_NE(m0.fields[0].values, m2.fields[0].values);
+    // A constant field has no common range: every frame as `uvr render` draws it (a warning).
+    ASSERT_EQ(uvr("-q generate box --cells 2000 --fields constant --steps 2 -o c.uvrm", dir).code,
+              0);
+    const CliRun constant = uvr("animate c.pvd -o cf --size 32x32 --device cpu", dir);
+    EXPECT_EQ(constant.code, 0) << constant.err;
+    EXPECT_NE(constant.err.find("one value or none"), std::string::npos) << constant.err;
+    EXPECT_TRUE(std::filesystem::exists(dir + "/cf/frame_0001.png"));
     // The same series as one temporal VTKHDF file: the geometry once, the same values per step.
     if (!vtkHdfSupported()) GTEST_SKIP() << "built without HDF5";
     ASSERT_EQ(
