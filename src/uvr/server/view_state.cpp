@@ -268,8 +268,8 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.width = static_cast<int>(w);
             next.height = static_cast<int>(h);
         } else if (k == "step") {
-            const bool index = v.is_number_unsigned() ||
-                               (v.is_number_integer() && v.get<std::int64_t>() >= 0);
+            const bool index =
+                v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0);
             if (!index || v.get<std::uint64_t>() >= stepCount)
                 bad(k,
                     stepCount == 1 ? "0: the file has no other time step"

@@ -169,7 +169,8 @@ TEST(ViewState, TheStepIsOneOfTheFilesTimeSteps) {
             applySet(s, {{"step", bad}, {"heatmap", true}}, 3);
             ADD_FAILURE() << "accepted";
         } catch (const Error& e) {
-            EXPECT_THAT(e.what(), ::testing::HasSubstr("\"step\": expected a time step from 0 to 2"));
+            EXPECT_THAT(e.what(),
+                        ::testing::HasSubstr("\"step\": expected a time step from 0 to 2"));
         }
         EXPECT_EQ(s.step, 2u);
         EXPECT_FALSE(s.heatmap);  // all or nothing

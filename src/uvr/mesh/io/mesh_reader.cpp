@@ -16,11 +16,8 @@
 
 namespace uvr {
 
-namespace {
-
-enum class Format { Legacy, Vtu, Pvtu, Pvd, Native, Exodus, VtkHdf, Unknown };
-
-Format sniffFormat(const std::string& path) {
+MeshFormat sniffMeshFormat(const std::string& path) {
+    using Format = MeshFormat;
     checkRegularFile(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throwError(ErrorKind::Io, path, std::string("cannot open: ") + std::strerror(errno));
@@ -46,10 +43,9 @@ Format sniffFormat(const std::string& path) {
     return Format::Unknown;
 }
 
-}  // namespace
-
 Mesh readMesh(const std::string& path, const ReadOptions& options) {
-    switch (sniffFormat(path)) {
+    using Format = MeshFormat;
+    switch (sniffMeshFormat(path)) {
         case Format::Legacy:
             return readVtkLegacy(path, options);
         case Format::Vtu:
@@ -74,7 +70,7 @@ Mesh readMesh(const std::string& path, const ReadOptions& options) {
 }
 
 std::optional<MeshSummary> readMeshSummary(const std::string& path, bool cellTypes) {
-    if (sniffFormat(path) == Format::Native) return readNativeSummary(path, cellTypes);
+    if (sniffMeshFormat(path) == MeshFormat::Native) return readNativeSummary(path, cellTypes);
     return std::nullopt;
 }
 

@@ -11,6 +11,14 @@
 
 namespace uvr {
 
+/// The formats readMesh reads.
+enum class MeshFormat { Legacy, Vtu, Pvtu, Pvd, Native, Exodus, VtkHdf, Unknown };
+
+/// The format of a file as readMesh and openMeshSeries choose it: magic bytes and content first
+/// (a VTKFile of type Collection is a .pvd whatever its name), extension second; Error(Io) when
+/// it cannot be opened.
+MeshFormat sniffMeshFormat(const std::string& path);
+
 /// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd, Exodus II and VTKHDF: their
 /// first step, .uvrm native), chosen by magic bytes first and extension second; throws Error
 /// naming the file on failure.

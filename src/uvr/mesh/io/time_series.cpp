@@ -242,30 +242,6 @@ std::vector<FileStep> globNumbered(const std::string& pattern) {
     return steps;
 }
 
-/// The first bytes of a file (fewer when it is shorter; none when it cannot be opened).
-std::string fileHead(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    char head[8] = {};
-    in.read(head, sizeof(head));
-    return std::string(head, static_cast<std::size_t>(in.gcount()));
-}
-
-}  // namespace
-
-namespace {
-
-/// True for a ParaView collection: a VTKFile of type Collection in the first bytes, or a .pvd
-/// name without a VTKFile in them (readMesh's rule: the two agree on what a collection is).
-bool isCollection(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    char head[512] = {};
-    in.read(head, sizeof(head) - 1);
-    const std::string text(head, static_cast<std::size_t>(in.gcount()));
-    if (text.find("<VTKFile") != std::string::npos)  // the content decides, as in readMesh
-        return text.find("type=\"Collection\"") != std::string::npos;
-    return fileExtension(path) == ".pvd";
-}
-
 }  // namespace
 
 bool isSeriesPattern(const std::string& path) {
@@ -277,9 +253,16 @@ std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path, const ReadOp
         return std::make_unique<FileSeries>(path, globNumbered(path), options);
     checkRegularFile(path);
     fileSize(path);  // a missing or unreadable file is named now, not at the first step
-    if (isCollection(path)) return std::make_unique<FileSeries>(path, readPvd(path), options);
-    if (looksLikeExodus(fileHead(path), path)) return openExodus(path, options);
-    if (looksLikeVtkHdf(path)) return openVtkHdfSeries(path, options);
+    switch (sniffMeshFormat(path)) {  // readMesh's choice, so that the two always agree
+        case MeshFormat::Pvd:
+            return std::make_unique<FileSeries>(path, readPvd(path), options);
+        case MeshFormat::Exodus:
+            return openExodus(path, options);
+        case MeshFormat::VtkHdf:
+            return openVtkHdfSeries(path, options);
+        default:
+            break;
+    }
     return std::make_unique<SingleFileSeries>(path, options);
 }
 

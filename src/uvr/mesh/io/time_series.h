@@ -59,8 +59,9 @@ private:
 /// Opens a mesh file or series: a .pvd collection (its DataSets by timestep, parts of one
 /// timestep merged), a numbered file series named by a pattern with one '*' in the file name
 /// (`run_*.vtu`: the '*' stands for the step's number, one or more digits; times 0, 1, 2, ...
-/// in numeric order), formats with time steps (Exodus II), and one step at time 0 for any other file that
-/// readMesh reads. Reads no step yet (only what lists the steps); throws Error naming the file.
+/// in numeric order), formats with time steps (Exodus II), and one step at time 0 for any other
+/// file that readMesh reads. Reads no step yet (only what lists the steps); throws Error naming the
+/// file.
 std::unique_ptr<MeshSeries> openMeshSeries(const std::string& path,
                                            const ReadOptions& options = {});
 

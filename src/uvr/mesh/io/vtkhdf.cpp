@@ -286,17 +286,24 @@ public:
         return d;
     }
 
-    /// Reads rows [start, start + rows) of a numeric dataset into out (rows * columns values
-    /// of T); checks the range and the stored bytes first. `what` says who needs the rows.
-    template <typename T>
-    void readRows(const Dataset& d, std::uint64_t start, std::uint64_t rows, T* out,
-                  const std::string& what) const {
+    /// Throws Error(Parse) naming the dataset unless it is numeric and has rows
+    /// [start, start + rows); `what` says who needs them.
+    void checkRows(const Dataset& d, std::uint64_t start, std::uint64_t rows,
+                   const std::string& what) const {
         if (!d.numeric())
             throwParseError(path_, d.name, "expected a numeric (integer or float) dataset");
         if (start > d.rows() || rows > d.rows() - start)
             throwParseError(path_, d.name,
                             "has " + std::to_string(d.rows()) + " rows; " + what + " needs rows [" +
                                 std::to_string(start) + ", " + std::to_string(start + rows) + ")");
+    }
+
+    /// Reads rows [start, start + rows) of a numeric dataset into out (rows * columns values
+    /// of T); checks the range and the stored bytes first. `what` says who needs the rows.
+    template <typename T>
+    void readRows(const Dataset& d, std::uint64_t start, std::uint64_t rows, T* out,
+                  const std::string& what) const {
+        checkRows(d, start, rows, what);
         if (rows == 0 || d.columns() == 0) return;
         hsize_t offset[2] = {start, 0}, count[2] = {rows, d.columns()};
         H5Handle fileSpace(H5Dget_space(d.id.get()), H5Sclose);
@@ -317,12 +324,7 @@ public:
     template <typename T>
     void admit(const Dataset& d, std::uint64_t start, std::uint64_t rows, LoadBudget& budget,
                const std::string& what) const {
-        if (!d.numeric())
-            throwParseError(path_, d.name, "expected a numeric (integer or float) dataset");
-        if (start > d.rows() || rows > d.rows() - start)
-            throwParseError(path_, d.name,
-                            "has " + std::to_string(d.rows()) + " rows; " + what + " needs rows [" +
-                                std::to_string(start) + ", " + std::to_string(start + rows) + ")");
+        checkRows(d, start, rows, what);
         const long double fileBytes =
             static_cast<long double>(rows) * d.columns() * static_cast<long double>(d.typeBytes);
         const long double stored =
