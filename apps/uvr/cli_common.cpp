@@ -319,6 +319,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
     app.add_flag("--no-seed-grid", noSeedGrid,
                  "Adaptive: locate long steps with the partition BVH instead of the seed grid "
                  "(for comparisons)");
+    app.add_flag("--split-cells", splitCells,
+                 "Split pyramids, wedges and hexahedra into tetrahedra (linear on the split, "
+                 "as ParaView's mappers do) instead of rendering them natively (trilinear "
+                 "hexahedra); for comparisons");
     if (oneFrame) {
         app.add_option("--heatmap", heatmapFile,
                        "Also write the per-pixel sample counts as a heat map PNG");
@@ -623,6 +627,7 @@ RendererOptions RenderFlags::rendererOptions(bool withReference) const {
     o.partitions = method == "adaptive";
     o.meshBvh = !o.partitions || withReference;  // the partition integrator uses its own BVHs
     o.seedGrids = !noSeedGrid;
+    o.splitCells = splitCells;
     o.leafCells = leafCells;
     return o;
 }
@@ -635,10 +640,10 @@ std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& fiel
     if (const CudaScene* gpu = renderer->gpu()) {
         char line[160];
         std::snprintf(line, sizeof line,
-                      "uploaded %.1f MiB to the GPU (%.1f bytes per tetrahedron) in %.3f s",
+                      "uploaded %.1f MiB to the GPU (%.1f bytes per cell) in %.3f s",
                       gpu->geometryBytes() / 1048576.0,
                       double(gpu->geometryBytes()) /
-                          std::max<std::size_t>(1, renderer->prepared().tets.tets.size()),
+                          double(std::max<std::uint64_t>(1, renderer->prepared().tets.cellCount())),
                       gpu->uploadSeconds());
         ctx.step(line);
     }
@@ -751,7 +756,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     const std::unique_ptr<Renderer> renderer =
         makeRenderer(mesh, field, flags.rendererOptions(), ctx);
     const PreparedMesh& prepared = renderer->prepared();
-    ctx.done("prepared " + std::to_string(prepared.tets.tets.size()) + " tetrahedra", start);
+    ctx.done("prepared " + describeCells(prepared.tets), start);
     ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
              " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
              (settings.supersample > 1
@@ -825,8 +830,14 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
             j["gpu"] = {
                 {"description", cudaDeviceDescription()},
                 {"geometry_bytes", renderer->gpu()->geometryBytes()},
-                {"bytes_per_tetrahedron", double(renderer->gpu()->geometryBytes()) /
-                                              std::max<std::size_t>(1, prepared.tets.tets.size())},
+                {"bytes_per_cell",
+                 double(renderer->gpu()->geometryBytes()) /
+                     double(std::max<std::uint64_t>(1, prepared.tets.cellCount()))},
+                // Per tetrahedron of the split (the cells' tetrahedra when split): comparable
+                // between native and split cells.
+                {"bytes_per_tetrahedron",
+                 double(renderer->gpu()->geometryBytes()) /
+                     double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
                 {"upload_seconds", renderer->gpu()->uploadSeconds()}};
         }
         j["threads"] = cpu::threadCount();
@@ -844,7 +855,7 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                 {"cells_min", sizes.empty() ? 0 : sizes.front()},
                 {"cells_median", sizes.empty() ? 0 : sizes[sizes.size() / 2]},
                 {"cells_max", sizes.empty() ? 0 : sizes.back()},
-                {"duplication_factor", kd.duplicationFactor(prepared.tets.tets.size())},
+                {"duplication_factor", kd.duplicationFactor(prepared.tets.cellCount())},
                 {"leaf_cells", prepared.kd->leafCells}};
             if (prepared.seeds)
                 j["seed_grids"] = {{"cells", prepared.seeds->seeds.size()},
@@ -871,7 +882,10 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["rays"] = result.stats.rays();
         j["mesh"] = {{"points", mesh.pointCount()},
                      {"cells", mesh.cellCount()},
-                     {"tetrahedra", prepared.tets.tets.size()}};
+                     {"tetrahedra", prepared.tets.tets.size()},
+                     {"pyramids", prepared.tets.pyramidCount},
+                     {"wedges", prepared.tets.wedgeCount},
+                     {"hexahedra", prepared.tets.hexCount}};
         j["prepare_seconds"] = {{"split", prepared.splitSeconds},
                                 {"bvh", prepared.bvhSeconds},
                                 {"adjacency", prepared.adjacencySeconds}};

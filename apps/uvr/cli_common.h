@@ -91,6 +91,7 @@ struct RenderFlags {
     bool noSkip = false, noAdaptive = false;
     std::uint32_t leafCells = 0;
     bool noSeedGrid = false;
+    bool splitCells = false;
     std::string device = "auto";
     std::string buildDevice = "auto";
     std::string heatmapFile;

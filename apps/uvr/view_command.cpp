@@ -36,6 +36,7 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
     if (f.power) add("--power", num(*f.power));
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
+    if (f.splitCells) add("--split-cells", "");
     if (f.supersample > 1) add("--supersample", std::to_string(f.supersample));
     if (f.jitter) add("--jitter", "");
     if (!f.background.empty()) add("--background", f.background);

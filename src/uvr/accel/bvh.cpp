@@ -321,12 +321,13 @@ Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
 
 void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
                         std::vector<Vec3f>& centers) {
-    const std::int64_t n = static_cast<std::int64_t>(mesh.tets.size());
+    const std::int64_t n = static_cast<std::int64_t>(mesh.cellCount());
+    const TetMeshView view = mesh.view();
     boxes.resize(n);
     centers.resize(n);
 #pragma omp parallel for schedule(static)
     for (std::int64_t t = 0; t < n; ++t) {
-        const Bounds3f b = tetBounds(mesh.points.data(), mesh.tets[t]);
+        const Bounds3f b = view.cellBounds(std::uint64_t(t));
         boxes[t] = b;
         centers[t] = b.center();
     }

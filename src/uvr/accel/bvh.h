@@ -95,7 +95,7 @@ struct Bvh {
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
 
-/// Bounding box and box centre of every tetrahedron of a mesh (resizes both arrays); parallel.
+/// Bounding box and box centre of every cell of a mesh (resizes both arrays); parallel.
 void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
                         std::vector<Vec3f>& centers);
 

@@ -220,8 +220,9 @@ LocalTree buildSubtree(const CellData& data, Task root, const KdBuildOptions& op
 KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     UVR_CHECK(options.leafCells >= 1, "leaf size must be positive");
-    const std::size_t n = mesh.tets.size();
-    UVR_CHECK(n < (1ull << 30), "too many tetrahedra for k-d partitions");
+    const std::size_t n = mesh.cellCount();
+    UVR_CHECK(n < (1ull << 30), "too many cells for k-d partitions");
+    const TetMeshView view = mesh.view();
     KdPartitions kd;
     kd.bounds = mesh.bounds;
     kd.leafCells = options.leafCells;
@@ -233,7 +234,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         data.boxes.resize(n), data.centers.resize(n);
 #pragma omp parallel for schedule(static)
         for (std::int64_t t = 0; t < tetCount; ++t) {
-            const Bounds3f box = tetBounds(mesh.points.data(), mesh.tets[t]);
+            const Bounds3f box = view.cellBounds(std::uint64_t(t));
             data.boxes[t] = box, data.centers[t] = box.center();
         }
     }
@@ -412,6 +413,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
 void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd) {
     const bool cellData = mesh.association == Association::Cell;
     const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+    const TetMeshView view = mesh.view();
 #pragma omp parallel for schedule(dynamic, 16)
     for (std::int64_t p = 0; p < n; ++p) {
         KdPartition& part = kd.partitions[p];
@@ -423,8 +425,10 @@ void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd) {
                 if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
                 continue;
             }
-            for (std::uint32_t k : mesh.tets[t].v) {
-                const float v = mesh.values[k];
+            std::uint32_t ids[kMaxCellCorners];
+            const int corners = view.corners(t, ids);
+            for (int k = 0; k < corners; ++k) {
+                const float v = mesh.values[ids[k]];
                 if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
             }
         }

@@ -39,8 +39,7 @@ LbvhResult buildLbvhCpu(const LbvhInput& input) {
     std::vector<std::uint64_t> keys(n);
     std::vector<std::uint32_t> rank(n + 1, 0u), innerSlot(n), innerParent(n), arrived(n, 0u);
     LbvhBuildView v;
-    v.points = input.mesh->points.data();
-    v.tets = input.mesh->tets.data();
+    v.mesh = input.mesh->view();
     v.tetIds = input.tetIds.empty() ? nullptr : input.tetIds.data();
     v.segmentBegin = input.segmentBegin.data();
     v.segmentBounds = input.segmentBounds.data();
@@ -93,7 +92,7 @@ LbvhResult buildLbvhCpu(const LbvhInput& input) {
 Bvh buildMeshLbvh(const TetMesh& mesh, const LbvhBuilder& build, int leafSize) {
     LbvhInput input;
     input.mesh = &mesh;
-    input.segmentBegin = {0, mesh.tets.size()};
+    input.segmentBegin = {0, mesh.cellCount()};
     input.segmentBounds = {mesh.bounds};
     input.leafSize = leafSize;
     LbvhResult r = build(input);

@@ -133,9 +133,8 @@ UVR_HOST_DEVICE inline std::uint32_t lbvhSegmentOf(const std::uint64_t* begin, s
 /// Element g of segment s (begin[s] <= g < begin[s + 1]) stands for inner node g - begin[s] of
 /// the segment's radix tree.
 struct LbvhBuildView {
-    const Vec3f* points = nullptr;
-    const Tet* tets = nullptr;
-    const std::uint32_t* tetIds = nullptr;  ///< null: primitive i is tetrahedron i
+    TetMeshView mesh;  ///< points and cells (values unused)
+    const std::uint32_t* tetIds = nullptr;  ///< null: primitive i is cell i
     const std::uint64_t* segmentBegin = nullptr;
     const Bounds3f* segmentBounds = nullptr;  ///< what each segment's Morton codes quantise
     std::uint32_t segments = 0;
@@ -153,7 +152,7 @@ struct LbvhBuildView {
         return lbvhSegmentOf(segmentBegin, segments, g);
     }
     UVR_HOST_DEVICE Bounds3f primBounds(std::uint64_t prim) const {
-        return tetBounds(points, tets[tetIds ? tetIds[prim] : prim]);
+        return mesh.cellBounds(tetIds ? tetIds[prim] : prim);
     }
     /// Step 1: the Morton key of primitive `prim` (input position) of segment s.
     UVR_HOST_DEVICE std::uint64_t mortonKey(std::uint64_t prim, std::uint32_t s) const {
@@ -249,7 +248,7 @@ struct LbvhInput {
     int leafSize = 4;                         ///< primitives per leaf at most
 
     std::uint64_t primCount() const {
-        return tetIds.empty() ? (mesh ? mesh->tets.size() : 0) : tetIds.size();
+        return tetIds.empty() ? (mesh ? mesh->cellCount() : 0) : tetIds.size();
     }
 };
 

@@ -14,7 +14,7 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
     const auto start = std::chrono::steady_clock::now();
     UVR_CHECK(tetsPerCell > 0.f, "macrocell density must be positive");
     MacroGrids out;
-    out.grids = layoutPartitionGrids(kd, tetsPerCell, "macrocell grids");
+    out.grids = layoutPartitionGrids(kd, tetsPerCell, "macrocell grids", mesh.meanSplitTets());
     fillMacroCells(mesh, kd, neighbors, out);
     out.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -23,7 +23,8 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
 
 void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
                     const std::vector<std::uint32_t>& neighbors, MacroGrids& out) {
-    UVR_CHECK(neighbors.size() == 4 * mesh.tets.size(), "macrocells need the face neighbours");
+    const TetMeshView view = mesh.view();
+    UVR_CHECK(neighbors.size() == view.faceSlots(), "macrocells need the face neighbours");
     UVR_CHECK(out.grids.size() == kd.partitions.size(), "one macrocell grid per partition");
     const std::size_t n = kd.partitions.size();
     out.cells.assign(gridCellCount(out.grids), MacroCell{});
@@ -42,32 +43,30 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
         std::vector<Bounds3f> gradients(count);  // bounding boxes of the gradients
         for (std::uint32_t i = 0; i < part.cellCount; ++i) {
             const std::uint32_t t = kd.cells[part.firstCell + i];
-            const Tet& tet = mesh.tets[t];
+            std::uint32_t ids[kMaxCellCorners];
+            const int corners = view.corners(t, ids);
             Bounds3f box;
-            for (int k = 0; k < 4; ++k) box.extend(mesh.points[tet.v[k]]);
+            for (int k = 0; k < corners; ++k) box.extend(mesh.points[ids[k]]);
             float lo = INFINITY, hi = -INFINITY;
-            Vec3f grad(0.f);
-            bool gradOk = false;
+            Bounds3f grad;  // the cell's gradients (one for a tetrahedron)
             bool nan = false;
             if (cellData) {
                 lo = hi = mesh.values[t];
                 nan = anyNan && lo != lo;
             } else {
-                for (int k = 0; k < 4 && anyNan; ++k)
-                    nan = nan || mesh.values[tet.v[k]] != mesh.values[tet.v[k]];
-                for (int k = 0; k < 4; ++k) {
-                    lo = std::fmin(lo, mesh.values[tet.v[k]]);  // NaN values are left out
-                    hi = std::fmax(hi, mesh.values[tet.v[k]]);
+                for (int k = 0; k < corners && anyNan; ++k)
+                    nan = nan || mesh.values[ids[k]] != mesh.values[ids[k]];
+                for (int k = 0; k < corners; ++k) {
+                    lo = std::fmin(lo, mesh.values[ids[k]]);  // NaN values are left out
+                    hi = std::fmax(hi, mesh.values[ids[k]]);
                 }
-                grad =
-                    tetGradient(mesh.points[tet.v[0]], mesh.points[tet.v[1]], mesh.points[tet.v[2]],
-                                mesh.points[tet.v[3]], mesh.values[tet.v[0]], mesh.values[tet.v[1]],
-                                mesh.values[tet.v[2]], mesh.values[tet.v[3]]);
-                gradOk = isFinite(grad);
+                grad = cellGradientBounds(view, t);
             }
+            const bool gradOk = !grad.empty();
             bool boundary = false;
-            for (int f = 0; f < 4; ++f)
-                boundary = boundary || neighbors[4 * std::size_t(t) + f] == kNoTet;
+            const std::uint64_t faces = view.faceBase(t);
+            for (int f = 0; f < kindFaces(view.kind(t)); ++f)
+                boundary = boundary || neighbors[faces + f] == kNoTet;
             std::uint32_t a[3], b[3];
             macroCellOf(g, box.lo, a);
             macroCellOf(g, box.hi, b);

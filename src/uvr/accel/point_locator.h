@@ -26,22 +26,46 @@ struct LocateCounters {
     std::uint64_t bvhQueries = 0;  ///< searches that fell back to the BVH
 };
 
-/// Point location in a tetrahedral mesh: first the hint (the previous sample's tetrahedron),
-/// then a walk across faces towards p (ray coherence), then the BVH.
+/// Point location in a mesh of tetrahedra and native cells: first the hint (the previous
+/// sample's cell), then a walk across faces towards p (ray coherence), then the BVH.
 struct TetLocator {
     TetMeshView mesh;
     BvhView bvh;
-    const std::uint32_t* neighbors = nullptr;  ///< 4 per tetrahedron, may be null (no walking)
+    /// Face neighbours (buildTetNeighbors: from TetMeshView::faceBase), may be null (no walking).
+    const std::uint32_t* neighbors = nullptr;
     int maxWalkSteps = kMaxWalkSteps;          ///< walk length before the BVH takes over
 
-    /// True when p lies in tetrahedron t (within kBaryEpsilon); fills bary.
+    /// True when p lies in cell t (within kBaryEpsilon); fills bary with p's local coordinates
+    /// (TetMeshView::interpolate).
     UVR_HOST_DEVICE bool inside(std::uint32_t t, Vec3f p, float bary[4]) const {
+        if (t >= mesh.tetCount) {
+            float excess;
+            nativeStep(t, p, bary, excess);
+            return excess <= kBaryEpsilon;
+        }
         const Tet& tet = mesh.tets[t];
         if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]], mesh.points[tet.v[2]],
                              mesh.points[tet.v[3]], bary))
             return false;
         return bary[0] >= -kBaryEpsilon && bary[1] >= -kBaryEpsilon && bary[2] >= -kBaryEpsilon &&
                bary[3] >= -kBaryEpsilon;
+    }
+
+    /// Native cell t: p's parametric coordinates into bary[0..2] and the face p lies furthest
+    /// outside of, with that excess (infinite when Newton's method does not converge: p is then
+    /// not in the cell, and the face is the last iterate's).
+    UVR_HOST_DEVICE int nativeStep(std::uint32_t t, Vec3f p, float bary[4], float& excess) const {
+        std::uint32_t ids[kMaxCellCorners];
+        const int n = mesh.corners(t, ids);
+        Vec3f x[kMaxCellCorners];
+        for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]];
+        const CellKind k = mesh.kind(t);
+        Vec3f rst;
+        const bool converged = cellParametric(k, x, p, rst);
+        bary[0] = rst.x, bary[1] = rst.y, bary[2] = rst.z, bary[3] = 0.f;
+        const int face = worstFace(k, rst, excess);
+        if (!converged) excess = INFINITY;
+        return face;
     }
 
     /// Index of a tetrahedron containing p, or kNoTet; bary receives p's barycentrics in it.
@@ -68,15 +92,23 @@ struct TetLocator {
         std::uint32_t t = start;
         for (int step = 0; step < maxWalkSteps; ++step) {
             ++counters.walkSteps;
-            const Tet& tet = mesh.tets[t];
-            if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
-                                 mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
-                return kNoTet;
             int worst = 0;
-            for (int i = 1; i < 4; ++i)
-                if (bary[i] < bary[worst]) worst = i;
-            if (bary[worst] >= -kBaryEpsilon) return t;
-            t = neighbors[4 * t + worst];
+            if (t < mesh.tetCount) {
+                const Tet& tet = mesh.tets[t];
+                if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
+                                     mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
+                    return kNoTet;
+                for (int i = 1; i < 4; ++i)
+                    if (bary[i] < bary[worst]) worst = i;
+                if (bary[worst] >= -kBaryEpsilon) return t;
+                t = neighbors[4 * std::uint64_t(t) + worst];
+            } else {
+                // A native cell: its parametric coordinates say which face p lies beyond.
+                float excess;
+                worst = nativeStep(t, p, bary, excess);
+                if (excess <= kBaryEpsilon) return t;
+                t = neighbors[mesh.faceBase(t) + worst];
+            }
             if (t == kNoTet) return kNoTet;
         }
         return kNoTet;

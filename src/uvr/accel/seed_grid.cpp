@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "uvr/core/error.h"
+#include "uvr/accel/point_locator.h"
 #include "uvr/mesh/tet_math.h"
 
 namespace uvr {
@@ -35,7 +36,7 @@ PartitionGrid layoutPartitionGrid(const Bounds3f& box, double target) {
 }
 
 std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float tetsPerCell,
-                                                const char* what) {
+                                                const char* what, double tetsPerMeshCell) {
     // Sequential: a few operations per partition.
     std::vector<PartitionGrid> grids(kd.partitions.size());
     std::uint64_t total = 0;
@@ -43,7 +44,7 @@ std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float te
         const KdPartition& part = kd.partitions[p];
         PartitionGrid g;
         if (part.cellCount > 0 && !part.box.empty())
-            g = layoutPartitionGrid(part.box, std::max(1.0, part.cellCount / double(tetsPerCell)));
+            g = layoutPartitionGrid(part.box, std::max(1.0, part.cellCount * tetsPerMeshCell / tetsPerCell));
         else
             g.dims[0] = g.dims[1] = g.dims[2] = 1;
         g.first = static_cast<std::uint32_t>(total);
@@ -59,7 +60,9 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
     UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
     SeedGrids out;
     const std::size_t n = kd.partitions.size();
-    out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids");
+    out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids", mesh.meanSplitTets());
+    const TetMeshView view = mesh.view();
+    const TetLocator locator{view, {}, nullptr};
     out.seeds.assign(gridCellCount(out.grids), kNoTet);
     // Seeds: per cell the smallest key (squared distance of a tetrahedron's centroid to the cell
     // centre, 0 when the tetrahedron contains the centre; ties to the smaller id). Partitions are
@@ -76,12 +79,15 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
             cellSize[a] = g.cellsPerUnit[a] > 0.f ? 1.f / g.cellsPerUnit[a] : 0.f;
         for (std::uint32_t i = 0; i < part.cellCount; ++i) {
             const std::uint32_t t = kd.cells[part.firstCell + i];
-            const Tet& tet = mesh.tets[t];
-            const Vec3f a = mesh.points[tet.v[0]], b = mesh.points[tet.v[1]],
-                        c = mesh.points[tet.v[2]], d = mesh.points[tet.v[3]];
+            std::uint32_t ids[kMaxCellCorners];
+            const int corners = view.corners(t, ids);
             Bounds3f box;
-            for (Vec3f q : {a, b, c, d}) box.extend(q);
-            const Vec3f centroid = (a + b + c + d) * 0.25f;
+            Vec3f centroid(0.f);
+            for (int k = 0; k < corners; ++k) {
+                box.extend(mesh.points[ids[k]]);
+                centroid += mesh.points[ids[k]];
+            }
+            centroid = centroid * (1.f / float(corners));
             std::uint32_t lo[3], hi[3];
             for (int k = 0; k < 3; ++k) {
                 lo[k] = SeedGridView::cellIndex(g, k, box.lo[k]);
@@ -95,9 +101,7 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
                                            g.lo.z + (z + 0.5f) * cellSize.z);
                         float bary[4];
                         float dist2 = 0.f;
-                        const bool inside =
-                            tetBarycentrics(centre, a, b, c, d, bary) &&
-                            std::min({bary[0], bary[1], bary[2], bary[3]}) >= -kBaryEpsilon;
+                        const bool inside = locator.inside(t, centre, bary);
                         if (!inside) {
                             const Vec3f e = centroid - centre;
                             dist2 = dot(e, e);

@@ -57,7 +57,7 @@ PartitionGrid layoutPartitionGrid(const Bounds3f& box, double target);
 /// grids in the error when their cells exceed 32-bit indices. Shared by the seed and macrocell
 /// grids.
 std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float tetsPerCell,
-                                                const char* what);
+                                                const char* what, double tetsPerMeshCell = 1.0);
 
 /// Cells of all grids laid out by layoutPartitionGrids.
 inline std::uint64_t gridCellCount(const std::vector<PartitionGrid>& grids) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <type_traits>
 
 #include "uvr/core/error.h"
 #include "uvr/core/scratch_vector.h"
@@ -11,12 +12,6 @@
 namespace uvr {
 
 namespace {
-
-/// A face in its smallest vertex's bucket: the other two vertex ids (sorted) and the slot
-/// 4 * tet + opposite vertex.
-struct FaceEntry {
-    std::uint32_t b, c, slot;
-};
 
 /// Tetrahedra per parallel chunk (fixed, so results never depend on the thread count).
 constexpr std::int64_t kChunk = 1 << 14;
@@ -83,77 +78,118 @@ std::vector<std::uint32_t> coincidentPointIds(const std::vector<Vec3f>& points) 
     return canon;
 }
 
-std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh) {
-    const std::int64_t n = static_cast<std::int64_t>(mesh.tets.size());
-    UVR_CHECK(static_cast<std::uint64_t>(n) < kNoTet / 4,
-              "too many tetrahedra for 32-bit neighbour ids");
-    const std::size_t points = mesh.points.size();
-    // Faces are matched on welded point ids: cells meeting at a seam of duplicated points (an
-    // O-grid's cut, a multi-block export) become neighbours, so walks cross the seam.
-    const std::vector<std::uint32_t> canon = coincidentPointIds(mesh.points);
-    const Tet* tets = mesh.tets.data();
-    // Faces bucketed by their smallest vertex id (a counting sort, vertex-to-face CSR), so each
-    // bucket is a handful of faces sorted on its own instead of one sort of 4n faces.
+namespace {
+
+/// A tetrahedron's face in its smallest vertex's bucket: the other two vertex ids (sorted) and
+/// the slot 4 * tet + opposite vertex (12 bytes: the pure-tetrahedron path).
+struct TetFace {
+    std::uint32_t b, c, slot;
+    std::uint32_t key3() const { return 0; }
+    std::uint32_t cell() const { return slot / 4; }
+    std::uint64_t tableSlot(const TetMeshView&) const { return slot; }
+};
+
+/// A face of a mixed mesh in its smallest vertex's bucket: the other vertex ids (sorted; d is
+/// kNoCell for a triangle, so a triangle never matches a quadrilateral), its cell and face.
+struct MixedFace {
+    std::uint32_t b, c, d, cellId;
+    std::uint8_t face;
+    std::uint32_t key3() const { return d; }
+    std::uint32_t cell() const { return cellId; }
+    std::uint64_t tableSlot(const TetMeshView& m) const { return m.faceBase(cellId) + face; }
+};
+
+/// Sorted welded vertex ids of face f of cell c (3 or 4; f[3] = kNoCell for a triangle).
+void sortedFace(const TetMeshView& m, const std::uint32_t* canon, std::uint64_t c, int face,
+                std::uint32_t f[4]) {
+    std::uint32_t ids[kMaxCellCorners];
+    m.corners(c, ids);
+    const std::uint32_t packed = packedFace(m.kind(c), face);
+    const int n = faceSize(packed);
+    for (int i = 0; i < n; ++i) f[i] = canon[ids[faceCorner(packed, i)]];
+    f[3] = kNoCell;
+    std::sort(f, f + n);
+}
+
+/// Face matching over every cell of the view: faces bucketed by their smallest vertex id (a
+/// counting sort, vertex-to-face CSR), each bucket sorted on its own by its full key, equal
+/// faces paired; the same table for any thread count.
+template <typename Entry>
+std::vector<std::uint32_t> matchFaces(const TetMeshView& m, const std::vector<std::uint32_t>& canon,
+                                      std::size_t points) {
+    const std::int64_t n = static_cast<std::int64_t>(m.cellCount());
     // Step 1: faces per smallest vertex.
-    std::vector<std::uint32_t> offsets(points + 1, 0);
-    auto faceOf = [&](std::int64_t t, int i, std::uint32_t f[3]) {
-        int k = 0;
-        for (int j = 0; j < 4; ++j)
-            if (j != i) f[k++] = canon[tets[t].v[j]];
-        if (f[0] > f[1]) std::swap(f[0], f[1]);
-        if (f[1] > f[2]) std::swap(f[1], f[2]);
-        if (f[0] > f[1]) std::swap(f[0], f[1]);
+    std::vector<std::uint64_t> offsets(points + 1, 0);
+    auto forFaces = [&](std::int64_t c, auto&& fn) {
+        const int faces = kindFaces(m.kind(std::uint64_t(c)));
+        for (int i = 0; i < faces; ++i) {
+            std::uint32_t f[4];
+            sortedFace(m, canon.data(), std::uint64_t(c), i, f);
+            fn(i, f);
+        }
     };
 #pragma omp parallel for schedule(static)
-    for (std::int64_t t = 0; t < n; ++t)
-        for (int i = 0; i < 4; ++i) {
-            std::uint32_t f[3];
-            faceOf(t, i, f);
-            std::atomic_ref<std::uint32_t>(offsets[f[0] + 1])
-                .fetch_add(1, std::memory_order_relaxed);
-        }
+    for (std::int64_t c = 0; c < n; ++c)
+        forFaces(c, [&](int, const std::uint32_t* f) {
+            std::atomic_ref<std::uint64_t>(offsets[f[0] + 1]).fetch_add(1, std::memory_order_relaxed);
+        });
     for (std::size_t p = 0; p < points; ++p) offsets[p + 1] += offsets[p];
     // Step 2: scatter faces into their buckets (in any order; step 3 sorts each bucket by its
     // full key, so the result does not depend on the order).
-    ScratchVector<FaceEntry> faces(static_cast<std::size_t>(4 * n));
+    ScratchVector<Entry> faces(static_cast<std::size_t>(offsets[points]));
     {
-        std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+        std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
 #pragma omp parallel for schedule(static)
-        for (std::int64_t t = 0; t < n; ++t)
-            for (int i = 0; i < 4; ++i) {
-                std::uint32_t f[3];
-                faceOf(t, i, f);
-                const std::uint32_t at = std::atomic_ref<std::uint32_t>(fill[f[0]])
+        for (std::int64_t c = 0; c < n; ++c)
+            forFaces(c, [&](int i, const std::uint32_t* f) {
+                const std::uint64_t at = std::atomic_ref<std::uint64_t>(fill[f[0]])
                                              .fetch_add(1, std::memory_order_relaxed);
-                faces[at] = {f[1], f[2], static_cast<std::uint32_t>(4 * t + i)};
-            }
+                if constexpr (std::is_same_v<Entry, TetFace>)
+                    faces[at] = {f[1], f[2], static_cast<std::uint32_t>(4 * c + i)};
+                else
+                    faces[at] = {f[1], f[2], f[3], static_cast<std::uint32_t>(c),
+                                 static_cast<std::uint8_t>(i)};
+            });
     }
     // Step 3: sort each bucket and pair equal faces.
-    std::vector<std::uint32_t> neighbors(static_cast<std::size_t>(4 * n), kNoTet);
+    std::vector<std::uint32_t> neighbors(static_cast<std::size_t>(m.faceSlots()), kNoCell);
     const std::int64_t pointCount = static_cast<std::int64_t>(points);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t start = 0; start < pointCount; start += kChunk) {
         const std::int64_t end = std::min(pointCount, start + kChunk);
         for (std::int64_t p = start; p < end; ++p) {
-            FaceEntry* first = faces.data() + offsets[p];
-            FaceEntry* last = faces.data() + offsets[p + 1];
-            std::sort(first, last, [](const FaceEntry& x, const FaceEntry& y) {
+            Entry* first = faces.data() + offsets[p];
+            Entry* last = faces.data() + offsets[p + 1];
+            std::sort(first, last, [&](const Entry& x, const Entry& y) {
                 if (x.b != y.b) return x.b < y.b;
                 if (x.c != y.c) return x.c < y.c;
-                return x.slot < y.slot;
+                if (x.key3() != y.key3()) return x.key3() < y.key3();
+                return x.tableSlot(m) < y.tableSlot(m);
             });
-            for (FaceEntry* i = first; i < last;) {
-                FaceEntry* j = i + 1;
-                while (j < last && j->b == i->b && j->c == i->c) ++j;
+            for (Entry* i = first; i < last;) {
+                Entry* j = i + 1;
+                while (j < last && j->b == i->b && j->c == i->c && j->key3() == i->key3()) ++j;
                 if (j - i == 2) {  // an interior face; non-manifold faces (3+) stay boundary
-                    neighbors[i[0].slot] = i[1].slot / 4;
-                    neighbors[i[1].slot] = i[0].slot / 4;
+                    neighbors[i[0].tableSlot(m)] = i[1].cell();
+                    neighbors[i[1].tableSlot(m)] = i[0].cell();
                 }
                 i = j;
             }
         }
     }
     return neighbors;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh) {
+    UVR_CHECK(mesh.cellCount() < kNoCell / 4, "too many cells for 32-bit neighbour ids");
+    // Faces are matched on welded point ids: cells meeting at a seam of duplicated points (an
+    // O-grid's cut, a multi-block export) become neighbours, so walks cross the seam.
+    const std::vector<std::uint32_t> canon = coincidentPointIds(mesh.points);
+    const TetMeshView view = mesh.view();
+    return mesh.hasNative() ? matchFaces<MixedFace>(view, canon, mesh.points.size())
+                            : matchFaces<TetFace>(view, canon, mesh.points.size());
 }
 
 }  // namespace uvr

@@ -153,6 +153,7 @@ struct CudaScene::Impl {
     const PreparedMesh& mesh;
     cuda::DeviceArray<Vec3f> points;
     cuda::DeviceArray<Tet> tets;
+    cuda::DeviceArray<std::uint32_t> nativeCorners;  ///< empty without native cells
     cuda::DeviceArray<float> values;
     cuda::DeviceArray<std::uint32_t> neighbors;
     cuda::DeviceArray<BvhNode> bvhNodes;
@@ -213,6 +214,7 @@ struct CudaScene::Impl {
         SceneView v = setup.scene(mesh);
         v.locator.mesh.points = points.data();
         v.locator.mesh.tets = tets.data();
+        v.locator.mesh.nativeCorners = nativeCorners.data();
         v.locator.mesh.values = values.data();
         v.locator.bvh.nodes = bvhNodes.data();
         v.locator.bvh.primIds = bvhPrims.data();
@@ -230,6 +232,7 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
     Impl& d = *impl_;
     d.points.upload(mesh.tets.points, "the mesh points");
     d.tets.upload(mesh.tets.tets, "the tetrahedra");
+    if (mesh.tets.hasNative()) d.nativeCorners.upload(mesh.tets.nativeCorners, "the native cells");
     d.neighbors.upload(mesh.neighbors, "the face neighbours");
     d.bvhNodes.upload(mesh.bvh.nodes, "the BVH nodes");
     d.bvhPrims.upload(mesh.bvh.primIds, "the BVH primitive ids");
@@ -254,7 +257,8 @@ CudaScene::~CudaScene() = default;
 
 std::uint64_t CudaScene::geometryBytes() const {
     const Impl& d = *impl_;
-    return d.points.bytes() + d.tets.bytes() + d.values.bytes() + d.neighbors.bytes() +
+    return d.points.bytes() + d.tets.bytes() + d.nativeCorners.bytes() + d.values.bytes() +
+           d.neighbors.bytes() +
            d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
            d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() + d.partitionCells.bytes() +
            d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes() +

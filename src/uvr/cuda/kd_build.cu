@@ -22,12 +22,12 @@ namespace {
 /// Elements per thread of the bounds pass (runs of one node's cells are reduced locally first).
 constexpr std::uint64_t kBoundsChunk = 256;
 
-/// Tetrahedron boxes, and the first level: every tetrahedron in node 0.
-__global__ void boxesKernel(const Vec3f* points, const Tet* tets, std::uint64_t n, Bounds3f* boxes,
+/// Cell boxes, and the first level: every cell in node 0.
+__global__ void boxesKernel(TetMeshView mesh, std::uint64_t n, Bounds3f* boxes,
                             std::uint32_t* cells, std::uint32_t* nodeOf) {
     const std::uint64_t t = globalThread();
     if (t >= n) return;
-    boxes[t] = tetBounds(points, tets[t]);
+    boxes[t] = mesh.cellBounds(t);
     cells[t] = static_cast<std::uint32_t>(t);
     nodeOf[t] = 0;
 }
@@ -157,8 +157,8 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
     if (!cudaDeviceAvailable())
         throwError(ErrorKind::Unsupported, "", "GPU k-d build: no CUDA device found");
     UVR_CHECK(options.leafCells >= 1, "leaf size must be positive");
-    const std::uint64_t n = mesh.tets.size();
-    UVR_CHECK(n < (1ull << 30), "too many tetrahedra for k-d partitions");
+    const std::uint64_t n = mesh.cellCount();
+    UVR_CHECK(n < (1ull << 30), "too many cells for k-d partitions");
     KdTree tree;
     tree.nodes.emplace_back();
     if (n == 0) {  // one empty partition, as the CPU's build makes
@@ -176,10 +176,15 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
     {
         cuda::DeviceArray<Vec3f> points;
         cuda::DeviceArray<Tet> tets;
+        cuda::DeviceArray<std::uint32_t> nativeCorners;
         points.upload(mesh.points, "the mesh points (GPU k-d build)");
         tets.upload(mesh.tets, "the tetrahedra (GPU k-d build)");
-        cuda::boxesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(
-            points.data(), tets.data(), n, boxes.data(), cells.data(), nodeOf.data());
+        nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU k-d build)");
+        TetMeshView view = mesh.view();
+        view.points = points.data(), view.tets = tets.data(), view.values = nullptr;
+        view.nativeCorners = nativeCorners.data();
+        cuda::boxesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(view, n, boxes.data(),
+                                                                cells.data(), nodeOf.data());
         UVR_CUDA_CHECK(cudaGetLastError());
         UVR_CUDA_CHECK(cudaDeviceSynchronize());
     }

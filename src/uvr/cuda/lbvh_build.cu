@@ -93,18 +93,22 @@ LbvhResult buildLbvhCuda(const LbvhInput& input) {
     const TetMesh& mesh = *input.mesh;
     cuda::DeviceArray<Vec3f> points;
     cuda::DeviceArray<Tet> tets;
-    cuda::DeviceArray<std::uint32_t> tetIds, occupiedBefore;
+    cuda::DeviceArray<std::uint32_t> tetIds, occupiedBefore, nativeCorners;
     cuda::DeviceArray<std::uint64_t> segmentBegin;
     cuda::DeviceArray<Bounds3f> segmentBounds;
     points.upload(mesh.points, "the mesh points (GPU build)");
     tets.upload(mesh.tets, "the tetrahedra (GPU build)");
+    nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU build)");
     tetIds.upload(input.tetIds.data(), input.tetIds.size(), "the primitive list (GPU build)");
     segmentBegin.upload(input.segmentBegin, "the segment offsets (GPU build)");
     segmentBounds.upload(input.segmentBounds, "the segment bounds (GPU build)");
     occupiedBefore.upload(plan.occupiedBefore, "the segment counts (GPU build)");
     LbvhBuildView v;  // device pointers; the per-element work of every step
-    v.points = points.data();
-    v.tets = tets.data();
+    v.mesh = mesh.view();
+    v.mesh.points = points.data();
+    v.mesh.tets = tets.data();
+    v.mesh.nativeCorners = nativeCorners.data();
+    v.mesh.values = nullptr;
     v.tetIds = tetIds.data();
     v.segmentBegin = segmentBegin.data();
     v.segmentBounds = segmentBounds.data();

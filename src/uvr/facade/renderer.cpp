@@ -37,6 +37,7 @@ PrepareOptions RendererOptions::prepareOptions() const {
     o.partitions = partitions;
     o.meshBvh = meshBvh;
     o.seedGrids = seedGrids;
+    o.cells.splitCells = splitCells;
     if (leafCells)
         o.kd.leafCells = leafCells;
     else if (renderOnCuda)

@@ -36,6 +36,8 @@ struct RendererOptions {
     bool partitions = true;       ///< the k-d partitions of RenderMethod::Partitions
     bool meshBvh = true;          ///< the mesh BVH of RenderMethod::Reference and Exact
     bool seedGrids = true;        ///< with partitions: seed grids for long steps
+    /// Split pyramids, wedges and hexahedra into tetrahedra instead of rendering them natively.
+    bool splitCells = false;
     std::uint32_t leafCells = 0;  ///< cells per k-d partition; 0: the device's default
 
     /// The preparation these options ask for (the builders of the GPU when buildDevice resolves

@@ -180,13 +180,15 @@ UVR_HOST_DEVICE inline void cellMap(CellKind k, const Vec3f* e, Vec3f rst, Vec3f
 inline constexpr int kNewtonIterations = 12;
 
 /// Parametric coordinates rst of point p in the cell of kind k with corners x[0..n-1]: the
-/// inverse of the isoparametric map by Newton's method from the parametric centre, in
+/// inverse of the isoparametric map by Newton's method from the parametric centre (or, with
+/// fromGuess, from rst as given: a nearby point's coordinates), in
 /// coordinates relative to corner 0 (for precision), each step's iterate kept within [-1, 2] (a
 /// far point's iteration cannot run away). Returns true when the residual fell below 1e-5 of the
 /// cell's size (or the step below 1e-6); false for a point the map does not reach from the
 /// centre (far outside a distorted cell, or a singular Jacobian), with rst the last iterate.
 /// Exact for tetrahedra and parallelepipeds in one step; a few steps otherwise.
-UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, Vec3f& rst) {
+UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, Vec3f& rst,
+                                           bool fromGuess = false) {
     Vec3f e[kMaxCellCorners];
     const int n = kindCorners(k);
     float size = 0.f;
@@ -196,7 +198,7 @@ UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, 
         size = fmaxf(size, fmaxf(fabsf(e[i].x), fmaxf(fabsf(e[i].y), fabsf(e[i].z))));
     }
     const Vec3f q = p - x[0];
-    rst = cellCentreParametric(k);
+    if (!fromGuess) rst = cellCentreParametric(k);
     const float tol = 1e-5f * size;
     bool converged = false;
     for (int it = 0; it < kNewtonIterations && !converged; ++it) {
@@ -259,6 +261,21 @@ UVR_HOST_DEVICE inline int worstFace(CellKind k, Vec3f rst, float& excess) {
         if (x > excess) excess = x, worst = f;
     }
     return worst;
+}
+
+/// rst moved to the nearest point of kind k's parametric domain, per coordinate (a point found
+/// just outside a face by rounding is read on the face, never extrapolated).
+UVR_HOST_DEVICE inline Vec3f clampParametric(CellKind k, Vec3f rst) {
+    auto unit = [](float v) { return fminf(fmaxf(v, 0.f), 1.f); };
+    Vec3f c(unit(rst.x), unit(rst.y), unit(rst.z));
+    if (k == CellKind::Wedge && c.x + c.y > 1.f) {
+        const float scale = 1.f / (c.x + c.y);
+        c.x *= scale, c.y *= scale;
+    } else if (k == CellKind::Tet && c.x + c.y + c.z > 1.f) {
+        const float scale = 1.f / (c.x + c.y + c.z);
+        c = c * scale;
+    }
+    return c;
 }
 
 /// Gradient of the field with corner values v at parametric rst of the cell with corners x:

@@ -2,15 +2,20 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/vec.h"
+#include "uvr/mesh/cell_math.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
 
 namespace uvr {
+
+/// Marks "no cell" (a boundary face, or a point outside the mesh); cell ids are below it.
+inline constexpr std::uint32_t kNoCell = 0xffffffffu;
 
 /// Four point indices of a positively oriented tetrahedron.
 struct Tet {
@@ -60,26 +65,94 @@ inline constexpr int kFrameShiftExponent = 8;
 /// and, per far axis, a translation to the box's centre.
 MeshFrame frameForBounds(const Bounds3f& bounds);
 
-/// Plain-data view of a TetMesh for CPU and GPU kernels.
+/// Plain-data view of a TetMesh for CPU and GPU kernels. Cell ids [0, tetCount) are
+/// tetrahedra; the native cells follow (issue 14): pyramids, then wedges, then hexahedra, their
+/// corners (5, 6, 8 point ids, VTK's order) one after another in nativeCorners. Face neighbour
+/// tables hold faceCount(c) entries per cell from faceBase(c).
 struct TetMeshView {
     const Vec3f* points = nullptr;
     const Tet* tets = nullptr;
-    const float* values = nullptr;  ///< per point, or per tet when cellCentered
+    const float* values = nullptr;  ///< per point, or per cell (tetrahedra first) when cellCentered
     std::uint64_t tetCount = 0;
     bool cellCentered = false;
+    const std::uint32_t* nativeCorners = nullptr;  ///< corners of the native cells, in id order
+    std::uint64_t pyramidCount = 0, wedgeCount = 0, hexCount = 0;
 
-    /// Interpolated field value at p given barycentrics in tet t (piecewise constant for cell
-    /// data).
+    /// Every cell: tetrahedra and native cells.
+    UVR_HOST_DEVICE std::uint64_t cellCount() const {
+        return tetCount + pyramidCount + wedgeCount + hexCount;
+    }
+    /// True when the mesh has native cells.
+    UVR_HOST_DEVICE bool hasNative() const { return pyramidCount + wedgeCount + hexCount > 0; }
+    /// The kind of cell c.
+    UVR_HOST_DEVICE CellKind kind(std::uint64_t c) const {
+        if (c < tetCount) return CellKind::Tet;
+        c -= tetCount;
+        if (c < pyramidCount) return CellKind::Pyramid;
+        c -= pyramidCount;
+        return c < wedgeCount ? CellKind::Wedge : CellKind::Hex;
+    }
+    /// Point ids of cell c's corners into ids; returns their count (4, 5, 6 or 8).
+    UVR_HOST_DEVICE int corners(std::uint64_t c, std::uint32_t ids[kMaxCellCorners]) const {
+        if (c < tetCount) {
+            const Tet& t = tets[c];
+            ids[0] = t.v[0], ids[1] = t.v[1], ids[2] = t.v[2], ids[3] = t.v[3];
+            return 4;
+        }
+        std::uint64_t j = c - tetCount, first = 0;
+        int n = 5;
+        if (j >= pyramidCount) {
+            first = 5 * pyramidCount, j -= pyramidCount, n = 6;
+            if (j >= wedgeCount) first += 6 * wedgeCount, j -= wedgeCount, n = 8;
+        }
+        const std::uint32_t* src = nativeCorners + first + std::uint64_t(n) * j;
+        for (int i = 0; i < n; ++i) ids[i] = src[i];
+        return n;
+    }
+    /// Index of cell c's first face in a face-neighbour table (faceCount(c) entries follow).
+    UVR_HOST_DEVICE std::uint64_t faceBase(std::uint64_t c) const {
+        if (c < tetCount) return 4 * c;
+        const std::uint64_t j = c - tetCount;
+        const std::uint64_t pw = pyramidCount + wedgeCount;
+        return 4 * tetCount + (j < pw ? 5 * j : 5 * pw + 6 * (j - pw));
+    }
+    /// Entries of a face-neighbour table over every cell.
+    UVR_HOST_DEVICE std::uint64_t faceSlots() const {
+        return 4 * tetCount + 5 * (pyramidCount + wedgeCount) + 6 * hexCount;
+    }
+    /// Bounding box of cell c.
+    UVR_HOST_DEVICE Bounds3f cellBounds(std::uint64_t c) const {
+        std::uint32_t ids[kMaxCellCorners];
+        const int n = corners(c, ids);
+        Bounds3f b;
+        for (int i = 0; i < n; ++i) b.extend(points[ids[i]]);
+        return b;
+    }
+
+    /// Interpolated field value in cell c at its local coordinates (piecewise constant for cell
+    /// data): barycentrics bary[0..3] in a tetrahedron, parametric (r, s, t) = bary[0..2] in a
+    /// native cell.
     UVR_HOST_DEVICE float interpolate(std::uint64_t t, const float bary[4]) const {
         if (cellCentered) return values[t];
-        const Tet& tet = tets[t];
-        return bary[0] * values[tet.v[0]] + bary[1] * values[tet.v[1]] +
-               bary[2] * values[tet.v[2]] + bary[3] * values[tet.v[3]];
+        if (t < tetCount) {
+            const Tet& tet = tets[t];
+            return bary[0] * values[tet.v[0]] + bary[1] * values[tet.v[1]] +
+                   bary[2] * values[tet.v[2]] + bary[3] * values[tet.v[3]];
+        }
+        std::uint32_t ids[kMaxCellCorners];
+        const int n = corners(t, ids);
+        float w[kMaxCellCorners];
+        shapeFunctions(kind(t), bary[0], bary[1], bary[2], w);
+        float v = 0.f;
+        for (int i = 0; i < n; ++i) v += w[i] * values[ids[i]];
+        return v;
     }
 };
 
-/// The rendering form of a mesh: every cell split into positively oriented tetrahedra (zero-volume
-/// ones dropped) and one scalar field per point or per tetrahedron.
+/// The rendering form of a mesh: tetrahedra (positively oriented, zero-volume ones dropped) and,
+/// unless cells are split (TetrahedralizeOptions::splitCells), native pyramids, wedges and
+/// hexahedra after them (TetMeshView says how ids are numbered); one scalar field per point or
+/// per cell.
 struct TetMesh {
     std::vector<Vec3f> points;
     std::vector<Tet> tets;
@@ -96,12 +169,46 @@ struct TetMesh {
     /// Per cell of the source mesh, how many tetrahedra it kept (0 to 6); tets lists them cell
     /// after cell, so this maps a cell field onto the tetrahedra (assignTetValues).
     std::vector<std::uint8_t> cellTets;
+    /// Native cells' corners (5 per pyramid, 6 per wedge, 8 per hexahedron) in id order.
+    std::vector<std::uint32_t> nativeCorners;
+    std::uint64_t pyramidCount = 0, wedgeCount = 0, hexCount = 0;
+    /// Per native cell, its cell of the source mesh (cell data is attached through it).
+    std::vector<std::uint64_t> nativeSource;
 
+    /// Every rendered cell: tetrahedra and native cells.
+    std::uint64_t cellCount() const { return tets.size() + pyramidCount + wedgeCount + hexCount; }
+    /// Tetrahedra the cells would split into (a pyramid 2, a wedge 3, a hexahedron 6): what the
+    /// default step and memory estimates count, so a native mesh samples as its split does.
+    std::uint64_t splitTetCount() const {
+        return tets.size() + 2 * pyramidCount + 3 * wedgeCount + 6 * hexCount;
+    }
+    /// True when the mesh has native cells.
+    bool hasNative() const { return pyramidCount + wedgeCount + hexCount > 0; }
+    /// splitTetCount per cell (1 for tetrahedra only): grids sized by tetrahedra per grid cell
+    /// scale a partition's cell count by it, so a native mesh gets its split's grids.
+    double meanSplitTets() const {
+        return cellCount() ? double(splitTetCount()) / double(cellCount()) : 1.0;
+    }
     /// View for kernels; the TetMesh must outlive it.
     TetMeshView view() const {
-        return {points.data(), tets.data(), values.data(), tets.size(),
-                association == Association::Cell};
+        TetMeshView v{points.data(), tets.data(), values.data(), tets.size(),
+                      association == Association::Cell};
+        v.nativeCorners = nativeCorners.data();
+        v.pyramidCount = pyramidCount, v.wedgeCount = wedgeCount, v.hexCount = hexCount;
+        return v;
     }
+};
+
+/// "N tetrahedra", or with native cells "N cells (a tetrahedra, b pyramids, c wedges, d
+/// hexahedra)" leaving out kinds of none: for progress lines.
+std::string describeCells(const TetMesh& mesh);
+
+/// How tetrahedralize treats pyramids, wedges and hexahedra.
+struct TetrahedralizeOptions {
+    /// Split every cell into tetrahedra (`--split-cells`); false: keep pyramids, wedges and
+    /// hexahedra whose isoparametric map is one-to-one (nativeOrientation) as native cells,
+    /// splitting only those that fold or collapse.
+    bool splitCells = false;
 };
 
 /// Number of tetrahedra (at most 6) a cell splits into and their corners, as indices into the
@@ -111,14 +218,22 @@ struct TetMesh {
 /// Tetrahedra are positively oriented when the cell is (VTK's vertex order).
 int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[6][4]);
 
-/// Splits every cell of the mesh into tetrahedra and attaches the field; inverted cells are
-/// re-oriented, zero-volume tetrahedra (also those with a NaN/Inf corner) dropped (validateMesh
-/// reports both); points are mapped by frameForBounds of the kept tetrahedra's bounds.
-TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field);
+/// Splits the cells of the mesh into tetrahedra (all of them, or only those that cannot stay
+/// native: options) and attaches the field; inverted cells are re-oriented, zero-volume
+/// tetrahedra (also those with a NaN/Inf corner) dropped (validateMesh reports both); points are
+/// mapped by frameForBounds of the kept cells' bounds.
+TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
+                       const TetrahedralizeOptions& options = {});
 
-/// Attaches a field of the source mesh to the tetrahedra: values (a point field's as they are, a
-/// cell field's copied onto each of its cell's tetrahedra through cellTets), association, name
-/// and the finite value range over the tetrahedra's values. tetrahedralize ends with it, and a
+/// The bounding box of the field's gradient over point-data cell c of m: a tetrahedron's one
+/// constant gradient; a native cell's gradients at its corners and centre (a pyramid's apex,
+/// where the map is singular, replaced by the middle of its axis), an estimate of their range.
+/// Empty when one is not finite (a degenerate cell, NaN values).
+Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c);
+
+/// Attaches a field of the source mesh to the cells: values (a point field's as they are, a
+/// cell field's copied onto each of its cell's tetrahedra through cellTets and onto native cells
+/// through nativeSource), association, name and the finite value range over the cells' values. tetrahedralize ends with it, and a
 /// time step of the same mesh is attached with it without splitting again. Throws
 /// Error(Argument) when the field does not hold one value per point (or per source cell).
 void assignTetValues(TetMesh& mesh, const ScalarField& field);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "uvr/core/error.h"
+#include "uvr/mesh/tet_math.h"
 
 namespace uvr {
 
@@ -141,7 +142,18 @@ CellSplit splitCell(const MeshView& mesh, std::uint64_t c) {
     return split;
 }
 
-TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field) {
+namespace {
+
+/// The native kind of a VTK cell type (tetrahedra are never native cells).
+CellKind nativeKind(CellType type) {
+    return type == CellType::Pyramid ? CellKind::Pyramid
+                                     : (type == CellType::Wedge ? CellKind::Wedge : CellKind::Hex);
+}
+
+}  // namespace
+
+TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
+                       const TetrahedralizeOptions& options) {
     TetMesh out;
     out.points.assign(mesh.points.begin(), mesh.points.end());
     const bool cellData = field.association == Association::Cell;
@@ -154,6 +166,8 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field) {
     const std::int64_t chunks = (cellCount + kCellChunk - 1) / kCellChunk;
     struct Chunk {
         std::vector<Tet> tets;
+        std::vector<std::uint32_t> native[3];  ///< corners of pyramids, wedges, hexahedra
+        std::vector<std::uint64_t> source[3];  ///< their source cells
         double volume = 0.0;
         Bounds3f bounds;
     };
@@ -166,6 +180,23 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field) {
         s.tets.reserve(static_cast<std::size_t>(end - c * kCellChunk));
         for (std::int64_t i = c * kCellChunk; i < end; ++i) {
             const CellSplit split = splitCell(mesh, i);
+            const CellType type = mesh.cellTypes[i];
+            if (!options.splitCells && type != CellType::Tetra && split.shape == CellShape::Valid) {
+                // Native: kept whole where its isoparametric map is one-to-one.
+                const auto ids = mesh.cell(i);
+                const CellKind kind = nativeKind(type);
+                const int n = kindCorners(kind);
+                Vec3f x[kMaxCellCorners];
+                for (int k = 0; k < n; ++k) x[k] = out.points[ids[k]];
+                if (nativeOrientation(kind, x) != 0) {
+                    const int slot = int(kind) - 1;
+                    s.native[slot].insert(s.native[slot].end(), ids.begin(), ids.begin() + n);
+                    s.source[slot].push_back(std::uint64_t(i));
+                    for (int t = 0; t < split.count; ++t) s.volume += split.volume6[t] / 6.0;
+                    for (int k = 0; k < n; ++k) s.bounds.extend(x[k]);
+                    continue;
+                }
+            }
             out.cellTets[i] = static_cast<std::uint8_t>(split.count);
             for (int t = 0; t < split.count; ++t) {
                 s.tets.push_back(split.tets[t]);
@@ -184,6 +215,22 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field) {
         std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
         s.tets = {};
     }
+    // Native cells by kind, each kind in chunk order.
+    std::uint64_t* counts[3] = {&out.pyramidCount, &out.wedgeCount, &out.hexCount};
+    for (int slot = 0; slot < 3; ++slot) {
+        for (Chunk& s : parts) {
+            out.nativeCorners.insert(out.nativeCorners.end(), s.native[slot].begin(),
+                                     s.native[slot].end());
+            out.nativeSource.insert(out.nativeSource.end(), s.source[slot].begin(),
+                                    s.source[slot].end());
+            *counts[slot] += s.source[slot].size();
+            s.native[slot] = {};
+            s.source[slot] = {};
+        }
+    }
+    UVR_CHECK(out.cellCount() < kNoCell, "the mesh has " << out.cellCount()
+                                                         << " cells; at most " << kNoCell - 1
+                                                         << " can be rendered");
     for (const Chunk& s : parts) {
         out.totalVolume += s.volume;
         out.bounds.extend(s.bounds);
@@ -212,6 +259,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field) {
 void assignTetValues(TetMesh& mesh, const ScalarField& field) {
     const bool cellData = field.association == Association::Cell;
     const std::uint64_t expected = cellData ? mesh.cellTets.size() : mesh.points.size();
+    const TetMeshView view = mesh.view();
     if (field.values.size() != expected)
         throwError(ErrorKind::Argument, "",
                    "field '" + field.name + "' has " + std::to_string(field.values.size()) + " " +
@@ -220,7 +268,6 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
                        " of the prepared mesh)");
     mesh.association = field.association;
     mesh.fieldName = field.name;
-    const std::int64_t tetCount = static_cast<std::int64_t>(mesh.tets.size());
     if (cellData) {
         // Each cell's value onto its tetrahedra, which follow in cell order: per chunk of cells
         // the first tetrahedron, then the chunks in parallel.
@@ -238,7 +285,7 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
         UVR_CHECK(
             first[chunks] == mesh.tets.size(),
             "cellTets lists " << first[chunks] << " tetrahedra, the mesh has " << mesh.tets.size());
-        mesh.values.resize(mesh.tets.size());
+        mesh.values.resize(mesh.cellCount());
 #pragma omp parallel for schedule(static)
         for (std::int64_t c = 0; c < chunks; ++c) {
             std::uint64_t t = first[c];
@@ -246,25 +293,32 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
             for (std::int64_t i = c * kCellChunk; i < end; ++i)
                 for (int k = 0; k < mesh.cellTets[i]; ++k) mesh.values[t++] = field.values[i];
         }
+        const std::int64_t nativeCount = static_cast<std::int64_t>(mesh.nativeSource.size());
+#pragma omp parallel for schedule(static)
+        for (std::int64_t j = 0; j < nativeCount; ++j)
+            mesh.values[mesh.tets.size() + j] = field.values[mesh.nativeSource[j]];
     } else {
         mesh.values.assign(field.values.begin(), field.values.end());
     }
     // The finite range over the tetrahedra's values (points no tetrahedron uses left out), per
     // fixed chunk and then in chunk order: the same for any thread count.
-    const std::int64_t chunks = (tetCount + kCellChunk - 1) / kCellChunk;
+    const std::int64_t allCells = static_cast<std::int64_t>(mesh.cellCount());
+    const std::int64_t chunks = (allCells + kCellChunk - 1) / kCellChunk;
     std::vector<float> lo(chunks, INFINITY), hi(chunks, -INFINITY);
 #pragma omp parallel for schedule(static)
     for (std::int64_t c = 0; c < chunks; ++c) {
         float l = INFINITY, h = -INFINITY;
-        const std::int64_t end = std::min(tetCount, (c + 1) * kCellChunk);
+        const std::int64_t end = std::min(allCells, (c + 1) * kCellChunk);
         for (std::int64_t t = c * kCellChunk; t < end; ++t) {
             if (cellData) {
                 const float v = mesh.values[t];
                 if (std::isfinite(v)) l = std::fmin(l, v), h = std::fmax(h, v);
                 continue;
             }
-            for (std::uint32_t p : mesh.tets[t].v) {
-                const float v = mesh.values[p];
+            std::uint32_t ids[kMaxCellCorners];
+            const int n = view.corners(std::uint64_t(t), ids);
+            for (int k = 0; k < n; ++k) {
+                const float v = mesh.values[ids[k]];
                 if (std::isfinite(v)) l = std::fmin(l, v), h = std::fmax(h, v);
             }
         }
@@ -274,6 +328,43 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
     for (std::int64_t c = 0; c < chunks; ++c) l = std::fmin(l, lo[c]), h = std::fmax(h, hi[c]);
     mesh.valueMin = l <= h ? l : 0.f;
     mesh.valueMax = l <= h ? h : 0.f;
+}
+
+std::string describeCells(const TetMesh& mesh) {
+    if (!mesh.hasNative()) return std::to_string(mesh.tets.size()) + " tetrahedra";
+    std::string parts;
+    auto add = [&](std::uint64_t n, const char* what) {
+        if (n == 0) return;
+        parts += (parts.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+    };
+    add(mesh.tets.size(), "tetrahedra");
+    add(mesh.pyramidCount, "pyramids");
+    add(mesh.wedgeCount, "wedges");
+    add(mesh.hexCount, "hexahedra");
+    return std::to_string(mesh.cellCount()) + " cells (" + parts + ")";
+}
+
+Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c) {
+    std::uint32_t ids[kMaxCellCorners];
+    const int n = m.corners(c, ids);
+    Vec3f x[kMaxCellCorners];
+    float v[kMaxCellCorners];
+    for (int i = 0; i < n; ++i) x[i] = m.points[ids[i]], v[i] = m.values[ids[i]];
+    const CellKind k = m.kind(c);
+    Bounds3f box;
+    if (k == CellKind::Tet) {
+        const Vec3f g = tetGradient(x[0], x[1], x[2], x[3], v[0], v[1], v[2], v[3]);
+        if (isFinite(g)) box.extend(g);
+        return box;
+    }
+    for (int i = 0; i <= n; ++i) {
+        Vec3f rst = i < n ? cornerParametric(k, i) : cellCentreParametric(k);
+        if (k == CellKind::Pyramid && i == 4) rst = Vec3f(0.5f, 0.5f, 0.5f);
+        const Vec3f g = cellGradient(k, x, v, rst);
+        if (!isFinite(g)) return Bounds3f{};
+        box.extend(g);
+    }
+    return box;
 }
 
 MeshFrame frameForBounds(const Bounds3f& bounds) {

@@ -19,6 +19,7 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/vec3d.h"
+#include "uvr/mesh/cell_clip.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/render/segment_integral.h"
 #include "uvr/tf/tf_table.h"
@@ -100,6 +101,78 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
     return s;
 }
 
+/// Clips the ray against cell t: clipTet for a tetrahedron; a native cell's faces as planes and
+/// bilinear patches (clipCell), without a closed-form field (nativeSegment samples it).
+UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
+                                       bool withValue = false) {
+    if (t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
+    std::uint32_t ids[kMaxCellCorners];
+    const int n = mesh.corners(t, ids);
+    Vec3f x[kMaxCellCorners];
+    for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]];
+    const CellSpan c = clipCell(mesh.kind(t), x, ray);
+    TetSpan s;
+    s.tIn = c.tIn, s.tOut = c.tOut, s.exitFace = c.exitFace;
+    return s;
+}
+
+/// Most pieces a native cell's segment is cut into (nativeSegment).
+inline constexpr int kNativeMaxPieces = 16;
+
+/// The point field along the ray through native cell t from t0 to t1 (issue 14): the inverse
+/// isoparametric map is not closed-form along a ray (a trilinear field is a cubic in t only in a
+/// parallelepiped), so the segment is cut into n equal pieces over which the field is taken as
+/// linear, each piece's end values from Newton's method (each start from the last point's
+/// coordinates). n follows the deviation d of the midpoint's value from the mean of the ends:
+/// a piece's deviation falls as 1 / n^2, so n = ceil(sqrt(d / tol)) with tol a quarter of a
+/// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
+/// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc.
+UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
+                                           std::uint32_t t, const Ray& ray, double t0, double t1,
+                                           float v0, double unit, Vec4f& acc) {
+    std::uint32_t ids[kMaxCellCorners];
+    const int n = mesh.corners(t, ids);
+    Vec3f x[kMaxCellCorners];
+    float cv[kMaxCellCorners];
+    for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]], cv[i] = mesh.values[ids[i]];
+    const CellKind k = mesh.kind(t);
+    Vec3f rst = cellCentreParametric(k);
+    auto valueAt = [&](double tp) {
+        const Vec3f p = ray.at(static_cast<float>(tp));
+        cellParametric(k, x, p, rst, true);
+        const Vec3f c = clampParametric(k, rst);
+        float w[kMaxCellCorners];
+        shapeFunctions(k, c.x, c.y, c.z, w);
+        float v = 0.f;
+        for (int i = 0; i < n; ++i) v += w[i] * cv[i];
+        return v;
+    };
+    const float vMid = valueAt(0.5 * (t0 + t1));
+    const Vec3f rstMid = rst;
+    if (!(v0 == v0)) v0 = valueAt(t0);
+    const float vEnd = valueAt(t1);
+    const double tol = 0.25 * (double(tf.hi) - tf.lo) / (tf.count > 1 ? tf.count - 1 : 1);
+    const double dev = fabs(double(vMid) - 0.5 * (double(v0) + vEnd));
+    int pieces = 1;
+    if (dev > tol || !(tol > 0.0)) {
+        const double want = tol > 0.0 ? ceil(sqrt(dev / tol)) : double(kNativeMaxPieces);
+        pieces = want < kNativeMaxPieces ? (want > 2.0 ? int(want) : 2) : kNativeMaxPieces;
+    }
+    if (pieces == 1) {
+        segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
+        return vEnd;
+    }
+    rst = rstMid;  // a good start for the pieces' points in the middle; each follows the last
+    float a = v0;
+    const double h = (t1 - t0) / pieces;
+    for (int i = 1; i <= pieces && acc.w < segment::kOpacityEnd; ++i) {
+        const float b = i == pieces ? vEnd : valueAt(t0 + h * i);
+        segment::integrate(tf, a, b, h, unit, acc, true);
+        a = b;
+    }
+    return vEnd;
+}
+
 /// The tetrahedron the ray is in just after t (entered last among those it is in, or the
 /// nearest ahead): over the BVH's tetrahedra with tOut > t + eps, the one whose max(tIn, t) is
 /// smallest (ties: the larger tOut). kNoTet when no tetrahedron lies ahead.
@@ -127,7 +200,7 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
         if (node.count > 0) {
             for (std::uint32_t k = 0; k < node.count; ++k) {
                 const std::uint32_t id = bvh.primIds[node.first + k];
-                const TetSpan s = clipTet(mesh, id, ray);
+                const TetSpan s = clipAny(mesh, id, ray);
                 if (!(s.tOut > t + eps) || !(s.tIn <= s.tOut)) continue;
                 const double key = s.tIn > t ? s.tIn : t;
                 if (key < bestKey || (key == bestKey && s.tOut > bestOut)) {
@@ -181,7 +254,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     std::uint32_t tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
     const bool continuous = !loc.mesh.cellCentered;
     if (tet != kNoTet) {
-        if (continuous) span = exact::clipTet(loc.mesh, tet, ray, true);  // with the field
+        if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true);  // with the field
         if (span.tIn > t) t = span.tIn;  // empty space before the mesh
     }
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
@@ -195,11 +268,17 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         const double tEnd = span.tOut;
         bool exitValue = false;
         if (tEnd > t) {
-            ++counters.samples;  // one segment per tetrahedron crossed
-            const float s0 = haveEntry ? sEntry : exact::scalarAt(loc, tet, span, ray, t);
-            const float s1 = exact::scalarAt(loc, tet, span, ray, tEnd);
-            // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
-            segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
+            ++counters.samples;  // one segment per cell crossed
+            float s1;
+            if (continuous && tet >= loc.mesh.tetCount) {
+                s1 = exact::nativeSegment(loc.mesh, scene.tf, tet, ray, t, tEnd,
+                                          haveEntry ? sEntry : NAN, unit, acc);
+            } else {
+                const float s0 = haveEntry ? sEntry : exact::scalarAt(loc, tet, span, ray, t);
+                s1 = exact::scalarAt(loc, tet, span, ray, tEnd);
+                // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
+                segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
+            }
             opaque = acc.w >= segment::kOpacityEnd;
             if (opaque) continue;
             t = tEnd;
@@ -211,10 +290,11 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         haveEntry = false;
         // Across the exit face; located again where there is no neighbour or the crossing is
         // degenerate (the neighbour's span does not continue the ray).
-        const std::uint32_t next =
-            loc.neighbors && span.exitFace >= 0 ? loc.neighbors[4 * tet + span.exitFace] : kNoTet;
+        const std::uint32_t next = loc.neighbors && span.exitFace >= 0
+                                       ? loc.neighbors[loc.mesh.faceBase(tet) + span.exitFace]
+                                       : kNoTet;
         if (next != kNoTet) {
-            const exact::TetSpan s = exact::clipTet(loc.mesh, next, ray, continuous);
+            const exact::TetSpan s = exact::clipAny(loc.mesh, next, ray, continuous);
             if (s.tOut > t + eps && s.tIn <= t + eps) {
                 tet = next;
                 span = s;
@@ -224,7 +304,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         }
         tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
         if (tet != kNoTet) {
-            if (continuous) span = exact::clipTet(loc.mesh, tet, ray, true);
+            if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true);
             if (span.tIn > t) t = span.tIn;  // empty space before it
         }
     }

@@ -29,20 +29,21 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     out.sourceCells = mesh.cellCount();
     auto start = std::chrono::steady_clock::now();
     if (progress)
-        progress("splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra");
-    out.tets = tetrahedralize(mesh, field);
+        progress(options.cells.splitCells
+                     ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
+                     : "preparing " + std::to_string(mesh.cellCount()) + " cells");
+    out.tets = tetrahedralize(mesh, field, options.cells);
     out.splitSeconds = secondsSince(start);
 
     // The other builders (the GPU's) only where the mesh is large enough to pay.
-    const bool elsewhere = out.tets.tets.size() >= options.builderMinTets;
+    const bool elsewhere = out.tets.cellCount() >= options.builderMinTets;
     const LbvhBuilder lbvh = elsewhere ? options.lbvh : nullptr;
     const KdSplitter splitter = elsewhere ? options.kdSplitter : nullptr;
     out.builtElsewhere = elsewhere && (lbvh || splitter);
     if (options.meshBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
-            progress("building the BVH over " + std::to_string(out.tets.tets.size()) +
-                     " tetrahedra" + (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
+            progress("building the BVH over " + std::to_string(out.tets.cellCount()) + " cells" + (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
         if (lbvh) {
             out.bvh = buildMeshLbvh(out.tets, lbvh);
         } else {
@@ -111,6 +112,7 @@ std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartiti
     const bool cellData = tets.association == Association::Cell;
     std::vector<std::uint8_t> out(kd.partitions.size(), 0);
     const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+    const TetMeshView view = tets.view();
 #pragma omp parallel for schedule(dynamic, 16)
     for (std::int64_t p = 0; p < n; ++p) {
         const KdPartition& part = kd.partitions[p];
@@ -120,7 +122,9 @@ std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartiti
             if (cellData) {
                 nan = isNan(tets.values[t]);
             } else {
-                for (std::uint32_t v : tets.tets[t].v) nan = nan || isNan(tets.values[v]);
+                std::uint32_t ids[kMaxCellCorners];
+                const int corners = view.corners(t, ids);
+                for (int k = 0; k < corners; ++k) nan = nan || isNan(tets.values[ids[k]]);
             }
         }
         out[p] = nan;
@@ -136,17 +140,13 @@ std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitio
             if (kd.partitions[p].cellCount > 0) out[p] = INFINITY;
         return out;
     }
+    const TetMeshView view = tets.view();
 #pragma omp parallel for schedule(dynamic, 16)
     for (std::int64_t p = 0; p < n; ++p) {
         const KdPartition& part = kd.partitions[p];
         Bounds3f box;
-        for (std::uint32_t i = 0; i < part.cellCount; ++i) {
-            const Tet& t = tets.tets[kd.cells[part.firstCell + i]];
-            const Vec3f g = tetGradient(
-                tets.points[t.v[0]], tets.points[t.v[1]], tets.points[t.v[2]], tets.points[t.v[3]],
-                tets.values[t.v[0]], tets.values[t.v[1]], tets.values[t.v[2]], tets.values[t.v[3]]);
-            if (isFinite(g)) box.extend(g);
-        }
+        for (std::uint32_t i = 0; i < part.cellCount; ++i)
+            box.extend(cellGradientBounds(view, kd.cells[part.firstCell + i]));
         out[p] = box.empty() ? 0.f : length(box.hi - box.lo);
     }
     return out;
@@ -167,9 +167,9 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field) {
 
 float defaultStep(const TetMesh& mesh) {
     const double diagonal = mesh.bounds.diagonal();
-    if (mesh.tets.empty() || !(mesh.totalVolume > 0.0))
+    if (mesh.cellCount() == 0 || !(mesh.totalVolume > 0.0))
         return diagonal > 0.0 ? static_cast<float>(0.01 * diagonal) : 1.f;
-    const double mean = 0.5 * std::cbrt(mesh.totalVolume / double(mesh.tets.size()));
+    const double mean = 0.5 * std::cbrt(mesh.totalVolume / double(mesh.splitTetCount()));
     const double step = std::min(mean, diagonal / kMinSamplesPerDiagonal);
     return static_cast<float>(std::max(step, kMinDefaultStepFraction * diagonal));
 }
@@ -384,7 +384,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     const MeshFrame& frame = mesh.tets.frame;
     f.frame = frame;
     const Bounds3f& bounds = mesh.tets.bounds;
-    const bool empty = mesh.tets.tets.empty();
+    const bool empty = mesh.tets.cellCount() == 0;
     if (empty && !settings.camera)
         throwError(ErrorKind::Argument, "",
                    "the mesh has no cell of non-zero volume (every cell is flat or uses NaN/Inf "
@@ -484,7 +484,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     if (settings.method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
     if (settings.method != RenderMethod::Partitions && mesh.bvh.nodes.empty() &&
-        !mesh.tets.tets.empty())
+        mesh.tets.cellCount() != 0)
         throwError(
             ErrorKind::Argument, "",
             std::string(settings.method == RenderMethod::Exact ? "the exact" : "the reference") +

@@ -32,6 +32,7 @@ struct PrepareOptions {
     bool partitions = true;  ///< build the k-d partitions the partition integrator needs
     bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
     bool macroGrids = true;  ///< with partitions: the macrocells the error-bound rule steps by
+    TetrahedralizeOptions cells;  ///< native cells or the split into tetrahedra
     KdBuildOptions kd;
     /// When set, the mesh BVH and the partitions' BVHs are LBVHs from this builder
     /// (buildLbvhCuda: on the GPU, in seconds for 100M+ tetrahedra); else binned SAH trees built
