@@ -170,8 +170,8 @@ UVR_HOST_DEVICE inline int crossBilinear(const Vec3d* q, Vec3d o, Vec3d d, doubl
     return count;
 }
 
-/// clipCell for tetrahedra: the four face planes as half-spaces (exactly clipTet's result, with
-/// each plane from its canonically ordered corners).
+/// clipCell for tetrahedra: the four face planes as half-spaces, as exact::clipTet (each plane
+/// from its canonically ordered corners; a plane within kGrazing of the ray counts as parallel).
 UVR_HOST_DEVICE inline CellSpan clipTetCell(const Vec3f* x, Vec3d o, Vec3d d, int orientation) {
     CellSpan s;
     for (int f = 0; f < 4; ++f) {
