@@ -50,9 +50,10 @@ UVR_HOST_DEVICE inline std::uint32_t packedFace(CellKind k, int f) {
     using cellface::pack;
     switch (k) {
         case CellKind::Tet:
-            return f == 0 ? pack(1, 2, 3, 0, 3)
-                          : f == 1 ? pack(0, 3, 2, 0, 3)
-                                   : f == 2 ? pack(0, 1, 3, 0, 3) : pack(0, 2, 1, 0, 3);
+            return f == 0   ? pack(1, 2, 3, 0, 3)
+                   : f == 1 ? pack(0, 3, 2, 0, 3)
+                   : f == 2 ? pack(0, 1, 3, 0, 3)
+                            : pack(0, 2, 1, 0, 3);
         case CellKind::Pyramid:
             return f == 0   ? pack(0, 3, 2, 1)
                    : f == 1 ? pack(0, 1, 4, 0, 3)
@@ -77,7 +78,9 @@ UVR_HOST_DEVICE inline std::uint32_t packedFace(CellKind k, int f) {
 }
 
 /// Corner count (3 or 4) of a packed face.
-UVR_HOST_DEVICE constexpr int faceSize(std::uint32_t packed) { return int(packed >> 16) & 7; }
+UVR_HOST_DEVICE constexpr int faceSize(std::uint32_t packed) {
+    return int(packed >> 16) & 7;
+}
 /// Local corner i of a packed face.
 UVR_HOST_DEVICE constexpr int faceCorner(std::uint32_t packed, int i) {
     return int(packed >> (4 * i)) & 15;
@@ -214,7 +217,8 @@ UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, 
         rst = rst + d;
         rst = Vec3f(fminf(fmaxf(rst.x, -1.f), 2.f), fminf(fmaxf(rst.y, -1.f), 2.f),
                     fminf(fmaxf(rst.z, -1.f), 2.f));
-        const float residual = fmaxf(fabsf(f.x), fmaxf(fabsf(f.y), fabsf(f.z)));
+        const float residual =
+            isFinite(f) ? fmaxf(fabsf(f.x), fmaxf(fabsf(f.y), fabsf(f.z))) : INFINITY;
         const float moved = fmaxf(fabsf(d.x), fmaxf(fabsf(d.y), fabsf(d.z)));
         converged = residual <= tol || moved <= 1e-6f || !(moved == moved);
         if (!(moved == moved)) return false;  // NaN
@@ -223,20 +227,28 @@ UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, 
         Vec3f f, jr, js, jt;
         cellMap(k, e, rst, f, jr, js, jt);
         f = f - q;
-        converged = fmaxf(fabsf(f.x), fmaxf(fabsf(f.y), fabsf(f.z))) <= tol;
+        converged = isFinite(f) && fmaxf(fabsf(f.x), fmaxf(fabsf(f.y), fabsf(f.z))) <= tol;
     }
     return converged;
 }
 
 /// How far parametric rst lies outside face f of kind k (positive: outside; the faces of
-/// packedFace).
+/// packedFace). A pyramid's sides count in units that shrink to 0 at the apex.
 UVR_HOST_DEVICE inline float faceExcess(CellKind k, Vec3f rst, int f) {
     const float r = rst.x, s = rst.y, t = rst.z;
     switch (k) {
         case CellKind::Tet:
             return f == 0 ? r + s + t - 1.f : (f == 1 ? -r : (f == 2 ? -s : -t));
-        case CellKind::Pyramid:
-            return f == 0 ? -t : (f == 1 ? -s : (f == 2 ? r - 1.f : (f == 3 ? s - 1.f : -r)));
+        case CellKind::Pyramid: {
+            // The sides scaled by 1 - t (as the physical distance to them is): beyond the apex
+            // (t > 1) the map mirrors the pyramid, and those points are outside every side.
+            const float tm = 1.f - t;
+            return f == 0   ? -t
+                   : f == 1 ? -s * tm
+                   : f == 2 ? (r - 1.f) * tm
+                   : f == 3 ? (s - 1.f) * tm
+                            : -r * tm;
+        }
         case CellKind::Wedge:
             return f == 0 ? -t : (f == 1 ? t - 1.f : (f == 2 ? -s : (f == 3 ? r + s - 1.f : -r)));
         case CellKind::Hex:
