@@ -181,8 +181,10 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
         for (std::int64_t i = c * kCellChunk; i < end; ++i) {
             const CellSplit split = splitCell(mesh, i);
             const CellType type = mesh.cellTypes[i];
-            if (!options.splitCells && type != CellType::Tetra && split.shape == CellShape::Valid) {
-                // Native: kept whole where its isoparametric map is one-to-one.
+            if (!options.splitCells && type != CellType::Tetra &&
+                (split.shape == CellShape::Valid || split.shape == CellShape::Inverted)) {
+                // Native: kept whole where its isoparametric map is one-to-one (either
+                // orientation: a mirrored vertex order is read as it is).
                 const auto ids = mesh.cell(i);
                 const CellKind kind = nativeKind(type);
                 const int n = kindCorners(kind);

@@ -102,15 +102,16 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
 }
 
 /// Clips the ray against cell t: clipTet for a tetrahedron; a native cell's faces as planes and
-/// bilinear patches (clipCell), without a closed-form field (nativeSegment samples it).
+/// bilinear patches (clipCell: of a curved cell the ray crosses twice, the span ending after
+/// tMin), without a closed-form field (nativeSegment samples it).
 UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
-                                       bool withValue = false) {
+                                       bool withValue = false, double tMin = -INFINITY) {
     if (t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
     std::uint32_t ids[kMaxCellCorners];
     const int n = mesh.corners(t, ids);
     Vec3f x[kMaxCellCorners];
     for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]];
-    const CellSpan c = clipCell(mesh.kind(t), x, ray);
+    const CellSpan c = clipCell(mesh.kind(t), x, ray, tMin);
     TetSpan s;
     s.tIn = c.tIn, s.tOut = c.tOut, s.exitFace = c.exitFace;
     return s;
@@ -200,7 +201,7 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
         if (node.count > 0) {
             for (std::uint32_t k = 0; k < node.count; ++k) {
                 const std::uint32_t id = bvh.primIds[node.first + k];
-                const TetSpan s = clipAny(mesh, id, ray);
+                const TetSpan s = clipAny(mesh, id, ray, false, t + eps);
                 if (!(s.tOut > t + eps) || !(s.tIn <= s.tOut)) continue;
                 const double key = s.tIn > t ? s.tIn : t;
                 if (key < bestKey || (key == bestKey && s.tOut > bestOut)) {
@@ -254,7 +255,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     std::uint32_t tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
     const bool continuous = !loc.mesh.cellCentered;
     if (tet != kNoTet) {
-        if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true);  // with the field
+        if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true, t + eps);  // with the field
         if (span.tIn > t) t = span.tIn;  // empty space before the mesh
     }
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
@@ -294,7 +295,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                                        ? loc.neighbors[loc.mesh.faceBase(tet) + span.exitFace]
                                        : kNoTet;
         if (next != kNoTet) {
-            const exact::TetSpan s = exact::clipAny(loc.mesh, next, ray, continuous);
+            const exact::TetSpan s = exact::clipAny(loc.mesh, next, ray, continuous, t + eps);
             if (s.tOut > t + eps && s.tIn <= t + eps) {
                 tet = next;
                 span = s;
@@ -304,7 +305,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         }
         tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
         if (tet != kNoTet) {
-            if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true);
+            if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true, t + eps);
             if (span.tIn > t) t = span.tIn;  // empty space before it
         }
     }
