@@ -682,7 +682,8 @@ PYBIND11_MODULE(_uvr, m) {
         .def(py::init([](const MeshData& mesh, const std::string& name,
                          const std::string& association, const py::handle& values,
                          const std::string& device, const std::string& buildDevice,
-                         std::uint32_t leafCells, bool meshBvh, bool seedGrids) {
+                         std::uint32_t leafCells, bool meshBvh, bool seedGrids,
+                         bool splitCells) {
                  ScalarField field = scalarField(name, association, values);
                  RendererOptions o;
                  o.device = parseDevice(device, "device");
@@ -690,6 +691,7 @@ PYBIND11_MODULE(_uvr, m) {
                  o.leafCells = leafCells;
                  o.meshBvh = meshBvh;
                  o.seedGrids = seedGrids;
+                 o.splitCells = splitCells;
                  const std::uint64_t expected = field.association == Association::Point
                                                     ? mesh.view.pointCount()
                                                     : mesh.view.cellCount();
@@ -705,7 +707,8 @@ PYBIND11_MODULE(_uvr, m) {
              }),
              py::arg("mesh"), py::arg("name"), py::arg("association"), py::arg("values"),
              py::arg("device") = "auto", py::arg("build_device") = "auto",
-             py::arg("leaf_cells") = 0, py::arg("mesh_bvh") = true, py::arg("seed_grids") = true)
+             py::arg("leaf_cells") = 0, py::arg("mesh_bvh") = true, py::arg("seed_grids") = true,
+             py::arg("split_cells") = false)
         .def(
             "set_field_values",
             [](PyRenderer& self, const std::string& name, const std::string& association,
@@ -731,6 +734,9 @@ PYBIND11_MODULE(_uvr, m) {
             const PreparedMesh& p = r.renderer->prepared();
             py::dict d;
             d["tetrahedra"] = p.tets.tets.size();
+            d["pyramids"] = p.tets.pyramidCount;
+            d["wedges"] = p.tets.wedgeCount;
+            d["hexahedra"] = p.tets.hexCount;
             d["source_cells"] = p.sourceCells;
             d["points"] = p.tets.points.size();
             d["field"] = p.tets.fieldName;

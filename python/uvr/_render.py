@@ -42,7 +42,8 @@ class Renderer:
     "T:cell"; None: the default field) or an array of values (one per point or cell). `device`:
     "auto" (CUDA when built with it and a GPU is present), "cpu" or "cuda".
     ``methods`` names the integrators to prepare for ("reference" and "exact" need the mesh
-    BVH). Changing the transfer function, camera, range, method or quality rebuilds nothing;
+    BVH). Pyramids, wedges and hexahedra are rendered natively (trilinear hexahedra);
+    ``split_cells=True`` splits them into tetrahedra instead, as ``uvr render --split-cells``. Changing the transfer function, camera, range, method or quality rebuilds nothing;
     new field values of the same mesh (``set_field``; ``render(field=...)``) rebuild nothing
     geometric either. Made from a ``uvr.Series``, it shows the first step and ``set_time`` /
     ``set_step`` show others (values only while the points and cells stay). The GIL is released
@@ -50,11 +51,12 @@ class Renderer:
     """
 
     def __init__(self, mesh, field=None, device="auto", *, build_device="auto", leaf_cells=0,
-                 methods=("adaptive", "reference", "exact"), seed_grids=True, association=None):
+                 methods=("adaptive", "reference", "exact"), seed_grids=True, split_cells=False,
+                 association=None):
         self.series = mesh if isinstance(mesh, Series) else None
         self._step = 0
         self._options = dict(device=device, build_device=build_device, leaf_cells=leaf_cells,
-                             methods=methods, seed_grids=seed_grids)
+                             methods=methods, seed_grids=seed_grids, split_cells=split_cells)
         self._prepare(as_mesh(mesh), field, association)
 
     def _prepare(self, mesh, field, association=None):
@@ -73,7 +75,8 @@ class Renderer:
             self._core = _uvr.Renderer(self.mesh._data, name, assoc, values, device,
                                        build_device, int(leaf_cells),
                                        mesh_bvh="reference" in methods or "exact" in methods,
-                                       seed_grids=bool(seed_grids))
+                                       seed_grids=bool(seed_grids),
+                                       split_cells=bool(self._options["split_cells"]))
         except BaseException:
             self.mesh = previous  # a failed new step leaves the renderer as it was
             raise

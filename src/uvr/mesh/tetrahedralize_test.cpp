@@ -108,7 +108,8 @@ TEST(Tetrahedralize, NeighbouringHexesSplitSharedFacesTheSameWay) {
     for (auto& id : m.cellIndices) id = perm[id];
     m.fields.clear();
     const TetMesh tets = tetrahedralize(
-        m, ScalarField{"c", Association::Cell, std::vector<float>(m.cellCount(), 1.f)});
+        m, ScalarField{"c", Association::Cell, std::vector<float>(m.cellCount(), 1.f)},
+        {.splitCells = true});
     ASSERT_EQ(tets.tets.size(), 6u * 64u);
     std::map<std::array<std::uint32_t, 3>, int> faces;
     for (const Tet& t : tets.tets)
@@ -144,7 +145,8 @@ TEST(Tetrahedralize, InvertedCellsAreReorientedAndZeroVolumeCellsDropped) {
     EXPECT_EQ(r.firstInvertedCell, 0u);
     EXPECT_EQ(r.zeroVolumeCells, 1u);
     EXPECT_EQ(r.firstZeroVolumeCell, 1u);
-    const TetMesh t = tetrahedralize(m, ScalarField{"c", Association::Cell, {1.f, 2.f, 3.f}});
+    const TetMesh t = tetrahedralize(m, ScalarField{"c", Association::Cell, {1.f, 2.f, 3.f}},
+                                     {.splitCells = true});
     ASSERT_EQ(t.tets.size(), 7u);
     for (const Tet& tet : t.tets)
         EXPECT_GT(signedVolume6(t.points[tet.v[0]], t.points[tet.v[1]], t.points[tet.v[2]],

@@ -69,7 +69,7 @@ double tetVolume(const Mesh& m, std::uint64_t c) {
 
 /// Boundary faces of the tetrahedra the renderer prepares from a mesh (faces without neighbour).
 std::uint64_t boundaryFaces(const Mesh& m) {
-    const TetMesh tets = tetrahedralize(m, selectScalarField(m, FieldSpec{}));
+    const TetMesh tets = tetrahedralize(m, selectScalarField(m, FieldSpec{}), {.splitCells = true});
     std::uint64_t n = 0;
     for (std::uint32_t t : buildTetNeighbors(tets)) n += t == kNoTet;
     return n;
