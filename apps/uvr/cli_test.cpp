@@ -263,6 +263,31 @@ TEST(Cli, GenerateAndDemo) {
     EXPECT_EQ(readPng(dir + "/demo.png").width, 32);
 }
 
+TEST(Cli, GenerateMixedCells) {
+    const std::string dir = testing::scratchDir();
+    // 4^3 blocks (about 4.2 cells a block), every cell type, nothing for validation to report.
+    CliRun r = uvr("-q generate mixed --cells 270 --seed 3 -o " + dir + "/m.vtu", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = uvr("-q info --json " + dir + "/m.vtu", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["cells"].get<int>(), 200);
+    EXPECT_LT(j["cells"].get<int>(), 400);
+    EXPECT_TRUE(j["validation"].empty()) << j["validation"];
+    const std::string text = j.dump();
+    for (const char* name :
+         {"hexahedron", "wedge", "pyramid", "tetra", "linear", "xyz", "block", "cell_type"})
+        EXPECT_NE(text.find(name), std::string::npos) << name << " not in " << text;
+    // Too much jitter for its cells, and options it does not take.
+    r = uvr("-q generate mixed --jitter 0.2 -o " + dir + "/x.vtu", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("jitter must be in [0, 0.15"), std::string::npos) << r.err;
+    r = uvr("-q generate mixed --fields linear -o " + dir + "/x.vtu", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--fields and --steps do not apply"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::ifstream(dir + "/x.vtu").good());
+}
+
 TEST(Cli, RefineMultipliesTetrahedraBy8PerLevel) {
     const std::string dir = testing::scratchDir();
     CliRun r = uvr("-q generate box --cells 1000 --fields linear -o " + dir + "/b.uvrm", dir);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -341,7 +342,11 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     auto out = std::make_shared<std::string>();
     auto spec = std::make_shared<ProceduralSpec>();
     auto fields = std::make_shared<std::vector<std::string>>();
-    cmd->add_option("SHAPE", *shape, "box, shell (hollow, non-convex) or graded (100x cell sizes)")
+    cmd->add_option("SHAPE", *shape,
+                    "box, shell (hollow, non-convex), graded (100x cell sizes) or mixed "
+                    "(hexahedra, wedges, pyramids and tetrahedra with every face pairing; its own "
+                    "fields linear, xyz, block and cell_type; jitter 0.1 unless given, at most "
+                    "0.15)")
         ->capture_default_str();
     cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu, .vtk or .vtkhdf)")->required();
     cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
@@ -369,9 +374,31 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("--dt", *dt, "Time between steps (radians the fields turn)")
         ->capture_default_str()
         ->check(CLI::Range(-1e6, 1e6));
-    cmd->callback([shape, out, spec, fields, steps, dt, &ctx] {
+    cmd->callback([cmd, shape, out, spec, fields, steps, dt, &ctx] {
         resolveOutput(*out);
         checkMeshWritable(*out);  // before generating
+        if (*shape == "mixed") {
+            if (!fields->empty() || *steps != 1)
+                throwError(ErrorKind::Argument, "",
+                           "generate mixed writes its own fields (linear, xyz, block, cell_type) "
+                           "and one step: --fields and --steps do not apply");
+            // About 4.2 cells a block; at most 12 (a block of tetrahedra to its centre).
+            const int n =
+                static_cast<int>(std::clamp(std::round(std::cbrt(double(spec->targetCells) / 4.2)),
+                                            1.0, double(kMaxMixedCellBlocks)));
+            const std::uint64_t blocks = std::uint64_t(n) * n * n;
+            const std::uint64_t points = std::uint64_t(n + 1) * (n + 1) * (n + 1) + blocks;
+            checkMemoryEstimate(ctx,
+                                "--cells " + std::to_string(spec->targetCells) + ": the mesh of " +
+                                    std::to_string(n) + "^3 blocks",
+                                points * 20 + blocks * 12 * (1 + 8 + 16 + 8));
+            ctx.setActivity(*out, "generating the mesh");
+            const float jitter = cmd->count("--jitter") ? spec->jitter : 0.1f;
+            const Mesh mesh = generateMixedCellMesh(n, jitter, spec->seed);
+            ctx.step("generated " + std::to_string(mesh.pointCount()) + " points, " +
+                     std::to_string(mesh.cellCount()) + " cells: " + mesh.notes.front());
+            return writeMeshWithProgress(mesh, *out, ctx);
+        }
         spec->shape = parseProceduralShape(*shape);
         if (!fields->empty()) {
             spec->fields.clear();

@@ -81,6 +81,24 @@ float proceduralFieldValue(ProceduralField field, Vec3f p, double cellSize = 0.0
 /// cube; the graded mesh's cells vary about it).
 double proceduralCellSize(const ProceduralSpec& spec);
 
+/// Largest allowed jitter of generateMixedCellMesh, in block sizes: every hexahedron, wedge,
+/// pyramid and tetrahedron of its templates stays positively oriented while each point moves less.
+inline constexpr float kMaxMixedCellJitter = 0.15f;
+/// Most blocks per axis of generateMixedCellMesh (its points must fit 32-bit indices).
+inline constexpr int kMaxMixedCellBlocks = 1000;
+
+/// A conforming mesh of [-1, 1]^3 with cells of all four types over n x n x n blocks, each block
+/// a hexahedron, 6 pyramids to its centre, 2 wedges, a wedge + pyramid + tetrahedron, or (where
+/// its neighbours cut its faces otherwise) pyramids and tetrahedra to its centre; for n >= 4 it
+/// holds every pairing of cell types across quadrilateral faces (hexahedron, pyramid, wedge) and
+/// triangles (tetrahedron, pyramid, wedge). Interior points move inside a ball of jitter (at most
+/// kMaxMixedCellJitter) times the block size, boundary points along the boundary only, so
+/// hexahedron faces are not planar. Point fields "linear" (x + 2y - z) and "xyz" (x y z), cell
+/// fields "block" (the block's index, x fastest) and "cell_type" (the VTK type code). Same
+/// arguments, same mesh; throws Error(Argument) for n outside [1, kMaxMixedCellBlocks] or jitter
+/// outside [0, kMaxMixedCellJitter].
+Mesh generateMixedCellMesh(int n, float jitter = 0.1f, std::uint64_t seed = 1);
+
 /// Field name as written into the mesh ("jet", ...).
 const char* proceduralFieldName(ProceduralField field);
 /// Shape name as the CLI spells it ("box", "shell", "graded").

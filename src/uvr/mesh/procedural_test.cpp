@@ -8,11 +8,16 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <iostream>
+#include <limits>
 #include <map>
 #include <numbers>
 
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/mesh/cell_math.h"
+#include "uvr/mesh/tet_mesh.h"
+#include "uvr/mesh/validate.h"
 
 namespace uvr {
 namespace {
@@ -420,6 +425,290 @@ TEST(Procedural, MultiscaleFieldHasDetailDownToTheCellSize) {
                   proceduralFieldValue(ProceduralField::Multiscale, m.points[i], kFine);
     }
     EXPECT_GT(differ, int(m.points.size() / 2));
+}
+
+// ---------------------------------------------------------------------------------------------
+// generateMixedCellMesh
+
+/// VTK's faces of each cell type (corner indices; orientation does not matter here), written out
+/// independently of the generator's tables.
+const std::vector<std::vector<int>>& vtkFaces(CellType type) {
+    static const std::vector<std::vector<int>> tet = {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 2, 1}};
+    static const std::vector<std::vector<int>> pyramid = {
+        {0, 1, 2, 3}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+    static const std::vector<std::vector<int>> wedge = {
+        {0, 1, 2}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
+    static const std::vector<std::vector<int>> hex = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                      {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    switch (type) {
+        case CellType::Tetra:
+            return tet;
+        case CellType::Pyramid:
+            return pyramid;
+        case CellType::Wedge:
+            return wedge;
+        case CellType::Hexahedron:
+            break;
+    }
+    return hex;
+}
+
+/// Every face of a mesh (sorted corner set) with the cells having it, and the face's corners in
+/// cyclic order.
+struct FaceCensus {
+    std::map<std::vector<std::uint32_t>, std::vector<std::uint64_t>> cells;
+    std::map<std::vector<std::uint32_t>, std::vector<std::uint32_t>> cyclic;
+
+    explicit FaceCensus(const Mesh& m) {
+        for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+            const auto ids = m.cell(c);
+            for (const auto& face : vtkFaces(m.cellTypes[c])) {
+                std::vector<std::uint32_t> corners;
+                for (int v : face) corners.push_back(ids[v]);
+                std::vector<std::uint32_t> key = corners;
+                std::sort(key.begin(), key.end());
+                cells[key].push_back(c);
+                cyclic[key] = corners;
+            }
+        }
+    }
+};
+
+std::string typeWord(CellType t) {
+    switch (t) {
+        case CellType::Tetra:
+            return "tet";
+        case CellType::Pyramid:
+            return "pyramid";
+        case CellType::Wedge:
+            return "wedge";
+        case CellType::Hexahedron:
+            break;
+    }
+    return "hex";
+}
+
+/// Interior faces by pairing: "quad hex-pyramid", "triangle tet-wedge", ... (types in the order
+/// tet, pyramid, wedge, hex).
+std::map<std::string, int> facePairings(const Mesh& m) {
+    std::map<std::string, int> counts;
+    const FaceCensus census(m);
+    for (const auto& [key, cells] : census.cells) {
+        if (cells.size() != 2) continue;
+        CellType a = m.cellTypes[cells[0]], b = m.cellTypes[cells[1]];
+        auto rank = [](CellType t) {
+            return t == CellType::Tetra     ? 0
+                   : t == CellType::Pyramid ? 1
+                   : t == CellType::Wedge   ? 2
+                                            : 3;
+        };
+        if (rank(a) > rank(b)) std::swap(a, b);
+        ++counts[(key.size() == 4 ? "quad " : "triangle ") + typeWord(a) + "-" + typeWord(b)];
+    }
+    return counts;
+}
+
+/// True when every corner of the face lies on one side of [-1, 1]^3.
+bool onBoundary(const Mesh& m, const std::vector<std::uint32_t>& face) {
+    for (int axis = 0; axis < 3; ++axis)
+        for (float side : {-1.f, 1.f}) {
+            bool all = true;
+            for (std::uint32_t v : face) all = all && m.points[v][axis] == side;
+            if (all) return true;
+        }
+    return false;
+}
+
+TEST(MixedCellMesh, EveryFacePairingOccurs) {
+    const std::vector<std::string> expected = {"quad hex-hex",           "quad pyramid-hex",
+                                               "quad wedge-hex",         "quad pyramid-pyramid",
+                                               "quad pyramid-wedge",     "quad wedge-wedge",
+                                               "triangle tet-tet",       "triangle tet-pyramid",
+                                               "triangle tet-wedge",     "triangle pyramid-pyramid",
+                                               "triangle pyramid-wedge", "triangle wedge-wedge"};
+    for (int n : {4, 5, 7}) {
+        for (std::uint64_t seed : {1, 2, 3}) {
+            SCOPED_TRACE("n " + std::to_string(n) + ", seed " + std::to_string(seed));
+            const Mesh m = generateMixedCellMesh(n, 0.1f, seed);
+            const auto counts = facePairings(m);
+            std::string report;
+            for (const auto& [pairing, count] : counts)
+                report += pairing + ": " + std::to_string(count) + "; ";
+            if (n == 4 && seed == 1) std::cout << "n = 4, seed 1: " << report << "\n";
+            for (const std::string& pairing : expected)
+                EXPECT_GT(counts.count(pairing) ? counts.at(pairing) : 0, 0)
+                    << pairing << " missing: " << report;
+            // Nothing else: no quad against a tetrahedron, no triangle against a hexahedron.
+            EXPECT_EQ(counts.size(), expected.size()) << report;
+        }
+    }
+}
+
+TEST(MixedCellMesh, IsConforming) {
+    for (int n : {1, 2, 3, 4, 6}) {
+        for (float jitter : {0.f, 0.15f}) {
+            for (std::uint64_t seed : {1, 9}) {
+                SCOPED_TRACE("n " + std::to_string(n) + ", jitter " + std::to_string(jitter) +
+                             ", seed " + std::to_string(seed));
+                const Mesh m = generateMixedCellMesh(n, jitter, seed);
+                const FaceCensus census(m);
+                std::uint64_t boundary = 0;
+                for (const auto& [key, cells] : census.cells) {
+                    ASSERT_LE(cells.size(), 2u)
+                        << "a face of cells " << cells[0] << ", " << cells[1] << ", " << cells[2];
+                    if (onBoundary(m, key)) {
+                        EXPECT_EQ(cells.size(), 1u) << "boundary face of cell " << cells[0];
+                        ++boundary;
+                    } else {
+                        EXPECT_EQ(cells.size(), 2u)
+                            << "interior face of cell " << cells[0] << " has no neighbour";
+                    }
+                    if (key.size() != 4) continue;
+                    // A quadrilateral is never matched against two triangles.
+                    const auto& q = census.cyclic.at(key);
+                    for (int skip = 0; skip < 4; ++skip) {
+                        std::vector<std::uint32_t> tri;
+                        for (int v = 0; v < 4; ++v)
+                            if (v != skip) tri.push_back(q[v]);
+                        std::sort(tri.begin(), tri.end());
+                        EXPECT_EQ(census.cells.count(tri), 0u)
+                            << "quad face of cell " << cells[0] << " also split into triangles";
+                    }
+                }
+                // The boundary: 6 n^2 block faces, quads or triangle pairs; area 24.
+                double area = 0.0;
+                for (const auto& [key, cells] : census.cells) {
+                    if (cells.size() != 1) continue;
+                    const auto& f = census.cyclic.at(key);
+                    for (std::size_t t = 1; t + 1 < f.size(); ++t) {
+                        const Vec3f a = m.points[f[0]], b = m.points[f[t]], c = m.points[f[t + 1]];
+                        area += 0.5 * double(length(cross(b - a, c - a)));
+                    }
+                }
+                EXPECT_GE(boundary, 6u * n * n);
+                EXPECT_NEAR(area, 24.0, 1e-4);
+            }
+        }
+    }
+}
+
+TEST(MixedCellMesh, FillsTheCubeWithPositiveCells) {
+    for (float jitter : {0.f, 0.1f, 0.15f}) {
+        for (std::uint64_t seed = 1; seed <= (jitter == 0.15f ? 12u : 2u); ++seed) {
+            SCOPED_TRACE("jitter " + std::to_string(jitter) + ", seed " + std::to_string(seed));
+            const Mesh m = generateMixedCellMesh(4, jitter, seed);
+            double volume = 0.0;
+            for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+                const CellSplit split = splitCell(m, c);
+                ASSERT_EQ(split.shape, CellShape::Valid) << "cell " << c;
+                for (int t = 0; t < split.count; ++t) volume += split.volume6[t] / 6.0;
+                // The native map (trilinear hexahedra, ...) does not fold; VTK-ordered wedges
+                // (cell_math.h's wedge map, (0, 1, 2) towards (3, 4, 5), mirrors VTK's order)
+                // have a negative Jacobian there, the other types a positive one.
+                Vec3f x[8];
+                const auto ids = m.cell(c);
+                for (std::size_t v = 0; v < ids.size(); ++v) x[v] = m.points[ids[v]];
+                const CellKind kind = m.cellTypes[c] == CellType::Tetra     ? CellKind::Tet
+                                      : m.cellTypes[c] == CellType::Pyramid ? CellKind::Pyramid
+                                      : m.cellTypes[c] == CellType::Wedge   ? CellKind::Wedge
+                                                                            : CellKind::Hex;
+                EXPECT_EQ(nativeOrientation(kind, x), kind == CellKind::Wedge ? -1 : 1)
+                    << "cell " << c;
+            }
+            EXPECT_NEAR(volume, 8.0, 1e-4);
+            const ValidationReport report = validateMesh(m);
+            EXPECT_TRUE(report.findings().empty()) << ::testing::PrintToString(report.findings());
+            EXPECT_EQ(report.invertedCells + report.distortedCells + report.zeroVolumeCells, 0u);
+        }
+    }
+}
+
+TEST(MixedCellMesh, HexahedronFacesAreNotPlanarWhenJittered) {
+    const Mesh m = generateMixedCellMesh(4, 0.1f, 1);
+    double worst =
+        0.0;  // largest distance of a hexahedron face corner from its other three's plane
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+        if (m.cellTypes[c] != CellType::Hexahedron) continue;
+        const auto ids = m.cell(c);
+        for (const auto& f : vtkFaces(CellType::Hexahedron)) {
+            const Vec3f a = m.points[ids[f[0]]], b = m.points[ids[f[1]]], d = m.points[ids[f[3]]],
+                        p = m.points[ids[f[2]]];
+            const Vec3f nrm = normalize(cross(b - a, d - a));
+            worst = std::max(worst, std::fabs(double(dot(p - a, nrm))));
+        }
+    }
+    EXPECT_GT(worst, 0.01);  // the block size is 0.5
+}
+
+TEST(MixedCellMesh, HasAllCellTypesAndFields) {
+    const int n = 4;
+    const Mesh m = generateMixedCellMesh(n, 0.1f, 5);
+    for (CellType t : {CellType::Tetra, CellType::Pyramid, CellType::Wedge, CellType::Hexahedron})
+        EXPECT_GT(std::count(m.cellTypes.begin(), m.cellTypes.end(), t), 0) << cellTypeName(t);
+    const Field* linear = m.findField("linear", Association::Point);
+    const Field* product = m.findField("xyz", Association::Point);
+    const Field* block = m.findField("block", Association::Cell);
+    const Field* types = m.findField("cell_type", Association::Cell);
+    ASSERT_TRUE(linear && product && block && types);
+    ASSERT_EQ(linear->values.size(), m.pointCount());
+    ASSERT_EQ(product->values.size(), m.pointCount());
+    for (std::uint64_t i = 0; i < m.pointCount(); ++i) {
+        const Vec3f p = m.points[i];
+        EXPECT_NEAR(linear->values[i], p.x + 2.0 * p.y - p.z, 1e-6);
+        EXPECT_NEAR(product->values[i], double(p.x) * p.y * p.z, 1e-6);
+    }
+    ASSERT_EQ(block->values.size(), m.cellCount());
+    ASSERT_EQ(types->values.size(), m.cellCount());
+    const double h = 2.0 / n;
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+        EXPECT_EQ(types->values[c], float(m.cellTypes[c]));
+        // The cell's corners lie in (or, jittered, by its side of) its block.
+        const auto b = static_cast<std::uint64_t>(block->values[c]);
+        ASSERT_LT(b, std::uint64_t(n * n * n));
+        const double lo[3] = {-1.0 + h * double(b % n), -1.0 + h * double(b / n % n),
+                              -1.0 + h * double(b / n / n)};
+        for (std::uint32_t v : m.cell(c))
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_GE(m.points[v][a], lo[a] - 0.1 * h - 1e-6);
+                EXPECT_LE(m.points[v][a], lo[a] + 1.1 * h + 1e-6);
+            }
+    }
+    ASSERT_FALSE(m.notes.empty());
+    EXPECT_THAT(m.notes[0], HasSubstr("4^3 blocks"));
+}
+
+TEST(MixedCellMesh, SameSeedSameMesh) {
+    const Mesh a = generateMixedCellMesh(5, 0.12f, 42), b = generateMixedCellMesh(5, 0.12f, 42);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    EXPECT_EQ(0, std::memcmp(a.points.data(), b.points.data(), a.points.size() * sizeof(Vec3f)));
+    EXPECT_EQ(a.cellTypes, b.cellTypes);
+    EXPECT_EQ(a.cellOffsets, b.cellOffsets);
+    EXPECT_EQ(a.cellIndices, b.cellIndices);
+    ASSERT_EQ(a.fields.size(), b.fields.size());
+    for (std::size_t f = 0; f < a.fields.size(); ++f)
+        EXPECT_EQ(a.fields[f].values, b.fields[f].values);
+    const Mesh c = generateMixedCellMesh(5, 0.12f, 43);
+    EXPECT_FALSE(a.points.size() == c.points.size() &&
+                 std::memcmp(a.points.data(), c.points.data(), a.points.size() * sizeof(Vec3f)) ==
+                     0);
+}
+
+TEST(MixedCellMesh, BadArgumentsAreArgumentErrors) {
+    auto expectArgument = [](int n, float jitter, const std::string& text) {
+        try {
+            generateMixedCellMesh(n, jitter, 1);
+            ADD_FAILURE() << "no error for n " << n << ", jitter " << jitter;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Argument);
+            EXPECT_THAT(e.what(), HasSubstr(text));
+        }
+    };
+    expectArgument(0, 0.1f, "blocks per axis must be in [1, 1000], got 0");
+    expectArgument(-3, 0.1f, "got -3");
+    expectArgument(kMaxMixedCellBlocks + 1, 0.1f, "got 1001");
+    expectArgument(4, -0.01f, "jitter must be in [0, 0.15");
+    expectArgument(4, 0.16f, "jitter must be in [0, 0.15");
+    expectArgument(4, std::numeric_limits<float>::quiet_NaN(), "jitter");
 }
 
 }  // namespace
