@@ -106,8 +106,8 @@ void sortedFace(const TetMeshView& m, const std::uint32_t* canon, std::uint64_t 
     m.corners(c, ids);
     const std::uint32_t packed = packedFace(m.kind(c), face);
     const int n = faceSize(packed);
+    f[3] = kNoCell;  // a triangle's
     for (int i = 0; i < n; ++i) f[i] = canon[ids[faceCorner(packed, i)]];
-    f[3] = kNoCell;
     std::sort(f, f + n);
 }
 

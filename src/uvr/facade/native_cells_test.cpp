@@ -17,6 +17,7 @@
 #include "uvr/facade/renderer.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/procedural.h"
 #include "uvr/mesh/validate.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/image_metrics.h"
@@ -236,6 +237,96 @@ TEST(NativeCells, RealHexahedralFilesNativeAgainstSplit) {
         const RenderResult exact = renderCpu(native, s);
         s.method = RenderMethod::Partitions;
         EXPECT_GE(ssimOf(renderCpu(native, s), exact), 0.99) << name;
+    }
+}
+
+/// True when every corner of face f of cell c lies on one face of the cube [-1, 1]^3.
+bool onCubeBoundary(const TetMeshView& m, std::uint32_t c, int f) {
+    std::uint32_t ids[kMaxCellCorners];
+    m.corners(c, ids);
+    const std::uint32_t packed = packedFace(m.kind(c), f);
+    for (int a = 0; a < 3; ++a)
+        for (float side : {-1.f, 1.f}) {
+            bool all = true;
+            for (int i = 0; i < faceSize(packed); ++i)
+                all = all && m.points[ids[faceCorner(packed, i)]][a] == side;
+            if (all) return true;
+        }
+    return false;
+}
+
+TEST(NativeCells, MixedMeshNeighboursMatchAcrossEveryFacePairing) {
+    // generateMixedCellMesh holds every quad pairing (hexahedron, pyramid, wedge) and every
+    // triangle pairing (tetrahedron, pyramid, wedge): each interior face must find its neighbour.
+    const Mesh m = generateMixedCellMesh(5, 0.1f, 3);
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {"linear"}), nativeOptions(false));
+    const TetMeshView v = pm.tets.view();
+    EXPECT_EQ(pm.tets.cellCount(), m.cellCount());
+    EXPECT_GT(pm.tets.tets.size(), 0u);
+    EXPECT_GT(pm.tets.pyramidCount, 0u);
+    EXPECT_GT(pm.tets.wedgeCount, 0u);
+    EXPECT_GT(pm.tets.hexCount, 0u);
+    std::uint64_t boundary = 0, matched = 0;
+    for (std::uint32_t c = 0; c < v.cellCount(); ++c)
+        for (int f = 0; f < kindFaces(v.kind(c)); ++f) {
+            const std::uint32_t n = pm.neighbors[v.faceBase(c) + f];
+            if (n == kNoTet) {
+                ++boundary;
+                EXPECT_TRUE(onCubeBoundary(v, c, f)) << "cell " << c << " face " << f;
+                continue;
+            }
+            ++matched;
+            bool back = false;  // the neighbour lists c across one of its faces
+            for (int g = 0; g < kindFaces(v.kind(n)); ++g)
+                back = back || pm.neighbors[v.faceBase(n) + g] == c;
+            EXPECT_TRUE(back) << c << " -> " << n;
+        }
+    EXPECT_GT(boundary, 0u);
+    EXPECT_GT(matched, 4 * boundary);
+}
+
+TEST(NativeCells, MixedMeshInterpolatesLinearFieldsAndRendersAsItsSplit) {
+    const Mesh m = generateMixedCellMesh(5, 0.12f, 5);
+    const ScalarField f = selectScalarField(m, {"linear"});
+    const PreparedMesh native = prepareMesh(m, f, nativeOptions(false));
+    const PreparedMesh split = prepareMesh(m, f, nativeOptions(true));
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-0.999f, 0.999f);
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3f p(u(rng), u(rng), u(rng));
+        ASSERT_NEAR(valueAt(native, p), p.x + 2.f * p.y - p.z, 3e-5f) << i;
+    }
+    for (RenderMethod method :
+         {RenderMethod::Exact, RenderMethod::Reference, RenderMethod::Partitions}) {
+        const RenderSettings s = frame(m.bounds(), method, "0:0,0.3:0.8,0.6:0.1,1:0.5");
+        const RenderResult a = renderCpu(native, s), b = renderCpu(split, s);
+        EXPECT_GE(ssimOf(a, b), 0.995) << int(method);
+        if (method == RenderMethod::Exact) {
+            // Rays walk across the mixed faces as they do across the split's: a BVH query to
+            // enter the mesh, hardly any after.
+            std::printf("exact: %llu BVH queries native, %llu split, for %llu rays\n",
+                        (unsigned long long)a.stats.bvhQueries,
+                        (unsigned long long)b.stats.bvhQueries, (unsigned long long)a.stats.rays());
+            EXPECT_LE(a.stats.bvhQueries, b.stats.bvhQueries + b.stats.bvhQueries / 50);
+        }
+    }
+}
+
+TEST(NativeCells, OnTheGpuMixedMeshMatchesTheCpu) {
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
+    const Mesh m = generateMixedCellMesh(8, 0.12f, 2);
+    const ScalarField f = selectScalarField(m, {"xyz"});
+    RendererOptions o;
+    o.leafCells = 128;
+    o.device = Device::Cpu;
+    Renderer cpu(m, f, o);
+    o.device = Device::Cuda;
+    o.buildDevice = Device::Cuda;  // the GPU's LBVH and k-d builds over native cells
+    Renderer gpu(m, f, o);
+    for (RenderMethod method :
+         {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
+        const RenderSettings s = frame(m.bounds(), method, "0:0,0.5:0.8,1:0.2");
+        EXPECT_GE(ssimOf(cpu.render(s), gpu.render(s)), 0.995) << int(method);
     }
 }
 
