@@ -288,6 +288,28 @@ TEST(Cli, GenerateMixedCells) {
     EXPECT_FALSE(std::ifstream(dir + "/x.vtu").good());
 }
 
+TEST(Cli, HexahedraRenderNativelyUnlessSplit) {
+    const std::string dir = testing::scratchDir();
+    CliRun r = uvr("-q generate hex --cells 1000 --seed 2 -o " + dir + "/h.vtu", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const bool split : {false, true}) {
+        const std::string tag = split ? "split" : "native";
+        r = uvr("render " + dir + "/h.vtu --field xyz --size 48x48 --device cpu -o " + dir + "/" +
+                    tag + ".png --stats " + dir + "/" + tag + ".json" +
+                    (split ? " --split-cells" : ""),
+                dir);
+        ASSERT_EQ(r.code, 0) << r.err;
+        std::ifstream in(dir + "/" + tag + ".json");
+        const auto j = nlohmann::json::parse(in);
+        EXPECT_EQ(j["mesh"]["cells"].get<int>(), 1000) << tag;
+        EXPECT_EQ(j["mesh"]["hexahedra"].get<int>(), split ? 0 : 1000) << tag;
+        EXPECT_EQ(j["mesh"]["tetrahedra"].get<int>(), split ? 6000 : 0) << tag;
+        EXPECT_NE(r.err.find(split ? "prepared 6000 tetrahedra" : "(1000 hexahedra)"),
+                  std::string::npos)
+            << r.err;
+    }
+}
+
 TEST(Cli, RefineMultipliesTetrahedraBy8PerLevel) {
     const std::string dir = testing::scratchDir();
     CliRun r = uvr("-q generate box --cells 1000 --fields linear -o " + dir + "/b.uvrm", dir);

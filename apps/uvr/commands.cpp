@@ -337,19 +337,19 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
 }
 
 void addGenerateCommand(CLI::App& app, Context& ctx) {
-    auto* cmd = app.add_subcommand("generate", "Write a procedural tetrahedral mesh");
+    auto* cmd = app.add_subcommand("generate", "Write a procedural mesh");
     auto shape = std::make_shared<std::string>("box");
     auto out = std::make_shared<std::string>();
     auto spec = std::make_shared<ProceduralSpec>();
     auto fields = std::make_shared<std::vector<std::string>>();
     cmd->add_option("SHAPE", *shape,
-                    "box, shell (hollow, non-convex), graded (100x cell sizes) or mixed "
+                    "box, shell (hollow, non-convex), graded (100x cell sizes), mixed "
                     "(hexahedra, wedges, pyramids and tetrahedra with every face pairing; its own "
                     "fields linear, xyz, block and cell_type; jitter 0.1 unless given, at most "
-                    "0.15)")
+                    "0.15) or hex (mixed's grid with a hexahedron per block)")
         ->capture_default_str();
     cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu, .vtk or .vtkhdf)")->required();
-    cmd->add_option("--cells", spec->targetCells, "Approximate tetrahedron count")
+    cmd->add_option("--cells", spec->targetCells, "Approximate cell count (tetrahedra; for mixed and hex, their cells)")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
     cmd->add_option("--seed", spec->seed, "Random seed (same seed, same mesh)")
@@ -377,15 +377,18 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
     cmd->callback([cmd, shape, out, spec, fields, steps, dt, &ctx] {
         resolveOutput(*out);
         checkMeshWritable(*out);  // before generating
-        if (*shape == "mixed") {
+        if (*shape == "mixed" || *shape == "hex") {
+            const bool hex = *shape == "hex";
             if (!fields->empty() || *steps != 1)
                 throwError(ErrorKind::Argument, "",
-                           "generate mixed writes its own fields (linear, xyz, block, cell_type) "
-                           "and one step: --fields and --steps do not apply");
-            // About 4.2 cells a block; at most 12 (a block of tetrahedra to its centre).
-            const int n =
-                static_cast<int>(std::clamp(std::round(std::cbrt(double(spec->targetCells) / 4.2)),
-                                            1.0, double(kMaxMixedCellBlocks)));
+                           "generate " + *shape +
+                               " writes its own fields (linear, xyz, block, cell_type) and one "
+                               "step: --fields and --steps do not apply");
+            // Mixed: about 4.2 cells a block; at most 12 (a block of tetrahedra to its centre).
+            const double perBlock = hex ? 1.0 : 4.2;
+            const int n = static_cast<int>(
+                std::clamp(std::round(std::cbrt(double(spec->targetCells) / perBlock)), 1.0,
+                           double(kMaxMixedCellBlocks)));
             const std::uint64_t blocks = std::uint64_t(n) * n * n;
             const std::uint64_t points = std::uint64_t(n + 1) * (n + 1) * (n + 1) + blocks;
             checkMemoryEstimate(ctx,
@@ -394,7 +397,7 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                                 points * 20 + blocks * 12 * (1 + 8 + 16 + 8));
             ctx.setActivity(*out, "generating the mesh");
             const float jitter = cmd->count("--jitter") ? spec->jitter : 0.1f;
-            const Mesh mesh = generateMixedCellMesh(n, jitter, spec->seed);
+            const Mesh mesh = generateMixedCellMesh(n, jitter, spec->seed, hex);
             ctx.step("generated " + std::to_string(mesh.pointCount()) + " points, " +
                      std::to_string(mesh.cellCount()) + " cells: " + mesh.notes.front());
             return writeMeshWithProgress(mesh, *out, ctx);

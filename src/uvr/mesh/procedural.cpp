@@ -656,7 +656,7 @@ void setProceduralFields(Mesh& mesh, const ProceduralSpec& spec,
     }
 }
 
-Mesh generateMixedCellMesh(int n, float jitter, std::uint64_t seed) {
+Mesh generateMixedCellMesh(int n, float jitter, std::uint64_t seed, bool hexahedraOnly) {
     if (n < 1 || n > kMaxMixedCellBlocks)
         throwError(ErrorKind::Argument, "",
                    "mixed-cell mesh: blocks per axis must be in [1, " +
@@ -681,7 +681,7 @@ Mesh generateMixedCellMesh(int n, float jitter, std::uint64_t seed) {
         return (mix64(seed ^ mix64(0x6d69786564ull + i + P * j)) & 1) != 0;
     };
     auto blockTemplate = [&](std::uint64_t i, std::uint64_t j, std::uint64_t k) {
-        return mixedBlockTemplate(int(i), int(j), int(k));
+        return hexahedraOnly ? BlockTemplate::Hex : mixedBlockTemplate(int(i), int(j), int(k));
     };
 
     // Face cuts: the faces normal to axis a have coordinate 0..N along a and 0..N-1 across.

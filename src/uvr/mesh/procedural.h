@@ -96,8 +96,10 @@ inline constexpr int kMaxMixedCellBlocks = 1000;
 /// hexahedron faces are not planar. Point fields "linear" (x + 2y - z) and "xyz" (x y z), cell
 /// fields "block" (the block's index, x fastest) and "cell_type" (the VTK type code). Same
 /// arguments, same mesh; throws Error(Argument) for n outside [1, kMaxMixedCellBlocks] or jitter
-/// outside [0, kMaxMixedCellJitter].
-Mesh generateMixedCellMesh(int n, float jitter = 0.1f, std::uint64_t seed = 1);
+/// outside [0, kMaxMixedCellJitter]. With hexahedraOnly every block is one hexahedron (a jittered
+/// hexahedral grid with the same points and fields: `uvr generate hex`).
+Mesh generateMixedCellMesh(int n, float jitter = 0.1f, std::uint64_t seed = 1,
+                           bool hexahedraOnly = false);
 
 /// Field name as written into the mesh ("jet", ...).
 const char* proceduralFieldName(ProceduralField field);
