@@ -17,7 +17,9 @@ namespace {
 PreparedMesh jitteredGrid() {
     Mesh m = testing::makeHexGrid(
         6, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.3f);
-    return prepareMesh(m, selectScalarField(m, {}));
+    PrepareOptions o;
+    o.cells.splitCells = true;  // the tests below walk the tetrahedra
+    return prepareMesh(m, selectScalarField(m, {}), o);
 }
 
 /// Brute force: every tetrahedron containing p.

@@ -17,6 +17,7 @@ PreparedMesh grid(std::uint32_t leafCells) {
         8, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
     PrepareOptions o;
     o.kd.leafCells = leafCells;
+    o.cells.splitCells = true;  // the tests below check the tetrahedra's lists
     return prepareMesh(m, selectScalarField(m, {}), o);
 }
 

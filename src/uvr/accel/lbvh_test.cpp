@@ -25,6 +25,7 @@ PreparedMesh prepared(const Mesh& m, bool lbvh, bool partitions = false) {
     PrepareOptions o;
     o.partitions = partitions;
     o.kd.leafCells = 128;
+    o.cells.splitCells = true;  // the tests below check trees over the tetrahedra
     if (lbvh) o.lbvh = buildLbvhCpu;
     return prepareMesh(m, selectScalarField(m, {}), o);
 }
@@ -164,7 +165,7 @@ TEST(Lbvh, CoincidentCentresGiveABalancedTree) {
 
 TEST(Lbvh, SegmentsGetTheirOwnTreesIncludingEmptyAndSingleLeafOnes) {
     const Mesh m = jitteredGrid(5);
-    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}));
+    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
     const std::uint32_t n = static_cast<std::uint32_t>(mesh.tets.size());
     // Segments: all tets reversed, nothing, three tets, the first half again.
     std::vector<std::uint32_t> ids;
@@ -199,7 +200,7 @@ TEST(Lbvh, SegmentsGetTheirOwnTreesIncludingEmptyAndSingleLeafOnes) {
 
 TEST(Lbvh, BadSegmentsAreRefused) {
     const Mesh m = jitteredGrid(2);
-    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}));
+    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
     LbvhInput in;
     in.mesh = &mesh;
     in.segmentBegin = {0, mesh.tets.size() - 1};  // one short

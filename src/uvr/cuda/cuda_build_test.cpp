@@ -32,13 +32,13 @@ TetMesh proceduralTets(std::uint64_t cells) {
     ProceduralSpec spec;
     spec.targetCells = cells;
     const Mesh m = generateMesh(spec);
-    return tetrahedralize(m, selectScalarField(m, {}));
+    return tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
 }
 
 TEST(CudaLbvh, WithoutADeviceTheBuildIsRefusedClearly) {
     if (cudaDeviceAvailable()) GTEST_SKIP() << "a CUDA device is present";
     const Mesh m = testing::makeHexGrid(2, 0.f, 1.f, [](Vec3f p) { return p.x; });
-    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}));
+    const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
     EXPECT_THROW(buildMeshLbvh(mesh, buildLbvhCuda), Error);
     EXPECT_THROW(buildKdTreeCuda(mesh, {}), Error);
 }

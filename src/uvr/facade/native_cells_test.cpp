@@ -208,7 +208,7 @@ TEST(NativeCells, CellDataOnNativeCells) {
     Field c{"c", Association::Cell, 1, {}};
     for (std::uint64_t i = 0; i < m.cellCount(); ++i) c.values.push_back(float(i % 7));
     m.fields.push_back(c);
-    const ScalarField f = selectScalarField(m, {"c"});
+    const ScalarField f = selectScalarField(m, parseFieldSpec("c"));
     const PreparedMesh native = prepareMesh(m, f, nativeOptions(false));
     const PreparedMesh split = prepareMesh(m, f, nativeOptions(true));
     for (RenderMethod method :
@@ -259,7 +259,7 @@ TEST(NativeCells, MixedMeshNeighboursMatchAcrossEveryFacePairing) {
     // generateMixedCellMesh holds every quad pairing (hexahedron, pyramid, wedge) and every
     // triangle pairing (tetrahedron, pyramid, wedge): each interior face must find its neighbour.
     const Mesh m = generateMixedCellMesh(5, 0.1f, 3);
-    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {"linear"}), nativeOptions(false));
+    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, parseFieldSpec("linear")), nativeOptions(false));
     const TetMeshView v = pm.tets.view();
     EXPECT_EQ(pm.tets.cellCount(), m.cellCount());
     EXPECT_GT(pm.tets.tets.size(), 0u);
@@ -287,7 +287,7 @@ TEST(NativeCells, MixedMeshNeighboursMatchAcrossEveryFacePairing) {
 
 TEST(NativeCells, MixedMeshInterpolatesLinearFieldsAndRendersAsItsSplit) {
     const Mesh m = generateMixedCellMesh(5, 0.12f, 5);
-    const ScalarField f = selectScalarField(m, {"linear"});
+    const ScalarField f = selectScalarField(m, parseFieldSpec("linear"));
     const PreparedMesh native = prepareMesh(m, f, nativeOptions(false));
     const PreparedMesh split = prepareMesh(m, f, nativeOptions(true));
     std::mt19937 rng(11);
@@ -315,7 +315,7 @@ TEST(NativeCells, MixedMeshInterpolatesLinearFieldsAndRendersAsItsSplit) {
 TEST(NativeCells, OnTheGpuMixedMeshMatchesTheCpu) {
     if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
     const Mesh m = generateMixedCellMesh(8, 0.12f, 2);
-    const ScalarField f = selectScalarField(m, {"xyz"});
+    const ScalarField f = selectScalarField(m, parseFieldSpec("xyz"));
     RendererOptions o;
     o.leafCells = 128;
     o.device = Device::Cpu;

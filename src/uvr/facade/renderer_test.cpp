@@ -233,7 +233,7 @@ TEST(Renderer, SetFieldValuesRefusesTheWrongCountAndChangesNothing) {
     // Another field of the same mesh, of the other association, is fine.
     r.setFieldValues(selectScalarField(m, parseFieldSpec("c")));
     EXPECT_EQ(r.prepared().tets.association, Association::Cell);
-    EXPECT_EQ(r.prepared().tets.values.size(), r.prepared().tets.tets.size());
+    EXPECT_EQ(r.prepared().tets.values.size(), r.prepared().tets.cellCount());
 }
 
 TEST(Renderer, OnTheGpuSetFieldValuesGivesTheFramesOfAFreshUpload) {

@@ -139,6 +139,11 @@ struct TetMeshView {
             return bary[0] * values[tet.v[0]] + bary[1] * values[tet.v[1]] +
                    bary[2] * values[tet.v[2]] + bary[3] * values[tet.v[3]];
         }
+        return interpolateNative(t, bary);
+    }
+    /// interpolate in native cell t (parametric coordinates bary[0..2]).
+    UVR_HOST_DEVICE UVR_NOINLINE float interpolateNative(std::uint64_t t,
+                                                         const float bary[4]) const {
         std::uint32_t ids[kMaxCellCorners];
         const int n = corners(t, ids);
         float w[kMaxCellCorners];

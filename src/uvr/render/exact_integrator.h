@@ -101,12 +101,9 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
     return s;
 }
 
-/// Clips the ray against cell t: clipTet for a tetrahedron; a native cell's faces as planes and
-/// bilinear patches (clipCell: of a curved cell the ray crosses twice, the span ending after
-/// tMin), without a closed-form field (nativeSegment samples it).
-UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
-                                       bool withValue = false, double tMin = -INFINITY) {
-    if (t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
+/// clipCell of native cell t as a TetSpan (without a field).
+UVR_HOST_DEVICE UVR_NOINLINE inline TetSpan clipNative(const TetMeshView& mesh, std::uint32_t t,
+                                                       const Ray& ray, double tMin) {
     std::uint32_t ids[kMaxCellCorners];
     const int n = mesh.corners(t, ids);
     Vec3f x[kMaxCellCorners];
@@ -115,6 +112,15 @@ UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t,
     TetSpan s;
     s.tIn = c.tIn, s.tOut = c.tOut, s.exitFace = c.exitFace;
     return s;
+}
+
+/// Clips the ray against cell t: clipTet for a tetrahedron; a native cell's faces as planes and
+/// bilinear patches (clipCell: of a curved cell the ray crosses twice, the span ending after
+/// tMin), without a closed-form field (nativeSegment samples it).
+UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
+                                       bool withValue = false, double tMin = -INFINITY) {
+    if (t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
+    return clipNative(mesh, t, ray, tMin);
 }
 
 /// Most pieces a native cell's segment is cut into (nativeSegment).
@@ -128,7 +134,7 @@ inline constexpr int kNativeMaxPieces = 16;
 /// a piece's deviation falls as 1 / n^2, so n = ceil(sqrt(d / tol)) with tol a quarter of a
 /// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
 /// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc.
-UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
+UVR_HOST_DEVICE UVR_NOINLINE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
                                            float v0, double unit, Vec4f& acc) {
     std::uint32_t ids[kMaxCellCorners];
