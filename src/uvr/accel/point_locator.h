@@ -37,8 +37,9 @@ struct TetLocator {
 
     /// True when p lies in cell t (within kBaryEpsilon); fills bary with p's local coordinates
     /// (TetMeshView::interpolate).
+    template <bool kNative = true>
     UVR_HOST_DEVICE bool inside(std::uint32_t t, Vec3f p, float bary[4]) const {
-        if (t >= mesh.tetCount) {
+        if (kNative && t >= mesh.tetCount) {
             float excess;
             nativeStep(t, p, bary, excess);
             return excess <= kBaryEpsilon;
@@ -70,23 +71,26 @@ struct TetLocator {
     }
 
     /// Index of a tetrahedron containing p, or kNoTet; bary receives p's barycentrics in it.
+    template <bool kNative = true>
     UVR_HOST_DEVICE std::uint32_t locate(Vec3f p, std::uint32_t hint, float bary[4],
                                          LocateCounters& counters) const {
-        return locateIn(bvh, 0, p, hint, bary, counters);
+        return locateIn<kNative>(bvh, 0, p, hint, bary, counters);
     }
 
     /// As locate, but the BVH fallback searches only the tree at `root` of `tree` (e.g. one
     /// k-d partition's cells).
+    template <bool kNative = true>
     UVR_HOST_DEVICE std::uint32_t locateIn(const BvhView& tree, std::uint32_t root, Vec3f p,
                                            std::uint32_t hint, float bary[4],
                                            LocateCounters& counters) const {
-        const std::uint32_t t = walk(p, hint, bary, counters);
-        return t != kNoTet ? t : search(tree, root, p, bary, counters);
+        const std::uint32_t t = walk<kNative>(p, hint, bary, counters);
+        return t != kNoTet ? t : search<kNative>(tree, root, p, bary, counters);
     }
 
     /// Walk across faces from tetrahedron `start` towards p (at most maxWalkSteps tetrahedra):
     /// the tetrahedron containing p, or kNoTet when the walk leaves the mesh, meets a degenerate
     /// tetrahedron or runs out of steps (or start is kNoTet, or there are no neighbours).
+    template <bool kNative = true>
     UVR_HOST_DEVICE std::uint32_t walk(Vec3f p, std::uint32_t start, float bary[4],
                                        LocateCounters& counters) const {
         if (start == kNoTet || !neighbors) return kNoTet;
@@ -94,7 +98,7 @@ struct TetLocator {
         for (int step = 0; step < maxWalkSteps; ++step) {
             ++counters.walkSteps;
             int worst = 0;
-            if (t < mesh.tetCount) {
+            if (!kNative || t < mesh.tetCount) {
                 const Tet& tet = mesh.tets[t];
                 if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
                                      mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
@@ -116,6 +120,7 @@ struct TetLocator {
     }
 
     /// Search of the tree at `root` of `tree` for a tetrahedron containing p, or kNoTet.
+    template <bool kNative = true>
     UVR_HOST_DEVICE std::uint32_t search(const BvhView& tree, std::uint32_t root, Vec3f p,
                                          float bary[4], LocateCounters& counters) const {
         ++counters.bvhQueries;
@@ -123,7 +128,7 @@ struct TetLocator {
         bvhVisitPoint(
             tree, p,
             [&](std::uint32_t t) {
-                if (inside(t, p, bary)) {
+                if (inside<kNative>(t, p, bary)) {
                     found = t;
                     return true;
                 }

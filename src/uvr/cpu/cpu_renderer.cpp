@@ -64,15 +64,18 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     const FrameView frame = makeFrameView(settings, result.setup, result.image.pixels.data(),
                                           result.sampleCounts.data());
     const auto start = std::chrono::steady_clock::now();
-    if (settings.method == RenderMethod::Reference)
-        launchFrame(frame, result.stats, ReferenceMarch{result.setup.scene(mesh)},
-                    settings.progress);
-    else if (settings.method == RenderMethod::Exact)
-        launchFrame(frame, result.stats, ExactMarch{result.setup.scene(mesh)}, settings.progress);
-    else
-        launchFrame(frame, result.stats,
-                    PartitionMarch{result.setup.partitionScene(mesh, settings.skip)},
-                    settings.progress);
+    dispatchNative(mesh.tets.hasNative(), [&](auto kNative) {
+        if (settings.method == RenderMethod::Reference)
+            launchFrame(frame, result.stats, ReferenceMarch<kNative()>{result.setup.scene(mesh)},
+                        settings.progress);
+        else if (settings.method == RenderMethod::Exact)
+            launchFrame(frame, result.stats, ExactMarch<kNative()>{result.setup.scene(mesh)},
+                        settings.progress);
+        else
+            launchFrame(frame, result.stats,
+                        PartitionMarch<kNative()>{result.setup.partitionScene(mesh, settings.skip)},
+                        settings.progress);
+    });
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;

@@ -367,12 +367,19 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaEventCreate(&begin));
     UVR_CUDA_CHECK(cudaEventCreate(&end));
     UVR_CUDA_CHECK(cudaEventRecord(begin));
+    const bool native = d.mesh.tets.hasNative();
     if (settings.method == RenderMethod::Reference) {
-        cuda::launchFrame(grid, block, frame, ReferenceMarch{d.deviceScene(result.setup)},
-                          d.totals.data());
+        dispatchNative(native, [&](auto kNative) {
+            cuda::launchFrame(grid, block, frame,
+                              ReferenceMarch<kNative()>{d.deviceScene(result.setup)},
+                              d.totals.data());
+        });
     } else if (settings.method == RenderMethod::Exact) {
-        cuda::launchFrame(grid, block, frame, ExactMarch{d.deviceScene(result.setup)},
-                          d.totals.data());
+        dispatchNative(native, [&](auto kNative) {
+            cuda::launchFrame(grid, block, frame,
+                              ExactMarch<kNative()>{d.deviceScene(result.setup)},
+                              d.totals.data());
+        });
     } else {
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
         scene.base = d.deviceScene(result.setup);
@@ -387,7 +394,10 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         else
             scene.longStep = INFINITY;  // without seeds, walking beats divergent BVH searches
         scene.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;
-        cuda::launchFrame(grid, block, frame, PartitionMarch{scene}, d.totals.data());
+        dispatchNative(native, [&](auto kNative) {
+            cuda::launchFrame(grid, block, frame, PartitionMarch<kNative()>{scene},
+                              d.totals.data());
+        });
     }
     UVR_CUDA_CHECK(cudaGetLastError());
     UVR_CUDA_CHECK(cudaEventRecord(end));

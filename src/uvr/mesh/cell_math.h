@@ -311,10 +311,22 @@ UVR_HOST_DEVICE inline Vec3f cellGradient(CellKind k, const Vec3f* x, const floa
     return (cross(js, jt) * fr + cross(jt, jr) * fs + cross(jr, js) * ft) * (1.f / det);
 }
 
-/// Orientation of a native cell's isoparametric map: +1 or -1 when the Jacobian's determinant has
-/// that sign, at least 1e-6 of the cell's size cubed, at every corner (a pyramid's apex, where it
-/// vanishes, is checked at t = 0.5 instead) and the centre; 0 for a cell that folds, collapses
-/// or has non-finite corners (it is rendered split into tetrahedra instead).
+/// How far a corner's Jacobian determinant may have the sign opposite to the centre's, relative
+/// to the centre's, for the cell to stay native: a corner folded a little (a jittered or sheared
+/// grid's cell) keeps the cell native, because splitting it would leave slivers between its
+/// planar triangles and its native neighbours' bilinear faces.
+inline constexpr double kNativeFold = 0.25;
+
+/// Smallest Jacobian determinant at a native cell's centre, relative to its size cubed: flatter
+/// cells are left to the split, whose zero-volume rule (1e-7 of the longest edge cubed) drops
+/// them.
+inline constexpr double kNativeMinDet = 1e-9;
+
+/// Orientation of a native cell's isoparametric map: +1 or -1, the sign of the Jacobian's
+/// determinant at the centre (at least kNativeMinDet of the cell's size cubed), when at every corner (a
+/// pyramid's apex, where it vanishes, at t = 0.5 instead) it has that sign or the opposite one by
+/// at most kNativeFold of the centre's; 0 for a cell that folds further, collapses or has
+/// non-finite corners (it is rendered split into tetrahedra instead).
 int nativeOrientation(CellKind k, const Vec3f* x);
 
 }  // namespace uvr

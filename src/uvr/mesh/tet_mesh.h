@@ -131,10 +131,12 @@ struct TetMeshView {
 
     /// Interpolated field value in cell c at its local coordinates (piecewise constant for cell
     /// data): barycentrics bary[0..3] in a tetrahedron, parametric (r, s, t) = bary[0..2] in a
-    /// native cell.
+    /// native cell. kNative false: the mesh has tetrahedra only (the kernels' specialisation
+    /// for them, without the native cells' code).
+    template <bool kNative = true>
     UVR_HOST_DEVICE float interpolate(std::uint64_t t, const float bary[4]) const {
         if (cellCentered) return values[t];
-        if (t < tetCount) {
+        if (!kNative || t < tetCount) {
             const Tet& tet = tets[t];
             return bary[0] * values[tet.v[0]] + bary[1] * values[tet.v[1]] +
                    bary[2] * values[tet.v[2]] + bary[3] * values[tet.v[3]];

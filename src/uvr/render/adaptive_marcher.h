@@ -168,6 +168,7 @@ struct PartitionSceneView {
 /// a long step never reaches deep into a macrocell that needs short ones); a sample in a
 /// transparent macrocell is not located: the run of samples ends there (as at a skipped
 /// partition) and the next sample is the first grid point past the macrocell.
+template <bool kNative = true>
 UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
                                              RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -276,16 +277,16 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         // boundaries of non-convex meshes and at seams of unshared points).
         const bool walk = kSample - kLocated <= scene.longStep;
         kLocated = kSample;
-        tet = walk ? locator.walk(pos, tet, bary, counters.locate) : kNoTet;
+        tet = walk ? locator.walk<kNative>(pos, tet, bary, counters.locate) : kNoTet;
         bool emptySpace = false;
         if (tet == kNoTet && scene.seeds.grids) {
             const std::uint32_t seed = scene.seeds.seed(p, pos);
             emptySpace = seed == kNoTet;
-            if (!emptySpace) tet = locator.walk(pos, seed, bary, counters.locate);
+            if (!emptySpace) tet = locator.walk<kNative>(pos, seed, bary, counters.locate);
         }
         if (tet == kNoTet && !emptySpace)
-            tet = locator.search(scene.kd.bvh, root, pos, bary, counters.locate);
-        const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate(tet, bary);
+            tet = locator.search<kNative>(scene.kd.bvh, root, pos, bary, counters.locate);
+        const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
         if (preintegrated) {
             // A step longer than s1 from inside the mesh to outside it, or back in: the mesh's
             // boundary lies somewhere in the step. Bisect for it with point locations (walks
@@ -304,11 +305,14 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     if (mid == lo || mid == hi) break;
                     ++counters.samples;
                     const Vec3f q = ray.at(mid * s1);
-                    std::uint32_t found = locator.walk(q, from, probeBary, counters.locate);
+                    std::uint32_t found =
+                        locator.walk<kNative>(q, from, probeBary, counters.locate);
                     if (found == kNoTet)
-                        found = locator.search(scene.kd.bvh, root, q, probeBary, counters.locate);
+                        found = locator.search<kNative>(scene.kd.bvh, root, q, probeBary,
+                                                        counters.locate);
                     const float vMid =
-                        found == kNoTet ? 0.f : locator.mesh.interpolate(found, probeBary);
+                        found == kNoTet ? 0.f
+                                        : locator.mesh.interpolate<kNative>(found, probeBary);
                     if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;

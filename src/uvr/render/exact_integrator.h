@@ -117,9 +117,10 @@ UVR_HOST_DEVICE UVR_NOINLINE inline TetSpan clipNative(const TetMeshView& mesh, 
 /// Clips the ray against cell t: clipTet for a tetrahedron; a native cell's faces as planes and
 /// bilinear patches (clipCell: of a curved cell the ray crosses twice, the span ending after
 /// tMin), without a closed-form field (nativeSegment samples it).
+template <bool kNative = true>
 UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
                                        bool withValue = false, double tMin = -INFINITY) {
-    if (t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
+    if (!kNative || t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
     return clipNative(mesh, t, ray, tMin);
 }
 
@@ -183,6 +184,7 @@ UVR_HOST_DEVICE UVR_NOINLINE inline float nativeSegment(const TetMeshView& mesh,
 /// The tetrahedron the ray is in just after t (entered last among those it is in, or the
 /// nearest ahead): over the BVH's tetrahedra with tOut > t + eps, the one whose max(tIn, t) is
 /// smallest (ties: the larger tOut). kNoTet when no tetrahedron lies ahead.
+template <bool kNative = true>
 UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const BvhView& bvh,
                                                   const Ray& ray, double t, double eps,
                                                   TetSpan& span, RayCounters& counters) {
@@ -207,7 +209,7 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
         if (node.count > 0) {
             for (std::uint32_t k = 0; k < node.count; ++k) {
                 const std::uint32_t id = bvh.primIds[node.first + k];
-                const TetSpan s = clipAny(mesh, id, ray, false, t + eps);
+                const TetSpan s = clipAny<kNative>(mesh, id, ray, false, t + eps);
                 if (!(s.tOut > t + eps) || !(s.tIn <= s.tOut)) continue;
                 const double key = s.tIn > t ? s.tIn : t;
                 if (key < bestKey || (key == bestKey && s.tOut > bestOut)) {
@@ -224,6 +226,7 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
 
 /// Scalar at parameter t of the ray inside tetrahedron tet: from the span's linear function
 /// when it has one, else barycentric at the point (clamped to the cell).
+template <bool kNative = true>
 UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, const TetSpan& span,
                                       const Ray& ray, double t) {
     const TetMeshView& m = loc.mesh;
@@ -239,12 +242,13 @@ UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, 
     for (float& b : bary) b = b > 0.f ? b : 0.f, sum += b;
     if (sum > 0.f)
         for (float& b : bary) b /= sum;
-    return m.interpolate(tet, bary);
+    return m.interpolate<kNative>(tet, bary);
 }
 
 }  // namespace exact
 
 /// The exact integrator for one ray (see the top of this file).
+template <bool kNative = true>
 UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -258,10 +262,12 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     const double unit = scene.params.opacityUnit;
     double t = b0;
     exact::TetSpan span;
-    std::uint32_t tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
+    std::uint32_t tet =
+        exact::nextTetAlong<kNative>(loc.mesh, loc.bvh, ray, t, eps, span, counters);
     const bool continuous = !loc.mesh.cellCentered;
     if (tet != kNoTet) {
-        if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true, t + eps);  // with the field
+        if (continuous)
+            span = exact::clipAny<kNative>(loc.mesh, tet, ray, true, t + eps);  // with the field
         if (span.tIn > t) t = span.tIn;  // empty space before the mesh
     }
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
@@ -277,12 +283,13 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         if (tEnd > t) {
             ++counters.samples;  // one segment per cell crossed
             float s1;
-            if (continuous && tet >= loc.mesh.tetCount) {
+            if (kNative && continuous && tet >= loc.mesh.tetCount) {
                 s1 = exact::nativeSegment(loc.mesh, scene.tf, tet, ray, t, tEnd,
                                           haveEntry ? sEntry : NAN, unit, acc);
             } else {
-                const float s0 = haveEntry ? sEntry : exact::scalarAt(loc, tet, span, ray, t);
-                s1 = exact::scalarAt(loc, tet, span, ray, tEnd);
+                const float s0 =
+                    haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
+                s1 = exact::scalarAt<kNative>(loc, tet, span, ray, tEnd);
                 // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
                 segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
             }
@@ -298,10 +305,13 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         // Across the exit face; located again where there is no neighbour or the crossing is
         // degenerate (the neighbour's span does not continue the ray).
         const std::uint32_t next = loc.neighbors && span.exitFace >= 0
-                                       ? loc.neighbors[loc.mesh.faceBase(tet) + span.exitFace]
+                                       ? loc.neighbors[(kNative ? loc.mesh.faceBase(tet)
+                                                                : 4 * std::uint64_t(tet)) +
+                                                       span.exitFace]
                                        : kNoTet;
         if (next != kNoTet) {
-            const exact::TetSpan s = exact::clipAny(loc.mesh, next, ray, continuous, t + eps);
+            const exact::TetSpan s =
+                exact::clipAny<kNative>(loc.mesh, next, ray, continuous, t + eps);
             if (s.tOut > t + eps && s.tIn <= t + eps) {
                 tet = next;
                 span = s;
@@ -309,9 +319,9 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 continue;
             }
         }
-        tet = exact::nextTetAlong(loc.mesh, loc.bvh, ray, t, eps, span, counters);
+        tet = exact::nextTetAlong<kNative>(loc.mesh, loc.bvh, ray, t, eps, span, counters);
         if (tet != kNoTet) {
-            if (continuous) span = exact::clipAny(loc.mesh, tet, ray, true, t + eps);
+            if (continuous) span = exact::clipAny<kNative>(loc.mesh, tet, ray, true, t + eps);
             if (span.tIn > t) t = span.tIn;  // empty space before it
         }
     }

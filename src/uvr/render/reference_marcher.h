@@ -118,6 +118,7 @@ private:
 /// consecutive samples (SampleSegments; or, with params.preintegrated off, classifies each sample
 /// through the transfer function and composites it with opacity correction), front to back,
 /// stopping early once opaque.
+template <bool kNative = true>
 UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -139,8 +140,9 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     for (; k <= kEnd && !opaque; k += 1.f) {
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
-        tet = scene.locator.locate(p, tet, bary, counters.locate);
-        const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate(tet, bary);
+        tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
+        const float v =
+            tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
         if (scene.params.preintegrated) {
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc);
         } else if (tet != kNoTet) {
