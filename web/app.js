@@ -175,7 +175,8 @@ function onState(state) {
 /// tetrahedra, preparation time and device.
 function onPrepared(m) {
     if (!session.info) return;
-    for (const k of ["tetrahedra", "prepare_seconds", "device"]) if (k in m) session.info[k] = m[k];
+    for (const k of ["tetrahedra", "rendered_cells", "prepare_seconds", "device"])
+        if (k in m) session.info[k] = m[k];
     fillMeshInfo(session.info);
     hideProgress();
 }
@@ -768,7 +769,7 @@ function fillMeshInfo(m) {
     const n = (v) => (Number.isFinite(v) ? v.toLocaleString("en-US") : "–");
     $("mesh-file").textContent = m.file || "–";
     $("mesh-cells").textContent = n(m.cells);
-    $("mesh-tets").textContent = n(m.tetrahedra);
+    $("mesh-tets").textContent = m.rendered_cells || (m.tetrahedra == null ? "–" : n(m.tetrahedra) + " tetrahedra");
     $("mesh-types").textContent = m.cell_types
         ? Object.entries(m.cell_types).map(([k, v]) => `${k} ${n(v)}`).join(", ") : "–";
     const b = m.bounds;

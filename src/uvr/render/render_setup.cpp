@@ -66,6 +66,11 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      " cells each" +
                      (out.builtElsewhere ? ", on " + options.builderDevice : std::string()) + ")");
         KdBuildOptions kd = options.kd;
+        // The leaf size counts tetrahedra of the split: native cells fill a leaf as the
+        // tetrahedra they stand for would (partitions of the same size in space).
+        if (out.tets.hasNative())
+            kd.leafCells = static_cast<std::uint32_t>(
+                std::max(1.0, std::round(kd.leafCells / out.tets.meanSplitTets())));
         if (lbvh) kd.lbvh = lbvh;
         if (splitter) kd.splitter = splitter;
         out.kd = buildKdPartitions(out.tets, kd);

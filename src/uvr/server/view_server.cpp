@@ -794,11 +794,12 @@ void ViewServer::Impl::prepareAtStart() {
     }
     Json prepared = {{"type", "prepared"},
                      {"tetrahedra", renderer->prepared().tets.tets.size()},
+                     {"rendered_cells", describeCells(renderer->prepared().tets)},
                      {"prepare_seconds", secondsSince(start)},
                      {"device", renderer->deviceDescription()}};
     {
         std::lock_guard lk(m);
-        for (const char* key : {"tetrahedra", "prepare_seconds", "device"})
+        for (const char* key : {"tetrahedra", "rendered_cells", "prepare_seconds", "device"})
             infoBase[key] = prepared[key];
     }
     broadcast(prepared.dump());
@@ -1077,7 +1078,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     for (const ColorMapInfo& p : transferFunctionPresets()) presets.push_back(p.name);
     // The command line's preparation serves the starting field.
     // Unknown (null) until the server's own preparation is done (prepareAtStart).
-    Json tets = nullptr, prepareSeconds = nullptr;
+    Json tets = nullptr, renderedCells = nullptr, prepareSeconds = nullptr;
     std::string device = resolvesToCuda(d.scene.rendererOptions.device) ? "cuda" : "cpu";
     d.meshStep = d.scene.initial.step;
     if (d.meshStep >= d.stepCount())
@@ -1092,6 +1093,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     }
     if (d.scene.renderer) {
         tets = d.scene.renderer->prepared().tets.tets.size();
+        renderedCells = describeCells(d.scene.renderer->prepared().tets);
         prepareSeconds = d.scene.renderer->prepareSeconds();
         device = d.scene.renderer->deviceDescription();
         d.renderer = std::move(d.scene.renderer);
@@ -1102,6 +1104,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                   {"cells", mesh.cellCount()},
                   {"points", mesh.pointCount()},
                   {"tetrahedra", tets},
+                  {"rendered_cells", renderedCells},
                   {"cell_types", types},
                   {"bounds", {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}}},
                   {"fields", fields},

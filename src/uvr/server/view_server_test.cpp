@@ -204,14 +204,14 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
     EXPECT_TRUE(isPng(c.lastBinary()));
     // The scene came unprepared: the server prepared it at start, and the tab knows the result
     // from info or, when it connected during the preparation, from `prepared`.
-    Json tets = info["tetrahedra"];
-    if (tets.is_null()) {
+    Json cells = info["rendered_cells"];
+    if (cells.is_null()) {
         bool seen = false;
         for (const Json& j : c.seen())
-            if (j.value("type", "") == "prepared") tets = j["tetrahedra"], seen = true;
+            if (j.value("type", "") == "prepared") cells = j["rendered_cells"], seen = true;
         EXPECT_TRUE(seen) << "no prepared message";
     }
-    EXPECT_EQ(tets, 1296);  // 216 hexahedra, 6 tetrahedra each
+    EXPECT_EQ(cells, "216 cells (216 hexahedra)");  // native, not 1296 tetrahedra
 }
 
 TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
