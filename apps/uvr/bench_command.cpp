@@ -216,9 +216,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             renderer.gpu() ? cudaDeviceDescription() : std::to_string(threads) + " CPU thread(s)";
         const int units = renderer.gpu() ? 1 : threads;
         std::printf(
-            "%s: %llu tetrahedra, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
+            "%s: %s, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
             "step rule %s, %s, median of %d frames\n",
-            printable(*file).c_str(), static_cast<unsigned long long>(prepared.tets.tets.size()),
+            printable(*file).c_str(), describeCells(prepared.tets).c_str(),
             prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
             ruleText.c_str(), where.c_str(), *repeat);
         std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
@@ -247,14 +247,17 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             prepared.kd->treeSeconds, seedSeconds);
         if (renderer.gpu()) {
             // The mesh BVH serves only the reference; `uvr render --method adaptive` leaves it out.
-            const double tets = double(std::max<std::size_t>(1, prepared.tets.tets.size()));
+            // Per cell, and per tetrahedron of the split (comparable between native and split).
+            const double cells = double(std::max<std::uint64_t>(1, prepared.tets.cellCount()));
+            const double tets = double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()));
             const double all = double(renderer.gpu()->geometryBytes());
             const double meshBvh = double(prepared.bvh.nodes.size() * sizeof(BvhNode) +
                                           prepared.bvh.primIds.size() * sizeof(std::uint32_t));
             std::printf(
-                "device memory: %.2f GiB, %.1f bytes per tetrahedron; without the mesh "
-                "BVH (adaptive method alone) %.1f bytes per tetrahedron\n",
-                all / 1073741824.0, all / tets, (all - meshBvh) / tets);
+                "device memory: %.2f GiB, %.1f bytes per cell, %.1f per tetrahedron of the "
+                "split; without the mesh BVH (adaptive method alone) %.1f and %.1f\n",
+                all / 1073741824.0, all / cells, all / tets, (all - meshBvh) / cells,
+                (all - meshBvh) / tets);
         }
         // Files.
         if (!csv->empty())
@@ -277,6 +280,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["field"] = field.name;
                 j["field_association"] = associationName(field.association);
                 j["tetrahedra"] = prepared.tets.tets.size();
+                j["cells"] = prepared.tets.cellCount();
+                j["split_tetrahedra"] = prepared.tets.splitTetCount();
                 j["partitions"] = prepared.kd->partitions.size();
                 j["partition_build_seconds"] = prepared.kd->buildSeconds;
                 j["mesh_bvh_seconds"] = prepared.bvhSeconds;

@@ -33,7 +33,7 @@ struct TetLocator {
     BvhView bvh;
     /// Face neighbours (buildTetNeighbors: from TetMeshView::faceBase), may be null (no walking).
     const std::uint32_t* neighbors = nullptr;
-    int maxWalkSteps = kMaxWalkSteps;          ///< walk length before the BVH takes over
+    int maxWalkSteps = kMaxWalkSteps;  ///< walk length before the BVH takes over
 
     /// True when p lies in cell t (within kBaryEpsilon); fills bary with p's local coordinates
     /// (TetMeshView::interpolate).
@@ -55,8 +55,7 @@ struct TetLocator {
     /// Native cell t: p's parametric coordinates into bary[0..2] and the face p lies furthest
     /// outside of, with that excess (infinite when Newton's method does not converge: p is then
     /// not in the cell, and the face is the last iterate's).
-    UVR_HOST_DEVICE UVR_NOINLINE int nativeStep(std::uint32_t t, Vec3f p, float bary[4],
-                                                float& excess) const {
+    UVR_HOST_DEVICE int nativeStep(std::uint32_t t, Vec3f p, float bary[4], float& excess) const {
         std::uint32_t ids[kMaxCellCorners];
         const int n = mesh.corners(t, ids);
         Vec3f x[kMaxCellCorners];

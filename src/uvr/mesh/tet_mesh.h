@@ -144,8 +144,7 @@ struct TetMeshView {
         return interpolateNative(t, bary);
     }
     /// interpolate in native cell t (parametric coordinates bary[0..2]).
-    UVR_HOST_DEVICE UVR_NOINLINE float interpolateNative(std::uint64_t t,
-                                                         const float bary[4]) const {
+    UVR_HOST_DEVICE float interpolateNative(std::uint64_t t, const float bary[4]) const {
         std::uint32_t ids[kMaxCellCorners];
         const int n = corners(t, ids);
         float w[kMaxCellCorners];
@@ -240,9 +239,10 @@ Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c);
 
 /// Attaches a field of the source mesh to the cells: values (a point field's as they are, a
 /// cell field's copied onto each of its cell's tetrahedra through cellTets and onto native cells
-/// through nativeSource), association, name and the finite value range over the cells' values. tetrahedralize ends with it, and a
-/// time step of the same mesh is attached with it without splitting again. Throws
-/// Error(Argument) when the field does not hold one value per point (or per source cell).
+/// through nativeSource), association, name and the finite value range over the cells' values.
+/// tetrahedralize ends with it, and a time step of the same mesh is attached with it without
+/// splitting again. Throws Error(Argument) when the field does not hold one value per point (or per
+/// source cell).
 void assignTetValues(TetMesh& mesh, const ScalarField& field);
 
 }  // namespace uvr

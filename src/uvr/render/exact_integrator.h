@@ -102,8 +102,8 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
 }
 
 /// clipCell of native cell t as a TetSpan (without a field).
-UVR_HOST_DEVICE UVR_NOINLINE inline TetSpan clipNative(const TetMeshView& mesh, std::uint32_t t,
-                                                       const Ray& ray, double tMin) {
+UVR_HOST_DEVICE inline TetSpan clipNative(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
+                                          double tMin) {
     std::uint32_t ids[kMaxCellCorners];
     const int n = mesh.corners(t, ids);
     Vec3f x[kMaxCellCorners];
@@ -135,7 +135,7 @@ inline constexpr int kNativeMaxPieces = 16;
 /// a piece's deviation falls as 1 / n^2, so n = ceil(sqrt(d / tol)) with tol a quarter of a
 /// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
 /// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc.
-UVR_HOST_DEVICE UVR_NOINLINE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
+UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
                                            float v0, double unit, Vec4f& acc) {
     std::uint32_t ids[kMaxCellCorners];
@@ -304,11 +304,11 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         haveEntry = false;
         // Across the exit face; located again where there is no neighbour or the crossing is
         // degenerate (the neighbour's span does not continue the ray).
-        const std::uint32_t next = loc.neighbors && span.exitFace >= 0
-                                       ? loc.neighbors[(kNative ? loc.mesh.faceBase(tet)
-                                                                : 4 * std::uint64_t(tet)) +
-                                                       span.exitFace]
-                                       : kNoTet;
+        const std::uint32_t next =
+            loc.neighbors && span.exitFace >= 0
+                ? loc.neighbors[(kNative ? loc.mesh.faceBase(tet) : 4 * std::uint64_t(tet)) +
+                                span.exitFace]
+                : kNoTet;
         if (next != kNoTet) {
             const exact::TetSpan s =
                 exact::clipAny<kNative>(loc.mesh, next, ray, continuous, t + eps);
