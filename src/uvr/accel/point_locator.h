@@ -55,14 +55,20 @@ struct TetLocator {
     /// Native cell t: p's parametric coordinates into bary[0..2] and the face p lies furthest
     /// outside of, with that excess (infinite when Newton's method does not converge: p is then
     /// not in the cell, and the face is the last iterate's).
-    UVR_HOST_DEVICE int nativeStep(std::uint32_t t, Vec3f p, float bary[4], float& excess) const {
+    /// With fromGuess, Newton's method starts from bary's coordinates (the previous sample's in
+    /// this cell) instead of the centre.
+    UVR_HOST_DEVICE int nativeStep(std::uint32_t t, Vec3f p, float bary[4], float& excess,
+                                   bool fromGuess = false) const {
         std::uint32_t ids[kMaxCellCorners];
         const int n = mesh.corners(t, ids);
         Vec3f x[kMaxCellCorners];
         for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]];
         const CellKind k = mesh.kind(t);
-        Vec3f rst;
-        const bool converged = cellParametric(k, x, p, rst);
+        Vec3f rst(bary[0], bary[1], bary[2]);
+        // A guess from elsewhere (another kind's coordinates, NaN) starts from the centre.
+        fromGuess = fromGuess && rst.x >= -0.5f && rst.x <= 1.5f && rst.y >= -0.5f &&
+                    rst.y <= 1.5f && rst.z >= -0.5f && rst.z <= 1.5f;
+        const bool converged = cellParametric(k, x, p, rst, fromGuess);
         bary[0] = rst.x, bary[1] = rst.y, bary[2] = rst.z, bary[3] = 0.f;
         const int face = worstFace(k, rst, excess);
         if (!converged) excess = INFINITY;
@@ -109,7 +115,7 @@ struct TetLocator {
             } else {
                 // A native cell: its parametric coordinates say which face p lies beyond.
                 float excess;
-                worst = nativeStep(t, p, bary, excess);
+                worst = nativeStep(t, p, bary, excess, step == 0);
                 if (excess <= kBaryEpsilon) return t;
                 t = neighbors[mesh.faceBase(t) + worst];
             }

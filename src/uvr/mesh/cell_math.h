@@ -181,6 +181,10 @@ UVR_HOST_DEVICE inline void cellMap(CellKind k, const Vec3f* e, Vec3f rst, Vec3f
 
 /// Newton iterations of cellParametric at most.
 inline constexpr int kNewtonIterations = 12;
+/// cellParametric gives up on a point whose iterate lies more than kNewtonGiveUpOutside outside
+/// the parametric unit box after kNewtonGiveUpAfter + 1 steps (it is not in the cell).
+inline constexpr int kNewtonGiveUpAfter = 2;
+inline constexpr float kNewtonGiveUpOutside = 0.5f;
 
 /// Parametric coordinates rst of point p in the cell of kind k with corners x[0..n-1]: the
 /// inverse of the isoparametric map by Newton's method from the parametric centre (or, with
@@ -188,7 +192,8 @@ inline constexpr int kNewtonIterations = 12;
 /// coordinates relative to corner 0 (for precision), each step's iterate kept within [-1, 2] (a
 /// far point's iteration cannot run away). Returns true when the residual fell below 1e-5 of the
 /// cell's size (or the step below 1e-6); false for a point the map does not reach from the
-/// centre (far outside a distorted cell, or a singular Jacobian), with rst the last iterate.
+/// centre (far outside a distorted cell, or a singular Jacobian) or whose iterate is still far
+/// outside after a few steps (kNewtonGiveUpOutside), with rst the last iterate.
 /// Exact for tetrahedra and parallelepipeds in one step; a few steps otherwise.
 UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, Vec3f& rst,
                                            bool fromGuess = false) {
@@ -222,6 +227,11 @@ UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, 
         const float moved = fmaxf(fabsf(d.x), fmaxf(fabsf(d.y), fabsf(d.z)));
         converged = residual <= tol || moved <= 1e-6f || !(moved == moved);
         if (!(moved == moved)) return false;  // NaN
+        // Far outside after a few steps: not in the cell (a walk needs only the direction, and
+        // a point outside may take every iteration to settle).
+        const float outside = fmaxf(fmaxf(fmaxf(-rst.x, rst.x - 1.f), fmaxf(-rst.y, rst.y - 1.f)),
+                                    fmaxf(-rst.z, rst.z - 1.f));
+        if (!converged && it >= kNewtonGiveUpAfter && outside > kNewtonGiveUpOutside) return false;
     }
     if (!converged) {  // the last step's residual
         Vec3f f, jr, js, jt;

@@ -185,7 +185,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     SampleSegments segments;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     std::uint32_t tet = kNoTet;
-    float bary[4];
+    float bary[4] = {0.f, 0.f, 0.f, 0.f};
     // One loop whose every iteration takes a sample, skips a transparent macrocell or moves to
     // the next partition, so GPU threads of a warp crossing partition boundaries at different
     // samples stay together. The loop leaves only through its condition (no break or return
@@ -299,7 +299,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 float lo = segments.kLast, hi = kSample;  // inside end first when leaving
                 float vHi = v;  // entering: the value at hi, the first position found inside
                 std::uint32_t from = in ? tet : lastInside;
-                float probeBary[4];
+                float probeBary[4] = {bary[0], bary[1], bary[2], bary[3]};
                 while (fabsf(hi - lo) > 1.f) {
                     const float mid = floorf(0.5f * (lo + hi) + 0.5f);
                     if (mid == lo || mid == hi) break;

@@ -131,7 +131,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     float k = ceilf(t0 / s);
     const float kEnd = floorf(t1 / s);
     std::uint32_t tet = kNoTet;
-    float bary[4];
+    float bary[4] = {0.f, 0.f, 0.f, 0.f};
     const float unit = scene.params.opacityUnit;
     SampleSegments segments;
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
