@@ -42,6 +42,17 @@ def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     assert img.stats["samples"] > 0
 
 
+def test_hexahedra_render_natively_unless_split_as_the_cli_does(data_dir, cli, tmp_path):
+    native = uvr.Renderer(data_dir / "hexa.vtk", device="cpu")
+    split = uvr.Renderer(data_dir / "hexa.vtk", device="cpu", split_cells=True)
+    assert (native.info["hexahedra"], native.info["tetrahedra"]) == (10648, 0)
+    assert (split.info["hexahedra"], split.info["tetrahedra"]) == (0, 6 * 10648)
+    for renderer, flags in ((native, []), (split, ["--split-cells"])):
+        out = tmp_path / "cli.png"
+        cli("render", data_dir / "hexa.vtk", "-o", out, *VIEW, *flags)
+        assert python_frame(renderer).png_bytes() == out.read_bytes()
+
+
 def test_a_pvcc_camera_and_a_paraview_json_give_the_clis_pixels(data_dir, cli, tmp_path):
     import pathlib
     oracle = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "oracle"
