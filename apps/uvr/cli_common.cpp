@@ -827,18 +827,17 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["field_association"] = associationName(field.association);
         j["device"] = renderer->deviceName();
         if (renderer->gpu()) {
-            j["gpu"] = {
-                {"description", cudaDeviceDescription()},
-                {"geometry_bytes", renderer->gpu()->geometryBytes()},
-                {"bytes_per_cell",
-                 double(renderer->gpu()->geometryBytes()) /
-                     double(std::max<std::uint64_t>(1, prepared.tets.cellCount()))},
-                // Per tetrahedron of the split (the cells' tetrahedra when split): comparable
-                // between native and split cells.
-                {"bytes_per_tetrahedron",
-                 double(renderer->gpu()->geometryBytes()) /
-                     double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
-                {"upload_seconds", renderer->gpu()->uploadSeconds()}};
+            j["gpu"] = {{"description", cudaDeviceDescription()},
+                        {"geometry_bytes", renderer->gpu()->geometryBytes()},
+                        {"bytes_per_cell",
+                         double(renderer->gpu()->geometryBytes()) /
+                             double(std::max<std::uint64_t>(1, prepared.tets.cellCount()))},
+                        // Per tetrahedron of the split (the cells' tetrahedra when split):
+                        // comparable between native and split cells.
+                        {"bytes_per_tetrahedron",
+                         double(renderer->gpu()->geometryBytes()) /
+                             double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
+                        {"upload_seconds", renderer->gpu()->uploadSeconds()}};
         }
         j["threads"] = cpu::threadCount();
         if (!flags.heatmapFile.empty()) j["heatmap_max"] = heatmapTop;

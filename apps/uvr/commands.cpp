@@ -349,7 +349,8 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                     "0.15) or hex (mixed's grid with a hexahedron per block)")
         ->capture_default_str();
     cmd->add_option("-o,--output", *out, "Output mesh (.uvrm, .vtu, .vtk or .vtkhdf)")->required();
-    cmd->add_option("--cells", spec->targetCells, "Approximate cell count (tetrahedra; for mixed and hex, their cells)")
+    cmd->add_option("--cells", spec->targetCells,
+                    "Approximate cell count (tetrahedra; for mixed and hex, their cells)")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t(1), std::uint64_t(4000000000)));
     cmd->add_option("--seed", spec->seed, "Random seed (same seed, same mesh)")

@@ -682,8 +682,7 @@ PYBIND11_MODULE(_uvr, m) {
         .def(py::init([](const MeshData& mesh, const std::string& name,
                          const std::string& association, const py::handle& values,
                          const std::string& device, const std::string& buildDevice,
-                         std::uint32_t leafCells, bool meshBvh, bool seedGrids,
-                         bool splitCells) {
+                         std::uint32_t leafCells, bool meshBvh, bool seedGrids, bool splitCells) {
                  ScalarField field = scalarField(name, association, values);
                  RendererOptions o;
                  o.device = parseDevice(device, "device");

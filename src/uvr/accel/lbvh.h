@@ -133,7 +133,7 @@ UVR_HOST_DEVICE inline std::uint32_t lbvhSegmentOf(const std::uint64_t* begin, s
 /// Element g of segment s (begin[s] <= g < begin[s + 1]) stands for inner node g - begin[s] of
 /// the segment's radix tree.
 struct LbvhBuildView {
-    TetMeshView mesh;  ///< points and cells (values unused)
+    TetMeshView mesh;                       ///< points and cells (values unused)
     const std::uint32_t* tetIds = nullptr;  ///< null: primitive i is cell i
     const std::uint64_t* segmentBegin = nullptr;
     const Bounds3f* segmentBounds = nullptr;  ///< what each segment's Morton codes quantise

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "uvr/core/error.h"
 #include "uvr/accel/point_locator.h"
+#include "uvr/core/error.h"
 #include "uvr/mesh/tet_math.h"
 
 namespace uvr {
@@ -44,7 +44,8 @@ std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float te
         const KdPartition& part = kd.partitions[p];
         PartitionGrid g;
         if (part.cellCount > 0 && !part.box.empty())
-            g = layoutPartitionGrid(part.box, std::max(1.0, part.cellCount * tetsPerMeshCell / tetsPerCell));
+            g = layoutPartitionGrid(part.box,
+                                    std::max(1.0, part.cellCount * tetsPerMeshCell / tetsPerCell));
         else
             g.dims[0] = g.dims[1] = g.dims[2] = 1;
         g.first = static_cast<std::uint32_t>(total);

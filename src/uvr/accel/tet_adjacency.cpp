@@ -131,7 +131,8 @@ std::vector<std::uint32_t> matchFaces(const TetMeshView& m, const std::vector<st
 #pragma omp parallel for schedule(static)
     for (std::int64_t c = 0; c < n; ++c)
         forFaces(c, [&](int, const std::uint32_t* f) {
-            std::atomic_ref<std::uint64_t>(offsets[f[0] + 1]).fetch_add(1, std::memory_order_relaxed);
+            std::atomic_ref<std::uint64_t>(offsets[f[0] + 1])
+                .fetch_add(1, std::memory_order_relaxed);
         });
     for (std::size_t p = 0; p < points; ++p) offsets[p + 1] += offsets[p];
     // Step 2: scatter faces into their buckets (in any order; step 3 sorts each bucket by its

@@ -258,11 +258,10 @@ CudaScene::~CudaScene() = default;
 std::uint64_t CudaScene::geometryBytes() const {
     const Impl& d = *impl_;
     return d.points.bytes() + d.tets.bytes() + d.nativeCorners.bytes() + d.values.bytes() +
-           d.neighbors.bytes() +
-           d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
-           d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() + d.partitionCells.bytes() +
-           d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes() +
-           d.partitionNan.bytes() + d.macroNan.bytes();
+           d.neighbors.bytes() + d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() +
+           d.partitions.bytes() + d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() +
+           d.partitionCells.bytes() + d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() +
+           d.macroCells.bytes() + d.partitionNan.bytes() + d.macroNan.bytes();
 }
 
 double CudaScene::uploadSeconds() const {
@@ -377,8 +376,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     } else if (settings.method == RenderMethod::Exact) {
         dispatchNative(native, [&](auto kNative) {
             cuda::launchFrame(grid, block, frame,
-                              ExactMarch<kNative()>{d.deviceScene(result.setup)},
-                              d.totals.data());
+                              ExactMarch<kNative()>{d.deviceScene(result.setup)}, d.totals.data());
         });
     } else {
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);

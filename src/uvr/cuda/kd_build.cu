@@ -183,8 +183,8 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
         TetMeshView view = mesh.view();
         view.points = points.data(), view.tets = tets.data(), view.values = nullptr;
         view.nativeCorners = nativeCorners.data();
-        cuda::boxesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(view, n, boxes.data(),
-                                                                cells.data(), nodeOf.data());
+        cuda::boxesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(view, n, boxes.data(), cells.data(),
+                                                                nodeOf.data());
         UVR_CUDA_CHECK(cudaGetLastError());
         UVR_CUDA_CHECK(cudaDeviceSynchronize());
     }

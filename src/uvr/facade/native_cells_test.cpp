@@ -93,8 +93,8 @@ TEST(NativeCells, HexahedraStayWholeAndCostLessThanTheirSplit) {
                p.bvh.primIds.size() * 4;
     };
     const double perHex = double(bytes(native)) / 512.0, perSplit = double(bytes(split)) / 512.0;
-    std::printf("geometry bytes per hexahedron: native %.1f, split into 6 tetrahedra %.1f\n", perHex,
-                perSplit);
+    std::printf("geometry bytes per hexahedron: native %.1f, split into 6 tetrahedra %.1f\n",
+                perHex, perSplit);
     EXPECT_LT(perHex, 0.5 * perSplit);
 }
 
@@ -191,8 +191,8 @@ TEST(NativeCells, ExactPiecesMatchTheFineReferenceOnDistortedHexahedra) {
         float worst = 0.f;
         for (std::size_t i = 0; i < exact.image.pixels.size(); ++i)
             for (int c = 0; c < 4; ++c)
-                worst = std::fmax(worst,
-                                  std::fabs(exact.image.pixels[i][c] - fine.image.pixels[i][c]));
+                worst =
+                    std::fmax(worst, std::fabs(exact.image.pixels[i][c] - fine.image.pixels[i][c]));
         std::printf("%s: exact vs reference at s1/32: SSIM %.5f, worst channel %.4f\n", opacity,
                     ssimOf(exact, fine), worst);
         EXPECT_GE(ssimOf(exact, fine), 0.995) << opacity;
@@ -204,7 +204,8 @@ TEST(NativeCells, ExactPiecesMatchTheFineReferenceOnDistortedHexahedra) {
 }
 
 TEST(NativeCells, CellDataOnNativeCells) {
-    Mesh m = testing::makeHexGrid(4, -1.f, 1.f, [](Vec3f) { return 0.f; }, 0.2f);
+    Mesh m = testing::makeHexGrid(
+        4, -1.f, 1.f, [](Vec3f) { return 0.f; }, 0.2f);
     Field c{"c", Association::Cell, 1, {}};
     for (std::uint64_t i = 0; i < m.cellCount(); ++i) c.values.push_back(float(i % 7));
     m.fields.push_back(c);
@@ -259,7 +260,8 @@ TEST(NativeCells, MixedMeshNeighboursMatchAcrossEveryFacePairing) {
     // generateMixedCellMesh holds every quad pairing (hexahedron, pyramid, wedge) and every
     // triangle pairing (tetrahedron, pyramid, wedge): each interior face must find its neighbour.
     const Mesh m = generateMixedCellMesh(5, 0.1f, 3);
-    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, parseFieldSpec("linear")), nativeOptions(false));
+    const PreparedMesh pm =
+        prepareMesh(m, selectScalarField(m, parseFieldSpec("linear")), nativeOptions(false));
     const TetMeshView v = pm.tets.view();
     EXPECT_EQ(pm.tets.cellCount(), m.cellCount());
     EXPECT_GT(pm.tets.tets.size(), 0u);

@@ -33,9 +33,9 @@ struct RendererOptions {
     /// Where the BVHs and the k-d tree build: Auto builds on the GPU when frames render there and
     /// the mesh has kAutoGpuBuildTets tetrahedra or more.
     Device buildDevice = Device::Auto;
-    bool partitions = true;       ///< the k-d partitions of RenderMethod::Partitions
-    bool meshBvh = true;          ///< the mesh BVH of RenderMethod::Reference and Exact
-    bool seedGrids = true;        ///< with partitions: seed grids for long steps
+    bool partitions = true;  ///< the k-d partitions of RenderMethod::Partitions
+    bool meshBvh = true;     ///< the mesh BVH of RenderMethod::Reference and Exact
+    bool seedGrids = true;   ///< with partitions: seed grids for long steps
     /// Split pyramids, wedges and hexahedra into tetrahedra instead of rendering them natively.
     bool splitCells = false;
     std::uint32_t leafCells = 0;  ///< cells per k-d partition; 0: the device's default

@@ -16,8 +16,8 @@ int nativeOrientation(CellKind k, const Vec3f* x) {
     for (int i = 0; i < n; ++i) {
         if (!isFinite(x[i])) return 0;
         e[i] = toDouble(x[i]) - toDouble(x[0]);
-        size = std::fmax(size, std::fmax(std::fabs(e[i].x), std::fmax(std::fabs(e[i].y),
-                                                                      std::fabs(e[i].z))));
+        size = std::fmax(
+            size, std::fmax(std::fabs(e[i].x), std::fmax(std::fabs(e[i].y), std::fabs(e[i].z))));
     }
     if (!(size > 0.0)) return 0;
     for (int i = 1; i < n; ++i) e[i] = e[i] * (1.0 / size);

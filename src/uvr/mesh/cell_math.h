@@ -333,10 +333,10 @@ inline constexpr double kNativeFold = 0.25;
 inline constexpr double kNativeMinDet = 1e-9;
 
 /// Orientation of a native cell's isoparametric map: +1 or -1, the sign of the Jacobian's
-/// determinant at the centre (at least kNativeMinDet of the cell's size cubed), when at every corner (a
-/// pyramid's apex, where it vanishes, at t = 0.5 instead) it has that sign or the opposite one by
-/// at most kNativeFold of the centre's; 0 for a cell that folds further, collapses or has
-/// non-finite corners (it is rendered split into tetrahedra instead).
+/// determinant at the centre (at least kNativeMinDet of the cell's size cubed), when at every
+/// corner (a pyramid's apex, where it vanishes, at t = 0.5 instead) it has that sign or the
+/// opposite one by at most kNativeFold of the centre's; 0 for a cell that folds further, collapses
+/// or has non-finite corners (it is rendered split into tetrahedra instead).
 int nativeOrientation(CellKind k, const Vec3f* x);
 
 }  // namespace uvr

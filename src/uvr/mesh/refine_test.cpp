@@ -41,7 +41,8 @@ double signedVolume(const Mesh& m, std::uint64_t c) {
 TEST(Refine, MultipliesTetsBy8AndKeepsVolumeFieldsAndConformity) {
     constexpr int kN = 4, kLevels = 2;
     const Mesh in = hexGrid(kN);
-    const TetMesh base = tetrahedralize(in, {"f", Association::Point, in.fields[0].values}, {.splitCells = true});
+    const TetMesh base =
+        tetrahedralize(in, {"f", Association::Point, in.fields[0].values}, {.splitCells = true});
     const Mesh out = refineMesh(in, kLevels);
     ASSERT_EQ(out.cellCount(), base.tets.size() * 64);
     // Volume: every child positive, their sum the parent volume (midpoints rounded to float).
@@ -102,7 +103,8 @@ TEST(Refine, MultipliesTetsBy8AndKeepsVolumeFieldsAndConformity) {
 TEST(Refine, ZeroLevelsSplitsOnly) {
     const Mesh in = hexGrid(2);
     const Mesh out = refineMesh(in, 0);
-    const TetMesh base = tetrahedralize(in, {"f", Association::Point, in.fields[0].values}, {.splitCells = true});
+    const TetMesh base =
+        tetrahedralize(in, {"f", Association::Point, in.fields[0].values}, {.splitCells = true});
     EXPECT_EQ(out.cellCount(), base.tets.size());
     EXPECT_EQ(out.pointCount(), in.pointCount());
 }

@@ -230,9 +230,8 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
             s.source[slot] = {};
         }
     }
-    UVR_CHECK(out.cellCount() < kNoCell, "the mesh has " << out.cellCount()
-                                                         << " cells; at most " << kNoCell - 1
-                                                         << " can be rendered");
+    UVR_CHECK(out.cellCount() < kNoCell, "the mesh has " << out.cellCount() << " cells; at most "
+                                                         << kNoCell - 1 << " can be rendered");
     for (const Chunk& s : parts) {
         out.totalVolume += s.volume;
         out.bounds.extend(s.bounds);

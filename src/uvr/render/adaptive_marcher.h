@@ -311,8 +311,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                         found = locator.search<kNative>(scene.kd.bvh, root, q, probeBary,
                                                         counters.locate);
                     const float vMid =
-                        found == kNoTet ? 0.f
-                                        : locator.mesh.interpolate<kNative>(found, probeBary);
+                        found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
                     if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;

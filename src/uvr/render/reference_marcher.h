@@ -141,8 +141,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
-        const float v =
-            tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
+        const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
         if (scene.params.preintegrated) {
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc);
         } else if (tet != kNoTet) {

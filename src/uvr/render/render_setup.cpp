@@ -43,7 +43,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     if (options.meshBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
-            progress("building the BVH over " + std::to_string(out.tets.cellCount()) + " cells" + (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
+            progress("building the BVH over " + std::to_string(out.tets.cellCount()) + " cells" +
+                     (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
         if (lbvh) {
             out.bvh = buildMeshLbvh(out.tets, lbvh);
         } else {

@@ -28,10 +28,10 @@ namespace uvr {
 
 /// What prepareMesh builds besides tetrahedra, BVH and neighbours.
 struct PrepareOptions {
-    bool meshBvh = true;     ///< build the BVH over all tetrahedra the reference marcher needs
-    bool partitions = true;  ///< build the k-d partitions the partition integrator needs
-    bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
-    bool macroGrids = true;  ///< with partitions: the macrocells the error-bound rule steps by
+    bool meshBvh = true;          ///< build the BVH over all tetrahedra the reference marcher needs
+    bool partitions = true;       ///< build the k-d partitions the partition integrator needs
+    bool seedGrids = true;        ///< with partitions: the seed grids that long steps locate from
+    bool macroGrids = true;       ///< with partitions: the macrocells the error-bound rule steps by
     TetrahedralizeOptions cells;  ///< native cells or the split into tetrahedra
     KdBuildOptions kd;
     /// When set, the mesh BVH and the partitions' BVHs are LBVHs from this builder
