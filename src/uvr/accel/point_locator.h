@@ -59,15 +59,16 @@ struct TetLocator {
     /// this cell) instead of the centre.
     UVR_HOST_DEVICE int nativeStep(std::uint32_t t, Vec3f p, float bary[4], float& excess,
                                    bool fromGuess = false) const {
-        std::uint32_t ids[kMaxCellCorners];
-        const int n = mesh.corners(t, ids);
         Vec3f x[kMaxCellCorners];
-        for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]];
+        mesh.gather(t, x);
         const CellKind k = mesh.kind(t);
-        Vec3f rst(bary[0], bary[1], bary[2]);
-        // A guess from elsewhere (another kind's coordinates, NaN) starts from the centre.
-        fromGuess = fromGuess && rst.x >= -0.5f && rst.x <= 1.5f && rst.y >= -0.5f &&
-                    rst.y <= 1.5f && rst.z >= -0.5f && rst.z <= 1.5f;
+        Vec3f rst(0.f);
+        if (fromGuess) {
+            // A guess from elsewhere (another kind's coordinates, NaN) starts from the centre.
+            rst = Vec3f(bary[0], bary[1], bary[2]);
+            fromGuess = rst.x >= -0.5f && rst.x <= 1.5f && rst.y >= -0.5f && rst.y <= 1.5f &&
+                        rst.z >= -0.5f && rst.z <= 1.5f;
+        }
         const bool converged = cellParametric(k, x, p, rst, fromGuess);
         bary[0] = rst.x, bary[1] = rst.y, bary[2] = rst.z, bary[3] = 0.f;
         const int face = worstFace(k, rst, excess);

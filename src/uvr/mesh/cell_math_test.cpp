@@ -11,16 +11,10 @@
 namespace uvr {
 namespace {
 
+using celltest::kindName;
 using celltest::kKinds;
 using celltest::Rng;
 using celltest::uniform;
-
-const char* kindName(CellKind k) {
-    return k == CellKind::Tet       ? "tet"
-           : k == CellKind::Pyramid ? "pyramid"
-           : k == CellKind::Wedge   ? "wedge"
-                                    : "hex";
-}
 
 TEST(CellMath, ShapeFunctionsArePartitionOfUnityAndKronecker) {
     Rng rng(1);

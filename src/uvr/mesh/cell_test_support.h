@@ -20,6 +20,14 @@ inline constexpr CellKind kKinds[4] = {CellKind::Tet, CellKind::Pyramid, CellKin
                                        CellKind::Hex};
 
 /// A uniform float in [lo, hi).
+/// A kind's name for test messages.
+inline const char* kindName(CellKind k) {
+    return k == CellKind::Tet       ? "tet"
+           : k == CellKind::Pyramid ? "pyramid"
+           : k == CellKind::Wedge   ? "wedge"
+                                    : "hex";
+}
+
 inline float uniform(Rng& rng, float lo, float hi) {
     return std::uniform_real_distribution<float>(lo, hi)(rng);
 }

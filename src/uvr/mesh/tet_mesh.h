@@ -109,6 +109,17 @@ struct TetMeshView {
         for (int i = 0; i < n; ++i) ids[i] = src[i];
         return n;
     }
+    /// Cell c's corner positions into x and, when v is not null, their values into v (point
+    /// data); returns the corner count.
+    UVR_HOST_DEVICE int gather(std::uint64_t c, Vec3f x[kMaxCellCorners],
+                               float* v = nullptr) const {
+        std::uint32_t ids[kMaxCellCorners];
+        const int n = corners(c, ids);
+        for (int i = 0; i < n; ++i) x[i] = points[ids[i]];
+        if (v)
+            for (int i = 0; i < n; ++i) v[i] = values[ids[i]];
+        return n;
+    }
     /// Index of cell c's first face in a face-neighbour table (faceCount(c) entries follow).
     UVR_HOST_DEVICE std::uint64_t faceBase(std::uint64_t c) const {
         if (c < tetCount) return 4 * c;

@@ -346,11 +346,9 @@ std::string describeCells(const TetMesh& mesh) {
 }
 
 Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c) {
-    std::uint32_t ids[kMaxCellCorners];
-    const int n = m.corners(c, ids);
     Vec3f x[kMaxCellCorners];
     float v[kMaxCellCorners];
-    for (int i = 0; i < n; ++i) x[i] = m.points[ids[i]], v[i] = m.values[ids[i]];
+    const int n = m.gather(c, x, v);
     const CellKind k = m.kind(c);
     Bounds3f box;
     if (k == CellKind::Tet) {

@@ -104,10 +104,8 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
 /// clipCell of native cell t as a TetSpan (without a field).
 UVR_HOST_DEVICE inline TetSpan clipNative(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
                                           double tMin) {
-    std::uint32_t ids[kMaxCellCorners];
-    const int n = mesh.corners(t, ids);
     Vec3f x[kMaxCellCorners];
-    for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]];
+    mesh.gather(t, x);
     const CellSpan c = clipCell(mesh.kind(t), x, ray, tMin);
     TetSpan s;
     s.tIn = c.tIn, s.tOut = c.tOut, s.exitFace = c.exitFace;
@@ -138,11 +136,9 @@ inline constexpr int kNativeMaxPieces = 16;
 UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
                                            float v0, double unit, Vec4f& acc) {
-    std::uint32_t ids[kMaxCellCorners];
-    const int n = mesh.corners(t, ids);
     Vec3f x[kMaxCellCorners];
     float cv[kMaxCellCorners];
-    for (int i = 0; i < n; ++i) x[i] = mesh.points[ids[i]], cv[i] = mesh.values[ids[i]];
+    const int n = mesh.gather(t, x, cv);
     const CellKind k = mesh.kind(t);
     Vec3f rst = cellCentreParametric(k);
     auto valueAt = [&](double tp) {
