@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/facade/renderer.h"
 #include "uvr/mesh/field_select.h"
+#include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/mesh/validate.h"
@@ -221,8 +224,14 @@ TEST(NativeCells, CellDataOnNativeCells) {
 
 TEST(NativeCells, RealHexahedralFilesNativeAgainstSplit) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
-    for (const char* name : {"hexa.vtk", "fire_ug.vtu"}) {
-        const Mesh m = readMesh(testing::sharedData(name));
+    std::vector<std::string> files = {testing::sharedData("hexa.vtk"),
+                                      testing::sharedData("fire_ug.vtu")};
+    // ParaView's tutorial data as Debian's mayavi2 ships it (Exodus II, hexahedra).
+    const std::string disk = "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
+    if (exodusSupported() && std::ifstream(disk).good()) files.push_back(disk);
+    for (const std::string& file : files) {
+        const char* name = file.c_str();
+        const Mesh m = readMesh(file);
         const ScalarField f = selectScalarField(m, {});
         const PreparedMesh native = prepareMesh(m, f, nativeOptions(false));
         const PreparedMesh split = prepareMesh(m, f, nativeOptions(true));
