@@ -26,9 +26,9 @@
 
 namespace uvr {
 
-/// What prepareMesh builds besides tetrahedra, BVH and neighbours.
+/// What prepareMesh builds besides the cells, BVH and neighbours.
 struct PrepareOptions {
-    bool meshBvh = true;          ///< build the BVH over all tetrahedra the reference marcher needs
+    bool meshBvh = true;          ///< build the BVH over all cells the reference marcher needs
     bool partitions = true;       ///< build the k-d partitions the partition integrator needs
     bool seedGrids = true;        ///< with partitions: the seed grids that long steps locate from
     bool macroGrids = true;       ///< with partitions: the macrocells the error-bound rule steps by
@@ -42,14 +42,15 @@ struct PrepareOptions {
     /// overrides kd.splitter.
     KdSplitter kdSplitter;
     std::string builderDevice = "cpu";  ///< where lbvh and kdSplitter build (progress messages)
-    std::uint64_t builderMinTets = 0;   ///< use them only from this many tetrahedra
+    std::uint64_t builderMinTets = 0;   ///< use them only from this many cells
 };
 
-/// A mesh made ready for rendering one field: tetrahedra, BVH, face neighbours and (optionally)
+/// A mesh made ready for rendering one field: cells (tetrahedra, native cells), BVH, face
+/// neighbours and (optionally)
 /// k-d partitions, built once and reused by every frame and transfer-function change.
 struct PreparedMesh {
     TetMesh tets;
-    Bvh bvh;  ///< over all tetrahedra; empty unless PrepareOptions::meshBvh
+    Bvh bvh;  ///< over all cells; empty unless PrepareOptions::meshBvh
     std::vector<std::uint32_t> neighbors;
     std::optional<KdPartitions> kd;
     std::optional<SeedGrids> seeds;  ///< per-partition walk starts (with partitions)
@@ -63,7 +64,7 @@ struct PreparedMesh {
     /// empty when the field has none.
     std::vector<std::uint8_t> partitionNan;
     std::uint64_t sourceCells = 0;  ///< cells of the mesh before splitting
-    double splitSeconds = 0.0;      ///< time to split cells into tetrahedra
+    double splitSeconds = 0.0;      ///< time to split cells (or keep them native)
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
     bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
@@ -77,7 +78,7 @@ struct PreparedMesh {
 /// Optional progress report: a step name ("splitting cells", ...) when a step starts.
 using ProgressFn = std::function<void(const std::string&)>;
 
-/// Splits cells, builds the BVH over the tetrahedra and the face-neighbour table.
+/// Splits cells (or keeps them native), builds the BVH over them and the face-neighbour table.
 PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                          const PrepareOptions& options, const ProgressFn& progress = {});
 /// prepareMesh with the default options.
@@ -95,7 +96,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field);
 void updateFieldValues(PreparedMesh& mesh, const ScalarField& field);
 
 /// Per partition, the diagonal of the bounding box of the field gradients of its cells (each
-/// linear tetrahedron's constant gradient): it bounds how much the derivative of the field along
+/// linear tetrahedron's constant gradient, a native cell's at its corners and centre:
+/// cellGradientBounds): it bounds how much the derivative of the field along
 /// any ray varies inside the partition. 0 for a partition without cells or with a linear field;
 /// infinite for a cell-centred field (piecewise constant: its jumps have no gradient bound).
 /// Cells with non-finite gradients (degenerate, or NaN values) are left out.
@@ -106,11 +108,12 @@ std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitio
 /// needs these to keep NaN regions of non-zero NaN opacity (shadeNan).
 std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartitions& kd);
 
-/// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume,
-/// 0.5 * cbrt(totalVolume / tetCount): about two to three samples per tetrahedron along a ray;
-/// at most the bounds' diagonal / kMinSamplesPerDiagonal (a mesh of few cells is cheap to sample
-/// finely, and where a ray enters and leaves the mesh a sample's share is uncertain by a step);
-/// at least kMinDefaultStepFraction of the diagonal (a mesh of slivers has a tiny mean volume).
+/// Default sample spacing s1: half the edge of a cube with the mean tetrahedron volume of the
+/// split, 0.5 * cbrt(totalVolume / splitTetCount): about two to three samples per tetrahedron along
+/// a ray; at most the bounds' diagonal / kMinSamplesPerDiagonal (a mesh of few cells is cheap to
+/// sample finely, and where a ray enters and leaves the mesh a sample's share is uncertain by a
+/// step); at least kMinDefaultStepFraction of the diagonal (a mesh of slivers has a tiny mean
+/// volume).
 float defaultStep(const TetMesh& mesh);
 
 /// Fewest samples the default step takes across the bounds' diagonal (it decides the step of
@@ -128,7 +131,7 @@ float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount);
 enum class RenderMethod {
     Reference,   ///< fixed step s1 through the whole volume (the yardstick)
     Partitions,  ///< k-d partitions with space skipping and adaptive steps (Morrical et al. 2019)
-    Exact,       ///< no sampling: each tetrahedron's segment integrated exactly (the ground truth)
+    Exact,       ///< no sampling: each cell's segment integrated (the ground truth)
 };
 
 /// Default --quality: the error-bound rule's SSIM target against the exact integrator.
@@ -319,7 +322,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
 struct RenderStats {
     double seconds = 0.0;                 ///< wall time of the frame (rendering only)
     std::uint64_t samples = 0;            ///< samples taken
-    std::uint64_t walkSteps = 0;          ///< tetrahedra tested while walking
+    std::uint64_t walkSteps = 0;          ///< cells tested while walking
     std::uint64_t bvhQueries = 0;         ///< point locations that fell back to the BVH
     std::uint64_t partitionsVisited = 0;  ///< partitions entered by rays (partition method)
     std::uint64_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
