@@ -8,8 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <string>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "test_meshes.h"
@@ -323,41 +323,38 @@ TEST(NativeCells, MixedMeshInterpolatesLinearFieldsAndRendersAsItsSplit) {
     }
 }
 
-TEST(NativeCells, OnTheGpuMixedMeshMatchesTheCpu) {
-    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
-    const Mesh m = generateMixedCellMesh(8, 0.12f, 2);
-    const ScalarField f = selectScalarField(m, parseFieldSpec("xyz"));
+/// Renders field f of m on the CPU and on the GPU (built there when gpuBuild), which keeps more
+/// than minHexahedra hexahedra native, with every method and expects the frames to agree.
+void expectGpuMatchesCpu(const Mesh& m, const ScalarField& f, std::uint32_t leafCells,
+                         bool gpuBuild, std::uint64_t minHexahedra, const char* opacity) {
     RendererOptions o;
-    o.leafCells = 128;
+    o.leafCells = leafCells;
     o.device = Device::Cpu;
     Renderer cpu(m, f, o);
     o.device = Device::Cuda;
-    o.buildDevice = Device::Cuda;  // the GPU's LBVH and k-d builds over native cells
+    if (gpuBuild) o.buildDevice = Device::Cuda;
     Renderer gpu(m, f, o);
+    EXPECT_GT(gpu.prepared().tets.hexCount, minHexahedra);
     for (RenderMethod method :
          {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
-        const RenderSettings s = frame(m.bounds(), method, "0:0,0.5:0.8,1:0.2");
+        const RenderSettings s = frame(m.bounds(), method, opacity);
         EXPECT_GE(ssimOf(cpu.render(s), gpu.render(s)), 0.995) << int(method);
     }
+}
+
+TEST(NativeCells, OnTheGpuMixedMeshMatchesTheCpu) {
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
+    const Mesh m = generateMixedCellMesh(8, 0.12f, 2);
+    // Built on the GPU: its LBVH and k-d builds over native cells.
+    expectGpuMatchesCpu(m, selectScalarField(m, parseFieldSpec("xyz")), 128, true, 0,
+                        "0:0,0.5:0.8,1:0.2");
 }
 
 TEST(NativeCells, OnTheGpuFramesMatchTheCpu) {
     if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
     const Mesh m = testing::makeHexGrid(
         10, -1.f, 1.f, [](Vec3f p) { return std::sin(2.f * p.x) * p.y + p.z; }, 0.25f);
-    const ScalarField f = selectScalarField(m, {});
-    RendererOptions o;
-    o.leafCells = 64;
-    o.device = Device::Cpu;
-    Renderer cpu(m, f, o);
-    o.device = Device::Cuda;
-    Renderer gpu(m, f, o);
-    EXPECT_GT(gpu.prepared().tets.hexCount, 900u);
-    for (RenderMethod method :
-         {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
-        const RenderSettings s = frame(m.bounds(), method, "0:0,1:0.6");
-        EXPECT_GE(ssimOf(cpu.render(s), gpu.render(s)), 0.995) << int(method);
-    }
+    expectGpuMatchesCpu(m, selectScalarField(m, {}), 64, false, 900, "0:0,1:0.6");
 }
 
 }  // namespace
