@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The parallel builders (BVH, face neighbours, k-d partitions, splitting) give bit-identical
-// results whatever the thread count, on a mesh large enough for their data-parallel top levels.
+// The parallel builders (BVH, face neighbours, k-d partitions, splitting, the kernels' layout) give
+// bit-identical results whatever the thread count, on a mesh large enough for their data-parallel
+// top levels.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -60,6 +61,13 @@ TEST(ParallelBuild, SameResultsWithOneAndTwoThreads) {
         EXPECT_TRUE(sameBytes(a.kd->partitions, b.kd->partitions));
         EXPECT_TRUE(sameBytes(a.kd->cells, b.kd->cells));
         EXPECT_TRUE(sameBytes(a.kd->bvhNodes, b.kd->bvhNodes));
+        // The kernels' layout: Morton order, blocks, neighbour codes, cell tree.
+        EXPECT_TRUE(sameBytes(a.tets.tetSourceOrder, b.tets.tetSourceOrder));
+        EXPECT_TRUE(sameBytes(a.tets.tetCorners, b.tets.tetCorners));
+        EXPECT_TRUE(sameBytes(a.tets.blockVertices, b.tets.blockVertices));
+        EXPECT_TRUE(sameBytes(a.neighborCodes.tetCodes, b.neighborCodes.tetCodes));
+        EXPECT_TRUE(sameBytes(a.neighborCodes.escapes, b.neighborCodes.escapes));
+        EXPECT_TRUE(sameBytes(a.cellTree.nodes, b.cellTree.nodes));
     }
 }
 

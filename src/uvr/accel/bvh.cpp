@@ -333,4 +333,59 @@ void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
     }
 }
 
+Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells) {
+    Bvh bvh;
+    const std::uint64_t n = mesh.cellCount();
+    if (n == 0) return bvh;
+    UVR_CHECK(leafCells > 0, "buildCellTree: leaves of 0 cells");
+    const std::uint64_t leaves = (n + leafCells - 1) / leafCells;
+    UVR_CHECK(2 * leaves - 1 < 0xffffffffull, "cell tree nodes exceed 32-bit indices");
+    bvh.nodes.resize(2 * leaves - 1);
+    std::vector<std::uint32_t> leafNode(leaves);
+    // Structure: the node at `node` covers runs [b, e); its children take slots next and
+    // next + 1, the left one's descendants the 2 k - 2 slots after them (k: its runs).
+    struct Job {
+        std::uint32_t node;
+        std::uint64_t b, e;
+        std::uint32_t next;
+    };
+    std::vector<Job> stack{{0, 0, leaves, 1}};
+    while (!stack.empty()) {
+        const Job j = stack.back();
+        stack.pop_back();
+        BvhNode& node = bvh.nodes[j.node];
+        if (j.e - j.b == 1) {
+            node.first = static_cast<std::uint32_t>(j.b * leafCells);
+            node.count =
+                static_cast<std::uint32_t>(std::min<std::uint64_t>(leafCells, n - j.b * leafCells));
+            leafNode[j.b] = j.node;
+            continue;
+        }
+        const std::uint64_t mid = j.b + (j.e - j.b) / 2;
+        node.first = j.next;
+        node.count = 0;
+        stack.push_back({j.next, j.b, mid, j.next + 2});
+        stack.push_back(
+            {j.next + 1, mid, j.e, j.next + static_cast<std::uint32_t>(2 * (mid - j.b))});
+    }
+    // Boxes: the runs' in parallel, then the inner nodes from the last (children follow their
+    // parent).
+    const TetMeshView view = mesh.view();
+#pragma omp parallel for schedule(static)
+    for (std::int64_t l = 0; l < std::int64_t(leaves); ++l) {
+        BvhNode& node = bvh.nodes[leafNode[l]];
+        Bounds3f box;
+        for (std::uint32_t c = node.first; c < node.first + node.count; ++c)
+            box.extend(view.cellBounds(c));
+        node.box = box;
+    }
+    for (std::int64_t i = std::int64_t(bvh.nodes.size()) - 1; i >= 0; --i) {
+        BvhNode& node = bvh.nodes[i];
+        if (node.count > 0) continue;
+        node.box = bvh.nodes[node.first].box;
+        node.box.extend(bvh.nodes[node.first + 1].box);
+    }
+    return bvh;
+}
+
 }  // namespace uvr

@@ -22,6 +22,8 @@ struct BvhNode {
 /// Plain-data view of a BVH for CPU and GPU kernels; node 0 is the root.
 struct BvhView {
     const BvhNode* nodes = nullptr;
+    /// Leaf entries' primitive ids; null: a leaf's entries [first, first + count) are the ids
+    /// themselves (buildCellTree).
     const std::uint32_t* primIds = nullptr;
     std::uint32_t nodeCount = 0;
 };
@@ -59,7 +61,7 @@ UVR_HOST_DEVICE bool bvhVisitPoint(const BvhView& bvh, Vec3f p, Visit&& visit,
         if (boxHoldsPoint(n.box, p)) {
             if (n.count > 0) {
                 for (std::uint32_t i = 0; i < n.count; ++i)
-                    if (visit(bvh.primIds[n.first + i])) return true;
+                    if (visit(bvh.primIds ? bvh.primIds[n.first + i] : n.first + i)) return true;
             } else {
                 stack[top++] = n.first + 1;
                 node = n.first;
@@ -84,7 +86,8 @@ struct Bvh {
 
     /// View for kernels; the Bvh must outlive it.
     BvhView view() const {
-        return {nodes.data(), primIds.data(), static_cast<std::uint32_t>(nodes.size())};
+        return {nodes.data(), primIds.empty() ? nullptr : primIds.data(),
+                static_cast<std::uint32_t>(nodes.size())};
     }
 };
 
@@ -94,6 +97,15 @@ struct Bvh {
 /// data-parallel passes, then subtrees one per thread) and bit-identical for any thread count.
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
+
+/// Cells per leaf of the cell tree (buildCellTree): searches are rare (walks and seeds locate
+/// almost every sample), so large leaves cost little time and keep the tree at 2 bytes per cell.
+inline constexpr std::uint32_t kCellTreeLeaf = 32;
+
+/// A BVH whose leaves are runs of `leafCells` consecutive cell ids, without primitive ids (a
+/// leaf holds cells [first, first + count)): a balanced binary tree over the runs, siblings
+/// adjacent. Over cells in Morton order (sortCellsSpatially) the runs are compact. Parallel.
+Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells = kCellTreeLeaf);
 
 /// Bounding box and box centre of every cell of a mesh (resizes both arrays); parallel.
 void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,

@@ -8,6 +8,7 @@
 #include "test_meshes.h"
 #include "uvr/accel/point_locator.h"
 #include "uvr/accel/tet_adjacency.h"
+#include "uvr/mesh/procedural.h"
 #include "uvr/render/render_setup.h"
 
 namespace uvr {
@@ -140,6 +141,101 @@ TEST(TetAdjacency, NeighboursAreMutualAndShareTheFace) {
             ASSERT_EQ(shared, 3);
         }
     EXPECT_EQ(boundary, 2 * 6 * 36);  // two triangles per boundary quad
+}
+
+/// A procedural box of several blocks of tetrahedra, prepared with partitions (cell tree).
+PreparedMesh blockBox(std::uint64_t cells) {
+    ProceduralSpec spec;
+    spec.targetCells = cells;
+    spec.fields = {ProceduralField::Linear};
+    const Mesh m = generateMesh(spec);
+    PrepareOptions o;
+    o.meshBvh = false;
+    o.kd.leafCells = 4096;
+    return prepareMesh(m, selectScalarField(m, {}), o);
+}
+
+TEST(CompactNeighbors, DecodeToTheNeighbourTable) {
+    for (const PreparedMesh& pm : {blockBox(50000), jitteredGrid()}) {
+        const TetMeshView v = pm.tets.view();
+        const NeighborView nb = pm.neighborCodes.view();
+        for (std::uint32_t c = 0; c < v.cellCount(); ++c)
+            for (int f = 0; f < kindFaces(v.kind(c)); ++f)
+                ASSERT_EQ(nb.across(v, c, f), pm.neighbors[v.faceBase(c) + f])
+                    << "cell " << c << " face " << f;
+    }
+    // Mixed cells: native cells' faces, and tetrahedra whose neighbours are native.
+    const Mesh mixed = generateMixedCellMesh(6, 0.1f, 2);
+    const PreparedMesh pm = prepareMesh(mixed, selectScalarField(mixed, {}));
+    const TetMeshView v = pm.tets.view();
+    ASSERT_TRUE(v.hasNative() && v.tetCount > 0);
+    const NeighborView nb = pm.neighborCodes.view();
+    int tetToNative = 0;
+    for (std::uint32_t c = 0; c < v.cellCount(); ++c)
+        for (int f = 0; f < kindFaces(v.kind(c)); ++f) {
+            const std::uint32_t expected = pm.neighbors[v.faceBase(c) + f];
+            ASSERT_EQ(nb.across(v, c, f), expected) << "cell " << c << " face " << f;
+            tetToNative += c < v.tetCount && expected != kNoTet && expected >= v.tetCount;
+        }
+    EXPECT_GT(tetToNative, 0);
+}
+
+TEST(CompactNeighbors, FewNeighboursLeaveTheirBlock) {
+    const PreparedMesh pm = blockBox(200000);
+    ASSERT_GE(pm.tets.tets.size(), 20 * kTetBlockSize);
+    const double escapesPerFace =
+        double(pm.neighborCodes.escapes.size()) / double(4 * pm.tets.tets.size());
+    EXPECT_GT(escapesPerFace, 0.0);
+    EXPECT_LT(escapesPerFace, 0.1);  // Morton-ordered blocks are compact
+}
+
+TEST(CellTree, RunsOfCellsInNestedBoxesAndSearchesAgreeWithBruteForce) {
+    const PreparedMesh pm = blockBox(50000);
+    const Bvh& tree = pm.cellTree;
+    const std::uint64_t cells = pm.tets.cellCount();
+    const std::uint64_t leaves = (cells + kCellTreeLeaf - 1) / kCellTreeLeaf;
+    ASSERT_EQ(tree.nodes.size(), 2 * leaves - 1);
+    EXPECT_TRUE(tree.primIds.empty());
+    EXPECT_EQ(tree.view().primIds, nullptr);
+    // Every cell in one leaf, whose box holds it; every child box inside its parent's.
+    std::vector<int> seen(cells, 0);
+    const TetMeshView v = pm.tets.view();
+    auto holds = [](const Bounds3f& outer, const Bounds3f& inner) {
+        for (int a = 0; a < 3; ++a)
+            if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
+        return true;
+    };
+    for (const BvhNode& n : tree.nodes) {
+        if (n.count > 0) {
+            for (std::uint32_t c = n.first; c < n.first + n.count; ++c) {
+                ++seen[c];
+                ASSERT_TRUE(holds(n.box, v.cellBounds(c)));
+            }
+        } else {
+            ASSERT_TRUE(holds(n.box, tree.nodes[n.first].box));
+            ASSERT_TRUE(holds(n.box, tree.nodes[n.first + 1].box));
+        }
+    }
+    for (std::uint64_t c = 0; c < cells; ++c) ASSERT_EQ(seen[c], 1) << "cell " << c;
+    // Point searches find a containing cell exactly where brute force does.
+    const TetLocator loc = pm.locator();
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.1f, 1.1f);
+    int found = 0;
+    for (int i = 0; i < 400; ++i) {
+        const Vec3f p(u(rng), u(rng), u(rng));
+        const auto expected = containingTets(loc, p);
+        LocateCounters counters;
+        float bary[4];
+        const std::uint32_t t = loc.search(tree.view(), 0, p, bary, counters);
+        if (expected.empty()) {
+            ASSERT_EQ(t, kNoTet);
+        } else {
+            ASSERT_NE(std::find(expected.begin(), expected.end(), t), expected.end());
+            ++found;
+        }
+    }
+    EXPECT_GT(found, 100);
 }
 
 }  // namespace

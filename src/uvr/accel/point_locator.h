@@ -31,8 +31,8 @@ struct LocateCounters {
 struct TetLocator {
     TetMeshView mesh;
     BvhView bvh;
-    /// Face neighbours (buildTetNeighbors: from TetMeshView::faceBase), may be null (no walking).
-    const std::uint32_t* neighbors = nullptr;
+    /// Face neighbours (compactNeighbors); none present: no walking.
+    NeighborView neighbors;
     int maxWalkSteps = kMaxWalkSteps;  ///< walk length before the BVH takes over
 
     /// True when p lies in cell t (within kBaryEpsilon); fills bary with p's local coordinates
@@ -44,10 +44,9 @@ struct TetLocator {
             nativeStep(t, p, bary, excess);
             return excess <= kBaryEpsilon;
         }
-        const Tet& tet = mesh.tets[t];
-        if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]], mesh.points[tet.v[2]],
-                             mesh.points[tet.v[3]], bary))
-            return false;
+        BlockVertex x[4];
+        mesh.tetVertices(t, x);
+        if (!tetBarycentrics(p, x[0].p, x[1].p, x[2].p, x[3].p, bary)) return false;
         return bary[0] >= -kBaryEpsilon && bary[1] >= -kBaryEpsilon && bary[2] >= -kBaryEpsilon &&
                bary[3] >= -kBaryEpsilon;
     }
@@ -99,26 +98,25 @@ struct TetLocator {
     template <bool kNative = true>
     UVR_HOST_DEVICE std::uint32_t walk(Vec3f p, std::uint32_t start, float bary[4],
                                        LocateCounters& counters) const {
-        if (start == kNoTet || !neighbors) return kNoTet;
+        if (start == kNoTet || !neighbors.present()) return kNoTet;
         std::uint32_t t = start;
         for (int step = 0; step < maxWalkSteps; ++step) {
             ++counters.walkSteps;
             int worst = 0;
             if (!kNative || t < mesh.tetCount) {
-                const Tet& tet = mesh.tets[t];
-                if (!tetBarycentrics(p, mesh.points[tet.v[0]], mesh.points[tet.v[1]],
-                                     mesh.points[tet.v[2]], mesh.points[tet.v[3]], bary))
-                    return kNoTet;
+                BlockVertex x[4];
+                mesh.tetVertices(t, x);
+                if (!tetBarycentrics(p, x[0].p, x[1].p, x[2].p, x[3].p, bary)) return kNoTet;
                 for (int i = 1; i < 4; ++i)
                     if (bary[i] < bary[worst]) worst = i;
                 if (bary[worst] >= -kBaryEpsilon) return t;
-                t = neighbors[4 * std::uint64_t(t) + worst];
+                t = neighbors.ofTet(t, worst);
             } else {
                 // A native cell: its parametric coordinates say which face p lies beyond.
                 float excess;
                 worst = nativeStep(t, p, bary, excess, step == 0);
                 if (excess <= kBaryEpsilon) return t;
-                t = neighbors[mesh.faceBase(t) + worst];
+                t = neighbors.across(mesh, t, worst);
             }
             if (t == kNoTet) return kNoTet;
         }

@@ -63,7 +63,7 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
     const std::size_t n = kd.partitions.size();
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids", mesh.meanSplitTets());
     const TetMeshView view = mesh.view();
-    const TetLocator locator{view, {}, nullptr};
+    const TetLocator locator{view, {}, {}};
     out.seeds.assign(gridCellCount(out.grids), kNoTet);
     // Seeds: per cell the smallest key (squared distance of a tetrahedron's centroid to the cell
     // centre, 0 when the tetrahedron contains the centre; ties to the smaller id). Partitions are

@@ -125,6 +125,7 @@ TEST(SeedGrid, FlatAndEmptyPartitionsGetValidGrids) {
     mesh.values = {0, 1, 2, 3};
     mesh.bounds.extend(Vec3f(0, 0, 0));
     mesh.bounds.extend(Vec3f(1, 1, 1e-7f));
+    encodeTetBlocks(mesh);
     const KdPartitions kd = buildKdPartitions(mesh);
     const SeedGrids sg = buildSeedGrids(mesh, kd);
     ASSERT_EQ(sg.grids.size(), kd.partitions.size());

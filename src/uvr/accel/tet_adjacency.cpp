@@ -193,4 +193,58 @@ std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh) {
                             : matchFaces<TetFace>(view, canon, mesh.points.size());
 }
 
+CompactNeighbors compactNeighbors(const TetMesh& mesh,
+                                  const std::vector<std::uint32_t>& neighbors) {
+    const TetMeshView view = mesh.view();
+    UVR_CHECK(neighbors.size() == view.faceSlots(),
+              "compactNeighbors: " << neighbors.size() << " faces, expected " << view.faceSlots());
+    CompactNeighbors out;
+    const std::uint64_t n = mesh.tets.size();
+    const std::int64_t blocks = static_cast<std::int64_t>((n + kTetBlockSize - 1) / kTetBlockSize);
+    out.tetCodes.resize(n);
+    // Per block: its codes and how many escapes; then the escapes in block order.
+    std::vector<std::uint32_t> escapeCount(blocks, 0);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t b = 0; b < blocks; ++b) {
+        const std::uint64_t first = std::uint64_t(b) * kTetBlockSize;
+        const std::uint64_t end = std::min<std::uint64_t>(n, first + kTetBlockSize);
+        std::uint32_t escapes = 0;
+        for (std::uint64_t t = first; t < end; ++t)
+            for (int f = 0; f < 4; ++f) {
+                const std::uint32_t nb = neighbors[4 * t + f];
+                std::uint16_t code;
+                if (nb == kNoTet)
+                    code = kNoNeighborCode;
+                else if (nb < n && (nb >> kTetBlockBits) == std::uint64_t(b))
+                    code = static_cast<std::uint16_t>(nb & (kTetBlockSize - 1u));
+                else
+                    code = static_cast<std::uint16_t>(kTetBlockSize + escapes++);
+                out.tetCodes[t].c[f] = code;
+            }
+        escapeCount[b] = escapes;
+    }
+    out.escapeBase.assign(blocks + 1, 0);
+    std::uint64_t total = 0;
+    for (std::int64_t b = 0; b < blocks; ++b) {
+        total += escapeCount[b];
+        UVR_CHECK(total <= 0xffffffffull, "neighbour escapes exceed 32-bit indices");
+        out.escapeBase[b + 1] = static_cast<std::uint32_t>(total);
+    }
+    out.escapes.resize(total);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t b = 0; b < blocks; ++b) {
+        const std::uint64_t first = std::uint64_t(b) * kTetBlockSize;
+        const std::uint64_t end = std::min<std::uint64_t>(n, first + kTetBlockSize);
+        std::uint32_t at = out.escapeBase[b];
+        for (std::uint64_t t = first; t < end; ++t)
+            for (int f = 0; f < 4; ++f) {
+                const std::uint16_t code = out.tetCodes[t].c[f];
+                if (code >= kTetBlockSize && code != kNoNeighborCode)
+                    out.escapes[at++] = neighbors[4 * t + f];
+            }
+    }
+    out.native.assign(neighbors.begin() + std::int64_t(4 * n), neighbors.end());
+    return out;
+}
+
 }  // namespace uvr

@@ -151,19 +151,25 @@ std::string cudaDeviceDescription() {
 
 struct CudaScene::Impl {
     const PreparedMesh& mesh;
+    // The kernels' mesh (PreparedMesh::kernelMesh): points and values only where native cells
+    // or cell data need them; tetrahedra by blocks.
     cuda::DeviceArray<Vec3f> points;
-    cuda::DeviceArray<Tet> tets;
     cuda::DeviceArray<std::uint32_t> nativeCorners;  ///< empty without native cells
     cuda::DeviceArray<float> values;
-    cuda::DeviceArray<std::uint32_t> neighbors;
+    cuda::DeviceArray<TetCorners16> tetCorners;
+    cuda::DeviceArray<BlockVertex> blockVertices;
+    cuda::DeviceArray<std::uint32_t> blockVertexBase;
+    cuda::DeviceArray<NeighborCodes> neighborCodes;
+    cuda::DeviceArray<std::uint32_t> neighborEscapes;
+    cuda::DeviceArray<std::uint32_t> neighborEscapeBase;
+    cuda::DeviceArray<std::uint32_t> nativeNeighbors;
     cuda::DeviceArray<BvhNode> bvhNodes;
     cuda::DeviceArray<std::uint32_t> bvhPrims;
     cuda::DeviceArray<KdNode> kdNodes;
     cuda::DeviceArray<KdPartition> partitions;
     cuda::DeviceArray<float> gradientSpread;
     cuda::DeviceArray<std::uint8_t> partitionNan;  ///< empty when the field has no NaN
-    cuda::DeviceArray<BvhNode> partitionBvhNodes;
-    cuda::DeviceArray<std::uint32_t> partitionCells;
+    cuda::DeviceArray<BvhNode> cellTreeNodes;
     cuda::DeviceArray<PartitionGrid> seedGrids;
     cuda::DeviceArray<std::uint32_t> seeds;
     cuda::DeviceArray<PartitionGrid> macroGrids;
@@ -191,7 +197,12 @@ struct CudaScene::Impl {
     /// Uploads the arrays that depend on the field's values (the constructor's and
     /// updateValues' one code path); a NaN flag array the field no longer needs is freed.
     void uploadValues() {
-        values.upload(mesh.tets.values, "the field values");
+        const TetMeshView kernel = mesh.kernelMesh();
+        if (kernel.values)
+            values.upload(mesh.tets.values, "the field values");
+        else
+            values.clear();
+        blockVertices.upload(mesh.tets.blockVertices, "the tetrahedra's vertices");
         if (mesh.kd) {
             partitions.upload(mesh.kd->partitions, "the partitions");
             gradientSpread.upload(mesh.gradientSpread, "the partition gradient spreads");
@@ -212,13 +223,17 @@ struct CudaScene::Impl {
     /// The host scene view with every pointer replaced by its device copy.
     SceneView deviceScene(const FrameSetup& setup) const {
         SceneView v = setup.scene(mesh);
-        v.locator.mesh.points = points.data();
-        v.locator.mesh.tets = tets.data();
-        v.locator.mesh.nativeCorners = nativeCorners.data();
-        v.locator.mesh.values = values.data();
+        TetMeshView& m = v.locator.mesh;
+        m.points = points.data();
+        m.nativeCorners = nativeCorners.data();
+        m.values = values.data();
+        m.tetCorners = tetCorners.data();
+        m.blockVertices = blockVertices.data();
+        m.blockVertexBase = blockVertexBase.data();
         v.locator.bvh.nodes = bvhNodes.data();
         v.locator.bvh.primIds = bvhPrims.data();
-        v.locator.neighbors = neighbors.data();
+        v.locator.neighbors = {neighborCodes.data(), neighborEscapes.data(),
+                               neighborEscapeBase.data(), nativeNeighbors.data()};
         v.tf.entries = tfTable.data();
         v.tf.breaks = tfBreaks.data();
         return v;
@@ -230,16 +245,22 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
         throwError(ErrorKind::Unsupported, "", "--device cuda: no CUDA device found");
     const auto start = std::chrono::steady_clock::now();
     Impl& d = *impl_;
-    d.points.upload(mesh.tets.points, "the mesh points");
-    d.tets.upload(mesh.tets.tets, "the tetrahedra");
-    if (mesh.tets.hasNative()) d.nativeCorners.upload(mesh.tets.nativeCorners, "the native cells");
-    d.neighbors.upload(mesh.neighbors, "the face neighbours");
+    if (mesh.tets.hasNative()) {
+        d.points.upload(mesh.tets.points, "the mesh points");
+        d.nativeCorners.upload(mesh.tets.nativeCorners, "the native cells");
+    }
+    d.tetCorners.upload(mesh.tets.tetCorners, "the tetrahedra");
+    d.blockVertexBase.upload(mesh.tets.blockVertexBase, "the tetrahedra's blocks");
+    const CompactNeighbors& nb = mesh.neighborCodes;
+    d.neighborCodes.upload(nb.tetCodes, "the face neighbours");
+    d.neighborEscapes.upload(nb.escapes, "the face neighbours across blocks");
+    d.neighborEscapeBase.upload(nb.escapeBase, "the face neighbours' blocks");
+    d.nativeNeighbors.upload(nb.native, "the native cells' face neighbours");
     d.bvhNodes.upload(mesh.bvh.nodes, "the BVH nodes");
     d.bvhPrims.upload(mesh.bvh.primIds, "the BVH primitive ids");
     if (mesh.kd) {
         d.kdNodes.upload(mesh.kd->nodes, "the k-d nodes");
-        d.partitionBvhNodes.upload(mesh.kd->bvhNodes, "the partition BVH nodes");
-        d.partitionCells.upload(mesh.kd->cells, "the partition cell lists");
+        d.cellTreeNodes.upload(mesh.cellTree.nodes, "the cell tree");
     }
     if (mesh.seeds) {
         d.seedGrids.upload(mesh.seeds->grids, "the seed grids");
@@ -257,11 +278,13 @@ CudaScene::~CudaScene() = default;
 
 std::uint64_t CudaScene::geometryBytes() const {
     const Impl& d = *impl_;
-    return d.points.bytes() + d.tets.bytes() + d.nativeCorners.bytes() + d.values.bytes() +
-           d.neighbors.bytes() + d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() +
-           d.partitions.bytes() + d.gradientSpread.bytes() + d.partitionBvhNodes.bytes() +
-           d.partitionCells.bytes() + d.seedGrids.bytes() + d.seeds.bytes() + d.macroGrids.bytes() +
-           d.macroCells.bytes() + d.partitionNan.bytes() + d.macroNan.bytes();
+    return d.points.bytes() + d.nativeCorners.bytes() + d.values.bytes() + d.tetCorners.bytes() +
+           d.blockVertices.bytes() + d.blockVertexBase.bytes() + d.neighborCodes.bytes() +
+           d.neighborEscapes.bytes() + d.neighborEscapeBase.bytes() + d.nativeNeighbors.bytes() +
+           d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
+           d.gradientSpread.bytes() + d.cellTreeNodes.bytes() + d.seedGrids.bytes() +
+           d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes() + d.partitionNan.bytes() +
+           d.macroNan.bytes();
 }
 
 double CudaScene::uploadSeconds() const {
@@ -383,8 +406,8 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         scene.base = d.deviceScene(result.setup);
         scene.kd.nodes = d.kdNodes.data();
         scene.kd.partitions = d.partitions.data();
-        scene.kd.bvh.nodes = d.partitionBvhNodes.data();
-        scene.kd.bvh.primIds = d.partitionCells.data();
+        scene.kd.bvh = {};
+        scene.cells.nodes = d.cellTreeNodes.data();
         scene.shading = d.shading.data();
         if (d.macroActive) scene.macro = {d.macroGrids.data(), d.macroShading.data()};
         if (d.mesh.seeds)

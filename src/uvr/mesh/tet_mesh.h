@@ -65,6 +65,25 @@ inline constexpr int kFrameShiftExponent = 8;
 /// and, per far axis, a translation to the box's centre.
 MeshFrame frameForBounds(const Bounds3f& bounds);
 
+/// Kernels read tetrahedra in blocks of kTetBlockSize consecutive ids (issue 16): a tetrahedron
+/// names its corners by 16-bit indices into its block's vertex list, which holds the positions
+/// and point values side by side (TetMesh::tetCorners, encodeTetBlocks). A block's 4 * 8192
+/// corners have at most 32768 distinct points, so 16 bits always suffice.
+inline constexpr int kTetBlockBits = 13;
+/// Tetrahedra per block.
+inline constexpr std::uint32_t kTetBlockSize = 1u << kTetBlockBits;
+
+/// A block's vertex: position and the point field's value (0 for cell data), one 16-byte load.
+struct alignas(16) BlockVertex {
+    Vec3f p;
+    float value = 0.f;
+};
+
+/// A tetrahedron's four corners as indices into its block's vertices.
+struct TetCorners16 {
+    std::uint16_t v[4];
+};
+
 /// Plain-data view of a TetMesh for CPU and GPU kernels. Cell ids [0, tetCount) are
 /// tetrahedra; the native cells follow (issue 14): pyramids, then wedges, then hexahedra, their
 /// corners (5, 6, 8 point ids, VTK's order) one after another in nativeCorners. Face neighbour
@@ -77,6 +96,12 @@ struct TetMeshView {
     bool cellCentered = false;
     const std::uint32_t* nativeCorners = nullptr;  ///< corners of the native cells, in id order
     std::uint64_t pyramidCount = 0, wedgeCount = 0, hexCount = 0;
+    /// The kernels' tetrahedra (encodeTetBlocks): per tetrahedron its corners in its block, the
+    /// blocks' vertices, and per block the index of its first vertex. Kernels read tetrahedra
+    /// only through these (tetVertices); `tets` and point-data `values` serve host-side builds.
+    const TetCorners16* tetCorners = nullptr;
+    const BlockVertex* blockVertices = nullptr;
+    const std::uint32_t* blockVertexBase = nullptr;
 
     /// Every cell: tetrahedra and native cells.
     UVR_HOST_DEVICE std::uint64_t cellCount() const {
@@ -84,6 +109,12 @@ struct TetMeshView {
     }
     /// True when the mesh has native cells.
     UVR_HOST_DEVICE bool hasNative() const { return pyramidCount + wedgeCount + hexCount > 0; }
+    /// Tetrahedron t's corners (positions and point values) from its block.
+    UVR_HOST_DEVICE void tetVertices(std::uint64_t t, BlockVertex out[4]) const {
+        const TetCorners16 c = tetCorners[t];
+        const BlockVertex* base = blockVertices + blockVertexBase[t >> kTetBlockBits];
+        for (int k = 0; k < 4; ++k) out[k] = base[c.v[k]];
+    }
     /// The kind of cell c.
     UVR_HOST_DEVICE CellKind kind(std::uint64_t c) const {
         if (c < tetCount) return CellKind::Tet;
@@ -148,9 +179,10 @@ struct TetMeshView {
     UVR_HOST_DEVICE float interpolate(std::uint64_t t, const float bary[4]) const {
         if (cellCentered) return values[t];
         if (!kNative || t < tetCount) {
-            const Tet& tet = tets[t];
-            return bary[0] * values[tet.v[0]] + bary[1] * values[tet.v[1]] +
-                   bary[2] * values[tet.v[2]] + bary[3] * values[tet.v[3]];
+            BlockVertex x[4];
+            tetVertices(t, x);
+            return bary[0] * x[0].value + bary[1] * x[1].value + bary[2] * x[2].value +
+                   bary[3] * x[3].value;
         }
         return interpolateNative(t, bary);
     }
@@ -183,14 +215,22 @@ struct TetMesh {
     float valueMin = 0.f;  ///< finite range of the field over the tets' values
     float valueMax = 0.f;
     double totalVolume = 0.0;  ///< sum of tetrahedron volumes
-    /// Per cell of the source mesh, how many tetrahedra it kept (0 to 6); tets lists them cell
-    /// after cell, so this maps a cell field onto the tetrahedra (assignTetValues).
+    /// Per cell of the source mesh, how many tetrahedra it kept (0 to 6), in cell order: with
+    /// tetSourceOrder this maps a cell field onto the tetrahedra (assignTetValues).
     std::vector<std::uint8_t> cellTets;
     /// Native cells' corners (5 per pyramid, 6 per wedge, 8 per hexahedron) in id order.
     std::vector<std::uint32_t> nativeCorners;
     std::uint64_t pyramidCount = 0, wedgeCount = 0, hexCount = 0;
     /// Per native cell, its cell of the source mesh (cell data is attached through it).
     std::vector<std::uint64_t> nativeSource;
+    /// Per tetrahedron, its index in cell order (the tetrahedra of cell 0, then of cell 1, ...,
+    /// as cellTets counts them) before sortCellsSpatially reordered them; empty: that order.
+    std::vector<std::uint32_t> tetSourceOrder;
+    /// The kernels' form of the tetrahedra (encodeTetBlocks; TetMeshView::tetCorners).
+    std::vector<TetCorners16> tetCorners;
+    std::vector<BlockVertex> blockVertices;
+    std::vector<std::uint32_t> blockVertexBase;   ///< per block and one past the last
+    std::vector<std::uint32_t> blockVertexPoint;  ///< point id of each block vertex
 
     /// Every rendered cell: tetrahedra and native cells.
     std::uint64_t cellCount() const { return tets.size() + pyramidCount + wedgeCount + hexCount; }
@@ -212,6 +252,9 @@ struct TetMesh {
                       association == Association::Cell};
         v.nativeCorners = nativeCorners.data();
         v.pyramidCount = pyramidCount, v.wedgeCount = wedgeCount, v.hexCount = hexCount;
+        v.tetCorners = tetCorners.data();
+        v.blockVertices = blockVertices.data();
+        v.blockVertexBase = blockVertexBase.data();
         return v;
     }
 };
@@ -226,6 +269,9 @@ struct TetrahedralizeOptions {
     /// hexahedra whose isoparametric map is one-to-one (nativeOrientation) as native cells,
     /// splitting only those that fold or collapse.
     bool splitCells = false;
+    /// Reorder the cells of each kind along a Morton curve (sortCellsSpatially); false: cell
+    /// order (the tetrahedra of each source cell after those of the cells before it).
+    bool spatialOrder = true;
 };
 
 /// Number of tetrahedra (at most 6) a cell splits into and their corners, as indices into the
@@ -238,9 +284,23 @@ int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[
 /// Splits the cells of the mesh into tetrahedra (all of them, or only those that cannot stay
 /// native: options) and attaches the field; inverted cells are re-oriented, zero-volume
 /// tetrahedra (also those with a NaN/Inf corner) dropped (validateMesh reports both); points are
-/// mapped by frameForBounds of the kept cells' bounds.
+/// mapped by frameForBounds of the kept cells' bounds; cells are put in Morton order (unless
+/// options say not) and the tetrahedra's blocks encoded (encodeTetBlocks).
 TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
                        const TetrahedralizeOptions& options = {});
+
+/// Reorders the tetrahedra, and the native cells of each kind among themselves, by the 63-bit
+/// Morton code of their centroids over the mesh bounds (ties by their present order), so cells
+/// close in id lie close in space: the blocks of the kernels' layout then share most of their
+/// points and neighbours. Keeps tetSourceOrder (and nativeSource) so cell data still maps onto
+/// the cells; call it before assignTetValues and encodeTetBlocks. Parallel; the same order for
+/// any thread count.
+void sortCellsSpatially(TetMesh& mesh);
+
+/// Builds the kernels' form of the tetrahedra: per block of kTetBlockSize consecutive ids its
+/// distinct points (positions, point values) and each tetrahedron's corners as indices into
+/// them. Throws Error(Unsupported) when the blocks' vertices exceed 32-bit indices. Parallel.
+void encodeTetBlocks(TetMesh& mesh);
 
 /// The bounding box of the field's gradient over point-data cell c of m: a tetrahedron's one
 /// constant gradient; a native cell's gradients at its corners and centre (a pyramid's apex,
@@ -250,7 +310,8 @@ Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c);
 
 /// Attaches a field of the source mesh to the cells: values (a point field's as they are, a
 /// cell field's copied onto each of its cell's tetrahedra through cellTets and onto native cells
-/// through nativeSource), association, name and the finite value range over the cells' values.
+/// through nativeSource), association, name and the finite value range over the cells' values;
+/// the blocks' vertex values (encodeTetBlocks) when the blocks exist.
 /// tetrahedralize ends with it, and a time step of the same mesh is attached with it without
 /// splitting again. Throws Error(Argument) when the field does not hold one value per point (or per
 /// source cell).

@@ -236,6 +236,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
         out.totalVolume += s.volume;
         out.bounds.extend(s.bounds);
     }
+    if (options.spatialOrder) sortCellsSpatially(out);
     assignTetValues(out, field);
     out.frame = frameForBounds(out.bounds);
     if (!out.frame.identity()) {
@@ -254,6 +255,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
                       Vec3f(float(bhi[0]), float(bhi[1]), float(bhi[2]))};
         out.totalVolume *= f.scale * f.scale * f.scale;
     }
+    encodeTetBlocks(out);
     return out;
 }
 
@@ -294,6 +296,14 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
             for (std::int64_t i = c * kCellChunk; i < end; ++i)
                 for (int k = 0; k < mesh.cellTets[i]; ++k) mesh.values[t++] = field.values[i];
         }
+        if (!mesh.tetSourceOrder.empty()) {
+            // From cell order to the tetrahedra's order (sortCellsSpatially).
+            const std::int64_t n = static_cast<std::int64_t>(mesh.tets.size());
+            std::vector<float> inCellOrder(mesh.values.begin(), mesh.values.begin() + n);
+#pragma omp parallel for schedule(static)
+            for (std::int64_t t = 0; t < n; ++t)
+                mesh.values[t] = inCellOrder[mesh.tetSourceOrder[t]];
+        }
         const std::int64_t nativeCount = static_cast<std::int64_t>(mesh.nativeSource.size());
 #pragma omp parallel for schedule(static)
         for (std::int64_t j = 0; j < nativeCount; ++j)
@@ -329,6 +339,11 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
     for (std::int64_t c = 0; c < chunks; ++c) l = std::fmin(l, lo[c]), h = std::fmax(h, hi[c]);
     mesh.valueMin = l <= h ? l : 0.f;
     mesh.valueMax = l <= h ? h : 0.f;
+    // The blocks' copies of the point values.
+    const std::int64_t blockVertices = static_cast<std::int64_t>(mesh.blockVertexPoint.size());
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < blockVertices; ++i)
+        mesh.blockVertices[i].value = cellData ? 0.f : mesh.values[mesh.blockVertexPoint[i]];
 }
 
 std::string describeCells(const TetMesh& mesh) {

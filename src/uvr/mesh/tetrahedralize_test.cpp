@@ -153,8 +153,16 @@ TEST(Tetrahedralize, InvertedCellsAreReorientedAndZeroVolumeCellsDropped) {
                                 t.points[tet.v[3]]),
                   0.f);
     EXPECT_NEAR(t.totalVolume, 1.0 + 1.0 / 6, kVolumeTolerance);
-    // Cell data follows its cell: six tets of value 1, then the mirrored tet's 3.
-    EXPECT_EQ(t.values, (std::vector<float>{1, 1, 1, 1, 1, 1, 3}));
+    // Cell data follows its cell: in cell order six tets of value 1, then the mirrored tet's 3,
+    // wherever the Morton order put them.
+    ASSERT_EQ(t.tetSourceOrder.size(), 7u);
+    for (std::size_t i = 0; i < 7; ++i)
+        EXPECT_EQ(t.values[i], t.tetSourceOrder[i] == 6 ? 3.f : 1.f) << "tetrahedron " << i;
+    const TetMesh inCellOrder =
+        tetrahedralize(m, ScalarField{"c", Association::Cell, {1.f, 2.f, 3.f}},
+                       {.splitCells = true, .spatialOrder = false});
+    EXPECT_TRUE(inCellOrder.tetSourceOrder.empty());
+    EXPECT_EQ(inCellOrder.values, (std::vector<float>{1, 1, 1, 1, 1, 1, 3}));
 }
 
 TEST(Tetrahedralize, BarycentricsReproduceLinearFunctions) {

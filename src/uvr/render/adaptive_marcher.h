@@ -141,7 +141,9 @@ inline constexpr float kLongStep = 2.f;
 struct PartitionSceneView {
     SceneView base;
     KdView kd;
-    SeedGridView seeds;  ///< per-partition walk starts; without them long steps search the BVH
+    /// The tree the samples that walks and seeds do not locate search (buildCellTree).
+    BvhView cells;
+    SeedGridView seeds;  ///< per-partition walk starts; without them long steps search the tree
     const PartitionShading* shading = nullptr;
     /// Macrocells (null grids: none): when set, each sample's step is its macrocell's, and
     /// transparent macrocells are skipped like transparent partitions.
@@ -193,7 +195,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // warps whose threads split there ran one thread at a time (measured on the H100: 1.2
     // active threads per instruction, 12x the reference marcher's time at the same samples).
     KdLeafIterator leaves(tEnter, tExit);
-    std::uint32_t p = 0, root = 0;
+    std::uint32_t p = 0;
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
     float kLocated = -INFINITY;  // grid position of the last sample located
     bool marching = true, opaque = false, macro = false;
@@ -232,7 +234,6 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 mPiece = fmaxf(1.f, span / parts);
                 kStop = k1 - 0.5f * mPiece;  // rounding in k += m must not add a sample at k1
             }
-            root = part.bvhRoot;
             continue;
         }
         const float kSample = k;
@@ -273,8 +274,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         ++counters.samples;
         // Point location: a walk from the previous sample's tetrahedron (short steps), else
         // from the seed of the sample's grid cell (none: no cell of the partition is near, the
-        // sample is in empty space), else a search of the partition's BVH (walks stop at
-        // boundaries of non-convex meshes and at seams of unshared points).
+        // sample is in empty space), else a search of the cell tree (walks stop at boundaries
+        // of non-convex meshes and at seams of unshared points).
         const bool walk = kSample - kLocated <= scene.longStep;
         kLocated = kSample;
         tet = walk ? locator.walk<kNative>(pos, tet, bary, counters.locate) : kNoTet;
@@ -285,7 +286,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if (!emptySpace) tet = locator.walk<kNative>(pos, seed, bary, counters.locate);
         }
         if (tet == kNoTet && !emptySpace)
-            tet = locator.search<kNative>(scene.kd.bvh, root, pos, bary, counters.locate);
+            tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
         if (preintegrated) {
             // A step longer than s1 from inside the mesh to outside it, or back in: the mesh's
@@ -308,8 +309,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     std::uint32_t found =
                         locator.walk<kNative>(q, from, probeBary, counters.locate);
                     if (found == kNoTet)
-                        found = locator.search<kNative>(scene.kd.bvh, root, q, probeBary,
-                                                        counters.locate);
+                        found =
+                            locator.search<kNative>(scene.cells, 0, q, probeBary, counters.locate);
                     const float vMid =
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
                     if (found != kNoTet) from = found;

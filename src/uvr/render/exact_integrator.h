@@ -54,9 +54,10 @@ struct TetSpan {
 /// withValue: also the point field along the ray (TetSpan::valueAt; not for cell data).
 UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
                                        bool withValue = false) {
-    const Tet& tet = mesh.tets[t];
+    BlockVertex x[4];
+    mesh.tetVertices(t, x);
     Vec3d p[4];
-    for (int i = 0; i < 4; ++i) p[i] = toDouble(mesh.points[tet.v[i]]);
+    for (int i = 0; i < 4; ++i) p[i] = toDouble(x[i].p);
     const Vec3d o = toDouble(ray.org), d = toDouble(ray.dir);
     TetSpan s;
     bool degenerate = false;
@@ -84,16 +85,16 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
                 degenerate = true;
                 continue;
             }
-            const double v = mesh.values[tet.v[i]];
+            const double v = x[i].value;
             s.value0 -= v * num / height;
             s.valueSlope += v * den / height;
         }
     }
     if (withValue && !degenerate) {
         s.hasValue = true;
-        s.valueLo = s.valueHi = mesh.values[tet.v[0]];
+        s.valueLo = s.valueHi = x[0].value;
         for (int i = 1; i < 4; ++i) {
-            const float v = mesh.values[tet.v[i]];
+            const float v = x[i].value;
             s.valueLo = v < s.valueLo ? v : s.valueLo;
             s.valueHi = v > s.valueHi ? v : s.valueHi;
         }
@@ -204,7 +205,7 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
         if (b0 > bestKey) continue;
         if (node.count > 0) {
             for (std::uint32_t k = 0; k < node.count; ++k) {
-                const std::uint32_t id = bvh.primIds[node.first + k];
+                const std::uint32_t id = bvh.primIds ? bvh.primIds[node.first + k] : node.first + k;
                 const TetSpan s = clipAny<kNative>(mesh, id, ray, false, t + eps);
                 if (!(s.tOut > t + eps) || !(s.tIn <= s.tOut)) continue;
                 const double key = s.tIn > t ? s.tIn : t;
@@ -228,11 +229,11 @@ UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, 
     const TetMeshView& m = loc.mesh;
     if (m.cellCentered) return m.values[tet];
     if (span.hasValue) return span.valueAt(t);
-    const Tet& c = m.tets[tet];
+    BlockVertex x[4];
+    m.tetVertices(tet, x);
     float bary[4];
     const Vec3f p = ray.at(static_cast<float>(t));
-    if (!tetBarycentrics(p, m.points[c.v[0]], m.points[c.v[1]], m.points[c.v[2]], m.points[c.v[3]],
-                         bary))
+    if (!tetBarycentrics(p, x[0].p, x[1].p, x[2].p, x[3].p, bary))
         for (float& b : bary) b = 0.25f;  // a degenerate tetrahedron: the mean of its corners
     float sum = 0.f;
     for (float& b : bary) b = b > 0.f ? b : 0.f, sum += b;
@@ -300,11 +301,9 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         haveEntry = false;
         // Across the exit face; located again where there is no neighbour or the crossing is
         // degenerate (the neighbour's span does not continue the ray).
-        const std::uint32_t next =
-            loc.neighbors && span.exitFace >= 0
-                ? loc.neighbors[(kNative ? loc.mesh.faceBase(tet) : 4 * std::uint64_t(tet)) +
-                                span.exitFace]
-                : kNoTet;
+        const std::uint32_t next = loc.neighbors.present() && span.exitFace >= 0
+                                       ? loc.neighbors.across<kNative>(loc.mesh, tet, span.exitFace)
+                                       : kNoTet;
         if (next != kNoTet) {
             const exact::TetSpan s =
                 exact::clipAny<kNative>(loc.mesh, next, ray, continuous, t + eps);

@@ -59,6 +59,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     start = std::chrono::steady_clock::now();
     if (progress) progress("finding face neighbours");
     out.neighbors = buildTetNeighbors(out.tets);
+    out.neighborCodes = compactNeighbors(out.tets, out.neighbors);
     out.adjacencySeconds = secondsSince(start);
 
     if (options.partitions) {
@@ -75,6 +76,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         if (lbvh) kd.lbvh = lbvh;
         if (splitter) kd.splitter = splitter;
         out.kd = buildKdPartitions(out.tets, kd);
+        out.cellTree = buildCellTree(out.tets);
         if (options.seedGrids) {
             if (progress) progress("building seed grids");
             out.seeds = buildSeedGrids(out.tets, *out.kd);
@@ -287,6 +289,7 @@ PartitionSceneView FrameSetup::partitionScene(const PreparedMesh& mesh, bool ski
     PartitionSceneView v;
     v.base = scene(mesh);
     v.kd = mesh.kd->view();
+    v.cells = mesh.cellTree.view();
     if (mesh.seeds) v.seeds = mesh.seeds->view();
     v.shading = shading.data();
     v.skipTransparent = skip;

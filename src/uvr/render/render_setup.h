@@ -51,7 +51,13 @@ struct PrepareOptions {
 struct PreparedMesh {
     TetMesh tets;
     Bvh bvh;  ///< over all cells; empty unless PrepareOptions::meshBvh
+    /// Face neighbours as buildTetNeighbors gives them (host-side builds: macrocells).
     std::vector<std::uint32_t> neighbors;
+    /// The same neighbours in the kernels' layout (compactNeighbors).
+    CompactNeighbors neighborCodes;
+    /// With partitions: the tree of runs of consecutive cells (buildCellTree) that the partition
+    /// method searches where walks and seeds do not locate a sample.
+    Bvh cellTree;
     std::optional<KdPartitions> kd;
     std::optional<SeedGrids> seeds;  ///< per-partition walk starts (with partitions)
     /// Per-partition macrocells (with partitions): value ranges and gradient spreads finer than
@@ -71,8 +77,19 @@ struct PreparedMesh {
     std::uint64_t valueUpdates = 0;   ///< times updateFieldValues gave it new values
     double valueUpdateSeconds = 0.0;  ///< time the last updateFieldValues took
 
-    /// Point locator over this mesh.
-    TetLocator locator() const { return {tets.view(), bvh.view(), neighbors.data()}; }
+    /// The mesh as kernels read it: tetrahedra from their blocks only (tets null), points and
+    /// values only where native cells or cell data need them (what the GPU holds, too).
+    TetMeshView kernelMesh() const {
+        TetMeshView v = tets.view();
+        v.tets = nullptr;
+        if (!v.hasNative()) {
+            v.points = nullptr;
+            if (!v.cellCentered) v.values = nullptr;
+        }
+        return v;
+    }
+    /// Point locator over this mesh, as kernels use it.
+    TetLocator locator() const { return {kernelMesh(), bvh.view(), neighborCodes.view()}; }
 };
 
 /// Optional progress report: a step name ("splitting cells", ...) when a step starts.
