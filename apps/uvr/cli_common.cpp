@@ -632,6 +632,14 @@ RendererOptions RenderFlags::rendererOptions(bool withReference) const {
     return o;
 }
 
+CudaWarmUp::CudaWarmUp(const std::string& device) {
+    if (device != "cpu") startCudaWarmUp();
+}
+
+CudaWarmUp::~CudaWarmUp() {
+    finishCudaWarmUp();
+}
+
 std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
                                        const RendererOptions& options, const Context& ctx) {
     if (resolvesToCuda(options.device)) ctx.step("GPU: " + cudaDeviceDescription());
@@ -736,7 +744,11 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     const std::optional<Font> legendFont = flags.legendFont();  // before the expensive work
     const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
     auto start = Clock::now();
+    ctx.step("checking " + std::to_string(mesh.cellCount()) + " cells and " +
+             std::to_string(mesh.pointCount()) + " points");
     const ValidationReport report = validateMesh(mesh, source);
+    const double checkSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    ctx.done("checked the mesh", start);
     for (const std::string& f : report.findings()) ctx.step("validation: " + f);
     if (report.bounds.empty())
         throwError(ErrorKind::Validation, source,
@@ -885,9 +897,13 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                      {"pyramids", prepared.tets.pyramidCount},
                      {"wedges", prepared.tets.wedgeCount},
                      {"hexahedra", prepared.tets.hexCount}};
-        j["prepare_seconds"] = {{"split", prepared.splitSeconds},
+        // Every phase of the preparation, the check of the mesh first ("adjacency" is the
+        // neighbours' old name).
+        j["prepare_seconds"] = {{"check", checkSeconds},
                                 {"bvh", prepared.bvhSeconds},
                                 {"adjacency", prepared.adjacencySeconds}};
+        for (const auto& [phase, seconds] : prepared.phaseSeconds)
+            j["prepare_seconds"][phase] = seconds;
         j["render_seconds"] = result.stats.seconds;
         j["samples"] = result.stats.samples;
         j["mean_samples_per_pixel"] = result.stats.meanSamplesPerPixel();

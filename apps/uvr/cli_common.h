@@ -34,6 +34,16 @@ private:
     mutable std::string activityFile_, activity_;
 };
 
+/// Starts CUDA's initialisation in the background (startCudaWarmUp) unless --device is cpu, and
+/// waits for it when destroyed.
+class CudaWarmUp {
+public:
+    explicit CudaWarmUp(const std::string& device);
+    ~CudaWarmUp();
+    CudaWarmUp(const CudaWarmUp&) = delete;
+    CudaWarmUp& operator=(const CudaWarmUp&) = delete;
+};
+
 /// Applies a --threads value: 0 keeps the default (OMP_NUM_THREADS when set, else every hardware
 /// thread), 1 .. cpu::maxThreadCount() sets the count; anything else throws Error(Argument) naming
 /// the flag and the limit. Every command with --threads uses this one rule.

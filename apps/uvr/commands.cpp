@@ -257,6 +257,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         flags->checkFiles(*file);
         flags->checkBeforeLoading(*file);
         checkFrameMemory(*flags, ctx);
+        const CudaWarmUp cuda(flags->device);  // CUDA starts while the mesh is read
         const Mesh mesh = loadMesh(*file, ctx, *steps);
         renderAndWrite(mesh, *file, *flags, ctx);
     });

@@ -97,6 +97,11 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
             for (std::uint32_t z = lo[2]; z <= hi[2]; ++z)
                 for (std::uint32_t y = lo[1]; y <= hi[1]; ++y)
                     for (std::uint32_t x = lo[0]; x <= hi[0]; ++x) {
+                        std::uint64_t& slot =
+                            best[(std::size_t(z) * g.dims[1] + y) * g.dims[0] + x];
+                        // Every key of t is at least t: a cell whose best key is no larger
+                        // (a containing cell of smaller id) keeps it, so t is not tested there.
+                        if (slot <= t) continue;
                         const Vec3f centre(g.lo.x + (x + 0.5f) * cellSize.x,
                                            g.lo.y + (y + 0.5f) * cellSize.y,
                                            g.lo.z + (z + 0.5f) * cellSize.z);
@@ -110,8 +115,6 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
                         std::uint32_t bits;
                         std::memcpy(&bits, &dist2, sizeof bits);  // non-negative: orders as uint
                         const std::uint64_t key = (std::uint64_t(bits) << 32) | t;
-                        std::uint64_t& slot =
-                            best[(std::size_t(z) * g.dims[1] + y) * g.dims[0] + x];
                         slot = std::min(slot, key);
                     }
         }

@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <mutex>
+#include <thread>
 
 #include "uvr/core/error.h"
 #include "uvr/cuda/cuda_check.h"
@@ -129,12 +131,54 @@ __global__ void macroChoiceKernel(const PartitionGrid* grids, const PartitionSha
 }  // namespace
 }  // namespace cuda
 
+namespace {
+
+/// startCudaWarmUp's thread (joined at exit at the latest).
+struct WarmUp {
+    std::mutex mutex;
+    std::thread thread;
+    ~WarmUp() {
+        if (thread.joinable()) thread.join();
+    }
+};
+
+WarmUp& warmUp() {
+    static WarmUp w;
+    return w;
+}
+
+}  // namespace
+
+void startCudaWarmUp() {
+    WarmUp& w = warmUp();
+    const std::lock_guard<std::mutex> lock(w.mutex);
+    if (w.thread.joinable()) return;
+    try {
+        w.thread = std::thread([] {
+            // The driver's initialisation and the primary context (cudaFree(0) creates it);
+            // errors are left for the calls that need CUDA to report.
+            int count = 0;
+            if (cudaGetDeviceCount(&count) == cudaSuccess && count > 0) cudaFree(nullptr);
+            cudaGetLastError();
+        });
+    } catch (...) {  // no thread: CUDA starts when first used, as without a warm-up
+    }
+}
+
+void finishCudaWarmUp() {
+    WarmUp& w = warmUp();
+    const std::lock_guard<std::mutex> lock(w.mutex);
+    if (w.thread.joinable()) w.thread.join();
+}
+
 bool cudaDeviceAvailable() {
+    finishCudaWarmUp();
     int count = 0;
     return cudaGetDeviceCount(&count) == cudaSuccess && count > 0;
 }
 
 std::string cudaDeviceDescription() {
+    finishCudaWarmUp();
     int count = 0;
     if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) {
         cudaGetLastError();

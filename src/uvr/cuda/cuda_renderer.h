@@ -21,6 +21,16 @@ bool cudaDeviceAvailable();
 /// One line naming the CUDA device and its memory, or why there is none.
 std::string cudaDeviceDescription();
 
+/// Starts initialising CUDA (the driver and the device's context) on a background thread, so
+/// that it overlaps other work such as reading a mesh; does nothing when it runs already, when
+/// uvr was built without CUDA, or when no thread can start. Errors there are dropped: the same
+/// calls report them again where uvr first uses CUDA. cudaDeviceAvailable and
+/// cudaDeviceDescription (which every CUDA entry point of uvr calls first) wait for it.
+void startCudaWarmUp();
+
+/// Waits for startCudaWarmUp's thread when one runs (call it before the process exits).
+void finishCudaWarmUp();
+
 /// A prepared mesh resident on the GPU: geometry, BVH, neighbours and partitions are uploaded
 /// once; each render uploads only the baked transfer function and per-partition shading, so
 /// transfer-function changes never touch geometry. The PreparedMesh must outlive it.

@@ -16,6 +16,10 @@ std::string cudaDeviceDescription() {
     return "none: this uvr was built without CUDA";
 }
 
+void startCudaWarmUp() {}
+
+void finishCudaWarmUp() {}
+
 CudaScene::CudaScene(const PreparedMesh&) {
     throwError(ErrorKind::Unsupported, "",
                "--device cuda: this uvr was built without CUDA (configure with a CUDA compiler "

@@ -34,6 +34,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      : "preparing " + std::to_string(mesh.cellCount()) + " cells");
     out.tets = tetrahedralize(mesh, field, options.cells);
     out.splitSeconds = secondsSince(start);
+    out.phaseSeconds.emplace_back("split", out.splitSeconds);
 
     // The other builders (the GPU's) only where the mesh is large enough to pay.
     const bool elsewhere = out.tets.cellCount() >= options.builderMinTets;
@@ -54,6 +55,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
             out.bvh = buildBvh(boxes, centers);
         }
         out.bvhSeconds = secondsSince(start);
+        out.phaseSeconds.emplace_back("bvh", out.bvhSeconds);
     }
 
     start = std::chrono::steady_clock::now();
@@ -61,6 +63,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     out.neighbors = buildTetNeighbors(out.tets);
     out.neighborCodes = compactNeighbors(out.tets, out.neighbors);
     out.adjacencySeconds = secondsSince(start);
+    out.phaseSeconds.emplace_back("neighbours", out.adjacencySeconds);
 
     if (options.partitions) {
         if (progress)
@@ -75,17 +78,29 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                 std::max(1.0, std::round(kd.leafCells / out.tets.meanSplitTets())));
         if (lbvh) kd.lbvh = lbvh;
         if (splitter) kd.splitter = splitter;
+        start = std::chrono::steady_clock::now();
         out.kd = buildKdPartitions(out.tets, kd);
+        out.phaseSeconds.emplace_back("partitions", secondsSince(start));
+        start = std::chrono::steady_clock::now();
         out.cellTree = buildCellTree(out.tets);
+        out.phaseSeconds.emplace_back("cell_tree", secondsSince(start));
         if (options.seedGrids) {
             if (progress) progress("building seed grids");
+            start = std::chrono::steady_clock::now();
             out.seeds = buildSeedGrids(out.tets, *out.kd);
+            out.phaseSeconds.emplace_back("seed_grids", secondsSince(start));
         }
+        start = std::chrono::steady_clock::now();
         out.gradientSpread = partitionGradientSpread(out.tets, *out.kd);
+        out.phaseSeconds.emplace_back("gradient_spreads", secondsSince(start));
+        start = std::chrono::steady_clock::now();
         out.partitionNan = partitionNanFlags(out.tets, *out.kd);
+        out.phaseSeconds.emplace_back("nan_flags", secondsSince(start));
         if (options.macroGrids) {
             if (progress) progress("building macrocell grids");
+            start = std::chrono::steady_clock::now();
             out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors);
+            out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
         }
     }
     return out;

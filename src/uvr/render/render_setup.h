@@ -74,6 +74,10 @@ struct PreparedMesh {
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
     bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
+    /// Wall seconds of every phase prepareMesh ran, in order: "split", "bvh", "neighbours",
+    /// "partitions" (with their value ranges), "seed_grids", "gradient_spreads", "nan_flags",
+    /// "macrocells".
+    std::vector<std::pair<std::string, double>> phaseSeconds;
     std::uint64_t valueUpdates = 0;   ///< times updateFieldValues gave it new values
     double valueUpdateSeconds = 0.0;  ///< time the last updateFieldValues took
 
