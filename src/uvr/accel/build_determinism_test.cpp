@@ -60,7 +60,6 @@ TEST(ParallelBuild, SameResultsWithOneAndTwoThreads) {
         EXPECT_TRUE(sameBytes(a.kd->nodes, b.kd->nodes));
         EXPECT_TRUE(sameBytes(a.kd->partitions, b.kd->partitions));
         EXPECT_TRUE(sameBytes(a.kd->cells, b.kd->cells));
-        EXPECT_TRUE(sameBytes(a.kd->bvhNodes, b.kd->bvhNodes));
         // The kernels' layout: Morton order, blocks, neighbour codes, cell tree.
         EXPECT_TRUE(sameBytes(a.tets.tetSourceOrder, b.tets.tetSourceOrder));
         EXPECT_TRUE(sameBytes(a.tets.tetCorners, b.tets.tetCorners));

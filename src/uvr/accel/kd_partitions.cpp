@@ -38,7 +38,7 @@ struct Task {
     int depth;
 };
 
-/// A partition awaiting its BVH: the shrunk box and the cells.
+/// A partition awaiting its description: the shrunk box and the cells.
 struct Leaf {
     Bounds3f shrunk;
     std::vector<std::uint32_t> cells;
@@ -228,7 +228,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     kd.leafCells = options.leafCells;
     // Step 1: per-cell boxes and centres (the geometry alone decides the partitions).
     CellData data;
-    const bool needBoxes = !options.splitter || !options.lbvh;  // for the CPU's splits or SAH
+    const bool needBoxes = !options.splitter;  // for the CPU's splits
     const std::int64_t tetCount = static_cast<std::int64_t>(n);
     if (needBoxes) {
         data.boxes.resize(n), data.centers.resize(n);
@@ -297,8 +297,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     }
     kd.treeSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    // Step 5: cell-list offsets (known from the leaves) and room for at most 2 c - 1 BVH nodes
-    // per partition of c cells, reserved once (only what is written becomes resident).
+    // Step 5: cell-list offsets (known from the leaves).
     const std::int64_t leafCount =
         static_cast<std::int64_t>(tree ? tree->leafShrunk.size() : leaves.size());
     auto cellsOf = [&](std::int64_t p) -> std::span<const std::uint32_t> {
@@ -308,102 +307,24 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     };
     auto shrunkOf = [&](std::int64_t p) { return tree ? tree->leafShrunk[p] : leaves[p].shrunk; };
     kd.partitions.resize(leafCount);
-    std::uint64_t cells = 0, maxNodes = 0;
+    std::uint64_t cells = 0;
     for (std::int64_t p = 0; p < leafCount; ++p) {
         kd.partitions[p].firstCell = static_cast<std::uint32_t>(cells);
         cells += cellsOf(p).size();
-        maxNodes += std::max<std::uint64_t>(1, 2 * cellsOf(p).size());
         UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
     }
+    // Step 6: each partition's padded shrunk box and its cell list, in partition order.
     const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
-    if (options.lbvh) {
-        // Step 6, LBVH: the cell lists in partition order, then one segmented build (e.g. on the
-        // GPU) that sorts each list into its BVH's order.
-        if (!tree) kd.cells.resize(cells);
+    if (!tree) kd.cells.resize(cells);
 #pragma omp parallel for schedule(dynamic, 1)
-        for (std::int64_t p = 0; p < leafCount; ++p) {
-            describePartition(shrunkOf(p), cellsOf(p), pad, kd.partitions[p]);
-            if (tree) continue;
-            std::copy(leaves[p].cells.begin(), leaves[p].cells.end(),
-                      kd.cells.begin() + kd.partitions[p].firstCell);
-            leaves[p] = {};
-        }
-        if (tree) kd.cells = std::move(tree->leafCells);  // already in partition order
-        LbvhInput input;
-        input.mesh = &mesh;
-        input.tetIds = kd.cells;
-        input.segmentBegin.resize(leafCount + 1);
-        input.segmentBounds.resize(leafCount);
-        for (std::int64_t p = 0; p < leafCount; ++p) {
-            input.segmentBegin[p] = kd.partitions[p].firstCell;
-            input.segmentBounds[p] = kd.partitions[p].box;
-        }
-        input.segmentBegin[leafCount] = cells;
-        input.leafSize = options.bvhLeafSize;
-        LbvhResult r = options.lbvh(input);
-        std::vector<std::uint32_t> sorted(cells);
-#pragma omp parallel for schedule(static)
-        for (std::int64_t k = 0; k < static_cast<std::int64_t>(cells); ++k)
-            sorted[k] = kd.cells[r.order[k]];
-        kd.cells = std::move(sorted);
-        kd.bvhNodes = std::move(r.nodes);
-        for (std::int64_t p = 0; p < leafCount; ++p) kd.partitions[p].bvhRoot = r.roots[p];
-        computePartitionValueRanges(mesh, kd);
-        kd.buildSeconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return kd;
+    for (std::int64_t p = 0; p < leafCount; ++p) {
+        describePartition(shrunkOf(p), cellsOf(p), pad, kd.partitions[p]);
+        if (tree) continue;
+        std::copy(leaves[p].cells.begin(), leaves[p].cells.end(),
+                  kd.cells.begin() + kd.partitions[p].firstCell);
+        leaves[p] = {};
     }
-    kd.cells.resize(cells);
-    kd.bvhNodes.reserve(maxNodes);
-    // Step 6, binned SAH: batches of partitions (about kBatchCells cells each, so only one
-    // batch's BVHs are held at a time): padded shrunk boxes, whole-cell value ranges, BVHs and
-    // cell lists in BVH order in parallel, then the BVHs appended in partition order.
-    constexpr std::uint64_t kBatchCells = 1u << 22;
-    std::vector<Bvh> bvhs;
-    for (std::int64_t b0 = 0; b0 < leafCount;) {
-        std::int64_t b1 = b0;
-        for (std::uint64_t batchCells = 0; b1 < leafCount && batchCells < kBatchCells; ++b1)
-            batchCells += cellsOf(b1).size();
-        bvhs.assign(b1 - b0, Bvh{});
-#pragma omp parallel for schedule(dynamic, 1)
-        for (std::int64_t p = b0; p < b1; ++p) {
-            const std::span<const std::uint32_t> leafCells = cellsOf(p);
-            KdPartition& part = kd.partitions[p];
-            describePartition(shrunkOf(p), leafCells, pad, part);
-            const std::size_t count = leafCells.size();
-            std::vector<Bounds3f> leafBoxes(count);
-            std::vector<Vec3f> leafCenters(count);
-            for (std::size_t i = 0; i < count; ++i) {
-                leafBoxes[i] = data.boxes[leafCells[i]];
-                leafCenters[i] = data.centers[leafCells[i]];
-            }
-            Bvh& bvh = bvhs[p - b0];
-            bvh = buildBvh(leafBoxes, leafCenters, BvhBuildOptions{options.bvhLeafSize});
-            for (std::size_t i = 0; i < bvh.primIds.size(); ++i)
-                kd.cells[part.firstCell + i] = leafCells[bvh.primIds[i]];
-            bvh.primIds = {};
-            if (!tree) leaves[p] = {};
-        }
-        const std::size_t batchStart = kd.bvhNodes.size();
-        std::size_t end = batchStart;
-        for (std::int64_t p = b0; p < b1; ++p) {
-            kd.partitions[p].bvhRoot = static_cast<std::uint32_t>(end);
-            end += bvhs[p - b0].nodes.size();
-            UVR_CHECK(end < 0xffffffffull, "partition BVH nodes exceed 32-bit indices");
-        }
-        kd.bvhNodes.resize(end);
-#pragma omp parallel for schedule(dynamic, 1)
-        for (std::int64_t p = b0; p < b1; ++p) {
-            const KdPartition& part = kd.partitions[p];
-            const std::vector<BvhNode>& nodes = bvhs[p - b0].nodes;
-            for (std::size_t i = 0; i < nodes.size(); ++i) {
-                BvhNode node = nodes[i];
-                node.first += node.count > 0 ? part.firstCell : part.bvhRoot;
-                kd.bvhNodes[part.bvhRoot + i] = node;
-            }
-        }
-        b0 = b1;
-    }
+    if (tree) kd.cells = std::move(tree->leafCells);  // already in partition order
     computePartitionValueRanges(mesh, kd);
     kd.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

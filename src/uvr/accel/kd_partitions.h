@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "uvr/accel/bvh.h"
-#include "uvr/accel/lbvh.h"
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/ray.h"
@@ -34,7 +33,6 @@ struct KdPartition {
     float valueMax = 0.f;
     std::uint32_t firstCell = 0;  ///< into KdPartitions::cells
     std::uint32_t cellCount = 0;
-    std::uint32_t bvhRoot = 0;  ///< root of this partition's BVH in KdPartitions::bvhNodes
 };
 
 /// Plain-data view of the partitions for CPU and GPU kernels.
@@ -43,7 +41,6 @@ struct KdView {
     const KdPartition* partitions = nullptr;
     std::uint32_t partitionCount = 0;
     Bounds3f bounds;  ///< region of the root node
-    BvhView bvh;      ///< all partitions' BVHs; primIds are tetrahedron ids
 };
 
 /// Deepest k-d tree the builder makes (and the traversal stack holds).
@@ -198,37 +195,28 @@ using KdSplitter = std::function<KdTree(const TetMesh&, const KdBuildOptions&)>;
 struct KdBuildOptions {
     std::uint32_t leafCells = 1024;  ///< split nodes holding more cells (PERFORMANCE.md)
     int maxDepth = kKdMaxDepth;      ///< never deeper than this (at most kKdMaxDepth)
-    /// Tetrahedra per leaf of the partitions' BVHs at most: seed grids leave them few searches,
-    /// so leaves of 8 halve their memory against 4 (PERFORMANCE.md).
-    int bvhLeafSize = 8;
-    /// When set, the partitions' BVHs are LBVHs from this builder (buildLbvhCuda: on the GPU);
-    /// else binned SAH trees built on the CPU threads.
-    LbvhBuilder lbvh;
     /// When set, the k-d tree (splits, leaves and their cells) comes from this splitter
     /// (buildKdTreeCuda: on the GPU; the same partitions as the CPU's); else the CPU threads.
     KdSplitter splitter;
 };
 
 /// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its
-/// cells (a cell straddling a split goes to both sides), shrunk box, value range and a BVH over
+/// cells (a cell straddling a split goes to both sides), shrunk box and value range. (Samples
+/// the walks do not locate search the cell tree, buildCellTree: the partitions keep no BVHs.)
 /// its cells for point location restricted to the partition.
 struct KdPartitions {
     std::vector<KdNode> nodes;
     std::vector<KdPartition> partitions;
-    std::vector<std::uint32_t> cells;  ///< tetrahedron ids of every partition, in BVH order
-    std::vector<BvhNode> bvhNodes;
+    std::vector<std::uint32_t> cells;  ///< cell ids of every partition, partition by partition
     Bounds3f bounds;
     std::uint32_t leafCells = 0;  ///< the build's leaf size
     double buildSeconds = 0.0;
-    double treeSeconds = 0.0;  ///< of buildSeconds, the k-d tree (the rest: cell lists and BVHs)
+    double treeSeconds = 0.0;  ///< of buildSeconds, the k-d tree (the rest: the partitions)
 
     /// View for kernels; this object must outlive it.
     KdView view() const {
-        return {nodes.data(),
-                partitions.data(),
-                static_cast<std::uint32_t>(partitions.size()),
-                bounds,
-                {bvhNodes.data(), cells.data(), static_cast<std::uint32_t>(bvhNodes.size())}};
+        return {nodes.data(), partitions.data(), static_cast<std::uint32_t>(partitions.size()),
+                bounds};
     }
     /// Sum of cells over partitions divided by the mesh's cell count (>= 1).
     double duplicationFactor(std::uint64_t tetCount) const {
@@ -239,8 +227,8 @@ struct KdPartitions {
 /// Builds the partitions with median splits of cell centres along the longest axis of each node
 /// (Morrical et al. 2019, Sec. 2.1); O(n log n) for well-shaped meshes. A node whose split would
 /// not reduce the larger side below 90% of its cells becomes a leaf, which bounds duplication.
-/// Parallel (large nodes by data-parallel passes, then subtrees and partition BVHs one per
-/// thread) and bit-identical for any thread count.
+/// Parallel (large nodes by data-parallel passes, then subtrees one per thread) and
+/// bit-identical for any thread count.
 KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options = {});
 
 /// Sets every partition's value range: the finite minimum and maximum over its cells' values

@@ -221,19 +221,6 @@ TEST(Lbvh, EmptyMeshGivesAnEmptyTree) {
     EXPECT_TRUE(bvh.primIds.empty());
 }
 
-TEST(Lbvh, PartitionTreesHoldExactlyTheirCells) {
-    const PreparedMesh pm = prepared(jitteredGrid(8), /*lbvh=*/true, /*partitions=*/true);
-    const KdPartitions& kd = *pm.kd;
-    ASSERT_GT(kd.partitions.size(), 8u);
-    for (const KdPartition& p : kd.partitions) {
-        if (p.cellCount == 0) continue;
-        const std::vector<std::uint32_t> reached =
-            checkTree(pm.tets, kd.bvhNodes, kd.cells, p.bvhRoot, 8);
-        ASSERT_EQ(reached.size(), p.cellCount);
-        for (std::uint32_t k = 0; k < p.cellCount; ++k) ASSERT_EQ(reached[k], p.firstCell + k);
-    }
-}
-
 TEST(Lbvh, RendersMatchThoseWithSahTrees) {
     // Same mesh, same partitions, only the BVHs differ: a sample on a face shared by two cells may
     // resolve to either, so images agree to rounding.

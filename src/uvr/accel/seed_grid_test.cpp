@@ -60,7 +60,7 @@ TEST(SeedGrid, EmptyCellsHoldNoTetrahedronAndSeedsLeadToThePoint) {
             ASSERT_NE(s, kNoTet) << "partition " << p << ": a cell contains the point";
             LocateCounters c;
             float bary[4];
-            const std::uint32_t found = loc.locateIn(kd.view().bvh, part.bvhRoot, x, s, bary, c);
+            const std::uint32_t found = loc.locateIn(pm.cellTree.view(), 0, x, s, bary, c);
             ASSERT_NE(found, kNoTet);
             EXPECT_TRUE(contains(loc, found, x));
             walked += c.bvhQueries == 0;

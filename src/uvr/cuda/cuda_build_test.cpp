@@ -54,21 +54,28 @@ TEST(CudaLbvh, MeshTreeIsBitIdenticalToTheCpuBuild) {
     }
 }
 
-TEST(CudaLbvh, PartitionTreesAreBitIdenticalToTheCpuBuild) {
+TEST(CudaLbvh, SegmentedTreesAreBitIdenticalToTheCpuBuild) {
     UVR_REQUIRE_GPU();
+    // One tree per k-d partition's cells: many segments of the one build.
     const TetMesh mesh = proceduralTets(200000);
     KdBuildOptions o;
     o.leafCells = 4096;
-    o.lbvh = buildLbvhCpu;
-    const KdPartitions cpu = buildKdPartitions(mesh, o);
-    o.lbvh = buildLbvhCuda;
-    const KdPartitions gpu = buildKdPartitions(mesh, o);
-    ASSERT_GT(cpu.partitions.size(), 16u);
-    EXPECT_TRUE(sameNodes(cpu.bvhNodes, gpu.bvhNodes));
-    EXPECT_EQ(cpu.cells, gpu.cells);
-    ASSERT_EQ(cpu.partitions.size(), gpu.partitions.size());
-    for (std::size_t p = 0; p < cpu.partitions.size(); ++p)
-        ASSERT_EQ(cpu.partitions[p].bvhRoot, gpu.partitions[p].bvhRoot) << p;
+    const KdPartitions kd = buildKdPartitions(mesh, o);
+    ASSERT_GT(kd.partitions.size(), 16u);
+    LbvhInput in;
+    in.mesh = &mesh;
+    in.tetIds = kd.cells;
+    for (const KdPartition& p : kd.partitions) {
+        in.segmentBegin.push_back(p.firstCell);
+        in.segmentBounds.push_back(p.box);
+    }
+    in.segmentBegin.push_back(kd.cells.size());
+    in.leafSize = 8;
+    const LbvhResult cpu = buildLbvhCpu(in);
+    const LbvhResult gpu = buildLbvhCuda(in);
+    EXPECT_TRUE(sameNodes(cpu.nodes, gpu.nodes));
+    EXPECT_EQ(cpu.order, gpu.order);
+    EXPECT_EQ(cpu.roots, gpu.roots);
 }
 
 /// The partitions as a comparable set: (shrunk box, value range, cells in order) by box.
@@ -94,7 +101,6 @@ TEST(CudaKd, SameSplitsLeavesAndCellsAsTheCpuBuild) {
         for (const std::uint32_t leafCells : {64u, 4096u}) {
             KdBuildOptions o;
             o.leafCells = leafCells;
-            o.lbvh = buildLbvhCpu;  // the same BVHs either way: the cells come out in BVH order
             const KdPartitions cpu = buildKdPartitions(mesh, o);
             o.splitter = buildKdTreeCuda;
             const KdPartitions gpu = buildKdPartitions(mesh, o);

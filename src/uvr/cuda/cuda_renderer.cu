@@ -450,7 +450,6 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
         scene.base = d.deviceScene(result.setup);
         scene.kd.nodes = d.kdNodes.data();
         scene.kd.partitions = d.partitions.data();
-        scene.kd.bvh = {};
         scene.cells.nodes = d.cellTreeNodes.data();
         scene.shading = d.shading.data();
         if (d.macroActive) scene.macro = {d.macroGrids.data(), d.macroShading.data()};

@@ -88,11 +88,11 @@ TEST(NativeCells, HexahedraStayWholeAndCostLessThanTheirSplit) {
     EXPECT_NEAR(native.tets.totalVolume, split.tets.totalVolume, 1e-9);
     // The same default step: a native mesh samples as its split does.
     EXPECT_EQ(defaultStep(native.tets), defaultStep(split.tets));
-    // Geometry per cell: corners, neighbours, partition cell lists, BVH nodes.
+    // Geometry per cell: corners, neighbours, partition cell lists, trees.
     auto bytes = [](const PreparedMesh& p) {
         return p.tets.tets.size() * sizeof(Tet) + p.tets.nativeCorners.size() * 4 +
                p.neighbors.size() * 4 + p.kd->cells.size() * 4 +
-               p.kd->bvhNodes.size() * sizeof(BvhNode) + p.bvh.nodes.size() * sizeof(BvhNode) +
+               p.cellTree.nodes.size() * sizeof(BvhNode) + p.bvh.nodes.size() * sizeof(BvhNode) +
                p.bvh.primIds.size() * 4;
     };
     const double perHex = double(bytes(native)) / 512.0, perSplit = double(bytes(split)) / 512.0;

@@ -168,30 +168,34 @@ TEST(Renderer, SetFieldValuesGivesTheFramesOfAFreshPreparationWithoutRebuilding)
         ASSERT_TRUE(p.kd && p.seeds && p.macro);
         // The geometric structures: their contents and their memory, before the update.
         const PreparedMesh before = prepareMesh(m0, f0, o.prepareOptions());
-        const void* addresses[] = {p.tets.tets.data(),    p.tets.points.data(),
-                                   p.bvh.nodes.data(),    p.neighbors.data(),
-                                   p.kd->nodes.data(),    p.kd->cells.data(),
-                                   p.kd->bvhNodes.data(), p.seeds->seeds.data(),
-                                   p.macro->grids.data(), p.macro->cells.data()};
+        const void* addresses[] = {p.tets.tets.data(),      p.tets.points.data(),
+                                   p.bvh.nodes.data(),      p.neighbors.data(),
+                                   p.kd->nodes.data(),      p.kd->cells.data(),
+                                   p.cellTree.nodes.data(), p.seeds->seeds.data(),
+                                   p.macro->grids.data(),   p.macro->cells.data()};
         const double buildSeconds = p.kd->buildSeconds;
         r.setFieldValues(f1);
         EXPECT_EQ(p.valueUpdates, 1u);
         EXPECT_GE(p.valueUpdateSeconds, 0.0);
-        const void* after[] = {p.tets.tets.data(),    p.tets.points.data(),  p.bvh.nodes.data(),
-                               p.neighbors.data(),    p.kd->nodes.data(),    p.kd->cells.data(),
-                               p.kd->bvhNodes.data(), p.seeds->seeds.data(), p.macro->grids.data(),
-                               p.macro->cells.data()};
+        const void* after[] = {p.tets.tets.data(),      p.tets.points.data(),
+                               p.bvh.nodes.data(),      p.neighbors.data(),
+                               p.kd->nodes.data(),      p.kd->cells.data(),
+                               p.cellTree.nodes.data(), p.seeds->seeds.data(),
+                               p.macro->grids.data(),   p.macro->cells.data()};
         for (std::size_t i = 0; i < std::size(addresses); ++i)
             EXPECT_EQ(addresses[i], after[i]) << spec << ": array " << i << " was reallocated";
         EXPECT_EQ(p.kd->buildSeconds, buildSeconds);
         EXPECT_TRUE(sameBits(p.tets.tets, before.tets.tets));
         EXPECT_TRUE(sameBits(p.bvh.nodes, before.bvh.nodes));
         EXPECT_TRUE(sameBits(p.kd->cells, before.kd->cells));
-        EXPECT_TRUE(sameBits(p.kd->bvhNodes, before.kd->bvhNodes));
+        EXPECT_TRUE(sameBits(p.cellTree.nodes, before.cellTree.nodes));
+        EXPECT_TRUE(sameBits(p.tets.tetCorners, before.tets.tetCorners));
+        EXPECT_TRUE(sameBits(p.neighborCodes.tetCodes, before.neighborCodes.tetCodes));
         EXPECT_TRUE(sameBits(p.seeds->seeds, before.seeds->seeds));
         // The value-dependent structures equal a fresh preparation's, bit for bit.
         const PreparedMesh fresh = prepareMesh(m1, f1, o.prepareOptions());
         EXPECT_TRUE(sameBits(p.tets.values, fresh.tets.values)) << spec;
+        EXPECT_TRUE(sameBits(p.tets.blockVertices, fresh.tets.blockVertices)) << spec;
         EXPECT_EQ(p.tets.valueMin, fresh.tets.valueMin) << spec;
         EXPECT_EQ(p.tets.valueMax, fresh.tets.valueMax) << spec;
         EXPECT_TRUE(sameBits(p.kd->partitions, fresh.kd->partitions)) << spec;

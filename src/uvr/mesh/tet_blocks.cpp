@@ -164,23 +164,36 @@ void encodeTetBlocks(TetMesh& mesh) {
     const std::int64_t blocks = static_cast<std::int64_t>((n + kTetBlockSize - 1) / kTetBlockSize);
     const bool pointValues =
         mesh.association == Association::Point && mesh.values.size() == mesh.points.size();
-    // Per block: its distinct points in ascending order, and each corner's index among them.
+    // Per block: its distinct points in the order its corners first name them (an open-addressing
+    // table of 2^16 slots per thread: at most 32768 points, so it is never more than half full),
+    // and each corner's index among them.
     std::vector<std::vector<std::uint32_t>> lists(blocks);
     mesh.tetCorners.resize(n);
-#pragma omp parallel for schedule(dynamic, 4)
-    for (std::int64_t b = 0; b < blocks; ++b) {
-        const std::uint64_t first = std::uint64_t(b) * kTetBlockSize;
-        const std::uint64_t end = std::min<std::uint64_t>(n, first + kTetBlockSize);
-        std::vector<std::uint32_t>& ids = lists[b];
-        ids.reserve(4 * (end - first));
-        for (std::uint64_t t = first; t < end; ++t)
-            ids.insert(ids.end(), mesh.tets[t].v, mesh.tets[t].v + 4);
-        std::sort(ids.begin(), ids.end());
-        ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-        for (std::uint64_t t = first; t < end; ++t)
-            for (int k = 0; k < 4; ++k)
-                mesh.tetCorners[t].v[k] = static_cast<std::uint16_t>(
-                    std::lower_bound(ids.begin(), ids.end(), mesh.tets[t].v[k]) - ids.begin());
+#pragma omp parallel
+    {
+        constexpr std::uint32_t kSlots = 1u << 16, kEmpty = 0xffffffffu;
+        std::vector<std::uint32_t> keys(kSlots);
+        std::vector<std::uint16_t> local(kSlots);
+#pragma omp for schedule(dynamic, 4)
+        for (std::int64_t b = 0; b < blocks; ++b) {
+            std::fill(keys.begin(), keys.end(), kEmpty);
+            const std::uint64_t first = std::uint64_t(b) * kTetBlockSize;
+            const std::uint64_t end = std::min<std::uint64_t>(n, first + kTetBlockSize);
+            std::vector<std::uint32_t>& ids = lists[b];
+            for (std::uint64_t t = first; t < end; ++t)
+                for (int k = 0; k < 4; ++k) {
+                    const std::uint32_t id = mesh.tets[t].v[k];
+                    std::uint32_t slot = (id * 2654435761u) >> 16;
+                    while (keys[slot] != kEmpty && keys[slot] != id)
+                        slot = (slot + 1) & (kSlots - 1);
+                    if (keys[slot] == kEmpty) {
+                        keys[slot] = id;
+                        local[slot] = static_cast<std::uint16_t>(ids.size());
+                        ids.push_back(id);
+                    }
+                    mesh.tetCorners[t].v[k] = local[slot];
+                }
+        }
     }
     mesh.blockVertexBase.assign(blocks + 1, 0);
     std::uint64_t total = 0;

@@ -76,7 +76,6 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         if (out.tets.hasNative())
             kd.leafCells = static_cast<std::uint32_t>(
                 std::max(1.0, std::round(kd.leafCells / out.tets.meanSplitTets())));
-        if (lbvh) kd.lbvh = lbvh;
         if (splitter) kd.splitter = splitter;
         start = std::chrono::steady_clock::now();
         out.kd = buildKdPartitions(out.tets, kd);

@@ -12,6 +12,7 @@
 
 #include "uvr/accel/bvh.h"
 #include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/lbvh.h"
 #include "uvr/accel/macro_grid.h"
 #include "uvr/accel/seed_grid.h"
 #include "uvr/mesh/field_select.h"
@@ -34,9 +35,8 @@ struct PrepareOptions {
     bool macroGrids = true;       ///< with partitions: the macrocells the error-bound rule steps by
     TetrahedralizeOptions cells;  ///< native cells or the split into tetrahedra
     KdBuildOptions kd;
-    /// When set, the mesh BVH and the partitions' BVHs are LBVHs from this builder
-    /// (buildLbvhCuda: on the GPU, in seconds for 100M+ tetrahedra); else binned SAH trees built
-    /// on the CPU threads. It overrides kd.lbvh.
+    /// When set, the mesh BVH is an LBVH from this builder (buildLbvhCuda: on the GPU, in
+    /// seconds for 100M+ tetrahedra); else a binned SAH tree built on the CPU threads.
     LbvhBuilder lbvh;
     /// When set, the k-d tree comes from this splitter (buildKdTreeCuda: on the GPU); it
     /// overrides kd.splitter.
