@@ -672,7 +672,9 @@ std::uint64_t proceduralStreamBytes(const ProceduralSpec& spec) {
     const std::uint64_t points = (layers + 1) * layerPoints * sizeof(Vec3f);
     const std::uint64_t values = layers * layerPoints * sizeof(float);
     const std::uint64_t indices = layers * 6ull * block.nx * block.ny * 4 * sizeof(std::uint32_t);
-    return points + std::max(values, indices) + (1ull << 20) * (1 + sizeof(std::uint64_t));
+    const std::uint64_t typesAndOffsets =
+        std::min<std::uint64_t>(1ull << 20, block.cellCount() + 1) * (1 + sizeof(std::uint64_t));
+    return points + std::max(values, indices) + typesAndOffsets;
 }
 
 std::uint64_t proceduralTetCount(const ProceduralSpec& spec) {

@@ -351,11 +351,12 @@ std::uint64_t refineMemoryBytes(const Mesh& mesh, std::uint64_t tets, int levels
         return inBytes + outTets * (41 + 4 * cellComps) + outPoints * (12 + 4 * pointComps) +
                8 * tets;
     // Streamed: the last level's input (tetrahedra and the unsorted edge buckets, 16 + 24 bytes
-    // each; its points with their fields and 20 bytes of edge tables), the pieces written, and
-    // before it the levels refined in memory (each at most 18 bytes per tetrahedron it makes).
+    // each; its points with their fields and 20 bytes of edge tables) and the pieces written
+    // (children with their cell fields, midpoints); the levels refined in memory before it need
+    // less (about 21 bytes per tetrahedron they make).
     const std::uint64_t lastTets = outTets / 8, lastPoints = mesh.pointCount() + lastTets / 4;
     return inBytes + 8 * tets + lastTets * 40 + lastPoints * (32 + 4 * pointComps) +
-           kRefinePieceTets * 8 * (16 + 4 * cellComps) + outPoints / 8 * 4 * pointComps;
+           std::min(kRefinePieceTets, lastTets) * (8 * (16 + 4 * cellComps) + 12 + 4 * pointComps);
 }
 
 Mesh refineMesh(const Mesh& mesh, int levels,

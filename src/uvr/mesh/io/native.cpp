@@ -7,6 +7,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <type_traits>
 #include <vector>
@@ -419,6 +420,23 @@ NativeWriter::NativeWriter(const std::string& path, std::uint64_t pointCount,
     total_ = head.size();
     for (size_t a = 0; a < counts_.size(); ++a)
         total_ += counts_[a] * (a < kFirstField ? wordBytes[a] : 4);
+    // A file of many gigabytes is refused at once when its file system cannot hold it (the
+    // space of a file it replaces counts, since the old one goes only at the rename).
+    const OutputTarget target = resolveOutput(path);
+    if (target.kind == OutputKind::Atomic) {
+        std::error_code ec;
+        const auto space =
+            std::filesystem::space(std::filesystem::path(target.target).parent_path().empty()
+                                       ? std::filesystem::path(".")
+                                       : std::filesystem::path(target.target).parent_path(),
+                                   ec);
+        if (!ec && space.available < total_)
+            throwError(ErrorKind::Io, path,
+                       "the file needs " + std::to_string(total_) +
+                           " bytes, but its file system "
+                           "has only " +
+                           std::to_string(space.available) + " available");
+    }
     file_ = std::make_unique<OutputFile>(path);
     put(head.data(), head.size());
 }
@@ -457,6 +475,7 @@ void NativeWriter::append(int array, const void* data, std::uint64_t count, size
         auto full = [&](int a) { return (a == current_ ? written_ : 0) == counts_[a]; };
         while (count > 0 && array + 1 < int(counts_.size()) && full(array)) ++array;
     }
+    UVR_CHECK(array < int(counts_.size()), "NativeWriter: values for a field of none");
     advanceTo(array);
     UVR_CHECK(current_ == array && written_ + count <= counts_[array],
               "NativeWriter: " << count << " values for array " << array << " (now writing "

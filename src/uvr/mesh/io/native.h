@@ -49,7 +49,8 @@ class OutputFile;
 class NativeWriter {
 public:
     /// Opens the temporary output and writes the header and field descriptors; throws
-    /// Error(Argument) for a field name over 65535 bytes or more than 2^32 - 1 fields.
+    /// Error(Argument) for a field name over 65535 bytes or more than 2^32 - 1 fields, and
+    /// Error(Io) when the file system has less space available than the file's size.
     NativeWriter(const std::string& path, std::uint64_t pointCount, std::uint64_t cellCount,
                  std::uint64_t indexCount, const std::vector<FieldInfo>& fields,
                  std::function<void(double)> progress = {});
