@@ -667,7 +667,9 @@ void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint6
     throwError(ErrorKind::Resource, "",
                what + " would need about " + std::to_string(bytes) +
                    " bytes, more than the --max-memory limit of " +
-                   std::to_string(ctx.maxMemoryBytes) + " bytes");
+                   std::to_string(ctx.maxMemoryBytes) + " bytes" +
+                   (ctx.maxMemoryDefault.empty() ? std::string()
+                                                 : " (the default: " + ctx.maxMemoryDefault + ")"));
 }
 
 std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames) {

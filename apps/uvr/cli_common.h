@@ -18,6 +18,8 @@ class Context {
 public:
     bool quiet = false;
     std::uint64_t maxMemoryBytes = 0;  ///< a whole load, image buffers, meshes; 0 = no limit
+    /// How the default limit was found (MemoryDefault::how); empty when --max-memory was given.
+    std::string maxMemoryDefault;
     /// Prints a step message (control characters and invalid UTF-8 escaped: one line).
     void step(const std::string& message) const;
     /// Prints "uvr: warning: MESSAGE", also when quiet: the command goes on and exits 0.

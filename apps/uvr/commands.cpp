@@ -337,7 +337,10 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
 }
 
 void addGenerateCommand(CLI::App& app, Context& ctx) {
-    auto* cmd = app.add_subcommand("generate", "Write a procedural mesh");
+    auto* cmd = app.add_subcommand(
+        "generate",
+        "Write a procedural mesh (a .uvrm is written slab by slab as it is generated, in a few "
+        "hundred MB of memory whatever --cells)");
     auto shape = std::make_shared<std::string>("box");
     auto out = std::make_shared<std::string>();
     auto spec = std::make_shared<ProceduralSpec>();
@@ -491,7 +494,7 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
         "refine",
         "Split every tetrahedron into 8 at its edge midpoints, --levels times (non-tetrahedral "
         "cells are split into tetrahedra first); point fields are interpolated, cell fields "
-        "copied");
+        "copied; a .uvrm OUT is written as the last level is made, never held whole");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     auto levels = std::make_shared<int>(1);

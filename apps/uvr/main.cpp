@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
         cli::capEnvironmentThreads();
         ctx.maxMemoryBytes =
             maxMemory.empty() ? memoryDefault.bytes : cli::parseBytes("--max-memory", maxMemory);
+        if (maxMemory.empty()) ctx.maxMemoryDefault = memoryDefault.how;
     });
     cli::addInfoCommand(app, ctx);
     cli::addRenderCommand(app, ctx);
