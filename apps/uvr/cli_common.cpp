@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "progress.h"
+#include "uvr/core/host_memory.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 
@@ -158,10 +159,21 @@ std::uint64_t parseBytes(const std::string& flag, const std::string& text) {
     return value * scale;
 }
 
-std::uint64_t defaultMaxMemory() {
+MemoryDefault defaultMaxMemory() {
     const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGESIZE);
-    if (pages <= 0 || pageSize <= 0) return 0;
-    return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 10 * 8;
+    const std::uint64_t sysconfBytes =
+        pages > 0 && pageSize > 0
+            ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize)
+            : 0;
+    const HostMemory host = detectHostMemory("/", sysconfBytes);
+    if (host.bytes == 0) return {0, "no limit: the physical memory could not be read"};
+    auto gib = [](std::uint64_t bytes) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(1ull << 30));
+        return std::string(text);
+    };
+    const std::uint64_t bytes = host.bytes / 10 * 8;
+    return {bytes, gib(bytes) + " = 80% of " + gib(host.bytes) + " (" + host.source + ")"};
 }
 
 Vec3f parseVec3(const std::string& flag, const std::string& text) {
@@ -663,7 +675,9 @@ void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint6
     throwError(ErrorKind::Resource, "",
                what + " would need about " + std::to_string(bytes) +
                    " bytes, more than the --max-memory limit of " +
-                   std::to_string(ctx.maxMemoryBytes) + " bytes");
+                   std::to_string(ctx.maxMemoryBytes) + " bytes" +
+                   (ctx.maxMemoryDefault.empty() ? std::string()
+                                                 : " (the default: " + ctx.maxMemoryDefault + ")"));
 }
 
 std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames) {

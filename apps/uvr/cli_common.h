@@ -18,6 +18,8 @@ class Context {
 public:
     bool quiet = false;
     std::uint64_t maxMemoryBytes = 0;  ///< a whole load, image buffers, meshes; 0 = no limit
+    /// How the default limit was found (MemoryDefault::how); empty when --max-memory was given.
+    std::string maxMemoryDefault;
     /// Prints a step message (control characters and invalid UTF-8 escaped: one line).
     void step(const std::string& message) const;
     /// Prints "uvr: warning: MESSAGE", also when quiet: the command goes on and exits 0.
@@ -63,8 +65,15 @@ std::string jsonText(const nlohmann::json& j);
 /// Parses a byte count with an optional K, M, G or T suffix (powers of 1024) for a flag.
 std::uint64_t parseBytes(const std::string& flag, const std::string& text);
 
-/// The default --max-memory: 80% of the machine's physical memory.
-std::uint64_t defaultMaxMemory();
+/// The default --max-memory and how it was found.
+struct MemoryDefault {
+    std::uint64_t bytes = 0;  ///< 0: no limit (nothing credible was found)
+    std::string how;          ///< e.g. "80% of 128 GiB (1024 memory blocks of 128 MiB in ...)"
+};
+
+/// The default --max-memory: 80% of the machine's physical memory as detectHostMemory finds it
+/// (the larger of MemTotal and the hot-pluggable memory blocks, capped by a cgroup limit).
+MemoryDefault defaultMaxMemory();
 
 /// Parses "x,y,z" for a flag; throws Error(Argument) naming the flag.
 Vec3f parseVec3(const std::string& flag, const std::string& text);

@@ -46,9 +46,14 @@ TEST(CliLimits, ImageBuffersAboveMaxMemoryAreRefusedBeforeLoading) {
 
 TEST(CliLimits, GeneratedMeshesAboveMaxMemoryAreRefusedBeforeGenerating) {
     const std::string dir = testing::scratchDir();
-    expectOneLineError(uvr("-q generate --cells 4000000000 -o g.uvrm --max-memory 1G", dir),
+    // A .vtu is built whole first; a .uvrm is written slab by slab (the slabs must fit).
+    expectOneLineError(uvr("-q generate --cells 4000000000 -o g.vtu --max-memory 1G", dir),
                        {"--cells 4000000000: the mesh of ", " tetrahedra would need about ",
                         "more than the --max-memory limit of 1073741824 bytes"});
+    expectOneLineError(uvr("-q generate --cells 4000000000 -o g.uvrm --max-memory 10M", dir),
+                       {"--cells 4000000000: the slabs of ", " tetrahedra would need about ",
+                        "more than the --max-memory limit of 10485760 bytes"});
+    EXPECT_FALSE(std::filesystem::exists(dir + "/g.vtu"));
     expectOneLineError(uvr("-q demo --cells 2000000000 -o d.png --max-memory 1G", dir),
                        {"--cells 2000000000 --size 1024x1024: generating, preparing and rendering",
                         "more than the --max-memory limit of 1073741824 bytes"});

@@ -338,7 +338,10 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
 }
 
 void addGenerateCommand(CLI::App& app, Context& ctx) {
-    auto* cmd = app.add_subcommand("generate", "Write a procedural mesh");
+    auto* cmd = app.add_subcommand(
+        "generate",
+        "Write a procedural mesh (a .uvrm is written slab by slab as it is generated, in a few "
+        "hundred MB of memory whatever --cells)");
     auto shape = std::make_shared<std::string>("box");
     auto out = std::make_shared<std::string>();
     auto spec = std::make_shared<ProceduralSpec>();
@@ -409,11 +412,25 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
             spec->fields.clear();
             for (const std::string& f : *fields) spec->fields.push_back(parseProceduralField(f));
         }
+        // One .uvrm: written slab by slab as it is generated, never held whole.
+        const bool stream = *steps == 1 && fileExtension(*out) == ".uvrm";
         checkMemoryEstimate(ctx,
-                            "--cells " + std::to_string(spec->targetCells) + ": the mesh of " +
+                            "--cells " + std::to_string(spec->targetCells) + ": " +
+                                (stream ? "the slabs of " : "the mesh of ") +
                                 std::to_string(proceduralTetCount(*spec)) + " tetrahedra",
-                            proceduralMeshBytes(*spec));
+                            stream ? proceduralStreamBytes(*spec) : proceduralMeshBytes(*spec));
         ctx.setActivity(*out, "generating the mesh");
+        if (stream) {
+            Progress progress(ctx,
+                              "generating " + std::string(proceduralShapeName(spec->shape)) +
+                                  " with about " + std::to_string(spec->targetCells) +
+                                  " tetrahedra into " + *out,
+                              double(spec->targetCells), "tetrahedra");
+            writeProceduralNative(*spec, *out, progress.callback());
+            progress.done("wrote " + *out + " (" + std::to_string(proceduralTetCount(*spec)) +
+                          " tetrahedra)");
+            return;
+        }
         Progress progress(ctx,
                           "generating " + std::string(proceduralShapeName(spec->shape)) +
                               " with about " + std::to_string(spec->targetCells) + " tetrahedra",
@@ -478,7 +495,7 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
         "refine",
         "Split every tetrahedron into 8 at its edge midpoints, --levels times (non-tetrahedral "
         "cells are split into tetrahedra first); point fields are interpolated, cell fields "
-        "copied");
+        "copied; a .uvrm OUT is written as the last level is made, never held whole");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     auto levels = std::make_shared<int>(1);
@@ -502,13 +519,23 @@ void addRefineCommand(CLI::App& app, Context& ctx) {
         for (CellType t : mesh.cellTypes)
             tets += t == CellType::Tetra ? 1 : (t == CellType::Hexahedron ? 6 : 3);
         const std::uint64_t outTets = refinedTetCount(tets, *levels);
-        const std::uint64_t bytes = refineMemoryBytes(mesh, tets, *levels);
+        // A .uvrm output is written as the last level is made, never held whole.
+        const bool stream = fileExtension(*out) == ".uvrm";
+        const std::uint64_t bytes = refineMemoryBytes(mesh, tets, *levels, stream);
         checkMemoryEstimate(ctx,
                             *in + ": refining " + std::to_string(tets) + " tetrahedra " +
                                 std::to_string(*levels) + " times (about " +
                                 std::to_string(outTets) + " tetrahedra)",
                             bytes);
         ctx.setActivity(*in, "refining the mesh");
+        if (stream) {
+            Progress progress(ctx, "refining into " + *out, double(outTets), "tetrahedra");
+            refineToNative(
+                mesh, *levels, *out, [&](const std::string& s) { ctx.step(s); },
+                progress.callback());
+            progress.done("wrote " + *out + " (" + std::to_string(outTets) + " tetrahedra)");
+            return;
+        }
         Progress progress(ctx, "refining", double(outTets), "tetrahedra");
         const Mesh refined = refineMesh(
             mesh, *levels, [&](const std::string& s) { ctx.step(s); }, progress.callback());

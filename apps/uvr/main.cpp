@@ -22,15 +22,18 @@ int main(int argc, char** argv) {
     cli::Context ctx;
     app.add_flag("-q,--quiet", ctx.quiet, "No progress messages on stderr");
     std::string maxMemory;
+    const cli::MemoryDefault memoryDefault = cli::defaultMaxMemory();
     app.add_option("--max-memory", maxMemory,
-                   "Memory limit, e.g. 16G (default: 80% of physical memory): the most a file "
-                   "load holds in all (its arrays, pieces and file buffers), and the estimated "
-                   "image buffers of --size and meshes of --cells; larger needs are refused "
-                   "before allocating");
+                   "Memory limit, e.g. 16G (default: 80% of physical memory, here " +
+                       memoryDefault.how +
+                       "): the most a file load holds in all (its arrays, pieces and file "
+                       "buffers), and the estimated image buffers of --size and meshes of "
+                       "--cells; larger needs are refused before allocating");
     app.parse_complete_callback([&] {
         cli::capEnvironmentThreads();
-        ctx.maxMemoryBytes = maxMemory.empty() ? cli::defaultMaxMemory()
-                                               : cli::parseBytes("--max-memory", maxMemory);
+        ctx.maxMemoryBytes =
+            maxMemory.empty() ? memoryDefault.bytes : cli::parseBytes("--max-memory", maxMemory);
+        if (maxMemory.empty()) ctx.maxMemoryDefault = memoryDefault.how;
     });
     cli::addInfoCommand(app, ctx);
     cli::addRenderCommand(app, ctx);

@@ -3,14 +3,17 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <sstream>
 
 #include "uvr/core/error.h"
 #include "uvr/mesh/cell_math.h"
+#include "uvr/mesh/io/native.h"
 
 namespace uvr {
 
@@ -201,38 +204,6 @@ struct Block {
     }
 };
 
-/// Fills the mesh's cells with the Kuhn split of every cube of the block (reserved exactly; no
-/// per-cell allocation) and checks that every tetrahedron has positive volume.
-void emitKuhnCells(const Block& block, Mesh& mesh, ProgressReporter& progress) {
-    const std::uint64_t cells = block.cellCount();
-    mesh.cellTypes.assign(cells, CellType::Tetra);
-    mesh.cellOffsets.resize(cells + 1);
-    for (std::uint64_t c = 0; c <= cells; ++c) mesh.cellOffsets[c] = 4 * c;
-    mesh.cellIndices.resize(4 * cells);
-    const auto templates = kuhnTemplates();
-    std::uint32_t* out = mesh.cellIndices.data();
-    const Vec3f* pts = mesh.points.data();
-    for (std::uint32_t k = 0; k < block.nz; ++k) {
-        for (std::uint32_t j = 0; j < block.ny; ++j) {
-            for (std::uint32_t i = 0; i < block.nx; ++i) {
-                std::uint32_t corner[8];
-                for (int b = 0; b < 8; ++b)
-                    corner[b] = block.pointIndex(i + (b & 1), j + ((b >> 1) & 1), k + (b >> 2));
-                for (const TetTemplate& t : templates) {
-                    for (int v = 0; v < 4; ++v) out[v] = corner[t[v]];
-                    const double volume =
-                        signedVolume(pts[out[0]], pts[out[1]], pts[out[2]], pts[out[3]]);
-                    UVR_CHECK(volume > 0.0, "procedural tetrahedron "
-                                                << (out - mesh.cellIndices.data()) / 4
-                                                << " has volume " << volume);
-                    out += 4;
-                }
-            }
-            progress.advance(6.0 * block.nx);
-        }
-    }
-}
-
 /// Grid coordinates along one axis of the Box/Graded shapes and the jitter scale of each: the
 /// smaller of the two neighbouring spacings (0 at the ends, which stay on the boundary).
 struct AxisSamples {
@@ -294,71 +265,183 @@ Block proceduralBlock(const ProceduralSpec& spec) {
                  true};
 }
 
-void generateBox(const ProceduralSpec& spec, bool graded, Mesh& mesh, ProgressReporter& progress) {
-    const Block block = proceduralBlock(spec);
-    const std::uint32_t n = block.nx;
-    checkPointCount(block, spec);
-    const AxisSamples axis = axisSamples(n, graded);
-    mesh.points.resize(block.pointCount());
-    std::uint64_t index = 0;
-    for (std::uint32_t k = 0; k <= n; ++k) {
-        for (std::uint32_t j = 0; j <= n; ++j) {
-            for (std::uint32_t i = 0; i <= n; ++i, ++index) {
-                // Boundary coordinates have jitterScale 0, so faces stay planar.
-                const Vec3f d = unitBallSample(spec.seed, index);
-                mesh.points[index] = {
-                    static_cast<float>(axis.coord[i] + spec.jitter * axis.jitterScale[i] * d.x),
-                    static_cast<float>(axis.coord[j] + spec.jitter * axis.jitterScale[j] * d.y),
-                    static_cast<float>(axis.coord[k] + spec.jitter * axis.jitterScale[k] * d.z)};
+/// The points of a Box, Graded or Shell grid, each computed from its index alone (so that a file
+/// can be written slab by slab without holding them): point i + pointsX (j + pointsY k).
+class GridPoints {
+public:
+    explicit GridPoints(const ProceduralSpec& spec) : spec_(spec), block_(proceduralBlock(spec)) {
+        checkPointCount(block_, spec);
+        if (spec.shape != ProceduralShape::Shell)
+            axis_ = axisSamples(block_.nx, spec.shape == ProceduralShape::Graded);
+    }
+    const Block& block() const { return block_; }
+    /// Points per layer of constant k.
+    std::uint64_t layerPoints() const { return block_.pointsX() * block_.pointsY(); }
+
+    /// Points [begin, end) into out, in parallel.
+    void fill(std::uint64_t begin, std::uint64_t end, Vec3f* out) const {
+#pragma omp parallel for schedule(static)
+        for (std::int64_t i = std::int64_t(begin); i < std::int64_t(end); ++i)
+            out[std::uint64_t(i) - begin] = at(std::uint64_t(i));
+    }
+
+    Vec3f at(std::uint64_t index) const {
+        const std::uint64_t i = index % block_.pointsX(), j = index / block_.pointsX();
+        const std::uint64_t k = j / block_.pointsY();
+        return spec_.shape == ProceduralShape::Shell ? shellPoint(index, i, j % block_.pointsY(), k)
+                                                     : boxPoint(index, i, j % block_.pointsY(), k);
+    }
+
+private:
+    /// Box and Graded: boundary coordinates have jitterScale 0, so faces stay planar.
+    Vec3f boxPoint(std::uint64_t index, std::uint64_t i, std::uint64_t j, std::uint64_t k) const {
+        const Vec3f d = unitBallSample(spec_.seed, index);
+        return {static_cast<float>(axis_.coord[i] + spec_.jitter * axis_.jitterScale[i] * d.x),
+                static_cast<float>(axis_.coord[j] + spec_.jitter * axis_.jitterScale[j] * d.y),
+                static_cast<float>(axis_.coord[k] + spec_.jitter * axis_.jitterScale[k] * d.z)};
+    }
+
+    /// Shell: a torus around the z axis whose tube wall spans radii [kShellInnerRadius,
+    /// kShellOuterRadius], built from a (u, v, r) grid periodic in u (around the axis) and v
+    /// (around the tube). The map (u, v, r) -> ((R + r cos v) cos u, (R + r cos v) sin u, r sin v)
+    /// has Jacobian r (R + r cos v) > 0, so positively oriented Kuhn tetrahedra stay positive. The
+    /// map is not affine within a cell, which eats into the jitter margin of the Kuhn split: with
+    /// the jitter radius scaled by kShellJitterScale and at least 16 x 8 x 1 cubes, inversions
+    /// first appeared (over 1600 seeds and sizes at the largest jitter) only at a scale of 0.9
+    /// to 1.0.
+    Vec3f shellPoint(std::uint64_t index, std::uint64_t i, std::uint64_t j, std::uint64_t k) const {
+        constexpr double kR = kShellMajorRadius, kR0 = kShellInnerRadius;
+        constexpr double kShellJitterScale = 0.6;
+        const double jitter = kShellJitterScale * spec_.jitter;
+        const bool wall = k == 0 || k == block_.nz;  // the wall surfaces stay on their radius
+        const Vec3f d = unitBallSample(spec_.seed, index);
+        const double u = 2.0 * kPi * (double(i) + jitter * d.x) / block_.nx;
+        const double v = 2.0 * kPi * (double(j) + jitter * d.y) / block_.ny;
+        const double r = kR0 + kShellLenR * (double(k) + (wall ? 0.0 : jitter * d.z)) / block_.nz;
+        const double rho = kR + r * std::cos(v);
+        return {static_cast<float>(rho * std::cos(u)), static_cast<float>(rho * std::sin(u)),
+                static_cast<float>(r * std::sin(v))};
+    }
+
+    const ProceduralSpec& spec_;
+    Block block_;
+    AxisSamples axis_;
+};
+
+/// Writes the Kuhn split of the cubes of layers [k0, k1) (6 tetrahedra a cube, x fastest) to out,
+/// 4 indices each, in parallel, and checks that every tetrahedron has positive volume; pts holds
+/// the points from index ptsBase on (at least those of layers k0 to k1).
+void kuhnCells(const Block& block, std::uint32_t k0, std::uint32_t k1, const Vec3f* pts,
+               std::uint64_t ptsBase, std::uint32_t* out) {
+    const auto templates = kuhnTemplates();
+    const std::int64_t rows = std::int64_t(k1 - k0) * block.ny;
+    const std::uint64_t rowCells = 6ull * block.nx;
+    std::atomic<std::uint64_t> firstBad{UINT64_MAX};  // no exception leaves the parallel loop
+#pragma omp parallel for schedule(static)
+    for (std::int64_t row = 0; row < rows; ++row) {
+        const std::uint64_t k = k0 + std::uint64_t(row) / block.ny,
+                            j = std::uint64_t(row) % block.ny;
+        std::uint32_t* o = out + 4 * rowCells * std::uint64_t(row);
+        for (std::uint64_t i = 0; i < block.nx; ++i) {
+            std::uint32_t corner[8];
+            for (int b = 0; b < 8; ++b)
+                corner[b] = block.pointIndex(i + (b & 1), j + ((b >> 1) & 1), k + (b >> 2));
+            for (const TetTemplate& t : templates) {
+                for (int v = 0; v < 4; ++v) o[v] = corner[t[v]];
+                if (!(signedVolume(pts[o[0] - ptsBase], pts[o[1] - ptsBase], pts[o[2] - ptsBase],
+                                   pts[o[3] - ptsBase]) > 0.0)) {
+                    const std::uint64_t cell = std::uint64_t(o - out) / 4;
+                    std::uint64_t seen = firstBad.load();
+                    while (cell < seen && !firstBad.compare_exchange_weak(seen, cell)) {
+                    }
+                }
+                o += 4;
             }
-            progress.advance(n + 1.0);
         }
     }
-    emitKuhnCells(block, mesh, progress);
+    const std::uint64_t bad = firstBad.load();
+    if (bad == UINT64_MAX) return;
+    const std::uint32_t* o = out + 4 * bad;
+    const double volume = signedVolume(pts[o[0] - ptsBase], pts[o[1] - ptsBase],
+                                       pts[o[2] - ptsBase], pts[o[3] - ptsBase]);
+    UVR_CHECK(volume > 0.0, "procedural tetrahedron " << 6ull * block.nx * block.ny * k0 + bad
+                                                      << " has volume " << volume);
+}
+
+/// Layers of cubes per slab of a streamed write: about slabTets tetrahedra, at least one layer.
+std::uint32_t layersPerChunk(const Block& block, std::uint64_t slabTets = kProceduralSlabTets) {
+    const std::uint64_t layerCells = 6ull * block.nx * block.ny;
+    return static_cast<std::uint32_t>(
+        std::clamp<std::uint64_t>(slabTets / layerCells, 1, block.nz));
+}
+
+/// The Box, Graded and Shell meshes: a grid of points and the Kuhn split of its cubes.
+void generateGrid(const ProceduralSpec& spec, Mesh& mesh, ProgressReporter& progress) {
+    const GridPoints grid(spec);
+    const Block& block = grid.block();
+    const std::uint64_t layer = grid.layerPoints();
+    mesh.points.resize(block.pointCount());
+    for (std::uint64_t k = 0; k <= block.nz; ++k) {
+        grid.fill(k * layer, (k + 1) * layer, mesh.points.data() + k * layer);
+        progress.advance(double(layer));
+    }
+    const std::uint64_t cells = block.cellCount();
+    mesh.cellTypes.assign(cells, CellType::Tetra);
+    mesh.cellOffsets.resize(cells + 1);
+    for (std::uint64_t c = 0; c <= cells; ++c) mesh.cellOffsets[c] = 4 * c;
+    mesh.cellIndices.resize(4 * cells);
+    const std::uint64_t layerCells = 6ull * block.nx * block.ny;
+    for (std::uint32_t k = 0; k < block.nz; ++k) {
+        kuhnCells(block, k, k + 1, mesh.points.data(), 0,
+                  mesh.cellIndices.data() + 4 * layerCells * k);
+        progress.advance(double(layerCells));
+    }
     std::ostringstream note;
-    note << "procedural " << (graded ? "graded" : "box") << ": " << n << "^3 cubes, Kuhn split, "
-         << mesh.cellCount() << " tetrahedra, seed " << spec.seed << ", jitter " << spec.jitter;
+    note << "procedural " << proceduralShapeName(spec.shape) << ": ";
+    if (spec.shape == ProceduralShape::Shell)
+        note << block.nx << " x " << block.ny << " x " << block.nz << " (u, v, r) cubes";
+    else
+        note << block.nx << "^3 cubes";
+    note << ", Kuhn split, " << mesh.cellCount() << " tetrahedra, seed " << spec.seed << ", jitter "
+         << spec.jitter;
     mesh.notes.push_back(note.str());
 }
 
-/// Shell: a torus around the z axis whose tube wall spans radii [kShellInnerRadius,
-/// kShellOuterRadius], built from a (u, v, r) grid periodic in u (around the axis) and v (around
-/// the tube). The map (u, v, r) -> ((R + r cos v) cos u, (R + r cos v) sin u, r sin v) has
-/// Jacobian r (R + r cos v) > 0, so positively oriented Kuhn tetrahedra stay positive. The map is
-/// not affine within a cell, which eats into the jitter margin of the Kuhn split: with the jitter
-/// radius scaled by kShellJitterScale and at least 16 x 8 x 1 cubes, inversions first appeared
-/// (over 1600 seeds and sizes at the largest jitter) only at a scale of 0.9 to 1.0.
-void generateShell(const ProceduralSpec& spec, Mesh& mesh, ProgressReporter& progress) {
-    constexpr double kR = kShellMajorRadius, kR0 = kShellInnerRadius;
-    constexpr double kShellJitterScale = 0.6;
-    const double jitter = kShellJitterScale * spec.jitter;
-    const double lenR = kShellLenR;
-    const Block block = proceduralBlock(spec);
-    checkPointCount(block, spec);
-    mesh.points.resize(block.pointCount());
-    std::uint64_t index = 0;
-    for (std::uint32_t k = 0; k <= block.nz; ++k) {
-        const bool wall = k == 0 || k == block.nz;  // the wall surfaces stay on their radius
-        for (std::uint32_t j = 0; j < block.ny; ++j) {
-            for (std::uint32_t i = 0; i < block.nx; ++i, ++index) {
-                const Vec3f d = unitBallSample(spec.seed, index);
-                const double u = 2.0 * kPi * (i + jitter * d.x) / block.nx;
-                const double v = 2.0 * kPi * (j + jitter * d.y) / block.ny;
-                const double r = kR0 + lenR * (k + (wall ? 0.0 : jitter * d.z)) / block.nz;
-                const double rho = kR + r * std::cos(v);
-                mesh.points[index] = {static_cast<float>(rho * std::cos(u)),
-                                      static_cast<float>(rho * std::sin(u)),
-                                      static_cast<float>(r * std::sin(v))};
-            }
-            progress.advance(block.nx);
-        }
+/// Values of a procedural field at spec.time at the points, in parallel.
+void fieldValues(const ProceduralSpec& spec, ProceduralField f, std::span<const Vec3f> points,
+                 float* out) {
+    const double c = std::cos(spec.time), s = std::sin(spec.time);
+    const double cellSize = proceduralCellSize(spec);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < std::int64_t(points.size()); ++i) {
+        Vec3f p = points[i];
+        if (spec.time != 0.0)  // turned by -time about y
+            p = Vec3f(float(c * p.x + s * p.z), p.y, float(-s * p.x + c * p.z));
+        out[i] = proceduralFieldValue(f, p, cellSize);
     }
-    emitKuhnCells(block, mesh, progress);
-    std::ostringstream note;
-    note << "procedural shell: " << block.nx << " x " << block.ny << " x " << block.nz
-         << " (u, v, r) cubes, Kuhn split, " << mesh.cellCount() << " tetrahedra, seed "
-         << spec.seed << ", jitter " << spec.jitter;
-    mesh.notes.push_back(note.str());
+}
+
+/// Throws Error(Argument) for a spec generateMesh refuses.
+void checkSpec(const ProceduralSpec& spec) {
+    if (spec.targetCells == 0)
+        throwError(ErrorKind::Argument, "", "procedural targetCells must be at least 1");
+    if (!(spec.jitter >= 0.f && spec.jitter <= kMaxProceduralJitter))
+        throwError(ErrorKind::Argument, "",
+                   "procedural jitter must be in [0, " + std::to_string(kMaxProceduralJitter) +
+                       "], got " + std::to_string(spec.jitter));
+    for (size_t a = 0; a < spec.fields.size(); ++a)
+        for (size_t b = 0; b < a; ++b)
+            if (spec.fields[a] == spec.fields[b])
+                throwError(ErrorKind::Argument, "",
+                           std::string("procedural field '") + proceduralFieldName(spec.fields[a]) +
+                               "' is listed twice");
+}
+
+/// Work units of generateMesh and writeProceduralNative: points and cells once, then every field
+/// at every point.
+double proceduralWork(const ProceduralSpec& spec) {
+    const double estPoints = static_cast<double>(spec.targetCells) / 6.0;
+    return estPoints + static_cast<double>(spec.targetCells) + spec.fields.size() * estPoints;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -580,42 +663,29 @@ std::uint64_t proceduralMeshBytes(const ProceduralSpec& spec) {
     return block.pointCount() * pointBytes + block.cellCount() * cellBytes;
 }
 
+std::uint64_t proceduralStreamBytes(const ProceduralSpec& spec) {
+    const Block block = proceduralBlock(spec);
+    const std::uint64_t layers = layersPerChunk(block);
+    const std::uint64_t layerPoints = block.pointsX() * block.pointsY();
+    // A slab of points (one layer more for the cells) and its field values or cell indices, the
+    // pieces of cell types and offsets.
+    const std::uint64_t points = (layers + 1) * layerPoints * sizeof(Vec3f);
+    const std::uint64_t values = layers * layerPoints * sizeof(float);
+    const std::uint64_t indices = layers * 6ull * block.nx * block.ny * 4 * sizeof(std::uint32_t);
+    const std::uint64_t typesAndOffsets =
+        std::min<std::uint64_t>(1ull << 20, block.cellCount() + 1) * (1 + sizeof(std::uint64_t));
+    return points + std::max(values, indices) + typesAndOffsets;
+}
+
 std::uint64_t proceduralTetCount(const ProceduralSpec& spec) {
     return proceduralBlock(spec).cellCount();
 }
 
 Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>& progress) {
-    if (spec.targetCells == 0)
-        throwError(ErrorKind::Argument, "", "procedural targetCells must be at least 1");
-    if (!(spec.jitter >= 0.f && spec.jitter <= kMaxProceduralJitter))
-        throwError(ErrorKind::Argument, "",
-                   "procedural jitter must be in [0, " + std::to_string(kMaxProceduralJitter) +
-                       "], got " + std::to_string(spec.jitter));
-    for (size_t a = 0; a < spec.fields.size(); ++a)
-        for (size_t b = 0; b < a; ++b)
-            if (spec.fields[a] == spec.fields[b])
-                throwError(ErrorKind::Argument, "",
-                           std::string("procedural field '") + proceduralFieldName(spec.fields[a]) +
-                               "' is listed twice");
-
-    // Work units: points and cells once, then every field at every point.
-    const double estPoints = static_cast<double>(spec.targetCells) / 6.0;
-    ProgressReporter reporter(progress, estPoints + static_cast<double>(spec.targetCells) +
-                                            spec.fields.size() * estPoints);
-
+    checkSpec(spec);
+    ProgressReporter reporter(progress, proceduralWork(spec));
     Mesh mesh;
-    switch (spec.shape) {
-        case ProceduralShape::Box:
-            generateBox(spec, false, mesh, reporter);
-            break;
-        case ProceduralShape::Graded:
-            generateBox(spec, true, mesh, reporter);
-            break;
-        case ProceduralShape::Shell:
-            generateShell(spec, mesh, reporter);
-            break;
-    }
-
+    generateGrid(spec, mesh, reporter);
     const double fieldWork = double(spec.fields.size()) * double(mesh.points.size());
     double reported = 0.0;
     setProceduralFields(mesh, spec, [&](double fraction) {
@@ -630,30 +700,82 @@ void setProceduralFields(Mesh& mesh, const ProceduralSpec& spec,
                          const std::function<void(double)>& progress) {
     const double total = double(mesh.points.size()) * double(spec.fields.size());
     double done = 0.0;
-    const double c = std::cos(spec.time), s = std::sin(spec.time);
     mesh.fields.clear();
     mesh.fields.reserve(spec.fields.size());
-    const double cellSize = proceduralCellSize(spec);
     for (ProceduralField f : spec.fields) {
         Field field;
         field.name = proceduralFieldName(f);
         field.association = Association::Point;
         field.components = 1;
         field.values.resize(mesh.points.size());
-        constexpr size_t kChunk = 65536;
+        constexpr size_t kChunk = 8192;
         for (size_t begin = 0; begin < mesh.points.size(); begin += kChunk) {
             const size_t end = std::min(begin + kChunk, mesh.points.size());
-            for (size_t i = begin; i < end; ++i) {
-                Vec3f p = mesh.points[i];
-                if (spec.time != 0.0)  // turned by -time about y
-                    p = Vec3f(float(c * p.x + s * p.z), p.y, float(-s * p.x + c * p.z));
-                field.values[i] = proceduralFieldValue(f, p, cellSize);
-            }
+            fieldValues(spec, f, std::span(mesh.points).subspan(begin, end - begin),
+                        field.values.data() + begin);
             done += double(end - begin);
             if (progress && total > 0) progress(done / total);
         }
         mesh.fields.push_back(std::move(field));
     }
+}
+
+void writeProceduralNative(const ProceduralSpec& spec, const std::string& path,
+                           const std::function<void(double)>& progress, std::uint64_t slabTets) {
+    checkSpec(spec);
+    const GridPoints grid(spec);
+    const Block& block = grid.block();
+    const std::uint64_t pointCount = block.pointCount(), cellCount = block.cellCount();
+    std::vector<FieldInfo> fields;
+    for (ProceduralField f : spec.fields)
+        fields.push_back({proceduralFieldName(f), Association::Point, 1});
+    ProgressReporter reporter(progress, proceduralWork(spec));
+    NativeWriter out(path, pointCount, cellCount, 4 * cellCount, fields);
+
+    // Points, then each field, in slabs of layers of points (recomputed for each array).
+    const std::uint64_t layer = grid.layerPoints();
+    const std::uint32_t slabLayers = layersPerChunk(block, slabTets);
+    const std::uint64_t slabPoints = layer * slabLayers;
+    std::vector<Vec3f> points;
+    std::vector<float> values;
+    auto pointSlabs = [&](auto&& use) {
+        for (std::uint64_t begin = 0; begin < pointCount; begin += slabPoints) {
+            const std::uint64_t end = std::min(pointCount, begin + slabPoints);
+            points.resize(end - begin);
+            grid.fill(begin, end, points.data());
+            use();
+        }
+    };
+    pointSlabs([&] {
+        out.points(points);
+        reporter.advance(double(points.size()));
+    });
+
+    // Cells: the types and offsets, then the indices in slabs of layers of cubes.
+    out.tetrahedronTypesAndOffsets();
+    const std::uint64_t layerCells = 6ull * block.nx * block.ny;
+    std::vector<std::uint32_t> indices;
+    for (std::uint32_t k0 = 0; k0 < block.nz; k0 += slabLayers) {
+        const std::uint32_t k1 = std::min(block.nz, k0 + slabLayers);
+        const std::uint64_t first = layer * k0, last = layer * (k1 + 1ull);
+        points.resize(last - first);
+        grid.fill(first, last, points.data());
+        indices.resize(4 * layerCells * (k1 - k0));
+        kuhnCells(block, k0, k1, points.data(), first, indices.data());
+        out.cellIndices(indices);
+        reporter.advance(double(layerCells * (k1 - k0)));
+    }
+
+    // Fields.
+    for (ProceduralField f : spec.fields)
+        pointSlabs([&] {
+            values.resize(points.size());
+            fieldValues(spec, f, points, values.data());
+            out.fieldValues(values);
+            reporter.advance(double(points.size()));
+        });
+    out.commit();
+    reporter.finish();
 }
 
 Mesh generateMixedCellMesh(int n, float jitter, std::uint64_t seed, bool hexahedraOnly) {

@@ -61,6 +61,21 @@ struct ProceduralSpec {
 /// is called now and then when given.
 Mesh generateMesh(const ProceduralSpec& spec, const std::function<void(double)>& progress = {});
 
+/// Tetrahedra per slab of writeProceduralNative (128 MiB of corner indices).
+inline constexpr std::uint64_t kProceduralSlabTets = 1ull << 23;
+
+/// Writes generateMesh(spec) to a native .uvrm file (byte for byte what writeNative would write)
+/// without holding it: points, cells and fields are computed slab by slab of layers of about
+/// slabTets tetrahedra (each slab in parallel) and written as they come, so the memory needed
+/// is a few slabs (about 300 MB) however large the mesh. Atomic (temporary file, then rename);
+/// progress(fraction) now and then.
+void writeProceduralNative(const ProceduralSpec& spec, const std::string& path,
+                           const std::function<void(double)>& progress = {},
+                           std::uint64_t slabTets = kProceduralSlabTets);
+
+/// Bytes writeProceduralNative(spec) holds at its peak (its slabs), for a memory limit.
+std::uint64_t proceduralStreamBytes(const ProceduralSpec& spec);
+
 /// Replaces the mesh's fields by spec's fields at spec.time (what generateMesh(spec) stores); the
 /// mesh must be generateMesh's of a spec differing at most in time and fields.
 void setProceduralFields(Mesh& mesh, const ProceduralSpec& spec,

@@ -8,14 +8,18 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <sstream>
 
 #include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/mesh/cell_math.h"
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/mesh/validate.h"
 
@@ -709,6 +713,71 @@ TEST(MixedCellMesh, BadArgumentsAreArgumentErrors) {
     expectArgument(4, -0.01f, "jitter must be in [0, 0.15");
     expectArgument(4, 0.16f, "jitter must be in [0, 0.15");
     expectArgument(4, std::numeric_limits<float>::quiet_NaN(), "jitter");
+}
+
+}  // namespace
+}  // namespace uvr
+
+namespace uvr {
+namespace {
+
+std::string fileBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+TEST(ProceduralStream, SameBytesAsTheMeshWrittenWhole) {
+    const std::string dir = testing::scratchDir();
+    struct Case {
+        ProceduralSpec spec;
+        std::uint64_t slabTets;
+    };
+    std::vector<Case> cases;
+    cases.push_back({makeSpec(ProceduralShape::Box, 5), kProceduralSlabTets});
+    cases.push_back({makeSpec(ProceduralShape::Box, 30000, 3), kProceduralSlabTets});
+    cases.push_back({makeSpec(ProceduralShape::Box, 30000, 3), 1000});  // many slabs
+    cases.push_back({makeSpec(ProceduralShape::Graded, 20000, 5), 1});  // a layer a slab
+    cases.push_back({makeSpec(ProceduralShape::Shell, 20000), 3000});
+    ProceduralSpec timed = makeSpec(ProceduralShape::Box, 8000);
+    timed.fields = {ProceduralField::Multiscale, ProceduralField::Linear};
+    timed.time = 0.7;
+    timed.jitter = kMaxProceduralJitter;
+    cases.push_back({timed, 500});
+    ProceduralSpec noFields = makeSpec(ProceduralShape::Graded, 4000);
+    noFields.fields.clear();
+    cases.push_back({noFields, 700});
+    for (size_t c = 0; c < cases.size(); ++c) {
+        SCOPED_TRACE("case " + std::to_string(c));
+        const std::string whole = dir + "/whole.uvrm", streamed = dir + "/streamed.uvrm";
+        writeNative(generateMesh(cases[c].spec), whole);
+        std::vector<double> calls;
+        writeProceduralNative(
+            cases[c].spec, streamed, [&](double f) { calls.push_back(f); }, cases[c].slabTets);
+        const std::string a = fileBytes(whole), b = fileBytes(streamed);
+        ASSERT_FALSE(a.empty());
+        EXPECT_EQ(a.size(), b.size());
+        EXPECT_TRUE(a == b) << "first difference at byte "
+                            << std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first -
+                                   a.begin();
+        ASSERT_FALSE(calls.empty());
+        EXPECT_EQ(calls.front(), 0.0);
+        EXPECT_EQ(calls.back(), 1.0);
+        EXPECT_TRUE(std::is_sorted(calls.begin(), calls.end()));
+    }
+    // Nothing but the two outputs is left in the folder (the temporary was renamed).
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir),
+                            std::filesystem::directory_iterator()),
+              2);
+}
+
+TEST(ProceduralStream, PeakEstimateIsSmallForLargeMeshes) {
+    ProceduralSpec spec = makeSpec(ProceduralShape::Box, 1000000000);
+    EXPECT_LT(proceduralStreamBytes(spec), 600ull << 20);
+    EXPECT_GT(proceduralMeshBytes(spec), 20000000000ull);
+    EXPECT_THROW(writeProceduralNative(makeSpec(ProceduralShape::Box, 0), "/nonexistent/x.uvrm"),
+                 Error);
 }
 
 }  // namespace

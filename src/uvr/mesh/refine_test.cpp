@@ -5,11 +5,16 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "test_meshes.h"
+#include "test_support.h"
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/threads.h"
+#include "uvr/mesh/io/native.h"
+#include "uvr/mesh/procedural.h"
 #include "uvr/mesh/tet_mesh.h"
 
 namespace uvr {
@@ -144,6 +149,68 @@ TEST(Refine, BadLevelsAreArgumentErrors) {
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Resource);
     }
+}
+
+}  // namespace
+}  // namespace uvr
+
+namespace uvr {
+namespace {
+
+std::string fileBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+TEST(RefineStream, SameBytesAsTheRefinedMeshWrittenWhole) {
+    const std::string dir = testing::scratchDir();
+    // A hex grid with a point and a cell field; a mixed-cell mesh with two of each and a vector
+    // point field added; levels 0 to 2; pieces of every size.
+    Mesh mixed = generateMixedCellMesh(3);
+    Field vec{"vec", Association::Point, 3, {}};
+    for (const Vec3f& p : mixed.points) vec.values.insert(vec.values.end(), {p.x, p.y, -p.z});
+    mixed.fields.insert(mixed.fields.begin() + 1, std::move(vec));
+    struct Case {
+        const Mesh* mesh;
+        int levels;
+        std::uint64_t pieceTets;
+    };
+    const Mesh grid = hexGrid(4);
+    const std::vector<Case> cases = {{&grid, 1, kRefinePieceTets},
+                                     {&grid, 2, 7},
+                                     {&grid, 0, 5},
+                                     {&mixed, 1, 1},
+                                     {&mixed, 2, 100},
+                                     {&mixed, 0, kRefinePieceTets}};
+    for (size_t c = 0; c < cases.size(); ++c) {
+        SCOPED_TRACE("case " + std::to_string(c));
+        const std::string whole = dir + "/whole.uvrm", streamed = dir + "/streamed.uvrm";
+        writeNative(refineMesh(*cases[c].mesh, cases[c].levels), whole);
+        std::vector<double> calls;
+        refineToNative(
+            *cases[c].mesh, cases[c].levels, streamed, {}, [&](double f) { calls.push_back(f); },
+            cases[c].pieceTets);
+        const std::string a = fileBytes(whole), b = fileBytes(streamed);
+        ASSERT_FALSE(a.empty());
+        EXPECT_EQ(a.size(), b.size());
+        EXPECT_TRUE(a == b) << "first difference at byte "
+                            << std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first -
+                                   a.begin();
+        ASSERT_FALSE(calls.empty());
+        EXPECT_TRUE(std::is_sorted(calls.begin(), calls.end()));
+        EXPECT_EQ(calls.back(), 1.0);
+    }
+}
+
+TEST(RefineStream, StreamedPeakEstimateIsBelowTheWholeOutput) {
+    // 1.3M tetrahedra in, 84M out in 2 levels (only the counts are used).
+    const Mesh grid = hexGrid(60);
+    const std::uint64_t tets = 6 * grid.cellCount();
+    EXPECT_LT(refineMemoryBytes(grid, tets, 2, true), refineMemoryBytes(grid, tets, 2) / 4);
+    EXPECT_LT(refineMemoryBytes(grid, tets, 2, true), 10 * refinedTetCount(tets, 2));
+    EXPECT_THROW(refineToNative(hexGrid(2), 9, testing::scratchDir() + "/x.uvrm"), Error);
 }
 
 }  // namespace

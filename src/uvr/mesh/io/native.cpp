@@ -7,6 +7,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <type_traits>
 #include <vector>
@@ -378,17 +379,19 @@ MeshSummary readNativeSummary(const std::string& path, bool cellTypes) {
     return summary;
 }
 
-void writeNative(const Mesh& mesh, const std::string& path,
-                 const std::function<void(double)>& progress) {
-    // Refuse meshes the reader would refuse, before creating any file.
-    validateStructure(mesh, path);
-    for (const Field& f : mesh.fields) {
+NativeWriter::NativeWriter(const std::string& path, std::uint64_t pointCount,
+                           std::uint64_t cellCount, std::uint64_t indexCount,
+                           const std::vector<FieldInfo>& fields,
+                           std::function<void(double)> progress)
+    : progress_(std::move(progress)) {
+    // Refuse what the reader would refuse, before creating any file.
+    for (const FieldInfo& f : fields) {
         if (f.name.size() > kMaxNameBytes)
             throwError(ErrorKind::Argument, path,
                        "field name of " + std::to_string(f.name.size()) +
                            " bytes, expected at most " + std::to_string(kMaxNameBytes));
     }
-    if (mesh.fields.size() > UINT32_MAX)
+    if (fields.size() > UINT32_MAX)
         throwError(ErrorKind::Argument, path, "more than 2^32 - 1 fields");
 
     // Header and descriptors.
@@ -396,60 +399,163 @@ void writeNative(const Mesh& mesh, const std::string& path,
     std::memcpy(head.data(), kNativeMagic, 8);
     storeLe<std::uint32_t>(head, kNativeVersion);
     storeLe<std::uint32_t>(head, 0);  // flags
-    storeLe<std::uint64_t>(head, mesh.pointCount());
-    storeLe<std::uint64_t>(head, mesh.cellCount());
-    storeLe<std::uint64_t>(head, mesh.cellIndices.size());
-    storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(mesh.fields.size()));
+    storeLe<std::uint64_t>(head, pointCount);
+    storeLe<std::uint64_t>(head, cellCount);
+    storeLe<std::uint64_t>(head, indexCount);
+    storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(fields.size()));
     storeLe<std::uint32_t>(head, 0);  // reserved
-    for (const Field& f : mesh.fields) {
+    counts_ = {3 * pointCount, cellCount, cellCount + 1, indexCount};
+    const std::uint64_t wordBytes[4] = {4, 1, 8, 4};
+    for (const FieldInfo& f : fields) {
+        const std::uint64_t values =
+            (f.association == Association::Point ? pointCount : cellCount) *
+            static_cast<std::uint64_t>(f.components);
         storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(f.name.size()));
         head.insert(head.end(), f.name.begin(), f.name.end());
         head.push_back(static_cast<unsigned char>(f.association));
         storeLe<std::uint32_t>(head, static_cast<std::uint32_t>(f.components));
-        storeLe<std::uint64_t>(head, f.values.size());
+        storeLe<std::uint64_t>(head, values);
+        counts_.push_back(values);
     }
-
-    std::uint64_t total = head.size() + 12 * mesh.points.size() + mesh.cellTypes.size() +
-                          8 * mesh.cellOffsets.size() + 4 * mesh.cellIndices.size();
-    for (const Field& f : mesh.fields) total += 4 * f.values.size();
-    OutputFile file(path);
-    std::uint64_t offset = 0;
-    // Large arrays go out in 64 MiB pieces so that progress moves while an 8 GB file is written.
-    auto put = [&](const void* data, std::uint64_t bytes) {
-        constexpr std::uint64_t kPiece = 64ull << 20;
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::uint64_t done = 0; done < bytes; done += kPiece) {
-            file.write(p + done, std::min(kPiece, bytes - done));
-            if (progress) progress(double(offset + std::min(bytes, done + kPiece)) / double(total));
-        }
-        offset += bytes;
-    };
-    // Arrays in file order, each after zero padding to a multiple of 8; on big-endian hosts
-    // they are swapped chunk by chunk into a scratch buffer.
-    auto putArray = [&](const void* data, std::uint64_t count, size_t wordBytes) {
-        static constexpr unsigned char kZeros[8] = {};
-        put(kZeros, align8(offset) - offset);
-        if constexpr (std::endian::native == std::endian::little) {
-            put(data, count * wordBytes);
-        } else {
-            std::vector<unsigned char> chunk;
-            const auto* p = static_cast<const unsigned char*>(data);
-            constexpr std::uint64_t kWords = 1 << 20;
-            for (std::uint64_t i = 0; i < count; i += kWords) {
-                const std::uint64_t n = std::min(kWords, count - i);
-                chunk.assign(p + i * wordBytes, p + (i + n) * wordBytes);
-                swapWordsIfBigEndian(chunk.data(), n, wordBytes);
-                put(chunk.data(), chunk.size());
-            }
-        }
-    };
+    total_ = head.size();
+    for (size_t a = 0; a < counts_.size(); ++a)
+        total_ += counts_[a] * (a < kFirstField ? wordBytes[a] : 4);
+    // A file of many gigabytes is refused at once when its file system cannot hold it (the
+    // space of a file it replaces counts, since the old one goes only at the rename).
+    const OutputTarget target = resolveOutput(path);
+    if (target.kind == OutputKind::Atomic) {
+        std::error_code ec;
+        const auto space =
+            std::filesystem::space(std::filesystem::path(target.target).parent_path().empty()
+                                       ? std::filesystem::path(".")
+                                       : std::filesystem::path(target.target).parent_path(),
+                                   ec);
+        if (!ec && space.available < total_)
+            throwError(ErrorKind::Io, path,
+                       "the file needs " + std::to_string(total_) +
+                           " bytes, but its file system "
+                           "has only " +
+                           std::to_string(space.available) + " available");
+    }
+    file_ = std::make_unique<OutputFile>(path);
     put(head.data(), head.size());
-    putArray(mesh.points.data(), mesh.points.size() * 3, 4);
-    putArray(mesh.cellTypes.data(), mesh.cellTypes.size(), 1);
-    putArray(mesh.cellOffsets.data(), mesh.cellOffsets.size(), 8);
-    putArray(mesh.cellIndices.data(), mesh.cellIndices.size(), 4);
-    for (const Field& f : mesh.fields) putArray(f.values.data(), f.values.size(), 4);
-    file.commit();
+}
+
+NativeWriter::~NativeWriter() = default;
+
+void NativeWriter::put(const void* data, std::uint64_t bytes) {
+    // Large pieces go out in 64 MiB parts so that progress moves while an 8 GB file is written.
+    constexpr std::uint64_t kPiece = 64ull << 20;
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::uint64_t done = 0; done < bytes; done += kPiece) {
+        const std::uint64_t n = std::min(kPiece, bytes - done);
+        file_->write(p + done, n);
+        if (progress_) progress_(double(offset_ + done + n) / double(total_));
+    }
+    offset_ += bytes;
+}
+
+void NativeWriter::advanceTo(int array) {
+    // Arrays in file order, each after zero padding to a multiple of 8.
+    while (current_ < array) {
+        UVR_CHECK(current_ < 0 || written_ == counts_[current_],
+                  "NativeWriter: array " << current_ << " has " << written_ << " of "
+                                         << counts_[current_] << " values");
+        ++current_;
+        written_ = 0;
+        static constexpr unsigned char kZeros[8] = {};
+        put(kZeros, align8(offset_) - offset_);
+    }
+}
+
+void NativeWriter::append(int array, const void* data, std::uint64_t count, size_t wordBytes) {
+    if (array == kFirstField) {
+        // The current field, or the next one when it is full.
+        array = std::max(current_, int(kFirstField));
+        auto full = [&](int a) { return (a == current_ ? written_ : 0) == counts_[a]; };
+        while (count > 0 && array + 1 < int(counts_.size()) && full(array)) ++array;
+    }
+    UVR_CHECK(array < int(counts_.size()), "NativeWriter: values for a field of none");
+    advanceTo(array);
+    UVR_CHECK(current_ == array && written_ + count <= counts_[array],
+              "NativeWriter: " << count << " values for array " << array << " (now writing "
+                               << current_ << ", " << written_ << " of " << counts_[current_]
+                               << ")");
+    written_ += count;
+    if constexpr (std::endian::native == std::endian::little) {
+        put(data, count * wordBytes);
+    } else {
+        // Swapped chunk by chunk into a scratch buffer on big-endian hosts.
+        std::vector<unsigned char> chunk;
+        const auto* p = static_cast<const unsigned char*>(data);
+        constexpr std::uint64_t kWords = 1 << 20;
+        for (std::uint64_t i = 0; i < count; i += kWords) {
+            const std::uint64_t n = std::min(kWords, count - i);
+            chunk.assign(p + i * wordBytes, p + (i + n) * wordBytes);
+            swapWordsIfBigEndian(chunk.data(), n, wordBytes);
+            put(chunk.data(), chunk.size());
+        }
+    }
+}
+
+void NativeWriter::points(std::span<const Vec3f> values) {
+    append(kPoints, values.data(), 3 * values.size(), 4);
+}
+
+void NativeWriter::cellTypes(std::span<const CellType> values) {
+    append(kCellTypes, values.data(), values.size(), 1);
+}
+
+void NativeWriter::cellOffsets(std::span<const std::uint64_t> values) {
+    append(kCellOffsets, values.data(), values.size(), 8);
+}
+
+void NativeWriter::tetrahedronTypesAndOffsets() {
+    const std::uint64_t cells = counts_[kCellTypes];
+    UVR_CHECK(counts_[kCellIndices] == 4 * cells, "NativeWriter: " << counts_[kCellIndices]
+                                                                   << " indices for " << cells
+                                                                   << " tetrahedra");
+    constexpr std::uint64_t kPiece = 1 << 20;
+    const std::vector<CellType> types(std::min(kPiece, cells), CellType::Tetra);
+    for (std::uint64_t c = 0; c < cells; c += kPiece)
+        cellTypes(std::span(types).first(std::min(kPiece, cells - c)));
+    std::vector<std::uint64_t> offsets;
+    for (std::uint64_t c = 0; c <= cells; c += kPiece) {
+        offsets.resize(std::min(kPiece, cells + 1 - c));
+        for (std::uint64_t i = 0; i < offsets.size(); ++i) offsets[i] = 4 * (c + i);
+        cellOffsets(offsets);
+    }
+}
+
+void NativeWriter::cellIndices(std::span<const std::uint32_t> values) {
+    append(kCellIndices, values.data(), values.size(), 4);
+}
+
+void NativeWriter::fieldValues(std::span<const float> values) {
+    append(kFirstField, values.data(), values.size(), 4);
+}
+
+void NativeWriter::commit() {
+    advanceTo(int(counts_.size()) - 1);
+    UVR_CHECK(written_ == counts_.back(), "NativeWriter: the last array has "
+                                              << written_ << " of " << counts_.back() << " values");
+    file_->commit();
+}
+
+void writeNative(const Mesh& mesh, const std::string& path,
+                 const std::function<void(double)>& progress) {
+    // Refuse meshes the reader would refuse, before creating any file.
+    validateStructure(mesh, path);
+    std::vector<FieldInfo> fields;
+    for (const Field& f : mesh.fields) fields.push_back({f.name, f.association, f.components});
+    NativeWriter out(path, mesh.pointCount(), mesh.cellCount(), mesh.cellIndices.size(), fields,
+                     progress);
+    out.points(mesh.points);
+    out.cellTypes(mesh.cellTypes);
+    out.cellOffsets(mesh.cellOffsets);
+    out.cellIndices(mesh.cellIndices);
+    for (const Field& f : mesh.fields) out.fieldValues(f.values);
+    out.commit();
 }
 
 }  // namespace uvr

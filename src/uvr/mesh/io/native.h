@@ -3,6 +3,8 @@
 
 #include <functional>
 #include <map>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,5 +36,57 @@ MeshSummary readNativeSummary(const std::string& path, bool cellTypes = true);
 /// Writes a mesh in the native format, atomically (temporary file, then rename).
 void writeNative(const Mesh& mesh, const std::string& path,
                  const std::function<void(double)>& progress = {});
+
+class OutputFile;
+
+/// Writes a .uvrm piece by piece, so that a mesh larger than memory can be generated straight
+/// into its file: the header (counts and fields) is given first, then the arrays' values in file
+/// order (points, cell types, cell offsets, cell indices, each field's values), each in as many
+/// pieces as the caller likes. The bytes are those writeNative writes for the same mesh (which
+/// uses this writer). Atomic: nothing appears at `path` before commit(). The caller's data is
+/// not validated (writeNative validates a whole mesh first); a piece beyond an array's count, or
+/// commit() before every array is complete, is an internal error.
+class NativeWriter {
+public:
+    /// Opens the temporary output and writes the header and field descriptors; throws
+    /// Error(Argument) for a field name over 65535 bytes or more than 2^32 - 1 fields, and
+    /// Error(Io) when the file system has less space available than the file's size.
+    NativeWriter(const std::string& path, std::uint64_t pointCount, std::uint64_t cellCount,
+                 std::uint64_t indexCount, const std::vector<FieldInfo>& fields,
+                 std::function<void(double)> progress = {});
+    ~NativeWriter();
+    NativeWriter(const NativeWriter&) = delete;
+    NativeWriter& operator=(const NativeWriter&) = delete;
+
+    /// Appends points.
+    void points(std::span<const Vec3f> values);
+    /// Appends cell types.
+    void cellTypes(std::span<const CellType> values);
+    /// Appends cell offsets (cellCount + 1 in all).
+    void cellOffsets(std::span<const std::uint64_t> values);
+    /// Writes the whole cell types and offsets arrays of a mesh of tetrahedra only (type 10 and
+    /// offsets 0, 4, 8, ..., in pieces of a few MiB); indexCount must be 4 cellCount.
+    void tetrahedronTypesAndOffsets();
+    /// Appends corner indices.
+    void cellIndices(std::span<const std::uint32_t> values);
+    /// Appends values of the current field (fields in the order given, each filled before the
+    /// next begins).
+    void fieldValues(std::span<const float> values);
+    /// Checks that every array is complete and makes the file appear at its path.
+    void commit();
+
+private:
+    enum Array : int { kPoints, kCellTypes, kCellOffsets, kCellIndices, kFirstField };
+    void append(int array, const void* data, std::uint64_t count, std::size_t wordBytes);
+    void put(const void* data, std::uint64_t bytes);
+    void advanceTo(int array);
+
+    std::unique_ptr<OutputFile> file_;
+    std::function<void(double)> progress_;
+    std::vector<std::uint64_t> counts_;  ///< elements of each array (words for points: x, y, z)
+    int current_ = -1;                   ///< the array being written, -1 before the first
+    std::uint64_t written_ = 0;          ///< elements of the current array written
+    std::uint64_t offset_ = 0, total_ = 0;
+};
 
 }  // namespace uvr

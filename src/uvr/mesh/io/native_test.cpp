@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <span>
+#include <type_traits>
 
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -368,6 +370,86 @@ TEST(Native, FailedWritesLeaveNoFile) {
     const std::string before = readBytes(out);
     expectError([&] { writeNative(bad, out); }, ErrorKind::Validation, {out});
     EXPECT_EQ(readBytes(out), before);
+}
+
+TEST(NativeWriter, PiecesOfAnySizeGiveWriteNativesBytes) {
+    const std::string dir = testing::scratchDir();
+    Mesh mesh = generateMesh([] {
+        ProceduralSpec spec;
+        spec.targetCells = 2000;
+        return spec;
+    }());
+    mesh.fields.push_back({"cellf", Association::Cell, 2, {}});
+    mesh.fields.back().values.assign(2 * mesh.cellCount(), 0.5f);
+    writeNative(mesh, dir + "/whole.uvrm");
+    std::vector<FieldInfo> fields;
+    for (const Field& f : mesh.fields) fields.push_back({f.name, f.association, f.components});
+    NativeWriter out(dir + "/pieces.uvrm", mesh.pointCount(), mesh.cellCount(),
+                     mesh.cellIndices.size(), fields);
+    // Pieces of 1, 2, 3, ... values, an empty piece now and then.
+    auto inPieces = [](const auto& values, auto&& put) {
+        using T = typename std::decay_t<decltype(values)>::value_type;
+        std::size_t at = 0;
+        for (std::size_t n = 0; at < values.size(); ++n) {
+            const std::size_t take = std::min(n % 7, values.size() - at);
+            put(std::span<const T>(values.data() + at, take));
+            at += take;
+        }
+    };
+    inPieces(mesh.points, [&](std::span<const Vec3f> v) { out.points(v); });
+    out.tetrahedronTypesAndOffsets();
+    inPieces(mesh.cellIndices, [&](std::span<const std::uint32_t> v) { out.cellIndices(v); });
+    for (const Field& f : mesh.fields)
+        inPieces(f.values, [&](std::span<const float> v) { out.fieldValues(v); });
+    out.commit();
+    EXPECT_EQ(readBytes(dir + "/pieces.uvrm"), readBytes(dir + "/whole.uvrm"));
+}
+
+TEST(NativeWriter, MisuseIsAnInternalErrorAndLeavesNoFile) {
+    const std::string dir = testing::scratchDir();
+    auto expectInternal = [&](auto&& fn, const std::string& text) {
+        try {
+            fn();
+            ADD_FAILURE() << "no error for " << text;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Internal);
+            EXPECT_THAT(e.what(), HasSubstr(text));
+        }
+        EXPECT_TRUE(std::filesystem::is_empty(dir));
+    };
+    const std::vector<Vec3f> points(5);
+    expectInternal(
+        [&] {
+            NativeWriter out(dir + "/x.uvrm", 4, 1, 4, {});
+            out.points(points);
+        },
+        "15 values for array 0");  // 15 words for an array of 12
+    expectInternal(
+        [&] {
+            NativeWriter out(dir + "/x.uvrm", 5, 1, 4, {});
+            out.points(points);
+            out.commit();
+        },
+        "has 0 of 1 values");
+    expectInternal(
+        [&] {
+            NativeWriter out(dir + "/x.uvrm", 0, 1, 5, {});
+            out.tetrahedronTypesAndOffsets();
+        },
+        "5 indices for 1 tetrahedra");
+}
+
+TEST(NativeWriter, AFileLargerThanTheFreeSpaceIsRefusedAtOnce) {
+    const std::string dir = testing::scratchDir();
+    try {
+        NativeWriter out(dir + "/huge.uvrm", 1ull << 50, 1, 4, {});
+        ADD_FAILURE() << "no error for a 12 PiB file";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Io);
+        EXPECT_THAT(e.what(), AllOf(HasSubstr("huge.uvrm"), HasSubstr("the file needs 135107988"),
+                                    HasSubstr("available")));
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 
 }  // namespace
