@@ -7,6 +7,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/morton.h"
+#include "uvr/core/scratch_vector.h"
 #include "uvr/mesh/tet_mesh.h"
 
 namespace uvr {
@@ -30,7 +31,7 @@ constexpr std::size_t kBuckets = std::size_t(1) << kRadixBits;
 /// over the key's high bits (each pass parallel over fixed chunks) until each is small, then the
 /// small ranges are sorted in parallel; the result is the one sorted order, so it does not
 /// depend on the thread count. Skewed keys (graded meshes) only take more passes.
-void sortKeys(std::vector<KeyIndex>& a) {
+void sortKeys(ScratchVector<KeyIndex>& a) {
     const std::size_t n = a.size();
     struct Range {
         std::size_t begin, end;
@@ -38,7 +39,7 @@ void sortKeys(std::vector<KeyIndex>& a) {
     };
     const std::size_t small = std::max<std::size_t>(std::size_t(1) << 16, n / 256);
     std::vector<Range> work{{0, n, 63 - kRadixBits}}, leaves;
-    std::vector<KeyIndex> tmp;
+    ScratchVector<KeyIndex> tmp;
     while (!work.empty()) {
         std::vector<Range> next;
         for (const Range& r : work) {
@@ -95,9 +96,9 @@ void sortKeys(std::vector<KeyIndex>& a) {
 
 /// The Morton order of `count` cells of `corners` corners each from ids (corner point ids, one
 /// cell after another).
-std::vector<KeyIndex> mortonOrder(const std::vector<Vec3f>& points, const Bounds3f& bounds,
+ScratchVector<KeyIndex> mortonOrder(const std::vector<Vec3f>& points, const Bounds3f& bounds,
                                   const std::uint32_t* ids, std::uint64_t count, int corners) {
-    std::vector<KeyIndex> keys(count);
+    ScratchVector<KeyIndex> keys(count);
     const float inv = 1.f / static_cast<float>(corners);
 #pragma omp parallel for schedule(static)
     for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
@@ -117,19 +118,24 @@ void sortCellsSpatially(TetMesh& mesh) {
     const std::uint64_t n = mesh.tets.size();
     if (n > 1) {
         static_assert(sizeof(Tet) == 4 * sizeof(std::uint32_t));
-        const std::vector<KeyIndex> order =
+        const ScratchVector<KeyIndex> order =
             mortonOrder(mesh.points, mesh.bounds, &mesh.tets[0].v[0], n, 4);
-        std::vector<Tet> sorted(n);
-        std::vector<std::uint32_t> source(n);
+        // Gathered back into the arrays in place (new arrays would be zeroed on one thread).
+        ScratchVector<Tet> old(n);
         const bool had = !mesh.tetSourceOrder.empty();
+        ScratchVector<std::uint32_t> oldSource(had ? n : 0);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
+            old[i] = mesh.tets[i];
+            if (had) oldSource[i] = mesh.tetSourceOrder[i];
+        }
+        mesh.tetSourceOrder.resize(n);
 #pragma omp parallel for schedule(static)
         for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
             const std::uint32_t from = order[i].index;
-            sorted[i] = mesh.tets[from];
-            source[i] = had ? mesh.tetSourceOrder[from] : from;
+            mesh.tets[i] = old[from];
+            mesh.tetSourceOrder[i] = had ? oldSource[from] : from;
         }
-        mesh.tets = std::move(sorted);
-        mesh.tetSourceOrder = std::move(source);
     }
     // Native cells, each kind among its own.
     const std::uint64_t counts[3] = {mesh.pyramidCount, mesh.wedgeCount, mesh.hexCount};
@@ -139,7 +145,7 @@ void sortCellsSpatially(TetMesh& mesh) {
         const std::uint64_t m = counts[kind];
         if (m > 1) {
             std::uint32_t* ids = mesh.nativeCorners.data() + firstCorner;
-            const std::vector<KeyIndex> order =
+            const ScratchVector<KeyIndex> order =
                 mortonOrder(mesh.points, mesh.bounds, ids, m, corners);
             std::vector<std::uint32_t> sortedIds(m * corners);
             std::vector<std::uint64_t> sortedSource(m);
