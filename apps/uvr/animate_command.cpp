@@ -149,7 +149,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                        "no cell has volume (or the mesh has no volumetric cells): nothing to "
                        "render");
         ctx.done("read and prepared step " + std::to_string(chosen[0]) + " (" +
-                     std::to_string(player.renderer().prepared().tets.tets.size()) +
+                     std::to_string(player.renderer().prepared().tets.tetCount()) +
                      " tetrahedra) of " + std::to_string(series->stepCount()),
                  start);
         std::vector<std::string> notes;

@@ -279,7 +279,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["file"] = *file;
                 j["field"] = field.name;
                 j["field_association"] = associationName(field.association);
-                j["tetrahedra"] = prepared.tets.tets.size();
+                j["tetrahedra"] = prepared.tets.tetCount();
                 j["cells"] = prepared.tets.cellCount();
                 j["split_tetrahedra"] = prepared.tets.splitTetCount();
                 j["partitions"] = prepared.kd->partitions.size();

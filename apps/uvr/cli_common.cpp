@@ -652,21 +652,29 @@ CudaWarmUp::~CudaWarmUp() {
     finishCudaWarmUp();
 }
 
+namespace {
+
+/// Prints what was uploaded to the GPU, when the renderer renders there.
+void reportUpload(const Renderer& renderer, const Context& ctx) {
+    const CudaScene* gpu = renderer.gpu();
+    if (!gpu) return;
+    char line[160];
+    std::snprintf(line, sizeof line, "uploaded %.1f MiB to the GPU (%.1f bytes per cell) in %.3f s",
+                  gpu->geometryBytes() / 1048576.0,
+                  double(gpu->geometryBytes()) /
+                      double(std::max<std::uint64_t>(1, renderer.prepared().tets.cellCount())),
+                  gpu->uploadSeconds());
+    ctx.step(line);
+}
+
+}  // namespace
+
 std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
                                        const RendererOptions& options, const Context& ctx) {
     if (resolvesToCuda(options.device)) ctx.step("GPU: " + cudaDeviceDescription());
     auto renderer = std::make_unique<Renderer>(mesh, field, options,
                                                [&](const std::string& s) { ctx.step(s); });
-    if (const CudaScene* gpu = renderer->gpu()) {
-        char line[160];
-        std::snprintf(line, sizeof line,
-                      "uploaded %.1f MiB to the GPU (%.1f bytes per cell) in %.3f s",
-                      gpu->geometryBytes() / 1048576.0,
-                      double(gpu->geometryBytes()) /
-                          double(std::max<std::uint64_t>(1, renderer->prepared().tets.cellCount())),
-                      gpu->uploadSeconds());
-        ctx.step(line);
-    }
+    reportUpload(*renderer, ctx);
     return renderer;
 }
 
@@ -752,18 +760,25 @@ Mesh loadMesh(const std::string& path, const Context& ctx, const StepFlags& step
     return mesh;
 }
 
-RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
-                            const Context& ctx) {
-    const std::optional<Vec3f> background = flags.backgroundColor();
-    const std::optional<Font> legendFont = flags.legendFont();  // before the expensive work
-    const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
-    auto start = Clock::now();
+SourceSummary checkForRendering(const Mesh& mesh, const ScalarField& field,
+                                const std::string& source, const Context& ctx,
+                                double* checkSeconds) {
+    const auto start = Clock::now();
     ctx.step("checking " + std::to_string(mesh.cellCount()) + " cells and " +
              std::to_string(mesh.pointCount()) + " points");
     const ValidationReport report = validateMesh(mesh, source);
-    const double checkSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (checkSeconds) *checkSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     ctx.done("checked the mesh", start);
-    for (const std::string& f : report.findings()) ctx.step("validation: " + f);
+    SourceSummary summary;
+    summary.points = mesh.pointCount();
+    summary.cells = mesh.cellCount();
+    summary.bounds = report.bounds;
+    summary.fieldName = field.name;
+    summary.association = field.association;
+    summary.fieldChoice = field.choice;
+    summary.notes = mesh.notes;
+    summary.findings = report.findings();
+    for (const std::string& f : summary.findings) ctx.step("validation: " + f);
     if (report.bounds.empty())
         throwError(ErrorKind::Validation, source,
                    mesh.cellCount() == 0
@@ -771,18 +786,41 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
                        : "no cell has volume: all " + std::to_string(mesh.cellCount()) +
                              " cell(s) are flat (thinner than 1e-7 of their size) or use "
                              "NaN/Inf points; nothing to render");
-    // Every flag is parsed before the expensive preparation, so a bad flag fails fast. The
-    // camera fits the rendered cells (unused and NaN/Inf points and flat cells left out).
+    return summary;
+}
+
+std::string stepKey(const StepFlags& steps) {
+    if (steps.time) {
+        char t[40];
+        std::snprintf(t, sizeof t, "--time %.17g", *steps.time);
+        return t;
+    }
+    if (steps.index) return "--step-index " + std::to_string(*steps.index);
+    return "";
+}
+
+namespace {
+
+/// The settings of a render of `src`, checked; the camera fits the rendered cells (unused and
+/// NaN/Inf points and flat cells left out).
+RenderSettings checkedSettings(const RenderFlags& flags, const RenderSource& src,
+                               const Context& ctx) {
     std::vector<std::string> notes;
-    RenderSettings settings = flags.settings(report.bounds, source, &notes);
+    RenderSettings settings = flags.settings(src.summary.bounds, src.path, &notes);
     for (const std::string& note : notes) ctx.step("note: " + note);
     validateSettings(settings);
+    return settings;
+}
 
-    ctx.setActivity(source, "preparing the mesh for rendering");
-    const std::unique_ptr<Renderer> renderer =
-        makeRenderer(mesh, field, flags.rendererOptions(), ctx);
-    const PreparedMesh& prepared = renderer->prepared();
-    ctx.done("prepared " + describeCells(prepared.tets), start);
+/// Renders a prepared mesh and writes the PNG, heat map and statistics: what a render from the
+/// mesh and one from a prepared cache share.
+RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
+                                    RenderSettings settings, const std::optional<Font>& legendFont,
+                                    const RenderFlags& flags, const Context& ctx) {
+    const std::optional<Vec3f> background = flags.backgroundColor();
+    const std::string& source = src.path;
+    const ScalarField field = src.summary.field();
+    const PreparedMesh& prepared = renderer.prepared();
     ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
              " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
              (settings.supersample > 1
@@ -796,14 +834,14 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     {
         Progress progress(ctx, "rendering", double(settings.width) * settings.height, "pixels");
         settings.progress = progress.callback();
-        result = renderer->render(settings);
+        result = renderer.render(settings);
         settings.progress = {};
     }
     ctx.setActivity(flags.output, "writing the image");
     char line[200];
     std::snprintf(
         line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
-        renderer->deviceName(), result.stats.seconds,
+        renderer.deviceName(), result.stats.seconds,
         static_cast<unsigned long long>(result.stats.samples), result.stats.meanSamplesPerPixel(),
         result.setup.params.step / result.setup.frame.scale);
     ctx.step(line);
@@ -851,19 +889,19 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["source"] = source;
         j["field"] = field.name;
         j["field_association"] = associationName(field.association);
-        j["device"] = renderer->deviceName();
-        if (renderer->gpu()) {
+        j["device"] = renderer.deviceName();
+        if (renderer.gpu()) {
             j["gpu"] = {{"description", cudaDeviceDescription()},
-                        {"geometry_bytes", renderer->gpu()->geometryBytes()},
+                        {"geometry_bytes", renderer.gpu()->geometryBytes()},
                         {"bytes_per_cell",
-                         double(renderer->gpu()->geometryBytes()) /
+                         double(renderer.gpu()->geometryBytes()) /
                              double(std::max<std::uint64_t>(1, prepared.tets.cellCount()))},
                         // Per tetrahedron of the split (the cells' tetrahedra when split):
                         // comparable between native and split cells.
                         {"bytes_per_tetrahedron",
-                         double(renderer->gpu()->geometryBytes()) /
+                         double(renderer.gpu()->geometryBytes()) /
                              double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
-                        {"upload_seconds", renderer->gpu()->uploadSeconds()}};
+                        {"upload_seconds", renderer.gpu()->uploadSeconds()}};
         }
         j["threads"] = cpu::threadCount();
         if (!flags.heatmapFile.empty()) j["heatmap_max"] = heatmapTop;
@@ -905,15 +943,18 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         j["supersample"] = settings.supersample;
         if (settings.supersample > 1) j["jitter"] = settings.jitter;
         j["rays"] = result.stats.rays();
-        j["mesh"] = {{"points", mesh.pointCount()},
-                     {"cells", mesh.cellCount()},
-                     {"tetrahedra", prepared.tets.tets.size()},
-                     {"pyramids", prepared.tets.pyramidCount},
-                     {"wedges", prepared.tets.wedgeCount},
-                     {"hexahedra", prepared.tets.hexCount}};
+        j["mesh"] = {
+            {"points", src.summary.points},           {"cells", src.summary.cells},
+            {"tetrahedra", prepared.tets.tetCount()}, {"pyramids", prepared.tets.pyramidCount},
+            {"wedges", prepared.tets.wedgeCount},     {"hexahedra", prepared.tets.hexCount}};
         // Every phase of the preparation, the check of the mesh first ("adjacency" is the
         // neighbours' old name).
-        j["prepare_seconds"] = {{"check", checkSeconds},
+        j["prepared_cache"] = {{"used", !src.cacheFile.empty()}};
+        if (!src.cacheFile.empty()) {
+            j["prepared_cache"]["file"] = src.cacheFile;
+            j["prepared_cache"]["read_seconds"] = src.cacheReadSeconds;
+        }
+        j["prepare_seconds"] = {{"check", src.checkSeconds},
                                 {"bvh", prepared.bvhSeconds},
                                 {"adjacency", prepared.adjacencySeconds}};
         for (const auto& [phase, seconds] : prepared.phaseSeconds)
@@ -957,6 +998,96 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
         ctx.step("wrote " + out->path());
     }
     return result;
+}
+
+}  // namespace
+
+RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
+                            const Context& ctx) {
+    flags.backgroundColor();
+    const std::optional<Font> legendFont = flags.legendFont();  // before the expensive work
+    const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
+    const auto start = Clock::now();
+    RenderSource src;
+    src.path = source;
+    src.summary = checkForRendering(mesh, field, source, ctx, &src.checkSeconds);
+    // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
+    const RenderSettings settings = checkedSettings(flags, src, ctx);
+    ctx.setActivity(source, "preparing the mesh for rendering");
+    const std::unique_ptr<Renderer> renderer =
+        makeRenderer(mesh, field, flags.rendererOptions(), ctx);
+    ctx.done("prepared " + describeCells(renderer->prepared().tets), start);
+    return renderPreparedAndWrite(*renderer, src, settings, legendFont, flags, ctx);
+}
+
+void CacheFlags::registerOn(CLI::App& app) {
+    auto* c = app.add_option("--cache", file,
+                             "Render from this prepared cache (`uvr prepare`) without reading the "
+                             "mesh; an error when it does not match the mesh and the flags "
+                             "(default: MESH.uvrprep when it exists and matches)");
+    auto* n = app.add_flag("--no-cache", off, "Ignore MESH.uvrprep: read and prepare the mesh");
+    c->excludes(n);
+}
+
+std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx) {
+    if (resolvesToCuda(device)) ctx.step("GPU: " + cudaDeviceDescription());
+    auto renderer = std::make_unique<Renderer>(std::move(prepared), device);
+    reportUpload(*renderer, ctx);
+    return renderer;
+}
+
+bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
+                     const CacheFlags& cache, const Context& ctx) {
+    const bool explicitCache = !cache.file.empty();
+    if (cache.off) return false;
+    const std::string path = explicitCache ? cache.file : meshFile + kPreparedCacheSuffix;
+    std::error_code ec;
+    if (!explicitCache && (!std::filesystem::is_regular_file(path, ec) ||
+                           !std::filesystem::is_regular_file(meshFile, ec)))
+        return false;
+    const auto start = Clock::now();
+    const RendererOptions options = flags.rendererOptions();
+    const CacheKey expected =
+        makeCacheKey(meshFile, flags.field, stepKey(steps), options.prepareOptions());
+    // The header first: a stale or damaged default cache is set aside with a note.
+    RenderSource src;
+    src.path = meshFile;
+    src.cacheFile = path;
+    PreparedMesh prepared;
+    try {
+        const CacheHeader header = readPreparedCacheHeader(path);
+        const std::string why = cacheKeyMismatch(header.key, expected);
+        if (!why.empty()) throw StaleCacheError(path, why);
+        src.summary = header.source;
+    } catch (const Error& e) {
+        if (explicitCache || e.kind() == ErrorKind::Resource) throw;
+        ctx.warn("not using the prepared cache " + path + ": " +
+                 (dynamic_cast<const StaleCacheError*>(&e)
+                      ? dynamic_cast<const StaleCacheError&>(e).reason()
+                      : std::string(e.what())) +
+                 "; preparing from the mesh (`uvr prepare` renews the cache)");
+        return false;
+    }
+    const std::optional<Font> legendFont = flags.legendFont();
+    const RenderSettings settings = checkedSettings(flags, src, ctx);
+    ctx.setActivity(path, "reading the prepared cache");
+    {
+        LoadBudget budget(ctx.maxMemoryBytes);
+        Progress progress(ctx, "reading the prepared cache " + path);
+        prepared = readPreparedCache(path, expected, budget, nullptr, progress.callback());
+    }
+    src.cacheReadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    char line[64];
+    std::snprintf(line, sizeof line, " (read in %.3f s)", src.cacheReadSeconds);
+    ctx.step("using the prepared cache " + path + line + ": " + describeCells(prepared.tets) +
+             " prepared from " + meshFile);
+    for (const std::string& note : src.summary.notes) ctx.step("note: " + note);
+    for (const std::string& f : src.summary.findings) ctx.step("validation: " + f);
+    ctx.setActivity(path, "uploading the prepared mesh");
+    const std::unique_ptr<Renderer> renderer =
+        makeRenderer(std::move(prepared), options.device, ctx);
+    renderPreparedAndWrite(*renderer, src, settings, legendFont, flags, ctx);
+    return true;
 }
 
 }  // namespace uvr::cli

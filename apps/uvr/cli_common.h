@@ -189,10 +189,49 @@ std::unique_ptr<MeshSeries> openSeries(const std::string& path, const Context& c
 /// notes, and which step of how many it read when the file has several.
 Mesh loadMesh(const std::string& path, const Context& ctx, const StepFlags& steps = {});
 
+/// Checks a mesh for rendering `field` (validateMesh, its findings printed) and summarises what
+/// rendering needs of it; throws Error(Validation) when no cell renders. checkSeconds, when
+/// given, receives the time of the check.
+SourceSummary checkForRendering(const Mesh& mesh, const ScalarField& field,
+                                const std::string& source, const Context& ctx,
+                                double* checkSeconds = nullptr);
+
+/// The time step the flags ask for, as a prepared cache's key records it ("" for the first).
+std::string stepKey(const StepFlags& steps);
+
+/// A prepared mesh's source, as a render reports it: the mesh file, its summary, and the
+/// prepared cache it came from (empty when prepared from the mesh).
+struct RenderSource {
+    std::string path;
+    SourceSummary summary;
+    double checkSeconds = 0.0;  ///< the mesh's check (0 from a cache)
+    std::string cacheFile;
+    double cacheReadSeconds = 0.0;
+};
+
 /// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its
 /// image carries the legend).
 RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx);
+
+/// `render`'s --cache FILE and --no-cache.
+struct CacheFlags {
+    std::string file;  ///< --cache; empty: MESH.uvrprep when it exists
+    bool off = false;  ///< --no-cache
+    /// Adds the flags (exclusive) to a subcommand.
+    void registerOn(CLI::App& app);
+};
+
+/// Renders from a prepared cache instead of the mesh when one applies and writes the outputs as
+/// renderAndWrite does: --cache FILE (a mismatch or a damaged file is an error), else
+/// MESH.uvrprep when it exists (a stale or damaged one is set aside with a warning saying why:
+/// false is returned and the caller prepares from the mesh). False without a cache.
+bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
+                     const CacheFlags& cache, const Context& ctx);
+
+/// A Renderer over a mesh already prepared (read from a prepared cache) on `device`; prints
+/// where it renders as the other makeRenderer does.
+std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx);
 
 /// Refuses with Error(Resource) an estimate above --max-memory: "WHAT would need about N bytes,
 /// more than the --max-memory limit of M bytes" (what names the flags responsible).
@@ -217,6 +256,7 @@ void addBenchCommand(CLI::App& app, Context& ctx);
 void addPresetsCommand(CLI::App& app, Context& ctx);
 void addViewCommand(CLI::App& app, Context& ctx);
 void addAnimateCommand(CLI::App& app, Context& ctx);
+void addPrepareCommand(CLI::App& app, Context& ctx);
 
 /// Adds --method (adaptive, reference or exact) bound to `method`.
 void addMethodOption(CLI::App& app, std::string& method);

@@ -80,9 +80,9 @@ TEST(CliDocs, EveryCommandLineInTheReadmeAndDocsParses) {
                 const std::string where =
                     file.filename().string() + ":" + std::to_string(number) + ": " + line;
                 // Prose such as "uvr renders" is not a command line.
-                static const std::set<std::string> kCommands = {"info",    "render",   "demo",
-                                                                "convert", "generate", "refine",
-                                                                "compare", "bench",    "presets"};
+                static const std::set<std::string> kCommands = {
+                    "info",   "render",  "demo",  "convert", "generate",
+                    "refine", "compare", "bench", "presets", "prepare"};
                 if (!kCommands.count(command)) continue;
                 ++lines;
                 EXPECT_TRUE(help.commandExists(command)) << where;

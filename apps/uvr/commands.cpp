@@ -249,15 +249,20 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     auto steps = std::make_shared<StepFlags>();
+    auto cache = std::make_shared<CacheFlags>();
     cmd->add_option("FILE", *file, kMeshFileHelp)->required();
     flags->registerOn(*cmd);
     steps->registerOn(*cmd);
-    cmd->callback([file, flags, steps, &ctx] {
+    cache->registerOn(*cmd);
+    cmd->callback([file, flags, steps, cache, &ctx] {
         applyThreads(flags->threads);
         flags->checkFiles(*file);
+        if (!cache->file.empty())
+            checkOutputsDistinct({{"--cache", cache->file}}, flags->outputs());
         flags->checkBeforeLoading(*file);
         checkFrameMemory(*flags, ctx);
         const CudaWarmUp cuda(flags->device);  // CUDA starts while the mesh is read
+        if (renderFromCache(*file, *flags, *steps, *cache, ctx)) return;
         const Mesh mesh = loadMesh(*file, ctx, *steps);
         renderAndWrite(mesh, *file, *flags, ctx);
     });

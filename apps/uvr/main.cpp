@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
     });
     cli::addInfoCommand(app, ctx);
     cli::addRenderCommand(app, ctx);
+    cli::addPrepareCommand(app, ctx);
     cli::addDemoCommand(app, ctx);
     cli::addConvertCommand(app, ctx);
     cli::addGenerateCommand(app, ctx);

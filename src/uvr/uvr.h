@@ -4,6 +4,7 @@
 /// The uvr library facade: everything an application needs to read, render and write.
 #include "uvr/annotate/font.h"
 #include "uvr/annotate/legend.h"
+#include "uvr/cache/prepared_cache.h"
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
 #include "uvr/core/output_file.h"

@@ -232,12 +232,17 @@ struct TetMesh {
     std::vector<std::uint32_t> blockVertexBase;   ///< per block and one past the last
     std::vector<std::uint32_t> blockVertexPoint;  ///< point id of each block vertex
 
+    /// Tetrahedra: those of `tets`, or of the kernels' blocks where `tets` is not held (a mesh
+    /// read from a prepared cache).
+    std::uint64_t tetCount() const {
+        return tets.size() > tetCorners.size() ? tets.size() : tetCorners.size();
+    }
     /// Every rendered cell: tetrahedra and native cells.
-    std::uint64_t cellCount() const { return tets.size() + pyramidCount + wedgeCount + hexCount; }
+    std::uint64_t cellCount() const { return tetCount() + pyramidCount + wedgeCount + hexCount; }
     /// Tetrahedra the cells would split into (a pyramid 2, a wedge 3, a hexahedron 6): what the
     /// default step and memory estimates count, so a native mesh samples as its split does.
     std::uint64_t splitTetCount() const {
-        return tets.size() + 2 * pyramidCount + 3 * wedgeCount + 6 * hexCount;
+        return tetCount() + 2 * pyramidCount + 3 * wedgeCount + 6 * hexCount;
     }
     /// True when the mesh has native cells.
     bool hasNative() const { return pyramidCount + wedgeCount + hexCount > 0; }
@@ -248,8 +253,8 @@ struct TetMesh {
     }
     /// View for kernels; the TetMesh must outlive it.
     TetMeshView view() const {
-        TetMeshView v{points.data(), tets.data(), values.data(), tets.size(),
-                      association == Association::Cell};
+        TetMeshView v{points.data(), tets.empty() ? nullptr : tets.data(), values.data(),
+                      tetCount(), association == Association::Cell};
         v.nativeCorners = nativeCorners.data();
         v.pyramidCount = pyramidCount, v.wedgeCount = wedgeCount, v.hexCount = hexCount;
         v.tetCorners = tetCorners.data();

@@ -347,13 +347,13 @@ void assignTetValues(TetMesh& mesh, const ScalarField& field) {
 }
 
 std::string describeCells(const TetMesh& mesh) {
-    if (!mesh.hasNative()) return std::to_string(mesh.tets.size()) + " tetrahedra";
+    if (!mesh.hasNative()) return std::to_string(mesh.tetCount()) + " tetrahedra";
     std::string parts;
     auto add = [&](std::uint64_t n, const char* what) {
         if (n == 0) return;
         parts += (parts.empty() ? "" : ", ") + std::to_string(n) + " " + what;
     };
-    add(mesh.tets.size(), "tetrahedra");
+    add(mesh.tetCount(), "tetrahedra");
     add(mesh.pyramidCount, "pyramids");
     add(mesh.wedgeCount, "wedges");
     add(mesh.hexCount, "hexahedra");

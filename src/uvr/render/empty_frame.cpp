@@ -56,9 +56,16 @@ std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& se
                    "pixel's ray meets its bounds); check the camera (--camera, "
                    "--camera-position/--camera-focal, --azimuth, --elevation, ") +
                (f.camera.parallelProjection ? "--parallel-scale" : "--view-angle") + ")";
+    // The values the kernels read: the blocks' vertices hold a tetrahedral mesh's point values
+    // where `values` is not kept (a mesh read from a prepared cache).
     double lo = INFINITY, hi = -INFINITY;
-    for (float v : mesh.tets.values)
+    const auto extend = [&](float v) {
         if (std::isfinite(v)) lo = std::fmin(lo, v), hi = std::fmax(hi, v);
+    };
+    if (mesh.tets.values.empty())
+        for (const BlockVertex& v : mesh.tets.blockVertices) extend(v.value);
+    else
+        for (float v : mesh.tets.values) extend(v);
     if (!(lo <= hi)) return "the image is empty: the field has no finite value";
     if (maxOpacityOver(f, lo, hi) > 0.f)
         return "the image is empty: every pixel's opacity is below half an 8-bit level; raise "

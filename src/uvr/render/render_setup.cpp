@@ -107,6 +107,11 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
 
 void updateFieldValues(PreparedMesh& mesh, const ScalarField& field) {
     const auto start = std::chrono::steady_clock::now();
+    if (!mesh.cacheFile.empty())
+        throwError(ErrorKind::Argument, mesh.cacheFile,
+                   "prepared from the cache " + mesh.cacheFile +
+                       ", which holds only what rendering reads: change fields (or time steps) by "
+                       "preparing from the mesh");
     // Checked before anything changes (assignTetValues checks it too).
     const bool cellData = field.association == Association::Cell;
     const std::uint64_t expected = cellData ? mesh.sourceCells : mesh.tets.points.size();

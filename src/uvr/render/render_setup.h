@@ -78,6 +78,9 @@ struct PreparedMesh {
     /// "partitions" (with their value ranges), "seed_grids", "gradient_spreads", "nan_flags",
     /// "macrocells".
     std::vector<std::pair<std::string, double>> phaseSeconds;
+    /// The prepared cache it was read from (readPreparedCache), holding only what rendering
+    /// reads; empty when prepared from a mesh. updateFieldValues refuses such a mesh.
+    std::string cacheFile;
     std::uint64_t valueUpdates = 0;   ///< times updateFieldValues gave it new values
     double valueUpdateSeconds = 0.0;  ///< time the last updateFieldValues took
 
@@ -113,7 +116,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field);
 /// computePartitionValueRanges, partitionGradientSpread, partitionNanFlags, fillMacroCells), so
 /// frames equal those of a fresh prepareMesh of the new values bit for bit. Throws
 /// Error(Argument) when the field does not hold one value per point (or cell) of the source
-/// mesh; the prepared mesh is unchanged then.
+/// mesh, or when the mesh was read from a prepared cache (PreparedMesh::cacheFile: the arrays
+/// new values need are not there); the prepared mesh is unchanged then.
 void updateFieldValues(PreparedMesh& mesh, const ScalarField& field);
 
 /// Per partition, the diagonal of the bounding box of the field gradients of its cells (each

@@ -793,7 +793,7 @@ void ViewServer::Impl::prepareAtStart() {
         return;
     }
     Json prepared = {{"type", "prepared"},
-                     {"tetrahedra", renderer->prepared().tets.tets.size()},
+                     {"tetrahedra", renderer->prepared().tets.tetCount()},
                      {"rendered_cells", describeCells(renderer->prepared().tets)},
                      {"prepare_seconds", secondsSince(start)},
                      {"device", renderer->deviceDescription()}};
@@ -1092,7 +1092,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
         entry.histogram = histogramOf(values.values, entry.range);
     }
     if (d.scene.renderer) {
-        tets = d.scene.renderer->prepared().tets.tets.size();
+        tets = d.scene.renderer->prepared().tets.tetCount();
         renderedCells = describeCells(d.scene.renderer->prepared().tets);
         prepareSeconds = d.scene.renderer->prepareSeconds();
         device = d.scene.renderer->deviceDescription();

@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: MIT
+// `uvr prepare` and `uvr render` from a prepared cache (issue 16).
+#include <gmock/gmock.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli_test_support.h"
+#include "test_support.h"
+
+namespace uvr {
+namespace {
+
+using cli_testing::CliRun;
+using cli_testing::uvr;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// A small procedural box in a scratch folder.
+std::string makeBox(const std::string& dir) {
+    const std::string mesh = dir + "/box.uvrm";
+    EXPECT_EQ(uvr("-q generate box --cells 6000 -o " + mesh, dir).code, 0);
+    return mesh;
+}
+
+constexpr const char* kFrame = " --device cpu --size 64x48 --azimuth 20 --elevation 10";
+
+TEST(CliPrepare, RenderUsesTheCacheAndWritesTheSamePng) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = makeBox(dir);
+    for (const std::string method : {"adaptive", "reference"}) {
+        const std::string m = " --method " + method;
+        std::filesystem::remove(mesh + ".uvrprep");
+        CliRun fresh = uvr("render " + mesh + kFrame + m + " -o a.png --stats a.json", dir);
+        ASSERT_EQ(fresh.code, 0) << fresh.err;
+        EXPECT_THAT(fresh.err, Not(HasSubstr("prepared cache")));
+        CliRun prep = uvr("prepare " + mesh + " --device cpu" + m, dir);
+        ASSERT_EQ(prep.code, 0) << prep.err;
+        EXPECT_THAT(prep.err, HasSubstr("wrote " + mesh + ".uvrprep"));
+        ASSERT_TRUE(std::filesystem::exists(mesh + ".uvrprep"));
+        CliRun cached = uvr("render " + mesh + kFrame + m + " -o b.png --stats b.json", dir);
+        ASSERT_EQ(cached.code, 0) << cached.err;
+        EXPECT_THAT(cached.err,
+                    HasSubstr("using the prepared cache " + mesh + ".uvrprep (read in"));
+        EXPECT_THAT(cached.err, Not(HasSubstr("read " + mesh)));
+        EXPECT_EQ(slurp(dir + "/a.png"), slurp(dir + "/b.png")) << method;
+        EXPECT_THAT(slurp(dir + "/a.json"), HasSubstr("\"used\": false"));
+        EXPECT_THAT(slurp(dir + "/b.json"), HasSubstr("\"used\": true"));
+        // Both statistics describe the same mesh.
+        EXPECT_THAT(slurp(dir + "/b.json"), HasSubstr("\"tetrahedra\": "));
+        // --no-cache reads the mesh.
+        CliRun off = uvr("render " + mesh + kFrame + m + " -o c.png --no-cache", dir);
+        ASSERT_EQ(off.code, 0) << off.err;
+        EXPECT_THAT(off.err, Not(HasSubstr("using the prepared cache")));
+        EXPECT_EQ(slurp(dir + "/a.png"), slurp(dir + "/c.png"));
+    }
+}
+
+TEST(CliPrepare, AStaleDefaultCacheIsSetAsideWithTheReason) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = makeBox(dir);
+    ASSERT_EQ(uvr("-q prepare " + mesh + " --device cpu", dir).code, 0);
+    // Another method: the cache lacks the mesh BVH.
+    CliRun r = uvr("render " + mesh + kFrame + " --method exact -o a.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("warning: not using the prepared cache " + mesh + ".uvrprep"));
+    EXPECT_THAT(r.err, HasSubstr("mesh BVH"));
+    // A touched mesh.
+    std::filesystem::last_write_time(
+        mesh, std::filesystem::last_write_time(mesh) + std::chrono::seconds(3));
+    r = uvr("render " + mesh + kFrame + " -o b.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("the mesh changed since the cache was prepared"));
+    EXPECT_THAT(r.err, HasSubstr("read " + mesh + ": "));
+}
+
+TEST(CliPrepare, AnExplicitMismatchingCacheIsAnError) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = makeBox(dir);
+    ASSERT_EQ(uvr("-q prepare " + mesh + " --device cpu -o p.uvrprep", dir).code, 0);
+    CliRun r = uvr("render " + mesh + kFrame + " --field linear --cache p.uvrprep -o a.png", dir);
+    EXPECT_NE(r.code, 0);
+    EXPECT_THAT(r.err, HasSubstr("p.uvrprep: the prepared cache does not match"));
+    EXPECT_THAT(r.err, HasSubstr("this asks for 'linear'"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/a.png"));
+    // Not a cache at all.
+    testing::writeFile(dir + "/junk.uvrprep", std::string(100, 'j'));
+    r = uvr("render " + mesh + kFrame + " --cache junk.uvrprep -o a.png", dir);
+    EXPECT_NE(r.code, 0);
+    EXPECT_THAT(r.err, HasSubstr("not a prepared cache"));
+    // The matching one renders.
+    r = uvr("render " + mesh + kFrame + " --cache p.uvrprep -o a.png", dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("using the prepared cache p.uvrprep"));
+}
+
+TEST(CliPrepare, SeriesAreRefused) {
+    const std::string dir = testing::scratchDir();
+    testing::writeFile(dir + "/s.pvd", "<VTKFile/>");
+    CliRun r = uvr("prepare s.pvd", dir);
+    EXPECT_NE(r.code, 0);
+    EXPECT_THAT(r.err, HasSubstr("a cache's key covers one file"));
+}
+
+}  // namespace
+}  // namespace uvr
