@@ -1002,7 +1002,7 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
 
 }  // namespace
 
-RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
+RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx) {
     flags.backgroundColor();
     const std::optional<Font> legendFont = flags.legendFont();  // before the expensive work
@@ -1014,8 +1014,10 @@ RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const R
     // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
     const RenderSettings settings = checkedSettings(flags, src, ctx);
     ctx.setActivity(source, "preparing the mesh for rendering");
-    const std::unique_ptr<Renderer> renderer =
-        makeRenderer(mesh, field, flags.rendererOptions(), ctx);
+    RendererOptions options = flags.rendererOptions();
+    // The mesh as read is not needed once split: freed then (a billion cells' arrays).
+    options.afterSplit = [&mesh] { mesh = Mesh(); };
+    const std::unique_ptr<Renderer> renderer = makeRenderer(mesh, field, options, ctx);
     ctx.done("prepared " + describeCells(renderer->prepared().tets), start);
     return renderPreparedAndWrite(*renderer, src, settings, legendFont, flags, ctx);
 }

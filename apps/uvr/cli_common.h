@@ -210,8 +210,8 @@ struct RenderSource {
 };
 
 /// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its
-/// image carries the legend).
-RenderResult renderAndWrite(const Mesh& mesh, const std::string& source, const RenderFlags& flags,
+/// image carries the legend). The mesh is taken over and freed once its cells are split.
+RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const RenderFlags& flags,
                             const Context& ctx);
 
 /// `render`'s --cache FILE and --no-cache.

@@ -263,8 +263,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         checkFrameMemory(*flags, ctx);
         const CudaWarmUp cuda(flags->device);  // CUDA starts while the mesh is read
         if (renderFromCache(*file, *flags, *steps, *cache, ctx)) return;
-        const Mesh mesh = loadMesh(*file, ctx, *steps);
-        renderAndWrite(mesh, *file, *flags, ctx);
+        renderAndWrite(loadMesh(*file, ctx, *steps), *file, *flags, ctx);
     });
 }
 
@@ -307,9 +306,9 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
         Progress progress(ctx,
                           "generating the demo mesh (" + std::to_string(*cells) + " tetrahedra)",
                           double(*cells), "tetrahedra");
-        const Mesh mesh = generateMesh(spec, progress.callback());
+        Mesh mesh = generateMesh(spec, progress.callback());
         progress.done("generated " + std::to_string(mesh.cellCount()) + " tetrahedra");
-        renderAndWrite(mesh, "demo", *flags, ctx);
+        renderAndWrite(std::move(mesh), "demo", *flags, ctx);
     });
 }
 

@@ -38,6 +38,7 @@ PrepareOptions RendererOptions::prepareOptions() const {
     o.meshBvh = meshBvh;
     o.seedGrids = seedGrids;
     o.cells.splitCells = splitCells;
+    o.afterSplit = afterSplit;
     if (leafCells)
         o.kd.leafCells = leafCells;
     else if (renderOnCuda)

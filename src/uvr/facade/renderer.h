@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -39,6 +40,9 @@ struct RendererOptions {
     /// Split pyramids, wedges and hexahedra into tetrahedra instead of rendering them natively.
     bool splitCells = false;
     std::uint32_t leafCells = 0;  ///< cells per k-d partition; 0: the device's default
+    /// PrepareOptions::afterSplit: called once the source mesh is no longer read (it may be
+    /// freed then).
+    std::function<void()> afterSplit;
 
     /// The preparation these options ask for (the builders of the GPU when buildDevice resolves
     /// to it, the device's default leaf size).

@@ -66,6 +66,30 @@ TEST(Renderer, RendersEveryMethodAsTheBackendDoesOnThePreparedMesh) {
     }
 }
 
+TEST(Renderer, TheSourceMeshFreedOnceSplitChangesNoFrame) {
+    const Mesh kept = jitteredGrid();
+    Mesh freed = kept;
+    const ScalarField f = selectScalarField(kept, {});
+    RendererOptions o;
+    o.device = Device::Cpu;
+    o.leafCells = 64;
+    Renderer a(kept, f, o);
+    int calls = 0;
+    o.afterSplit = [&] { freed = Mesh(), ++calls; };
+    Renderer b(freed, f, o);
+    EXPECT_EQ(calls, 1);
+    EXPECT_EQ(freed.cellCount(), 0u);
+    for (RenderMethod method :
+         {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
+        const RenderSettings s = frameOf(kept.bounds(), method);
+        const RenderResult x = a.render(s), y = b.render(s);
+        ASSERT_EQ(x.image.pixels.size(), y.image.pixels.size());
+        EXPECT_EQ(0, std::memcmp(x.image.pixels.data(), y.image.pixels.data(),
+                                 x.image.pixels.size() * sizeof(Vec4f)))
+            << int(method);
+    }
+}
+
 TEST(Renderer, AMethodWhoseStructuresWereNotPreparedIsRefused) {
     const Mesh m = jitteredGrid();
     RendererOptions o;

@@ -33,6 +33,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
                      : "preparing " + std::to_string(mesh.cellCount()) + " cells");
     out.tets = tetrahedralize(mesh, field, options.cells);
+    if (options.afterSplit) options.afterSplit();
     out.splitSeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
 

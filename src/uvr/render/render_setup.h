@@ -41,6 +41,10 @@ struct PrepareOptions {
     /// When set, the k-d tree comes from this splitter (buildKdTreeCuda: on the GPU); it
     /// overrides kd.splitter.
     KdSplitter kdSplitter;
+    /// Called once the cells are split (tetrahedralize), after which prepareMesh reads nothing of
+    /// the source mesh: a caller holding the only copy may free it then, so a one-shot render of
+    /// a billion cells does not hold the mesh as read beside the prepared one.
+    std::function<void()> afterSplit;
     std::string builderDevice = "cpu";  ///< where lbvh and kdSplitter build (progress messages)
     std::uint64_t builderMinTets = 0;   ///< use them only from this many cells
 };
