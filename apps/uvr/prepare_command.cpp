@@ -74,15 +74,16 @@ void addPrepareCommand(CLI::App& app, Context& ctx) {
         checkOutputsDistinct({{"the input mesh", *file}}, {{"-o", cache}});
         resolveOutput(cache);
         const RendererOptions options = flags->rendererOptions();
-        const PrepareOptions prepareOptions = options.prepareOptions();
+        PrepareOptions prepareOptions = options.prepareOptions();
         // The key before the read: a mesh changed while it is read gives a stale cache.
         const CacheKey key = makeCacheKey(*file, flags->field, stepKey(*steps), prepareOptions);
         const CudaWarmUp cuda(flags->device);
-        const Mesh mesh = loadMesh(*file, ctx, *steps);
+        Mesh mesh = loadMesh(*file, ctx, *steps);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
         const auto start = std::chrono::steady_clock::now();
         const SourceSummary summary = checkForRendering(mesh, field, *file, ctx);
         ctx.setActivity(*file, "preparing the mesh for rendering");
+        prepareOptions.afterSplit = [&mesh] { mesh = Mesh(); };  // not read once split
         const PreparedMesh prepared =
             prepareMesh(mesh, field, prepareOptions, [&](const std::string& s) { ctx.step(s); });
         ctx.done("prepared " + describeCells(prepared.tets) + " of " + field.describe(), start);

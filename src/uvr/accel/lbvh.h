@@ -209,8 +209,7 @@ struct LbvhBuildView {
 };
 
 /// What an LBVH build reads: primitives are tetrahedra (tetIds[i], or i when tetIds is empty),
-/// grouped in consecutive segments that each get their own tree (the k-d partitions' BVHs; one
-/// segment for the mesh BVH).
+/// grouped in consecutive segments that each get their own tree (one segment for the mesh BVH).
 struct LbvhInput {
     const TetMesh* mesh = nullptr;
     std::span<const std::uint32_t> tetIds;    ///< primitive -> tetrahedron; empty: the identity
