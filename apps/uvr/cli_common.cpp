@@ -328,9 +328,10 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                        std::to_string(KdBuildOptions{}.leafCells) + " on the CPU, " +
                        std::to_string(kCudaDefaultLeafCells) + " with CUDA)")
         ->check(CLI::Range(1u, 1u << 30));
-    app.add_flag("--no-seed-grid", noSeedGrid,
-                 "Adaptive: no seed grids; long steps walk from the previous sample (GPU) or search "
-                 "the cell tree (CPU) (for comparisons)");
+    app.add_flag(
+        "--no-seed-grid", noSeedGrid,
+        "Adaptive: no seed grids; long steps walk from the previous sample (GPU) or search "
+        "the cell tree (CPU) (for comparisons)");
     app.add_flag("--split-cells", splitCells,
                  "Split pyramids, wedges and hexahedra into tetrahedra (linear on the split, "
                  "as ParaView's mappers do) instead of rendering them natively (trilinear "

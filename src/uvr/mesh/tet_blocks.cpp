@@ -97,7 +97,7 @@ void sortKeys(ScratchVector<KeyIndex>& a) {
 /// The Morton order of `count` cells of `corners` corners each from ids (corner point ids, one
 /// cell after another).
 ScratchVector<KeyIndex> mortonOrder(const std::vector<Vec3f>& points, const Bounds3f& bounds,
-                                  const std::uint32_t* ids, std::uint64_t count, int corners) {
+                                    const std::uint32_t* ids, std::uint64_t count, int corners) {
     ScratchVector<KeyIndex> keys(count);
     const float inv = 1.f / static_cast<float>(corners);
 #pragma omp parallel for schedule(static)
