@@ -49,6 +49,15 @@ inline std::string scratchDir() {
     return dir.string();
 }
 
+/// The whole file's bytes ("" when it cannot be read).
+inline std::string readFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes;
+    char buf[1 << 16];
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) bytes.append(buf, std::size_t(in.gcount()));
+    return bytes;
+}
+
 /// Writes text (or bytes) to a file and returns its path.
 inline std::string writeFile(const std::string& path, const std::string& contents) {
     std::ofstream out(path, std::ios::binary);

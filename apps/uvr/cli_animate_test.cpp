@@ -23,13 +23,6 @@ using cli_testing::CliRun;
 using cli_testing::expectOneLineError;
 using cli_testing::uvr;
 
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// Three steps of a generated box, a blob moving along x (point field "blob"), as step_K.vtu
 /// and run.pvd with times 0, 0.5 and 1.
 void writeSeries(const std::string& dir) {
@@ -66,7 +59,8 @@ TEST(CliAnimate, EveryStepIsTheFrameRenderWouldDrawWithTheGeometryPreparedOnce) 
     std::string previous;
     for (int k = 0; k < 3; ++k) {
         SCOPED_TRACE(k);
-        const std::string frame = slurp(dir + "/frames/frame_000" + std::to_string(k) + ".png");
+        const std::string frame =
+            testing::readFile(dir + "/frames/frame_000" + std::to_string(k) + ".png");
         ASSERT_FALSE(frame.empty());
         EXPECT_NE(frame, previous);  // the blob moves
         previous = frame;
@@ -76,15 +70,16 @@ TEST(CliAnimate, EveryStepIsTheFrameRenderWouldDrawWithTheGeometryPreparedOnce) 
             uvr("-q render run.pvd --step-index " + std::to_string(k) + " -o " + one + kLook, dir)
                 .code,
             0);
-        EXPECT_EQ(slurp(dir + "/" + one), frame);
+        EXPECT_EQ(testing::readFile(dir + "/" + one), frame);
     }
     // --time snaps to the last step at or before it; a numbered series is the same steps.
     ASSERT_EQ(uvr("-q render run.pvd --time 0.9 -o t.png" + kLook, dir).code, 0);
-    EXPECT_EQ(slurp(dir + "/t.png"), slurp(dir + "/frames/frame_0001.png"));
+    EXPECT_EQ(testing::readFile(dir + "/t.png"), testing::readFile(dir + "/frames/frame_0001.png"));
     const CliRun b = uvr("-q animate 'step_*.vtu' -o series --steps 1: --prefix s" + kLook, dir);
     ASSERT_EQ(b.code, 0) << b.err;
     EXPECT_FALSE(std::filesystem::exists(dir + "/series/s0000.png"));
-    EXPECT_EQ(slurp(dir + "/series/s0002.png"), slurp(dir + "/frames/frame_0002.png"));
+    EXPECT_EQ(testing::readFile(dir + "/series/s0002.png"),
+              testing::readFile(dir + "/frames/frame_0002.png"));
     // Without --range, one range over the steps: the log says it.
     const CliRun c = uvr("animate run.pvd -o auto --field blob --size 32x32 --device cpu", dir);
     ASSERT_EQ(c.code, 0) << c.err;
@@ -123,7 +118,8 @@ TEST(CliAnimate, GenerateWritesATimeSeriesOfOneGeometry) {
             .code,
         0);
     ASSERT_EQ(uvr("-q generate box --cells 3000 --fields jet,linear -o one.uvrm", dir).code, 0);
-    EXPECT_EQ(slurp(dir + "/t_0000.uvrm"), slurp(dir + "/one.uvrm"));  // time 0: the plain mesh
+    EXPECT_EQ(testing::readFile(dir + "/t_0000.uvrm"),
+              testing::readFile(dir + "/one.uvrm"));  // time 0: the plain mesh
     const CliRun info = uvr("-q info --json t.pvd", dir);
     ASSERT_EQ(info.code, 0) << info.err;
     const nlohmann::json j = nlohmann::json::parse(info.out);

@@ -18,13 +18,6 @@ using cli_testing::uvr;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// A small procedural box in a scratch folder.
 std::string makeBox(const std::string& dir) {
     const std::string mesh = dir + "/box.uvrm";
@@ -52,16 +45,16 @@ TEST(CliPrepare, RenderUsesTheCacheAndWritesTheSamePng) {
         EXPECT_THAT(cached.err,
                     HasSubstr("using the prepared cache " + mesh + ".uvrprep (read in"));
         EXPECT_THAT(cached.err, Not(HasSubstr("read " + mesh)));
-        EXPECT_EQ(slurp(dir + "/a.png"), slurp(dir + "/b.png")) << method;
-        EXPECT_THAT(slurp(dir + "/a.json"), HasSubstr("\"used\": false"));
-        EXPECT_THAT(slurp(dir + "/b.json"), HasSubstr("\"used\": true"));
+        EXPECT_EQ(testing::readFile(dir + "/a.png"), testing::readFile(dir + "/b.png")) << method;
+        EXPECT_THAT(testing::readFile(dir + "/a.json"), HasSubstr("\"used\": false"));
+        EXPECT_THAT(testing::readFile(dir + "/b.json"), HasSubstr("\"used\": true"));
         // Both statistics describe the same mesh.
-        EXPECT_THAT(slurp(dir + "/b.json"), HasSubstr("\"tetrahedra\": "));
+        EXPECT_THAT(testing::readFile(dir + "/b.json"), HasSubstr("\"tetrahedra\": "));
         // --no-cache reads the mesh.
         CliRun off = uvr("render " + mesh + kFrame + m + " -o c.png --no-cache", dir);
         ASSERT_EQ(off.code, 0) << off.err;
         EXPECT_THAT(off.err, Not(HasSubstr("using the prepared cache")));
-        EXPECT_EQ(slurp(dir + "/a.png"), slurp(dir + "/c.png"));
+        EXPECT_EQ(testing::readFile(dir + "/a.png"), testing::readFile(dir + "/c.png"));
     }
 }
 

@@ -28,13 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// Names in a folder, sorted.
 std::vector<std::string> listing(const std::string& dir) {
     std::vector<std::string> names;
@@ -75,7 +68,7 @@ TEST(OutputFile, NewFileAppearsOnlyOnCommitWithTheUmasksMode) {
     }
     ::umask(old);
     EXPECT_EQ(listing(dir), std::vector<std::string>{"out.txt"});
-    EXPECT_EQ(slurp(path), "hello " + std::string(3 << 20, 'x'));
+    EXPECT_EQ(testing::readFile(path), "hello " + std::string(3 << 20, 'x'));
     struct stat st;
     ASSERT_EQ(::stat(path.c_str(), &st), 0);
     EXPECT_EQ(st.st_mode & 0777, 0640u);
@@ -92,9 +85,9 @@ TEST(OutputFile, AbandonedOutputLeavesTheOldFileAndNoTemporary) {
                              }),
                  Error);
     EXPECT_EQ(listing(dir), std::vector<std::string>{"out.txt"});
-    EXPECT_EQ(slurp(path), "old");
+    EXPECT_EQ(testing::readFile(path), "old");
     writeTextOutput(path, "new");
-    EXPECT_EQ(slurp(path), "new");
+    EXPECT_EQ(testing::readFile(path), "new");
     struct stat st;
     ASSERT_EQ(::stat(path.c_str(), &st), 0);
     EXPECT_EQ(st.st_mode & 0777, 0604u) << "a replaced file keeps its permissions";
@@ -109,13 +102,13 @@ TEST(OutputFile, SymbolicLinksAreWrittenThroughAndKept) {
     writeTextOutput(dir + "/chain.png", "new");
     EXPECT_TRUE(fs::is_symlink(dir + "/latest.png"));
     EXPECT_TRUE(fs::is_symlink(dir + "/chain.png"));
-    EXPECT_EQ(slurp(target), "new");
+    EXPECT_EQ(testing::readFile(target), "new");
     EXPECT_EQ(listing(dir + "/runs/42"), std::vector<std::string>{"out.png"});
     // A dangling link: the file it names is created.
     fs::create_symlink("runs/42/next.png", dir + "/next.png");
     writeTextOutput(dir + "/next.png", "created");
     EXPECT_TRUE(fs::is_symlink(dir + "/next.png"));
-    EXPECT_EQ(slurp(dir + "/runs/42/next.png"), "created");
+    EXPECT_EQ(testing::readFile(dir + "/runs/42/next.png"), "created");
     // A loop is an error, not a hang.
     fs::create_symlink(dir + "/loop-b", dir + "/loop-a");
     fs::create_symlink(dir + "/loop-a", dir + "/loop-b");
@@ -127,7 +120,7 @@ TEST(OutputFile, LongNamesFitBecauseTheTemporaryNameIsShort) {
     const std::string dir = testing::scratchDir();
     const std::string path = dir + "/" + std::string(251, 'n') + ".png";  // 255 bytes
     writeTextOutput(path, "x");
-    EXPECT_EQ(slurp(path), "x");
+    EXPECT_EQ(testing::readFile(path), "x");
 }
 
 TEST(OutputFile, FifoIsWrittenInPlace) {
@@ -135,7 +128,7 @@ TEST(OutputFile, FifoIsWrittenInPlace) {
     const std::string fifo = dir + "/pipe";
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
     std::string received;
-    std::thread reader([&] { received = slurp(fifo); });
+    std::thread reader([&] { received = testing::readFile(fifo); });
     writeTextOutput(fifo, "through the pipe");
     reader.join();
     EXPECT_EQ(received, "through the pipe");
@@ -250,7 +243,7 @@ TEST(OutputFile, StandardOutputIsWrittenWhenRedirected) {
     int status = 0;
     ::waitpid(pid, &status, 0);
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-    EXPECT_EQ(slurp(path), "to stdout");
+    EXPECT_EQ(testing::readFile(path), "to stdout");
 }
 
 TEST(OutputFile, AFileSizeLimitIsAnErrorThatLeavesNothingBehind) {
@@ -271,7 +264,7 @@ TEST(OutputFile, AFileSizeLimitIsAnErrorThatLeavesNothingBehind) {
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 0);
     EXPECT_EQ(listing(dir), std::vector<std::string>{"out.bin"});
-    EXPECT_EQ(slurp(path), "old");
+    EXPECT_EQ(testing::readFile(path), "old");
 }
 
 TEST(OutputFile, TerminatingSignalsRemoveTemporaries) {
@@ -306,7 +299,7 @@ TEST(OutputFile, OutputsNamingAnInputOrEachOtherAreRefused) {
         EXPECT_EQ(msg,
                   out + ": -o names the input mesh '" + mesh + "': refusing to overwrite an input");
     }
-    EXPECT_EQ(slurp(mesh), "mesh");
+    EXPECT_EQ(testing::readFile(mesh), "mesh");
     // Two outputs naming one file, existing or not yet, however spelt.
     EXPECT_EQ(
         errorOf([&] {

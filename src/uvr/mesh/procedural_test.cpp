@@ -721,13 +721,6 @@ TEST(MixedCellMesh, BadArgumentsAreArgumentErrors) {
 namespace uvr {
 namespace {
 
-std::string fileBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 TEST(ProceduralStream, SameBytesAsTheMeshWrittenWhole) {
     const std::string dir = testing::scratchDir();
     struct Case {
@@ -755,7 +748,7 @@ TEST(ProceduralStream, SameBytesAsTheMeshWrittenWhole) {
         std::vector<double> calls;
         writeProceduralNative(
             cases[c].spec, streamed, [&](double f) { calls.push_back(f); }, cases[c].slabTets);
-        const std::string a = fileBytes(whole), b = fileBytes(streamed);
+        const std::string a = testing::readFile(whole), b = testing::readFile(streamed);
         ASSERT_FALSE(a.empty());
         EXPECT_EQ(a.size(), b.size());
         EXPECT_TRUE(a == b) << "first difference at byte "

@@ -157,13 +157,6 @@ TEST(Refine, BadLevelsAreArgumentErrors) {
 namespace uvr {
 namespace {
 
-std::string fileBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 TEST(RefineStream, SameBytesAsTheRefinedMeshWrittenWhole) {
     const std::string dir = testing::scratchDir();
     // A hex grid with a point and a cell field; a mixed-cell mesh with two of each and a vector
@@ -192,7 +185,7 @@ TEST(RefineStream, SameBytesAsTheRefinedMeshWrittenWhole) {
         refineToNative(
             *cases[c].mesh, cases[c].levels, streamed, {}, [&](double f) { calls.push_back(f); },
             cases[c].pieceTets);
-        const std::string a = fileBytes(whole), b = fileBytes(streamed);
+        const std::string a = testing::readFile(whole), b = testing::readFile(streamed);
         ASSERT_FALSE(a.empty());
         EXPECT_EQ(a.size(), b.size());
         EXPECT_TRUE(a == b) << "first difference at byte "

@@ -72,13 +72,6 @@ std::string variant(const std::string& name) {
     return variantsDir() + "/" + name;
 }
 
-std::string readText(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 json loadJson(const std::string& path) {
     std::ifstream in(path);
     return json::parse(in);
@@ -238,7 +231,7 @@ TEST(PvtuVariants, ReadVtuForwardsAPvtu) {
 
 TEST(VtuVariants, SeveralPiecesInOneFileAreMerged) {
     REQUIRE_VARIANTS();
-    const std::string text = readText(variant("vtk_ascii_raw_none_UInt32_le.vtu"));
+    const std::string text = testing::readFile(variant("vtk_ascii_raw_none_UInt32_le.vtu"));
     const std::size_t begin = text.find("<Piece"), end = text.find("</Piece>") + 8;
     const std::string piece = text.substr(begin, end - begin);
     const std::string dir = uvr::testing::scratchDir();
@@ -298,7 +291,7 @@ TEST_F(VtuErrors, MissingFileIsAnIoError) {
 }
 
 TEST_F(VtuErrors, XmlSyntaxErrorNamesLineAndColumn) {
-    const std::string text = readText(variant(kAscii));
+    const std::string text = testing::readFile(variant(kAscii));
     const std::size_t pos = text.find("</Points>");
     const std::string path = write("syntax.vtu", replaceOnce(text, "</Points>", "</Pointz>"));
     expectError(
@@ -307,20 +300,20 @@ TEST_F(VtuErrors, XmlSyntaxErrorNamesLineAndColumn) {
 }
 
 TEST_F(VtuErrors, TruncatedInlineFileIsAnXmlError) {
-    const std::string text = readText(variant(kBinary));
+    const std::string text = testing::readFile(variant(kBinary));
     const std::string path = write("cut.vtu", text.substr(0, text.size() / 2));
     expectError([&] { readVtu(path); }, ErrorKind::Parse, {path + ": line ", "XML syntax error"});
 }
 
 TEST_F(VtuErrors, TruncatedAppendedDataIsRefused) {
-    const std::string text = readText(variant(kRaw));
+    const std::string text = testing::readFile(variant(kRaw));
     const std::string path = write("cut.vtu", text.substr(0, text.size() - 400));
     expectError([&] { readVtu(path); }, ErrorKind::Parse,
                 {path + ": byte ", "expected </AppendedData>", "truncated"});
 }
 
 TEST_F(VtuErrors, AppendedDataWithoutUnderscoreIsRefused) {
-    const std::string text = readText(variant(kRaw));
+    const std::string text = testing::readFile(variant(kRaw));
     const std::size_t tag = text.find("<AppendedData");
     const std::size_t underscore = text.find('_', tag);
     std::string edited = text;
@@ -331,7 +324,7 @@ TEST_F(VtuErrors, AppendedDataWithoutUnderscoreIsRefused) {
 }
 
 TEST_F(VtuErrors, BadBase64CharacterNamesItsByteOffset) {
-    std::string text = readText(variant(kBinary));
+    std::string text = testing::readFile(variant(kBinary));
     const std::size_t tag = text.find("Name=\"u16\"");
     const std::size_t pos = text.find('>', tag) + 20;  // inside the base64 text
     text[pos] = '#';
@@ -355,7 +348,7 @@ std::uint32_t loadLe32(const std::string& text, std::size_t pos) {
 }
 
 TEST_F(VtuErrors, CorruptZlibBlockIsNamed) {
-    std::string text = readText(variant(kRawZlib));
+    std::string text = testing::readFile(variant(kRawZlib));
     // Points: 26 x 3 Float64 = 624 bytes in blocks of 256: 3 blocks; corrupt the third.
     const std::size_t start = appendedArrayStart(text, "Points");
     ASSERT_EQ(loadLe32(text, start), 3u);
@@ -372,7 +365,7 @@ TEST_F(VtuErrors, CorruptZlibBlockIsNamed) {
 TEST_F(VtuErrors, WrongPointCountIsASizeMismatch) {
     for (const char* name : {kAscii, kBinary, kRaw, kRawZlib, kB64Zlib}) {
         SCOPED_TRACE(name);
-        const std::string text = readText(variant(name));
+        const std::string text = testing::readFile(variant(name));
         const std::string path =
             write("count.vtu", replaceOnce(text, "NumberOfPoints=\"26\"", "NumberOfPoints=\"27\""));
         expectError([&] { readVtu(path); }, ErrorKind::Parse,
@@ -384,20 +377,20 @@ TEST_F(VtuErrors, AbsurdCountsAreRefusedBeforeAllocating) {
     const std::string huge = "NumberOfPoints=\"900000000000000\"";
     for (const char* name : {kAscii, kBinary, kRaw, kRawZlib}) {
         SCOPED_TRACE(name);
-        const std::string path = write(
-            "absurd.vtu", replaceOnce(readText(variant(name)), "NumberOfPoints=\"26\"", huge));
+        const std::string path = write("absurd.vtu", replaceOnce(testing::readFile(variant(name)),
+                                                                 "NumberOfPoints=\"26\"", huge));
         expectError([&] { readVtu(path); }, ErrorKind::Parse,
                     {path + ": ", "DataArray 'Points' holds 78 values, expected 2700000000000000"});
     }
     // An uncompressed size header larger than the file.
-    std::string text = readText(variant(kRaw));
+    std::string text = testing::readFile(variant(kRaw));
     const std::size_t start = appendedArrayStart(text, "f64");
     text.replace(start, 4, std::string("\xf8\xff\xff\x7f", 4));
     const std::string path = write("header.vtu", text);
     expectError([&] { readVtu(path); }, ErrorKind::Parse,
                 {path + ": byte ", "DataArray 'f64'", "holds 268435455 values, expected 26"});
     // A compressed header declaring 2^32 - 1 blocks.
-    text = readText(variant(kRawZlib));
+    text = testing::readFile(variant(kRawZlib));
     text.replace(appendedArrayStart(text, "f64"), 4, std::string("\xff\xff\xff\xff", 4));
     const std::string path2 = write("blocks.vtu", text);
     expectError([&] { readVtu(path2); }, ErrorKind::Parse,
@@ -416,7 +409,7 @@ TEST_F(VtuErrors, MemoryLimitIsAResourceError) {
 }
 
 TEST_F(VtuErrors, MissingValueInAsciiArrayNamesTheLine) {
-    const std::string text = readText(variant(kAscii));
+    const std::string text = testing::readFile(variant(kAscii));
     const std::size_t tag = text.find("Name=\"cell_id\"");
     const std::size_t textStart = text.find('>', tag) + 1;
     const std::size_t first = text.find_first_not_of(" \n", textStart);
@@ -428,7 +421,7 @@ TEST_F(VtuErrors, MissingValueInAsciiArrayNamesTheLine) {
 }
 
 TEST_F(VtuErrors, BadAsciiTokenNamesTheLine) {
-    const std::string text = readText(variant(kAscii));
+    const std::string text = testing::readFile(variant(kAscii));
     const std::size_t tag = text.find("Name=\"f64\"");
     const std::size_t textStart = text.find('>', tag) + 1;
     const std::size_t secondLine = text.find('\n', text.find_first_not_of(" \n", textStart));
@@ -442,7 +435,7 @@ TEST_F(VtuErrors, BadAsciiTokenNamesTheLine) {
 }
 
 TEST_F(VtuErrors, MissingCellArrayIsNamed) {
-    const std::string text = readText(variant(kAscii));
+    const std::string text = testing::readFile(variant(kAscii));
     const std::string path =
         write("noconn.vtu",
               std::regex_replace(text,
@@ -454,7 +447,7 @@ TEST_F(VtuErrors, MissingCellArrayIsNamed) {
 }
 
 TEST_F(VtuErrors, UnknownTypeNameNamesTheLine) {
-    const std::string text = readText(variant(kRaw));
+    const std::string text = testing::readFile(variant(kRaw));
     const std::size_t pos = text.find("type=\"Float64\" Name=\"f64\"");
     const std::string path = write("type.vtu", replaceOnce(text, "type=\"Float64\" Name=\"f64\"",
                                                            "type=\"Float128\" Name=\"f64\""));
@@ -464,7 +457,7 @@ TEST_F(VtuErrors, UnknownTypeNameNamesTheLine) {
 }
 
 TEST_F(VtuErrors, AppendedOffsetBeyondTheDataIsRefused) {
-    const std::string text = readText(variant(kRaw));
+    const std::string text = testing::readFile(variant(kRaw));
     const std::size_t tag = text.find("Name=\"f64\"");
     const std::size_t off = text.find("offset=\"", tag);
     const std::size_t close = text.find('"', off + 8);
@@ -485,15 +478,15 @@ std::string withAsciiArray(const std::string& text, const std::string& name,
 }
 
 TEST_F(VtuErrors, UnknownCellTypeIsNamed) {
-    const std::string path =
-        write("celltype.vtu",
-              withAsciiArray(readText(variant(kAscii)), "types", "10 12 13 14 24 5 99 10"));
+    const std::string path = write(
+        "celltype.vtu",
+        withAsciiArray(testing::readFile(variant(kAscii)), "types", "10 12 13 14 24 5 99 10"));
     expectError([&] { readVtu(path); }, ErrorKind::Parse,
                 {path, "cell 6: unknown VTK cell type 99"});
 }
 
 TEST_F(VtuErrors, OutOfRangePointIndexIsNamed) {
-    const std::string text = readText(variant(kAscii));
+    const std::string text = testing::readFile(variant(kAscii));
     const std::size_t tag = text.find("Name=\"connectivity\"");
     const std::size_t first = text.find_first_not_of(" \n", text.find('>', tag) + 1);
     std::string edited = text;
@@ -504,25 +497,25 @@ TEST_F(VtuErrors, OutOfRangePointIndexIsNamed) {
 }
 
 TEST_F(VtuErrors, DecreasingOffsetsAreRefused) {
-    const std::string path =
-        write("offsets.vtu",
-              withAsciiArray(readText(variant(kAscii)), "offsets", "4 12 18 23 33 30 44 48"));
+    const std::string path = write(
+        "offsets.vtu",
+        withAsciiArray(testing::readFile(variant(kAscii)), "offsets", "4 12 18 23 33 30 44 48"));
     expectError([&] { readVtu(path); }, ErrorKind::Parse,
                 {path + ": line ", "Piece 0: DataArray 'offsets'",
                  "end offset 30 of cell 5 is below the previous offset 33"});
 }
 
 TEST_F(VtuErrors, UnsupportedCompressorAndDatasetTypeAreNamed) {
-    const std::string text = readText(variant(kRawZlib));
+    const std::string text = testing::readFile(variant(kRawZlib));
     const std::string other =
         write("other.vtu", replaceOnce(text, "vtkZLibDataCompressor", "vtkBZip2DataCompressor"));
     expectError([&] { readVtu(other); }, ErrorKind::Unsupported,
                 {other + ": line " + std::to_string(lineOf(text, text.find("<VTKFile"))),
                  "compressor 'vtkBZip2DataCompressor' is not supported: expected "
                  "vtkZLibDataCompressor, vtkLZ4DataCompressor, vtkLZMADataCompressor or none"});
-    const std::string poly = write(
-        "poly.vtu",
-        replaceOnce(readText(variant(kAscii)), "type=\"UnstructuredGrid\"", "type=\"PolyData\""));
+    const std::string poly =
+        write("poly.vtu", replaceOnce(testing::readFile(variant(kAscii)),
+                                      "type=\"UnstructuredGrid\"", "type=\"PolyData\""));
     expectError([&] { readVtu(poly); }, ErrorKind::Unsupported, {poly, "'PolyData'"});
 }
 
@@ -532,9 +525,9 @@ TEST_F(VtuErrors, PvtuPieceMissingAFieldIsNamed) {
     fs::copy_file(variant("three_0.vtu"), dir_ + "/three_0.vtu");
     fs::copy_file(variant("three_2.vtu"), dir_ + "/three_2.vtu");
     write("three_1.vtu",
-          std::regex_replace(readText(variant("three_1.vtu")),
+          std::regex_replace(testing::readFile(variant("three_1.vtu")),
                              std::regex("<DataArray type=\"Int16\" Name=\"i16\"[^>]*/>"), ""));
-    const std::string text = readText(variant("three.pvtu"));
+    const std::string text = testing::readFile(variant("three.pvtu"));
     const std::string path = write("three.pvtu", text);
     expectError([&] { readPvtu(path); }, ErrorKind::Parse,
                 {path + ": line " + std::to_string(lineOf(text, text.find("three_1.vtu"))),
@@ -542,7 +535,7 @@ TEST_F(VtuErrors, PvtuPieceMissingAFieldIsNamed) {
 }
 
 TEST_F(VtuErrors, PvtuNamingItselfOrAMissingPieceIsRefused) {
-    const std::string text = readText(variant("three.pvtu"));
+    const std::string text = testing::readFile(variant("three.pvtu"));
     const std::string self = write("self.pvtu", replaceOnce(text, "three_0.vtu", "self.pvtu"));
     expectError([&] { readPvtu(self); }, ErrorKind::Parse,
                 {self + ": line ", "Piece 0 ('self.pvtu') names the .pvtu file itself"});
@@ -712,7 +705,7 @@ TEST(VtuNumbers, SignedCountsExponentsAndNanReadAsVtkReadsThem) {
 }
 
 TEST(VtuNumbers, GarbageCountsAndValuesKeepTheirMessages) {
-    const std::string text = readText(testing::testData("vtk/plus_counts.vtu"));
+    const std::string text = testing::readFile(testing::testData("vtk/plus_counts.vtu"));
     const std::string dir = testing::scratchDir();
     struct Case {
         std::string from, to, message;
@@ -766,7 +759,7 @@ TEST(VtuCompressors, CorruptLz4AndLzmaBlocksAreNamed) {
         writeVtu(m, good, {}, options);
         EXPECT_EQ(readVtu(good).points, m.points);
         const std::string bad =
-            testing::writeFile(dir + "/bad.vtu", corruptThirdPointsBlock(readText(good)));
+            testing::writeFile(dir + "/bad.vtu", corruptThirdPointsBlock(testing::readFile(good)));
         expectError([&] { readVtu(bad); }, ErrorKind::Parse,
                     {bad + ": byte ", "Piece 0: DataArray 'Points': ",
                      std::string(name) + " block 2 of DataArray 'Points' is corrupt ("});
