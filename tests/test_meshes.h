@@ -38,7 +38,8 @@ inline Mesh makeHexGrid(
                 Vec3f p(lo + i * h, lo + j * h, lo + k * h);
                 const bool interior = i > 0 && j > 0 && k > 0 && i < n && j < n && k < n;
                 if (interior && jitter > 0.f) {
-                    unsigned s = static_cast<unsigned>(i * 73856093 ^ j * 19349663 ^ k * 83492791);
+                    unsigned s = unsigned(i) * 73856093u ^ unsigned(j) * 19349663u ^
+                                 unsigned(k) * 83492791u;  // wraps (no signed overflow)
                     for (int a = 0; a < 3; ++a) {
                         s = s * 1664525u + 1013904223u;
                         p[a] += jitter * h * ((s >> 8) * (1.f / 16777216.f) - 0.5f) * 2.f;
