@@ -78,9 +78,9 @@ struct PreparedMesh {
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
     bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
-    /// Wall seconds of every phase prepareMesh ran, in order: "split", "bvh", "neighbours",
-    /// "partitions" (with their value ranges), "seed_grids", "gradient_spreads", "nan_flags",
-    /// "macrocells".
+    /// Wall seconds of every phase prepareMesh ran, in order: "split" (with the Morton order and
+    /// the kernels' blocks), "bvh", "neighbours" (with their codes), "partitions" (with their
+    /// value ranges), "cell_tree", "seed_grids", "gradient_spreads", "nan_flags", "macrocells".
     std::vector<std::pair<std::string, double>> phaseSeconds;
     /// The prepared cache it was read from (readPreparedCache), holding only what rendering
     /// reads; empty when prepared from a mesh. updateFieldValues refuses such a mesh.
