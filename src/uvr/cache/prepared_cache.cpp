@@ -396,6 +396,117 @@ void expect(bool ok, const std::string& path, const std::string& what) {
     if (!ok) throwError(ErrorKind::Parse, path, "the prepared cache is inconsistent: " + what);
 }
 
+/// True when a tree of BvhNode (children of an inner node at first, first + 1) is well formed:
+/// from the root, no node is reached twice (no cycles), leaves lie within `prims` entries and no
+/// path is deeper than a traversal's stack holds.
+bool bvhWellFormed(const std::vector<BvhNode>& nodes, std::uint64_t prims) {
+    if (nodes.empty()) return true;
+    std::vector<std::uint8_t> seen(nodes.size(), 0);
+    std::vector<std::pair<std::uint32_t, int>> stack{{0u, 1}};
+    while (!stack.empty()) {
+        const auto [i, depth] = stack.back();
+        stack.pop_back();
+        if (seen[i]) return false;
+        seen[i] = 1;
+        const BvhNode& n = nodes[i];
+        if (n.count > 0) {
+            if (std::uint64_t(n.first) + n.count > prims) return false;
+            continue;
+        }
+        if (depth >= kBvhMaxDepth || std::uint64_t(n.first) + 1 >= nodes.size()) return false;
+        stack.push_back({n.first, depth + 1});
+        stack.push_back({n.first + 1, depth + 1});
+    }
+    return true;
+}
+
+/// The same for the k-d tree: leaves name partitions, no path is deeper than its traversal's
+/// stack.
+bool kdWellFormed(const std::vector<KdNode>& nodes, std::uint64_t partitions) {
+    if (nodes.empty()) return partitions == 0;
+    std::vector<std::uint8_t> seen(nodes.size(), 0);
+    std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
+    while (!stack.empty()) {
+        const auto [i, depth] = stack.back();
+        stack.pop_back();
+        if (seen[i]) return false;
+        seen[i] = 1;
+        const KdNode& n = nodes[i];
+        if (n.isLeaf()) {
+            if (n.child() >= partitions) return false;
+            continue;
+        }
+        if (depth >= kKdMaxDepth || std::uint64_t(n.child()) + 1 >= nodes.size()) return false;
+        stack.push_back({n.child(), depth + 1});
+        stack.push_back({n.child() + 1, depth + 1});
+    }
+    return true;
+}
+
+/// True when every id is a cell or kNoTet.
+bool cellIds(const std::uint32_t* ids, std::uint64_t n, std::uint64_t cells) {
+    std::uint64_t bad = 0;
+#pragma omp parallel for schedule(static) reduction(+ : bad)
+    for (std::int64_t i = 0; i < std::int64_t(n); ++i) bad += ids[i] != kNoTet && ids[i] >= cells;
+    return bad == 0;
+}
+
+/// True when every grid's cells lie within `cells` entries.
+bool gridsWithin(const std::vector<PartitionGrid>& grids, std::uint64_t cells) {
+    for (const PartitionGrid& g : grids)
+        if (std::uint64_t(g.first) + std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2] > cells)
+            return false;
+    return true;
+}
+
+/// Every index the kernels follow lies in range: corners in their block, neighbour codes, escapes
+/// and ids, trees, grids (a crafted file whose CRCs match must not send a kernel out of bounds).
+void checkIndices(const PreparedMesh& m, std::uint64_t tetCount, const std::string& path) {
+    const TetMesh& t = m.tets;
+    const CompactNeighbors& nb = m.neighborCodes;
+    const std::uint64_t cells = tetCount + t.pyramidCount + t.wedgeCount + t.hexCount;
+    const std::uint64_t blocks = (tetCount + kTetBlockSize - 1) / kTetBlockSize;
+    expect(tetCount == 0 || nb.escapeBase.size() == blocks + 1, path,
+           "neighbors.escapeBase does not hold one entry per block and one more");
+    std::uint64_t badCorners = 0, badCodes = 0;
+#pragma omp parallel for schedule(static) reduction(+ : badCorners, badCodes)
+    for (std::int64_t i = 0; i < std::int64_t(tetCount); ++i) {
+        const std::uint64_t b = std::uint64_t(i) >> kTetBlockBits;
+        const std::uint32_t vertices = t.blockVertexBase[b + 1] - t.blockVertexBase[b];
+        const std::uint32_t escapes = nb.escapeBase[b + 1] - nb.escapeBase[b];
+        for (int k = 0; k < 4; ++k) {
+            badCorners += t.tetCorners[i].v[k] >= vertices;
+            const std::uint32_t code = nb.tetCodes[i].c[k];
+            if (code < kTetBlockSize)
+                badCodes +=
+                    ((std::uint64_t(i) & ~std::uint64_t(kTetBlockSize - 1)) | code) >= tetCount;
+            else if (code != kNoNeighborCode)
+                badCodes += code - kTetBlockSize >= escapes;
+        }
+    }
+    expect(badCorners == 0, path, "a tetrahedron's corner lies outside its block");
+    expect(badCodes == 0, path, "a tetrahedron's neighbour code lies outside its block");
+    expect(cellIds(nb.escapes.data(), nb.escapes.size(), cells) &&
+               cellIds(nb.native.data(), nb.native.size(), cells),
+           path, "a face neighbour is not a cell");
+    expect(bvhWellFormed(m.cellTree.nodes, cells), path, "the cell tree is malformed");
+    expect(bvhWellFormed(m.bvh.nodes, m.bvh.primIds.size()) &&
+               cellIds(m.bvh.primIds.data(), m.bvh.primIds.size(), cells) &&
+               std::find(m.bvh.primIds.begin(), m.bvh.primIds.end(), kNoTet) == m.bvh.primIds.end(),
+           path, "the mesh BVH is malformed");
+    if (m.kd) {
+        expect(kdWellFormed(m.kd->nodes, m.kd->partitions.size()), path,
+               "the k-d tree is malformed");
+        if (m.seeds)
+            expect(gridsWithin(m.seeds->grids, m.seeds->seeds.size()) &&
+                       cellIds(m.seeds->seeds.data(), m.seeds->seeds.size(), cells),
+                   path, "the seed grids name cells or seeds out of range");
+        if (m.macro)
+            expect(gridsWithin(m.macro->grids, m.macro->cells.size()), path,
+                   "the macrocell grids reach beyond their cells");
+    }
+}
+
 /// The counts the arrays must agree on (a damaged or crafted file whose CRCs match).
 void checkConsistent(const PreparedMesh& m, std::uint64_t tetCount, const std::string& path) {
     const TetMesh& t = m.tets;
@@ -644,6 +755,7 @@ PreparedMesh readPreparedCache(const std::string& path, const CacheKey& expected
                    "the prepared cache lists " + std::to_string(parsed.table.size()) +
                        " arrays, expected " + std::to_string(next));
     checkConsistent(m, parsed.tetCount, path);
+    checkIndices(m, parsed.tetCount, path);
     m.cacheFile = path;
     return m;
 }

@@ -227,6 +227,56 @@ TEST(PreparedCache, CountLargerThanTheFileIsRefusedBeforeAllocating) {
     EXPECT_EQ(budget.peak(), 0u);
 }
 
+/// Overwrites `size` bytes at byte `at` of array `name` with `value` and reseals the array's
+/// CRC32 and the header's: a crafted file whose checksums all match.
+void craftBytes(std::string& bytes, const std::string& name, std::uint64_t at, const void* value,
+                std::size_t size) {
+    const std::size_t entry = bytes.find(name, 32);
+    ASSERT_NE(entry, std::string::npos);
+    std::uint64_t elementSize, count, offset;
+    std::memcpy(&elementSize, bytes.data() + entry + name.size(), 8);
+    std::memcpy(&count, bytes.data() + entry + name.size() + 8, 8);
+    std::memcpy(&offset, bytes.data() + entry + name.size() + 16, 8);
+    ASSERT_LE(at + size, count * elementSize);
+    std::memcpy(bytes.data() + offset + at, value, size);
+    const std::uint32_t crc = static_cast<std::uint32_t>(crc32(
+        0L, reinterpret_cast<const Bytef*>(bytes.data() + offset), uInt(count * elementSize)));
+    std::memcpy(bytes.data() + entry + name.size() + 24, &crc, 4);
+    resealHeader(bytes);
+}
+
+TEST(PreparedCache, CraftedIndicesWithMatchingChecksumsAreRefused) {
+    const SmallCache c;
+    const std::string good = readAll(c.path);
+    struct Case {
+        const char* array;
+        std::uint64_t at;  ///< byte in the array
+        std::uint64_t value;
+        std::size_t size;
+        const char* message;
+    };
+    const Case cases[] = {
+        // Tetrahedron 1's second corner; tetrahedron 0's fourth neighbour code (an escape far
+        // beyond its block's); the root's `first` (after its 24-byte box); the first seed.
+        {"tets.tetCorners", 10, 0xffffull, 2, "corner lies outside its block"},
+        {"neighbors.tetCodes", 6, 0x2000ull + 30000, 2, "neighbour code lies outside its block"},
+        {"cellTree.nodes", 24, 0xfffffff0ull, 4, "the cell tree is malformed"},
+        {"seeds.seeds", 0, 0x7fffffffull, 4, "name cells or seeds out of range"},
+    };
+    for (const Case& k : cases) {
+        std::string bytes = good;
+        craftBytes(bytes, k.array, k.at, &k.value, k.size);
+        writeAll(c.path, bytes);
+        const Error e = c.readError();
+        EXPECT_EQ(e.kind(), ErrorKind::Parse) << k.array;
+        EXPECT_THAT(e.what(), HasSubstr(k.message)) << k.array;
+        EXPECT_THAT(e.what(), HasSubstr(c.path)) << k.array;
+    }
+    writeAll(c.path, good);
+    LoadBudget budget;
+    EXPECT_NO_THROW(readPreparedCache(c.path, c.key, budget));
+}
+
 TEST(PreparedCache, TheBudgetIsChargedBeforeAllocating) {
     const SmallCache c;
     LoadBudget budget(1000);
