@@ -6,12 +6,10 @@
 
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include "test_support.h"
 #include "uvr/core/error.h"
-#include "uvr/core/file_util.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/tf/transfer_function.h"
@@ -38,15 +36,6 @@ PrepareOptions bothMethods() {
     PrepareOptions o;
     o.kd.leafCells = 64;
     return o;
-}
-
-std::string readAll(const std::string& path) {
-    const std::vector<char> b = readFileBytes(path);
-    return {b.begin(), b.end()};
-}
-
-void writeAll(const std::string& path, const std::string& bytes) {
-    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 }
 
 /// A source file for the key (its contents only matter to the fingerprint).
@@ -165,44 +154,44 @@ void resealHeader(std::string& bytes) {
 
 TEST(PreparedCache, TruncatedFileIsRefused) {
     const SmallCache c;
-    std::string bytes = readAll(c.path);
-    writeAll(c.path, bytes.substr(0, bytes.size() - 200));
+    std::string bytes = testing::readFile(c.path);
+    testing::writeFile(c.path, bytes.substr(0, bytes.size() - 200));
     const Error e = c.readError();
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
     EXPECT_THAT(e.what(), HasSubstr(c.path));
     EXPECT_THAT(e.what(), HasSubstr("reaches beyond the file's"));
-    writeAll(c.path, bytes.substr(0, 20));
+    testing::writeFile(c.path, bytes.substr(0, 20));
     EXPECT_THAT(c.readError().what(), HasSubstr("shorter than its 32-byte preamble"));
 }
 
 TEST(PreparedCache, FlippedByteFailsItsArraysCrc) {
     const SmallCache c;
-    std::string bytes = readAll(c.path);
+    std::string bytes = testing::readFile(c.path);
     // A byte of the first array (tets.tetCorners), which starts at the first multiple of 64
     // after the header.
     bytes[(32 + headerLength(bytes) + 63) / 64 * 64 + 10] ^= 0x10;
-    writeAll(c.path, bytes);
+    testing::writeFile(c.path, bytes);
     const Error e = c.readError();
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
     EXPECT_THAT(e.what(), HasSubstr("fails its CRC32 check"));
     // A flipped byte of the header fails the header's CRC.
-    bytes = readAll(c.path);
+    bytes = testing::readFile(c.path);
     bytes[40] ^= 0x01;
-    writeAll(c.path, bytes);
+    testing::writeFile(c.path, bytes);
     EXPECT_THAT(c.readError().what(), HasSubstr("the header's CRC32 does not match"));
 }
 
 TEST(PreparedCache, WrongMagicAndVersionAreRefused) {
     const SmallCache c;
-    const std::string bytes = readAll(c.path);
+    const std::string bytes = testing::readFile(c.path);
     std::string other = bytes;
     other[0] = 'X';
-    writeAll(c.path, other);
+    testing::writeFile(c.path, other);
     EXPECT_THAT(c.readError().what(), HasSubstr("not a prepared cache"));
     other = bytes;
     const std::uint32_t version = kPreparedCacheVersion + 1;
     std::memcpy(other.data() + 8, &version, 4);
-    writeAll(c.path, other);
+    testing::writeFile(c.path, other);
     const Error e = c.readError();
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
     EXPECT_THAT(e.what(), HasSubstr("format version " + std::to_string(version)));
@@ -211,7 +200,7 @@ TEST(PreparedCache, WrongMagicAndVersionAreRefused) {
 
 TEST(PreparedCache, CountLargerThanTheFileIsRefusedBeforeAllocating) {
     const SmallCache c;
-    std::string bytes = readAll(c.path);
+    std::string bytes = testing::readFile(c.path);
     // The table entry of tets.tetCorners: name, element size, count (docs/PREPARED_CACHE.md).
     const std::string name = "tets.tetCorners";
     const std::size_t at = bytes.find(name, 32);
@@ -219,7 +208,7 @@ TEST(PreparedCache, CountLargerThanTheFileIsRefusedBeforeAllocating) {
     const std::uint64_t huge = 1ull << 60;
     std::memcpy(bytes.data() + at + name.size() + 8, &huge, 8);
     resealHeader(bytes);
-    writeAll(c.path, bytes);
+    testing::writeFile(c.path, bytes);
     LoadBudget budget(1ull << 30);
     const Error e = catchError([&] { readPreparedCache(c.path, c.key, budget); });
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
@@ -247,7 +236,7 @@ void craftBytes(std::string& bytes, const std::string& name, std::uint64_t at, c
 
 TEST(PreparedCache, CraftedIndicesWithMatchingChecksumsAreRefused) {
     const SmallCache c;
-    const std::string good = readAll(c.path);
+    const std::string good = testing::readFile(c.path);
     struct Case {
         const char* array;
         std::uint64_t at;  ///< byte in the array
@@ -266,13 +255,13 @@ TEST(PreparedCache, CraftedIndicesWithMatchingChecksumsAreRefused) {
     for (const Case& k : cases) {
         std::string bytes = good;
         craftBytes(bytes, k.array, k.at, &k.value, k.size);
-        writeAll(c.path, bytes);
+        testing::writeFile(c.path, bytes);
         const Error e = c.readError();
         EXPECT_EQ(e.kind(), ErrorKind::Parse) << k.array;
         EXPECT_THAT(e.what(), HasSubstr(k.message)) << k.array;
         EXPECT_THAT(e.what(), HasSubstr(c.path)) << k.array;
     }
-    writeAll(c.path, good);
+    testing::writeFile(c.path, good);
     LoadBudget budget;
     EXPECT_NO_THROW(readPreparedCache(c.path, c.key, budget));
 }
