@@ -5,7 +5,6 @@
 #include <chrono>
 
 #include "uvr/core/error.h"
-#include "uvr/mesh/tet_math.h"
 
 namespace uvr {
 
@@ -43,33 +42,15 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
         std::vector<Bounds3f> gradients(count);  // bounding boxes of the gradients
         for (std::uint32_t i = 0; i < part.cellCount; ++i) {
             const std::uint32_t t = kd.cells[part.firstCell + i];
-            std::uint32_t ids[kMaxCellCorners];
-            const int corners = view.corners(t, ids);
-            Bounds3f box;
-            for (int k = 0; k < corners; ++k) box.extend(mesh.points[ids[k]]);
-            float lo = INFINITY, hi = -INFINITY;
-            Bounds3f grad;  // the cell's gradients (one for a tetrahedron)
-            bool nan = false;
-            if (cellData) {
-                lo = hi = mesh.values[t];
-                nan = anyNan && lo != lo;
-            } else {
-                for (int k = 0; k < corners && anyNan; ++k)
-                    nan = nan || mesh.values[ids[k]] != mesh.values[ids[k]];
-                for (int k = 0; k < corners; ++k) {
-                    lo = std::fmin(lo, mesh.values[ids[k]]);  // NaN values are left out
-                    hi = std::fmax(hi, mesh.values[ids[k]]);
-                }
-                grad = cellGradientBounds(view, t);
-            }
-            const bool gradOk = !grad.empty();
+            const MacroContribution add = macroContribution(view, t, anyNan);
+            const bool gradOk = !add.gradients.empty();
             bool boundary = false;
             const std::uint64_t faces = view.faceBase(t);
             for (int f = 0; f < kindFaces(view.kind(t)); ++f)
                 boundary = boundary || neighbors[faces + f] == kNoTet;
             std::uint32_t a[3], b[3];
-            macroCellOf(g, box.lo, a);
-            macroCellOf(g, box.hi, b);
+            macroCellOf(g, add.box.lo, a);
+            macroCellOf(g, add.box.hi, b);
             for (std::uint32_t z = a[2]; z <= b[2]; ++z)
                 for (std::uint32_t y = a[1]; y <= b[1]; ++y)
                     for (std::uint32_t x = a[0]; x <= b[0]; ++x) {
@@ -77,13 +58,13 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
                         MacroCell& m = cells[c];
                         // A tetrahedron whose values are all NaN adds no range; nanCells
                         // records it (shadeNan keeps the macrocell while NaN is visible).
-                        m.valueMin = std::fmin(m.valueMin, lo);
-                        m.valueMax = std::fmax(m.valueMax, hi);
-                        if (nan) out.nanCells[g.first + c] = 1;
+                        m.valueMin = std::fmin(m.valueMin, add.lo);
+                        m.valueMax = std::fmax(m.valueMax, add.hi);
+                        if (add.nan) out.nanCells[g.first + c] = 1;
                         if (cellData || boundary)
                             m.gradientSpread = INFINITY;
                         else if (gradOk)
-                            gradients[c].extend(grad);
+                            gradients[c].extend(add.gradients);
                     }
         }
         if (!cellData)

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "uvr/accel/kd_partitions.h"
@@ -64,6 +65,37 @@ UVR_HOST_DEVICE inline std::uint32_t macroCellOf(const PartitionGrid& g, Vec3f p
     return g.first + (idx[2] * g.dims[1] + idx[1]) * g.dims[0] + idx[0];
 }
 
+/// What cell t adds to every macrocell its bounding box overlaps (fillMacroCells' rule, shared by
+/// the CPU's build and the GPU's).
+struct MacroContribution {
+    Bounds3f box;                         ///< the cell's bounding box
+    float lo = INFINITY, hi = -INFINITY;  ///< its value range, NaN left out
+    Bounds3f gradients;                   ///< its field gradients (point data; cellGradientBounds)
+    bool nan = false;                     ///< one of its values is NaN (looked for when anyNan)
+};
+
+/// Cell t's MacroContribution, read as kernels read cells (TetMeshView::kernelGather).
+UVR_HOST_DEVICE inline MacroContribution macroContribution(const TetMeshView& m, std::uint32_t t,
+                                                           bool anyNan) {
+    MacroContribution out;
+    Vec3f x[kMaxCellCorners];
+    float v[kMaxCellCorners];
+    const int corners = m.kernelGather(t, x, m.cellCentered ? nullptr : v);
+    for (int k = 0; k < corners; ++k) out.box.extend(x[k]);
+    if (m.cellCentered) {
+        out.lo = out.hi = m.values[t];
+        out.nan = anyNan && out.lo != out.lo;
+        return out;
+    }
+    for (int k = 0; k < corners; ++k) {
+        out.nan = out.nan || (anyNan && v[k] != v[k]);
+        out.lo = fminf(out.lo, v[k]);  // NaN values are left out
+        out.hi = fmaxf(out.hi, v[k]);
+    }
+    out.gradients = cellGradientBounds(m, t);
+    return out;
+}
+
 /// Builds the macrocell grids of every partition of kd over mesh (in parallel over partitions;
 /// the result does not depend on the thread count). Each tetrahedron of a partition adds its
 /// values and gradient to every macrocell its bounding box overlaps; neighbors (4 per
@@ -78,5 +110,16 @@ MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
 /// need only this. The capacity of out.cells is reused.
 void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
                     const std::vector<std::uint32_t>& neighbors, MacroGrids& out);
+
+/// Macrocell grids and the partitions' gradient spreads (partitionGradientSpread) at once.
+struct MacroBuild {
+    MacroGrids macro;
+    std::vector<float> gradientSpread;
+};
+
+/// Builds macrocells and gradient spreads elsewhere (buildMacroGridsCuda: on the GPU): the same
+/// as buildMacroGrids and partitionGradientSpread (zeros may differ in sign).
+using MacroBuilder = std::function<MacroBuild(const TetMesh&, const KdPartitions&,
+                                              const std::vector<std::uint32_t>&, float)>;
 
 }  // namespace uvr

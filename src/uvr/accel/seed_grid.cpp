@@ -62,12 +62,10 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
     SeedGrids out;
     const std::size_t n = kd.partitions.size();
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids", mesh.meanSplitTets());
-    const TetMeshView view = mesh.view();
-    const TetLocator locator{view, {}, {}};
+    const TetLocator locator{mesh.view(), {}, {}};
     out.seeds.assign(gridCellCount(out.grids), kNoTet);
-    // Seeds: per cell the smallest key (squared distance of a tetrahedron's centroid to the cell
-    // centre, 0 when the tetrahedron contains the centre; ties to the smaller id). Partitions are
-    // independent, each filled by one thread in cell order: the result is deterministic.
+    // Partitions are independent, each filled by one thread in cell order with the smallest key
+    // offered (offerSeedKeys): the result is deterministic.
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {
         const KdPartition& part = kd.partitions[p];
@@ -75,49 +73,10 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
         if (part.cellCount == 0 || part.box.empty()) continue;
         const std::size_t cells = std::size_t(g.dims[0]) * g.dims[1] * g.dims[2];
         std::vector<std::uint64_t> best(cells, ~std::uint64_t(0));
-        Vec3f cellSize;
-        for (int a = 0; a < 3; ++a)
-            cellSize[a] = g.cellsPerUnit[a] > 0.f ? 1.f / g.cellsPerUnit[a] : 0.f;
-        for (std::uint32_t i = 0; i < part.cellCount; ++i) {
-            const std::uint32_t t = kd.cells[part.firstCell + i];
-            std::uint32_t ids[kMaxCellCorners];
-            const int corners = view.corners(t, ids);
-            Bounds3f box;
-            Vec3f centroid(0.f);
-            for (int k = 0; k < corners; ++k) {
-                box.extend(mesh.points[ids[k]]);
-                centroid += mesh.points[ids[k]];
-            }
-            centroid = centroid * (1.f / float(corners));
-            std::uint32_t lo[3], hi[3];
-            for (int k = 0; k < 3; ++k) {
-                lo[k] = SeedGridView::cellIndex(g, k, box.lo[k]);
-                hi[k] = SeedGridView::cellIndex(g, k, box.hi[k]);
-            }
-            for (std::uint32_t z = lo[2]; z <= hi[2]; ++z)
-                for (std::uint32_t y = lo[1]; y <= hi[1]; ++y)
-                    for (std::uint32_t x = lo[0]; x <= hi[0]; ++x) {
-                        std::uint64_t& slot =
-                            best[(std::size_t(z) * g.dims[1] + y) * g.dims[0] + x];
-                        // Every key of t is at least t: a cell whose best key is no larger
-                        // (a containing cell of smaller id) keeps it, so t is not tested there.
-                        if (slot <= t) continue;
-                        const Vec3f centre(g.lo.x + (x + 0.5f) * cellSize.x,
-                                           g.lo.y + (y + 0.5f) * cellSize.y,
-                                           g.lo.z + (z + 0.5f) * cellSize.z);
-                        float bary[4];
-                        float dist2 = 0.f;
-                        const bool inside = locator.inside(t, centre, bary);
-                        if (!inside) {
-                            const Vec3f e = centroid - centre;
-                            dist2 = dot(e, e);
-                        }
-                        std::uint32_t bits;
-                        std::memcpy(&bits, &dist2, sizeof bits);  // non-negative: orders as uint
-                        const std::uint64_t key = (std::uint64_t(bits) << 32) | t;
-                        slot = std::min(slot, key);
-                    }
-        }
+        for (std::uint32_t i = 0; i < part.cellCount; ++i)
+            offerSeedKeys(
+                locator, g, kd.cells[part.firstCell + i], [&](std::uint64_t c) { return best[c]; },
+                [&](std::uint64_t c, std::uint64_t key) { best[c] = std::min(best[c], key); });
         std::uint32_t* seeds = out.seeds.data() + g.first;
         for (std::size_t k = 0; k < cells; ++k)
             seeds[k] = best[k] == ~std::uint64_t(0) ? kNoTet : static_cast<std::uint32_t>(best[k]);

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/point_locator.h"
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/host_device.h"
 #include "uvr/mesh/tet_mesh.h"
@@ -88,6 +91,60 @@ UVR_HOST_DEVICE inline float gridCellExit(const PartitionGrid& g, const std::uin
 /// any point of its cell, so a walk from it takes a few steps whatever the ray's step length.
 inline constexpr float kTetsPerSeedCell = 2.f;
 
+/// The bits of a float (for a non-negative one, ordered as the float is).
+UVR_HOST_DEVICE inline std::uint32_t floatBits(float f) {
+#if defined(__CUDA_ARCH__)
+    return __float_as_uint(f);
+#else
+    return std::bit_cast<std::uint32_t>(f);
+#endif
+}
+
+/// The seed keys cell t offers grid g (buildSeedGrids' rule): for each grid cell its bounding box
+/// overlaps (index i, x fastest) whose best key so far, best(i), exceeds t, offer(i, key) with key
+/// = (squared distance from t's centroid to the grid cell's centre, 0 when t contains the centre)
+/// << 32 | t. Every key of t is at least t, so a grid cell whose best is no larger (a containing
+/// cell of smaller id) is not tested. The seed is the smallest key offered: the CPU's build
+/// takes it serially per partition, the GPU's by atomic minima, and both get the same seeds
+/// (best(i) may be stale: it only saves tests).
+template <class Best, class Offer>
+UVR_HOST_DEVICE void offerSeedKeys(const TetLocator& locator, const PartitionGrid& g,
+                                   std::uint32_t t, Best&& best, Offer&& offer) {
+    Vec3f x[kMaxCellCorners];
+    const int corners = locator.mesh.kernelGather(t, x);
+    Bounds3f box;
+    Vec3f centroid(0.f);
+    for (int k = 0; k < corners; ++k) {
+        box.extend(x[k]);
+        centroid += x[k];
+    }
+    centroid = centroid * (1.f / float(corners));
+    Vec3f cellSize;
+    std::uint32_t lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        cellSize[a] = g.cellsPerUnit[a] > 0.f ? 1.f / g.cellsPerUnit[a] : 0.f;
+        lo[a] = SeedGridView::cellIndex(g, a, box.lo[a]);
+        hi[a] = SeedGridView::cellIndex(g, a, box.hi[a]);
+    }
+    for (std::uint32_t z = lo[2]; z <= hi[2]; ++z)
+        for (std::uint32_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::uint32_t xi = lo[0]; xi <= hi[0]; ++xi) {
+                const std::uint64_t i = (std::uint64_t(z) * g.dims[1] + y) * g.dims[0] + xi;
+                if (best(i) <= t) continue;
+                const Vec3f centre(g.lo.x + (xi + 0.5f) * cellSize.x,
+                                   g.lo.y + (y + 0.5f) * cellSize.y,
+                                   g.lo.z + (z + 0.5f) * cellSize.z);
+                float bary[4];
+                float dist2 = 0.f;
+                if (!locator.inside(t, centre, bary)) {
+                    const Vec3f e = centroid - centre;
+                    dist2 = dot(e, e);
+                }
+                // A non-negative float orders as its bits do.
+                offer(i, (std::uint64_t(floatBits(dist2)) << 32) | t);
+            }
+}
+
 /// Seed grids of all partitions: for every grid cell, the partition's tetrahedron containing the
 /// cell's centre, else the one overlapping the cell whose centroid lies closest to the centre,
 /// else kNoTet. Point location with long steps starts its walk there (O(1) per sample instead of
@@ -109,5 +166,9 @@ struct SeedGrids {
 /// result does not depend on the thread count.
 SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd,
                          float tetsPerCell = kTetsPerSeedCell);
+
+/// Builds seed grids elsewhere (buildSeedGridsCuda: on the GPU): the same grids and seeds as
+/// buildSeedGrids.
+using SeedBuilder = std::function<SeedGrids(const TetMesh&, const KdPartitions&, float)>;
 
 }  // namespace uvr

@@ -3,6 +3,8 @@
 
 #include "uvr/accel/kd_partitions.h"
 #include "uvr/accel/lbvh.h"
+#include "uvr/accel/macro_grid.h"
+#include "uvr/accel/seed_grid.h"
 
 namespace uvr {
 
@@ -23,5 +25,23 @@ LbvhResult buildLbvhCuda(const LbvhInput& input);
 /// same splits, leaves and cell lists as the CPU's build, numbered breadth-first. Throws as
 /// buildLbvhCuda does.
 KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options);
+
+/// Finds the face neighbours of buildTetNeighbors on the GPU (points welded on the CPU; faces
+/// counted, scattered into their smallest vertex's bucket and paired there, in passes over
+/// vertex ranges when they do not all fit, or of at most facesPerPass faces when it is not 0):
+/// the same table. Throws as buildLbvhCuda does.
+std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh,
+                                                 std::uint64_t facesPerPass = 0);
+
+/// Builds the seed grids of buildSeedGrids on the GPU (one block per partition, seed keys kept
+/// by atomic minima): the same grids and seeds. Throws as buildLbvhCuda does.
+SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell);
+
+/// Builds the macrocell grids of buildMacroGrids and the gradient spreads of
+/// partitionGradientSpread on the GPU (one block per partition; ranges, gradient boxes and flags
+/// kept by atomic minima, maxima and ors): the same values, zeros possibly of the other sign.
+/// Throws as buildLbvhCuda does.
+MacroBuild buildMacroGridsCuda(const TetMesh& mesh, const KdPartitions& kd,
+                               const std::vector<std::uint32_t>& neighbors, float tetsPerCell);
 
 }  // namespace uvr

@@ -41,6 +41,8 @@ TEST(CudaLbvh, WithoutADeviceTheBuildIsRefusedClearly) {
     const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
     EXPECT_THROW(buildMeshLbvh(mesh, buildLbvhCuda), Error);
     EXPECT_THROW(buildKdTreeCuda(mesh, {}), Error);
+    EXPECT_THROW(buildTetNeighborsCuda(mesh), Error);
+    EXPECT_THROW(buildSeedGridsCuda(mesh, buildKdPartitions(mesh, {}), kTetsPerSeedCell), Error);
 }
 
 TEST(CudaLbvh, MeshTreeIsBitIdenticalToTheCpuBuild) {
@@ -125,6 +127,63 @@ TEST(CudaKd, SameSplitsLeavesAndCellsAsTheCpuBuild) {
                 ASSERT_TRUE(a.lo == b.lo && a.hi == b.hi) << "query " << q;
             }
         }
+    }
+}
+
+/// Meshes for the face and seed builders: tetrahedra only, mixed native cells, and tetrahedra
+/// with a seam of duplicated points across every other cell (welded faces) and a face shared by
+/// three tetrahedra (left a boundary).
+std::vector<std::pair<std::string, TetMesh>> builderMeshes() {
+    std::vector<std::pair<std::string, TetMesh>> out;
+    out.emplace_back("tetrahedra", proceduralTets(300000));
+    const Mesh mixed = generateMixedCellMesh(24);
+    out.emplace_back("mixed cells", tetrahedralize(mixed, selectScalarField(mixed, {}), {}));
+    ProceduralSpec spec;
+    spec.targetCells = 20000;
+    Mesh seams = generateMesh(spec);
+    const std::size_t points = seams.points.size();
+    seams.points.insert(seams.points.end(), seams.points.begin(), seams.points.end());
+    for (Field& f : seams.fields) f.values.insert(f.values.end(), f.values.begin(), f.values.end());
+    for (std::size_t c = 1; c < seams.cellCount(); c += 2)
+        for (std::uint64_t k = seams.cellOffsets[c]; k < seams.cellOffsets[c + 1]; ++k)
+            seams.cellIndices[k] += static_cast<std::uint32_t>(points);
+    const std::vector<std::uint32_t> first(seams.cell(0).begin(), seams.cell(0).end());
+    seams.cellIndices.insert(seams.cellIndices.end(), first.begin(), first.end());
+    seams.cellOffsets.push_back(seams.cellIndices.size());  // a third cell on the first's faces
+    seams.cellTypes.push_back(seams.cellTypes[0]);
+    out.emplace_back("seams",
+                     tetrahedralize(seams, selectScalarField(seams, {}), {.splitCells = true}));
+    return out;
+}
+
+TEST(CudaPrepare, FaceNeighboursEqualTheCpuTable) {
+    UVR_REQUIRE_GPU();
+    for (const auto& [name, mesh] : builderMeshes()) {
+        const std::vector<std::uint32_t> cpu = buildTetNeighbors(mesh);
+        EXPECT_EQ(buildTetNeighborsCuda(mesh), cpu) << name;
+        // In passes over vertex ranges, as when the faces do not fit at once.
+        EXPECT_EQ(buildTetNeighborsCuda(mesh, mesh.view().faceSlots() / 7 + 64), cpu) << name;
+    }
+}
+
+TEST(CudaPrepare, SeedGridsEqualTheCpuSeeds) {
+    UVR_REQUIRE_GPU();
+    for (const auto& [name, mesh] : builderMeshes()) {
+        KdBuildOptions o;
+        o.leafCells = 2048;
+        const KdPartitions kd = buildKdPartitions(mesh, o);
+        const SeedGrids cpu = buildSeedGrids(mesh, kd);
+        const SeedGrids gpu = buildSeedGridsCuda(mesh, kd, kTetsPerSeedCell);
+        ASSERT_EQ(cpu.grids.size(), gpu.grids.size()) << name;
+        EXPECT_EQ(std::memcmp(cpu.grids.data(), gpu.grids.data(),
+                              cpu.grids.size() * sizeof(PartitionGrid)),
+                  0)
+            << name;
+        EXPECT_EQ(cpu.seeds, gpu.seeds) << name;
+        EXPECT_GT(std::count_if(gpu.seeds.begin(), gpu.seeds.end(),
+                                [](std::uint32_t t) { return t != kNoTet; }),
+                  std::ptrdiff_t(gpu.seeds.size() / 2))
+            << name;
     }
 }
 

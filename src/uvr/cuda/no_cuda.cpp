@@ -6,6 +6,17 @@
 
 namespace uvr {
 
+namespace {
+
+/// The error of every GPU builder here.
+[[noreturn]] void noCudaBuilders() {
+    throwError(ErrorKind::Unsupported, "",
+               "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
+               "compiler and UVR_ENABLE_CUDA=ON)");
+}
+
+}  // namespace
+
 struct CudaScene::Impl {};
 
 bool cudaDeviceAvailable() {
@@ -47,15 +58,24 @@ double CudaScene::uploadSeconds() const {
 }
 
 LbvhResult buildLbvhCuda(const LbvhInput&) {
-    throwError(ErrorKind::Unsupported, "",
-               "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
-               "compiler and UVR_ENABLE_CUDA=ON)");
+    noCudaBuilders();
 }
 
 KdTree buildKdTreeCuda(const TetMesh&, const KdBuildOptions&) {
-    throwError(ErrorKind::Unsupported, "",
-               "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
-               "compiler and UVR_ENABLE_CUDA=ON)");
+    noCudaBuilders();
+}
+
+std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh&, std::uint64_t) {
+    noCudaBuilders();
+}
+
+SeedGrids buildSeedGridsCuda(const TetMesh&, const KdPartitions&, float) {
+    noCudaBuilders();
+}
+
+MacroBuild buildMacroGridsCuda(const TetMesh&, const KdPartitions&,
+                               const std::vector<std::uint32_t>&, float) {
+    noCudaBuilders();
 }
 
 }  // namespace uvr

@@ -31,6 +31,8 @@ PrepareOptions RendererOptions::prepareOptions() const {
     if (buildOnCuda) {
         o.lbvh = buildLbvhCuda;
         o.kdSplitter = buildKdTreeCuda;
+        o.faceMatcher = [](const TetMesh& m) { return buildTetNeighborsCuda(m); };
+        o.seedBuilder = buildSeedGridsCuda;
         o.builderDevice = "the GPU";
         if (buildDevice == Device::Auto) o.builderMinTets = kAutoGpuBuildTets;
     }

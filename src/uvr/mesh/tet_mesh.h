@@ -11,6 +11,7 @@
 #include "uvr/mesh/cell_math.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
+#include "uvr/mesh/tet_math.h"
 
 namespace uvr {
 
@@ -150,6 +151,18 @@ struct TetMeshView {
         if (v)
             for (int i = 0; i < n; ++i) v[i] = values[ids[i]];
         return n;
+    }
+    /// gather as kernels read cells: a tetrahedron's corners from its block (where the blocks
+    /// exist), a native cell's from the points; the same positions and point values.
+    UVR_HOST_DEVICE int kernelGather(std::uint64_t c, Vec3f x[kMaxCellCorners],
+                                     float* v = nullptr) const {
+        if (c >= tetCount || !tetCorners) return gather(c, x, v);
+        BlockVertex b[4];
+        tetVertices(c, b);
+        for (int k = 0; k < 4; ++k) x[k] = b[k].p;
+        if (v)
+            for (int k = 0; k < 4; ++k) v[k] = b[k].value;
+        return 4;
     }
     /// Index of cell c's first face in a face-neighbour table (faceCount(c) entries follow).
     UVR_HOST_DEVICE std::uint64_t faceBase(std::uint64_t c) const {
@@ -311,7 +324,26 @@ void encodeTetBlocks(TetMesh& mesh);
 /// constant gradient; a native cell's gradients at its corners and centre (a pyramid's apex,
 /// where the map is singular, replaced by the middle of its axis), an estimate of their range.
 /// Empty when one is not finite (a degenerate cell, NaN values).
-Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c);
+UVR_HOST_DEVICE inline Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c) {
+    Vec3f x[kMaxCellCorners];
+    float v[kMaxCellCorners];
+    const int n = m.kernelGather(c, x, v);
+    const CellKind k = m.kind(c);
+    Bounds3f box;
+    if (k == CellKind::Tet) {
+        const Vec3f g = tetGradient(x[0], x[1], x[2], x[3], v[0], v[1], v[2], v[3]);
+        if (isFinite(g)) box.extend(g);
+        return box;
+    }
+    for (int i = 0; i <= n; ++i) {
+        Vec3f rst = i < n ? cornerParametric(k, i) : cellCentreParametric(k);
+        if (k == CellKind::Pyramid && i == 4) rst = Vec3f(0.5f, 0.5f, 0.5f);
+        const Vec3f g = cellGradient(k, x, v, rst);
+        if (!isFinite(g)) return Bounds3f{};
+        box.extend(g);
+    }
+    return box;
+}
 
 /// Attaches a field of the source mesh to the cells: values (a point field's as they are, a
 /// cell field's copied onto each of its cell's tetrahedra through cellTets and onto native cells

@@ -360,27 +360,6 @@ std::string describeCells(const TetMesh& mesh) {
     return std::to_string(mesh.cellCount()) + " cells (" + parts + ")";
 }
 
-Bounds3f cellGradientBounds(const TetMeshView& m, std::uint64_t c) {
-    Vec3f x[kMaxCellCorners];
-    float v[kMaxCellCorners];
-    const int n = m.gather(c, x, v);
-    const CellKind k = m.kind(c);
-    Bounds3f box;
-    if (k == CellKind::Tet) {
-        const Vec3f g = tetGradient(x[0], x[1], x[2], x[3], v[0], v[1], v[2], v[3]);
-        if (isFinite(g)) box.extend(g);
-        return box;
-    }
-    for (int i = 0; i <= n; ++i) {
-        Vec3f rst = i < n ? cornerParametric(k, i) : cellCentreParametric(k);
-        if (k == CellKind::Pyramid && i == 4) rst = Vec3f(0.5f, 0.5f, 0.5f);
-        const Vec3f g = cellGradient(k, x, v, rst);
-        if (!isFinite(g)) return Bounds3f{};
-        box.extend(g);
-    }
-    return box;
-}
-
 MeshFrame frameForBounds(const Bounds3f& bounds) {
     MeshFrame f;
     if (bounds.empty() || !isFinite(bounds.lo) || !isFinite(bounds.hi)) return f;

@@ -41,7 +41,9 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     const bool elsewhere = out.tets.cellCount() >= options.builderMinTets;
     const LbvhBuilder lbvh = elsewhere ? options.lbvh : nullptr;
     const KdSplitter splitter = elsewhere ? options.kdSplitter : nullptr;
-    out.builtElsewhere = elsewhere && (lbvh || splitter);
+    const auto faceMatcher = elsewhere ? options.faceMatcher : nullptr;
+    const SeedBuilder seedBuilder = elsewhere ? options.seedBuilder : nullptr;
+    out.builtElsewhere = elsewhere && (lbvh || splitter || faceMatcher || seedBuilder);
     if (options.meshBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
@@ -60,8 +62,10 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     }
 
     start = std::chrono::steady_clock::now();
-    if (progress) progress("finding face neighbours");
-    out.neighbors = buildTetNeighbors(out.tets);
+    if (progress)
+        progress("finding face neighbours" +
+                 (faceMatcher ? " (on " + options.builderDevice + ")" : std::string()));
+    out.neighbors = faceMatcher ? faceMatcher(out.tets) : buildTetNeighbors(out.tets);
     out.neighborCodes = compactNeighbors(out.tets, out.neighbors);
     out.adjacencySeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("neighbours", out.adjacencySeconds);
@@ -69,8 +73,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     if (options.partitions) {
         if (progress)
             progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
-                     " cells each" +
-                     (out.builtElsewhere ? ", on " + options.builderDevice : std::string()) + ")");
+                     " cells each" + (splitter ? ", on " + options.builderDevice : std::string()) +
+                     ")");
         KdBuildOptions kd = options.kd;
         // The leaf size counts tetrahedra of the split: native cells fill a leaf as the
         // tetrahedra they stand for would (partitions of the same size in space).
@@ -85,9 +89,12 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         out.cellTree = buildCellTree(out.tets);
         out.phaseSeconds.emplace_back("cell_tree", secondsSince(start));
         if (options.seedGrids) {
-            if (progress) progress("building seed grids");
+            if (progress)
+                progress("building seed grids" +
+                         (seedBuilder ? " (on " + options.builderDevice + ")" : std::string()));
             start = std::chrono::steady_clock::now();
-            out.seeds = buildSeedGrids(out.tets, *out.kd);
+            out.seeds = seedBuilder ? seedBuilder(out.tets, *out.kd, kTetsPerSeedCell)
+                                    : buildSeedGrids(out.tets, *out.kd);
             out.phaseSeconds.emplace_back("seed_grids", secondsSince(start));
         }
         start = std::chrono::steady_clock::now();

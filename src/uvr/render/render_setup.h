@@ -41,11 +41,16 @@ struct PrepareOptions {
     /// When set, the k-d tree comes from this splitter (buildKdTreeCuda: on the GPU); it
     /// overrides kd.splitter.
     KdSplitter kdSplitter;
+    /// When set, the face neighbours come from this builder (buildTetNeighborsCuda: on the GPU),
+    /// the same table as buildTetNeighbors.
+    std::function<std::vector<std::uint32_t>(const TetMesh&)> faceMatcher;
+    /// When set, the seed grids come from this builder (buildSeedGridsCuda: on the GPU).
+    SeedBuilder seedBuilder;
     /// Called once the cells are split (tetrahedralize), after which prepareMesh reads nothing of
     /// the source mesh: a caller holding the only copy may free it then, so a one-shot render of
     /// a billion cells does not hold the mesh as read beside the prepared one.
     std::function<void()> afterSplit;
-    std::string builderDevice = "cpu";  ///< where lbvh and kdSplitter build (progress messages)
+    std::string builderDevice = "cpu";  ///< where the builders above build (progress messages)
     std::uint64_t builderMinTets = 0;   ///< use them only from this many cells
 };
 
@@ -77,7 +82,7 @@ struct PreparedMesh {
     double splitSeconds = 0.0;      ///< time to split cells (or keep them native)
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
-    bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) made BVHs and k-d tree
+    bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) built parts of it
     /// Wall seconds of every phase prepareMesh ran, in order: "split" (with the Morton order and
     /// the kernels' blocks), "bvh", "neighbours" (with their codes), "partitions" (with their
     /// value ranges), "cell_tree", "seed_grids", "gradient_spreads", "nan_flags", "macrocells".

@@ -1,0 +1,456 @@
+// SPDX-License-Identifier: MIT
+// The GPU's builds of face neighbours and seed grids (issue 16: the first image of 100M
+// tetrahedra in seconds). Memory, atomics and launches only: the face rule is buildTetNeighbors'
+// (faces bucketed by their smallest welded vertex, a face paired only with its one equal) and the
+// seed rule is offerSeedKeys', so the tables equal the CPU's bit for bit. This file is compiled
+// with --fmad=false: no multiply-add is fused, so the seeds' barycentrics and distances round as
+// the CPU's do.
+#include <cub/device/device_scan.cuh>
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include "uvr/accel/macro_grid.h"
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/core/error.h"
+#include "uvr/cuda/cuda_build.h"
+#include "uvr/cuda/cuda_check.h"
+#include "uvr/cuda/launch.cuh"
+
+namespace uvr {
+
+namespace cuda {
+namespace {
+
+/// A face in its smallest welded vertex's bucket: the other vertex ids (sorted; d is kNoCell for
+/// a triangle) and its slot in the neighbour table (TetMeshView::faceBase + face).
+struct FaceEntry {
+    std::uint32_t b, c, d, slot;
+};
+
+/// Sorted welded vertex ids of face `face` of cell c into f (f[3] = kNoCell for a triangle).
+__device__ void sortedFace(const TetMeshView& m, const std::uint32_t* canon, std::uint64_t c,
+                           int face, std::uint32_t f[4]) {
+    std::uint32_t ids[kMaxCellCorners];
+    m.corners(c, ids);
+    const std::uint32_t packed = packedFace(m.kind(c), face);
+    const int n = faceSize(packed);
+    f[3] = kNoCell;
+    for (int i = 0; i < n; ++i) f[i] = canon[ids[faceCorner(packed, i)]];
+    for (int i = 1; i < n; ++i)  // insertion sort of 3 or 4
+        for (int j = i; j > 0 && f[j - 1] > f[j]; --j) {
+            const std::uint32_t s = f[j];
+            f[j] = f[j - 1];
+            f[j - 1] = s;
+        }
+}
+
+/// The cell whose faces hold neighbour-table slot s (the inverse of TetMeshView::faceBase).
+__device__ std::uint32_t cellOfSlot(const TetMeshView& m, std::uint64_t s) {
+    if (s < 4 * m.tetCount) return static_cast<std::uint32_t>(s / 4);
+    s -= 4 * m.tetCount;
+    const std::uint64_t pw = m.pyramidCount + m.wedgeCount;
+    if (s < 5 * pw) return static_cast<std::uint32_t>(m.tetCount + s / 5);
+    return static_cast<std::uint32_t>(m.tetCount + pw + (s - 5 * pw) / 6);
+}
+
+/// Faces per smallest welded vertex.
+__global__ void countFacesKernel(TetMeshView m, const std::uint32_t* canon,
+                                 unsigned long long* counts) {
+    const std::uint64_t c = globalThread();
+    if (c >= m.cellCount()) return;
+    const int faces = kindFaces(m.kind(c));
+    for (int i = 0; i < faces; ++i) {
+        std::uint32_t f[4];
+        sortedFace(m, canon, c, i, f);
+        atomicAdd(&counts[f[0]], 1ull);
+    }
+}
+
+/// Faces whose smallest vertex lies in [lo, hi) into their buckets (entries from offset `base`),
+/// in any order: matchKernel's rule does not depend on it.
+__global__ void scatterFacesKernel(TetMeshView m, const std::uint32_t* canon, std::uint32_t lo,
+                                   std::uint32_t hi, unsigned long long base,
+                                   unsigned long long* fill, FaceEntry* entries) {
+    const std::uint64_t c = globalThread();
+    if (c >= m.cellCount()) return;
+    const int faces = kindFaces(m.kind(c));
+    const std::uint64_t first = m.faceBase(c);
+    for (int i = 0; i < faces; ++i) {
+        std::uint32_t f[4];
+        sortedFace(m, canon, c, i, f);
+        if (f[0] < lo || f[0] >= hi) continue;
+        const unsigned long long at = atomicAdd(&fill[f[0]], 1ull) - base;
+        entries[at] = {f[1], f[2], f[3], static_cast<std::uint32_t>(first + i)};
+    }
+}
+
+/// Per vertex of [lo, hi): each face of its bucket with exactly one equal face gets that face's
+/// cell as its neighbour (a face shared by three or more cells stays a boundary, as on the CPU).
+__global__ void matchKernel(TetMeshView m, std::uint32_t lo, std::uint32_t hi,
+                            const unsigned long long* offsets, unsigned long long base,
+                            const FaceEntry* entries, std::uint32_t* neighbors) {
+    const std::uint64_t v = lo + globalThread();
+    if (v >= hi) return;
+    const std::uint64_t begin = offsets[v] - base, end = offsets[v + 1] - base;
+    for (std::uint64_t i = begin; i < end; ++i) {
+        const FaceEntry e = entries[i];
+        std::uint32_t equal = 0, other = 0;
+        for (std::uint64_t j = begin; j < end && equal < 2; ++j) {
+            const FaceEntry o = entries[j];
+            if (j != i && o.b == e.b && o.c == e.c && o.d == e.d) {
+                ++equal;
+                other = o.slot;
+            }
+        }
+        if (equal == 1) neighbors[e.slot] = cellOfSlot(m, other);
+    }
+}
+
+/// Seeds of every partition: one block per partition, its threads over the partition's cells,
+/// each offering its keys by atomic minima.
+__global__ void seedKernel(TetLocator locator, const KdPartition* partitions,
+                           const std::uint32_t* kdCells, const PartitionGrid* grids,
+                           unsigned long long* best) {
+    const KdPartition part = partitions[blockIdx.x];
+    const PartitionGrid g = grids[blockIdx.x];
+    if (part.cellCount == 0 || part.box.empty()) return;
+    unsigned long long* slots = best + g.first;
+    for (std::uint32_t i = threadIdx.x; i < part.cellCount; i += blockDim.x)
+        offerSeedKeys(
+            locator, g, kdCells[part.firstCell + i],
+            [&](std::uint64_t c) { return static_cast<std::uint64_t>(slots[c]); },
+            [&](std::uint64_t c, std::uint64_t key) {
+                atomicMin(&slots[c], static_cast<unsigned long long>(key));
+            });
+}
+
+/// Best keys to seeds (the key's low half; kNoTet where no cell offered one).
+__global__ void seedsFromKeysKernel(const unsigned long long* best, std::uint64_t n,
+                                    std::uint32_t* seeds) {
+    const std::uint64_t i = globalThread();
+    if (i >= n) return;
+    seeds[i] = best[i] == ~0ull ? kNoTet : static_cast<std::uint32_t>(best[i]);
+}
+
+/// Order-preserving keys of a box's corners, folded into six keys (atomic min / max).
+__device__ void foldBox(const Bounds3f& b, std::uint32_t* keys) {
+    for (int a = 0; a < 3; ++a) {
+        atomicMin(&keys[a], kdsplit::floatKey(b.lo[a]));
+        atomicMax(&keys[3 + a], kdsplit::floatKey(b.hi[a]));
+    }
+}
+
+/// The box of six keys (empty when nothing was folded in).
+__device__ Bounds3f unfoldBox(const std::uint32_t* keys) {
+    Bounds3f b;
+    for (int a = 0; a < 3; ++a) {
+        b.lo[a] = kdsplit::keyFloat(keys[a]);
+        b.hi[a] = kdsplit::keyFloat(keys[3 + a]);
+    }
+    return b;
+}
+
+/// Macrocell flags.
+constexpr std::uint32_t kUnboundedSpread = 1u, kHasNan = 2u;
+
+/// Empty boxes and ranges as keys: lows at +infinity, highs at -infinity.
+__global__ void clearKeysKernel(std::uint32_t* keys, std::uint64_t count, int perItem) {
+    const std::uint64_t i = globalThread();
+    if (i >= count) return;
+    const int k = static_cast<int>(i % perItem);
+    keys[i] = kdsplit::floatKey(k < perItem / 2 ? INFINITY : -INFINITY);
+}
+
+/// Macrocells and partition gradient boxes: one block per partition, its threads over the
+/// partition's cells, each folding its MacroContribution into the macrocells its box overlaps
+/// (fillMacroCells' rule) and its gradients into its partition's box.
+__global__ void macroKernel(TetMeshView m, const KdPartition* partitions,
+                            const std::uint32_t* kdCells, const PartitionGrid* grids,
+                            const std::uint8_t* boundary, bool anyNan, std::uint32_t* rangeKeys,
+                            std::uint32_t* gradientKeys, std::uint32_t* flags,
+                            std::uint32_t* partitionKeys) {
+    const KdPartition part = partitions[blockIdx.x];
+    const PartitionGrid g = grids[blockIdx.x];
+    const bool macro = !part.box.empty();  // fillMacroCells skips empty boxes
+    Bounds3f spread;                       // this thread's cells' gradients
+    for (std::uint32_t i = threadIdx.x; i < part.cellCount; i += blockDim.x) {
+        const std::uint32_t t = kdCells[part.firstCell + i];
+        const MacroContribution add = macroContribution(m, t, anyNan);
+        spread.extend(add.gradients);
+        if (!macro) continue;
+        const bool unbounded = m.cellCentered || boundary[t];
+        std::uint32_t a[3], b[3];
+        macroCellOf(g, add.box.lo, a);
+        macroCellOf(g, add.box.hi, b);
+        for (std::uint32_t z = a[2]; z <= b[2]; ++z)
+            for (std::uint32_t y = a[1]; y <= b[1]; ++y)
+                for (std::uint32_t x = a[0]; x <= b[0]; ++x) {
+                    const std::uint64_t c =
+                        g.first + (std::uint64_t(z) * g.dims[1] + y) * g.dims[0] + x;
+                    if (add.lo <= add.hi) {  // a range without NaN values
+                        atomicMin(&rangeKeys[2 * c], kdsplit::floatKey(add.lo));
+                        atomicMax(&rangeKeys[2 * c + 1], kdsplit::floatKey(add.hi));
+                    }
+                    const std::uint32_t f =
+                        (unbounded ? kUnboundedSpread : 0u) | (add.nan ? kHasNan : 0u);
+                    if (f) atomicOr(&flags[c], f);
+                    if (!unbounded && !add.gradients.empty())
+                        foldBox(add.gradients, gradientKeys + 6 * c);
+                }
+    }
+    if (!spread.empty()) foldBox(spread, partitionKeys + 6 * blockIdx.x);
+}
+
+/// Macrocells from their keys and flags (fillMacroCells' last step).
+__global__ void macroCellsKernel(const std::uint32_t* rangeKeys, const std::uint32_t* gradientKeys,
+                                 const std::uint32_t* flags, std::uint64_t count,
+                                 MacroCell* cells) {
+    const std::uint64_t c = globalThread();
+    if (c >= count) return;
+    MacroCell m;
+    m.valueMin = kdsplit::keyFloat(rangeKeys[2 * c]);
+    m.valueMax = kdsplit::keyFloat(rangeKeys[2 * c + 1]);
+    const Bounds3f gradients = unfoldBox(gradientKeys + 6 * c);
+    if (flags[c] & kUnboundedSpread)
+        m.gradientSpread = INFINITY;
+    else if (!gradients.empty())
+        m.gradientSpread = length(gradients.hi - gradients.lo);
+    cells[c] = m;
+}
+
+/// Free device memory in bytes.
+std::size_t freeDeviceMemory() {
+    std::size_t freeBytes = 0, totalBytes = 0;
+    UVR_CUDA_CHECK(cudaMemGetInfo(&freeBytes, &totalBytes));
+    return freeBytes;
+}
+
+}  // namespace
+}  // namespace cuda
+
+std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, std::uint64_t facesPerPass) {
+    const TetMeshView host = mesh.view();
+    const std::uint64_t n = host.cellCount(), slots = host.faceSlots();
+    const std::size_t points = mesh.points.size();
+    UVR_CHECK(n < kNoCell / 4 && slots < kNoCell, "too many cells for 32-bit neighbour ids: " << n);
+    std::vector<std::uint32_t> neighbors(slots, kNoTet);
+    if (n == 0 || points == 0) return neighbors;
+    const std::vector<std::uint32_t> canon = coincidentPointIds(mesh.points);
+    // The cells, welded ids, per-vertex counts and offsets, and the table.
+    cuda::DeviceArray<Tet> tets;
+    cuda::DeviceArray<std::uint32_t> nativeCorners, canonIds, table;
+    cuda::DeviceArray<unsigned long long> counts, offsets;
+    cuda::DeviceArray<unsigned char> temp;
+    tets.upload(mesh.tets, "the tetrahedra (GPU face neighbours)");
+    nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU face neighbours)");
+    canonIds.upload(canon, "the welded point ids (GPU face neighbours)");
+    table.reserve(slots, "the neighbour table (GPU face neighbours)");
+    counts.reserve(points + 1, "the faces per point (GPU face neighbours)");
+    offsets.reserve(points + 1, "the face offsets (GPU face neighbours)");
+    UVR_CUDA_CHECK(cudaMemset(table.data(), 0xff, slots * sizeof(std::uint32_t)));
+    UVR_CUDA_CHECK(cudaMemset(counts.data(), 0, (points + 1) * sizeof(unsigned long long)));
+    TetMeshView view = host;
+    view.tets = tets.data(), view.nativeCorners = nativeCorners.data();
+    view.points = nullptr, view.values = nullptr, view.tetCorners = nullptr;
+    view.blockVertices = nullptr, view.blockVertexBase = nullptr;
+    cuda::countFacesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(view, canonIds.data(),
+                                                                 counts.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    cuda::withScratch(
+        temp, "the scan's scratch (GPU face neighbours)", [&](void* s, std::size_t& b) {
+            return cub::DeviceScan::ExclusiveSum(s, b, counts.data(), offsets.data(), points + 1);
+        });
+    std::vector<unsigned long long> hostOffsets(points + 1);
+    offsets.download(hostOffsets.data(), points + 1);
+    // Passes over ranges of vertices whose faces fit in the free memory.
+    const std::uint64_t budget = std::max<std::uint64_t>(
+        std::uint64_t(1) << 20, static_cast<std::uint64_t>(0.8 * double(cuda::freeDeviceMemory())) /
+                                    sizeof(cuda::FaceEntry));
+    const std::uint64_t most =
+        std::min<std::uint64_t>(facesPerPass > 0 ? facesPerPass : budget, slots);
+    cuda::DeviceArray<cuda::FaceEntry> entries;
+    entries.reserve(most, "the faces (GPU face neighbours)");
+    UVR_CUDA_CHECK(cudaMemcpy(counts.data(), offsets.data(),
+                              (points + 1) * sizeof(unsigned long long),
+                              cudaMemcpyDeviceToDevice));  // counts now serve as fill pointers
+    for (std::size_t lo = 0; lo < points;) {
+        // The longest run of vertices from lo whose faces fit (at least one vertex).
+        const unsigned long long base = hostOffsets[lo];
+        const auto end =
+            std::upper_bound(hostOffsets.begin() + lo + 1, hostOffsets.end(), base + most);
+        std::size_t hi = std::size_t(end - hostOffsets.begin()) - 1;
+        hi = std::max(hi, lo + 1);
+        UVR_CHECK(hostOffsets[hi] - base <= most,
+                  "one vertex has more faces than the GPU holds: " << hostOffsets[hi] - base);
+        cuda::scatterFacesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(
+            view, canonIds.data(), static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi),
+            base, counts.data(), entries.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        cuda::matchKernel<<<cuda::blocksFor(hi - lo), cuda::kBlock>>>(
+            view, static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi), offsets.data(),
+            base, entries.data(), table.data());
+        UVR_CUDA_CHECK(cudaGetLastError());
+        lo = hi;
+    }
+    table.download(neighbors.data(), slots);
+    return neighbors;
+}
+
+SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell) {
+    const auto start = std::chrono::steady_clock::now();
+    UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
+    SeedGrids out;
+    out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids", mesh.meanSplitTets());
+    const std::uint64_t cells = gridCellCount(out.grids);
+    out.seeds.assign(cells, kNoTet);
+    if (kd.partitions.empty() || cells == 0) return out;
+    // The kernels' layout of the cells (what offerSeedKeys reads) and the partitions.
+    cuda::DeviceArray<TetCorners16> corners;
+    cuda::DeviceArray<BlockVertex> blockVertices;
+    cuda::DeviceArray<std::uint32_t> blockBase, nativeCorners, kdCells, seeds;
+    cuda::DeviceArray<Vec3f> points;
+    cuda::DeviceArray<KdPartition> partitions;
+    cuda::DeviceArray<PartitionGrid> grids;
+    cuda::DeviceArray<unsigned long long> best;
+    corners.upload(mesh.tetCorners, "the tetrahedra's corners (GPU seed grids)");
+    blockVertices.upload(mesh.blockVertices, "the block vertices (GPU seed grids)");
+    blockBase.upload(mesh.blockVertexBase, "the block offsets (GPU seed grids)");
+    TetMeshView view = mesh.view();
+    view.tets = nullptr, view.values = nullptr, view.points = nullptr;
+    view.nativeCorners = nullptr;
+    if (view.hasNative()) {
+        points.upload(mesh.points, "the points (GPU seed grids)");
+        nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU seed grids)");
+        view.points = points.data(), view.nativeCorners = nativeCorners.data();
+    }
+    view.tetCorners = corners.data(), view.blockVertices = blockVertices.data();
+    view.blockVertexBase = blockBase.data();
+    kdCells.upload(kd.cells, "the partitions' cells (GPU seed grids)");
+    partitions.upload(kd.partitions, "the partitions (GPU seed grids)");
+    grids.upload(out.grids, "the seed grids' layout (GPU seed grids)");
+    best.reserve(cells, "the seed keys (GPU seed grids)");
+    UVR_CUDA_CHECK(cudaMemset(best.data(), 0xff, cells * sizeof(unsigned long long)));
+    const TetLocator locator{view, {}, {}};
+    cuda::seedKernel<<<static_cast<unsigned>(kd.partitions.size()), cuda::kBlock>>>(
+        locator, partitions.data(), kdCells.data(), grids.data(), best.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    seeds.reserve(cells, "the seeds (GPU seed grids)");
+    cuda::seedsFromKeysKernel<<<cuda::blocksFor(cells), cuda::kBlock>>>(best.data(), cells,
+                                                                        seeds.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    seeds.download(out.seeds.data(), cells);
+    out.buildSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+MacroBuild buildMacroGridsCuda(const TetMesh& mesh, const KdPartitions& kd,
+                               const std::vector<std::uint32_t>& neighbors, float tetsPerCell) {
+    const auto start = std::chrono::steady_clock::now();
+    UVR_CHECK(tetsPerCell > 0.f, "macrocell density must be positive");
+    const TetMeshView host = mesh.view();
+    UVR_CHECK(neighbors.size() == host.faceSlots(), "macrocells need the face neighbours");
+    MacroBuild out;
+    out.macro.grids =
+        layoutPartitionGrids(kd, tetsPerCell, "macrocell grids", mesh.meanSplitTets());
+    const std::uint64_t cells = gridCellCount(out.macro.grids);
+    const std::size_t parts = kd.partitions.size();
+    out.macro.cells.assign(cells, MacroCell{});
+    out.gradientSpread.assign(parts, 0.f);
+    if (parts == 0 || cells == 0) return out;
+    // Per cell: a face on the mesh's boundary.
+    const std::int64_t n = static_cast<std::int64_t>(host.cellCount());
+    std::vector<std::uint8_t> boundary(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static)
+    for (std::int64_t c = 0; c < n; ++c) {
+        bool b = false;
+        const std::uint64_t faces = host.faceBase(std::uint64_t(c));
+        for (int f = 0; f < kindFaces(host.kind(std::uint64_t(c))); ++f)
+            b = b || neighbors[faces + f] == kNoTet;
+        boundary[c] = b;
+    }
+    const bool anyNan =
+        std::any_of(mesh.values.begin(), mesh.values.end(), [](float v) { return v != v; });
+    // The kernels' layout of the cells, values for cell data and native cells, the partitions.
+    cuda::DeviceArray<TetCorners16> corners;
+    cuda::DeviceArray<BlockVertex> blockVertices;
+    cuda::DeviceArray<std::uint32_t> blockBase, nativeCorners, kdCells;
+    cuda::DeviceArray<std::uint32_t> rangeKeys, gradientKeys, flags, partitionKeys;
+    cuda::DeviceArray<std::uint8_t> boundaryFlags;
+    cuda::DeviceArray<Vec3f> points;
+    cuda::DeviceArray<float> values;
+    cuda::DeviceArray<KdPartition> partitions;
+    cuda::DeviceArray<PartitionGrid> grids;
+    cuda::DeviceArray<MacroCell> macroCells;
+    corners.upload(mesh.tetCorners, "the tetrahedra's corners (GPU macrocells)");
+    blockVertices.upload(mesh.blockVertices, "the block vertices (GPU macrocells)");
+    blockBase.upload(mesh.blockVertexBase, "the block offsets (GPU macrocells)");
+    TetMeshView view = host;
+    view.tets = nullptr, view.values = nullptr, view.points = nullptr;
+    view.nativeCorners = nullptr;
+    if (view.hasNative() || view.cellCentered) {
+        values.upload(mesh.values, "the values (GPU macrocells)");
+        view.values = values.data();
+    }
+    if (view.hasNative()) {
+        points.upload(mesh.points, "the points (GPU macrocells)");
+        nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU macrocells)");
+        view.points = points.data(), view.nativeCorners = nativeCorners.data();
+    }
+    view.tetCorners = corners.data(), view.blockVertices = blockVertices.data();
+    view.blockVertexBase = blockBase.data();
+    boundaryFlags.upload(boundary, "the boundary cells (GPU macrocells)");
+    kdCells.upload(kd.cells, "the partitions' cells (GPU macrocells)");
+    partitions.upload(kd.partitions, "the partitions (GPU macrocells)");
+    grids.upload(out.macro.grids, "the macrocell grids' layout (GPU macrocells)");
+    rangeKeys.reserve(2 * cells, "the macrocells' ranges (GPU macrocells)");
+    gradientKeys.reserve(6 * cells, "the macrocells' gradients (GPU macrocells)");
+    flags.reserve(cells, "the macrocells' flags (GPU macrocells)");
+    partitionKeys.reserve(6 * parts, "the partitions' gradients (GPU macrocells)");
+    cuda::clearKeysKernel<<<cuda::blocksFor(2 * cells), cuda::kBlock>>>(rangeKeys.data(), 2 * cells,
+                                                                        2);
+    cuda::clearKeysKernel<<<cuda::blocksFor(6 * cells), cuda::kBlock>>>(gradientKeys.data(),
+                                                                        6 * cells, 6);
+    cuda::clearKeysKernel<<<cuda::blocksFor(6 * parts), cuda::kBlock>>>(partitionKeys.data(),
+                                                                        6 * parts, 6);
+    UVR_CUDA_CHECK(cudaGetLastError());
+    UVR_CUDA_CHECK(cudaMemset(flags.data(), 0, cells * sizeof(std::uint32_t)));
+    cuda::macroKernel<<<static_cast<unsigned>(parts), cuda::kBlock>>>(
+        view, partitions.data(), kdCells.data(), grids.data(), boundaryFlags.data(), anyNan,
+        rangeKeys.data(), gradientKeys.data(), flags.data(), partitionKeys.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    macroCells.reserve(cells, "the macrocells (GPU macrocells)");
+    cuda::macroCellsKernel<<<cuda::blocksFor(cells), cuda::kBlock>>>(
+        rangeKeys.data(), gradientKeys.data(), flags.data(), cells, macroCells.data());
+    UVR_CUDA_CHECK(cudaGetLastError());
+    macroCells.download(out.macro.cells.data(), cells);
+    if (anyNan) {
+        std::vector<std::uint32_t> hostFlags(cells);
+        flags.download(hostFlags.data(), cells);
+        out.macro.nanCells.resize(cells);
+        for (std::uint64_t c = 0; c < cells; ++c)
+            out.macro.nanCells[c] = (hostFlags[c] & cuda::kHasNan) ? 1 : 0;
+    }
+    // The partitions' gradient spreads (partitionGradientSpread's rule).
+    std::vector<std::uint32_t> keys(6 * parts);
+    partitionKeys.download(keys.data(), keys.size());
+    for (std::size_t p = 0; p < parts; ++p) {
+        if (view.cellCentered) {
+            out.gradientSpread[p] = kd.partitions[p].cellCount > 0 ? INFINITY : 0.f;
+            continue;
+        }
+        Bounds3f box;
+        for (int a = 0; a < 3; ++a) {
+            box.lo[a] = kdsplit::keyFloat(keys[6 * p + a]);
+            box.hi[a] = kdsplit::keyFloat(keys[6 * p + 3 + a]);
+        }
+        out.gradientSpread[p] = box.empty() ? 0.f : length(box.hi - box.lo);
+    }
+    out.macro.buildSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+}  // namespace uvr
