@@ -69,6 +69,10 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
         prepareMesh(mesh, field, options.prepareOptions(), progress));
     prepareSeconds_ =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (progress && resolvesToCuda(options.device))
+        progress("uploading " +
+                 std::to_string((cudaSceneBytes(*prepared_) + (1u << 20) - 1) >> 20) +
+                 " MiB to the GPU");
     gpu_ = uploadIf(options.device, *prepared_);
 }
 

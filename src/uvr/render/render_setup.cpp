@@ -32,7 +32,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         progress(options.cells.splitCells
                      ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
                      : "preparing " + std::to_string(mesh.cellCount()) + " cells");
-    out.tets = tetrahedralize(mesh, field, options.cells);
+    out.tets = tetrahedralize(mesh, field, options.cells, progress.fraction);
     if (options.afterSplit) options.afterSplit();
     out.splitSeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
@@ -61,8 +61,11 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
 
     start = std::chrono::steady_clock::now();
     if (progress) progress("finding face neighbours");
-    out.neighbors = buildTetNeighbors(out.tets);
-    out.neighborCodes = compactNeighbors(out.tets, out.neighbors);
+    // Their codes take 0.74 of 4.91 seconds at 100M tetrahedra.
+    constexpr double kNeighborsEnd = 4.17 / 4.91;
+    out.neighbors = buildTetNeighbors(out.tets, subRange(progress.fraction, 0.0, kNeighborsEnd));
+    out.neighborCodes =
+        compactNeighbors(out.tets, out.neighbors, subRange(progress.fraction, kNeighborsEnd, 1.0));
     out.adjacencySeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("neighbours", out.adjacencySeconds);
 
@@ -79,10 +82,11 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                 std::max(1.0, std::round(kd.leafCells / out.tets.meanSplitTets())));
         if (splitter) kd.splitter = splitter;
         start = std::chrono::steady_clock::now();
-        out.kd = buildKdPartitions(out.tets, kd);
+        out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
         out.phaseSeconds.emplace_back("partitions", secondsSince(start));
+        if (progress) progress("building the cell tree");
         start = std::chrono::steady_clock::now();
-        out.cellTree = buildCellTree(out.tets);
+        out.cellTree = buildCellTree(out.tets, kCellTreeLeaf, progress.fraction);
         out.phaseSeconds.emplace_back("cell_tree", secondsSince(start));
         if (options.seedGrids) {
             if (progress) progress("building seed grids");
@@ -90,9 +94,11 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
             out.seeds = buildSeedGrids(out.tets, *out.kd);
             out.phaseSeconds.emplace_back("seed_grids", secondsSince(start));
         }
+        if (progress) progress("measuring the partitions' gradient spreads");
         start = std::chrono::steady_clock::now();
-        out.gradientSpread = partitionGradientSpread(out.tets, *out.kd);
+        out.gradientSpread = partitionGradientSpread(out.tets, *out.kd, progress.fraction);
         out.phaseSeconds.emplace_back("gradient_spreads", secondsSince(start));
+        if (progress) progress("looking for NaN values");
         start = std::chrono::steady_clock::now();
         out.partitionNan = partitionNanFlags(out.tets, *out.kd);
         out.phaseSeconds.emplace_back("nan_flags", secondsSince(start));
@@ -160,12 +166,15 @@ std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartiti
     return out;
 }
 
-std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd) {
+std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd,
+                                           const FractionFn& progress) {
     const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
     std::vector<float> out(n, 0.f);
+    ProgressCounter done(progress, n);
     if (tets.association == Association::Cell) {
         for (std::int64_t p = 0; p < n; ++p)
             if (kd.partitions[p].cellCount > 0) out[p] = INFINITY;
+        done.finish();
         return out;
     }
     const TetMeshView view = tets.view();
@@ -176,7 +185,9 @@ std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitio
         for (std::uint32_t i = 0; i < part.cellCount; ++i)
             box.extend(cellGradientBounds(view, kd.cells[part.firstCell + i]));
         out[p] = box.empty() ? 0.f : length(box.hi - box.lo);
+        done.add();
     }
+    done.finish();
     return out;
 }
 
@@ -559,23 +570,6 @@ FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int h
     w.samples =
         w.samplesPerRay * std::max(width, 0) * std::max(height, 0) * std::max(raysPerPixel, 1);
     return w;
-}
-
-void FrameProgress::partDone() {
-    const std::int64_t done = done_.fetch_add(1, std::memory_order_relaxed) + 1;
-    if (!report_ || done >= total_ || !reporting_.try_lock()) return;
-    const double fraction = double(done_.load(std::memory_order_relaxed)) / double(total_);
-    if (fraction > reported_ && fraction < 1.0) {
-        reported_ = fraction;
-        report_(fraction);
-    }
-    reporting_.unlock();
-}
-
-void FrameProgress::finish() {
-    const std::lock_guard<std::mutex> lock(reporting_);
-    if (report_) report_(1.0);
-    reported_ = 1.0;
 }
 
 }  // namespace uvr
