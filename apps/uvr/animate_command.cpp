@@ -138,11 +138,18 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         ctx.setActivity(series->stepSource(chosen[0]), "reading and preparing the first step");
         if (resolvesToCuda(flags->rendererOptions().device))
             ctx.step("GPU: " + cudaDeviceDescription());
+        // A new geometry of a later step is prepared in player.show (phases ended after it).
+        PhaseProgress phases(ctx);
         SeriesPlayer player(std::unique_ptr<MeshSeries>(openSeries(*file, ctx)), spec,
-                            flags->rendererOptions(), chosen[0],
-                            [&](const std::string& s) { ctx.step(s); });
+                            flags->rendererOptions(), chosen[0], phases.callbacks());
+        phases.finish();
         for (const std::string& note : player.mesh().notes) ctx.step("note: " + note);
-        const ValidationReport report = validateMesh(player.mesh(), series->stepSource(chosen[0]));
+        ValidationReport report;
+        {
+            Progress checking(ctx, "checking the mesh");
+            report =
+                validateMesh(player.mesh(), series->stepSource(chosen[0]), checking.callback());
+        }
         for (const std::string& f : report.findings()) ctx.step("validation: " + f);
         if (report.bounds.empty())
             throwError(ErrorKind::Validation, series->stepSource(chosen[0]),
@@ -206,6 +213,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             StepUpdate u;
             if (k > 0) {
                 u = player.show(i, next);  // the next read overlaps this step's refresh
+                phases.finish();
                 reads.push_back(u.readSeconds);
                 updates.push_back(u.updateSeconds);
             } else if (next) {

@@ -673,8 +673,9 @@ void reportUpload(const Renderer& renderer, const Context& ctx) {
 std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
                                        const RendererOptions& options, const Context& ctx) {
     if (resolvesToCuda(options.device)) ctx.step("GPU: " + cudaDeviceDescription());
-    auto renderer = std::make_unique<Renderer>(mesh, field, options,
-                                               [&](const std::string& s) { ctx.step(s); });
+    PhaseProgress phases(ctx);
+    auto renderer = std::make_unique<Renderer>(mesh, field, options, phases.callbacks());
+    phases.finish();
     reportUpload(*renderer, ctx);
     return renderer;
 }
@@ -767,7 +768,11 @@ SourceSummary checkForRendering(const Mesh& mesh, const ScalarField& field,
     const auto start = Clock::now();
     ctx.step("checking " + std::to_string(mesh.cellCount()) + " cells and " +
              std::to_string(mesh.pointCount()) + " points");
-    const ValidationReport report = validateMesh(mesh, source);
+    ValidationReport report;
+    {
+        Progress progress(ctx, "checking the mesh");
+        report = validateMesh(mesh, source, progress.callback());
+    }
     if (checkSeconds) *checkSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     ctx.done("checked the mesh", start);
     SourceSummary summary;

@@ -263,6 +263,28 @@ TEST(Cli, GenerateAndDemo) {
     EXPECT_EQ(readPng(dir + "/demo.png").width, 32);
 }
 
+TEST(Cli, RenderNamesEveryPreparationPhaseInALog) {
+    // stderr is a file: phases print their start lines; phases under a second print no end line.
+    const std::string dir = testing::scratchDir();
+    CliRun r = uvr("-q generate shell --cells 5000 -o " + dir + "/s.uvrm", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = uvr("render " + dir + "/s.uvrm --size 32x32 -o " + dir + "/s.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::size_t at = 0;
+    for (const char* line :
+         {"uvr: checking ", "uvr: preparing ", "uvr: finding face neighbours\n",
+          "uvr: building k-d partitions (up to ", "uvr: building the cell tree\n",
+          "uvr: building seed grids\n", "uvr: measuring the partitions' gradient spreads\n",
+          "uvr: looking for NaN values\n", "uvr: building macrocell grids\n"}) {
+        const std::size_t found = r.err.find(line, at);
+        ASSERT_NE(found, std::string::npos) << "no '" << line << "' (in order) in\n" << r.err;
+        EXPECT_EQ(r.err.find(line, found + 1), std::string::npos) << line << " twice:\n" << r.err;
+        at = found;
+    }
+    EXPECT_EQ(r.err.find(": done ("), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+}
+
 TEST(Cli, GenerateMixedCells) {
     const std::string dir = testing::scratchDir();
     // 4^3 blocks (about 4.2 cells a block), every cell type, nothing for validation to report.

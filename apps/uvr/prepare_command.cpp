@@ -84,8 +84,9 @@ void addPrepareCommand(CLI::App& app, Context& ctx) {
         const SourceSummary summary = checkForRendering(mesh, field, *file, ctx);
         ctx.setActivity(*file, "preparing the mesh for rendering");
         prepareOptions.afterSplit = [&mesh] { mesh = Mesh(); };  // not read once split
-        const PreparedMesh prepared =
-            prepareMesh(mesh, field, prepareOptions, [&](const std::string& s) { ctx.step(s); });
+        PhaseProgress phases(ctx);
+        const PreparedMesh prepared = prepareMesh(mesh, field, prepareOptions, phases.callbacks());
+        phases.finish();
         ctx.done("prepared " + describeCells(prepared.tets) + " of " + field.describe(), start);
         ctx.setActivity(cache, "writing the prepared cache");
         std::uint64_t bytes = 0;

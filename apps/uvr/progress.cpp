@@ -144,4 +144,41 @@ void Progress::run() {
     }
 }
 
+PhaseProgress::PhaseProgress(const Context& ctx, double doneAfterSeconds)
+    : ctx_(ctx), doneAfter_(doneAfterSeconds) {}
+
+PhaseProgress::~PhaseProgress() {
+    finish();
+}
+
+ProgressFn PhaseProgress::callbacks() {
+    return {[this](const std::string& name) { step(name); }, [this](double f) { fraction(f); }};
+}
+
+void PhaseProgress::step(const std::string& name) {
+    std::lock_guard lock(mutex_);
+    endPhase();
+    ctx_.step(name);
+    name_ = name;
+    start_ = Clock::now();
+    phase_ = std::make_unique<Progress>(ctx_, name);
+}
+
+void PhaseProgress::fraction(double f) {
+    std::lock_guard lock(mutex_);
+    if (phase_) phase_->set(f);
+}
+
+void PhaseProgress::finish() {
+    std::lock_guard lock(mutex_);
+    endPhase();
+}
+
+void PhaseProgress::endPhase() {
+    if (!phase_) return;
+    const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    if (seconds >= doneAfter_) phase_->done(name_ + ": done");
+    phase_.reset();
+}
+
 }  // namespace uvr::cli

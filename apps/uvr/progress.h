@@ -5,9 +5,12 @@
 #include <chrono>
 #include <condition_variable>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
+
+#include "uvr/render/render_setup.h"
 
 namespace uvr::cli {
 
@@ -64,6 +67,41 @@ private:
     bool stopping_ = false;
     bool shown_ = false;  ///< a terminal line is on screen
     std::thread ticker_;
+};
+
+/// Shows the phases of a preparation (prepareMesh's ProgressFn) as Progress lines: each step
+/// prints its name at once ("uvr: finding face neighbours"), as before, and runs a Progress of
+/// that name that its fractions move ("uvr: finding face neighbours: 42% (ETA 8 s)", after a
+/// second); the next step, finish() or the destructor end it, with a line and its time
+/// ("uvr: finding face neighbours: done (2.31 s)") only when it lasted doneAfterSeconds or
+/// more, so a small mesh's log does not double.
+class PhaseProgress {
+public:
+    /// Reports through ctx (nothing with --quiet).
+    explicit PhaseProgress(const Context& ctx, double doneAfterSeconds = 1.0);
+    /// finish().
+    ~PhaseProgress();
+    PhaseProgress(const PhaseProgress&) = delete;
+    PhaseProgress& operator=(const PhaseProgress&) = delete;
+
+    /// The callbacks for prepareMesh, Renderer and the like; valid while this lives.
+    ProgressFn callbacks();
+    /// Ends the phase running and starts one named `name`.
+    void step(const std::string& name);
+    /// How far the phase running has come, in [0, 1] (thread-safe; ignored between phases).
+    void fraction(double f);
+    /// Ends the phase running, if any.
+    void finish();
+
+private:
+    void endPhase();  // with mutex_ held
+
+    const Context& ctx_;
+    double doneAfter_;
+    std::mutex mutex_;
+    std::unique_ptr<Progress> phase_;
+    std::string name_;
+    std::chrono::steady_clock::time_point start_;
 };
 
 }  // namespace uvr::cli

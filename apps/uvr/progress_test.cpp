@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -57,6 +58,64 @@ TEST(Progress, LongPhasesReportWhileTheyRunWhenNotATerminal) {
     EXPECT_NE(err.find("uvr: refining: 40% ("), std::string::npos) << err;
     EXPECT_EQ(err.find('\r'), std::string::npos) << err;
     EXPECT_NE(err.find("uvr: refined ("), std::string::npos) << err;
+}
+
+int lineCount(const std::string& s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
+
+TEST(PhaseProgress, StepsPrintTheirNameAndOnlyLongPhasesTheirEnd) {
+    Context ctx;
+    ::testing::internal::CaptureStderr();
+    {
+        PhaseProgress phases(ctx);  // an end line after a second: none here
+        const ProgressFn fn = phases.callbacks();
+        fn("splitting 8 cells into tetrahedra");
+        fn.fraction(0.5);
+        fn.fraction(1.0);
+        fn("finding face neighbours");
+    }
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(),
+              "uvr: splitting 8 cells into tetrahedra\nuvr: finding face neighbours\n");
+
+    ::testing::internal::CaptureStderr();
+    {
+        PhaseProgress phases(ctx, 0.0);  // every phase long enough for its end line
+        phases.fraction(0.3);            // before any step: ignored
+        phases.step("a");
+        phases.step("b");
+        phases.finish();
+        phases.finish();  // once
+    }
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(err.rfind("uvr: a\nuvr: a: done (", 0), 0u) << err;
+    const std::size_t b = err.find(" s)\nuvr: b\nuvr: b: done (");
+    EXPECT_NE(b, std::string::npos) << err;
+    EXPECT_EQ(err.find("b: done", err.find("b: done") + 1), std::string::npos) << err;
+    EXPECT_EQ(lineCount(err), 4) << err;
+}
+
+TEST(PhaseProgress, FractionsShowWithAnEtaInLongPhases) {
+    Context ctx;
+    ::testing::internal::CaptureStderr();  // a file: plain lines
+    {
+        PhaseProgress phases(ctx);
+        phases.step("building k-d partitions");
+        phases.fraction(0.25);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1300));
+    }
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(err.rfind("uvr: building k-d partitions\n", 0), 0u) << err;
+    EXPECT_NE(err.find("uvr: building k-d partitions: 25% (ETA "), std::string::npos) << err;
+    EXPECT_NE(err.find("uvr: building k-d partitions: done (1."), std::string::npos) << err;
+    ctx.quiet = true;
+    ::testing::internal::CaptureStderr();
+    {
+        PhaseProgress phases(ctx, 0.0);
+        phases.step("quiet");
+        phases.fraction(0.5);
+    }
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
 }
 
 }  // namespace

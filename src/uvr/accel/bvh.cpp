@@ -333,10 +333,13 @@ void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,
     }
 }
 
-Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells) {
+Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells, const FractionFn& progress) {
     Bvh bvh;
     const std::uint64_t n = mesh.cellCount();
-    if (n == 0) return bvh;
+    if (n == 0) {
+        if (progress) progress(1.0);
+        return bvh;
+    }
     UVR_CHECK(leafCells > 0, "buildCellTree: leaves of 0 cells");
     const std::uint64_t leaves = (n + leafCells - 1) / leafCells;
     UVR_CHECK(2 * leaves - 1 < 0xffffffffull, "cell tree nodes exceed 32-bit indices");
@@ -371,6 +374,9 @@ Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells) {
     // Boxes: the runs' in parallel, then the inner nodes from the last (children follow their
     // parent).
     const TetMeshView view = mesh.view();
+    // Progress: the structure to 0.2, the runs' boxes to 0.9, the inner boxes to 1.
+    if (progress) progress(0.2);
+    ProgressCounter boxed(progress, std::int64_t(leaves), 0.2, 0.9);
 #pragma omp parallel for schedule(static)
     for (std::int64_t l = 0; l < std::int64_t(leaves); ++l) {
         BvhNode& node = bvh.nodes[leafNode[l]];
@@ -378,13 +384,16 @@ Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells) {
         for (std::uint32_t c = node.first; c < node.first + node.count; ++c)
             box.extend(view.cellBounds(c));
         node.box = box;
+        boxed.tick(l);
     }
+    boxed.finish();
     for (std::int64_t i = std::int64_t(bvh.nodes.size()) - 1; i >= 0; --i) {
         BvhNode& node = bvh.nodes[i];
         if (node.count > 0) continue;
         node.box = bvh.nodes[node.first].box;
         node.box.extend(bvh.nodes[node.first + 1].box);
     }
+    if (progress) progress(1.0);
     return bvh;
 }
 

@@ -104,8 +104,10 @@ inline constexpr std::uint32_t kCellTreeLeaf = 32;
 
 /// A BVH whose leaves are runs of `leafCells` consecutive cell ids, without primitive ids (a
 /// leaf holds cells [first, first + count)): a balanced binary tree over the runs, siblings
-/// adjacent. Over cells in Morton order (sortCellsSpatially) the runs are compact. Parallel.
-Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells = kCellTreeLeaf);
+/// adjacent. Over cells in Morton order (sortCellsSpatially) the runs are compact. Parallel;
+/// `progress` hears the fraction done.
+Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells = kCellTreeLeaf,
+                  const FractionFn& progress = {});
 
 /// Bounding box and box centre of every cell of a mesh (resizes both arrays); parallel.
 void tetBoxesAndCenters(const TetMesh& mesh, std::vector<Bounds3f>& boxes,

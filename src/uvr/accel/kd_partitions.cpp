@@ -217,8 +217,12 @@ LocalTree buildSubtree(const CellData& data, Task root, const KdBuildOptions& op
 
 }  // namespace
 
-KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options) {
+KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options,
+                               const FractionFn& progress) {
     const auto start = std::chrono::steady_clock::now();
+    // Progress: boxes to 0.1, the top of the tree to 0.45 (cells passed through splitLarge, about
+    // n per level), the subtrees to 0.9 (their cells), the cell lists and value ranges to 1.
+    constexpr double kBoxesEnd = 0.1, kTopEnd = 0.45, kSubtreesEnd = 0.9;
     UVR_CHECK(options.leafCells >= 1, "leaf size must be positive");
     const std::size_t n = mesh.cellCount();
     UVR_CHECK(n < (1ull << 30), "too many cells for k-d partitions");
@@ -232,11 +236,14 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     const std::int64_t tetCount = static_cast<std::int64_t>(n);
     if (needBoxes) {
         data.boxes.resize(n), data.centers.resize(n);
+        ProgressCounter boxed(progress, tetCount, 0.0, kBoxesEnd);
 #pragma omp parallel for schedule(static)
         for (std::int64_t t = 0; t < tetCount; ++t) {
             const Bounds3f box = view.cellBounds(std::uint64_t(t));
             data.boxes[t] = box, data.centers[t] = box.center();
+            boxed.tick(t);
         }
+        boxed.finish();
     }
     std::vector<Leaf> leaves;  // the CPU's leaves; or, from a splitter, `tree`
     std::optional<KdTree> tree;
@@ -249,6 +256,10 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         // at most kSubtreeCells cells become subtree jobs.
         kd.nodes.emplace_back();
         std::vector<Task> stack, jobs;
+        const int topLevels = static_cast<int>(
+            std::ceil(std::log2(std::max(1.0, double(n) / double(kSubtreeCells)))));
+        ProgressCounter topDone(progress, std::int64_t(n) * std::max(topLevels, 1), kBoxesEnd,
+                                kTopEnd);
         {
             std::vector<std::uint32_t> all(n);
 #pragma omp parallel for schedule(static)
@@ -266,17 +277,25 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
                 jobs.push_back(std::move(task));
                 continue;
             }
+            topDone.add(std::int64_t(task.cells.size()));
             splitNode(kd.nodes, stack, task, axis, plane, std::move(left), std::move(right));
         }
+        topDone.finish();
         // Step 3: the subtrees, in parallel.
         const std::int64_t jobCount = static_cast<std::int64_t>(jobs.size());
         std::vector<LocalTree> local(jobs.size());
+        std::int64_t jobCells = 0;
+        for (const Task& job : jobs) jobCells += std::int64_t(job.cells.size());
+        ProgressCounter subtreesDone(progress, jobCells, kTopEnd, kSubtreesEnd);
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::int64_t j = 0; j < jobCount; ++j) {
             const std::uint32_t node = jobs[j].node;
+            const std::int64_t cells = std::int64_t(jobs[j].cells.size());
             local[j] = buildSubtree(data, std::move(jobs[j]), options);
             jobs[j].node = node;
+            subtreesDone.add(cells);
         }
+        subtreesDone.finish();
         // Step 4: append the subtrees in job order (each root replaces its placeholder) and number
         // their leaves.
         for (std::int64_t j = 0; j < jobCount; ++j) {
@@ -326,6 +345,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     }
     if (tree) kd.cells = std::move(tree->leafCells);  // already in partition order
     computePartitionValueRanges(mesh, kd);
+    if (progress) progress(1.0);
     kd.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return kd;

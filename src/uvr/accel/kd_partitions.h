@@ -228,8 +228,9 @@ struct KdPartitions {
 /// (Morrical et al. 2019, Sec. 2.1); O(n log n) for well-shaped meshes. A node whose split would
 /// not reduce the larger side below 90% of its cells becomes a leaf, which bounds duplication.
 /// Parallel (large nodes by data-parallel passes, then subtrees one per thread) and
-/// bit-identical for any thread count.
-KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options = {});
+/// bit-identical for any thread count. `progress` hears the fraction done.
+KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& options = {},
+                               const FractionFn& progress = {});
 
 /// Sets every partition's value range: the finite minimum and maximum over its cells' values
 /// (whole cells: all four vertices, or the cell's own value for cell data; {0, 0} when none is

@@ -12,8 +12,10 @@ namespace uvr {
 inline constexpr std::uint32_t kNoTet = kNoCell;
 
 /// For every point, the smallest index of a point at exactly the same position (its own index
-/// when no earlier point coincides); the same for any thread count.
-std::vector<std::uint32_t> coincidentPointIds(const std::vector<Vec3f>& points);
+/// when no earlier point coincides); the same for any thread count. `progress` hears the
+/// fraction done.
+std::vector<std::uint32_t> coincidentPointIds(const std::vector<Vec3f>& points,
+                                              const FractionFn& progress = {});
 
 /// Face neighbours: result[faceBase(c) + i] is the cell sharing face i (packedFace's numbering;
 /// for a tetrahedron t, 4 t + i, the face opposite vertex i) of cell c, or kNoTet on the
@@ -22,8 +24,8 @@ std::vector<std::uint32_t> coincidentPointIds(const std::vector<Vec3f>& points);
 /// a pyramid's base, a wedge's and a tetrahedron's triangles.
 /// Faces match on positions, not only on indices: coincident points count as one.
 /// Faces are bucketed by their smallest vertex (a parallel counting sort); the same table for any
-/// thread count.
-std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh);
+/// thread count. `progress` hears the fraction done.
+std::vector<std::uint32_t> buildTetNeighbors(const TetMesh& mesh, const FractionFn& progress = {});
 
 /// A tetrahedron's four face neighbours in the kernels' layout (issue 16): code c < kTetBlockSize
 /// is tetrahedron c of its own block, kNoNeighborCode none, any other an entry of its block's
@@ -85,7 +87,9 @@ struct CompactNeighbors {
 
 /// Encodes a face-neighbour table (buildTetNeighbors of the same mesh) in the kernels' layout:
 /// a tetrahedron's neighbours in its own block as 16-bit codes, the others (other blocks, native
-/// cells) through its block's escape list. Parallel; the same for any thread count.
-CompactNeighbors compactNeighbors(const TetMesh& mesh, const std::vector<std::uint32_t>& neighbors);
+/// cells) through its block's escape list. Parallel; the same for any thread count. `progress`
+/// hears the fraction done.
+CompactNeighbors compactNeighbors(const TetMesh& mesh, const std::vector<std::uint32_t>& neighbors,
+                                  const FractionFn& progress = {});
 
 }  // namespace uvr

@@ -39,7 +39,7 @@ void launchFrame(const FrameView& frame, RenderStats& stats, const March& march,
     constexpr int kTile = 8;
     const int tilesX = (frame.width + kTile - 1) / kTile;
     const int tilesY = (frame.height + kTile - 1) / kTile;
-    FrameProgress progress(report, std::int64_t(tilesX) * tilesY);
+    ProgressCounter progress(report, std::int64_t(tilesX) * tilesY);
     cpu::parallelFor(std::int64_t(tilesX) * tilesY, 1, [&](std::int64_t tile, int thread) {
         const int x0 = static_cast<int>(tile % tilesX) * kTile;
         const int y0 = static_cast<int>(tile / tilesX) * kTile;
@@ -48,7 +48,7 @@ void launchFrame(const FrameView& frame, RenderStats& stats, const March& march,
             for (int x = x0; x < x0 + kTile && x < frame.width; ++x)
                 s.add(frame.supersample == 1 ? shadePixel<false>(frame, x, y, march)
                                              : shadePixel<true>(frame, x, y, march));
-        progress.partDone();
+        progress.add();
     });
     progress.finish();
     for (const RenderStats& s : perThread) stats.merge(s);

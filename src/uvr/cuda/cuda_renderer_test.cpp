@@ -45,6 +45,7 @@ void expectSameAsCpu(const PreparedMesh& pm, const RenderSettings& s, const std:
                 0.001 * c.stats.partitionsVisited)
         << what;
     EXPECT_GT(gpu.geometryBytes(), 0u);
+    EXPECT_EQ(gpu.geometryBytes(), cudaSceneBytes(pm)) << what;  // the upload's progress line
 }
 
 TEST(Cuda, DescriptionIsOneLine) {

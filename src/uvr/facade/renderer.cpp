@@ -33,6 +33,7 @@ PrepareOptions RendererOptions::prepareOptions() const {
         o.kdSplitter = buildKdTreeCuda;
         o.faceMatcher = [](const TetMesh& m) { return buildTetNeighborsCuda(m); };
         o.seedBuilder = buildSeedGridsCuda;
+        o.macroBuilder = buildMacroGridsCuda;
         o.builderDevice = "the GPU";
         if (buildDevice == Device::Auto) o.builderMinTets = kAutoGpuBuildTets;
     }
@@ -71,6 +72,10 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
         prepareMesh(mesh, field, options.prepareOptions(), progress));
     prepareSeconds_ =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (progress && resolvesToCuda(options.device))
+        progress("uploading " +
+                 std::to_string((cudaSceneBytes(*prepared_) + (1u << 20) - 1) >> 20) +
+                 " MiB to the GPU");
     gpu_ = uploadIf(options.device, *prepared_);
 }
 

@@ -57,7 +57,8 @@ struct RendererOptions {
 class Renderer {
 public:
     /// Prepares `field` of `mesh` (a Mesh or a view of arrays held elsewhere; neither need
-    /// outlive the renderer) as `options` ask and uploads it when rendering on the GPU. Throws
+    /// outlive the renderer) as `options` ask and uploads it when rendering on the GPU
+    /// (`progress` hears prepareMesh's phases, then "uploading N MiB to the GPU"). Throws
     /// Error(Unsupported) for Device::Cuda without a usable CUDA device, Error(Resource) when
     /// the GPU lacks memory.
     Renderer(const MeshView& mesh, const ScalarField& field, const RendererOptions& options = {},

@@ -30,8 +30,9 @@ constexpr std::size_t kBuckets = std::size_t(1) << kRadixBits;
 /// Sorts pairs by (key, index), keys of at most 63 bits. Ranges are split by stable radix passes
 /// over the key's high bits (each pass parallel over fixed chunks) until each is small, then the
 /// small ranges are sorted in parallel; the result is the one sorted order, so it does not
-/// depend on the thread count. Skewed keys (graded meshes) only take more passes.
-void sortKeys(ScratchVector<KeyIndex>& a) {
+/// depend on the thread count. Skewed keys (graded meshes) only take more passes. `done` counts
+/// the pairs each pass and the final sorts place (2n when one pass leaves only small ranges).
+void sortKeys(ScratchVector<KeyIndex>& a, ProgressCounter& done) {
     const std::size_t n = a.size();
     struct Range {
         std::size_t begin, end;
@@ -78,6 +79,7 @@ void sortKeys(ScratchVector<KeyIndex>& a) {
                 const std::size_t e = std::min(r.end, b + chunk);
                 std::uint64_t* at = counts.data() + std::size_t(c) * kBuckets;
                 for (std::size_t i = b; i < e; ++i) tmp[at[bucketOf(a[i])]++] = a[i];
+                done.add(std::int64_t(e - b));
             }
 #pragma omp parallel for schedule(static)
             for (std::int64_t i = std::int64_t(r.begin); i < std::int64_t(r.end); ++i)
@@ -90,36 +92,48 @@ void sortKeys(ScratchVector<KeyIndex>& a) {
     }
     tmp = {};
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t i = 0; i < std::int64_t(leaves.size()); ++i)
+    for (std::int64_t i = 0; i < std::int64_t(leaves.size()); ++i) {
         std::sort(a.begin() + leaves[i].begin, a.begin() + leaves[i].end);
+        done.add(std::int64_t(leaves[i].end - leaves[i].begin));
+    }
 }
 
 /// The Morton order of `count` cells of `corners` corners each from ids (corner point ids, one
-/// cell after another).
+/// cell after another); `progress` hears the keys' fraction (first 1/4) and the sort's.
 ScratchVector<KeyIndex> mortonOrder(const std::vector<Vec3f>& points, const Bounds3f& bounds,
-                                    const std::uint32_t* ids, std::uint64_t count, int corners) {
+                                    const std::uint32_t* ids, std::uint64_t count, int corners,
+                                    const FractionFn& progress) {
     ScratchVector<KeyIndex> keys(count);
     const float inv = 1.f / static_cast<float>(corners);
+    ProgressCounter keyed(progress, std::int64_t(count), 0.0, 0.25);
 #pragma omp parallel for schedule(static)
     for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
         Vec3f centroid(0.f);
         for (int k = 0; k < corners; ++k) centroid += points[ids[std::uint64_t(c) * corners + k]];
         keys[c] = {morton63(centroid * inv, bounds), static_cast<std::uint32_t>(c)};
+        keyed.tick(c);
     }
-    sortKeys(keys);
+    keyed.finish();
+    ProgressCounter sorted(progress, 2 * std::int64_t(count), 0.25, 1.0);
+    sortKeys(keys, sorted);
+    sorted.finish();
     return keys;
 }
 
 }  // namespace
 
-void sortCellsSpatially(TetMesh& mesh) {
-    if (mesh.bounds.empty()) return;
+void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress) {
+    // The tetrahedra's order (keys and sort) to 0.7, their gather to 0.9, native cells to 1.
+    if (mesh.bounds.empty()) {
+        if (progress) progress(1.0);
+        return;
+    }
     // Tetrahedra.
     const std::uint64_t n = mesh.tets.size();
     if (n > 1) {
         static_assert(sizeof(Tet) == 4 * sizeof(std::uint32_t));
-        const ScratchVector<KeyIndex> order =
-            mortonOrder(mesh.points, mesh.bounds, &mesh.tets[0].v[0], n, 4);
+        const ScratchVector<KeyIndex> order = mortonOrder(
+            mesh.points, mesh.bounds, &mesh.tets[0].v[0], n, 4, subRange(progress, 0.0, 0.7));
         // Gathered back into the arrays in place (new arrays would be zeroed on one thread).
         ScratchVector<Tet> old(n);
         const bool had = !mesh.tetSourceOrder.empty();
@@ -130,12 +144,15 @@ void sortCellsSpatially(TetMesh& mesh) {
             if (had) oldSource[i] = mesh.tetSourceOrder[i];
         }
         mesh.tetSourceOrder.resize(n);
+        ProgressCounter gathered(progress, std::int64_t(n), 0.7, 0.9);
 #pragma omp parallel for schedule(static)
         for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
             const std::uint32_t from = order[i].index;
             mesh.tets[i] = old[from];
             mesh.tetSourceOrder[i] = had ? oldSource[from] : from;
+            gathered.tick(i);
         }
+        gathered.finish();
     }
     // Native cells, each kind among its own.
     const std::uint64_t counts[3] = {mesh.pyramidCount, mesh.wedgeCount, mesh.hexCount};
@@ -146,7 +163,7 @@ void sortCellsSpatially(TetMesh& mesh) {
         if (m > 1) {
             std::uint32_t* ids = mesh.nativeCorners.data() + firstCorner;
             const ScratchVector<KeyIndex> order =
-                mortonOrder(mesh.points, mesh.bounds, ids, m, corners);
+                mortonOrder(mesh.points, mesh.bounds, ids, m, corners, {});
             std::vector<std::uint32_t> sortedIds(m * corners);
             std::vector<std::uint64_t> sortedSource(m);
 #pragma omp parallel for schedule(static)
@@ -163,9 +180,10 @@ void sortCellsSpatially(TetMesh& mesh) {
         firstCell += m;
         firstCorner += m * corners;
     }
+    if (progress) progress(1.0);
 }
 
-void encodeTetBlocks(TetMesh& mesh) {
+void encodeTetBlocks(TetMesh& mesh, const FractionFn& progress) {
     const std::uint64_t n = mesh.tets.size();
     const std::int64_t blocks = static_cast<std::int64_t>((n + kTetBlockSize - 1) / kTetBlockSize);
     const bool pointValues =
@@ -175,6 +193,7 @@ void encodeTetBlocks(TetMesh& mesh) {
     // and each corner's index among them.
     std::vector<std::vector<std::uint32_t>> lists(blocks);
     mesh.tetCorners.resize(n);
+    ProgressCounter listed(progress, blocks, 0.0, 0.7);
 #pragma omp parallel
     {
         constexpr std::uint32_t kSlots = 1u << 16, kEmpty = 0xffffffffu;
@@ -199,8 +218,10 @@ void encodeTetBlocks(TetMesh& mesh) {
                     }
                     mesh.tetCorners[t].v[k] = local[slot];
                 }
+            listed.add();
         }
     }
+    listed.finish();
     mesh.blockVertexBase.assign(blocks + 1, 0);
     std::uint64_t total = 0;
     for (std::int64_t b = 0; b < blocks; ++b) {
@@ -213,6 +234,7 @@ void encodeTetBlocks(TetMesh& mesh) {
     }
     mesh.blockVertices.resize(total);
     mesh.blockVertexPoint.resize(total);
+    ProgressCounter copied(progress, blocks, 0.7, 1.0);
 #pragma omp parallel for schedule(dynamic, 4)
     for (std::int64_t b = 0; b < blocks; ++b) {
         const std::uint32_t base = mesh.blockVertexBase[b];
@@ -223,7 +245,9 @@ void encodeTetBlocks(TetMesh& mesh) {
                                             pointValues ? mesh.values[ids[i]] : 0.f};
         }
         lists[b] = {};
+        copied.add();
     }
+    copied.finish();
 }
 
 }  // namespace uvr

@@ -7,6 +7,7 @@
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
+#include "uvr/core/progress.h"
 #include "uvr/core/vec.h"
 #include "uvr/mesh/cell_math.h"
 #include "uvr/mesh/field_select.h"
@@ -303,22 +304,24 @@ int splitCellIntoTets(CellType type, const std::uint32_t* ids, std::uint8_t out[
 /// native: options) and attaches the field; inverted cells are re-oriented, zero-volume
 /// tetrahedra (also those with a NaN/Inf corner) dropped (validateMesh reports both); points are
 /// mapped by frameForBounds of the kept cells' bounds; cells are put in Morton order (unless
-/// options say not) and the tetrahedra's blocks encoded (encodeTetBlocks).
+/// options say not) and the tetrahedra's blocks encoded (encodeTetBlocks). `progress` hears the
+/// fraction done.
 TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
-                       const TetrahedralizeOptions& options = {});
+                       const TetrahedralizeOptions& options = {}, const FractionFn& progress = {});
 
 /// Reorders the tetrahedra, and the native cells of each kind among themselves, by the 63-bit
 /// Morton code of their centroids over the mesh bounds (ties by their present order), so cells
 /// close in id lie close in space: the blocks of the kernels' layout then share most of their
 /// points and neighbours. Keeps tetSourceOrder (and nativeSource) so cell data still maps onto
 /// the cells; call it before assignTetValues and encodeTetBlocks. Parallel; the same order for
-/// any thread count.
-void sortCellsSpatially(TetMesh& mesh);
+/// any thread count. `progress` hears the fraction done.
+void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress = {});
 
 /// Builds the kernels' form of the tetrahedra: per block of kTetBlockSize consecutive ids its
 /// distinct points (positions, point values) and each tetrahedron's corners as indices into
-/// them. Throws Error(Unsupported) when the blocks' vertices exceed 32-bit indices. Parallel.
-void encodeTetBlocks(TetMesh& mesh);
+/// them. Throws Error(Unsupported) when the blocks' vertices exceed 32-bit indices. Parallel;
+/// `progress` hears the fraction done.
+void encodeTetBlocks(TetMesh& mesh, const FractionFn& progress = {});
 
 /// The bounding box of the field's gradient over point-data cell c of m: a tetrahedron's one
 /// constant gradient; a native cell's gradients at its corners and centre (a pyramid's apex,

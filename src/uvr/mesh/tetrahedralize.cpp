@@ -152,8 +152,18 @@ CellKind nativeKind(CellType type) {
 
 }  // namespace
 
+namespace {
+
+/// Where each part of tetrahedralize ends in its progress fraction: split loop, gather, Morton
+/// order, values, blocks (by their seconds at 100M tetrahedra on 16 cores: 1.0, 0.8, 1.4, 0.3,
+/// 0.7).
+constexpr double kSplitEnd = 1.0 / 4.2, kGatherEnd = 1.8 / 4.2, kSortEnd = 3.2 / 4.2,
+                 kValuesEnd = 3.5 / 4.2;
+
+}  // namespace
+
 TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
-                       const TetrahedralizeOptions& options) {
+                       const TetrahedralizeOptions& options, const FractionFn& progress) {
     TetMesh out;
     out.points.assign(mesh.points.begin(), mesh.points.end());
     const bool cellData = field.association == Association::Cell;
@@ -173,6 +183,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
     };
     std::vector<Chunk> parts(chunks);
     out.cellTets.assign(mesh.cellCount(), 0);
+    ProgressCounter splitDone(progress, chunks, 0.0, kSplitEnd);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
         Chunk& s = parts[c];
@@ -206,16 +217,20 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
                 for (std::uint32_t v : split.tets[t].v) s.bounds.extend(out.points[v]);
             }
         }
+        splitDone.add();
     }
+    splitDone.finish();
     std::vector<std::uint64_t> chunkStart(chunks + 1, 0);
     for (std::int64_t c = 0; c < chunks; ++c)
         chunkStart[c + 1] = chunkStart[c] + parts[c].tets.size();
     out.tets.resize(chunkStart[chunks]);
+    ProgressCounter gathered(progress, chunks, kSplitEnd, kGatherEnd);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
         Chunk& s = parts[c];
         std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
         s.tets = {};
+        gathered.add();
     }
     // Native cells by kind, each kind in chunk order.
     std::uint64_t* counts[3] = {&out.pyramidCount, &out.wedgeCount, &out.hexCount};
@@ -236,8 +251,10 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
         out.totalVolume += s.volume;
         out.bounds.extend(s.bounds);
     }
-    if (options.spatialOrder) sortCellsSpatially(out);
+    gathered.finish();
+    if (options.spatialOrder) sortCellsSpatially(out, subRange(progress, kGatherEnd, kSortEnd));
     assignTetValues(out, field);
+    if (progress) progress(kValuesEnd);
     out.frame = frameForBounds(out.bounds);
     if (!out.frame.identity()) {
         const MeshFrame& f = out.frame;
@@ -255,7 +272,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
                       Vec3f(float(bhi[0]), float(bhi[1]), float(bhi[2]))};
         out.totalVolume *= f.scale * f.scale * f.scale;
     }
-    encodeTetBlocks(out);
+    encodeTetBlocks(out, subRange(progress, kValuesEnd, 1.0));
     return out;
 }
 

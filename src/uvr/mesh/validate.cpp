@@ -197,7 +197,10 @@ void validateStructure(const Mesh& mesh, const std::string& file) {
     }
 }
 
-ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
+ValidationReport validateMesh(const Mesh& mesh, const std::string& file,
+                              const FractionFn& progress) {
+    // Progress: the cells to 0.7, the points (coincident ones among them) to 0.9, fields to 1.
+    constexpr double kCellsEnd = 0.7, kPointsEnd = 0.9;
     validateStructure(mesh, file);
     ValidationReport r;
     // Cell geometry (the same split the renderer uses), per fixed chunk of cells in parallel,
@@ -212,6 +215,7 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
     };
     std::vector<Chunk> parts(chunks);
     std::vector<std::uint8_t> used(mesh.pointCount(), 0);
+    ProgressCounter cellsDone(progress, chunks, 0.0, kCellsEnd);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
         Chunk& s = parts[c];
@@ -228,7 +232,9 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
                                                                     : -1;
             if (kind >= 0 && s.count[kind]++ == 0) s.first[kind] = i;
         }
+        cellsDone.add();
     }
+    cellsDone.finish();
     std::uint64_t* counts[3] = {&r.invertedCells, &r.zeroVolumeCells, &r.distortedCells};
     std::uint64_t* firsts[3] = {&r.firstInvertedCell, &r.firstZeroVolumeCell,
                                 &r.firstDistortedCell};
@@ -254,6 +260,7 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
     r.unusedPoints = unused;
     r.nonFinitePoints = nonFinite;
     r.coincidentPoints = countCoincidentPoints(mesh.points);
+    if (progress) progress(kPointsEnd);
     // Fields: per chunk the count and first non-finite value.
     for (const Field& f : mesh.fields) {
         const std::uint64_t n = f.values.size();
@@ -272,6 +279,7 @@ ValidationReport validateMesh(const Mesh& mesh, const std::string& file) {
             r.nonFiniteFields.push_back(
                 {f.name, f.association, count, first / static_cast<std::uint64_t>(f.components)});
     }
+    if (progress) progress(1.0);
     return r;
 }
 

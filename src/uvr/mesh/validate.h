@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "uvr/core/progress.h"
 #include "uvr/mesh/mesh.h"
 
 namespace uvr {
@@ -55,8 +56,10 @@ struct ValidationReport {
 
 /// Checks the mesh's structure (offsets, corner counts, point indices in range, field sizes) and
 /// throws Error(Validation) naming the first offending cell or field; then classifies every cell's
-/// geometry and scans points and fields, returning the counts.
-ValidationReport validateMesh(const Mesh& mesh, const std::string& file = "");
+/// geometry and scans points and fields, returning the counts. `progress` hears the fraction
+/// done.
+ValidationReport validateMesh(const Mesh& mesh, const std::string& file = "",
+                              const FractionFn& progress = {});
 
 /// Only the structural checks of validateMesh (cheap; run by every load).
 void validateStructure(const Mesh& mesh, const std::string& file = "");

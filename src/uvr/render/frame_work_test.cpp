@@ -77,27 +77,5 @@ TEST(FrameWork, CpuRenderReportsIncreasingFractionsEndingWithOne) {
     omp_set_num_threads(threadsBefore);
 }
 
-TEST(FrameWork, FrameProgressFromManyThreadsReportsOneAtATimeInOrder) {
-    std::vector<double> seen;
-    int inside = 0, overlapped = 0;
-    const std::function<void(double)> report = [&](double f) {
-        if (++inside > 1) ++overlapped;
-        seen.push_back(f);
-        --inside;
-    };
-    FrameProgress progress(report, 10000);
-#pragma omp parallel for num_threads(4)
-    for (int i = 0; i < 10000; ++i) progress.partDone();
-    progress.finish();
-    EXPECT_EQ(overlapped, 0);
-    ASSERT_GE(seen.size(), 1u);
-    for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GT(seen[i], seen[i - 1]);
-    EXPECT_EQ(seen.back(), 1.0);
-    // No callback: nothing happens.
-    FrameProgress silent({}, 3);
-    silent.partDone();
-    silent.finish();
-}
-
 }  // namespace
 }  // namespace uvr

@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -15,6 +14,7 @@
 #include "uvr/accel/lbvh.h"
 #include "uvr/accel/macro_grid.h"
 #include "uvr/accel/seed_grid.h"
+#include "uvr/core/progress.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/mesh/tet_mesh.h"
@@ -46,6 +46,9 @@ struct PrepareOptions {
     std::function<std::vector<std::uint32_t>(const TetMesh&)> faceMatcher;
     /// When set, the seed grids come from this builder (buildSeedGridsCuda: on the GPU).
     SeedBuilder seedBuilder;
+    /// When set (and with macroGrids), the macrocells and the partitions' gradient spreads come
+    /// from this builder (buildMacroGridsCuda: on the GPU).
+    MacroBuilder macroBuilder;
     /// Called once the cells are split (tetrahedralize), after which prepareMesh reads nothing of
     /// the source mesh: a caller holding the only copy may free it then, so a one-shot render of
     /// a billion cells does not hold the mesh as read beside the prepared one.
@@ -85,7 +88,9 @@ struct PreparedMesh {
     bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) built parts of it
     /// Wall seconds of every phase prepareMesh ran, in order: "split" (with the Morton order and
     /// the kernels' blocks), "bvh", "neighbours" (with their codes), "partitions" (with their
-    /// value ranges), "cell_tree", "seed_grids", "gradient_spreads", "nan_flags", "macrocells".
+    /// value ranges), "cell_tree", "seed_grids", "gradient_spreads", "nan_flags", "macrocells"
+    /// (with the gradient spreads, which then have no phase of their own, when
+    /// PrepareOptions::macroBuilder builds them).
     std::vector<std::pair<std::string, double>> phaseSeconds;
     /// The prepared cache it was read from (readPreparedCache), holding only what rendering
     /// reads; empty when prepared from a mesh. updateFieldValues refuses such a mesh.
@@ -108,10 +113,38 @@ struct PreparedMesh {
     TetLocator locator() const { return {kernelMesh(), bvh.view(), neighborCodes.view()}; }
 };
 
-/// Optional progress report: a step name ("splitting cells", ...) when a step starts.
-using ProgressFn = std::function<void(const std::string&)>;
+/// Optional progress report of a preparation: `step` names each phase as it starts ("finding
+/// face neighbours", ...) and `fraction` tells how far the phase named last has come, in [0, 1],
+/// increasing within the phase (only phases that can take long report it, ending with 1; from
+/// one thread at a time, any thread; it must not throw). Either may be empty. Any callable taking
+/// a step name converts to one with only `step`.
+struct ProgressFn {
+    std::function<void(const std::string&)> step;  ///< a phase starts: its name
+    FractionFn fraction;                           ///< how far the phase named last has come
 
-/// Splits cells (or keeps them native), builds the BVH over them and the face-neighbour table.
+    /// No reports.
+    ProgressFn() = default;
+    /// Both callbacks.
+    ProgressFn(std::function<void(const std::string&)> onStep, FractionFn onFraction)
+        : step(std::move(onStep)), fraction(std::move(onFraction)) {}
+    /// Only step names, from any callable taking one (a lambda, a std::function).
+    template <class F, class = std::enable_if_t<!std::is_same_v<std::decay_t<F>, ProgressFn> &&
+                                                std::is_invocable_v<F&, const std::string&>>>
+    ProgressFn(F&& onStep)  // NOLINT(google-explicit-constructor): lambdas convert
+        : step(std::forward<F>(onStep)) {}
+
+    /// Names a phase that starts (nothing when step is empty).
+    void operator()(const std::string& name) const {
+        if (step) step(name);
+    }
+    /// Whether anything is reported.
+    explicit operator bool() const { return step || fraction; }
+};
+
+/// Splits cells (or keeps them native), builds the BVH over them and the face-neighbour table,
+/// and what options ask for besides. `progress` hears each phase of PreparedMesh::phaseSeconds
+/// named as it starts, in that order, and the fraction done of the long ones (split,
+/// neighbours, partitions, cell tree, gradient spreads).
 PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                          const PrepareOptions& options, const ProgressFn& progress = {});
 /// prepareMesh with the default options.
@@ -134,8 +167,10 @@ void updateFieldValues(PreparedMesh& mesh, const ScalarField& field);
 /// cellGradientBounds): it bounds how much the derivative of the field along
 /// any ray varies inside the partition. 0 for a partition without cells or with a linear field;
 /// infinite for a cell-centred field (piecewise constant: its jumps have no gradient bound).
-/// Cells with non-finite gradients (degenerate, or NaN values) are left out.
-std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd);
+/// Cells with non-finite gradients (degenerate, or NaN values) are left out. `progress` hears the
+/// fraction done.
+std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd,
+                                           const FractionFn& progress = {});
 
 /// Per partition, 1 where one of its cells has a NaN value (a vertex's, or the cell's own for
 /// cell data); empty when no cell has one. Partition value ranges leave NaN out, so skipping
@@ -257,26 +292,6 @@ inline constexpr std::uint64_t kHeatmapBytesPerPixel = 20;
 /// tetrahedra, the BVH with its build arrays, the neighbours, partitions and seed grids took
 /// 120 to 130 bytes on 4-million-tetrahedron procedural meshes.
 inline constexpr std::uint64_t kPrepareBytesPerTet = 160;
-
-/// Counts finished parts of a frame from many threads and reports the fraction done to a
-/// callback (RenderSettings::progress) from one thread at a time, increasing; finish() reports 1.
-class FrameProgress {
-public:
-    /// Reports to `report` (may be empty: nothing is reported) out of `total` parts.
-    FrameProgress(const std::function<void(double)>& report, std::int64_t total)
-        : report_(report), total_(total > 0 ? total : 1) {}
-    /// Marks one part done (thread-safe) and reports unless another thread is reporting.
-    void partDone();
-    /// Reports 1 (call after the parallel loop).
-    void finish();
-
-private:
-    std::function<void(double)> report_;
-    std::int64_t total_;
-    std::atomic<std::int64_t> done_{0};
-    std::mutex reporting_;
-    double reported_ = 0.0;
-};
 
 /// Default s2 / s1 of the adaptive step.
 inline constexpr float kDefaultMaxStepFactor = 16.f;

@@ -53,6 +53,45 @@ double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
+/// Least time between two "progress" messages of a phase with fractions.
+constexpr double kProgressInterval = 0.1;
+
+/// A preparation's progress as "progress" messages given to `send`: each phase's name with
+/// fraction null when it starts (`onStep` hears the name first, when set), then its fractions
+/// at most every kProgressInterval seconds and its end (1) always. Callable from any thread.
+ProgressFn progressMessages(std::function<void(const std::string&)> send,
+                            std::function<void(const std::string&)> onStep = {}) {
+    struct Phase {
+        std::mutex m;
+        std::string name;
+        Clock::time_point last;
+    };
+    auto phase = std::make_shared<Phase>();
+    auto message = [](const std::string& name, const Json& fraction) {
+        return Json{{"type", "progress"}, {"phase", name}, {"fraction", fraction}}.dump(
+            -1, ' ', false, Json::error_handler_t::replace);
+    };
+    return {[=](const std::string& name) {
+                if (onStep) onStep(name);
+                {
+                    std::lock_guard lk(phase->m);
+                    phase->name = name;
+                    phase->last = Clock::now();
+                }
+                send(message(name, nullptr));
+            },
+            [=](double f) {
+                std::string text;
+                {
+                    std::lock_guard lk(phase->m);
+                    if (f < 1.0 && secondsSince(phase->last) < kProgressInterval) return;
+                    phase->last = Clock::now();
+                    text = message(phase->name, f);
+                }
+                send(text);
+            }};
+}
+
 std::string randomToken() {
     std::random_device rd;  // /dev/urandom on Linux
     static const char* hex = "0123456789abcdef";
@@ -781,10 +820,9 @@ void ViewServer::Impl::prepareAtStart() {
     if (renderer) return;
     const auto start = Clock::now();
     try {
-        field(scene.initial.field, scene.initial.step, [this](const std::string& phase) {
-            say("view: " + phase);
-            broadcast(Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
-        });
+        field(scene.initial.field, scene.initial.step,
+              progressMessages([this](const std::string& text) { broadcast(text); },
+                               [this](const std::string& phase) { say("view: " + phase); }));
     } catch (const std::exception& e) {
         // Said to the log and the page; the first frame tries again and answers with the error.
         say(std::string("view: preparation failed: ") + e.what());
@@ -872,12 +910,10 @@ void ViewServer::Impl::renderLoop() {
         bool sent = false;
         try {
             const std::string key = fieldKey(state.field, state.step);
-            const FieldEntry entry = field(state.field, state.step, [&](const std::string& phase) {
-                post([phase](Session& c) {
-                    c.sendText(
-                        Json{{"type", "progress"}, {"phase", phase}, {"fraction", nullptr}}.dump());
-                });
-            });
+            const FieldEntry entry =
+                field(state.field, state.step, progressMessages([&](const std::string& text) {
+                          post([text](Session& c) { c.sendText(text); });
+                      }));
             if (resetRange) {
                 state.range = entry.range;
                 if (!(state.range.first < state.range.second))
