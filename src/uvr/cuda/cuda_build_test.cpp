@@ -43,6 +43,9 @@ TEST(CudaLbvh, WithoutADeviceTheBuildIsRefusedClearly) {
     EXPECT_THROW(buildKdTreeCuda(mesh, {}), Error);
     EXPECT_THROW(buildTetNeighborsCuda(mesh), Error);
     EXPECT_THROW(buildSeedGridsCuda(mesh, buildKdPartitions(mesh, {}), kTetsPerSeedCell), Error);
+    EXPECT_THROW(buildMacroGridsCuda(mesh, buildKdPartitions(mesh, {}), buildTetNeighbors(mesh),
+                                     kTetsPerMacroCell),
+                 Error);
 }
 
 TEST(CudaLbvh, MeshTreeIsBitIdenticalToTheCpuBuild) {
@@ -151,8 +154,18 @@ std::vector<std::pair<std::string, TetMesh>> builderMeshes() {
     seams.cellIndices.insert(seams.cellIndices.end(), first.begin(), first.end());
     seams.cellOffsets.push_back(seams.cellIndices.size());  // a third cell on the first's faces
     seams.cellTypes.push_back(seams.cellTypes[0]);
+    for (std::size_t i = 0; i < seams.fields[0].values.size(); i += 101)
+        seams.fields[0].values[i] = NAN;  // NaN point values
     out.emplace_back("seams",
                      tetrahedralize(seams, selectScalarField(seams, {}), {.splitCells = true}));
+    Field cellField{"c", Association::Cell, 1, {}};
+    for (std::size_t c = 0; c < seams.cellCount(); ++c)
+        cellField.values.push_back(c % 97 == 0 ? NAN : float(c % 13));
+    seams.fields.push_back(cellField);
+    FieldSpec cellSpec;
+    cellSpec.name = "c";
+    out.emplace_back("cell data", tetrahedralize(seams, selectScalarField(seams, cellSpec),
+                                                 {.splitCells = true}));
     return out;
 }
 
@@ -184,6 +197,36 @@ TEST(CudaPrepare, SeedGridsEqualTheCpuSeeds) {
                                 [](std::uint32_t t) { return t != kNoTet; }),
                   std::ptrdiff_t(gpu.seeds.size() / 2))
             << name;
+    }
+}
+
+TEST(CudaPrepare, MacrocellsAndGradientSpreadsEqualTheCpus) {
+    UVR_REQUIRE_GPU();
+    for (const auto& [name, mesh] : builderMeshes()) {
+        KdBuildOptions o;
+        o.leafCells = 2048;
+        const KdPartitions kd = buildKdPartitions(mesh, o);
+        const std::vector<std::uint32_t> neighbors = buildTetNeighbors(mesh);
+        const MacroGrids cpu = buildMacroGrids(mesh, kd, neighbors);
+        const std::vector<float> cpuSpread = partitionGradientSpread(mesh, kd);
+        const MacroBuild gpu = buildMacroGridsCuda(mesh, kd, neighbors, kTetsPerMacroCell);
+        ASSERT_EQ(cpu.cells.size(), gpu.macro.cells.size()) << name;
+        std::size_t differ = 0, unbounded = 0, visible = 0;
+        for (std::size_t c = 0; c < cpu.cells.size(); ++c) {
+            const MacroCell &a = cpu.cells[c], &b = gpu.macro.cells[c];
+            // == : a zero may come back with the other sign.
+            differ += !(a.valueMin == b.valueMin && a.valueMax == b.valueMax &&
+                        a.gradientSpread == b.gradientSpread);
+            unbounded += a.gradientSpread == INFINITY;
+            visible += !a.empty();
+        }
+        EXPECT_EQ(differ, 0u) << name;
+        EXPECT_GT(unbounded, 0u) << name;  // the boundary's macrocells
+        EXPECT_GT(visible, cpu.cells.size() / 2) << name;
+        EXPECT_EQ(cpu.nanCells, gpu.macro.nanCells) << name;
+        ASSERT_EQ(cpuSpread.size(), gpu.gradientSpread.size()) << name;
+        for (std::size_t p = 0; p < cpuSpread.size(); ++p)
+            ASSERT_EQ(cpuSpread[p], gpu.gradientSpread[p]) << name << ", partition " << p;
     }
 }
 
