@@ -7,6 +7,7 @@
 #include "uvr/core/vec.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -47,6 +48,14 @@ inline std::string scratchDir() {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir.string();
+}
+
+/// True when two arrays (any vector type) hold the same bytes.
+template <class T>
+bool sameBytes(const T& a, const T& b) {
+    return a.size() == b.size() &&
+           (a.empty() ||
+            std::memcmp(a.data(), b.data(), a.size() * sizeof(typename T::value_type)) == 0);
 }
 
 /// The whole file's bytes ("" when it cannot be read).

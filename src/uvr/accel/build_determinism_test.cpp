@@ -4,6 +4,8 @@
 // top levels.
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <algorithm>
 #include <cstring>
 #include <map>
@@ -17,11 +19,6 @@
 
 namespace uvr {
 namespace {
-
-template <class T>
-bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
 
 /// A procedural box of about 400k tetrahedra (above the builders' one-thread subtree sizes).
 const Mesh& bigBox() {
@@ -52,21 +49,21 @@ TEST(ParallelBuild, SameResultsWithOneAndTwoThreads) {
         const PreparedMesh& a = prepareWith(1, leafCells);
         const PreparedMesh& b = prepareWith(2, leafCells);
         ASSERT_GT(a.tets.tets.size(), 300000u);
-        EXPECT_TRUE(sameBytes(a.tets.tets, b.tets.tets));
+        EXPECT_TRUE(testing::sameBytes(a.tets.tets, b.tets.tets));
         EXPECT_EQ(a.tets.totalVolume, b.tets.totalVolume);
-        EXPECT_TRUE(sameBytes(a.bvh.nodes, b.bvh.nodes));
-        EXPECT_TRUE(sameBytes(a.bvh.primIds, b.bvh.primIds));
-        EXPECT_TRUE(sameBytes(a.neighbors, b.neighbors));
-        EXPECT_TRUE(sameBytes(a.kd->nodes, b.kd->nodes));
-        EXPECT_TRUE(sameBytes(a.kd->partitions, b.kd->partitions));
-        EXPECT_TRUE(sameBytes(a.kd->cells, b.kd->cells));
+        EXPECT_TRUE(testing::sameBytes(a.bvh.nodes, b.bvh.nodes));
+        EXPECT_TRUE(testing::sameBytes(a.bvh.primIds, b.bvh.primIds));
+        EXPECT_TRUE(testing::sameBytes(a.neighbors, b.neighbors));
+        EXPECT_TRUE(testing::sameBytes(a.kd->nodes, b.kd->nodes));
+        EXPECT_TRUE(testing::sameBytes(a.kd->partitions, b.kd->partitions));
+        EXPECT_TRUE(testing::sameBytes(a.kd->cells, b.kd->cells));
         // The kernels' layout: Morton order, blocks, neighbour codes, cell tree.
-        EXPECT_TRUE(sameBytes(a.tets.tetSourceOrder, b.tets.tetSourceOrder));
-        EXPECT_TRUE(sameBytes(a.tets.tetCorners, b.tets.tetCorners));
-        EXPECT_TRUE(sameBytes(a.tets.blockVertices, b.tets.blockVertices));
-        EXPECT_TRUE(sameBytes(a.neighborCodes.tetCodes, b.neighborCodes.tetCodes));
-        EXPECT_TRUE(sameBytes(a.neighborCodes.escapes, b.neighborCodes.escapes));
-        EXPECT_TRUE(sameBytes(a.cellTree.nodes, b.cellTree.nodes));
+        EXPECT_TRUE(testing::sameBytes(a.tets.tetSourceOrder, b.tets.tetSourceOrder));
+        EXPECT_TRUE(testing::sameBytes(a.tets.tetCorners, b.tets.tetCorners));
+        EXPECT_TRUE(testing::sameBytes(a.tets.blockVertices, b.tets.blockVertices));
+        EXPECT_TRUE(testing::sameBytes(a.neighborCodes.tetCodes, b.neighborCodes.tetCodes));
+        EXPECT_TRUE(testing::sameBytes(a.neighborCodes.escapes, b.neighborCodes.escapes));
+        EXPECT_TRUE(testing::sameBytes(a.cellTree.nodes, b.cellTree.nodes));
     }
 }
 

@@ -26,6 +26,11 @@ LbvhResult buildLbvhCuda(const LbvhInput& input);
 /// buildLbvhCuda does.
 KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options);
 
+/// The order of cells by 63-bit keys (a CellOrderSorter for sortCellsSpatially): CUB's stable
+/// radix sort of (key, position) pairs, the same order as the CPU's sort. Throws as
+/// buildLbvhCuda does.
+void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint32_t* order);
+
 /// Finds the face neighbours of buildTetNeighbors on the GPU (points welded on the CPU; faces
 /// counted, scattered into their smallest vertex's bucket and paired there, in passes over
 /// vertex ranges when they do not all fit, or of at most facesPerPass faces when it is not 0):

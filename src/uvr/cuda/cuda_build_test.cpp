@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "test_meshes.h"
+#include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_renderer.h"
@@ -42,6 +43,7 @@ TEST(CudaLbvh, WithoutADeviceTheBuildIsRefusedClearly) {
     EXPECT_THROW(buildMeshLbvh(mesh, buildLbvhCuda), Error);
     EXPECT_THROW(buildKdTreeCuda(mesh, {}), Error);
     EXPECT_THROW(buildTetNeighborsCuda(mesh), Error);
+    EXPECT_THROW(tetrahedralize(m, selectScalarField(m, {}), {.sorter = sortCellKeysCuda}), Error);
     EXPECT_THROW(buildSeedGridsCuda(mesh, buildKdPartitions(mesh, {}), kTetsPerSeedCell), Error);
     EXPECT_THROW(buildMacroGridsCuda(mesh, buildKdPartitions(mesh, {}), buildTetNeighbors(mesh),
                                      kTetsPerMacroCell),
@@ -227,6 +229,25 @@ TEST(CudaPrepare, MacrocellsAndGradientSpreadsEqualTheCpus) {
         ASSERT_EQ(cpuSpread.size(), gpu.gradientSpread.size()) << name;
         for (std::size_t p = 0; p < cpuSpread.size(); ++p)
             ASSERT_EQ(cpuSpread[p], gpu.gradientSpread[p]) << name << ", partition " << p;
+    }
+}
+
+TEST(CudaPrepare, MortonOrderEqualsTheCpus) {
+    UVR_REQUIRE_GPU();
+    for (const bool mixed : {false, true}) {
+        const Mesh m = mixed ? generateMixedCellMesh(24) : generateMesh([] {
+            ProceduralSpec spec;
+            spec.targetCells = 300000;
+            return spec;
+        }());
+        const ScalarField f = selectScalarField(m, {});
+        const TetMesh cpu = tetrahedralize(m, f, {});
+        const TetMesh gpu = tetrahedralize(m, f, {.sorter = sortCellKeysCuda});
+        EXPECT_TRUE(testing::sameBytes(cpu.tets, gpu.tets)) << mixed;
+        EXPECT_TRUE(testing::sameBytes(cpu.tetSourceOrder, gpu.tetSourceOrder)) << mixed;
+        EXPECT_TRUE(testing::sameBytes(cpu.tetCorners, gpu.tetCorners)) << mixed;
+        EXPECT_EQ(cpu.nativeCorners, gpu.nativeCorners) << mixed;
+        EXPECT_EQ(cpu.nativeSource, gpu.nativeSource) << mixed;
     }
 }
 

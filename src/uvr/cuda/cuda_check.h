@@ -48,7 +48,8 @@ public:
                   "cudaMemcpy(upload)", __FILE__, __LINE__);
     }
     /// Allocates and copies a host vector.
-    void upload(const std::vector<T>& host, const char* what) {
+    template <class Allocator>
+    void upload(const std::vector<T, Allocator>& host, const char* what) {
         upload(host.data(), host.size(), what);
     }
     /// Copies the first n elements to host memory.

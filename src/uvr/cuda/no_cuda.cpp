@@ -65,6 +65,10 @@ KdTree buildKdTreeCuda(const TetMesh&, const KdBuildOptions&) {
     noCudaBuilders();
 }
 
+void sortCellKeysCuda(const std::uint64_t*, std::uint64_t, std::uint32_t*) {
+    noCudaBuilders();
+}
+
 std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh&, std::uint64_t) {
     noCudaBuilders();
 }

@@ -5,6 +5,7 @@
 // seed rule is offerSeedKeys', so the tables equal the CPU's bit for bit. This file is compiled
 // with --fmad=false: no multiply-add is fused, so the seeds' barycentrics and distances round as
 // the CPU's do.
+#include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
 #include <algorithm>
@@ -220,6 +221,12 @@ __global__ void macroCellsKernel(const std::uint32_t* rangeKeys, const std::uint
     cells[c] = m;
 }
 
+/// Positions 0, 1, ..., n - 1.
+__global__ void iotaKernel(std::uint32_t* out, std::uint64_t n) {
+    const std::uint64_t i = globalThread();
+    if (i < n) out[i] = static_cast<std::uint32_t>(i);
+}
+
 /// Free device memory in bytes.
 std::size_t freeDeviceMemory() {
     std::size_t freeBytes = 0, totalBytes = 0;
@@ -229,6 +236,29 @@ std::size_t freeDeviceMemory() {
 
 }  // namespace
 }  // namespace cuda
+
+void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint32_t* order) {
+    UVR_CHECK(count < (std::uint64_t(1) << 32), "too many cells to sort: " << count);
+    if (count == 0) return;
+    // A stable radix sort of (key, position) pairs by key: ties keep their positions' order.
+    cuda::DeviceArray<std::uint64_t> keyArrays[2];
+    cuda::DeviceArray<std::uint32_t> positions[2];
+    cuda::DeviceArray<unsigned char> temp;
+    keyArrays[0].upload(keys, count, "the cells' Morton keys (GPU sort)");
+    keyArrays[1].reserve(count, "the sorted Morton keys (GPU sort)");
+    positions[0].reserve(count, "the cells' positions (GPU sort)");
+    positions[1].reserve(count, "the sorted positions (GPU sort)");
+    cuda::iotaKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(positions[0].data(), count);
+    UVR_CUDA_CHECK(cudaGetLastError());
+    cub::DoubleBuffer<std::uint64_t> keyBuffer(keyArrays[0].data(), keyArrays[1].data());
+    cub::DoubleBuffer<std::uint32_t> positionBuffer(positions[0].data(), positions[1].data());
+    cuda::withScratch(temp, "the radix sort's scratch (GPU sort)", [&](void* s, std::size_t& b) {
+        return cub::DeviceRadixSort::SortPairs(s, b, keyBuffer, positionBuffer,
+                                               static_cast<std::int64_t>(count), 0, 63);
+    });
+    UVR_CUDA_CHECK(cudaMemcpy(order, positionBuffer.Current(), count * sizeof(std::uint32_t),
+                              cudaMemcpyDeviceToHost));
+}
 
 std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, std::uint64_t facesPerPass) {
     const TetMeshView host = mesh.view();

@@ -34,6 +34,7 @@ PrepareOptions RendererOptions::prepareOptions() const {
         o.faceMatcher = [](const TetMesh& m) { return buildTetNeighborsCuda(m); };
         o.seedBuilder = buildSeedGridsCuda;
         o.macroBuilder = buildMacroGridsCuda;
+        o.cells.sorter = sortCellKeysCuda;
         o.builderDevice = "the GPU";
         if (buildDevice == Device::Auto) o.builderMinTets = kAutoGpuBuildTets;
     }

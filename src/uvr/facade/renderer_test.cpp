@@ -162,18 +162,12 @@ Mesh timeStep(float t) {
 }
 
 /// Bitwise equality of two float arrays (NaN equal to NaN, -0 unequal to +0).
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() &&
-           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
 /// Every pixel of two frames equal, bit for bit.
 void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::string& what) {
     ASSERT_EQ(a.image.pixels.size(), b.image.pixels.size()) << what;
     EXPECT_EQ(a.stats.samples, b.stats.samples) << what;
-    EXPECT_TRUE(sameBits(a.image.pixels, b.image.pixels)) << what;
-    EXPECT_TRUE(sameBits(a.sampleCounts, b.sampleCounts)) << what;
+    EXPECT_TRUE(testing::sameBytes(a.image.pixels, b.image.pixels)) << what;
+    EXPECT_TRUE(testing::sameBytes(a.sampleCounts, b.sampleCounts)) << what;
 }
 
 TEST(Renderer, SetFieldValuesGivesTheFramesOfAFreshPreparationWithoutRebuilding) {
@@ -209,26 +203,26 @@ TEST(Renderer, SetFieldValuesGivesTheFramesOfAFreshPreparationWithoutRebuilding)
         for (std::size_t i = 0; i < std::size(addresses); ++i)
             EXPECT_EQ(addresses[i], after[i]) << spec << ": array " << i << " was reallocated";
         EXPECT_EQ(p.kd->buildSeconds, buildSeconds);
-        EXPECT_TRUE(sameBits(p.tets.tets, before.tets.tets));
-        EXPECT_TRUE(sameBits(p.bvh.nodes, before.bvh.nodes));
-        EXPECT_TRUE(sameBits(p.kd->cells, before.kd->cells));
-        EXPECT_TRUE(sameBits(p.cellTree.nodes, before.cellTree.nodes));
-        EXPECT_TRUE(sameBits(p.tets.tetCorners, before.tets.tetCorners));
-        EXPECT_TRUE(sameBits(p.neighborCodes.tetCodes, before.neighborCodes.tetCodes));
-        EXPECT_TRUE(sameBits(p.seeds->seeds, before.seeds->seeds));
+        EXPECT_TRUE(testing::sameBytes(p.tets.tets, before.tets.tets));
+        EXPECT_TRUE(testing::sameBytes(p.bvh.nodes, before.bvh.nodes));
+        EXPECT_TRUE(testing::sameBytes(p.kd->cells, before.kd->cells));
+        EXPECT_TRUE(testing::sameBytes(p.cellTree.nodes, before.cellTree.nodes));
+        EXPECT_TRUE(testing::sameBytes(p.tets.tetCorners, before.tets.tetCorners));
+        EXPECT_TRUE(testing::sameBytes(p.neighborCodes.tetCodes, before.neighborCodes.tetCodes));
+        EXPECT_TRUE(testing::sameBytes(p.seeds->seeds, before.seeds->seeds));
         // The value-dependent structures equal a fresh preparation's, bit for bit.
         const PreparedMesh fresh = prepareMesh(m1, f1, o.prepareOptions());
-        EXPECT_TRUE(sameBits(p.tets.values, fresh.tets.values)) << spec;
-        EXPECT_TRUE(sameBits(p.tets.blockVertices, fresh.tets.blockVertices)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.tets.values, fresh.tets.values)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.tets.blockVertices, fresh.tets.blockVertices)) << spec;
         EXPECT_EQ(p.tets.valueMin, fresh.tets.valueMin) << spec;
         EXPECT_EQ(p.tets.valueMax, fresh.tets.valueMax) << spec;
-        EXPECT_TRUE(sameBits(p.kd->partitions, fresh.kd->partitions)) << spec;
-        EXPECT_TRUE(sameBits(p.gradientSpread, fresh.gradientSpread)) << spec;
-        EXPECT_TRUE(sameBits(p.partitionNan, fresh.partitionNan)) << spec;
-        EXPECT_TRUE(sameBits(p.macro->cells, fresh.macro->cells)) << spec;
-        EXPECT_TRUE(sameBits(p.macro->nanCells, fresh.macro->nanCells)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.kd->partitions, fresh.kd->partitions)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.gradientSpread, fresh.gradientSpread)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.partitionNan, fresh.partitionNan)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.macro->cells, fresh.macro->cells)) << spec;
+        EXPECT_TRUE(testing::sameBytes(p.macro->nanCells, fresh.macro->nanCells)) << spec;
         EXPECT_EQ(p.partitionNan.empty(), spec[0] == 'c') << spec;
-        EXPECT_FALSE(sameBits(p.tets.values, before.tets.values)) << spec;
+        EXPECT_FALSE(testing::sameBytes(p.tets.values, before.tets.values)) << spec;
         for (RenderMethod method :
              {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
             RenderSettings s = frameOf(m0.bounds(), method);
@@ -257,7 +251,7 @@ TEST(Renderer, SetFieldValuesRefusesTheWrongCountAndChangesNothing) {
     EXPECT_THAT(catchError([&] { r.setFieldValues(bad); }).what(),
                 HasSubstr("expected " + std::to_string(m.cellCount())));
     EXPECT_EQ(r.prepared().valueUpdates, 0u);
-    EXPECT_TRUE(sameBits(r.prepared().tets.values, values));
+    EXPECT_TRUE(testing::sameBytes(r.prepared().tets.values, values));
     // Another field of the same mesh, of the other association, is fine.
     r.setFieldValues(selectScalarField(m, parseFieldSpec("c")));
     EXPECT_EQ(r.prepared().tets.association, Association::Cell);

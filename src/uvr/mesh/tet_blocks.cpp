@@ -99,30 +99,50 @@ void sortKeys(ScratchVector<KeyIndex>& a, ProgressCounter& done) {
 }
 
 /// The Morton order of `count` cells of `corners` corners each from ids (corner point ids, one
-/// cell after another); `progress` hears the keys' fraction (first 1/4) and the sort's.
-ScratchVector<KeyIndex> mortonOrder(const std::vector<Vec3f>& points, const Bounds3f& bounds,
-                                    const std::uint32_t* ids, std::uint64_t count, int corners,
-                                    const FractionFn& progress) {
-    ScratchVector<KeyIndex> keys(count);
+/// cell after another): the cells' positions sorted by (key, position), by `sorter` when set;
+/// `progress` hears the keys' fraction (first 1/4) and the sort's.
+ScratchVector<std::uint32_t> mortonOrder(const std::vector<Vec3f>& points, const Bounds3f& bounds,
+                                         const std::uint32_t* ids, std::uint64_t count, int corners,
+                                         const CellOrderSorter& sorter,
+                                         const FractionFn& progress) {
     const float inv = 1.f / static_cast<float>(corners);
-    ProgressCounter keyed(progress, std::int64_t(count), 0.0, 0.25);
-#pragma omp parallel for schedule(static)
-    for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
+    auto key = [&](std::int64_t c) {
         Vec3f centroid(0.f);
         for (int k = 0; k < corners; ++k) centroid += points[ids[std::uint64_t(c) * corners + k]];
-        keys[c] = {morton63(centroid * inv, bounds), static_cast<std::uint32_t>(c)};
-        keyed.tick(c);
+        return morton63(centroid * inv, bounds);
+    };
+    ScratchVector<std::uint32_t> order(count);
+    ProgressCounter keyed(progress, std::int64_t(count), 0.0, 0.25);
+    if (sorter) {
+        ScratchVector<std::uint64_t> keys(count);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
+            keys[c] = key(c);
+            keyed.tick(c);
+        }
+        keyed.finish();
+        sorter(keys.data(), count, order.data());
+    } else {
+        ScratchVector<KeyIndex> keys(count);
+#pragma omp parallel for schedule(static)
+        for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
+            keys[c] = {key(c), static_cast<std::uint32_t>(c)};
+            keyed.tick(c);
+        }
+        keyed.finish();
+        ProgressCounter sorted(progress, 2 * std::int64_t(count), 0.25, 1.0);
+        sortKeys(keys, sorted);
+        sorted.finish();
+#pragma omp parallel for schedule(static)
+        for (std::int64_t c = 0; c < std::int64_t(count); ++c) order[c] = keys[c].index;
     }
-    keyed.finish();
-    ProgressCounter sorted(progress, 2 * std::int64_t(count), 0.25, 1.0);
-    sortKeys(keys, sorted);
-    sorted.finish();
-    return keys;
+    if (progress) progress(1.0);
+    return order;
 }
 
 }  // namespace
 
-void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress) {
+void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress, const CellOrderSorter& sorter) {
     // The tetrahedra's order (keys and sort) to 0.7, their gather to 0.9, native cells to 1.
     if (mesh.bounds.empty()) {
         if (progress) progress(1.0);
@@ -132,8 +152,9 @@ void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress) {
     const std::uint64_t n = mesh.tets.size();
     if (n > 1) {
         static_assert(sizeof(Tet) == 4 * sizeof(std::uint32_t));
-        const ScratchVector<KeyIndex> order = mortonOrder(
-            mesh.points, mesh.bounds, &mesh.tets[0].v[0], n, 4, subRange(progress, 0.0, 0.7));
+        const ScratchVector<std::uint32_t> order =
+            mortonOrder(mesh.points, mesh.bounds, &mesh.tets[0].v[0], n, 4, sorter,
+                        subRange(progress, 0.0, 0.7));
         // Gathered back into the arrays in place (new arrays would be zeroed on one thread).
         ScratchVector<Tet> old(n);
         const bool had = !mesh.tetSourceOrder.empty();
@@ -147,7 +168,7 @@ void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress) {
         ProgressCounter gathered(progress, std::int64_t(n), 0.7, 0.9);
 #pragma omp parallel for schedule(static)
         for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
-            const std::uint32_t from = order[i].index;
+            const std::uint32_t from = order[i];
             mesh.tets[i] = old[from];
             mesh.tetSourceOrder[i] = had ? oldSource[from] : from;
             gathered.tick(i);
@@ -162,13 +183,13 @@ void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress) {
         const std::uint64_t m = counts[kind];
         if (m > 1) {
             std::uint32_t* ids = mesh.nativeCorners.data() + firstCorner;
-            const ScratchVector<KeyIndex> order =
-                mortonOrder(mesh.points, mesh.bounds, ids, m, corners, {});
+            const ScratchVector<std::uint32_t> order =
+                mortonOrder(mesh.points, mesh.bounds, ids, m, corners, sorter, {});
             std::vector<std::uint32_t> sortedIds(m * corners);
             std::vector<std::uint64_t> sortedSource(m);
 #pragma omp parallel for schedule(static)
             for (std::int64_t i = 0; i < std::int64_t(m); ++i) {
-                const std::uint64_t from = order[i].index;
+                const std::uint64_t from = order[i];
                 std::copy(ids + from * corners, ids + (from + 1) * corners,
                           sortedIds.begin() + std::uint64_t(i) * corners);
                 sortedSource[i] = mesh.nativeSource[firstCell + from];

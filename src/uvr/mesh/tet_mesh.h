@@ -2,12 +2,14 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/progress.h"
+#include "uvr/core/scratch_vector.h"
 #include "uvr/core/vec.h"
 #include "uvr/mesh/cell_math.h"
 #include "uvr/mesh/field_select.h"
@@ -218,7 +220,7 @@ struct TetMeshView {
 /// per cell.
 struct TetMesh {
     std::vector<Vec3f> points;
-    std::vector<Tet> tets;
+    ScratchVector<Tet> tets;  ///< (scratch vectors: filled in parallel, never zeroed first)
     std::vector<float> values;
     Association association = Association::Point;
     std::string fieldName;
@@ -239,9 +241,9 @@ struct TetMesh {
     std::vector<std::uint64_t> nativeSource;
     /// Per tetrahedron, its index in cell order (the tetrahedra of cell 0, then of cell 1, ...,
     /// as cellTets counts them) before sortCellsSpatially reordered them; empty: that order.
-    std::vector<std::uint32_t> tetSourceOrder;
+    ScratchVector<std::uint32_t> tetSourceOrder;
     /// The kernels' form of the tetrahedra (encodeTetBlocks; TetMeshView::tetCorners).
-    std::vector<TetCorners16> tetCorners;
+    ScratchVector<TetCorners16> tetCorners;
     std::vector<BlockVertex> blockVertices;
     std::vector<std::uint32_t> blockVertexBase;   ///< per block and one past the last
     std::vector<std::uint32_t> blockVertexPoint;  ///< point id of each block vertex
@@ -282,6 +284,11 @@ struct TetMesh {
 /// hexahedra)" leaving out kinds of none: for progress lines.
 std::string describeCells(const TetMesh& mesh);
 
+/// Sorts cells by 63-bit keys elsewhere (sortCellKeysCuda: on the GPU): writes to
+/// order[0, count) the positions of keys[0, count) in ascending order of (key, position).
+using CellOrderSorter =
+    std::function<void(const std::uint64_t* keys, std::uint64_t count, std::uint32_t* order)>;
+
 /// How tetrahedralize treats pyramids, wedges and hexahedra.
 struct TetrahedralizeOptions {
     /// Split every cell into tetrahedra (`--split-cells`); false: keep pyramids, wedges and
@@ -291,6 +298,8 @@ struct TetrahedralizeOptions {
     /// Reorder the cells of each kind along a Morton curve (sortCellsSpatially); false: cell
     /// order (the tetrahedra of each source cell after those of the cells before it).
     bool spatialOrder = true;
+    /// When set, the Morton order's sort runs there (the same order).
+    CellOrderSorter sorter = nullptr;
 };
 
 /// Number of tetrahedra (at most 6) a cell splits into and their corners, as indices into the
@@ -314,8 +323,9 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
 /// close in id lie close in space: the blocks of the kernels' layout then share most of their
 /// points and neighbours. Keeps tetSourceOrder (and nativeSource) so cell data still maps onto
 /// the cells; call it before assignTetValues and encodeTetBlocks. Parallel; the same order for
-/// any thread count. `progress` hears the fraction done.
-void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress = {});
+/// any thread count. `progress` hears the fraction done; `sorter`, when set, sorts the keys.
+void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress = {},
+                        const CellOrderSorter& sorter = {});
 
 /// Builds the kernels' form of the tetrahedra: per block of kTetBlockSize consecutive ids its
 /// distinct points (positions, point values) and each tetrahedron's corners as indices into

@@ -252,7 +252,8 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
         out.bounds.extend(s.bounds);
     }
     gathered.finish();
-    if (options.spatialOrder) sortCellsSpatially(out, subRange(progress, kGatherEnd, kSortEnd));
+    if (options.spatialOrder)
+        sortCellsSpatially(out, subRange(progress, kGatherEnd, kSortEnd), options.sorter);
     assignTetValues(out, field);
     if (progress) progress(kValuesEnd);
     out.frame = frameForBounds(out.bounds);

@@ -4,6 +4,8 @@
 // one thread or two.
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <cstring>
 #include <mutex>
 #include <set>
@@ -16,11 +18,6 @@
 
 namespace uvr {
 namespace {
-
-template <class T>
-bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
 
 /// A procedural box of about 400k tetrahedra: several chunks of every parallel loop, and above
 /// the k-d builder's one-thread subtree size.
@@ -114,16 +111,16 @@ TEST(PrepareProgress, ReportsChangeNothingPreparedWithOneOrTwoThreads) {
     const PreparedMesh b = prepareWith(1, r1.callbacks());
     const PreparedMesh c = prepareWith(2, r2.callbacks());
     for (const PreparedMesh* x : {&b, &c}) {
-        EXPECT_TRUE(sameBytes(a.tets.tets, x->tets.tets));
-        EXPECT_TRUE(sameBytes(a.tets.tetCorners, x->tets.tetCorners));
-        EXPECT_TRUE(sameBytes(a.tets.blockVertices, x->tets.blockVertices));
-        EXPECT_TRUE(sameBytes(a.neighbors, x->neighbors));
-        EXPECT_TRUE(sameBytes(a.neighborCodes.tetCodes, x->neighborCodes.tetCodes));
-        EXPECT_TRUE(sameBytes(a.neighborCodes.escapes, x->neighborCodes.escapes));
-        EXPECT_TRUE(sameBytes(a.kd->nodes, x->kd->nodes));
-        EXPECT_TRUE(sameBytes(a.kd->cells, x->kd->cells));
-        EXPECT_TRUE(sameBytes(a.cellTree.nodes, x->cellTree.nodes));
-        EXPECT_TRUE(sameBytes(a.gradientSpread, x->gradientSpread));
+        EXPECT_TRUE(testing::sameBytes(a.tets.tets, x->tets.tets));
+        EXPECT_TRUE(testing::sameBytes(a.tets.tetCorners, x->tets.tetCorners));
+        EXPECT_TRUE(testing::sameBytes(a.tets.blockVertices, x->tets.blockVertices));
+        EXPECT_TRUE(testing::sameBytes(a.neighbors, x->neighbors));
+        EXPECT_TRUE(testing::sameBytes(a.neighborCodes.tetCodes, x->neighborCodes.tetCodes));
+        EXPECT_TRUE(testing::sameBytes(a.neighborCodes.escapes, x->neighborCodes.escapes));
+        EXPECT_TRUE(testing::sameBytes(a.kd->nodes, x->kd->nodes));
+        EXPECT_TRUE(testing::sameBytes(a.kd->cells, x->kd->cells));
+        EXPECT_TRUE(testing::sameBytes(a.cellTree.nodes, x->cellTree.nodes));
+        EXPECT_TRUE(testing::sameBytes(a.gradientSpread, x->gradientSpread));
     }
 }
 

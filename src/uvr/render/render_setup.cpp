@@ -32,7 +32,9 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         progress(options.cells.splitCells
                      ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
                      : "preparing " + std::to_string(mesh.cellCount()) + " cells");
-    out.tets = tetrahedralize(mesh, field, options.cells, progress.fraction);
+    TetrahedralizeOptions cells = options.cells;
+    if (mesh.cellCount() < options.builderMinTets) cells.sorter = nullptr;  // as for the others
+    out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
     if (options.afterSplit) options.afterSplit();
     out.splitSeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
