@@ -122,6 +122,7 @@ ScratchVector<std::uint32_t> mortonOrder(const std::vector<Vec3f>& points, const
         }
         keyed.finish();
         sorter(keys.data(), count, order.data());
+        if (progress) progress(1.0);
     } else {
         ScratchVector<KeyIndex> keys(count);
 #pragma omp parallel for schedule(static)
@@ -136,7 +137,6 @@ ScratchVector<std::uint32_t> mortonOrder(const std::vector<Vec3f>& points, const
 #pragma omp parallel for schedule(static)
         for (std::int64_t c = 0; c < std::int64_t(count); ++c) order[c] = keys[c].index;
     }
-    if (progress) progress(1.0);
     return order;
 }
 
