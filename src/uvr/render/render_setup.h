@@ -90,7 +90,9 @@ struct PreparedMesh {
     /// the kernels' blocks), "bvh", "neighbours" (with their codes), "partitions" (with their
     /// value ranges), "cell_tree", "seed_grids", "gradient_spreads", "nan_flags", "macrocells"
     /// (with the gradient spreads, which then have no phase of their own, when
-    /// PrepareOptions::macroBuilder builds them).
+    /// PrepareOptions::macroBuilder builds them). With PrepareOptions::faceMatcher the cell tree
+    /// is built beside the neighbours and the neighbours' codes ("neighbour_codes", last) beside
+    /// the later phases, on threads of their own: their seconds overlap the others'.
     std::vector<std::pair<std::string, double>> phaseSeconds;
     /// The prepared cache it was read from (readPreparedCache), holding only what rendering
     /// reads; empty when prepared from a mesh. updateFieldValues refuses such a mesh.
