@@ -155,25 +155,21 @@ void sortCellsSpatially(TetMesh& mesh, const FractionFn& progress, const CellOrd
         const ScratchVector<std::uint32_t> order =
             mortonOrder(mesh.points, mesh.bounds, &mesh.tets[0].v[0], n, 4, sorter,
                         subRange(progress, 0.0, 0.7));
-        // Gathered back into the arrays in place (new arrays would be zeroed on one thread).
-        ScratchVector<Tet> old(n);
+        // Gathered into new arrays (scratch vectors: not zeroed first).
+        ScratchVector<Tet> sorted(n);
         const bool had = !mesh.tetSourceOrder.empty();
-        ScratchVector<std::uint32_t> oldSource(had ? n : 0);
-#pragma omp parallel for schedule(static)
-        for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
-            old[i] = mesh.tets[i];
-            if (had) oldSource[i] = mesh.tetSourceOrder[i];
-        }
-        mesh.tetSourceOrder.resize(n);
+        ScratchVector<std::uint32_t> source(n);
         ProgressCounter gathered(progress, std::int64_t(n), 0.7, 0.9);
 #pragma omp parallel for schedule(static)
         for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
             const std::uint32_t from = order[i];
-            mesh.tets[i] = old[from];
-            mesh.tetSourceOrder[i] = had ? oldSource[from] : from;
+            sorted[i] = mesh.tets[from];
+            source[i] = had ? mesh.tetSourceOrder[from] : from;
             gathered.tick(i);
         }
         gathered.finish();
+        mesh.tets.swap(sorted);
+        mesh.tetSourceOrder.swap(source);
     }
     // Native cells, each kind among its own.
     const std::uint64_t counts[3] = {mesh.pyramidCount, mesh.wedgeCount, mesh.hexCount};

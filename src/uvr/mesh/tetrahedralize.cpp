@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "uvr/core/error.h"
 #include "uvr/mesh/tet_math.h"
@@ -176,6 +177,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
     const std::int64_t chunks = (cellCount + kCellChunk - 1) / kCellChunk;
     struct Chunk {
         std::vector<Tet> tets;
+        std::uint64_t kept = 0;                ///< tetrahedra written in place (tetrahedra only)
         std::vector<std::uint32_t> native[3];  ///< corners of pyramids, wedges, hexahedra
         std::vector<std::uint64_t> source[3];  ///< their source cells
         double volume = 0.0;
@@ -183,12 +185,19 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
     };
     std::vector<Chunk> parts(chunks);
     out.cellTets.assign(mesh.cellCount(), 0);
+    // A mesh of tetrahedra only (the common large case): each cell keeps at most its one
+    // tetrahedron, written in place at its chunk's start; no lists to gather.
+    bool tetsOnly = true;
+#pragma omp parallel for schedule(static) reduction(&& : tetsOnly)
+    for (std::int64_t i = 0; i < cellCount; ++i)
+        tetsOnly = tetsOnly && mesh.cellTypes[i] == CellType::Tetra;
+    if (tetsOnly) out.tets.resize(mesh.cellCount());
     ProgressCounter splitDone(progress, chunks, 0.0, kSplitEnd);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < chunks; ++c) {
         Chunk& s = parts[c];
         const std::int64_t end = std::min(cellCount, (c + 1) * kCellChunk);
-        s.tets.reserve(static_cast<std::size_t>(end - c * kCellChunk));
+        if (!tetsOnly) s.tets.reserve(static_cast<std::size_t>(end - c * kCellChunk));
         for (std::int64_t i = c * kCellChunk; i < end; ++i) {
             const CellSplit split = splitCell(mesh, i);
             const CellType type = mesh.cellTypes[i];
@@ -212,7 +221,10 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
             }
             out.cellTets[i] = static_cast<std::uint8_t>(split.count);
             for (int t = 0; t < split.count; ++t) {
-                s.tets.push_back(split.tets[t]);
+                if (tetsOnly)
+                    out.tets[c * kCellChunk + s.kept++] = split.tets[t];
+                else
+                    s.tets.push_back(split.tets[t]);
                 s.volume += split.volume6[t] / 6.0;
                 for (std::uint32_t v : split.tets[t].v) s.bounds.extend(out.points[v]);
             }
@@ -222,15 +234,25 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
     splitDone.finish();
     std::vector<std::uint64_t> chunkStart(chunks + 1, 0);
     for (std::int64_t c = 0; c < chunks; ++c)
-        chunkStart[c + 1] = chunkStart[c] + parts[c].tets.size();
-    out.tets.resize(chunkStart[chunks]);
+        chunkStart[c + 1] = chunkStart[c] + parts[c].tets.size() + parts[c].kept;
     ProgressCounter gathered(progress, chunks, kSplitEnd, kGatherEnd);
+    if (tetsOnly) {
+        // Cells that kept no tetrahedron (zero volume) leave gaps: closed up in chunk order
+        // (each chunk moves down, never over one not yet moved).
+        if (chunkStart[chunks] != out.tets.size())
+            for (std::int64_t c = 0; c < chunks; ++c)
+                std::memmove(out.tets.data() + chunkStart[c], out.tets.data() + c * kCellChunk,
+                             parts[c].kept * sizeof(Tet));
+        out.tets.resize(chunkStart[chunks]);
+    } else {
+        out.tets.resize(chunkStart[chunks]);
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < chunks; ++c) {
-        Chunk& s = parts[c];
-        std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
-        s.tets = {};
-        gathered.add();
+        for (std::int64_t c = 0; c < chunks; ++c) {
+            Chunk& s = parts[c];
+            std::copy(s.tets.begin(), s.tets.end(), out.tets.begin() + chunkStart[c]);
+            s.tets = {};
+            gathered.add();
+        }
     }
     // Native cells by kind, each kind in chunk order.
     std::uint64_t* counts[3] = {&out.pyramidCount, &out.wedgeCount, &out.hexCount};

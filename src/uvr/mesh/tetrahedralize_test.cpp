@@ -9,6 +9,7 @@
 #include <random>
 
 #include "test_meshes.h"
+#include "uvr/mesh/procedural.h"
 #include "uvr/mesh/tet_math.h"
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/mesh/validate.h"
@@ -219,6 +220,31 @@ TEST(Tetrahedralize, FrameIsTheIdentityExceptAtTheEdgesOfFloat) {
     EXPECT_EQ(huge.bounds.lo, unit.bounds.lo);
     EXPECT_EQ(huge.bounds.hi, unit.bounds.hi);
     EXPECT_DOUBLE_EQ(huge.totalVolume, unit.totalVolume);
+}
+
+TEST(Tetrahedralize, TetrahedraOnlyClosesTheGapsOfDroppedCellsAcrossChunks) {
+    ProceduralSpec spec;
+    spec.targetCells = 60000;  // several chunks of cells
+    Mesh m = generateMesh(spec);
+    std::vector<std::uint64_t> flat;
+    for (std::uint64_t c = 0; c < m.cellCount(); c += 997) {  // a repeated corner: no volume
+        m.cellIndices[m.cellOffsets[c] + 1] = m.cellIndices[m.cellOffsets[c]];
+        flat.push_back(c);
+    }
+    const ScalarField f = selectScalarField(m, {});
+    const TetMesh t = tetrahedralize(m, f, {.splitCells = false, .spatialOrder = false});
+    ASSERT_EQ(t.tets.size(), m.cellCount() - flat.size());
+    std::size_t k = 0, next = 0;
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+        if (next < flat.size() && flat[next] == c) {
+            EXPECT_EQ(t.cellTets[c], 0u);
+            ++next;
+            continue;
+        }
+        const auto ids = m.cell(c);
+        ASSERT_TRUE(std::equal(ids.begin(), ids.end(), t.tets[k].v)) << "cell " << c;
+        ++k;
+    }
 }
 
 }  // namespace
