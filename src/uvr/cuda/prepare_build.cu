@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <vector>
 
 #include "uvr/accel/macro_grid.h"
@@ -265,9 +266,12 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, std::uint6
     const std::uint64_t n = host.cellCount(), slots = host.faceSlots();
     const std::size_t points = mesh.points.size();
     UVR_CHECK(n < kNoCell / 4 && slots < kNoCell, "too many cells for 32-bit neighbour ids: " << n);
-    std::vector<std::uint32_t> neighbors(slots, kNoTet);
-    if (n == 0 || points == 0) return neighbors;
-    const std::vector<std::uint32_t> canon = coincidentPointIds(mesh.points);
+    if (n == 0 || points == 0) return std::vector<std::uint32_t>(slots, kNoTet);
+    // On threads of their own while the cells go up: the welded ids, and the host's table
+    // (zeroed by its constructor, on one thread).
+    auto welded = std::async(std::launch::async, [&] { return coincidentPointIds(mesh.points); });
+    auto hostTable =
+        std::async(std::launch::async, [slots] { return std::vector<std::uint32_t>(slots); });
     // The cells, welded ids, per-vertex counts and offsets, and the table.
     cuda::DeviceArray<Tet> tets;
     cuda::DeviceArray<std::uint32_t> nativeCorners, canonIds, table;
@@ -275,7 +279,7 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, std::uint6
     cuda::DeviceArray<unsigned char> temp;
     tets.upload(mesh.tets, "the tetrahedra (GPU face neighbours)");
     nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU face neighbours)");
-    canonIds.upload(canon, "the welded point ids (GPU face neighbours)");
+    canonIds.upload(welded.get(), "the welded point ids (GPU face neighbours)");
     table.reserve(slots, "the neighbour table (GPU face neighbours)");
     counts.reserve(points + 1, "the faces per point (GPU face neighbours)");
     offsets.reserve(points + 1, "the face offsets (GPU face neighbours)");
@@ -324,6 +328,7 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, std::uint6
         UVR_CUDA_CHECK(cudaGetLastError());
         lo = hi;
     }
+    std::vector<std::uint32_t> neighbors = hostTable.get();
     table.download(neighbors.data(), slots);
     return neighbors;
 }
