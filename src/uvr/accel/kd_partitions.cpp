@@ -249,7 +249,7 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
     std::optional<KdTree> tree;
     if (options.splitter) {
         // Steps 2-4 elsewhere (the GPU): the same splits and leaves.
-        tree = options.splitter(mesh, options);
+        tree = options.splitter(mesh, options, subRange(progress, 0.0, kSubtreesEnd));
         kd.nodes = std::move(tree->nodes);
     } else {
         // Step 2: the top of the tree, one large node at a time, split by parallel passes; nodes of

@@ -189,7 +189,8 @@ struct KdTree {
 struct KdBuildOptions;
 
 /// Builds the k-d tree of buildKdPartitions elsewhere (buildKdTreeCuda: on the GPU).
-using KdSplitter = std::function<KdTree(const TetMesh&, const KdBuildOptions&)>;
+/// The FractionFn hears how far the build has come.
+using KdSplitter = std::function<KdTree(const TetMesh&, const KdBuildOptions&, const FractionFn&)>;
 
 /// Build parameters.
 struct KdBuildOptions {

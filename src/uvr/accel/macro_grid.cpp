@@ -9,19 +9,21 @@
 namespace uvr {
 
 MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
-                           const std::vector<std::uint32_t>& neighbors, float tetsPerCell) {
+                           const std::vector<std::uint32_t>& neighbors, float tetsPerCell,
+                           const FractionFn& progress) {
     const auto start = std::chrono::steady_clock::now();
     UVR_CHECK(tetsPerCell > 0.f, "macrocell density must be positive");
     MacroGrids out;
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "macrocell grids", mesh.meanSplitTets());
-    fillMacroCells(mesh, kd, neighbors, out);
+    fillMacroCells(mesh, kd, neighbors, out, progress);
     out.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
 }
 
 void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
-                    const std::vector<std::uint32_t>& neighbors, MacroGrids& out) {
+                    const std::vector<std::uint32_t>& neighbors, MacroGrids& out,
+                    const FractionFn& progress) {
     const TetMeshView view = mesh.view();
     UVR_CHECK(neighbors.size() == view.faceSlots(), "macrocells need the face neighbours");
     UVR_CHECK(out.grids.size() == kd.partitions.size(), "one macrocell grid per partition");
@@ -32,6 +34,7 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
     const bool anyNan =
         std::any_of(mesh.values.begin(), mesh.values.end(), [](float v) { return v != v; });
     if (anyNan) out.nanCells.assign(out.cells.size(), 0);
+    ProgressCounter done(progress, static_cast<std::int64_t>(kd.cells.size()));
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {
         const KdPartition& part = kd.partitions[p];
@@ -71,7 +74,9 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
             for (std::size_t c = 0; c < count; ++c)
                 if (!gradients[c].empty() && cells[c].gradientSpread < INFINITY)
                     cells[c].gradientSpread = length(gradients[c].hi - gradients[c].lo);
+        done.add(part.cellCount);
     }
+    done.finish();
 }
 
 }  // namespace uvr

@@ -102,14 +102,15 @@ UVR_HOST_DEVICE inline MacroContribution macroContribution(const TetMeshView& m,
 /// tetrahedron, kNoTet on the boundary) mark the boundary's macrocells.
 MacroGrids buildMacroGrids(const TetMesh& mesh, const KdPartitions& kd,
                            const std::vector<std::uint32_t>& neighbors,
-                           float tetsPerCell = kTetsPerMacroCell);
+                           float tetsPerCell = kTetsPerMacroCell, const FractionFn& progress = {});
 
 /// The value-dependent part of the macrocell grids: recomputes every macrocell (value range,
 /// gradient spread) and the NaN flags over the grids' existing layout (out.grids, which only the
 /// geometry decides). buildMacroGrids ends with it; new values of the same mesh (a time step)
 /// need only this. The capacity of out.cells is reused.
 void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
-                    const std::vector<std::uint32_t>& neighbors, MacroGrids& out);
+                    const std::vector<std::uint32_t>& neighbors, MacroGrids& out,
+                    const FractionFn& progress = {});
 
 /// Macrocell grids and the partitions' gradient spreads (partitionGradientSpread) at once.
 struct MacroBuild {
@@ -119,7 +120,8 @@ struct MacroBuild {
 
 /// Builds macrocells and gradient spreads elsewhere (buildMacroGridsCuda: on the GPU): the same
 /// as buildMacroGrids and partitionGradientSpread (zeros may differ in sign).
-using MacroBuilder = std::function<MacroBuild(const TetMesh&, const KdPartitions&,
-                                              const std::vector<std::uint32_t>&, float)>;
+using MacroBuilder =
+    std::function<MacroBuild(const TetMesh&, const KdPartitions&, const std::vector<std::uint32_t>&,
+                             float, const FractionFn&)>;
 
 }  // namespace uvr

@@ -56,7 +56,8 @@ std::vector<PartitionGrid> layoutPartitionGrids(const KdPartitions& kd, float te
     return grids;
 }
 
-SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell) {
+SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell,
+                         const FractionFn& progress) {
     const auto start = std::chrono::steady_clock::now();
     UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
     SeedGrids out;
@@ -64,6 +65,7 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids", mesh.meanSplitTets());
     const TetLocator locator{mesh.view(), {}, {}};
     out.seeds.assign(gridCellCount(out.grids), kNoTet);
+    ProgressCounter done(progress, static_cast<std::int64_t>(kd.cells.size()));
     // Partitions are independent, each filled by one thread in cell order with the smallest key
     // offered (offerSeedKeys): the result is deterministic.
 #pragma omp parallel for schedule(dynamic, 1)
@@ -80,7 +82,9 @@ SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd, float tets
         std::uint32_t* seeds = out.seeds.data() + g.first;
         for (std::size_t k = 0; k < cells; ++k)
             seeds[k] = best[k] == ~std::uint64_t(0) ? kNoTet : static_cast<std::uint32_t>(best[k]);
+        done.add(part.cellCount);
     }
+    done.finish();
     out.buildSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;

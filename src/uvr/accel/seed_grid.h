@@ -163,12 +163,13 @@ struct SeedGrids {
 };
 
 /// Builds the seed grids of every partition of kd over mesh, in parallel over partitions; the
-/// result does not depend on the thread count.
+/// result does not depend on the thread count. `progress` hears the fraction of cells done.
 SeedGrids buildSeedGrids(const TetMesh& mesh, const KdPartitions& kd,
-                         float tetsPerCell = kTetsPerSeedCell);
+                         float tetsPerCell = kTetsPerSeedCell, const FractionFn& progress = {});
 
 /// Builds seed grids elsewhere (buildSeedGridsCuda: on the GPU): the same grids and seeds as
 /// buildSeedGrids.
-using SeedBuilder = std::function<SeedGrids(const TetMesh&, const KdPartitions&, float)>;
+using SeedBuilder =
+    std::function<SeedGrids(const TetMesh&, const KdPartitions&, float, const FractionFn&)>;
 
 }  // namespace uvr

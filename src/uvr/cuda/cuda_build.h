@@ -24,7 +24,8 @@ LbvhResult buildLbvhCuda(const LbvhInput& input);
 /// level at once: bounds, a sort of (node, centre) keys for the medians, scans for the sides): the
 /// same splits, leaves and cell lists as the CPU's build, numbered breadth-first. Throws as
 /// buildLbvhCuda does.
-KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options);
+KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
+                       const FractionFn& progress = {});
 
 /// The order of cells by 63-bit keys (a CellOrderSorter for sortCellsSpatially): CUB's stable
 /// radix sort of (key, position) pairs, the same order as the CPU's sort. Throws as
@@ -36,17 +37,20 @@ void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint3
 /// vertex ranges when they do not all fit, or of at most facesPerPass faces when it is not 0):
 /// the same table. Throws as buildLbvhCuda does.
 std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh,
+                                                 const FractionFn& progress = {},
                                                  std::uint64_t facesPerPass = 0);
 
 /// Builds the seed grids of buildSeedGrids on the GPU (one block per partition, seed keys kept
 /// by atomic minima): the same grids and seeds. Throws as buildLbvhCuda does.
-SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell);
+SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell,
+                             const FractionFn& progress = {});
 
 /// Builds the macrocell grids of buildMacroGrids and the gradient spreads of
 /// partitionGradientSpread on the GPU (one block per partition; ranges, gradient boxes and flags
 /// kept by atomic minima, maxima and ors): the same values, zeros possibly of the other sign.
 /// Throws as buildLbvhCuda does.
 MacroBuild buildMacroGridsCuda(const TetMesh& mesh, const KdPartitions& kd,
-                               const std::vector<std::uint32_t>& neighbors, float tetsPerCell);
+                               const std::vector<std::uint32_t>& neighbors, float tetsPerCell,
+                               const FractionFn& progress = {});
 
 }  // namespace uvr

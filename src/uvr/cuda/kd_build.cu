@@ -153,7 +153,8 @@ struct LevelNode {
 }  // namespace
 }  // namespace cuda
 
-KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
+KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
+                       const FractionFn& progress) {
     if (!cudaDeviceAvailable())
         throwError(ErrorKind::Unsupported, "", "GPU k-d build: no CUDA device found");
     UVR_CHECK(options.leafCells >= 1, "leaf size must be positive");
@@ -312,6 +313,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options) {
             UVR_CUDA_CHECK(cudaMemcpy(tree.leafCells.data() + at, cells.data() + levelBegin[s],
                                       nodeCount * sizeof(std::uint32_t), cudaMemcpyDeviceToHost));
             tree.leafBegin.push_back(tree.leafCells.size());
+            if (progress) progress(0.98 * double(tree.leafCells.size()) / double(n));
             UVR_CHECK(tree.leafCells.size() < 0xffffffffull,
                       "partition cell lists exceed 32-bit indices");
         }

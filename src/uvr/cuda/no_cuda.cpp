@@ -61,7 +61,7 @@ LbvhResult buildLbvhCuda(const LbvhInput&) {
     noCudaBuilders();
 }
 
-KdTree buildKdTreeCuda(const TetMesh&, const KdBuildOptions&) {
+KdTree buildKdTreeCuda(const TetMesh&, const KdBuildOptions&, const FractionFn&) {
     noCudaBuilders();
 }
 
@@ -69,16 +69,16 @@ void sortCellKeysCuda(const std::uint64_t*, std::uint64_t, std::uint32_t*) {
     noCudaBuilders();
 }
 
-std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh&, std::uint64_t) {
+std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh&, const FractionFn&, std::uint64_t) {
     noCudaBuilders();
 }
 
-SeedGrids buildSeedGridsCuda(const TetMesh&, const KdPartitions&, float) {
+SeedGrids buildSeedGridsCuda(const TetMesh&, const KdPartitions&, float, const FractionFn&) {
     noCudaBuilders();
 }
 
 MacroBuild buildMacroGridsCuda(const TetMesh&, const KdPartitions&,
-                               const std::vector<std::uint32_t>&, float) {
+                               const std::vector<std::uint32_t>&, float, const FractionFn&) {
     noCudaBuilders();
 }
 

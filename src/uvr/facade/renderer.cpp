@@ -31,7 +31,9 @@ PrepareOptions RendererOptions::prepareOptions() const {
     if (buildOnCuda) {
         o.lbvh = buildLbvhCuda;
         o.kdSplitter = buildKdTreeCuda;
-        o.faceMatcher = [](const TetMesh& m) { return buildTetNeighborsCuda(m); };
+        o.faceMatcher = [](const TetMesh& m, const FractionFn& progress) {
+            return buildTetNeighborsCuda(m, progress);
+        };
         o.seedBuilder = buildSeedGridsCuda;
         o.macroBuilder = buildMacroGridsCuda;
         o.cells.sorter = sortCellKeysCuda;

@@ -70,8 +70,9 @@ PreparedMesh prepareWith(int threads, const ProgressFn& progress) {
 }
 
 TEST(PrepareProgress, EveryPhaseIsNamedAndTheLongOnesCountToOne) {
-    const std::set<std::string> counted = {"split", "neighbours", "partitions", "cell_tree",
-                                           "gradient_spreads"};
+    const std::set<std::string> counted = {"split",     "neighbours", "partitions",
+                                           "cell_tree", "seed_grids", "gradient_spreads",
+                                           "macrocells"};
     for (int threads : {1, 2}) {
         Recorded r;
         const PreparedMesh pm = prepareWith(threads, r.callbacks());

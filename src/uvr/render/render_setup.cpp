@@ -91,7 +91,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     constexpr double kNeighborsEnd = 4.17 / 4.91;
     std::future<std::pair<CompactNeighbors, double>> codes;
     if (faceMatcher) {
-        out.neighbors = faceMatcher(out.tets);
+        out.neighbors = faceMatcher(out.tets, progress.fraction);
         codes = beside([&tets = out.tets, &neighbors = out.neighbors] {
             return compactNeighbors(tets, neighbors);
         });
@@ -134,8 +134,10 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                 progress("building seed grids" +
                          (seedBuilder ? " (on " + options.builderDevice + ")" : std::string()));
             start = std::chrono::steady_clock::now();
-            out.seeds = seedBuilder ? seedBuilder(out.tets, *out.kd, kTetsPerSeedCell)
-                                    : buildSeedGrids(out.tets, *out.kd);
+            out.seeds =
+                seedBuilder
+                    ? seedBuilder(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction)
+                    : buildSeedGrids(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction);
             out.phaseSeconds.emplace_back("seed_grids", secondsSince(start));
         }
         if (macroBuilder) {
@@ -143,7 +145,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                 progress("building macrocell grids and gradient spreads (on " +
                          options.builderDevice + ")");
             start = std::chrono::steady_clock::now();
-            MacroBuild built = macroBuilder(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell);
+            MacroBuild built = macroBuilder(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,
+                                            progress.fraction);
             out.gradientSpread = std::move(built.gradientSpread);
             out.macro = std::move(built.macro);
             out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
@@ -160,7 +163,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         if (options.macroGrids && !macroBuilder) {
             if (progress) progress("building macrocell grids");
             start = std::chrono::steady_clock::now();
-            out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors);
+            out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,
+                                        progress.fraction);
             out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
         }
     }

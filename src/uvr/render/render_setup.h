@@ -43,7 +43,7 @@ struct PrepareOptions {
     KdSplitter kdSplitter;
     /// When set, the face neighbours come from this builder (buildTetNeighborsCuda: on the GPU),
     /// the same table as buildTetNeighbors.
-    std::function<std::vector<std::uint32_t>(const TetMesh&)> faceMatcher;
+    std::function<std::vector<std::uint32_t>(const TetMesh&, const FractionFn&)> faceMatcher;
     /// When set, the seed grids come from this builder (buildSeedGridsCuda: on the GPU).
     SeedBuilder seedBuilder;
     /// When set (and with macroGrids), the macrocells and the partitions' gradient spreads come
