@@ -284,22 +284,29 @@ struct CudaScene::Impl {
     }
 };
 
-CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(mesh)) {
+CudaScene::CudaScene(const PreparedMesh& mesh, const FractionFn& progress)
+    : impl_(std::make_unique<Impl>(mesh)) {
     if (!cudaDeviceAvailable())
         throwError(ErrorKind::Unsupported, "", "--device cuda: no CUDA device found");
     const auto start = std::chrono::steady_clock::now();
     Impl& d = *impl_;
+    const double total = double(std::max<std::uint64_t>(1, cudaSceneBytes(mesh)));
+    auto uploaded = [&] {
+        if (progress) progress(std::min(0.99, double(geometryBytes()) / total));
+    };
     if (mesh.tets.hasNative()) {
         d.points.upload(mesh.tets.points, "the mesh points");
         d.nativeCorners.upload(mesh.tets.nativeCorners, "the native cells");
     }
     d.tetCorners.upload(mesh.tets.tetCorners, "the tetrahedra");
     d.blockVertexBase.upload(mesh.tets.blockVertexBase, "the tetrahedra's blocks");
+    uploaded();
     const CompactNeighbors& nb = mesh.neighborCodes;
     d.neighborCodes.upload(nb.tetCodes, "the face neighbours");
     d.neighborEscapes.upload(nb.escapes, "the face neighbours across blocks");
     d.neighborEscapeBase.upload(nb.escapeBase, "the face neighbours' blocks");
     d.nativeNeighbors.upload(nb.native, "the native cells' face neighbours");
+    uploaded();
     d.bvhNodes.upload(mesh.bvh.nodes, "the BVH nodes");
     d.bvhPrims.upload(mesh.bvh.primIds, "the BVH primitive ids");
     if (mesh.kd) {
@@ -311,11 +318,13 @@ CudaScene::CudaScene(const PreparedMesh& mesh) : impl_(std::make_unique<Impl>(me
         d.seeds.upload(mesh.seeds->seeds, "the seeds");
     }
     if (mesh.macro) d.macroGrids.upload(mesh.macro->grids, "the macrocell grids");
+    uploaded();
     d.uploadValues();
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     d.uploadSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (progress) progress(1.0);
 }
 
 CudaScene::~CudaScene() = default;

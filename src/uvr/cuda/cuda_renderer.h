@@ -62,7 +62,8 @@ class CudaScene {
 public:
     /// Uploads the mesh; throws Error(Resource) naming the need and the free memory when it does
     /// not fit, Error(Unsupported) when uvr was built without CUDA or no device is present.
-    explicit CudaScene(const PreparedMesh& mesh);
+    /// `progress` hears the fraction of the bytes uploaded.
+    explicit CudaScene(const PreparedMesh& mesh, const FractionFn& progress = {});
     ~CudaScene();
     CudaScene(const CudaScene&) = delete;
     CudaScene& operator=(const CudaScene&) = delete;

@@ -31,7 +31,7 @@ void startCudaWarmUp() {}
 
 void finishCudaWarmUp() {}
 
-CudaScene::CudaScene(const PreparedMesh&) {
+CudaScene::CudaScene(const PreparedMesh&, const FractionFn&) {
     throwError(ErrorKind::Unsupported, "",
                "--device cuda: this uvr was built without CUDA (configure with a CUDA compiler "
                "and UVR_ENABLE_CUDA=ON)");

@@ -61,8 +61,9 @@ void checkDeviceUsable(Device device) {
                    "rendering on CUDA was asked for, but " + cudaDeviceDescription());
 }
 
-std::unique_ptr<CudaScene> uploadIf(Device device, const PreparedMesh& prepared) {
-    return resolvesToCuda(device) ? std::make_unique<CudaScene>(prepared) : nullptr;
+std::unique_ptr<CudaScene> uploadIf(Device device, const PreparedMesh& prepared,
+                                    const FractionFn& progress = {}) {
+    return resolvesToCuda(device) ? std::make_unique<CudaScene>(prepared, progress) : nullptr;
 }
 
 }  // namespace
@@ -79,7 +80,7 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
         progress("uploading " +
                  std::to_string((cudaSceneBytes(*prepared_) + (1u << 20) - 1) >> 20) +
                  " MiB to the GPU");
-    gpu_ = uploadIf(options.device, *prepared_);
+    gpu_ = uploadIf(options.device, *prepared_, progress.fraction);
 }
 
 Renderer::Renderer(PreparedMesh prepared, Device device)
