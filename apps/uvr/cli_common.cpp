@@ -370,9 +370,11 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
         ->capture_default_str();
     app.add_option("--build-device", buildDevice,
-                   "Where the BVHs and k-d partitions are built: cpu (the CPU threads, binned "
-                   "SAH BVHs), cuda (the GPU, linear BVHs: seconds for 100M+ tetrahedra), or auto "
-                   "(cuda when rendering on CUDA and the mesh has 4M tetrahedra or more)")
+                   "Where the preparation builds: cpu (the CPU threads, binned SAH BVHs), cuda "
+                   "(the GPU: linear BVHs, and the same k-d partitions, cell order, face "
+                   "neighbours, seed grids and macrocells as the CPU's; seconds for 100M+ "
+                   "tetrahedra), or auto (cuda when rendering on CUDA and the mesh has 4M "
+                   "tetrahedra or more)")
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
         ->capture_default_str();
     app.add_option("--threads", threads, threadsHelp())->capture_default_str();
