@@ -8,6 +8,7 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/ray.h"
 #include "uvr/mesh/mesh.h"
+#include "uvr/mesh/procedural.h"
 
 namespace uvr::testing {
 
@@ -21,6 +22,18 @@ inline bool boxSpan(const Bounds3f& b, const Ray& ray, double& t0, double& t1) {
         t1 = std::min(t1, std::max(lo, hi));
     }
     return t0 < t1;
+}
+
+/// A procedural box of about 400k tetrahedra with a linear field (made once): several chunks of
+/// every parallel loop of the preparation, and above the builders' one-thread subtree sizes.
+inline const Mesh& box400k() {
+    static const Mesh mesh = [] {
+        ProceduralSpec spec;
+        spec.targetCells = 400000;
+        spec.fields = {ProceduralField::Linear};
+        return generateMesh(spec);
+    }();
+    return mesh;
 }
 
 /// An n x n x n grid of hexahedra over the box [lo, hi]^3 with a point field f(x, y, z) named

@@ -4,6 +4,7 @@
 // top levels.
 #include <gtest/gtest.h>
 
+#include "test_meshes.h"
 #include "test_support.h"
 
 #include <algorithm>
@@ -20,17 +21,6 @@
 namespace uvr {
 namespace {
 
-/// A procedural box of about 400k tetrahedra (above the builders' one-thread subtree sizes).
-const Mesh& bigBox() {
-    static const Mesh mesh = [] {
-        ProceduralSpec spec;
-        spec.targetCells = 400000;
-        spec.fields = {ProceduralField::Linear};
-        return generateMesh(spec);
-    }();
-    return mesh;
-}
-
 /// Prepares bigBox with a thread count and k-d leaf size (cached: the tests share them).
 const PreparedMesh& prepareWith(int threads, std::uint32_t leafCells) {
     static std::map<std::pair<int, std::uint32_t>, PreparedMesh> cache;
@@ -39,7 +29,8 @@ const PreparedMesh& prepareWith(int threads, std::uint32_t leafCells) {
     cpu::setThreadCount(threads);
     PrepareOptions options;
     options.kd.leafCells = leafCells;
-    PreparedMesh pm = prepareMesh(bigBox(), selectScalarField(bigBox(), {}), options);
+    PreparedMesh pm =
+        prepareMesh(testing::box400k(), selectScalarField(testing::box400k(), {}), options);
     cpu::setThreadCount(0);
     return cache.emplace(key, std::move(pm)).first->second;
 }

@@ -51,24 +51,19 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
             const std::uint64_t faces = view.faceBase(t);
             for (int f = 0; f < kindFaces(view.kind(t)); ++f)
                 boundary = boundary || neighbors[faces + f] == kNoTet;
-            std::uint32_t a[3], b[3];
-            macroCellOf(g, add.box.lo, a);
-            macroCellOf(g, add.box.hi, b);
-            for (std::uint32_t z = a[2]; z <= b[2]; ++z)
-                for (std::uint32_t y = a[1]; y <= b[1]; ++y)
-                    for (std::uint32_t x = a[0]; x <= b[0]; ++x) {
-                        const std::size_t c = (std::size_t(z) * g.dims[1] + y) * g.dims[0] + x;
-                        MacroCell& m = cells[c];
-                        // A tetrahedron whose values are all NaN adds no range; nanCells
-                        // records it (shadeNan keeps the macrocell while NaN is visible).
-                        m.valueMin = std::fmin(m.valueMin, add.lo);
-                        m.valueMax = std::fmax(m.valueMax, add.hi);
-                        if (add.nan) out.nanCells[g.first + c] = 1;
-                        if (cellData || boundary)
-                            m.gradientSpread = INFINITY;
-                        else if (gradOk)
-                            gradients[c].extend(add.gradients);
-                    }
+            forOverlappedMacroCells(g, add.box, [&](std::uint64_t at) {
+                const std::uint64_t c = at - g.first;
+                MacroCell& m = cells[c];
+                // A tetrahedron whose values are all NaN adds no range; nanCells records it
+                // (shadeNan keeps the macrocell while NaN is visible).
+                m.valueMin = std::fmin(m.valueMin, add.lo);
+                m.valueMax = std::fmax(m.valueMax, add.hi);
+                if (add.nan) out.nanCells[at] = 1;
+                if (cellData || boundary)
+                    m.gradientSpread = INFINITY;
+                else if (gradOk)
+                    gradients[c].extend(add.gradients);
+            });
         }
         if (!cellData)
             for (std::size_t c = 0; c < count; ++c)

@@ -65,6 +65,19 @@ UVR_HOST_DEVICE inline std::uint32_t macroCellOf(const PartitionGrid& g, Vec3f p
     return g.first + (idx[2] * g.dims[1] + idx[1]) * g.dims[0] + idx[0];
 }
 
+/// Calls fn(c) for every macrocell c of grid g (its index from g.first, x fastest) that box
+/// overlaps (macroCellOf's clamped cells of its corners and all between).
+template <class Fn>
+UVR_HOST_DEVICE void forOverlappedMacroCells(const PartitionGrid& g, const Bounds3f& box, Fn&& fn) {
+    std::uint32_t a[3], b[3];
+    macroCellOf(g, box.lo, a);
+    macroCellOf(g, box.hi, b);
+    for (std::uint32_t z = a[2]; z <= b[2]; ++z)
+        for (std::uint32_t y = a[1]; y <= b[1]; ++y)
+            for (std::uint32_t x = a[0]; x <= b[0]; ++x)
+                fn(g.first + (std::uint64_t(z) * g.dims[1] + y) * g.dims[0] + x);
+}
+
 /// What cell t adds to every macrocell its bounding box overlaps (fillMacroCells' rule, shared by
 /// the CPU's build and the GPU's).
 struct MacroContribution {

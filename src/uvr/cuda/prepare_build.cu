@@ -183,24 +183,15 @@ __global__ void macroKernel(TetMeshView m, const KdPartition* partitions,
         spread.extend(add.gradients);
         if (!macro) continue;
         const bool unbounded = m.cellCentered || boundary[t];
-        std::uint32_t a[3], b[3];
-        macroCellOf(g, add.box.lo, a);
-        macroCellOf(g, add.box.hi, b);
-        for (std::uint32_t z = a[2]; z <= b[2]; ++z)
-            for (std::uint32_t y = a[1]; y <= b[1]; ++y)
-                for (std::uint32_t x = a[0]; x <= b[0]; ++x) {
-                    const std::uint64_t c =
-                        g.first + (std::uint64_t(z) * g.dims[1] + y) * g.dims[0] + x;
-                    if (add.lo <= add.hi) {  // a range without NaN values
-                        atomicMin(&rangeKeys[2 * c], kdsplit::floatKey(add.lo));
-                        atomicMax(&rangeKeys[2 * c + 1], kdsplit::floatKey(add.hi));
-                    }
-                    const std::uint32_t f =
-                        (unbounded ? kUnboundedSpread : 0u) | (add.nan ? kHasNan : 0u);
-                    if (f) atomicOr(&flags[c], f);
-                    if (!unbounded && !add.gradients.empty())
-                        foldBox(add.gradients, gradientKeys + 6 * c);
-                }
+        forOverlappedMacroCells(g, add.box, [&](std::uint64_t c) {
+            if (add.lo <= add.hi) {  // a range without NaN values
+                atomicMin(&rangeKeys[2 * c], kdsplit::floatKey(add.lo));
+                atomicMax(&rangeKeys[2 * c + 1], kdsplit::floatKey(add.hi));
+            }
+            const std::uint32_t f = (unbounded ? kUnboundedSpread : 0u) | (add.nan ? kHasNan : 0u);
+            if (f) atomicOr(&flags[c], f);
+            if (!unbounded && !add.gradients.empty()) foldBox(add.gradients, gradientKeys + 6 * c);
+        });
     }
     if (!spread.empty()) foldBox(spread, partitionKeys + 6 * blockIdx.x);
 }

@@ -4,6 +4,7 @@
 // one thread or two.
 #include <gtest/gtest.h>
 
+#include "test_meshes.h"
 #include "test_support.h"
 
 #include <cstring>
@@ -18,18 +19,6 @@
 
 namespace uvr {
 namespace {
-
-/// A procedural box of about 400k tetrahedra: several chunks of every parallel loop, and above
-/// the k-d builder's one-thread subtree size.
-const Mesh& box() {
-    static const Mesh mesh = [] {
-        ProceduralSpec spec;
-        spec.targetCells = 400000;
-        spec.fields = {ProceduralField::Linear};
-        return generateMesh(spec);
-    }();
-    return mesh;
-}
 
 /// The reports of one preparation: per phase its name and fractions.
 struct Recorded {
@@ -64,7 +53,8 @@ struct Recorded {
 
 PreparedMesh prepareWith(int threads, const ProgressFn& progress) {
     cpu::setThreadCount(threads);
-    PreparedMesh pm = prepareMesh(box(), selectScalarField(box(), {}), PrepareOptions{}, progress);
+    PreparedMesh pm = prepareMesh(testing::box400k(), selectScalarField(testing::box400k(), {}),
+                                  PrepareOptions{}, progress);
     cpu::setThreadCount(0);
     return pm;
 }
