@@ -18,6 +18,7 @@
 #include "uvr/core/error.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_check.h"
+#include "uvr/cuda/cuda_renderer.h"
 #include "uvr/cuda/launch.cuh"
 
 namespace uvr {
@@ -219,6 +220,12 @@ __global__ void iotaKernel(std::uint32_t* out, std::uint64_t n) {
     if (i < n) out[i] = static_cast<std::uint32_t>(i);
 }
 
+/// Throws Error(Unsupported) naming the build when no CUDA device is present.
+void requireDevice(const char* build) {
+    if (!cudaDeviceAvailable())
+        throwError(ErrorKind::Unsupported, "", std::string(build) + ": no CUDA device found");
+}
+
 /// Free device memory in bytes.
 std::size_t freeDeviceMemory() {
     std::size_t freeBytes = 0, totalBytes = 0;
@@ -230,6 +237,7 @@ std::size_t freeDeviceMemory() {
 }  // namespace cuda
 
 void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint32_t* order) {
+    cuda::requireDevice("GPU sort of the cells");
     UVR_CHECK(count < (std::uint64_t(1) << 32), "too many cells to sort: " << count);
     if (count == 0) return;
     // A stable radix sort of (key, position) pairs by key: ties keep their positions' order.
@@ -254,6 +262,7 @@ void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint3
 
 std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, const FractionFn& progress,
                                                  std::uint64_t facesPerPass) {
+    cuda::requireDevice("GPU face neighbours");
     const TetMeshView host = mesh.view();
     const std::uint64_t n = host.cellCount(), slots = host.faceSlots();
     const std::size_t points = mesh.points.size();
@@ -335,6 +344,7 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, const Frac
 SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float tetsPerCell,
                              const FractionFn& progress) {
     const auto start = std::chrono::steady_clock::now();
+    cuda::requireDevice("GPU seed grids");
     UVR_CHECK(tetsPerCell > 0.f, "seed grid density must be positive");
     SeedGrids out;
     out.grids = layoutPartitionGrids(kd, tetsPerCell, "seed grids", mesh.meanSplitTets());
@@ -387,6 +397,7 @@ MacroBuild buildMacroGridsCuda(const TetMesh& mesh, const KdPartitions& kd,
                                const std::vector<std::uint32_t>& neighbors, float tetsPerCell,
                                const FractionFn& progress) {
     const auto start = std::chrono::steady_clock::now();
+    cuda::requireDevice("GPU macrocells");
     UVR_CHECK(tetsPerCell > 0.f, "macrocell density must be positive");
     const TetMeshView host = mesh.view();
     UVR_CHECK(neighbors.size() == host.faceSlots(), "macrocells need the face neighbours");
