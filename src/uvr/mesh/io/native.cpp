@@ -106,9 +106,6 @@ struct FieldDescriptor {
 };
 
 /// One array of the file: its name in messages, element count and size, and where it starts.
-/// Threads reading a file's arrays at once (enough to keep a fast disk busy).
-constexpr int kReadThreads = 8;
-
 struct ArraySpan {
     std::string what;
     std::uint64_t count = 0;
@@ -329,7 +326,7 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
         budgeted.budget().charge(path, a.what, a.count, a.elementBytes);
 
     // Arrays: allocated (each on a thread of its own), then read straight into the mesh's
-    // vectors in pieces by several threads at once, so the disk, the page faults and the copies
+    // vectors in pieces by all threads at once, so the disk, the page faults and the copies
     // overlap (a 3 GB file reads at the disk's speed).
     Mesh mesh;
     mesh.fields.resize(fieldCount);
@@ -366,7 +363,7 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
     errors.assign(pieces.size(), nullptr);
     ProgressCounter read(options.progress, static_cast<std::int64_t>(size));
     const std::int64_t pieceCount = static_cast<std::int64_t>(pieces.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(kReadThreads)
+#pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t i = 0; i < pieceCount; ++i) {
         const Piece& p = pieces[i];
         try {
