@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <type_traits>
 
 #include "uvr/core/output_file.h"
@@ -396,51 +397,53 @@ void expect(bool ok, const std::string& path, const std::string& what) {
     if (!ok) throwError(ErrorKind::Parse, path, "the prepared cache is inconsistent: " + what);
 }
 
-/// True when a tree of BvhNode (children of an inner node at first, first + 1) is well formed:
-/// from the root, no node is reached twice (no cycles), leaves lie within `prims` entries and no
-/// path is deeper than a traversal's stack holds.
-bool bvhWellFormed(const std::vector<BvhNode>& nodes, std::uint64_t prims) {
-    if (nodes.empty()) return true;
-    std::vector<std::uint8_t> seen(nodes.size(), 0);
-    std::vector<std::pair<std::uint32_t, int>> stack{{0u, 1}};
+/// True when a binary tree of `count` nodes whose inner nodes keep their children at c, c + 1 is
+/// well formed: from the root (at depth rootDepth), no node is reached twice (no cycles), no inner
+/// node sits at maxDepth or deeper (a traversal's stack) and every leaf passes leafOk(i).
+/// firstChild(i) is node i's first child, or nothing for a leaf.
+template <class FirstChild, class LeafOk>
+bool treeWellFormed(std::size_t count, int rootDepth, int maxDepth, FirstChild firstChild,
+                    LeafOk leafOk) {
+    std::vector<std::uint8_t> seen(count, 0);
+    std::vector<std::pair<std::uint32_t, int>> stack{{0u, rootDepth}};
     while (!stack.empty()) {
         const auto [i, depth] = stack.back();
         stack.pop_back();
         if (seen[i]) return false;
         seen[i] = 1;
-        const BvhNode& n = nodes[i];
-        if (n.count > 0) {
-            if (std::uint64_t(n.first) + n.count > prims) return false;
+        const std::optional<std::uint32_t> child = firstChild(i);
+        if (!child) {
+            if (!leafOk(i)) return false;
             continue;
         }
-        if (depth >= kBvhMaxDepth || std::uint64_t(n.first) + 1 >= nodes.size()) return false;
-        stack.push_back({n.first, depth + 1});
-        stack.push_back({n.first + 1, depth + 1});
+        if (depth >= maxDepth || std::uint64_t(*child) + 1 >= count) return false;
+        stack.push_back({*child, depth + 1});
+        stack.push_back({*child + 1, depth + 1});
     }
     return true;
 }
 
-/// The same for the k-d tree: leaves name partitions, no path is deeper than its traversal's
-/// stack.
+/// treeWellFormed for a BVH whose leaves lie within `prims` entries.
+bool bvhWellFormed(const std::vector<BvhNode>& nodes, std::uint64_t prims) {
+    if (nodes.empty()) return true;
+    return treeWellFormed(
+        nodes.size(), 1, kBvhMaxDepth,
+        [&](std::uint32_t i) {
+            return nodes[i].count > 0 ? std::nullopt : std::optional<std::uint32_t>(nodes[i].first);
+        },
+        [&](std::uint32_t i) { return std::uint64_t(nodes[i].first) + nodes[i].count <= prims; });
+}
+
+/// treeWellFormed for the k-d tree, whose leaves name partitions.
 bool kdWellFormed(const std::vector<KdNode>& nodes, std::uint64_t partitions) {
     if (nodes.empty()) return partitions == 0;
-    std::vector<std::uint8_t> seen(nodes.size(), 0);
-    std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
-    while (!stack.empty()) {
-        const auto [i, depth] = stack.back();
-        stack.pop_back();
-        if (seen[i]) return false;
-        seen[i] = 1;
-        const KdNode& n = nodes[i];
-        if (n.isLeaf()) {
-            if (n.child() >= partitions) return false;
-            continue;
-        }
-        if (depth >= kKdMaxDepth || std::uint64_t(n.child()) + 1 >= nodes.size()) return false;
-        stack.push_back({n.child(), depth + 1});
-        stack.push_back({n.child() + 1, depth + 1});
-    }
-    return true;
+    return treeWellFormed(
+        nodes.size(), 0, kKdMaxDepth,
+        [&](std::uint32_t i) {
+            return nodes[i].isLeaf() ? std::nullopt
+                                     : std::optional<std::uint32_t>(nodes[i].child());
+        },
+        [&](std::uint32_t i) { return nodes[i].child() < partitions; });
 }
 
 /// True when every id is a cell or kNoTet.

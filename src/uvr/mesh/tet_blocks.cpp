@@ -106,31 +106,30 @@ ScratchVector<std::uint32_t> mortonOrder(const std::vector<Vec3f>& points, const
                                          const CellOrderSorter& sorter,
                                          const FractionFn& progress) {
     const float inv = 1.f / static_cast<float>(corners);
-    auto key = [&](std::int64_t c) {
-        Vec3f centroid(0.f);
-        for (int k = 0; k < corners; ++k) centroid += points[ids[std::uint64_t(c) * corners + k]];
-        return morton63(centroid * inv, bounds);
-    };
-    ScratchVector<std::uint32_t> order(count);
     ProgressCounter keyed(progress, std::int64_t(count), 0.0, 0.25);
-    if (sorter) {
-        ScratchVector<std::uint64_t> keys(count);
+    // Every cell's key, given to store(c, key) (in parallel).
+    auto makeKeys = [&](auto&& store) {
 #pragma omp parallel for schedule(static)
         for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
-            keys[c] = key(c);
+            Vec3f centroid(0.f);
+            for (int k = 0; k < corners; ++k)
+                centroid += points[ids[std::uint64_t(c) * corners + k]];
+            store(c, morton63(centroid * inv, bounds));
             keyed.tick(c);
         }
         keyed.finish();
+    };
+    ScratchVector<std::uint32_t> order(count);
+    if (sorter) {
+        ScratchVector<std::uint64_t> keys(count);
+        makeKeys([&](std::int64_t c, std::uint64_t key) { keys[c] = key; });
         sorter(keys.data(), count, order.data());
         if (progress) progress(1.0);
     } else {
         ScratchVector<KeyIndex> keys(count);
-#pragma omp parallel for schedule(static)
-        for (std::int64_t c = 0; c < std::int64_t(count); ++c) {
-            keys[c] = {key(c), static_cast<std::uint32_t>(c)};
-            keyed.tick(c);
-        }
-        keyed.finish();
+        makeKeys([&](std::int64_t c, std::uint64_t key) {
+            keys[c] = {key, static_cast<std::uint32_t>(c)};
+        });
         ProgressCounter sorted(progress, 2 * std::int64_t(count), 0.25, 1.0);
         sortKeys(keys, sorted);
         sorted.finish();
