@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "uvr/core/bounds.h"
 #include "uvr/core/ray.h"
@@ -34,6 +35,26 @@ inline const Mesh& box400k() {
         return generateMesh(spec);
     }();
     return mesh;
+}
+
+/// A procedural mesh of about `cells` cells whose every other cell names a second copy of the
+/// points (a seam of duplicated points across their faces, which only a weld matches), with a
+/// last cell on the first one's corners (a face shared by three cells).
+inline Mesh seamMesh(std::uint64_t cells) {
+    ProceduralSpec spec;
+    spec.targetCells = cells;
+    Mesh seams = generateMesh(spec);
+    const std::size_t points = seams.points.size();
+    seams.points.insert(seams.points.end(), seams.points.begin(), seams.points.end());
+    for (Field& f : seams.fields) f.values.insert(f.values.end(), f.values.begin(), f.values.end());
+    for (std::size_t c = 1; c < seams.cellCount(); c += 2)
+        for (std::uint64_t k = seams.cellOffsets[c]; k < seams.cellOffsets[c + 1]; ++k)
+            seams.cellIndices[k] += static_cast<std::uint32_t>(points);
+    const std::vector<std::uint32_t> first(seams.cell(0).begin(), seams.cell(0).end());
+    seams.cellIndices.insert(seams.cellIndices.end(), first.begin(), first.end());
+    seams.cellOffsets.push_back(seams.cellIndices.size());
+    seams.cellTypes.push_back(seams.cellTypes[0]);
+    return seams;
 }
 
 /// An n x n x n grid of hexahedra over the box [lo, hi]^3 with a point field f(x, y, z) named

@@ -31,7 +31,7 @@ std::uint64_t positionHash(Vec3f p) {
 
 }  // namespace
 
-std::vector<std::uint32_t> coincidentPointIds(const std::vector<Vec3f>& points,
+std::vector<std::uint32_t> coincidentPointIds(std::span<const Vec3f> points,
                                               const FractionFn& progress) {
     const std::int64_t n = static_cast<std::int64_t>(points.size());
     ProgressCounter done(progress, 3 * n);  // three passes over the points

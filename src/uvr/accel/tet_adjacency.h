@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "uvr/mesh/tet_mesh.h"
@@ -14,7 +15,7 @@ inline constexpr std::uint32_t kNoTet = kNoCell;
 /// For every point, the smallest index of a point at exactly the same position (its own index
 /// when no earlier point coincides); the same for any thread count. `progress` hears the
 /// fraction done.
-std::vector<std::uint32_t> coincidentPointIds(const std::vector<Vec3f>& points,
+std::vector<std::uint32_t> coincidentPointIds(std::span<const Vec3f> points,
                                               const FractionFn& progress = {});
 
 /// Face neighbours: result[faceBase(c) + i] is the cell sharing face i (packedFace's numbering;

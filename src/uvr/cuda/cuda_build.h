@@ -32,13 +32,15 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
 /// buildLbvhCuda does.
 void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint32_t* order);
 
-/// Finds the face neighbours of buildTetNeighbors on the GPU (points welded on the CPU; faces
-/// counted, scattered into their smallest vertex's bucket and paired there, in passes over
-/// vertex ranges when they do not all fit, or of at most facesPerPass faces when it is not 0):
-/// the same table. Throws as buildLbvhCuda does.
+/// Finds the face neighbours of buildTetNeighbors on the GPU (points welded on the CPU, or
+/// `welded` when given: coincidentPointIds(mesh.points), found earlier; faces counted,
+/// scattered into their smallest vertex's bucket and paired there, in passes over vertex ranges
+/// when they do not all fit, or of at most facesPerPass faces when it is not 0): the same
+/// table. Throws as buildLbvhCuda does.
 std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh,
                                                  const FractionFn& progress = {},
-                                                 std::uint64_t facesPerPass = 0);
+                                                 std::uint64_t facesPerPass = 0,
+                                                 const std::vector<std::uint32_t>* welded = nullptr);
 
 /// Builds the seed grids of buildSeedGrids on the GPU (one block per partition, seed keys kept
 /// by atomic minima): the same grids and seeds. Throws as buildLbvhCuda does.

@@ -143,19 +143,7 @@ std::vector<std::pair<std::string, TetMesh>> builderMeshes() {
     out.emplace_back("tetrahedra", proceduralTets(300000));
     const Mesh mixed = generateMixedCellMesh(24);
     out.emplace_back("mixed cells", tetrahedralize(mixed, selectScalarField(mixed, {}), {}));
-    ProceduralSpec spec;
-    spec.targetCells = 20000;
-    Mesh seams = generateMesh(spec);
-    const std::size_t points = seams.points.size();
-    seams.points.insert(seams.points.end(), seams.points.begin(), seams.points.end());
-    for (Field& f : seams.fields) f.values.insert(f.values.end(), f.values.begin(), f.values.end());
-    for (std::size_t c = 1; c < seams.cellCount(); c += 2)
-        for (std::uint64_t k = seams.cellOffsets[c]; k < seams.cellOffsets[c + 1]; ++k)
-            seams.cellIndices[k] += static_cast<std::uint32_t>(points);
-    const std::vector<std::uint32_t> first(seams.cell(0).begin(), seams.cell(0).end());
-    seams.cellIndices.insert(seams.cellIndices.end(), first.begin(), first.end());
-    seams.cellOffsets.push_back(seams.cellIndices.size());  // a third cell on the first's faces
-    seams.cellTypes.push_back(seams.cellTypes[0]);
+    Mesh seams = testing::seamMesh(20000);
     for (std::size_t i = 0; i < seams.fields[0].values.size(); i += 101)
         seams.fields[0].values[i] = NAN;  // NaN point values
     out.emplace_back("seams",

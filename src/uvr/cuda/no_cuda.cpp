@@ -69,7 +69,8 @@ void sortCellKeysCuda(const std::uint64_t*, std::uint64_t, std::uint32_t*) {
     noCudaBuilders();
 }
 
-std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh&, const FractionFn&, std::uint64_t) {
+std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh&, const FractionFn&, std::uint64_t,
+                                                 const std::vector<std::uint32_t>*) {
     noCudaBuilders();
 }
 

@@ -261,16 +261,21 @@ void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint3
 }
 
 std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, const FractionFn& progress,
-                                                 std::uint64_t facesPerPass) {
+                                                 std::uint64_t facesPerPass,
+                                                 const std::vector<std::uint32_t>* welded) {
     cuda::requireDevice("GPU face neighbours");
     const TetMeshView host = mesh.view();
     const std::uint64_t n = host.cellCount(), slots = host.faceSlots();
     const std::size_t points = mesh.points.size();
     UVR_CHECK(n < kNoCell / 4 && slots < kNoCell, "too many cells for 32-bit neighbour ids: " << n);
     if (n == 0 || points == 0) return std::vector<std::uint32_t>(slots, kNoTet);
-    // On threads of their own while the cells go up: the welded ids, and the host's table
-    // (zeroed by its constructor, on one thread).
-    auto welded = std::async(std::launch::async, [&] { return coincidentPointIds(mesh.points); });
+    UVR_CHECK(!welded || welded->size() == points,
+              "welded ids for " << welded->size() << " points, the mesh has " << points);
+    // On threads of their own while the cells go up: the welded ids (unless given), and the
+    // host's table (zeroed by its constructor, on one thread).
+    std::future<std::vector<std::uint32_t>> welding;
+    if (!welded)
+        welding = std::async(std::launch::async, [&] { return coincidentPointIds(mesh.points); });
     auto hostTable =
         std::async(std::launch::async, [slots] { return std::vector<std::uint32_t>(slots); });
     // The cells, welded ids, per-vertex counts and offsets, and the table.
@@ -280,7 +285,8 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, const Frac
     cuda::DeviceArray<unsigned char> temp;
     tets.upload(mesh.tets, "the tetrahedra (GPU face neighbours)");
     nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU face neighbours)");
-    canonIds.upload(welded.get(), "the welded point ids (GPU face neighbours)");
+    const std::vector<std::uint32_t> own = welded ? std::vector<std::uint32_t>() : welding.get();
+    canonIds.upload(welded ? *welded : own, "the welded point ids (GPU face neighbours)");
     if (progress) progress(0.3);  // the fractions: seconds measured at 100M tetrahedra
     table.reserve(slots, "the neighbour table (GPU face neighbours)");
     counts.reserve(points + 1, "the faces per point (GPU face neighbours)");

@@ -31,8 +31,9 @@ PrepareOptions RendererOptions::prepareOptions() const {
     if (buildOnCuda) {
         o.lbvh = buildLbvhCuda;
         o.kdSplitter = buildKdTreeCuda;
-        o.faceMatcher = [](const TetMesh& m, const FractionFn& progress) {
-            return buildTetNeighborsCuda(m, progress);
+        o.faceMatcher = [](const TetMesh& m, const std::vector<std::uint32_t>& welded,
+                           const FractionFn& progress) {
+            return buildTetNeighborsCuda(m, progress, 0, &welded);
         };
         o.seedBuilder = buildSeedGridsCuda;
         o.macroBuilder = buildMacroGridsCuda;

@@ -44,13 +44,22 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
                      : "preparing " + std::to_string(mesh.cellCount()) + " cells");
     TetrahedralizeOptions cells = options.cells;
-    if (mesh.cellCount() < options.builderMinTets) cells.sorter = nullptr;  // as for the others
+    // The builders (the GPU's) only where the mesh is large enough to pay.
+    const bool large = mesh.cellCount() >= options.builderMinTets;
+    if (!large) cells.sorter = nullptr;
+    // For the face neighbours found elsewhere, the points' welded ids (coincidentPointIds) on a
+    // thread of their own beside the split, which keeps the points' numbering.
+    std::future<std::pair<std::vector<std::uint32_t>, double>> welding;
+    if (large && options.faceMatcher)
+        welding = beside([points = mesh.points] { return coincidentPointIds(points); });
     out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
+    std::vector<std::uint32_t> welded;
+    if (welding.valid()) welded = std::move(welding.get().first);  // before the points are freed
     if (options.afterSplit) options.afterSplit();
     out.splitSeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
 
-    // The other builders (the GPU's) only where the mesh is large enough to pay.
+    // The other builders too, by the cells of the split.
     const bool elsewhere = out.tets.cellCount() >= options.builderMinTets;
     const LbvhBuilder lbvh = elsewhere ? options.lbvh : nullptr;
     const KdSplitter splitter = elsewhere ? options.kdSplitter : nullptr;
@@ -91,7 +100,12 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     constexpr double kNeighborsEnd = 4.17 / 4.91;
     std::future<std::pair<CompactNeighbors, double>> codes;
     if (faceMatcher) {
-        out.neighbors = faceMatcher(out.tets, progress.fraction);
+        // Welded again where the split moved the points into a frame (equal points stay equal,
+        // but the weld is of the points the matcher reads), or where none were welded.
+        if (welded.size() != out.tets.points.size() || !out.tets.frame.identity())
+            welded = coincidentPointIds(out.tets.points);
+        out.neighbors = faceMatcher(out.tets, welded, progress.fraction);
+        welded = {};
         codes = beside([&tets = out.tets, &neighbors = out.neighbors] {
             return compactNeighbors(tets, neighbors);
         });

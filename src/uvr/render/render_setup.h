@@ -42,8 +42,12 @@ struct PrepareOptions {
     /// overrides kd.splitter.
     KdSplitter kdSplitter;
     /// When set, the face neighbours come from this builder (buildTetNeighborsCuda: on the GPU),
-    /// the same table as buildTetNeighbors.
-    std::function<std::vector<std::uint32_t>(const TetMesh&, const FractionFn&)> faceMatcher;
+    /// the same table as buildTetNeighbors. It is given the points' welded ids
+    /// (coincidentPointIds of the tetrahedra's points), found on a thread of their own beside
+    /// the split.
+    std::function<std::vector<std::uint32_t>(const TetMesh&, const std::vector<std::uint32_t>&,
+                                             const FractionFn&)>
+        faceMatcher;
     /// When set, the seed grids come from this builder (buildSeedGridsCuda: on the GPU).
     SeedBuilder seedBuilder;
     /// When set (and with macroGrids), the macrocells and the partitions' gradient spreads come

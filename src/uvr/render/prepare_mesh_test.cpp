@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: MIT
+// prepareMesh with a face matcher from elsewhere (the GPU's): it is given the points' weld,
+// found beside the split, and the preparation equals the CPU's.
+#include <gtest/gtest.h>
+
+#include "test_meshes.h"
+
+#include <vector>
+
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/render/render_setup.h"
+
+namespace uvr {
+namespace {
+
+TEST(PrepareMesh, AFaceMatcherIsGivenTheWeldOfThePointsItReads) {
+    // Near the origin (the split keeps the points) and far from it (the split moves them into a
+    // frame, and they are welded again).
+    for (const float shift : {0.f, 1e4f}) {
+        SCOPED_TRACE("shifted by " + std::to_string(shift));
+        Mesh seams = testing::seamMesh(20000);
+        for (Vec3f& p : seams.points) p.x += shift;
+        const ScalarField field = selectScalarField(seams, {});
+        const PreparedMesh cpu = prepareMesh(seams, field);
+        int calls = 0;
+        std::vector<std::uint32_t> given;
+        PrepareOptions o;
+        o.faceMatcher = [&](const TetMesh& m, const std::vector<std::uint32_t>& welded,
+                            const FractionFn& progress) {
+            ++calls;
+            given = welded;
+            return buildTetNeighbors(m, progress);
+        };
+        // The caller frees the mesh once it is split, as the CLI does: the weld beside the split
+        // is done by then.
+        Mesh copy = seams;
+        o.afterSplit = [&copy] { copy = Mesh(); };
+        const PreparedMesh pm = prepareMesh(copy, selectScalarField(copy, {}), o);
+        EXPECT_TRUE(copy.points.empty());
+        ASSERT_EQ(calls, 1);
+        EXPECT_EQ(pm.tets.frame.identity(), shift == 0.f);
+        EXPECT_EQ(given, coincidentPointIds(pm.tets.points));
+        // The seam's copies are welded to the first points.
+        EXPECT_EQ(given[seams.points.size() / 2], 0u);
+        EXPECT_EQ(pm.neighbors, cpu.neighbors);
+    }
+}
+
+}  // namespace
+}  // namespace uvr
