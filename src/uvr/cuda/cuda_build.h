@@ -37,10 +37,9 @@ void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint3
 /// scattered into their smallest vertex's bucket and paired there, in passes over vertex ranges
 /// when they do not all fit, or of at most facesPerPass faces when it is not 0): the same
 /// table. Throws as buildLbvhCuda does.
-std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh,
-                                                 const FractionFn& progress = {},
-                                                 std::uint64_t facesPerPass = 0,
-                                                 const std::vector<std::uint32_t>* welded = nullptr);
+std::vector<std::uint32_t> buildTetNeighborsCuda(
+    const TetMesh& mesh, const FractionFn& progress = {}, std::uint64_t facesPerPass = 0,
+    const std::vector<std::uint32_t>* welded = nullptr);
 
 /// Builds the seed grids of buildSeedGrids on the GPU (one block per partition, seed keys kept
 /// by atomic minima): the same grids and seeds. Throws as buildLbvhCuda does.

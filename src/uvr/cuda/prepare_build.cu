@@ -233,6 +233,38 @@ std::size_t freeDeviceMemory() {
     return freeBytes;
 }
 
+/// The cells in the kernels' layout (the blocks' corners and vertices; the points and corners of
+/// native cells; the values when `values` is true and the cells read them: cell data, native
+/// cells) on the GPU, and a view of them: what the seed and macrocell builders read.
+struct DeviceCells {
+    DeviceArray<TetCorners16> corners;
+    DeviceArray<BlockVertex> blockVertices;
+    DeviceArray<std::uint32_t> blockBase, nativeCorners;
+    DeviceArray<Vec3f> points;
+    DeviceArray<float> values;
+    TetMeshView view;
+
+    DeviceCells(const TetMesh& mesh, bool withValues, const char* build) : view(mesh.view()) {
+        auto what = [build](const char* array) { return std::string(array) + " (" + build + ")"; };
+        corners.upload(mesh.tetCorners, what("the tetrahedra's corners").c_str());
+        blockVertices.upload(mesh.blockVertices, what("the block vertices").c_str());
+        blockBase.upload(mesh.blockVertexBase, what("the block offsets").c_str());
+        view.tets = nullptr, view.values = nullptr, view.points = nullptr;
+        view.nativeCorners = nullptr;
+        if (withValues && (view.hasNative() || view.cellCentered)) {
+            values.upload(mesh.values, what("the values").c_str());
+            view.values = values.data();
+        }
+        if (view.hasNative()) {
+            points.upload(mesh.points, what("the points").c_str());
+            nativeCorners.upload(mesh.nativeCorners, what("the native cells").c_str());
+            view.points = points.data(), view.nativeCorners = nativeCorners.data();
+        }
+        view.tetCorners = corners.data(), view.blockVertices = blockVertices.data();
+        view.blockVertexBase = blockBase.data();
+    }
+};
+
 }  // namespace
 }  // namespace cuda
 
@@ -358,33 +390,18 @@ SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float 
     out.seeds.assign(cells, kNoTet);
     if (kd.partitions.empty() || cells == 0) return out;
     // The kernels' layout of the cells (what offerSeedKeys reads) and the partitions.
-    cuda::DeviceArray<TetCorners16> corners;
-    cuda::DeviceArray<BlockVertex> blockVertices;
-    cuda::DeviceArray<std::uint32_t> blockBase, nativeCorners, kdCells, seeds;
-    cuda::DeviceArray<Vec3f> points;
+    const cuda::DeviceCells device(mesh, false, "GPU seed grids");
+    cuda::DeviceArray<std::uint32_t> kdCells, seeds;
     cuda::DeviceArray<KdPartition> partitions;
     cuda::DeviceArray<PartitionGrid> grids;
     cuda::DeviceArray<unsigned long long> best;
-    corners.upload(mesh.tetCorners, "the tetrahedra's corners (GPU seed grids)");
-    blockVertices.upload(mesh.blockVertices, "the block vertices (GPU seed grids)");
-    blockBase.upload(mesh.blockVertexBase, "the block offsets (GPU seed grids)");
-    TetMeshView view = mesh.view();
-    view.tets = nullptr, view.values = nullptr, view.points = nullptr;
-    view.nativeCorners = nullptr;
-    if (view.hasNative()) {
-        points.upload(mesh.points, "the points (GPU seed grids)");
-        nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU seed grids)");
-        view.points = points.data(), view.nativeCorners = nativeCorners.data();
-    }
-    view.tetCorners = corners.data(), view.blockVertices = blockVertices.data();
-    view.blockVertexBase = blockBase.data();
     kdCells.upload(kd.cells, "the partitions' cells (GPU seed grids)");
     partitions.upload(kd.partitions, "the partitions (GPU seed grids)");
     grids.upload(out.grids, "the seed grids' layout (GPU seed grids)");
     best.reserve(cells, "the seed keys (GPU seed grids)");
     UVR_CUDA_CHECK(cudaMemset(best.data(), 0xff, cells * sizeof(unsigned long long)));
     if (progress) progress(0.5);
-    const TetLocator locator{view, {}, {}};
+    const TetLocator locator{device.view, {}, {}};
     cuda::seedKernel<<<static_cast<unsigned>(kd.partitions.size()), cuda::kBlock>>>(
         locator, partitions.data(), kdCells.data(), grids.data(), best.data());
     UVR_CUDA_CHECK(cudaGetLastError());
@@ -429,33 +446,14 @@ MacroBuild buildMacroGridsCuda(const TetMesh& mesh, const KdPartitions& kd,
     const bool anyNan =
         std::any_of(mesh.values.begin(), mesh.values.end(), [](float v) { return v != v; });
     // The kernels' layout of the cells, values for cell data and native cells, the partitions.
-    cuda::DeviceArray<TetCorners16> corners;
-    cuda::DeviceArray<BlockVertex> blockVertices;
-    cuda::DeviceArray<std::uint32_t> blockBase, nativeCorners, kdCells;
+    const cuda::DeviceCells device(mesh, true, "GPU macrocells");
+    const TetMeshView& view = device.view;
+    cuda::DeviceArray<std::uint32_t> kdCells;
     cuda::DeviceArray<std::uint32_t> rangeKeys, gradientKeys, flags, partitionKeys;
     cuda::DeviceArray<std::uint8_t> boundaryFlags;
-    cuda::DeviceArray<Vec3f> points;
-    cuda::DeviceArray<float> values;
     cuda::DeviceArray<KdPartition> partitions;
     cuda::DeviceArray<PartitionGrid> grids;
     cuda::DeviceArray<MacroCell> macroCells;
-    corners.upload(mesh.tetCorners, "the tetrahedra's corners (GPU macrocells)");
-    blockVertices.upload(mesh.blockVertices, "the block vertices (GPU macrocells)");
-    blockBase.upload(mesh.blockVertexBase, "the block offsets (GPU macrocells)");
-    TetMeshView view = host;
-    view.tets = nullptr, view.values = nullptr, view.points = nullptr;
-    view.nativeCorners = nullptr;
-    if (view.hasNative() || view.cellCentered) {
-        values.upload(mesh.values, "the values (GPU macrocells)");
-        view.values = values.data();
-    }
-    if (view.hasNative()) {
-        points.upload(mesh.points, "the points (GPU macrocells)");
-        nativeCorners.upload(mesh.nativeCorners, "the native cells (GPU macrocells)");
-        view.points = points.data(), view.nativeCorners = nativeCorners.data();
-    }
-    view.tetCorners = corners.data(), view.blockVertices = blockVertices.data();
-    view.blockVertexBase = blockBase.data();
     boundaryFlags.upload(boundary, "the boundary cells (GPU macrocells)");
     kdCells.upload(kd.cells, "the partitions' cells (GPU macrocells)");
     partitions.upload(kd.partitions, "the partitions (GPU macrocells)");
