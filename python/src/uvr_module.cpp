@@ -127,34 +127,85 @@ std::array<float, 3> arr3(Vec3f v) {
 // ---- Meshes ----
 
 /// A mesh for the renderer: read from a file (owned by uvr, its arrays shown to Python as
-/// read-only views without copies) or the caller's numpy arrays in uvr's layout (borrowed, kept
-/// alive here, never copied).
+/// read-only views without copies) or the caller's numpy arrays in uvr's layout (borrowed: kept
+/// alive here, never copied by the mesh). The caller may change borrowed arrays at any time, so
+/// nothing reads them but cellsNow and countsNow, which check them again.
 struct MeshData {
     std::shared_ptr<Mesh> owned;  ///< a file's mesh or a converted one; null when borrowed
     py::object arrays[4];         ///< borrowed points, types, offsets, connectivity
-    MeshView view;
 };
 
-/// Borrows the four arrays after checking dtype, layout, shape and every index (validateCells).
-std::unique_ptr<MeshData> borrowMesh(const py::handle& points, const py::handle& types,
-                                     const py::handle& offsets, const py::handle& connectivity) {
-    auto p = exactArray<float>(points, "points");
+/// A view of the borrowed arrays as they are now: dtype, layout and shapes checked again (an
+/// array may have been retyped, reshaped or resized in place since); the indices unchecked.
+/// Valid only while the GIL is held (no other thread can then free or resize an array).
+MeshView borrowedView(const py::object (&arrays)[4]) {
+    auto p = exactArray<float>(arrays[0], "points");
     checkShape(p, {-1, 3}, "points");
-    auto t = exactArray<std::uint8_t>(types, "types");
+    auto t = exactArray<std::uint8_t>(arrays[1], "types");
     checkShape(t, {-1}, "types");
-    auto o = exactArray<std::uint64_t>(offsets, "offsets");
+    auto o = exactArray<std::uint64_t>(arrays[2], "offsets");
     checkShape(o, {t.shape(0) + 1}, "offsets (one more than the cells)");
-    auto c = exactArray<std::uint32_t>(connectivity, "connectivity");
+    auto c = exactArray<std::uint32_t>(arrays[3], "connectivity");
     checkShape(c, {-1}, "connectivity");
-    auto out = std::make_unique<MeshData>();
-    out->arrays[0] = p, out->arrays[1] = t, out->arrays[2] = o, out->arrays[3] = c;
-    MeshView& v = out->view;
+    MeshView v;
     v.points = {reinterpret_cast<const Vec3f*>(p.data()), static_cast<std::size_t>(p.shape(0))};
     v.cellTypes = {reinterpret_cast<const CellType*>(t.data()),
                    static_cast<std::size_t>(t.shape(0))};
     v.cellOffsets = {o.data(), static_cast<std::size_t>(o.shape(0))};
     v.cellIndices = {c.data(), static_cast<std::size_t>(c.shape(0))};
-    validateCells(v, "");
+    return v;
+}
+
+/// Runs `fn` and adds to the message of an Error it throws that the borrowed arrays changed
+/// (they passed the same checks when the mesh was made).
+template <class Fn>
+auto changedSinceMesh(Fn&& fn) {
+    try {
+        return fn();
+    } catch (const Error& e) {
+        raise(e.kind(), std::string("the mesh's arrays changed after uvr.Mesh(): ") + e.what());
+    }
+}
+
+/// The points and cells of `d` as they are now, safe to read without the GIL for as long as the
+/// pointer is held: a file's mesh itself; of borrowed arrays a copy made now (with the GIL, so
+/// no array is freed meanwhile) and checked by validateCells. Nothing reads the borrowed memory
+/// afterwards, so a later change, or one made from another thread while this copies (a torn
+/// copy), reaches only a copy that validateCells has checked.
+std::shared_ptr<const Mesh> cellsNow(const MeshData& d) {
+    if (d.owned) return d.owned;
+    return changedSinceMesh([&] {
+        const MeshView v = borrowedView(d.arrays);
+        auto copy = std::make_shared<Mesh>();
+        copy->points.assign(v.points.begin(), v.points.end());
+        copy->cellTypes.assign(v.cellTypes.begin(), v.cellTypes.end());
+        copy->cellOffsets.assign(v.cellOffsets.begin(), v.cellOffsets.end());
+        copy->cellIndices.assign(v.cellIndices.begin(), v.cellIndices.end());
+        py::gil_scoped_release release;
+        validateCells(*copy, "");
+        return std::shared_ptr<const Mesh>(std::move(copy));
+    });
+}
+
+/// The mesh's arrays as they are now, for their counts (a borrowed array's shape may have
+/// changed): borrowed ones checked again by borrowedView, their indices not; valid only while
+/// the GIL is held.
+MeshView shapesNow(const MeshData& d) {
+    if (d.owned) return *d.owned;
+    return changedSinceMesh([&] { return borrowedView(d.arrays); });
+}
+
+/// Borrows the four arrays after checking dtype, layout, shape and every index (validateCells,
+/// which checks each offset before indexing with it: it reads in bounds even while another
+/// thread writes).
+std::unique_ptr<MeshData> borrowMesh(const py::handle& points, const py::handle& types,
+                                     const py::handle& offsets, const py::handle& connectivity) {
+    auto out = std::make_unique<MeshData>();
+    out->arrays[0] = py::reinterpret_borrow<py::object>(points);
+    out->arrays[1] = py::reinterpret_borrow<py::object>(types);
+    out->arrays[2] = py::reinterpret_borrow<py::object>(offsets);
+    out->arrays[3] = py::reinterpret_borrow<py::object>(connectivity);
+    validateCells(borrowedView(out->arrays), "");
     return out;
 }
 
@@ -182,7 +233,6 @@ std::unique_ptr<MeshData> convertMesh(const py::handle& points, const py::handle
               "cell 0: offset " + std::to_string(cells.offsets[0]) + ", expected 0");
     appendVtkCells(cells, *mesh, "");
     auto out = std::make_unique<MeshData>();
-    out->view = *mesh;
     out->owned = std::move(mesh);
     return out;
 }
@@ -244,6 +294,7 @@ ScalarField scalarField(const std::string& name, const std::string& association,
 /// and extracts its scalar (component or magnitude); returns (name, association, values,
 /// choice).
 py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::string& spec) {
+    const MeshView shapes = shapesNow(mesh);
     std::vector<FieldInfo> infos;
     std::vector<py::array_t<float, py::array::c_style>> arrays;
     for (const py::handle& item : fields) {
@@ -252,7 +303,7 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
         const Association assoc = parseAssociation(t[1].cast<std::string>(), "association");
         auto a = exactArray<float>(t[2], "field '" + name + "'");
         const std::uint64_t tuples =
-            assoc == Association::Point ? mesh.view.pointCount() : mesh.view.cellCount();
+            assoc == Association::Point ? shapes.pointCount() : shapes.cellCount();
         if (a.ndim() < 1 || a.ndim() > 2 || static_cast<std::uint64_t>(a.shape(0)) != tuples)
             raise(ErrorKind::Argument,
                   std::string(associationName(assoc)) + " field '" + name + "': expected " +
@@ -266,7 +317,7 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
     const auto& a = arrays[choice.index];
     Field f{infos[choice.index].name, infos[choice.index].association,
             infos[choice.index].components, std::vector<float>(a.data(), a.data() + a.size())};
-    ScalarField s = scalarFieldOf(mesh.view, f, parsed.component);
+    ScalarField s = scalarFieldOf(shapes, f, parsed.component);  // reads only the counts
     const auto n = static_cast<py::ssize_t>(s.values.size());
     return py::make_tuple(s.name, associationName(s.association),
                           vectorArray<float>(std::move(s.values), {n}), choice.choice);
@@ -417,7 +468,6 @@ PYBIND11_MODULE(_uvr, m) {
                     o.maxMemoryBytes = maxMemory;
                     out->owned = std::make_shared<Mesh>(readMesh(path, o));
                 }
-                out->view = *out->owned;
                 return out;
             },
             py::arg("path"), py::arg("max_memory") = 0)
@@ -426,37 +476,41 @@ PYBIND11_MODULE(_uvr, m) {
         .def_static("convert", &convertMesh, py::arg("points"), py::arg("types"),
                     py::arg("offsets"), py::arg("connectivity"))
         .def_property_readonly("borrowed", [](const MeshData& d) { return !d.owned; })
-        .def_property_readonly("point_count", [](const MeshData& d) { return d.view.pointCount(); })
-        .def_property_readonly("cell_count", [](const MeshData& d) { return d.view.cellCount(); })
+        .def_property_readonly("point_count",
+                               [](const MeshData& d) { return shapesNow(d).pointCount(); })
+        .def_property_readonly("cell_count",
+                               [](const MeshData& d) { return shapesNow(d).cellCount(); })
         .def_property_readonly("points",
                                [](py::object self) -> py::object {
                                    const auto& d = self.cast<const MeshData&>();
                                    if (!d.owned) return d.arrays[0];
                                    return viewArray(
-                                       reinterpret_cast<const float*>(d.view.points.data()),
-                                       {py::ssize_t(d.view.pointCount()), 3}, self);
+                                       reinterpret_cast<const float*>(d.owned->points.data()),
+                                       {py::ssize_t(d.owned->pointCount()), 3}, self);
                                })
         .def_property_readonly(
             "types",
             [](py::object self) -> py::object {
                 const auto& d = self.cast<const MeshData&>();
                 if (!d.owned) return d.arrays[1];
-                return viewArray(reinterpret_cast<const std::uint8_t*>(d.view.cellTypes.data()),
-                                 {py::ssize_t(d.view.cellCount())}, self);
+                return viewArray(reinterpret_cast<const std::uint8_t*>(d.owned->cellTypes.data()),
+                                 {py::ssize_t(d.owned->cellCount())}, self);
             })
         .def_property_readonly("offsets",
                                [](py::object self) -> py::object {
                                    const auto& d = self.cast<const MeshData&>();
                                    if (!d.owned) return d.arrays[2];
-                                   return viewArray(d.view.cellOffsets.data(),
-                                                    {py::ssize_t(d.view.cellOffsets.size())}, self);
+                                   return viewArray(d.owned->cellOffsets.data(),
+                                                    {py::ssize_t(d.owned->cellOffsets.size())},
+                                                    self);
                                })
         .def_property_readonly("connectivity",
                                [](py::object self) -> py::object {
                                    const auto& d = self.cast<const MeshData&>();
                                    if (!d.owned) return d.arrays[3];
-                                   return viewArray(d.view.cellIndices.data(),
-                                                    {py::ssize_t(d.view.cellIndices.size())}, self);
+                                   return viewArray(d.owned->cellIndices.data(),
+                                                    {py::ssize_t(d.owned->cellIndices.size())},
+                                                    self);
                                })
         .def_property_readonly(
             "fields",
@@ -465,7 +519,12 @@ PYBIND11_MODULE(_uvr, m) {
             "notes",
             [](const MeshData& d) { return d.owned ? d.owned->notes : std::vector<std::string>{}; })
         .def("bounds", [](const MeshData& d) {
-            const Bounds3f b = d.view.bounds();
+            const std::shared_ptr<const Mesh> cells = cellsNow(d);
+            Bounds3f b;
+            {
+                py::gil_scoped_release release;
+                b = cells->bounds();
+            }
             return py::make_tuple(arr3(b.lo), arr3(b.hi));
         });
     py::class_<FieldSet>(m, "FieldSet", "A time step's fields (see uvr.Series).")
@@ -493,17 +552,17 @@ PYBIND11_MODULE(_uvr, m) {
                     py::gil_scoped_release release;
                     out->owned = std::make_shared<Mesh>(s.series->readStep(i));
                 }
-                out->view = *out->owned;
                 return out;
             },
             py::arg("step"))
         .def(
             "read_fields",
             [](PySeries& s, std::size_t i, const MeshData& geometry) -> py::object {
+                const std::shared_ptr<const Mesh> cells = cellsNow(geometry);
                 std::optional<std::vector<Field>> fields;
                 {
                     py::gil_scoped_release release;
-                    fields = s.series->readFieldsIfSameGeometry(i, geometry.view);
+                    fields = s.series->readFieldsIfSameGeometry(i, *cells);
                 }
                 if (!fields) return py::none();
                 auto set = std::make_unique<FieldSet>();
@@ -570,7 +629,8 @@ PYBIND11_MODULE(_uvr, m) {
                 if (a.shape(0) < 1) raise(ErrorKind::Argument, "colors: at least one point");
                 std::vector<ColorPoint> pts;
                 for (py::ssize_t i = 0; i < a.shape(0); ++i) {
-                    const float* r = a.data(i, 0);
+                    float r[4];  // read once: the checked values are the ones kept
+                    std::memcpy(r, a.data(i, 0), sizeof(r));
                     for (int c = 0; c < 4; ++c)
                         if (!(r[c] >= 0.f && r[c] <= 1.f))
                             raise(ErrorKind::Argument, "colors: row " + std::to_string(i) +
@@ -691,9 +751,13 @@ PYBIND11_MODULE(_uvr, m) {
                  o.meshBvh = meshBvh;
                  o.seedGrids = seedGrids;
                  o.splitCells = splitCells;
+                 // The mesh's points and cells as they are now (a borrowed mesh's copied and
+                 // checked again), freed as soon as they are split.
+                 std::shared_ptr<const Mesh> cells = cellsNow(mesh);
+                 o.afterSplit = [&cells] { cells.reset(); };
                  const std::uint64_t expected = field.association == Association::Point
-                                                    ? mesh.view.pointCount()
-                                                    : mesh.view.cellCount();
+                                                    ? cells->pointCount()
+                                                    : cells->cellCount();
                  if (field.values.size() != expected)
                      raise(ErrorKind::Argument, "values: " + std::to_string(field.values.size()) +
                                                     " " + associationName(field.association) +
@@ -701,7 +765,7 @@ PYBIND11_MODULE(_uvr, m) {
                                                     std::to_string(expected));
                  auto r = std::make_unique<PyRenderer>();
                  py::gil_scoped_release release;
-                 r->renderer = std::make_unique<Renderer>(mesh.view, field, o);
+                 r->renderer = std::make_unique<Renderer>(MeshView(*cells), field, o);
                  return r;
              }),
              py::arg("mesh"), py::arg("name"), py::arg("association"), py::arg("values"),

@@ -63,9 +63,12 @@ class Mesh:
     The arrays are used without a copy when they already have uvr's layout: float32 points of
     shape (n, 3), uint32 (or non-negative int32) connectivity, int64/uint64 offsets of length
     cells + 1, uint8 types of only 10, 12, 13, 14, all C-contiguous; the mesh then keeps
-    references to them (do not change them while a Renderer prepares). Anything else is converted
-    once; ``mesh.copied`` names the arguments that were. Fields are float32 arrays of shape (n,)
-    or (n, components) (converted when not).
+    references to them. Anything else is converted once; ``mesh.copied`` names the arguments
+    that were. Fields are float32 arrays of shape (n,) or (n, components) (converted when not).
+
+    Borrowed arrays may be changed afterwards: a Renderer made later (and ``bounds``) checks
+    them again and prepares from a copy (an invalid change raises ValidationError or
+    ArgumentError); a Renderer made earlier never reads them again (docs/PYTHON.md).
     """
 
     def __init__(self, points, cells=None, offsets=None, types=None, point_data=None,
