@@ -129,7 +129,7 @@ std::array<float, 3> arr3(Vec3f v) {
 /// A mesh for the renderer: read from a file (owned by uvr, its arrays shown to Python as
 /// read-only views without copies) or the caller's numpy arrays in uvr's layout (borrowed: kept
 /// alive here, never copied by the mesh). The caller may change borrowed arrays at any time, so
-/// nothing reads them but cellsNow and countsNow, which check them again.
+/// nothing reads them but cellsNow and shapesNow, which check them again.
 struct MeshData {
     std::shared_ptr<Mesh> owned;  ///< a file's mesh or a converted one; null when borrowed
     py::object arrays[4];         ///< borrowed points, types, offsets, connectivity
