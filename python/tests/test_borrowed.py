@@ -225,3 +225,17 @@ def test_transfer_function_and_camera_arrays_are_copied():
     cam = uvr.Camera(position=position, focal_point=(0.5, 0.5, 0.5))
     position[:] = np.nan
     assert tuple(cam.position) == (0.5, 0.5, 4.0)
+
+
+def test_a_series_compares_a_borrowed_geometry_as_it_is_now(data_dir):
+    path = data_dir / "spx.vtk"
+    read = uvr.read(path)
+    conn = np.array(read.connectivity)
+    borrowed = uvr.Mesh(np.array(read.points), cells=conn, offsets=np.array(read.offsets),
+                        types=np.array(read.types))
+    assert borrowed.copied == []
+    series = uvr.Series(path)
+    assert series._same_geometry(0, borrowed) is not None  # only the fields are read
+    conn[-1] = 4000000000
+    with pytest.raises(uvr.ValidationError, match="changed after uvr.Mesh.*point 4000000000"):
+        series._same_geometry(0, borrowed)
