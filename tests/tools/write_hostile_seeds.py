@@ -91,7 +91,7 @@ def vtu_seeds(out):
           .replace(b"vtkZLibDataCompressor", b"vtkLZMADataCompressor"))
     # Round three: an LZMA block table declaring 6.3 GB from 200 KB of garbage blocks (within
     # LZMA's 32768:1 per block), and 3,000 Pieces reading one LZMA block of 1.2 MB of zeros.
-    lblocks, lblock, lsize = 200, 33554424, 1000
+    lblocks, lblock, lsize = 200, 33554424, 1024
     data = le32(lblocks) + le32(lblock) + le32(0) + le32(lsize) * lblocks + b"x" * (lblocks * lsize)
     write(out, "lzma_lying_block_table.vtu",
           appended_zlib_vtu(points_piece(lblocks * lblock // 12), data)
