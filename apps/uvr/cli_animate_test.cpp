@@ -180,5 +180,33 @@ TEST(CliAnimate, BadStepsAndOutputsAreRefusedBeforeRendering) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
 }
 
+TEST(CliAnimate, CollectionsNamingEachOtherAreOneLineErrors) {
+    // cycA.pvd lists cycB.pvd, which lists cycA.pvd: `uvr info cycA.pvd` died of a stack
+    // overflow (SIGSEGV), as did every command reaching the step.
+    const std::string dir = testing::scratchDir();
+    writeSeries(dir);
+    auto collection = [&](const std::string& name, const std::string& files) {
+        testing::writeFile(dir + "/" + name, "<VTKFile type=\"Collection\"><Collection>\n" + files +
+                                                 "</Collection></VTKFile>\n");
+    };
+    collection("cycA.pvd", "<DataSet timestep=\"0\" file=\"cycB.pvd\"/>\n");
+    collection("cycB.pvd", "<DataSet timestep=\"0\" file=\"cycA.pvd\"/>\n");
+    collection("later.pvd",
+               "<DataSet timestep=\"0\" file=\"step_0.vtu\"/>\n"
+               "<DataSet timestep=\"1\" file=\"./later.pvd\"/>\n");
+    collection("mixed.pvd",
+               "<DataSet timestep=\"0\" file=\"step_0.vtu\"/>\n"
+               "<DataSet timestep=\"1\" file=\"cycA.pvd\"/>\n");
+    const std::string cycle = "is itself a ParaView collection (.pvd)";
+    expectOneLineError(uvr("info cycA.pvd", dir), {"cycA.pvd: line 2: ", "cycB.pvd", cycle});
+    expectOneLineError(uvr("render cycA.pvd -o a.png" + kLook, dir), {"cycB.pvd", cycle});
+    expectOneLineError(uvr("render mixed.pvd --time 1 -o b.png" + kLook, dir),
+                       {"mixed.pvd: line 3: ", "cycA.pvd", cycle});
+    expectOneLineError(uvr("info later.pvd", dir),
+                       {"later.pvd: line 3: a DataSet names the .pvd itself"});
+    EXPECT_FALSE(std::filesystem::exists(dir + "/a.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/b.png"));
+}
+
 }  // namespace
 }  // namespace uvr

@@ -89,6 +89,27 @@ def vtu_seeds(out):
     write(out, "lzma_zeros.vtu",
           appended_zlib_vtu(points_piece(100), le32(1) + le32(1200) + le32(1200) + le32(len(xz)) + xz)
           .replace(b"vtkZLibDataCompressor", b"vtkLZMADataCompressor"))
+    # Round three: an LZMA block table declaring 6.3 GB from 200 KB of garbage blocks (within
+    # LZMA's 32768:1 per block), and 3,000 Pieces reading one LZMA block of 1.2 MB of zeros.
+    lblocks, lblock, lsize = 200, 33554424, 1024
+    data = le32(lblocks) + le32(lblock) + le32(0) + le32(lsize) * lblocks + b"x" * (lblocks * lsize)
+    write(out, "lzma_lying_block_table.vtu",
+          appended_zlib_vtu(points_piece(lblocks * lblock // 12), data)
+          .replace(b"vtkZLibDataCompressor", b"vtkLZMADataCompressor"))
+    xz = lzma.compress(bytes(1200000), format=lzma.FORMAT_XZ, check=lzma.CHECK_CRC64)
+    write(out, "lzma_reused_block.vtu",
+          appended_zlib_vtu(points_piece(100000) * 3000,
+                            le32(1) + le32(1200000) + le32(1200000) + le32(len(xz)) + xz)
+          .replace(b"vtkZLibDataCompressor", b"vtkLZMADataCompressor"))
+
+
+def pvd_seeds(out):
+    # The fuzz target's input.pvd naming itself through './' and a missing folder's '..'.
+    for name, self_name in (("self_dot.pvd", "./input.pvd"),
+                            ("self_parent.pvd", "nowhere/../input.pvd")):
+        write(out, name, '<VTKFile type="Collection"><Collection>\n<DataSet timestep="0" '
+              'file="step0.vtu"/>\n<DataSet timestep="1" file="%s"/>\n</Collection></VTKFile>\n'
+              % self_name)
 
 
 def pvtu_seeds(out):
@@ -168,7 +189,7 @@ def render_seeds(out):
                       (0.5, 2.5, 0.05) + camera))
 
 
-WRITERS = {"colormap_json": colormap_seeds, "vtu": vtu_seeds, "pvtu": pvtu_seeds,
+WRITERS = {"colormap_json": colormap_seeds, "vtu": vtu_seeds, "pvtu": pvtu_seeds, "pvd": pvd_seeds,
            "vtk_legacy": vtk_legacy_seeds, "render": render_seeds}
 
 

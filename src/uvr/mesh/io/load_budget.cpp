@@ -6,11 +6,19 @@
 
 namespace uvr {
 
-void LoadBudget::charge(const std::string& file, const std::string& what, std::uint64_t count,
-                        std::uint64_t elementSize) {
-    const std::uint64_t kMax = ~std::uint64_t(0);
-    const std::uint64_t bytes =
-        elementSize != 0 && count > kMax / elementSize ? kMax : count * elementSize;
+namespace {
+
+constexpr std::uint64_t kMax = ~std::uint64_t(0);
+
+std::uint64_t bytesOf(std::uint64_t count, std::uint64_t elementSize) {
+    return elementSize != 0 && count > kMax / elementSize ? kMax : count * elementSize;
+}
+
+}  // namespace
+
+void LoadBudget::check(const std::string& file, const std::string& what, std::uint64_t count,
+                       std::uint64_t elementSize) const {
+    const std::uint64_t bytes = bytesOf(count, elementSize);
     if (limit_ != 0 && (bytes > limit_ || used_ > limit_ - bytes)) {
         const std::string need = bytes == kMax ? "more than 2^64" : std::to_string(bytes);
         throwError(
@@ -20,6 +28,12 @@ void LoadBudget::charge(const std::string& file, const std::string& what, std::u
                        : std::string()) +
                 "exceed the memory limit of " + std::to_string(limit_) + " bytes (--max-memory)");
     }
+}
+
+void LoadBudget::charge(const std::string& file, const std::string& what, std::uint64_t count,
+                        std::uint64_t elementSize) {
+    check(file, what, count, elementSize);
+    const std::uint64_t bytes = bytesOf(count, elementSize);
     used_ = used_ > kMax - bytes ? kMax : used_ + bytes;
     if (used_ > peak_) peak_ = used_;
 }

@@ -23,6 +23,11 @@ public:
     /// bytes (--max-memory)" instead when they do not fit.
     void charge(const std::string& file, const std::string& what, std::uint64_t count,
                 std::uint64_t elementSize);
+    /// Throws what charge would throw for count * elementSize bytes more, charging nothing: for
+    /// a need known before the allocations that make it up are charged one by one (the mesh a
+    /// file declares, checked before decoding any of it).
+    void check(const std::string& file, const std::string& what, std::uint64_t count,
+               std::uint64_t elementSize) const;
     /// Returns bytes charged earlier for a buffer that has been freed.
     void release(std::uint64_t bytes) { used_ -= bytes < used_ ? bytes : used_; }
     /// Sets the bytes held, after a step whose temporaries are freed, to what it keeps.

@@ -2,6 +2,7 @@
 #include "uvr/mesh/io/mesh_reader.h"
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "uvr/core/error.h"
@@ -41,6 +42,19 @@ MeshFormat sniffMeshFormat(const std::string& path) {
     if (ext == ".pvd") return Format::Pvd;
     if (ext == ".uvrm") return Format::Native;
     return Format::Unknown;
+}
+
+bool sameFile(const std::string& a, const std::string& b) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) {
+        const bool same = fs::equivalent(a, b, ec);
+        if (!ec) return same;
+    }
+    const fs::path ca = fs::weakly_canonical(a, ec);
+    if (ec) return fs::path(a).lexically_normal() == fs::path(b).lexically_normal();
+    const fs::path cb = fs::weakly_canonical(b, ec);
+    return !ec && ca == cb;
 }
 
 Mesh readMesh(const std::string& path, const ReadOptions& options) {

@@ -19,6 +19,10 @@ enum class MeshFormat { Legacy, Vtu, Pvtu, Pvd, Native, Exodus, VtkHdf, Unknown 
 /// it cannot be opened.
 MeshFormat sniffMeshFormat(const std::string& path);
 
+/// True when a and b name one file: the same inode when both exist (hard and symbolic links
+/// included), else the same weakly canonical path (`./x`, `sub/../x` and `x` alike).
+bool sameFile(const std::string& a, const std::string& b);
+
 /// Reads any supported mesh file (.vtk legacy, .vtu, .pvtu, .pvd, Exodus II and VTKHDF: their
 /// first step, .uvrm native), chosen by magic bytes first and extension second; throws Error
 /// naming the file on failure.

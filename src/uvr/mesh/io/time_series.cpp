@@ -76,11 +76,32 @@ public:
 // ---- Several files, one (or several parts) per step: .pvd and numbered series ----
 
 /// A step of a file-per-step series: its files (parts merged in order) and, for messages, where
-/// the step is listed.
+/// the step and each file are listed.
 struct FileStep {
     double time = 0;
     std::vector<std::string> files;
     std::string where;
+    std::vector<std::string> fileWheres;  // per file: "line 4" (.pvd) or "file NAME" (pattern)
+};
+
+/// Reads of a collection's steps now running on this thread: a step that is itself a collection
+/// is refused by its format, and this catches one that turns into a collection between that
+/// check and its read (unbounded recursion otherwise).
+thread_local int stepReadDepth = 0;
+
+class StepReadGuard {
+public:
+    StepReadGuard(const std::string& series, const std::string& where) {
+        if (stepReadDepth > 0)
+            throwError(ErrorKind::Parse, series,
+                       where +
+                           ": a step of a collection or file series is itself one (a "
+                           "collection's DataSets are datasets, not collections)");
+        ++stepReadDepth;
+    }
+    ~StepReadGuard() { --stepReadDepth; }
+    StepReadGuard(const StepReadGuard&) = delete;
+    StepReadGuard& operator=(const StepReadGuard&) = delete;
 };
 
 class FileSeries final : public MeshSeries {
@@ -98,6 +119,8 @@ public:
     Mesh readStep(std::size_t i) override {
         checkStep(i);
         const FileStep& step = steps_[i];
+        const StepReadGuard guard(path(), step.where);
+        for (std::size_t k = 0; k < step.files.size(); ++k) checkStepFile(step, k);
         if (step.files.size() == 1) return readMesh(step.files[0], options());
         Mesh mesh;
         for (std::size_t k = 0; k < step.files.size(); ++k) {
@@ -109,6 +132,16 @@ public:
     }
 
 private:
+    /// Refuses a step's file that is itself a collection (ParaView's collections hold datasets;
+    /// one naming another, or itself, would recurse without end).
+    void checkStepFile(const FileStep& step, std::size_t k) const {
+        const std::string& file = step.files[k];
+        if (sniffMeshFormat(file) != MeshFormat::Pvd) return;
+        throwError(ErrorKind::Parse, path(),
+                   step.fileWheres[k] + ": the step's file " + file +
+                       " is itself a ParaView collection (.pvd); a collection's DataSets and a "
+                       "series' files must be datasets (.vtu, .pvtu, .vtk, ...), not collections");
+    }
     static std::vector<double> timesOf(const std::vector<FileStep>& steps) {
         std::vector<double> t;
         for (const FileStep& s : steps) t.push_back(s.time);
@@ -157,11 +190,17 @@ void XMLCALL onPvdStart(void* data, const XML_Char* name, const XML_Char** attrs
             return fail(st, std::string("<DataSet timestep=\"") + t + "\">: expected a number");
         time = *v;
     }
+    if (isSeriesPattern(file))
+        return fail(st, std::string("<DataSet file=\"") + file +
+                            "\">: a file series pattern ('*'); a collection's DataSets are "
+                            "single datasets");
     const fs::path source(file);
     FileStep& step = st.steps[time];
     step.time = time;
-    if (step.where.empty()) step.where = atLine(XML_GetCurrentLineNumber(st.parser));
+    const std::string where = atLine(XML_GetCurrentLineNumber(st.parser));
+    if (step.where.empty()) step.where = where;
     step.files.push_back((source.is_absolute() ? source : st.folder / source).string());
+    step.fileWheres.push_back(where);
 }
 
 std::vector<FileStep> readPvd(const std::string& path) {
@@ -189,9 +228,11 @@ std::vector<FileStep> readPvd(const std::string& path) {
         throwError(ErrorKind::Parse, path, "the collection lists no <DataSet file=...>");
     std::vector<FileStep> steps;
     for (auto& [t, s] : st.steps) {
-        for (const std::string& f : s.files)
-            if (fs::path(f) == fs::path(path))
-                throwError(ErrorKind::Parse, path, s.where + ": a DataSet names the .pvd itself");
+        for (std::size_t k = 0; k < s.files.size(); ++k)
+            if (sameFile(s.files[k], path))
+                throwError(
+                    ErrorKind::Parse, path,
+                    s.fileWheres[k] + ": a DataSet names the .pvd itself (" + s.files[k] + ")");
         steps.push_back(std::move(s));
     }
     return steps;
@@ -236,8 +277,8 @@ std::vector<FileStep> globNumbered(const std::string& pattern) {
             throwError(ErrorKind::Argument, pattern,
                        "two files have the number " + std::to_string(found[i].first) + ": " +
                            found[i - 1].second + " and " + found[i].second);
-        steps.push_back(
-            FileStep{static_cast<double>(i), {found[i].second}, "file " + found[i].second});
+        const std::string where = "file " + found[i].second;
+        steps.push_back(FileStep{static_cast<double>(i), {found[i].second}, where, {where}});
     }
     return steps;
 }

@@ -149,5 +149,57 @@ TEST(TimeSeries, BadCollectionsAndPatternsAreClearErrors) {
                 HasSubstr("missing.vtu"));
 }
 
+TEST(TimeSeries, CollectionsNamingCollectionsAreRefusedWhereverTheStepIsRead) {
+    // Two collections naming each other recursed readMesh -> openMeshSeries -> readStep ->
+    // readMesh until the stack overflowed (SIGSEGV), from `uvr info`, `render --time`, Python
+    // and a viewer tab moving to the step alike.
+    namespace fs = std::filesystem;
+    const std::string dir = testing::scratchDir();
+    writeMesh(stepMesh(0), dir + "/a.vtu");
+    auto collection = [&](const std::string& name, const std::vector<std::string>& files) {
+        std::string text = "<VTKFile type=\"Collection\"><Collection>\n";
+        for (std::size_t k = 0; k < files.size(); ++k)
+            text += "<DataSet timestep=\"" + std::to_string(k) + "\" file=\"" + files[k] + "\"/>\n";
+        return testing::writeFile(dir + "/" + name, text + "</Collection></VTKFile>\n");
+    };
+    const std::string a = collection("cycA.pvd", {"cycB.pvd"});
+    collection("cycB.pvd", {"cycA.pvd"});
+    const std::string expected =
+        a + ": line 2: the step's file " + dir + "/cycB.pvd is itself a ParaView collection (.pvd)";
+    EXPECT_THAT(catchError([&] { readMesh(a); }).what(), HasSubstr(expected));
+    EXPECT_EQ(catchError([&] { readMesh(a); }).kind(), ErrorKind::Parse);
+    EXPECT_THAT(catchError([&] { openMeshSeries(a)->readStep(0); }).what(), HasSubstr(expected));
+    // A later step, as a viewer moving between steps reads it, whole or fields only.
+    const std::string later = collection("later.pvd", {"a.vtu", "cycA.pvd"});
+    auto s = openMeshSeries(later);
+    const Mesh first = s->readStep(0);
+    EXPECT_THAT(catchError([&] { s->readStep(1); }).what(),
+                HasSubstr(later + ": line 3: the step's file " + a + " is itself a ParaView"));
+    EXPECT_THAT(catchError([&] { s->readFieldsIfSameGeometry(1, first); }).what(),
+                HasSubstr("is itself a ParaView collection"));
+    // A numbered series of collections.
+    collection("c_1.pvd", {"a.vtu"});
+    EXPECT_THAT(catchError([&] { openMeshSeries(dir + "/c_*.pvd")->readStep(0); }).what(),
+                HasSubstr("file " + dir + "/c_1.pvd: the step's file " + dir +
+                          "/c_1.pvd is itself a ParaView collection"));
+    // Naming itself through './', 'sub/../' (whether sub exists or not) or a hard link.
+    fs::create_directories(dir + "/sub");
+    for (const std::string& self : {"./dot.pvd", "sub/../dot.pvd", "none/../dot.pvd"}) {
+        SCOPED_TRACE(self);
+        const std::string path = collection("dot.pvd", {"a.vtu", self});
+        EXPECT_THAT(catchError([&] { openMeshSeries(path); }).what(),
+                    HasSubstr(path + ": line 3: a DataSet names the .pvd itself"));
+    }
+    const std::string hard = collection("hard.pvd", {"alias.pvd"});
+    fs::create_hard_link(hard, dir + "/alias.pvd");
+    EXPECT_THAT(catchError([&] { readMesh(hard); }).what(),
+                HasSubstr(hard + ": line 2: a DataSet names the .pvd itself"));
+    // A series pattern as a DataSet.
+    const std::string pattern = collection("pattern.pvd", {"run_*.vtu"});
+    EXPECT_THAT(catchError([&] { openMeshSeries(pattern); }).what(),
+                HasSubstr(pattern + ": line 2: <DataSet file=\"run_*.vtu\">: a file series "
+                                    "pattern ('*'); a collection's DataSets are single datasets"));
+}
+
 }  // namespace
 }  // namespace uvr

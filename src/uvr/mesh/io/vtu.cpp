@@ -2,24 +2,30 @@
 #include "uvr/mesh/io/vtu.h"
 
 #include <expat.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <iterator>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string_view>
 #include <type_traits>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/cell_types.h"
 #include "uvr/mesh/io/base64.h"
 #include "uvr/mesh/io/mesh_merge.h"
+#include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/scalar_type.h"
 #include "uvr/mesh/io/vtk_cells.h"
 #include "uvr/mesh/io/vtk_compression.h"
@@ -68,10 +74,11 @@ struct XmlDoc {
     std::vector<PieceDesc> pieces;
     bool hasAppended = false;
     bool appendedBase64 = false;
-    std::uint64_t appendedStart = 0;         // file byte offset just after the '_' marker
-    std::uint64_t appendedEnd = 0;           // file byte offset of </AppendedData>
-    std::uint64_t fileBytes = 0;             // size of the file
-    mutable std::uint64_t decodedBytes = 0;  // binary payload bytes decoded so far, all arrays
+    std::uint64_t appendedStart = 0;  // file byte offset just after the '_' marker
+    std::uint64_t appendedEnd = 0;    // file byte offset of </AppendedData>
+    std::uint64_t fileBytes = 0;      // size of the file
+    /// The appended byte ranges read so far: file offset of the start -> end and the array.
+    mutable std::map<std::uint64_t, std::pair<std::uint64_t, std::string>> appendedReads;
 };
 
 // ---- XML parsing with expat ----
@@ -370,6 +377,24 @@ public:
         out.insert(out.end(), raw_ + pos_, raw_ + pos_ + n);  // n checked against remaining()
         pos_ += n;
     }
+    /// Reads n bytes (checked against remaining()) to dst.
+    void readInto(std::size_t n, unsigned char* dst) {
+        if (!b64_) {
+            std::memcpy(dst, raw_ + pos_, n);
+            pos_ += n;
+            return;
+        }
+        std::vector<unsigned char> chunk;
+        for (std::size_t done = 0; done < n;) {
+            const std::size_t k = std::min<std::size_t>(n - done, std::size_t(1) << 16);
+            chunk.clear();
+            b64_->read(k, chunk);
+            std::memcpy(dst + done, chunk.data(), k);
+            done += k;
+        }
+    }
+    /// True for raw bytes, whose file offsets advance one per byte (base64 text: four per three).
+    bool raw() const { return !b64_; }
     std::uint64_t remaining() const { return b64_ ? b64_->remainingBound() : size_ - pos_; }
     std::uint64_t fileOffset() const { return b64_ ? b64_->fileOffset() : fileBase_ + pos_; }
 
@@ -389,16 +414,66 @@ std::uint64_t loadHeaderInt(const unsigned char* p, std::size_t size, bool bigEn
     return v;
 }
 
+/// An allocator that default-initialises: a buffer sized for what a header declares is not
+/// zero-filled (pages never written are never touched), so only what decompression really
+/// produces occupies memory.
+template <class T>
+struct DefaultInitAllocator : std::allocator<T> {
+    using value_type = T;
+    template <class U>
+    struct rebind {
+        using other = DefaultInitAllocator<U>;
+    };
+    DefaultInitAllocator() = default;
+    template <class U>
+    DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+/// An array's decoded payload bytes.
+using PayloadBytes = std::vector<unsigned char, DefaultInitAllocator<unsigned char>>;
+
 std::string sizeMismatch(const ArrayDesc& a, std::uint64_t values, std::uint64_t expected) {
     return a.label + " holds " + std::to_string(values) + " values, expected " +
            std::to_string(expected);
 }
 
+/// Claims the appended bytes [start, end) for array a before they are decoded: every DataArray
+/// has data of its own (VTK's writers write each once), so bytes that another array already read
+/// are refused, whatever the codec. Data reused by many arrays or Pieces would otherwise be
+/// decoded again and again from one small block, without bound by the file.
+void claimAppended(const XmlDoc& doc, const ArrayDesc& a, std::uint64_t start, std::uint64_t end) {
+    end = std::max(end, start + 1);
+    auto next = doc.appendedReads.lower_bound(end);
+    if (next != doc.appendedReads.begin()) {
+        const auto& [prevStart, prev] = *std::prev(next);
+        if (prev.first > start)
+            throwParseError(doc.file, atByte(start),
+                            a.label + " (appended offset " + std::to_string(a.offset) +
+                                "): its data (file bytes " + std::to_string(start) + " to " +
+                                std::to_string(end) + ") overlap the data of " + prev.second +
+                                " (bytes " + std::to_string(prevStart) + " to " +
+                                std::to_string(prev.first) +
+                                "): each DataArray must have data of its own");
+    }
+    doc.appendedReads.emplace(start, std::pair{end, a.label});
+}
+
 /// Reads an array's binary payload: [nbytes] + data, or, compressed, [nblocks, blockSize,
 /// lastBlockSize, compressed sizes...] + blocks (VTK's layout for zlib, LZ4 and LZMA alike).
-std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, ByteSource& src,
-                                       std::optional<std::uint64_t> expected,
-                                       const ReadOptions& options) {
+/// The sizes the header declares must equal what the DataArray declares (expected values), and
+/// are charged to the budget, before anything is decompressed; appendedStart (the file offset of
+/// appended data) claims the bytes read for this array alone.
+PayloadBytes readPayload(const XmlDoc& doc, const ArrayDesc& a, ByteSource& src,
+                         std::uint64_t expected, std::optional<std::uint64_t> appendedStart,
+                         const ReadOptions& options) {
     const std::size_t hs = doc.headerSize;
     const std::size_t es = scalarSize(*a.type);
     auto fail = [&](const std::string& message) {
@@ -415,19 +490,24 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
             v[i] = loadHeaderInt(raw.data() + i * hs, hs, doc.bigEndian);
         return v;
     };
+    // The declared sizes first: the header's total must be the DataArray's, so a header cannot
+    // make the reader allocate more than the mesh the file declares.
     auto checkTotal = [&](std::uint64_t totalBytes) {
         if (totalBytes % es != 0)
             fail("holds " + std::to_string(totalBytes) + " bytes, not a whole number of " +
                  xmlTypeName(*a.type) + " values");
-        if (expected && totalBytes / es != *expected)
+        if (totalBytes / es != expected)
             throwParseError(doc.file, atByte(src.fileOffset()),
-                            sizeMismatch(a, totalBytes / es, *expected));
+                            sizeMismatch(a, totalBytes / es, expected));
         checkAllocation(doc.file, a.label, totalBytes / es, es, options.maxMemoryBytes);
     };
+    // The bytes this array's data span in the file, claimed before decoding.
+    auto claim = [&](std::uint64_t sourceBytes) {
+        if (!appendedStart) return;
+        const std::uint64_t span = src.raw() ? sourceBytes : sourceBytes / 3 * 4;
+        claimAppended(doc, a, *appendedStart, src.fileOffset() + span);
+    };
 
-    // All payloads of a file together must fit what it can hold at the compressor's maximum
-    // ratio, so data reused by many arrays (or many Pieces) cannot expand without bound; then
-    // the load's memory budget.
     const std::uint64_t maxRatio = maxCompressionRatio(doc.compressor);
     const std::string ratioName = std::string(doc.compressor == VtuCompressor::Lz4    ? "LZ4"
                                               : doc.compressor == VtuCompressor::Lzma ? "LZMA"
@@ -436,27 +516,18 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
     const std::string blockName = doc.compressor == VtuCompressor::Lz4    ? "LZ4 block "
                                   : doc.compressor == VtuCompressor::Lzma ? "LZMA block "
                                                                           : "zlib block ";
-    auto chargeDecoded = [&](std::uint64_t bytes) {
-        const std::uint64_t possible = doc.fileBytes * maxRatio;
-        if (doc.decodedBytes > possible || bytes > possible - doc.decodedBytes)
-            fail(std::to_string(bytes) + " bytes more make " +
-                 std::to_string(doc.decodedBytes + bytes) +
-                 " bytes decoded from the file's arrays, more than its " +
-                 std::to_string(doc.fileBytes) + " bytes can hold at " + ratioName +
-                 " (data reused by many arrays?)");
-        doc.decodedBytes += bytes;
-        options.budget->charge(doc.file, a.label, bytes, 1);
-    };
 
-    std::vector<unsigned char> out;
+    PayloadBytes out;
     if (doc.compressor == VtuCompressor::None) {
         const std::uint64_t nbytes = header(1, "size header")[0];
         checkTotal(nbytes);
         if (nbytes > src.remaining())
             fail("declares " + std::to_string(nbytes) + " bytes, but only " +
                  std::to_string(src.remaining()) + " remain");
-        chargeDecoded(nbytes);
-        src.read(static_cast<std::size_t>(nbytes), out);
+        claim(nbytes);
+        options.budget->charge(doc.file, a.label, nbytes, 1);
+        out.resize(static_cast<std::size_t>(nbytes));
+        src.readInto(static_cast<std::size_t>(nbytes), out.data());
         return out;
     }
     const std::vector<std::uint64_t> h = header(3, "compression header");
@@ -489,8 +560,9 @@ std::vector<unsigned char> readPayload(const XmlDoc& doc, const ArrayDesc& a, By
                  std::to_string(expect) + " bytes the header declares (at most " +
                  std::to_string(sizes[b] * maxRatio) + " at " + ratioName + ")");
     }
-    chargeDecoded(total);
-    out.resize(static_cast<std::size_t>(total));
+    claim(compressedTotal);
+    options.budget->charge(doc.file, a.label, total, 1);
+    out.resize(static_cast<std::size_t>(total));  // not zero-filled: only decoded bytes touch it
     std::vector<unsigned char> block;
     for (std::uint64_t b = 0; b < blocks; ++b) {
         const std::uint64_t expect = (b + 1 == blocks && lastSize != 0) ? lastSize : blockSize;
@@ -571,7 +643,7 @@ std::vector<T> parseAscii(const XmlDoc& doc, const ArrayDesc& a,
 /// Converts raw file values of type S (byte-swapped when swap) to T; float -> integer conversions
 /// outside the int64 range become -1, which index checks reject.
 template <class T, class S>
-std::vector<T> convertValues(const std::vector<unsigned char>& raw, bool swap, const XmlDoc& doc,
+std::vector<T> convertValues(const PayloadBytes& raw, bool swap, const XmlDoc& doc,
                              const ArrayDesc& a, const ReadOptions& options) {
     const std::size_t count = raw.size() / sizeof(S);
     checkAllocation(doc.file, a.label, count, sizeof(T), options.maxMemoryBytes);
@@ -597,12 +669,12 @@ std::vector<T> convertValues(const std::vector<unsigned char>& raw, bool swap, c
 
 template <class T>
 std::vector<T> readArray(const std::vector<char>& bytes, const XmlDoc& doc, const ArrayDesc& a,
-                         std::optional<std::uint64_t> expected, const ReadOptions& options) {
+                         std::uint64_t expected, const ReadOptions& options) {
     if (a.encoding == Encoding::Ascii) return parseAscii<T>(doc, a, expected, options);
-    std::vector<unsigned char> raw;
+    PayloadBytes raw;
     if (a.encoding == Encoding::Binary) {
         ByteSource src(a.text, Base64Origin{doc.file, a.textByte, a.label});
-        raw = readPayload(doc, a, src, expected, options);
+        raw = readPayload(doc, a, src, expected, std::nullopt, options);
     } else {
         if (!doc.hasAppended)
             throwParseError(doc.file, atLine(a.line),
@@ -619,10 +691,10 @@ std::vector<T> readArray(const std::vector<char>& bytes, const XmlDoc& doc, cons
         if (doc.appendedBase64) {
             ByteSource src(std::string_view(bytes.data() + start, n),
                            Base64Origin{doc.file, start, label});
-            raw = readPayload(doc, a, src, expected, options);
+            raw = readPayload(doc, a, src, expected, start, options);
         } else {
             ByteSource src(bytes.data() + start, n, start);
-            raw = readPayload(doc, a, src, expected, options);
+            raw = readPayload(doc, a, src, expected, start, options);
         }
     }
     const bool swap = doc.bigEndian == hostIsLittleEndian();
@@ -650,6 +722,8 @@ std::vector<T> readArray(const std::vector<char>& bytes, const XmlDoc& doc, cons
     }
     return {};
 }
+
+constexpr std::int64_t kVtkPolyhedron = 42;
 
 /// Points, cells (VtkCellArrays convention) and fields of all Pieces, point indices offset.
 struct RawGrid {
@@ -681,8 +755,6 @@ std::unordered_map<std::string, F*> indexFields(std::vector<F>& fields) {
     for (F& f : fields) index.emplace(fieldId(f), &f);
     return index;
 }
-
-constexpr std::int64_t kVtkPolyhedron = 42;
 
 /// Appends a Piece's polyhedron face streams to out.faces and its cells' stream ranges to
 /// out.faceOffsets (padded for the cells of earlier Pieces). VTK 9.1's layout: `faces` holds the
@@ -800,6 +872,19 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
         }
         const std::vector<std::int64_t> types =
             readArray<std::int64_t>(bytes, doc, typeA, p.cells, options);
+        // What the cells can list, before the connectivity is read: a 3D cell (of any order,
+        // or a polyhedron) lists distinct points, so no more than the Piece declares.
+        for (std::size_t c = 0; c < types.size(); ++c) {
+            const std::int64_t nodes = ends[c] - (c == 0 ? 0 : ends[c - 1]);
+            if (types[c] < 0 || types[c] > 255 || static_cast<std::uint64_t>(nodes) <= p.points)
+                continue;
+            const VtkCellTypeInfo info = vtkCellTypeInfo(static_cast<int>(types[c]));
+            if (info.volumetric || types[c] == kVtkPolyhedron)
+                throwParseError(doc.file, atLine(offA.line),
+                                offA.label + ": cell " + std::to_string(c) + " (" + info.name +
+                                    ") lists " + std::to_string(nodes) + " nodes, more than the " +
+                                    std::to_string(p.points) + " points of its Piece");
+        }
         const std::vector<std::int64_t> conn = readArray<std::int64_t>(
             bytes, doc, connA, static_cast<std::uint64_t>(ends.back()), options);
         VtkCellArrays& out = grid.cells;
@@ -875,12 +960,42 @@ void readPiece(const std::vector<char>& bytes, const XmlDoc& doc, std::size_t in
 
 Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allowParallel);
 
+/// Checks before decoding anything that the mesh the file declares fits the budget: every
+/// Piece's points (3 x float), cells (a type and an offset) and field values (float), which
+/// the reader holds all at once before converting the cells. What a file can make the reader
+/// allocate follows from these counts (every array's decoded size must equal its declared size),
+/// not from its size or its codec.
+void checkDeclaredMesh(const XmlDoc& doc, const LoadBudget& budget) {
+    constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+    auto add = [](std::uint64_t& sum, std::uint64_t count, std::uint64_t size) {
+        const std::uint64_t bytes = size != 0 && count > kMax / size ? kMax : count * size;
+        sum = sum > kMax - bytes ? kMax : sum + bytes;
+    };
+    std::uint64_t bytes = 0, points = 0, cells = 0, values = 0;
+    for (const PieceDesc& p : doc.pieces) {
+        add(points, p.points, 1);
+        add(cells, p.cells, 1);
+        for (const ArrayDesc& a : p.arrays)
+            if (a.type && (a.section == Section::PointData || a.section == Section::CellData)) {
+                std::uint64_t n = 0;
+                add(n, a.section == Section::PointData ? p.points : p.cells, a.components);
+                add(values, n, 1);
+            }
+    }
+    add(bytes, points, sizeof(Vec3f));
+    add(bytes, cells, sizeof(std::int32_t) + sizeof(std::int64_t));
+    add(bytes, values, sizeof(float));
+    budget.check(doc.file,
+                 "the mesh it declares (" + std::to_string(points) + " points, " +
+                     std::to_string(cells) + " cells and " + std::to_string(values) +
+                     " field values in " + std::to_string(doc.pieces.size()) + " Pieces)",
+                 bytes, 1);
+}
+
 Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions& options) {
     if (doc.pieces.empty()) throwParseError(path, atByte(0), "expected <Piece Source=...> entries");
     namespace fs = std::filesystem;
     const fs::path folder = fs::path(path).parent_path();
-    std::error_code ec;
-    const fs::path self = fs::weakly_canonical(fs::path(path), ec);
     // Every piece's file, checked before reading any: not the .pvtu itself, and each file once
     // (one piece listed many times would multiply the load).
     std::vector<std::string> piecePaths;
@@ -890,12 +1005,19 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
         const fs::path source = fs::path(p.source);
         piecePaths.push_back((source.is_absolute() ? source : folder / source).string());
         const std::string label = "Piece " + std::to_string(k) + " ('" + p.source + "')";
-        std::error_code ec2;
-        const fs::path canonical = fs::weakly_canonical(fs::path(piecePaths.back()), ec2);
-        if (canonical == self && !ec && !ec2)
+        if (sameFile(piecePaths.back(), path))
             throwParseError(path, atLine(p.line), label + " names the .pvtu file itself");
-        const auto [first, fresh] =
-            firstListing.emplace(ec2 ? piecePaths.back() : canonical.string(), k);
+        // The same file by inode (hard links too), else by canonical path.
+        struct stat info {};
+        std::string key;
+        if (::stat(piecePaths.back().c_str(), &info) == 0) {
+            key = std::to_string(info.st_dev) + ":" + std::to_string(info.st_ino);
+        } else {
+            std::error_code ec;
+            const fs::path canonical = fs::weakly_canonical(fs::path(piecePaths.back()), ec);
+            key = ec ? piecePaths.back() : canonical.string();
+        }
+        const auto [first, fresh] = firstListing.emplace(key, k);
         if (!fresh)
             throwParseError(path, atLine(p.line),
                             label + " is listed twice: Piece " + std::to_string(first->second) +
@@ -909,6 +1031,15 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
         const PieceDesc& p = doc.pieces[k];
         const std::string& piecePath = piecePaths[k];
         const std::string label = "Piece " + std::to_string(k) + " ('" + p.source + "')";
+        // A piece is a dataset: a .pvtu or a .pvd there could recurse (ParaView reads only
+        // UnstructuredGrid pieces).
+        const MeshFormat format = sniffMeshFormat(piecePath);
+        if (format == MeshFormat::Pvtu || format == MeshFormat::Pvd)
+            throwError(ErrorKind::Unsupported, path,
+                       atLine(p.line) + ": " + label + ": " + piecePath + " is " +
+                           (format == MeshFormat::Pvd ? "a ParaView collection (.pvd)"
+                                                      : "a PUnstructuredGrid (.pvtu)") +
+                           "; a .pvtu piece must be an UnstructuredGrid .vtu file");
         Mesh piece = readVtuFile(piecePath, options, false);
         budget.charge(path, label, meshBytes(piece), 1);  // its copy in the merged mesh
 
@@ -939,6 +1070,7 @@ Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allow
     if (doc.pieces.empty())
         throwParseError(path, atByte(0),
                         "expected at least one <Piece NumberOfPoints=... NumberOfCells=...>");
+    checkDeclaredMesh(doc, budget);
     RawGrid grid;
     for (std::size_t k = 0; k < doc.pieces.size(); ++k) readPiece(bytes, doc, k, options, grid);
     Mesh mesh;

@@ -4,6 +4,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -21,6 +23,7 @@
 
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/mesh/io/vtk_compression.h"
 
 namespace uvr {
 namespace {
@@ -178,11 +181,12 @@ TEST(VtuSharedData, FireUgRefusesAnArrayAboveTheMemoryLimit) {
     if (!uvr::testing::haveSharedData()) GTEST_SKIP() << "no shared data";
     const std::string path = uvr::testing::sharedData("fire_ug.vtu");
     ReadOptions options;
-    // The limit bounds the whole load: the file's 631781 bytes fit, its points' 12323 * 3 * 4
-    // decoded bytes on top do not.
+    // The limit bounds the whole load: the file's 631781 bytes fit, the mesh it declares on top
+    // does not (refused before any array is decoded).
     options.maxMemoryBytes = 700000;
     expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
-                {path, "Piece 0: DataArray 'Points' needs 147876 bytes",
+                {path + ": the mesh it declares (12323 points, 10462 cells and 98584 field values "
+                        "in 1 Pieces) needs 667756 bytes",
                  "with the 631781 bytes this load holds so far", "memory limit of 700000"});
     options.maxMemoryBytes = 100000;  // below the file itself: refused before reading it
     expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
@@ -600,7 +604,7 @@ TEST(VtuAmplification, BlockHeadersDeclaringGigabytesAreRefusedBeforeAllocating)
                  "header declares (at most 1032 at deflate's maximum ratio of 1032:1)"});
 }
 
-TEST(VtuAmplification, OneBlockReusedByManyPiecesIsBoundedByTheFileAndTheLimit) {
+TEST(VtuAmplification, OneBlockReusedByManyPiecesIsRefusedBeforeDecodingItAgain) {
     // 40 Pieces of 100000 points each, all reading the same 1.2 MB block of zeros (about 1.2 KB
     // compressed): 48 MB of points from a 9 KB file.
     std::string pieces;
@@ -609,22 +613,174 @@ TEST(VtuAmplification, OneBlockReusedByManyPiecesIsBoundedByTheFileAndTheLimit) 
     ASSERT_LT(text.size(), 12000u);
     const std::string dir = testing::scratchDir();
     const std::string path = testing::writeFile(dir + "/reuse.vtu", text);
-    // Without a limit: what 1032 times the file can hold.
-    expectError(
-        [&] { readVtu(path); }, ErrorKind::Parse,
-        {path + ": byte ", "DataArray 'Points'",
-         "bytes decoded from the file's arrays, more than its " + std::to_string(text.size()) +
-             " bytes can hold at deflate's maximum ratio of 1032:1"});
-    // With a limit: every array fits it, all of them together do not.
+    // Without a limit: the second Piece reading the block is refused before decoding it.
+    const std::uint64_t data = text.find("\n_") + 2;
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": byte " + std::to_string(data) +
+                     ": Piece 1: DataArray 'Points' (appended offset 0): its data (file bytes " +
+                     std::to_string(data) + " to ",
+                 ") overlap the data of Piece 0: DataArray 'Points' (bytes " +
+                     std::to_string(data) + " to ",
+                 "each DataArray must have data of its own"});
+    // With a limit: the mesh the file declares is refused before any array is decoded.
     ReadOptions options;
     options.maxMemoryBytes = 4 << 20;
     expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
-                {path + ": Piece ", "this load holds so far",
-                 "exceed the memory limit of 4194304 bytes (--max-memory)"});
+                {path +
+                 ": the mesh it declares (4000000 points, 0 cells and 0 field values in 40 "
+                 "Pieces) needs 48000000 bytes, which with the " +
+                 std::to_string(text.size()) +
+                 " bytes this load holds so far exceed the "
+                 "memory limit of 4194304 bytes (--max-memory)"});
     // One piece is a legitimate file (its 1.2 MB of zeros compress 1000:1).
     const std::string one = testing::writeFile(
         dir + "/one.vtu", appendedZlibVtu(pointsPiece(100000), zlibZerosPayload(1200000)));
     EXPECT_EQ(readVtu(one).pointCount(), 100000u);
+}
+
+/// What reading a file gave in a child process: the error ("" when it read) and how far the
+/// child's peak resident memory grew meanwhile (getrusage's maxrss, KiB; -1 when it died).
+struct ChildRead {
+    std::string error;
+    long growthKiB = -1;
+};
+
+ChildRead readVtuInChild(const std::string& path) {
+    int fds[2];
+    if (::pipe(fds) != 0) return {};
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::close(fds[0]);
+        rusage before{}, after{};
+        ::getrusage(RUSAGE_SELF, &before);
+        std::string error;
+        try {
+            (void)readVtu(path);
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+        ::getrusage(RUSAGE_SELF, &after);
+        const std::string out = std::to_string(after.ru_maxrss - before.ru_maxrss) + "\n" + error;
+        (void)!::write(fds[1], out.data(), out.size());
+        ::_exit(0);
+    }
+    ::close(fds[1]);
+    std::string text;
+    char buf[4096];
+    for (ssize_t n; (n = ::read(fds[0], buf, sizeof(buf))) > 0;) text.append(buf, std::size_t(n));
+    ::close(fds[0]);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ChildRead r;
+    const std::size_t nl = text.find('\n');
+    if (nl == std::string::npos) return r;
+    r.growthKiB = std::stol(text.substr(0, nl));
+    r.error = text.substr(nl + 1);
+    return r;
+}
+
+/// An xz stream of n zero bytes, as vtkLZMADataCompressor writes a block.
+std::string xzZeros(std::size_t n) {
+    const std::vector<unsigned char> zeros(n, 0);
+    std::vector<unsigned char> out;
+    compressBlock(VtuCompressor::Lzma, 6, zeros.data(), zeros.size(), out, "test");
+    return std::string(out.begin(), out.end());
+}
+
+std::string asLzma(const std::string& zlibVtu) {
+    return replaceOnce(zlibVtu, "vtkZLibDataCompressor", "vtkLZMADataCompressor");
+}
+
+TEST(VtuAmplification, LzmaBlockTableDeclaringGigabytesTouchesOnlyWhatItDecodes) {
+    // 64 LZMA blocks of 32 MiB, each 1024 compressed bytes of garbage (within LZMA's 32768:1):
+    // a 66 KB file declaring 2 GiB of points. The buffer sized from the header was zero-filled
+    // before block 0 was found corrupt (6.3 GB for the 200 KB file).
+    if (!vtuCompressorAvailable(VtuCompressor::Lzma)) GTEST_SKIP() << "built without LZMA";
+    constexpr std::uint32_t kBlocks = 64, kBlock = 33554424, kCompressed = 1024;
+    std::string data = le32(kBlocks) + le32(kBlock) + le32(0);
+    for (std::uint32_t b = 0; b < kBlocks; ++b) data += le32(kCompressed);
+    data += std::string(kBlocks * kCompressed, 'x');
+    const std::uint64_t points = std::uint64_t(kBlocks) * kBlock / 12;
+    const std::string path = testing::writeFile(testing::scratchDir() + "/lying.vtu",
+                                                asLzma(appendedZlibVtu(pointsPiece(points), data)));
+    const ChildRead read = readVtuInChild(path);
+    EXPECT_THAT(read.error, HasSubstr(path + ": byte "));
+    EXPECT_THAT(read.error,
+                HasSubstr("LZMA block 0 of DataArray 'Points' is corrupt (not an xz stream)"));
+    ASSERT_GE(read.growthKiB, 0) << "the reading process died";
+    EXPECT_LT(read.growthKiB, 256 * 1024) << "KiB of resident memory for a 66 KB file";
+}
+
+TEST(VtuAmplification, LzmaBlockReusedByThreeThousandPiecesIsRefused) {
+    // 3,000 Pieces reading one LZMA block of 12 KB of zeros (about 100 bytes of xz): each Piece
+    // decoded it again, bounded only by the file's size times LZMA's 32768:1.
+    if (!vtuCompressorAvailable(VtuCompressor::Lzma)) GTEST_SKIP() << "built without LZMA";
+    const std::string xz = xzZeros(12000);
+    const std::string payload =
+        le32(1) + le32(12000) + le32(12000) + le32(static_cast<std::uint32_t>(xz.size())) + xz;
+    std::string pieces;
+    for (int k = 0; k < 3000; ++k) pieces += pointsPiece(1000);
+    const std::string path = testing::writeFile(testing::scratchDir() + "/lzma_reuse.vtu",
+                                                asLzma(appendedZlibVtu(pieces, payload)));
+    LoadBudget budget;
+    ReadOptions options;
+    options.budget = &budget;
+    expectError([&] { readVtu(path, options); }, ErrorKind::Parse,
+                {path + ": byte ", "Piece 1: DataArray 'Points' (appended offset 0): its data",
+                 "overlap the data of Piece 0: DataArray 'Points'"});
+    EXPECT_LT(budget.peak(), fs::file_size(path) + (1u << 20));
+}
+
+TEST(VtuAmplification, ZlibPiecesReusingBlocksInALargeFileAreRefusedAtTheFirstReuse) {
+    // 40,000 Pieces in a 17 MB file, reading 40 zlib blocks in turn: 1032 times the file's size
+    // (17.5 GB) allowed 19.3 GB of decoding over 240 s before the file was refused.
+    constexpr int kPieces = 40000, kBlocks = 40;
+    std::string data;
+    std::vector<std::size_t> offsets;
+    for (int b = 0; b < kBlocks; ++b) {
+        offsets.push_back(data.size());
+        data += zlibZerosPayload(1200);
+    }
+    std::string pieces;
+    const std::string padding = "<!--" + std::string(260, 'x') + "-->";
+    for (int k = 0; k < kPieces; ++k)
+        pieces += replaceOnce(pointsPiece(100), "offset=\"0\"",
+                              "offset=\"" + std::to_string(offsets[k % kBlocks]) + "\"") +
+                  padding;
+    const std::string text = appendedZlibVtu(pieces, data);
+    ASSERT_GT(text.size(), 16u << 20);
+    const std::string path = testing::writeFile(testing::scratchDir() + "/zlib_reuse.vtu", text);
+    LoadBudget budget;
+    ReadOptions options;
+    options.budget = &budget;
+    expectError([&] { readVtu(path, options); }, ErrorKind::Parse,
+                {path + ": byte ", "Piece 40: DataArray 'Points' (appended offset 0): its data",
+                 "overlap the data of Piece 0: DataArray 'Points'"});
+    EXPECT_LT(budget.peak(), text.size() + (1u << 20));
+    // Under a limit, the 4M points the Pieces declare are refused before any block is decoded.
+    LoadBudget limited(text.size() + (16u << 20));
+    options.budget = &limited;
+    expectError([&] { readVtu(path, options); }, ErrorKind::Resource,
+                {path + ": the mesh it declares (4000000 points, 0 cells and 0 field values in "
+                        "40000 Pieces) needs 48000000 bytes"});
+    EXPECT_EQ(limited.peak(), text.size());
+}
+
+TEST(VtuAmplification, ConnectivityBeyondWhatTheCellsCanListIsRefusedBeforeReadingIt) {
+    // One hexahedron among 8 points whose end offset declares a billion nodes.
+    const std::string text =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
+        "<UnstructuredGrid><Piece NumberOfPoints=\"8\" NumberOfCells=\"1\">\n<Points><DataArray "
+        "type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 1 1 0 0 1 0 0 0 "
+        "1 1 0 1 1 1 1 0 1 1</DataArray></Points>\n<Cells>\n<DataArray type=\"Int64\" "
+        "Name=\"connectivity\" format=\"ascii\">0 1 2 3 4 5 6 7</DataArray>\n<DataArray "
+        "type=\"Int64\" Name=\"offsets\" format=\"ascii\">1000000000</DataArray>\n<DataArray "
+        "type=\"UInt8\" Name=\"types\" format=\"ascii\">12</DataArray>\n</Cells></Piece>"
+        "</UnstructuredGrid>\n</VTKFile>\n";
+    const std::string path = testing::writeFile(testing::scratchDir() + "/conn.vtu", text);
+    expectError([&] { readVtu(path); }, ErrorKind::Parse,
+                {path + ": line 7: Piece 0: DataArray 'offsets': cell 0 (hexahedron) lists "
+                        "1000000000 nodes, more than the 8 points of its Piece"});
 }
 
 TEST(VtuAmplification, PvtuListingAPieceTwiceIsRefusedBeforeReadingIt) {
@@ -648,6 +804,22 @@ TEST(VtuAmplification, PvtuListingAPieceTwiceIsRefusedBeforeReadingIt) {
     const std::string linked = pvtu("linked.pvtu", {"link.vtu", "p.vtu"});
     expectError([&] { readPvtu(linked); }, ErrorKind::Parse,
                 {linked + ": line 6: Piece 1 ('p.vtu') is listed twice"});
+    fs::create_hard_link(dir + "/p.vtu", dir + "/hard.vtu");
+    const std::string hard = pvtu("hard.pvtu", {"p.vtu", "hard.vtu"});
+    expectError([&] { readPvtu(hard); }, ErrorKind::Parse,
+                {hard + ": line 6: Piece 1 ('hard.vtu') is listed twice"});
+    // A piece naming the .pvtu through './', or a collection (which could recurse).
+    const std::string self = pvtu("self.pvtu", {"./self.pvtu"});
+    expectError([&] { readPvtu(self); }, ErrorKind::Parse,
+                {self + ": line 5: Piece 0 ('./self.pvtu') names the .pvtu file itself"});
+    testing::writeFile(dir + "/c.pvd",
+                       "<VTKFile type=\"Collection\"><Collection><DataSet file=\"loop.pvtu\"/>"
+                       "</Collection></VTKFile>\n");
+    const std::string loop = pvtu("loop.pvtu", {"c.pvd"});
+    expectError([&] { readPvtu(loop); }, ErrorKind::Unsupported,
+                {loop + ": line 5: Piece 0 ('c.pvd'): " + dir +
+                 "/c.pvd is a ParaView collection (.pvd); a .pvtu piece must be an "
+                 "UnstructuredGrid .vtu file"});
     const std::vector<std::string> sixty(60, "p.vtu");
     const std::string many = pvtu("many.pvtu", sixty);
     expectError([&] { readPvtu(many); }, ErrorKind::Parse, {many + ": line 6: Piece 1 "});
