@@ -258,6 +258,24 @@ TEST(HostileLibraryFiles, FilesTheLibrariesCrashOnGiveAnError) {
     EXPECT_GE(files, 2u);
 }
 
+TEST(HostileLibraryFiles, TheCliExitsWithTwoWhenALibraryCrashes) {
+    REQUIRE_LIBRARIES();
+    const std::string dir = testing::scratchDir();
+    const std::string folder = std::string(UVR_FUZZ_REGRESSIONS_DIR) + "/netcdf_hdf5/";
+    for (const auto& [name, library] :
+         {std::pair{"crash_global_heap_a.e", "netCDF"}, {"heap_link_table_free.vtkhdf", "HDF5"}}) {
+        SCOPED_TRACE(name);
+        const std::string log = dir + "/info.log";
+        // (The library's SIGSEGV killed uvr: the shell's status 139.)
+        EXPECT_EQ(testing::runCommand(testing::uvrBinary() + " info " + folder + name + " > " +
+                                      log + " 2>&1"),
+                  2);
+        // (signal 11 in a release build; a sanitizer's allocator may end the child itself.)
+        expectIn(testing::readFile(log), "uvr: error: " + folder + name + ": the " + library +
+                                             " library failed on this file (");
+    }
+}
+
 // --- Structure-aware mutation of real files ----------------------------------------------------
 
 /// A mutation of a netCDF or HDF5 file: header words set to telling values (lengths, counts,
