@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "uvr/core/error.h"
@@ -739,6 +740,8 @@ void checkClassicSize(const NcFile& f) {
 /// than it stores (beyond deflate's ratio when compressed): unwritten chunks read as fill values,
 /// so a small file could otherwise declare gigabytes of coordinates or millions of time steps.
 void checkNetcdf4Storage(const NcFile& f, const std::vector<Hdf5DatasetInfo>& datasets) {
+    std::unordered_map<std::string, const Hdf5DatasetInfo*> byName;
+    for (const Hdf5DatasetInfo& d : datasets) byName.emplace(d.name, &d);
     int nvars = 0;
     ncCheck(nc_inq_nvars(f.id(), &nvars), f.path(), "the variables");
     for (int v = 0; v < nvars; ++v) {
@@ -746,9 +749,10 @@ void checkNetcdf4Storage(const NcFile& f, const std::vector<Hdf5DatasetInfo>& da
         ncCheck(nc_inq_varname(f.id(), v, name), f.path(), "a variable's name");
         // netCDF-4 stores a variable as the dataset of its name (prefixed when it would clash
         // with a dimension's).
-        for (const Hdf5DatasetInfo& d : datasets)
-            if (d.name == name || d.name == std::string("_nc4_non_coord_") + name)
-                expectStored(f.path(), std::string("variable ") + name, d);
+        for (const std::string& dataset :
+             {std::string(name), "_nc4_non_coord_" + std::string(name)})
+            if (const auto it = byName.find(dataset); it != byName.end())
+                expectStored(f.path(), std::string("variable ") + name, *it->second);
     }
 }
 
