@@ -7,12 +7,16 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/mesh/io/hdf5_structure.h"
+#include "uvr/mesh/io/isolated_probe.h"
 #include "uvr/mesh/io/load_budget.h"
 
 #ifdef UVR_HAVE_NETCDF
@@ -137,14 +141,14 @@ public:
     }
     /// The count names of a (count, length) char variable, "" for each when it is absent.
     std::vector<std::string> names(const std::string& name, std::size_t count) const {
-        std::vector<std::string> out(count);
         const int v = var(name);
-        if (v < 0 || count == 0) return out;
+        if (v < 0 || count == 0) return std::vector<std::string>(count);
         const std::vector<std::size_t> s = shape(v);
         if (s.size() != 2 || s[0] != count || s[1] > 4096)
             throwError(ErrorKind::Parse, path_,
                        "variable " + name + ": expected " + std::to_string(count) +
                            " names of at most 4096 characters");
+        std::vector<std::string> out(count);
         std::string text(count * s[1], '\0');
         if (!text.empty()) ncCheck(nc_get_var_text(id_, v, text.data()), path_, name);
         for (std::size_t i = 0; i < count; ++i) out[i] = trim(text.substr(i * s[1], s[1]));
@@ -279,9 +283,14 @@ public:
           records_(records) {
         readLayout();
     }
+    ~ExodusSeries() override {
+        const FormatLibraryLock lock;
+        file_.reset();
+    }
 
     Mesh readStep(std::size_t i) override {
         checkStep(i);
+        const FormatLibraryLock lock;
         const BudgetedOptions budgeted(options());
         LoadBudget& budget = budgeted.budget();
         const std::uint64_t heldBefore = budget.used();
@@ -297,6 +306,7 @@ public:
     std::optional<std::vector<Field> > readFieldsIfSameGeometry(std::size_t i,
                                                                 const MeshView& geometry) override {
         checkStep(i);
+        const FormatLibraryLock lock;
         if (geometry.pointCount() != nodes_ || geometry.cellCount() != keptCells_ ||
             geometry.cellIndices.size() != keptIndices_)
             return std::nullopt;
@@ -425,10 +435,25 @@ private:
                            block.type.family);
     }
 
+    /// Error(Parse) when a count dimension (num_nod_var, num_elem_var) declares more variables
+    /// than the file has and no variable of that dimension (holder) stores them: nothing is
+    /// allocated for counts only a header declares.
+    void checkVariableCount(const char* dim, std::size_t count, const char* holder) const {
+        const NcFile& f = *file_;
+        int nvars = 0;
+        ncCheck(nc_inq_nvars(f.id(), &nvars), file(), "the variables");
+        if (count <= static_cast<std::size_t>(std::max(nvars, 0)) || f.var(holder) >= 0) return;
+        throwError(ErrorKind::Parse, file(),
+                   std::string(dim) + " is " + std::to_string(count) + ", but the file has " +
+                       std::to_string(nvars) + " variables and no " + holder +
+                       ": each of its variables needs one");
+    }
+
     void readVariables() {
         const NcFile& f = *file_;
         // Nodal variables: vals_nod_var1..N, or the old combined vals_nod_var (step, var, node).
         const std::size_t nodVars = f.dim("num_nod_var").value_or(0);
+        if (f.var("vals_nod_var") < 0) checkVariableCount("num_nod_var", nodVars, "name_nod_var");
         nodVarNames_ = f.names("name_nod_var", nodVars);
         if (nodVars && records_) {
             combinedNodVar_ = f.var("vals_nod_var");
@@ -460,10 +485,18 @@ private:
         }
         // Element variables: vals_elem_var{v}eb{b} where the truth table elem_var_tab says so.
         const std::size_t elemVars = f.dim("num_elem_var").value_or(0);
+        const int tableVar = f.var("elem_var_tab");
+        if (tableVar < 0) checkVariableCount("num_elem_var", elemVars, "name_elem_var");
         elemVarNames_ = f.names("name_elem_var", elemVars);
         if (!elemVars || !records_ || keptCells_ == 0) return;
+        // Without a stored truth table, every (variable, block) pair is looked up: bounded.
+        if (tableVar < 0 && elemVars * blocks_.size() > (std::size_t{1} << 24))
+            throwError(ErrorKind::Resource, file(),
+                       "num_elem_var (" + std::to_string(elemVars) + ") times num_el_blk (" +
+                           std::to_string(blocks_.size()) +
+                           ") without an elem_var_tab: more than 2^24 variable slots");
         std::vector<int> table;
-        if (const int t = f.var("elem_var_tab"); t >= 0) {
+        if (const int t = tableVar; t >= 0) {
             f.expectShape(t, "elem_var_tab", {blocks_.size(), elemVars},
                           "(num_el_blk, num_elem_var)");
             table.resize(blocks_.size() * elemVars);
@@ -658,16 +691,17 @@ private:
 
 namespace {
 
-/// Error(Parse) when a classic-format file (CDF-1, -2, -5) is shorter than its variables' data:
-/// netCDF reads past the end of a truncated file as fill values without an error.
+/// Error(Parse) naming the variable when a classic-format file (CDF-1, -2, -5) is shorter than
+/// its variables' data (a record variable's is its record size times the records): netCDF reads
+/// past the end as fill values without an error, so a small file could declare gigabytes.
 void checkClassicSize(const NcFile& f) {
     int format = 0;
     ncCheck(nc_inq_format(f.id(), &format), f.path(), "the netCDF format");
     if (format != NC_FORMAT_CLASSIC && format != NC_FORMAT_64BIT_OFFSET && format != NC_FORMAT_CDF5)
-        return;  // HDF5 checks its own
-    int nvars = 0, unlimited = -1;
+        return;  // netCDF-4: checkNetcdf4Storage
+    int nvars = 0;
     ncCheck(nc_inq_nvars(f.id(), &nvars), f.path(), "the variables");
-    ncCheck(nc_inq_unlimdim(f.id(), &unlimited), f.path(), "the record dimension");
+    const std::uint64_t size = fileSize(f.path());
     std::uint64_t needed = 32;  // the smallest header
     for (int v = 0; v < nvars; ++v) {
         nc_type type = NC_NAT;
@@ -684,21 +718,60 @@ void checkClassicSize(const NcFile& f) {
             ncCheck(nc_inq_dimlen(f.id(), d, &len), f.path(), "a dimension's length");
             bytes *= static_cast<long double>(len);
         }
-        needed += static_cast<std::uint64_t>(std::min(bytes, 1e19L));
-        if (needed > (1ull << 62)) break;
+        const long double total = static_cast<long double>(needed) + bytes;
+        if (total > static_cast<long double>(size)) {
+            char name[NC_MAX_NAME + 1] = {};
+            ncCheck(nc_inq_varname(f.id(), v, name), f.path(), "a variable's name");
+            throwError(ErrorKind::Parse, f.path(),
+                       "variable " + std::string(name) + " declares " +
+                           std::to_string(static_cast<unsigned long long>(
+                               std::min(bytes, static_cast<long double>(1e19)))) +
+                           " bytes, which with the variables before it need " +
+                           std::to_string(static_cast<unsigned long long>(
+                               std::min(total, static_cast<long double>(1e19)))) +
+                           " bytes: the file has " + std::to_string(size) +
+                           " (truncated or a lying header)");
+        }
+        needed = static_cast<std::uint64_t>(total);
     }
-    const std::uint64_t size = fileSize(f.path());
-    if (size < needed)
-        throwError(ErrorKind::Parse, f.path(),
-                   "truncated: its variables hold at least " + std::to_string(needed) +
-                       " bytes of data, the file has " + std::to_string(size));
 }
 
-}  // namespace
+/// Error(Parse) naming the variable when a netCDF-4 (HDF5) file declares more of a variable
+/// than it stores (beyond deflate's ratio when compressed): unwritten chunks read as fill values,
+/// so a small file could otherwise declare gigabytes of coordinates or millions of time steps.
+void checkNetcdf4Storage(const NcFile& f, const std::vector<Hdf5DatasetInfo>& datasets) {
+    std::unordered_map<std::string, const Hdf5DatasetInfo*> byName;
+    for (const Hdf5DatasetInfo& d : datasets) byName.emplace(d.name, &d);
+    int nvars = 0;
+    ncCheck(nc_inq_nvars(f.id(), &nvars), f.path(), "the variables");
+    for (int v = 0; v < nvars; ++v) {
+        char name[NC_MAX_NAME + 1] = {};
+        ncCheck(nc_inq_varname(f.id(), v, name), f.path(), "a variable's name");
+        // netCDF-4 stores a variable as the dataset of its name (prefixed when it would clash
+        // with a dimension's).
+        for (const std::string& dataset :
+             {std::string(name), "_nc4_non_coord_" + std::string(name)})
+            if (const auto it = byName.find(dataset); it != byName.end())
+                expectStored(f.path(), std::string("variable ") + name, *it->second);
+    }
+}
 
-std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOptions& options) {
+/// Opens and checks the file, reads its times and layout (the structure pass, also run in the
+/// probe child): every netCDF call the metadata needs, none of the bulk arrays.
+std::unique_ptr<MeshSeries> openExodusHere(const std::string& path, const ReadOptions& options) {
+    checkRegularFile(path);
+    if (!std::filesystem::exists(path))
+        throwError(ErrorKind::Io, path, "cannot open: no such file");
+    // A netCDF-4 file is walked with HDF5 first: external links and storage are refused before
+    // netCDF could follow them, and each dataset's stored bytes bound what it may declare.
+    std::vector<Hdf5DatasetInfo> datasets;
+    char head[8] = {};
+    std::ifstream in(path, std::ios::binary);
+    const bool hdf5 = in.read(head, 8) && std::memcmp(head, "\x89HDF\r\n\x1a\n", 8) == 0;
+    if (hdf5 && hdf5WalkSupported()) datasets = walkHdf5Structure(path);
     auto file = std::make_unique<NcFile>(path);
     checkClassicSize(*file);
+    if (hdf5) checkNetcdf4Storage(*file, datasets);
     // Time steps: time_whole over the time_step records; none is one step at time 0.
     const std::size_t records = file->dim("time_step").value_or(0);
     std::vector<double> times{0.0};
@@ -714,6 +787,22 @@ std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOption
         ncCheck(nc_get_var_double(file->id(), v, times.data()), path, "variable time_whole");
     }
     return std::make_unique<ExodusSeries>(std::move(file), std::move(times), records, options);
+}
+
+}  // namespace
+
+std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOptions& options) {
+    const FormatLibraryLock lock;
+    checkRegularFile(path);
+    std::error_code missing;
+    if (!std::filesystem::exists(path, missing)) return openExodusHere(path, options);  // says so
+    const FileIdentity identity = fileIdentity(path);
+    // netCDF and HDF5 crash or hang on some malformed files: the structure pass runs first in
+    // a child process, and the file is opened here only when it succeeded there.
+    runIsolatedProbe(path, "netCDF", [&] { (void)openExodusHere(path, options); });
+    std::unique_ptr<MeshSeries> series = openExodusHere(path, options);
+    expectSameFile(path, identity);
+    return series;
 }
 
 #endif

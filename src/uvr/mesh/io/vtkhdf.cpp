@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -20,9 +21,10 @@
 #include <hdf5.h>
 
 #include <atomic>
-#include <mutex>
 
 #include "uvr/core/output_file.h"
+#include "uvr/mesh/io/hdf5_structure.h"
+#include "uvr/mesh/io/isolated_probe.h"
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/vtk_cells.h"
 #include "uvr/mesh/validate.h"
@@ -84,22 +86,12 @@ namespace {
 /// The 8 bytes every HDF5 file without a user block starts with.
 constexpr char kHdf5Signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
 
-// Deflate cannot expand data by more than 1032:1; a filtered dataset declaring more than that
-// over its stored bytes is refused before anything is allocated.
-constexpr std::uint64_t kMaxFilterRatio = 1032;
 constexpr std::uint64_t kMaxComponents = 1u << 20;
 constexpr std::size_t kMaxStringAttribute = 4096;
 
 /// Turns off HDF5's printing of its error stack (its failures become uvr::Errors).
 void quietHdf5() {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-}
-
-/// Serialises uvr's calls into HDF5 (several series may be read from several threads; an HDF5
-/// built without its thread-safe option allows one caller at a time).
-std::recursive_mutex& hdf5Mutex() {
-    static std::recursive_mutex mutex;
-    return mutex;
 }
 
 /// The innermost message of HDF5's error stack (what failed at the bottom), then clears it.
@@ -328,7 +320,7 @@ public:
         const long double fileBytes =
             static_cast<long double>(rows) * d.columns() * static_cast<long double>(d.typeBytes);
         const long double stored =
-            static_cast<long double>(d.storageBytes) * (d.filtered ? kMaxFilterRatio : 1);
+            static_cast<long double>(d.storageBytes) * (d.filtered ? kMaxHdf5FilterRatio : 1);
         if (rows > 0 && fileBytes > stored)
             throwParseError(path_, d.name,
                             what + " needs " + std::to_string(rows) + " rows of " +
@@ -514,13 +506,13 @@ public:
           notes_(std::move(notes)) {}
 
     ~VtkHdfSeries() override {
-        const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
+        const FormatLibraryLock lock;
         file_.reset();
     }
 
     Mesh readStep(std::size_t i) override {
         checkStep(i);
-        const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
+        const FormatLibraryLock lock;
         quietHdf5();
         const BudgetedOptions budgeted(options());
         LoadBudget& budget = budgeted.budget();
@@ -548,7 +540,7 @@ public:
     std::optional<std::vector<Field> > readFieldsIfSameGeometry(std::size_t i,
                                                                 const MeshView& geometry) override {
         checkStep(i);
-        const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
+        const FormatLibraryLock lock;
         if (!lastGeometry_) return MeshSeries::readFieldsIfSameGeometry(i, geometry);
         if (!(steps_[i] == *lastGeometry_) || geometry.pointCount() != lastCounts_.first ||
             geometry.cellCount() != lastCounts_.second)
@@ -787,9 +779,9 @@ std::vector<FieldDesc> listFields(const VtkHdfFile& file, std::vector<std::strin
     return fields;
 }
 
-/// The step table of /VTKHDF/Steps, or one step covering the whole file.
-std::unique_ptr<MeshSeries> openSeries(const std::string& path, const ReadOptions& options) {
-    const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
+/// The step table of /VTKHDF/Steps, or one step covering the whole file (the structure pass,
+/// also run in the probe child).
+std::unique_ptr<MeshSeries> openSeriesHere(const std::string& path, const ReadOptions& options) {
     auto file = std::make_unique<VtkHdfFile>(path);
     const BudgetedOptions budgeted(options);
     LoadBudget& budget = budgeted.budget();
@@ -882,6 +874,25 @@ std::unique_ptr<MeshSeries> openSeries(const std::string& path, const ReadOption
     return std::make_unique<VtkHdfSeries>(path, options, std::move(file), std::move(times),
                                           std::move(steps), std::move(fields), std::move(notes),
                                           temporal);
+}
+
+/// openSeriesHere after the same pass succeeded in a probe child, with the file's whole HDF5
+/// structure walked there first (external links, external storage and virtual datasets
+/// refused; every chunk index read).
+std::unique_ptr<MeshSeries> openSeries(const std::string& path, const ReadOptions& options) {
+    const FormatLibraryLock lock;
+    checkRegularFile(path);
+    std::error_code missing;
+    if (!std::filesystem::exists(path, missing)) return openSeriesHere(path, options);  // says so
+    const FileIdentity identity = fileIdentity(path);
+    runIsolatedProbe(path, "HDF5", [&] {
+        quietHdf5();
+        if (H5Fis_hdf5(path.c_str()) > 0) (void)walkHdf5Structure(path);
+        (void)openSeriesHere(path, options);
+    });
+    std::unique_ptr<MeshSeries> series = openSeriesHere(path, options);
+    expectSameFile(path, identity);
+    return series;
 }
 
 /// A name HDF5 can hold as a link ('/' separates groups; "." is the group itself).
@@ -978,12 +989,20 @@ bool looksLikeVtkHdf(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     char head[8] = {};
     if (!in.read(head, sizeof head) || std::memcmp(head, kHdf5Signature, 8) != 0) return false;
-    const std::lock_guard<std::recursive_mutex> lock(hdf5Mutex());
-    quietHdf5();
-    H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-    const bool found = file.get() >= 0 && exists(file.get(), "VTKHDF");
-    H5Eclear2(H5E_DEFAULT);
-    return found;
+    // Asked in a probe child (HDF5 may crash on the file): it answers by an error or none.
+    const FormatLibraryLock lock;
+    try {
+        runIsolatedProbe(path, "HDF5", [&] {
+            quietHdf5();
+            H5Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+            const bool found = file.get() >= 0 && exists(file.get(), "VTKHDF");
+            H5Eclear2(H5E_DEFAULT);
+            if (!found) throwError(ErrorKind::Parse, path, "no /VTKHDF group");
+        });
+        return true;
+    } catch (const Error&) {
+        return false;
+    }
 }
 
 std::unique_ptr<MeshSeries> openVtkHdfSeries(const std::string& path, const ReadOptions& options) {
@@ -1014,7 +1033,7 @@ void writeVtkHdfFile(const Mesh& mesh, const std::string& path,
     };
 
     // The file, in memory: /VTKHDF with Version 2.2 and Type, one partition.
-    std::unique_lock<std::recursive_mutex> lock(hdf5Mutex());
+    std::optional<FormatLibraryLock> lock(std::in_place);
     Hdf5Writer w(path, total + (1u << 16));
     H5Handle root = w.group(w.file(), "VTKHDF");
     {
@@ -1149,7 +1168,7 @@ void writeVtkHdfFile(const Mesh& mesh, const std::string& path,
 
     // The image, written atomically in chunks.
     const std::vector<char> bytes = w.image();
-    lock.unlock();
+    lock.reset();
     writeOutput(path, [&](OutputFile& out) {
         constexpr std::size_t kChunk = 16u << 20;
         for (std::size_t begin = 0; begin < bytes.size(); begin += kChunk) {
