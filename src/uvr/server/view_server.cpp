@@ -60,6 +60,17 @@ constexpr auto kAcceptRetryFirst = std::chrono::milliseconds(10);
 constexpr auto kAcceptRetryMax = std::chrono::milliseconds(1000);
 constexpr auto kAcceptLogInterval = std::chrono::seconds(10);
 
+/// A duration of `s` seconds for timers.
+Clock::duration seconds(double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+std::string fmtSeconds(double s) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", s);
+    return buf;
+}
+
 double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
@@ -293,7 +304,7 @@ namespace {
 class Session : public std::enable_shared_from_this<Session> {
 public:
     Session(ViewServer::Impl& server, tcp::socket&& socket)
-        : server_(server), ws_(std::move(socket)) {}
+        : server_(server), ws_(std::move(socket)), writeTimer_(ws_.get_executor()) {}
 
     // State shared with the render thread, guarded by Impl::m.
     ViewState state;
@@ -640,6 +651,18 @@ private:
     void pump() {
         if (writing_ || outbox_.empty()) return;
         writing_ = true;
+        // A write that waits too long means the tab does not read: close it (a read failing
+        // meanwhile, e.g. on a message too big, waits for this write to send its close frame).
+        writeTimer_.expires_after(seconds(server_.opt.stalledWriteSeconds));
+        writeTimer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+            if (ec || self->closed_ || !self->writing_) return;
+            self->server_.say("view: " + self->peer + " does not read its messages (a write " +
+                              "waited " + fmtSeconds(self->server_.opt.stalledWriteSeconds) +
+                              " s): connection closed");
+            self->closed_ = true;
+            beast::error_code ignored;
+            beast::get_lowest_layer(self->ws_).socket().close(ignored);
+        });
         ws_.binary(outbox_.front().binary);
         ws_.async_write(
             net::buffer(outbox_.front().data),
@@ -648,6 +671,7 @@ private:
 
     void onWrite(beast::error_code ec) {
         writing_ = false;
+        writeTimer_.cancel();
         const bool endsFrame = outbox_.front().endsFrame;
         if (!outbox_.front().binary) queuedTextBytes_ -= outbox_.front().data.size();
         outbox_.pop_front();
@@ -674,7 +698,8 @@ private:
     ViewServer::Impl& server_;
     websocket::stream<beast::tcp_stream> ws_;
     beast::flat_buffer buffer_;
-    std::list<Out> outbox_;  ///< a list: the front being written stays put when others go
+    net::steady_timer writeTimer_;  ///< runs while a write is under way
+    std::list<Out> outbox_;         ///< a list: the front being written stays put when others go
     std::size_t queuedTextBytes_ = 0;
     bool writing_ = false;
     bool closed_ = false;
@@ -705,8 +730,7 @@ private:
         parser_.emplace();
         parser_->header_limit(16 * 1024);
         parser_->body_limit(64 * 1024);
-        stream_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-            std::chrono::duration<double>(server_.opt.idleSeconds)));
+        stream_.expires_after(seconds(server_.opt.idleSeconds));
         http::async_read(
             stream_, buffer_, *parser_,
             [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
@@ -1225,7 +1249,8 @@ void checkServerOptions(const ServerOptions& o, bool tryAddress) {
                            " or more characters from A-Z, a-z, 0-9, _ and -");
     }
     if (o.maxSessions < 1 || o.maxMessagesPerSecond < 1 || o.maxScale < 1 || o.maxConnections < 1 ||
-        o.maxMessageBytes < 1 || o.maxQueuedBytes < 1 || !(o.idleSeconds > 0.0))
+        o.maxMessageBytes < 1 || o.maxQueuedBytes < 1 || !(o.idleSeconds > 0.0) ||
+        !(o.stalledWriteSeconds > 0.0))
         throwError(ErrorKind::Argument, "", "server limits must be positive");
     hostAddress(o);
     if (tryAddress) {

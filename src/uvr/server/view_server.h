@@ -34,6 +34,8 @@ struct ServerOptions {
     std::size_t maxQueuedBytes = 8u << 20;
     /// An HTTP connection waiting this long for a request (idle, without a token too) is closed.
     double idleSeconds = 30.0;
+    /// A WebSocket connection whose write has waited this long (the tab does not read) is closed.
+    double stalledWriteSeconds = 30.0;
     double targetFrameMs = 30.0;  ///< reduced-resolution frames aim at this render time
     int refineDelayMs = 150;      ///< full resolution once the state has been still this long
     int maxScale = 8;             ///< coarsest reduced resolution: 1/maxScale of each side
