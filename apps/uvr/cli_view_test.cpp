@@ -31,6 +31,11 @@ TEST(CliView, BadServerFlagsAndABusyPortFailBeforeTheMeshIsRead) {
     expectOneLineError(view("--host not-an-address"), {"--host not-an-address"}, "--host");
     expectOneLineError(view("--port 70000"), {"--port"}, "--port");
     expectOneLineError(view("--tf nosuch"), {"nosuch"}, "--tf");
+    // Issue 28: the page's own limit on a side (4096), not render's 16384.
+    expectOneLineError(view("--size 8192x8192"), {"--size '8192x8192'", "from 16 to 4096"},
+                       "--size over the page's limit");
+    expectOneLineError(view("--size 4097x100"), {"--size", "4096"}, "--size 4097");
+    expectOneLineError(view("--size 8x8"), {"--size", "from 16"}, "--size under");
     // A port another program listens on.
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     ASSERT_GE(fd, 0);

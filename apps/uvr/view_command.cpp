@@ -81,6 +81,15 @@ void addViewCommand(CLI::App& app, Context& ctx) {
 #else
         applyThreads(flags->threads);
         flags->checkBeforeLoading(*file);
+        // The page's own limits on a side (one definition, the server's), before any reading.
+        if (const auto [w, h] = parseSize("--size", flags->size);
+            w < server::kMinViewSize || h < server::kMinViewSize || w > server::kMaxViewSize ||
+            h > server::kMaxViewSize)
+            throwError(ErrorKind::Argument, "",
+                       "--size '" + flags->size + "': the viewer's sides are from " +
+                           std::to_string(server::kMinViewSize) + " to " +
+                           std::to_string(server::kMaxViewSize) +
+                           " pixels (uvr render draws larger images)");
         server::ServerOptions so;
         so.host = options->first;
         so.port = static_cast<std::uint16_t>(options->second);

@@ -35,6 +35,16 @@ bool isValidUtf8(std::string_view text);
 /// UTF-8 formats use it to refuse such files with a clear message.
 const char* wideTextEncoding(const void* data, std::size_t size);
 
+/// Deepest nesting of JSON arrays and objects that uvr parses (a ParaView colour map nests 3
+/// levels, a viewer message 4): deeper text is refused before a parser sees it.
+inline constexpr int kMaxJsonDepth = 64;
+
+/// Byte offset of the first '[' or '{' of a JSON text that opens a level deeper than maxDepth
+/// (brackets inside strings do not count), or std::string_view::npos when none does. A linear
+/// scan without recursion, run before parsing so that neither the parser nor a later copy or
+/// dump of the value recurses deeper than maxDepth.
+std::size_t jsonTooDeepAt(std::string_view text, int maxDepth = kMaxJsonDepth);
+
 /// Edit distance (insertions, deletions, substitutions of bytes) between two words.
 int editDistance(std::string_view a, std::string_view b);
 

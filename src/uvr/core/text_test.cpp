@@ -43,6 +43,15 @@ TEST(Text, PrintableShortCutsOnACharacterBoundary) {
     EXPECT_LE(cut.size(), 12u);
 }
 
+TEST(Text, JsonTooDeepAtFindsTheFirstBracketPastTheLimit) {
+    EXPECT_EQ(jsonTooDeepAt(R"({"a": [[1], {"b": 2}]})", 3), std::string_view::npos);
+    EXPECT_EQ(jsonTooDeepAt(R"({"a": [[1], {"b": 2}]})", 2), 7u);
+    EXPECT_EQ(jsonTooDeepAt(R"(["[[[[", "\"[[[["])", 1), std::string_view::npos);  // in strings
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    EXPECT_EQ(jsonTooDeepAt(deep), std::size_t(kMaxJsonDepth));
+    EXPECT_EQ(jsonTooDeepAt(deep, 100000), std::string_view::npos);
+}
+
 TEST(Text, IsValidUtf8) {
     EXPECT_TRUE(isValidUtf8(""));
     EXPECT_TRUE(isValidUtf8("plain \xE2\x82\xAC"));

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/server/view_server.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -16,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <list>
 #include <map>
 #include <mutex>
 #include <random>
@@ -46,8 +49,27 @@ using Clock = std::chrono::steady_clock;
 constexpr int kHistogramBins = 256;
 /// Messages waiting to be written to one connection before it counts as not reading.
 constexpr std::size_t kMaxOutbox = 256;
-/// How long an HTTP request may take to arrive.
-constexpr auto kHttpTimeout = std::chrono::seconds(30);
+/// Longest error message sent to a page (a message quoting a client's value is cut).
+constexpr std::size_t kMaxErrorBytes = 512;
+/// Descriptors kept free of connections below the process's limit (files of time steps, the
+/// log, the render thread's needs).
+constexpr int kReservedDescriptors = 32;
+/// The first and longest wait before accepting again after accept failed (EMFILE: no
+/// descriptor left), and the least time between two log lines about it.
+constexpr auto kAcceptRetryFirst = std::chrono::milliseconds(10);
+constexpr auto kAcceptRetryMax = std::chrono::milliseconds(1000);
+constexpr auto kAcceptLogInterval = std::chrono::seconds(10);
+
+/// A duration of `s` seconds for timers.
+Clock::duration seconds(double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+std::string fmtSeconds(double s) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", s);
+    return buf;
+}
 
 double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
@@ -196,6 +218,7 @@ struct FieldEntry {
 };
 
 class Session;
+class HttpConnection;
 
 }  // namespace
 
@@ -208,6 +231,14 @@ struct ViewServer::Impl {
 
     net::io_context ioc{1};
     tcp::acceptor acceptor{ioc};
+    // Network thread only: the HTTP connections (oldest first), the connection cap in force,
+    // and the accept loop's backoff after failures.
+    std::deque<std::weak_ptr<HttpConnection>> httpConnections;
+    int connectionCap = 0;
+    net::steady_timer acceptRetry{ioc};
+    std::chrono::milliseconds acceptDelay{0};
+    std::uint64_t acceptFailures = 0;
+    Clock::time_point lastAcceptLog{};
     std::optional<net::signal_set> signals;
     std::thread ioThread, renderThread;
     std::uint16_t boundPort = 0;
@@ -246,9 +277,18 @@ struct ViewServer::Impl {
     /// returns the field's entry (render thread). `progress` reports the preparation's steps.
     FieldEntry field(const std::string& spec, std::size_t step, const ProgressFn& progress);
     void acceptLoop();
+    /// Handles a failed accept: closes the oldest HTTP connection when descriptors ran out, and
+    /// accepts again after a delay that doubles with each failure in a row (up to
+    /// kAcceptRetryMax), saying so in the log at most every kAcceptLogInterval.
+    void acceptFailed(const beast::error_code& ec);
+    /// Takes a new TCP connection: over the cap, closes the oldest HTTP connection to make room,
+    /// or the new one when all are WebSockets (network thread).
+    void admitConnection(tcp::socket socket);
+    /// Closes the oldest live HTTP connection (network thread); false when there is none.
+    bool closeOldestHttp();
     void renderLoop();
-    /// Sends a text message to every connection (any thread).
-    void broadcast(const std::string& text);
+    /// Sends a text message to every connection (any thread); `supersedes` as Session::sendText.
+    void broadcast(const std::string& text, std::string_view supersedes = {});
     /// Prepares the starting field before the first frame when the scene came without a
     /// renderer (render thread): every connection sees the steps as `progress` and the result
     /// as `prepared`, and later connections get it in `info`.
@@ -264,7 +304,7 @@ namespace {
 class Session : public std::enable_shared_from_this<Session> {
 public:
     Session(ViewServer::Impl& server, tcp::socket&& socket)
-        : server_(server), ws_(std::move(socket)) {}
+        : server_(server), ws_(std::move(socket)), writeTimer_(ws_.get_executor()) {}
 
     // State shared with the render thread, guarded by Impl::m.
     ViewState state;
@@ -287,8 +327,12 @@ public:
                          [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
     }
 
-    /// Queues a text message (network thread).
-    void sendText(std::string text) { queue(false, std::move(text), false); }
+    /// Queues a text message (network thread). With `supersedes` (its type: "state", "export",
+    /// "histogram", "progress"), it replaces a message of that type still waiting: a tab that
+    /// reads slowly gets the newest of each, not every one.
+    void sendText(std::string text, std::string_view supersedes = {}) {
+        queue(false, std::move(text), false, supersedes);
+    }
     /// Queues a frame's description and image; the frame ends when its image is written
     /// (network thread).
     void sendImage(std::string meta, std::string bytes) {
@@ -305,9 +349,12 @@ public:
         socket.close(ignored);
     }
 
+    /// Queues an `error` answering `request`, its message cut to kMaxErrorBytes.
     void sendError(const std::string& message, const std::string& request) {
-        sendText(Json{{"type", "error"}, {"message", message}, {"request", request}}.dump(
-            -1, ' ', false, Json::error_handler_t::replace));
+        sendText(Json{{"type", "error"},
+                      {"message", printableShort(message, kMaxErrorBytes)},
+                      {"request", request}}
+                     .dump(-1, ' ', false, Json::error_handler_t::replace));
     }
 
 private:
@@ -315,6 +362,7 @@ private:
         bool binary;
         std::string data;
         bool endsFrame;
+        std::string_view kind;  ///< the type a newer message replaces it for, or empty
     };
 
     void onAccept(beast::error_code ec) {
@@ -419,6 +467,12 @@ private:
         Json msg;
         std::string type;
         try {
+            // Nesting is bounded before parsing: nothing below (a copy, a description in an
+            // error) then recurses deeper than kMaxJsonDepth.
+            if (const std::size_t at = jsonTooDeepAt(text); at != std::string_view::npos)
+                throwError(ErrorKind::Argument, "",
+                           "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                               " levels (at byte " + std::to_string(at) + ")");
             msg = Json::parse(text);
             if (!msg.is_object() || !msg.contains("type") || !msg["type"].is_string())
                 throwError(ErrorKind::Argument, "",
@@ -433,7 +487,7 @@ private:
             else if (type == "export")
                 onExport();
             else if (type == "ping")
-                sendText(Json{{"type", "pong"}, {"seq", msg.value("seq", Json())}}.dump());
+                onPing(msg);
             else
                 throwError(ErrorKind::Argument, "",
                            "unknown message type \"" + printableShort(type, 40) +
@@ -450,8 +504,12 @@ private:
     /// Answers a refused request: the error (with the request's seq, when it had one) and, for a
     /// state change, the state as it stays, so that the page can show it again.
     void refused(const std::string& message, const std::string& type, const Json& msg) {
-        Json e = {{"type", "error"}, {"message", message}, {"request", type}};
-        if (msg.is_object() && msg.contains("seq")) e["seq"] = msg["seq"];
+        Json e = {{"type", "error"},
+                  {"message", printableShort(message, kMaxErrorBytes)},
+                  {"request", printableShort(type, 40)}};
+        if (msg.is_object())
+            if (auto it = msg.find("seq"); it != msg.end() && it->is_number_unsigned())
+                e["seq"] = *it;
         sendText(e.dump(-1, ' ', false, Json::error_handler_t::replace));
         if (type == "set" || type == "reset_camera") sendState();
     }
@@ -515,6 +573,16 @@ private:
         sendState();
     }
 
+    void onPing(const Json& msg) {
+        Json seqValue;
+        if (auto it = msg.find("seq"); it != msg.end()) {
+            if (!it->is_number_unsigned())
+                throwError(ErrorKind::Argument, "", "\"seq\": expected a non-negative integer");
+            seqValue = *it;
+        }
+        sendText(Json{{"type", "pong"}, {"seq", seqValue}}.dump());
+    }
+
     void onSnapshot() {
         {
             std::lock_guard lk(server_.m);
@@ -529,7 +597,8 @@ private:
             std::lock_guard lk(server_.m);
             s = state;
         }
-        sendText(server_.exportMessage(s).dump(-1, ' ', false, Json::error_handler_t::replace));
+        sendText(server_.exportMessage(s).dump(-1, ' ', false, Json::error_handler_t::replace),
+                 "export");
     }
 
     void sendState() {
@@ -538,28 +607,62 @@ private:
             std::lock_guard lk(server_.m);
             j = {{"type", "state"}, {"state", toJson(state)}};
         }
-        sendText(j.dump(-1, ' ', false, Json::error_handler_t::replace));
+        sendText(j.dump(-1, ' ', false, Json::error_handler_t::replace), "state");
     }
 
-    void queue(bool binary, std::string data, bool endsFrame) {
+    /// Queues a message: at most kMaxOutbox messages and opt.maxQueuedBytes of text wait (a
+    /// tab has at most one frame's image queued: the render thread waits for it to be sent);
+    /// past either the connection counts as not reading and is closed. The first message of
+    /// an empty queue always goes.
+    void queue(bool binary, std::string data, bool endsFrame, std::string_view kind = {}) {
         if (closed_) {
             if (endsFrame) frameDone();
             return;
         }
-        if (outbox_.size() >= kMaxOutbox) {
-            server_.say("view: " + peer + " does not read its messages: connection closed");
+        if (!kind.empty()) {
+            // The message being written (the front, while writing_) stays.
+            auto it = outbox_.begin();
+            if (writing_ && it != outbox_.end()) ++it;
+            for (; it != outbox_.end(); ++it)
+                if (it->kind == kind) {
+                    queuedTextBytes_ -= it->binary ? 0 : it->data.size();
+                    outbox_.erase(it);
+                    break;
+                }
+        }
+        const std::size_t textBytes = binary ? 0 : data.size();
+        if (!outbox_.empty() && (outbox_.size() >= kMaxOutbox ||
+                                 queuedTextBytes_ + textBytes > server_.opt.maxQueuedBytes)) {
+            server_.say("view: " + peer + " does not read its messages (" +
+                        std::to_string(outbox_.size()) + " waiting, " +
+                        std::to_string(queuedTextBytes_ + textBytes) +
+                        " bytes of text): connection closed");
             closed_ = true;
-            beast::get_lowest_layer(ws_).socket().close();
+            beast::error_code ignored;
+            beast::get_lowest_layer(ws_).socket().close(ignored);
             if (endsFrame) frameDone();
             return;
         }
-        outbox_.push_back({binary, std::move(data), endsFrame});
+        queuedTextBytes_ += textBytes;
+        outbox_.push_back({binary, std::move(data), endsFrame, kind});
         pump();
     }
 
     void pump() {
         if (writing_ || outbox_.empty()) return;
         writing_ = true;
+        // A write that waits too long means the tab does not read: close it (a read failing
+        // meanwhile, e.g. on a message too big, waits for this write to send its close frame).
+        writeTimer_.expires_after(seconds(server_.opt.stalledWriteSeconds));
+        writeTimer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+            if (ec || self->closed_ || !self->writing_) return;
+            self->server_.say("view: " + self->peer + " does not read its messages (a write " +
+                              "waited " + fmtSeconds(self->server_.opt.stalledWriteSeconds) +
+                              " s): connection closed");
+            self->closed_ = true;
+            beast::error_code ignored;
+            beast::get_lowest_layer(self->ws_).socket().close(ignored);
+        });
         ws_.binary(outbox_.front().binary);
         ws_.async_write(
             net::buffer(outbox_.front().data),
@@ -568,7 +671,9 @@ private:
 
     void onWrite(beast::error_code ec) {
         writing_ = false;
+        writeTimer_.cancel();
         const bool endsFrame = outbox_.front().endsFrame;
+        if (!outbox_.front().binary) queuedTextBytes_ -= outbox_.front().data.size();
         outbox_.pop_front();
         if (endsFrame) frameDone();
         if (ec) {
@@ -576,6 +681,7 @@ private:
             for (const Out& o : outbox_)
                 if (o.endsFrame) frameDone();
             outbox_.clear();
+            queuedTextBytes_ = 0;
             return;
         }
         pump();
@@ -592,7 +698,9 @@ private:
     ViewServer::Impl& server_;
     websocket::stream<beast::tcp_stream> ws_;
     beast::flat_buffer buffer_;
-    std::deque<Out> outbox_;
+    net::steady_timer writeTimer_;  ///< runs while a write is under way
+    std::list<Out> outbox_;         ///< a list: the front being written stays put when others go
+    std::size_t queuedTextBytes_ = 0;
     bool writing_ = false;
     bool closed_ = false;
     double tokens_ = 1e9;  // capped at the rate on first use
@@ -610,12 +718,19 @@ public:
 
     void start() { doRead(); }
 
+    /// Ends the connection (to make room for a new one; network thread).
+    void close() {
+        beast::error_code ignored;
+        stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
+        stream_.close();
+    }
+
 private:
     void doRead() {
         parser_.emplace();
         parser_->header_limit(16 * 1024);
         parser_->body_limit(64 * 1024);
-        stream_.expires_after(kHttpTimeout);
+        stream_.expires_after(seconds(server_.opt.idleSeconds));
         http::async_read(
             stream_, buffer_, *parser_,
             [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
@@ -765,7 +880,9 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
         std::snprintf(line, sizeof line, "view: prepared %s in %.2f s", values.describe().c_str(),
                       secondsSince(start));
     } else {
-        // The same mesh: only the values and what depends on them change.
+        // The same mesh: only the values and what depends on them change. Until that is done
+        // the renderer holds no field known by key (a failure leaves it to be set again).
+        rendererKey.clear();
         renderer->setFieldValues(values);
         std::snprintf(line, sizeof line, "view: switched to %s in %.3f s (no geometry rebuilt)",
                       values.describe().c_str(), secondsSince(start));
@@ -804,15 +921,15 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
             {"command", command}};
 }
 
-void ViewServer::Impl::broadcast(const std::string& text) {
-    net::post(ioc, [this, text] {
+void ViewServer::Impl::broadcast(const std::string& text, std::string_view supersedes) {
+    net::post(ioc, [this, text, supersedes] {
         std::vector<std::shared_ptr<Session>> live;
         {
             std::lock_guard lk(m);
             for (const auto& w : sessions)
                 if (auto s = w.lock()) live.push_back(std::move(s));
         }
-        for (const auto& s : live) s->sendText(text);
+        for (const auto& s : live) s->sendText(text, supersedes);
     });
 }
 
@@ -821,13 +938,15 @@ void ViewServer::Impl::prepareAtStart() {
     const auto start = Clock::now();
     try {
         field(scene.initial.field, scene.initial.step,
-              progressMessages([this](const std::string& text) { broadcast(text); },
+              progressMessages([this](const std::string& text) { broadcast(text, "progress"); },
                                [this](const std::string& phase) { say("view: " + phase); }));
     } catch (const std::exception& e) {
         // Said to the log and the page; the first frame tries again and answers with the error.
         say(std::string("view: preparation failed: ") + e.what());
-        broadcast(Json{{"type", "error"}, {"message", e.what()}, {"request", "prepare"}}.dump(
-            -1, ' ', false, Json::error_handler_t::replace));
+        broadcast(Json{{"type", "error"},
+                       {"message", printableShort(e.what(), kMaxErrorBytes)},
+                       {"request", "prepare"}}
+                      .dump(-1, ' ', false, Json::error_handler_t::replace));
         return;
     }
     Json prepared = {{"type", "prepared"},
@@ -912,7 +1031,7 @@ void ViewServer::Impl::renderLoop() {
             const std::string key = fieldKey(state.field, state.step);
             const FieldEntry entry =
                 field(state.field, state.step, progressMessages([&](const std::string& text) {
-                          post([text](Session& c) { c.sendText(text); });
+                          post([text](Session& c) { c.sendText(text, "progress"); });
                       }));
             if (resetRange) {
                 state.range = entry.range;
@@ -931,8 +1050,8 @@ void ViewServer::Impl::renderLoop() {
                 h["field"] = state.field;
                 Json st = {{"type", "state"}, {"state", toJson(state)}};
                 post([h = h.dump(), st = st.dump()](Session& c) {
-                    c.sendText(h);
-                    c.sendText(st);
+                    c.sendText(h, "histogram");
+                    c.sendText(st, "state");
                 });
             }
             const RenderSettings settings =
@@ -995,9 +1114,14 @@ void ViewServer::Impl::renderLoop() {
             });
             sent = true;
         } catch (const std::exception& e) {
-            const std::string message = e.what();
+            // A step or field that fails to read (uvr::Error, bad_alloc, anything): this tab
+            // hears why, the server goes on serving it and the others.
+            const std::string message = printableShort(e.what(), kMaxErrorBytes);
             say("view: frame failed: " + message);
             post([message](Session& c) { c.sendError(message, "frame"); });
+        } catch (...) {
+            say("view: frame failed: unknown exception");
+            post([](Session& c) { c.sendError("failed (unknown exception)", "frame"); });
         }
         lk.lock();
         if (!sent) s->inFlight = false;
@@ -1008,18 +1132,69 @@ void ViewServer::Impl::renderLoop() {
 }
 
 void ViewServer::Impl::acceptLoop() {
+    if (!acceptor.is_open()) return;
     acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
-        if (ec) {
-            if (ec == net::error::operation_aborted) return;
-            say("view: accept failed: " + ec.message());
-        } else {
-            // Frames go out as two messages (description, image): no Nagle delay between them.
-            beast::error_code ignored;
-            socket.set_option(tcp::no_delay(true), ignored);
-            std::make_shared<HttpConnection>(*this, std::move(socket))->start();
-        }
+        if (ec == net::error::operation_aborted || !acceptor.is_open()) return;
+        if (ec) return acceptFailed(ec);
+        acceptDelay = std::chrono::milliseconds(0);
+        admitConnection(std::move(socket));
         acceptLoop();
     });
+}
+
+void ViewServer::Impl::acceptFailed(const beast::error_code& ec) {
+    // Retrying at once would spin: a descriptor frees only when a connection ends.
+    ++acceptFailures;
+    acceptDelay =
+        acceptDelay.count() == 0 ? kAcceptRetryFirst : std::min(acceptDelay * 2, kAcceptRetryMax);
+    const bool noDescriptor = ec.value() == EMFILE || ec.value() == ENFILE;
+    const bool freed = noDescriptor && closeOldestHttp();
+    const auto now = Clock::now();
+    if (now - lastAcceptLog >= kAcceptLogInterval) {
+        lastAcceptLog = now;
+        say("view: accept failed (" + ec.message() + "; " + std::to_string(acceptFailures) +
+            " failure(s) so far): " + (freed ? "closed the oldest page connection, " : "") +
+            "retrying in " + std::to_string(acceptDelay.count()) + " ms");
+    }
+    acceptRetry.expires_after(acceptDelay);
+    acceptRetry.async_wait([this](beast::error_code wait) {
+        if (!wait) acceptLoop();
+    });
+}
+
+bool ViewServer::Impl::closeOldestHttp() {
+    while (!httpConnections.empty()) {
+        auto c = httpConnections.front().lock();
+        httpConnections.pop_front();
+        if (c) {
+            c->close();
+            return true;
+        }
+    }
+    return false;
+}
+
+void ViewServer::Impl::admitConnection(tcp::socket socket) {
+    httpConnections.erase(std::remove_if(httpConnections.begin(), httpConnections.end(),
+                                         [](const auto& w) { return w.expired(); }),
+                          httpConnections.end());
+    std::size_t sessionCount = 0;
+    {
+        std::lock_guard lk(m);
+        for (const auto& w : sessions) sessionCount += !w.expired();
+    }
+    if (httpConnections.size() + sessionCount >= static_cast<std::size_t>(connectionCap) &&
+        !closeOldestHttp()) {
+        beast::error_code ignored;
+        socket.close(ignored);  // every place is a WebSocket: the newcomer waits its turn
+        return;
+    }
+    // Frames go out as two messages (description, image): no Nagle delay between them.
+    beast::error_code ignored;
+    socket.set_option(tcp::no_delay(true), ignored);
+    auto c = std::make_shared<HttpConnection>(*this, std::move(socket));
+    httpConnections.push_back(c);
+    c->start();
 }
 
 void ViewServer::Impl::requestStop() {
@@ -1073,7 +1248,9 @@ void checkServerOptions(const ServerOptions& o, bool tryAddress) {
                        "--token: expected " + std::to_string(kMinTokenLength) +
                            " or more characters from A-Z, a-z, 0-9, _ and -");
     }
-    if (o.maxSessions < 1 || o.maxMessagesPerSecond < 1 || o.maxScale < 1)
+    if (o.maxSessions < 1 || o.maxMessagesPerSecond < 1 || o.maxScale < 1 || o.maxConnections < 1 ||
+        o.maxMessageBytes < 1 || o.maxQueuedBytes < 1 || !(o.idleSeconds > 0.0) ||
+        !(o.stalledWriteSeconds > 0.0))
         throwError(ErrorKind::Argument, "", "server limits must be positive");
     hostAddress(o);
     if (tryAddress) {
@@ -1116,6 +1293,14 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     // Unknown (null) until the server's own preparation is done (prepareAtStart).
     Json tets = nullptr, renderedCells = nullptr, prepareSeconds = nullptr;
     std::string device = resolvesToCuda(d.scene.rendererOptions.device) ? "cuda" : "cpu";
+    const ViewState& first = d.scene.initial;
+    if (first.width < kMinViewSize || first.height < kMinViewSize || first.width > kMaxViewSize ||
+        first.height > kMaxViewSize)
+        throwError(ErrorKind::Argument, "",
+                   "image size " + std::to_string(first.width) + "x" +
+                       std::to_string(first.height) + ": the viewer's sides are from " +
+                       std::to_string(kMinViewSize) + " to " + std::to_string(kMaxViewSize) +
+                       " pixels");
     d.meshStep = d.scene.initial.step;
     if (d.meshStep >= d.stepCount())
         throwError(
@@ -1155,7 +1340,8 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                    {{"max_message_bytes", d.opt.maxMessageBytes},
                     {"max_messages_per_second", d.opt.maxMessagesPerSecond},
                     {"min_size", kMinViewSize},
-                    {"max_size", kMaxViewSize}}}};
+                    {"max_size", kMaxViewSize},
+                    {"max_tf_points", kMaxTfPoints}}}};
 }
 
 ViewServer::~ViewServer() {
@@ -1171,6 +1357,14 @@ void ViewServer::start() {
     if (d.started) return;
     bindTo(d.acceptor, d.opt, true);
     d.boundPort = d.acceptor.local_endpoint().port();
+    // Connections stay below the descriptor limit, so that accept rarely finds none left.
+    d.connectionCap = d.opt.maxConnections;
+    rlimit files{};
+    if (getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur != RLIM_INFINITY)
+        d.connectionCap = static_cast<int>(std::max<rlim_t>(
+            1, std::min<rlim_t>(d.connectionCap, files.rlim_cur > kReservedDescriptors
+                                                     ? files.rlim_cur - kReservedDescriptors
+                                                     : 1)));
     d.acceptLoop();
     d.started = true;
     d.ioThread = std::thread([&d] { d.ioc.run(); });
@@ -1218,6 +1412,7 @@ void ViewServer::run(bool handleSignals) {
     net::post(d.ioc, [&d] {
         beast::error_code ignored;
         d.acceptor.close(ignored);
+        d.acceptRetry.cancel();
         if (d.signals) d.signals->cancel(ignored);
         std::lock_guard lk(d.m);
         for (const auto& w : d.sessions)

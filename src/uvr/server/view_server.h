@@ -25,10 +25,21 @@ struct ServerOptions {
     std::size_t maxMessageBytes = 4u << 20;  ///< larger WebSocket messages close the connection
     int maxMessagesPerSecond = 200;          ///< per connection; more are dropped with an error
     int maxSessions = 32;                    ///< WebSocket connections at once
-    double targetFrameMs = 30.0;             ///< reduced-resolution frames aim at this render time
-    int refineDelayMs = 150;  ///< full resolution once the state has been still this long
-    int maxScale = 8;         ///< coarsest reduced resolution: 1/maxScale of each side
-    int jpegQuality = 80;     ///< of reduced-resolution frames
+    /// TCP connections at once (page requests and WebSockets, with or without a token; fewer
+    /// when the descriptor limit is lower): one more closes the oldest that has not become a
+    /// WebSocket, or is closed itself.
+    int maxConnections = 128;
+    /// Text bytes waiting to be sent to one WebSocket connection (beyond at most one frame):
+    /// a connection that does not read past this is closed.
+    std::size_t maxQueuedBytes = 8u << 20;
+    /// An HTTP connection waiting this long for a request (idle, without a token too) is closed.
+    double idleSeconds = 30.0;
+    /// A WebSocket connection whose write has waited this long (the tab does not read) is closed.
+    double stalledWriteSeconds = 30.0;
+    double targetFrameMs = 30.0;  ///< reduced-resolution frames aim at this render time
+    int refineDelayMs = 150;      ///< full resolution once the state has been still this long
+    int maxScale = 8;             ///< coarsest reduced resolution: 1/maxScale of each side
+    int jpegQuality = 80;         ///< of reduced-resolution frames
 };
 
 /// Shortest token ServerOptions::token may be.

@@ -4,12 +4,22 @@
 
 #include <gmock/gmock.h>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/resource.h>
+#include <unistd.h>
+#include <atomic>
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <random>
 #include <thread>
 
 #include "test_meshes.h"
@@ -66,10 +76,14 @@ std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
 /// A WebSocket client with timeouts on its own io_context.
 class Client {
 public:
-    /// Connects to /ws?token=TOKEN; throws beast::system_error when the handshake fails.
-    Client(std::uint16_t port, const std::string& token) : ws_(ioc_) {
-        tcp::resolver resolver(ioc_);
-        net::connect(ws_.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
+    /// Connects to /ws?token=TOKEN; throws beast::system_error when the handshake fails. A
+    /// receiveBuffer above 0 sets the socket's receive buffer (bytes) before connecting.
+    Client(std::uint16_t port, const std::string& token, int receiveBuffer = 0) : ws_(ioc_) {
+        const tcp::endpoint to(net::ip::make_address("127.0.0.1"), port);
+        ws_.next_layer().open(to.protocol());
+        if (receiveBuffer > 0)
+            ws_.next_layer().set_option(net::socket_base::receive_buffer_size(receiveBuffer));
+        ws_.next_layer().connect(to);
         ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
     }
 
@@ -590,6 +604,373 @@ TEST(ViewServer, StopClosesConnectionsAndBadOptionsAreRefused) {
     ServerOptions named;
     named.host = "localhost";  // the one name taken: 127.0.0.1
     EXPECT_NO_THROW(checkServerOptions(named, false));
+}
+
+/// Log lines of a server, kept for a test to count.
+struct LogLines {
+    std::mutex mu;
+    std::vector<std::string> lines;
+    LogFn fn() {
+        return [this](const std::string& line) {
+            std::lock_guard lk(mu);
+            lines.push_back(line);
+        };
+    }
+    int count(const std::string& part) {
+        std::lock_guard lk(mu);
+        int n = 0;
+        for (const std::string& l : lines) n += l.find(part) != std::string::npos;
+        return n;
+    }
+};
+
+/// True when the server closes the socket (it reads end of file or an error) within timeout.
+bool closedByServer(tcp::socket& socket, std::chrono::milliseconds timeout) {
+    pollfd p{socket.native_handle(), POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(timeout.count())) <= 0) return false;
+    char byte;
+    return ::recv(socket.native_handle(), &byte, 1, MSG_DONTWAIT) <= 0;
+}
+
+/// CPU seconds (user + system) this process has used.
+double cpuSeconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+/// Resident memory of this process in bytes (VmRSS of /proc/self/status; 0 when unknown).
+std::size_t residentBytes() {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("VmRSS:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
+    return 0;
+}
+
+/// A ParaView colour-map JSON of n RGB points.
+std::string colorMapJson(std::size_t n) {
+    Json rgb = Json::array();
+    for (std::size_t i = 0; i < n; ++i)
+        for (double v : {double(i), 0.25, 0.5, 0.75}) rgb.push_back(v);
+    return Json::array({{{"Name", "many"}, {"ColorSpace", "RGB"}, {"RGBPoints", rgb}}}).dump();
+}
+
+TEST(ViewServer, DeeplyNestedMessagesAreRefusedBeforeParsing) {
+    // Issue 28: 100,000 levels killed the server (stack overflow copying and dumping the value
+    // to describe it in the error).
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    const std::string deep = R"({"type":"set","seq":4,"range":[)" + std::string(99999, '[') +
+                             std::string(99999, ']') + ",1]}";
+    c.sendText(deep);
+    Json e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("nested deeper than 64 levels"));
+    // At the limit it parses, and the error describes the value in a few bytes.
+    c.sendText(R"({"type":"set","seq":5,"range":[)" + std::string(58, '[') + std::string(58, ']') +
+               ",1]}");  // 60 levels with the object and the range
+    e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_EQ(e["seq"], 5);
+    EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("\"range[0]\""));
+    // A huge token in malformed JSON, or a huge seq, comes back cut, never whole.
+    c.sendText(R"({"type":"set","range":")" + std::string(1 << 20, 'z') + "\\q\"}");
+    e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_LE(e["message"].get<std::string>().size(), 512u);
+    c.send({{"type", "ping"}, {"seq", std::string(1 << 20, 's')}});
+    e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_FALSE(e.contains("seq"));
+    EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("\"seq\""));
+    c.send({{"type", "ping"}, {"seq", 8}});
+    EXPECT_EQ(c.until("pong")["seq"], 8);
+}
+
+TEST(ViewServer, RepliesToATabThatDoesNotReadAreReplacedNotQueued) {
+    // Issue 28: every `export` reply carried the whole (250,000-point) map and up to 256 of
+    // them waited per connection. Now the newest reply replaces one still waiting.
+    auto server = startServer();
+    Client c(server->port(), server->token());
+    ASSERT_FALSE(c.frame().is_null());
+    c.send({{"type", "set"}, {"colormap_json", colorMapJson(kMaxTfPoints)}});
+    const Json st = c.until("state");
+    ASSERT_FALSE(st.is_null());
+    ASSERT_EQ(st["state"]["tf"]["colors"].size(), kMaxTfPoints);
+    const int requests = 150;  // 40 MB of replies; within the rate and the message count
+    for (int i = 0; i < requests; ++i) c.send({{"type", "export"}});
+    std::this_thread::sleep_for(1500ms);
+    int exports = 0;
+    for (Json j = c.next(1500ms); !j.is_null(); j = c.next(1500ms))
+        exports += j.value("type", "") == "export";
+    EXPECT_FALSE(c.closed());
+    EXPECT_GE(exports, 1);
+    EXPECT_LT(exports, requests / 2) << "replies were queued, not replaced";
+    // A map past the limit is refused, the connection serves on.
+    c.send({{"type", "set"}, {"seq", 3}, {"colormap_json", colorMapJson(kMaxTfPoints + 1)}});
+    const Json e = c.until("error");
+    ASSERT_FALSE(e.is_null());
+    EXPECT_THAT(e["message"].get<std::string>(),
+                HasSubstr("at most " + std::to_string(kMaxTfPoints)));
+    c.send({{"type", "ping"}, {"seq", 1}});
+    EXPECT_FALSE(c.until("pong").is_null());
+}
+
+TEST(ViewServer, ATabWhoseQueuedBytesPassTheBoundIsClosed) {
+    // Replies that replace nothing (errors) pile up for a tab that never reads: past
+    // maxQueuedBytes (fewer than the 256 messages of the count) the connection is closed.
+    LogLines log;
+    ServerOptions o;
+    o.maxQueuedBytes = 16 << 10;
+    o.maxMessagesPerSecond = 100000;
+    auto server = startServer(o, log.fn());
+    Client c(server->port(), server->token(), 4096);
+    ASSERT_FALSE(c.frame().is_null());
+    // Malformed JSON quoting a long token: errors of ~600 bytes (cut at 512 for the message).
+    const std::string bad = R"({"type":"set","range":")" + std::string(2000, 'r') + "\\q\"}";
+    // ~9 MB of errors: more than the kernel's buffers of the socket (4 MiB at most) hold.
+    try {
+        for (int i = 0; i < 16000; ++i) c.sendText(bad);
+    } catch (const beast::system_error&) {
+        // closed while sending
+    }
+    for (int i = 0; i < 50 && !log.count("does not read"); ++i) std::this_thread::sleep_for(100ms);
+    ASSERT_EQ(log.count("does not read"), 1);
+    // Closed for its bytes, with fewer messages waiting than the count allows.
+    std::string line;
+    {
+        std::lock_guard lk(log.mu);
+        for (const std::string& l : log.lines)
+            if (l.find("does not read") != std::string::npos) line = l;
+    }
+    const auto open = line.find(" (");
+    ASSERT_NE(open, std::string::npos) << line;
+    EXPECT_LT(std::stoi(line.substr(open + 2)), 256) << line;
+    EXPECT_THAT(line, HasSubstr("bytes of text"));
+    for (Json j = c.next(3s); !j.is_null(); j = c.next(3s)) {
+    }
+    EXPECT_TRUE(c.closed());
+    Client d(server->port(), server->token());  // the server serves on
+    EXPECT_FALSE(d.frame().is_null());
+}
+
+TEST(ViewServer, ConnectionsAreCappedAndIdleOnesWithoutATokenTimeOut) {
+    // Issue 28: nothing bounded the connections without a token.
+    ServerOptions o;
+    o.maxConnections = 4;
+    o.idleSeconds = 0.5;
+    auto server = startServer(o);
+    net::io_context ioc;
+    const tcp::endpoint to(net::ip::make_address("127.0.0.1"), server->port());
+    std::vector<tcp::socket> idle;
+    for (int i = 0; i < 12; ++i) {
+        idle.emplace_back(ioc);
+        idle.back().connect(to);
+    }
+    // The newest stay (up to the cap), the older ones made room; soon all time out.
+    int closedSoon = 0;
+    for (tcp::socket& s : idle) closedSoon += closedByServer(s, 200ms);
+    EXPECT_GE(closedSoon, 12 - 4);
+    for (tcp::socket& s : idle) EXPECT_TRUE(closedByServer(s, 5s));
+    // A tab still gets in, and an idle connection does not shut it out.
+    tcp::socket one(ioc);
+    one.connect(to);
+    Client c(server->port(), server->token());
+    EXPECT_FALSE(c.frame().is_null());
+}
+
+TEST(ViewServer, AcceptBacksOffWhenNoDescriptorIsLeft) {
+    // Issue 28: under `ulimit -n 64`, accept failed with EMFILE and was retried at once
+    // forever: 100% CPU and megabytes of log lines a second.
+    LogLines log;
+    auto server = startServer({}, log.fn());
+    net::io_context ioc;
+    std::vector<tcp::socket> clients;
+    for (int i = 0; i < 20; ++i) {
+        clients.emplace_back(ioc);
+        clients.back().open(tcp::v4());  // their descriptors before the others run out
+    }
+    rlimit old{};
+    ASSERT_EQ(getrlimit(RLIMIT_NOFILE, &old), 0);
+    rlimit low = old;
+    low.rlim_cur = std::min<rlim_t>(old.rlim_cur, 1024);
+    ASSERT_EQ(setrlimit(RLIMIT_NOFILE, &low), 0);
+    std::vector<int> used;
+    const int null = ::open("/dev/null", O_RDONLY);
+    ASSERT_GE(null, 0);
+    used.push_back(null);
+    for (int fd = ::dup(null); fd >= 0; fd = ::dup(null)) used.push_back(fd);
+    const tcp::endpoint to(net::ip::make_address("127.0.0.1"), server->port());
+    for (tcp::socket& s : clients) s.connect(to);  // queued by the kernel; accept fails
+    const double cpu0 = cpuSeconds();
+    std::this_thread::sleep_for(2s);
+    const double cpu = cpuSeconds() - cpu0;
+    for (int fd : used) ::close(fd);
+    setrlimit(RLIMIT_NOFILE, &old);
+    EXPECT_GE(log.count("accept failed"), 1);
+    EXPECT_LE(log.count("accept failed"), 2) << "accept errors are not rate-limited";
+    EXPECT_LT(cpu, 0.5) << "accept is retried without a pause";
+    // Descriptors free again: the queued connections and a new tab are served.
+    Client c(server->port(), server->token());
+    EXPECT_FALSE(c.frame().is_null());
+}
+
+TEST(ViewServer, AStepThatFailsToReadIsAnErrorForThatTabOnly) {
+    // Issue 28: a failure while loading a tab's time step (a truncated file here, a .pvd
+    // cycle or bad_alloc there) must not take the server down.
+    const std::string dir = uvr::testing::scratchDir();
+    for (int k = 0; k < 3; ++k) {
+        Mesh m = *twoFieldMesh();
+        for (float& v : m.fields[0].values) v += float(k);
+        writeMesh(m, dir + "/s_" + std::to_string(k) + ".vtu");
+    }
+    ViewScene scene;
+    scene.file = dir + "/s_*.vtu";
+    scene.series = openMeshSeries(scene.file);
+    scene.mesh = std::make_shared<Mesh>(scene.series->readStep(0));
+    scene.bounds = scene.mesh->bounds();
+    scene.rendererOptions.device = Device::Cpu;
+    ViewState& st = scene.initial;
+    st.camera = resetCamera(scene.bounds, 64.f / 48.f);
+    st.tf = transferFunctionPreset("viridis");
+    st.range = {-3.f, 5.f};
+    st.width = 64;
+    st.height = 48;
+    // Step 2 is cut short after the series was opened.
+    const std::string step2 = dir + "/s_2.vtu";
+    std::filesystem::resize_file(step2, std::filesystem::file_size(step2) / 2);
+    ServerOptions o;
+    o.port = 0;
+    ViewServer server(std::move(scene), o);
+    server.start();
+    Client a(server.port(), server.token()), b(server.port(), server.token());
+    ASSERT_FALSE(a.frame().is_null());
+    ASSERT_FALSE(b.frame().is_null());
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        a.send({{"type", "set"}, {"seq", 10 + attempt}, {"step", 2}});
+        const Json e = a.until("error");
+        ASSERT_FALSE(e.is_null());
+        EXPECT_EQ(e["request"], "frame");
+        EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("s_2.vtu"));
+    }
+    b.send({{"type", "set"}, {"seq", 2}, {"step", 1}});
+    const Json fb = b.frame();
+    ASSERT_FALSE(fb.is_null());
+    EXPECT_EQ(fb["seq"], 2);
+    a.send({{"type", "set"}, {"seq", 20}, {"step", 0}});
+    const Json fa = a.frame();
+    ASSERT_FALSE(fa.is_null());
+    EXPECT_EQ(fa["seq"], 20);
+}
+
+TEST(ViewServer, SoakOfHostileAndSlowClientsKeepsMemoryAndCpuBounded) {
+    // Issue 28's soak: ~10 clients for about 30 s send a mix of valid and invalid messages
+    // (deep nesting, oversized, bad types, the largest colour maps, exports), some never read.
+    // Memory must stay flat after a warm-up, the CPU idle once they stop, and a well-behaved
+    // tab must still be served at the end. Bounds are resources, not timings: generous.
+    const auto seconds = std::chrono::seconds(
+        std::getenv("UVR_SOAK_SECONDS") ? std::atoi(std::getenv("UVR_SOAK_SECONDS")) : 30);
+    ServerOptions o;
+    o.maxMessageBytes = 1 << 20;
+    o.stalledWriteSeconds = 2.0;  // a tab that sent too much and never reads goes soon
+    auto server = startServer(o);
+    const std::string bigMap = colorMapJson(kMaxTfPoints);
+    const std::string tooBig = colorMapJson(60000);   // ~1.3 MB: over maxMessageBytes
+    const std::string tooMany = colorMapJson(20000);  // under it, over kMaxTfPoints
+    const std::string deep =
+        R"({"type":"set","range":)" + std::string(50000, '[') + std::string(50000, ']') + "}";
+    std::atomic<bool> stop{false};
+    std::atomic<std::uint64_t> sent{0};
+    auto hostile = [&](int id, bool reads) {
+        std::mt19937 rng(id);
+        while (!stop) {
+            try {
+                Client c(server->port(), server->token());
+                for (int i = 0; i < 400 && !stop; ++i) {
+                    switch (rng() % 10) {
+                        case 0:
+                            c.sendText(deep);
+                            break;
+                        case 1:
+                            c.send({{"type", "set"}, {"colormap_json", bigMap}});
+                            break;
+                        case 2:
+                            c.send({{"type", "set"}, {"colormap_json", tooMany}});
+                            break;
+                        case 3:
+                            c.send({{"type", "export"}});
+                            break;
+                        case 4:
+                            c.send({{"type", 7}, {"seq", {1, 2}}});
+                            break;
+                        case 5:
+                            c.sendText("{\"type\": \"set\", \"range\": [1, \"x\"]");
+                            break;
+                        case 6:
+                            c.send({{"type", "set"},
+                                    {"interactive", true},
+                                    {"camera", {{"view_angle", 20 + int(rng() % 20)}}}});
+                            break;
+                        case 7:
+                            c.send({{"type", "snapshot"}});
+                            break;
+                        case 8:
+                            c.sendBinary(std::string(1000, '\1'));
+                            break;
+                        default:
+                            if (rng() % 20 == 0)
+                                c.sendText(tooBig);  // closes this one
+                            else
+                                c.send({{"type", "ping"}, {"seq", i}});
+                    }
+                    ++sent;
+                    if (reads)
+                        while (!c.next(1ms).is_null()) {
+                        }
+                    else
+                        std::this_thread::sleep_for(2ms);
+                }
+            } catch (const std::exception&) {
+                // closed by the server (too big, not reading): connect again
+            }
+        }
+    };
+    std::vector<std::thread> clients;
+    for (int i = 0; i < 10; ++i) clients.emplace_back(hostile, i, i % 2 == 0);
+    const auto start = std::chrono::steady_clock::now();
+    std::this_thread::sleep_for(seconds / 4);  // warm-up: allocator pools, the first frames
+    const std::size_t warm = residentBytes();
+    std::size_t peak = warm;
+    while (std::chrono::steady_clock::now() - start < seconds) {
+        std::this_thread::sleep_for(500ms);
+        peak = std::max(peak, residentBytes());
+    }
+    stop = true;
+    for (std::thread& t : clients) t.join();
+    EXPECT_GT(sent.load(), 1000u);
+    // Growth after the warm-up: a few queues of bounded bytes, far from ~45 MB a second.
+    EXPECT_LT(peak, warm + (96u << 20))
+        << "warm " << (warm >> 20) << " MiB, peak " << (peak >> 20) << " MiB";
+    // Quiet: the server's threads wait.
+    std::this_thread::sleep_for(500ms);
+    const double cpu0 = cpuSeconds();
+    std::this_thread::sleep_for(2s);
+    const double quietCpu = cpuSeconds() - cpu0;
+    std::printf(
+        "soak: %llu messages; RSS after warm-up %zu MiB, peak %zu MiB; CPU %.3f s over a "
+        "quiet 2 s\n",
+        static_cast<unsigned long long>(sent.load()), warm >> 20, peak >> 20, quietCpu);
+    EXPECT_LT(quietCpu, 0.5) << "busy after the flood stopped";
+    Client c(server->port(), server->token());
+    ASSERT_EQ(c.next()["type"], "info");
+    c.send({{"type", "set"}, {"seq", 99}, {"quality", 0.9}});
+    Json f = c.frame();  // the starting state's, then the change's
+    for (int i = 0; i < 3 && !f.is_null() && f["seq"] != 99; ++i) f = c.frame();
+    ASSERT_FALSE(f.is_null());
+    EXPECT_EQ(f["seq"], 99);
 }
 
 }  // namespace

@@ -21,10 +21,44 @@ std::string fmtG(double v) {
     return buf;
 }
 
+/// Containers nested deeper than this in an error's description show as [...] or {...}.
+constexpr int kDescribeDepth = 4;
+
+/// Appends value as compact JSON to out, stopping soon after out passes maxBytes: strings and
+/// keys cut to about 40 bytes, containers deeper than kDescribeDepth elided. Bounded work and
+/// recursion whatever the value's size and depth.
+void appendShort(const Json& v, std::string& out, std::size_t maxBytes, int depth) {
+    if (v.is_array() || v.is_object()) {
+        const bool array = v.is_array();
+        if (depth >= kDescribeDepth && !v.empty()) {
+            out += array ? "[...]" : "{...}";
+            return;
+        }
+        out += array ? '[' : '{';
+        for (auto it = v.begin(); it != v.end(); ++it) {
+            if (out.size() > maxBytes) return;
+            if (it != v.begin()) out += ',';
+            if (!array) out += "\"" + printableShort(it.key(), 40) + "\":";
+            appendShort(*it, out, maxBytes, depth + 1);
+        }
+        out += array ? ']' : '}';
+    } else if (v.is_string()) {
+        out += "\"" + printableShort(v.get_ref<const std::string&>(), 40) + "\"";
+    } else {
+        out += v.dump();  // a number, boolean or null: short
+    }
+}
+
+/// A one-line description of a value of a message for an error, at most maxBytes long.
+std::string describe(const Json& v, std::size_t maxBytes = 80) {
+    std::string out;
+    appendShort(v, out, maxBytes, 0);
+    return printableShort(out, maxBytes);
+}
+
 [[noreturn]] void bad(const std::string& key, const std::string& expected, const Json& got) {
     throwError(ErrorKind::Argument, "",
-               "\"" + key + "\": expected " + expected + ", got " +
-                   printableShort(got.dump(-1, ' ', false, Json::error_handler_t::replace), 80));
+               "\"" + key + "\": expected " + expected + ", got " + describe(got));
 }
 
 double number(const std::string& key, const Json& v) {
@@ -208,6 +242,14 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
         const std::string& text = it->get_ref<const std::string&>();
         TransferFunction loaded =
             parseParaViewColorMap({text.begin(), text.end()}, "the uploaded colour map", name);
+        // The state (sent back in `state` and `export`, and by the page in later `set`s) holds
+        // no more points than a page may send.
+        const std::size_t points = std::max(loaded.colors.size(), loaded.opacities.size());
+        if (points > kMaxTfPoints)
+            throwError(ErrorKind::Argument, "the uploaded colour map",
+                       std::to_string(points) +
+                           " points (HSV segments count 32 each): the viewer takes at most " +
+                           std::to_string(kMaxTfPoints));
         // A map without opacity points (the loader's ramp) keeps the page's opacity.
         const bool hasPoints = text.find("\"Points\"") != std::string::npos;
         if (!hasPoints) loaded.opacities = next.tf.opacities;

@@ -15,7 +15,8 @@ namespace uvr::server {
 /// Smallest and largest side of a viewer image.
 inline constexpr int kMinViewSize = 16;
 inline constexpr int kMaxViewSize = 4096;
-/// Most colour or opacity points a transfer function sent by a page may have.
+/// Most colour or opacity points a tab's transfer function may have (sent as rows or uploaded as
+/// a colour map).
 inline constexpr std::size_t kMaxTfPoints = 4096;
 
 /// What one browser tab looks at (docs/VIEWER.md, "The session state"): everything a frame

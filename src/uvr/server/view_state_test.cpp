@@ -184,5 +184,52 @@ TEST(ViewState, TheStepIsOneOfTheFilesTimeSteps) {
     }
 }
 
+TEST(ViewState, AnUploadedColourMapHasAtMostTheStatesPoints) {
+    // Issue 28: a 250,000-point map came in through colormap_json (kMaxTfPoints bounded only
+    // the page's rows), and every `state` and `export` reply carried it.
+    auto upload = [](std::size_t n, const char* space) {
+        Json rgb = Json::array();
+        for (std::size_t i = 0; i < n; ++i)
+            for (double v : {double(i), 0.5, 0.5, 0.5}) rgb.push_back(v);
+        return Json{{"Name", "big"}, {"ColorSpace", space}, {"RGBPoints", rgb}}.dump();
+    };
+    ViewState s = startState();
+    applySet(s, {{"colormap_json", upload(kMaxTfPoints, "RGB")}});
+    EXPECT_EQ(s.tf.colors.size(), kMaxTfPoints);
+    // The state it makes goes back to the page and comes back as rows: accepted again.
+    ViewState again = startState();
+    EXPECT_NO_THROW(applySet(again, {{"tf", toJson(s)["tf"]}}));
+    for (const auto& [n, space] : {std::pair<std::size_t, const char*>{kMaxTfPoints + 1, "RGB"},
+                                   {250000, "RGB"},
+                                   {200, "HSV"}}) {  // resampled: 32 points a segment
+        SCOPED_TRACE(std::to_string(n) + " " + space);
+        ViewState t = startState();
+        try {
+            applySet(t, {{"colormap_json", upload(n, space)}, {"heatmap", true}});
+            ADD_FAILURE() << "accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::Argument);
+            EXPECT_THAT(e.what(), HasSubstr("at most " + std::to_string(kMaxTfPoints)));
+        }
+        EXPECT_FALSE(t.heatmap);
+    }
+}
+
+TEST(ViewState, ErrorsDescribeHugeOrDeepValuesInFewBytes) {
+    // Issue 28: the whole value was dumped (recursively) before being cut to 80 bytes.
+    Json deep = 1;
+    for (int i = 0; i < 60; ++i) deep = Json::array({deep});
+    Json wide = Json::array();
+    for (int i = 0; i < 100000; ++i) wide.push_back(std::string(100, 'x'));
+    for (const Json& v : {deep, wide, Json(std::string(1 << 20, 'y'))}) {
+        const std::string m = refusal({{"range", v}});
+        EXPECT_THAT(m, HasSubstr("\"range\": expected [lo, hi], got "));
+        EXPECT_LT(m.size(), 200u) << m;
+    }
+    EXPECT_THAT(refusal({{"range", {0, 1, {2, {3, {4, {5, 6}}}}}}}),
+                HasSubstr("got [0,1,[2,[3,[4,[...]]]]]"));
+    EXPECT_THAT(refusal({{"range", {0, 1, 2}}}), HasSubstr("got [0,1,2]"));
+}
+
 }  // namespace
 }  // namespace uvr::server

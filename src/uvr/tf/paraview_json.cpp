@@ -27,9 +27,6 @@ std::string lower(std::string s) {
     return s;
 }
 
-/// Deepest nesting of arrays and objects accepted (ParaView's exports nest 3 levels).
-constexpr int kMaxJsonDepth = 64;
-
 /// A short, one-line rendering of a JSON value for error messages: scalars as JSON (strings
 /// cut to about 40 characters, invalid UTF-8 and control characters escaped), arrays and
 /// objects by their size, so that no large or deeply nested value is ever serialised.
@@ -47,26 +44,11 @@ void checkJsonShape(const std::string& path, const std::vector<char>& bytes) {
     if (const char* wide = wideTextEncoding(bytes.data(), bytes.size()))
         throwParseError(path, atByte(0),
                         std::string(wide) + " text is not supported; save the colour map as UTF-8");
-    int depth = 0;
-    bool inString = false;
-    for (std::size_t i = 0; i < bytes.size(); ++i) {
-        const char c = bytes[i];
-        if (inString) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > kMaxJsonDepth)
-                throwParseError(path, atByte(i),
-                                "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
-                                    " levels (a ParaView colour map nests 3)");
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
+    const std::size_t deep = jsonTooDeepAt(std::string_view(bytes.data(), bytes.size()));
+    if (deep != std::string_view::npos)
+        throwParseError(path, atByte(deep),
+                        "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                            " levels (a ParaView colour map nests 3)");
 }
 
 /// Reads a flat array of numbers whose length is a non-zero multiple of 4.
