@@ -701,8 +701,20 @@ std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames) {
     return frames * bytes;
 }
 
+void checkFrameEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes) {
+    if (!ctx.maxMemoryDefault.empty() && bytes > kDefaultFrameMemoryBytes)
+        throwError(ErrorKind::Resource, "",
+                   what + " would need about " + std::to_string(bytes) +
+                       " bytes, more than the default limit of image buffers, " +
+                       std::to_string(kDefaultFrameMemoryBytes) + " bytes (" +
+                       std::to_string(kDefaultFrameMemoryBytes >> 30) +
+                       " GiB): give --max-memory to allow a larger frame (e.g. --max-memory " +
+                       std::to_string((bytes >> 30) + 1) + "G)");
+    checkMemoryEstimate(ctx, what, bytes);
+}
+
 void checkFrameMemory(const RenderFlags& flags, const Context& ctx) {
-    checkMemoryEstimate(
+    checkFrameEstimate(
         ctx,
         "--size " + flags.size + ": the image buffers (" + std::to_string(kFrameBytesPerPixel) +
             " bytes per pixel" +

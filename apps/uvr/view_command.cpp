@@ -81,6 +81,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
 #else
         applyThreads(flags->threads);
         flags->checkBeforeLoading(*file);
+        checkFrameMemory(*flags, ctx);
         server::ServerOptions so;
         so.host = options->first;
         so.port = static_cast<std::uint16_t>(options->second);
