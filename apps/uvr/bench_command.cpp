@@ -97,10 +97,10 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         checkOutputsDistinct(inputs, outputs);
         for (const NamedFile& out : outputs) resolveOutput(out.path);
         // Every variant's last frame is kept until the table is printed.
-        checkMemoryEstimate(ctx,
-                            "--size " + flags->size + ": the frames of " +
-                                std::to_string(6 + sweep->size()) + " variants",
-                            frameMemoryBytes(*flags, 6 + sweep->size()));
+        checkFrameEstimate(ctx,
+                           "--size " + flags->size + ": the frames of " +
+                               std::to_string(6 + sweep->size()) + " variants",
+                           frameMemoryBytes(*flags, 6 + sweep->size()));
         if (!images->empty()) {  // made when missing, before any heavy work
             std::error_code ec;
             std::filesystem::create_directories(*images, ec);

@@ -701,8 +701,20 @@ std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames) {
     return frames * bytes;
 }
 
+void checkFrameEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes) {
+    if (!ctx.maxMemoryDefault.empty() && bytes > kDefaultFrameMemoryBytes)
+        throwError(ErrorKind::Resource, "",
+                   what + " would need about " + std::to_string(bytes) +
+                       " bytes, more than the default limit of image buffers, " +
+                       std::to_string(kDefaultFrameMemoryBytes) + " bytes (" +
+                       std::to_string(kDefaultFrameMemoryBytes >> 30) +
+                       " GiB): give --max-memory to allow a larger frame (e.g. --max-memory " +
+                       std::to_string((bytes >> 30) + 1) + "G)");
+    checkMemoryEstimate(ctx, what, bytes);
+}
+
 void checkFrameMemory(const RenderFlags& flags, const Context& ctx) {
-    checkMemoryEstimate(
+    checkFrameEstimate(
         ctx,
         "--size " + flags.size + ": the image buffers (" + std::to_string(kFrameBytesPerPixel) +
             " bytes per pixel" +
@@ -1059,7 +1071,15 @@ bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, cons
     const RendererOptions options = flags.rendererOptions();
     const CacheKey expected =
         makeCacheKey(meshFile, flags.field, stepKey(steps), options.prepareOptions());
-    // The header first: a stale or damaged default cache is set aside with a note.
+    // A default cache that is stale, damaged or not trusted (another user's, or writable by
+    // others) is set aside with a warning saying why, and the mesh is prepared instead.
+    const auto notUsing = [&](const Error& e) {
+        const auto* stale = dynamic_cast<const StaleCacheError*>(&e);
+        return "not using the prepared cache " + path + ": " +
+               (stale ? stale->reason() : std::string(e.what())) +
+               "; preparing from the mesh (`uvr prepare` renews the cache)";
+    };
+    // The header first.
     RenderSource src;
     src.path = meshFile;
     src.cacheFile = path;
@@ -1071,20 +1091,22 @@ bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, cons
         src.summary = header.source;
     } catch (const Error& e) {
         if (explicitCache || e.kind() == ErrorKind::Resource) throw;
-        ctx.warn("not using the prepared cache " + path + ": " +
-                 (dynamic_cast<const StaleCacheError*>(&e)
-                      ? dynamic_cast<const StaleCacheError&>(e).reason()
-                      : std::string(e.what())) +
-                 "; preparing from the mesh (`uvr prepare` renews the cache)");
+        ctx.warn(notUsing(e));
         return false;
     }
     const std::optional<Font> legendFont = flags.legendFont();
     const RenderSettings settings = checkedSettings(flags, src, ctx);
     ctx.setActivity(path, "reading the prepared cache");
-    {
+    try {
         LoadBudget budget(ctx.maxMemoryBytes);
         Progress progress(ctx, "reading the prepared cache " + path);
         prepared = readPreparedCache(path, expected, budget, nullptr, progress.callback());
+    } catch (const Error& e) {
+        // Damage past the header (a truncated array, a failed CRC, a crafted index) sets a
+        // default cache aside as header damage does; memory limits stay errors.
+        if (explicitCache || e.kind() == ErrorKind::Resource) throw;
+        ctx.warn(notUsing(e));
+        return false;
     }
     src.cacheReadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     char line[64];

@@ -237,6 +237,10 @@ std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, con
 /// more than the --max-memory limit of M bytes" (what names the flags responsible).
 void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes);
 
+/// checkMemoryEstimate for image buffers; without an explicit --max-memory they must also fit
+/// kDefaultFrameMemoryBytes (Error(Resource) naming the need, the limit and the flag).
+void checkFrameEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes);
+
 /// Host bytes of `frames` frames at the flags' --size written as PNGs (with a heat map each when
 /// --heatmap is given), for checks before any work.
 std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames = 1);

@@ -44,6 +44,41 @@ TEST(CliLimits, ImageBuffersAboveMaxMemoryAreRefusedBeforeLoading) {
     EXPECT_EQ(uvr("-q render " + cube + " -o out.png --size 64x64 --max-memory 100M", dir).code, 0);
 }
 
+TEST(CliLimits, LargeFramesNeedAnExplicitMemoryLimit) {
+    // The 16384x16384 of five tetrahedra took 5.3 GB and a minute under the default
+    // limit (80% of physical memory); without an explicit --max-memory a command's image
+    // buffers must fit 2 GiB (kDefaultFrameMemoryBytes), for every command that renders.
+    const std::string dir = testing::scratchDir();
+    const std::string cube = writeCube(dir + "/cube.vtk");
+    const std::string limit =
+        "more than the default limit of image buffers, 2147483648 bytes (2 GiB): give "
+        "--max-memory to allow a larger frame (e.g. --max-memory 7G)";
+    expectOneLineError(uvr("-q render " + cube + " -o out.png --size 16384x16384", dir),
+                       {"--size 16384x16384: the image buffers (24 bytes per pixel) would need "
+                        "about 6442450944 bytes, " +
+                        limit},
+                       "render");
+    expectOneLineError(uvr("-q animate " + cube + " -o frames --size 16384x16384", dir), {limit},
+                       "animate");
+    expectOneLineError(uvr("-q demo -o out.png --size 16384x16384 --cells 1000", dir), {limit},
+                       "demo");
+    expectOneLineError(uvr("-q bench " + cube + " --size 8192x8192", dir),
+                       {"--size 8192x8192: the frames of", "more than the default limit"},
+                       "bench: its frames together");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/frames"));
+    // An explicit limit allows it (a junk mesh then fails to read: the frame passed).
+    const std::string junk = testing::writeFile(dir + "/junk.vtk", "not a mesh\n");
+    const CliRun r =
+        uvr("-q render " + junk + " -o out.png --size 16384x16384 --max-memory 7G", dir);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.find("image buffers"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("junk.vtk"), std::string::npos) << r.err;
+    // 8192x8192 (1.5 GiB) needs no flag.
+    const CliRun ok = uvr("-q render " + junk + " -o out.png --size 8192x8192", dir);
+    EXPECT_EQ(ok.err.find("image buffers"), std::string::npos) << ok.err;
+}
+
 TEST(CliLimits, GeneratedMeshesAboveMaxMemoryAreRefusedBeforeGenerating) {
     const std::string dir = testing::scratchDir();
     // A .vtu is built whole first; a .uvrm is written slab by slab (the slabs must fit).

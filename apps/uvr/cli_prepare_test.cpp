@@ -2,6 +2,9 @@
 // `uvr prepare` and `uvr render` from a prepared cache (issue 16).
 #include <gmock/gmock.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +17,7 @@ namespace uvr {
 namespace {
 
 using cli_testing::CliRun;
+using cli_testing::expectOneLineError;
 using cli_testing::uvr;
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -94,6 +98,105 @@ TEST(CliPrepare, AnExplicitMismatchingCacheIsAnError) {
     r = uvr("render " + mesh + kFrame + " --cache p.uvrprep -o a.png", dir);
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_THAT(r.err, HasSubstr("using the prepared cache p.uvrprep"));
+}
+
+TEST(CliPrepare, AnUntrustedDefaultCacheIsSetAsideAndAnExplicitOneRefused) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = makeBox(dir);
+    const std::string cache = mesh + ".uvrprep";
+    // Written under a permissive umask, the cache is still writable by its owner only.
+    ASSERT_EQ(uvr("-q prepare " + mesh + " --device cpu", dir, "umask 0; ").code, 0);
+    struct stat st;
+    ASSERT_EQ(::stat(cache.c_str(), &st), 0);
+    EXPECT_EQ(st.st_mode & 022, 0u);
+    CliRun r = uvr("render " + mesh + kFrame + " -o a.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("using the prepared cache"));
+    // Writable by others: anyone could have put anything there.
+    ASSERT_EQ(::chmod(cache.c_str(), 0666), 0);
+    r = uvr("render " + mesh + kFrame + " -o b.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("warning: not using the prepared cache " + cache));
+    EXPECT_THAT(r.err, HasSubstr("not trusted as a prepared cache: its group or other users may "
+                                 "write it (mode 0666)"));
+    EXPECT_THAT(r.err, HasSubstr("read " + mesh + ": "));
+    EXPECT_EQ(testing::readFile(dir + "/a.png"), testing::readFile(dir + "/b.png"));
+    expectOneLineError(uvr("-q render " + mesh + kFrame + " --cache " + cache + " -o c.png", dir),
+                       {cache + ": not trusted as a prepared cache"}, "--cache, mode 0666");
+    // Another user's (the issue's planted cache).
+    if (::geteuid() == 0) {
+        ASSERT_EQ(::chmod(cache.c_str(), 0644), 0);
+        ASSERT_EQ(::chown(cache.c_str(), 65534, 65534), 0);
+        r = uvr("render " + mesh + kFrame + " -o d.png", dir);
+        ASSERT_EQ(r.code, 0) << r.err;
+        EXPECT_THAT(r.err, HasSubstr("it belongs to uid 65534"));
+        EXPECT_THAT(r.err, HasSubstr("read " + mesh + ": "));
+        expectOneLineError(
+            uvr("-q render " + mesh + kFrame + " --cache " + cache + " -o c.png", dir),
+            {cache + ": not trusted as a prepared cache: it belongs to uid 65534"},
+            "--cache of another user");
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir + "/c.png"));
+}
+
+TEST(CliPrepare, ADamagedDefaultCacheIsSetAsideAndAnExplicitOneIsAnError) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = makeBox(dir);
+    const std::string cache = mesh + ".uvrprep";
+    ASSERT_EQ(uvr("-q prepare " + mesh + " --device cpu", dir).code, 0);
+    const std::string good = testing::readFile(cache);
+    ASSERT_EQ(uvr("-q render " + mesh + kFrame + " --no-cache -o fresh.png", dir).code, 0);
+    std::string flipped = good;
+    flipped[flipped.size() - 100] ^= 0x10;  // inside the last array: its CRC fails
+    const struct {
+        const char* what;
+        std::string bytes;
+        const char* message;
+    } cases[] = {
+        {"a truncated array", good.substr(0, good.size() - 300), "reaches beyond the file's"},
+        {"a bad CRC", flipped, "fails its CRC32 check"},
+    };
+    for (const auto& k : cases) {
+        testing::writeFile(cache, k.bytes);
+        CliRun r = uvr("render " + mesh + kFrame + " -o a.png", dir);
+        ASSERT_EQ(r.code, 0) << k.what << ": " << r.err;
+        EXPECT_THAT(r.err, HasSubstr("warning: not using the prepared cache " + cache)) << k.what;
+        EXPECT_THAT(r.err, HasSubstr(k.message)) << k.what;
+        EXPECT_THAT(r.err, HasSubstr("read " + mesh + ": ")) << k.what;
+        EXPECT_EQ(testing::readFile(dir + "/a.png"), testing::readFile(dir + "/fresh.png"))
+            << k.what;
+        std::filesystem::remove(dir + "/a.png");
+        expectOneLineError(
+            uvr("-q render " + mesh + kFrame + " --cache " + cache + " -o b.png", dir),
+            {cache, k.message}, k.what);
+        EXPECT_FALSE(std::filesystem::exists(dir + "/b.png")) << k.what;
+    }
+}
+
+TEST(CliPrepare, FifosAndDevicesAreRefusedAsCaches) {
+    const std::string dir = testing::scratchDir();
+    const std::string mesh = makeBox(dir);
+    const std::string fifo = dir + "/fifo.uvrprep";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    // `timeout`: before the fix these waited for a writer forever.
+    expectOneLineError(
+        uvr("-q render " + mesh + kFrame + " --cache " + fifo + " -o a.png", dir, "timeout 60 "),
+        {fifo + ": not a regular file (a FIFO): a prepared cache must be a file"}, "--cache FIFO");
+    expectOneLineError(
+        uvr("-q render " + mesh + kFrame + " --cache /dev/zero -o a.png", dir, "timeout 60 "),
+        {"/dev/zero: not a regular file (a character device)"}, "--cache /dev/zero");
+    // A FIFO where the default cache goes: render ignores it, prepare refuses to write into it
+    // (named with -o it is written, as every output: -o /dev/null).
+    ASSERT_EQ(::mkfifo((mesh + ".uvrprep").c_str(), 0600), 0);
+    CliRun r = uvr("render " + mesh + kFrame + " -o a.png", dir, "timeout 60 ");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, Not(HasSubstr("prepared cache")));
+    expectOneLineError(
+        uvr("-q prepare " + mesh + " --device cpu", dir, "timeout 60 "),
+        {mesh + ".uvrprep: the default prepared cache is not a regular file", "name it with -o"},
+        "prepare onto a FIFO");
+    r = uvr("-q prepare " + mesh + " --device cpu -o /dev/null", dir, "timeout 60 ");
+    EXPECT_EQ(r.code, 0) << r.err;
 }
 
 TEST(CliPrepare, SeriesAreRefused) {

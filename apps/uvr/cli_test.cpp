@@ -907,5 +907,50 @@ TEST(Cli, OutputsNeverDestroyWhatTheirPathNames) {
     }
 }
 
+TEST(Cli, LinksPlantedInASharedFolderByAnotherUserAreNotFollowed) {
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root to give links to another user";
+    namespace fs = std::filesystem;
+    const std::string dir = testing::scratchDir();
+    const std::string cube = fiveTetCube("f", "0 1 2 3 4 5 6 7");
+    const std::string mesh = testing::writeFile(dir + "/cube.vtk", cube);
+    const std::string shared = dir + "/shared";  // as /tmp: sticky, writable by everyone
+    fs::create_directory(shared);
+    ASSERT_EQ(::chmod(shared.c_str(), 01777), 0);
+    const std::string victim = testing::writeFile(dir + "/victim", "precious");
+    const auto plant = [&](const std::string& name) {  // another user's link to the victim
+        const std::string link = shared + "/" + name;
+        fs::create_symlink(victim, link);
+        EXPECT_EQ(::lchown(link.c_str(), 65534, 65534), 0);
+        return link;
+    };
+    const std::string render = "-q render " + mesh + " --size 16x16 --device cpu ";
+    const std::string refused = "refusing to follow the symbolic link '" + shared;
+    expectOneLineError(
+        uvr(render + "-o " + plant("out.png"), dir),
+        {refused + "/out.png' owned by uid 65534", "in the shared folder '" + shared + "'"}, "-o");
+    expectOneLineError(uvr(render + "-o " + dir + "/a.png --stats " + plant("s.json"), dir),
+                       {refused + "/s.json'"}, "--stats");
+    expectOneLineError(uvr(render + "-o " + dir + "/a.png --heatmap " + plant("h.png"), dir),
+                       {refused + "/h.png'"}, "--heatmap");
+    plant("frame_0000.png");
+    expectOneLineError(uvr("-q animate " + mesh + " --size 16x16 --device cpu -o " + shared, dir),
+                       {refused + "/frame_0000.png'"}, "animate");
+    testing::writeFile(shared + "/cube.vtk", cube);
+    plant("cube.vtk.uvrprep");
+    expectOneLineError(uvr("-q prepare " + shared + "/cube.vtk --device cpu", dir),
+                       {refused + "/cube.vtk.uvrprep'"}, "prepare");
+    EXPECT_EQ(testing::readFile(victim), "precious");
+    EXPECT_FALSE(fs::exists(dir + "/a.png"));
+    EXPECT_EQ(fileNames(shared),
+              (std::vector<std::string>{"cube.vtk", "cube.vtk.uvrprep", "frame_0000.png", "h.png",
+                                        "out.png", "s.json"}));
+    // The user's own link there is followed.
+    ASSERT_EQ(::lchown((shared + "/out.png").c_str(), 0, 0), 0);
+    const CliRun r = uvr(render + "-o " + shared + "/out.png", dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::is_symlink(shared + "/out.png"));
+    EXPECT_EQ(testing::readFile(victim).substr(1, 3), "PNG");
+}
+
 }  // namespace
 }  // namespace uvr

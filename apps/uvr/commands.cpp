@@ -292,6 +292,7 @@ void addDemoCommand(CLI::App& app, Context& ctx) {
         ProceduralSpec spec;
         spec.shape = ProceduralShape::Box;
         spec.targetCells = *cells;
+        checkFrameMemory(*flags, ctx);
         // The mesh, what rendering prepares from it and the frame, before generating anything.
         const std::uint64_t tets = proceduralTetCount(spec);
         checkMemoryEstimate(

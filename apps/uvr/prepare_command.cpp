@@ -72,7 +72,13 @@ void addPrepareCommand(CLI::App& app, Context& ctx) {
                        "--leaf-cells and --no-seed-grid need --method adaptive");
         const std::string cache = output->empty() ? *file + kPreparedCacheSuffix : *output;
         checkOutputsDistinct({{"the input mesh", *file}}, {{"-o", cache}});
-        resolveOutput(cache);
+        // The default cache is a file beside the mesh: anything else there (a FIFO, a device)
+        // is refused, not written into; -o may name one (the output conventions: written in
+        // place, e.g. -o /dev/null to time the preparation).
+        if (resolveOutput(cache).kind == OutputKind::Stream && output->empty())
+            throwError(ErrorKind::Io, cache,
+                       "the default prepared cache is not a regular file (a FIFO, socket or "
+                       "device): remove it, or name it with -o to write there");
         const RendererOptions options = flags->rendererOptions();
         PrepareOptions prepareOptions = options.prepareOptions();
         // The key before the read: a mesh changed while it is read gives a stale cache.

@@ -90,6 +90,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
                            std::to_string(server::kMinViewSize) + " to " +
                            std::to_string(server::kMaxViewSize) +
                            " pixels (uvr render draws larger images)");
+        checkFrameMemory(*flags, ctx);
         server::ServerOptions so;
         so.host = options->first;
         so.port = static_cast<std::uint16_t>(options->second);

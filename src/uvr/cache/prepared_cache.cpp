@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/cache/prepared_cache.h"
 
+#include <fcntl.h>
+#include <pwd.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -254,19 +258,82 @@ std::string headerBytes(const PreparedMesh& m, const CacheKey& key, const Source
     return w.bytes;
 }
 
+/// What a file is, for messages.
+const char* fileType(mode_t mode) {
+    if (S_ISDIR(mode)) return "a folder";
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    if (S_ISSOCK(mode)) return "a socket";
+    return "not a regular file";
+}
+
+/// "uid N (name)" for messages.
+std::string userName(uid_t uid) {
+    std::string out = "uid " + std::to_string(uid);
+    struct passwd pw, *found = nullptr;
+    char buf[1024];
+    if (::getpwuid_r(uid, &pw, buf, sizeof buf, &found) == 0 && found)
+        out += std::string(" (") + found->pw_name + ")";
+    return out;
+}
+
+/// A prepared cache is code-like input (its arrays steer the kernels), so only a file that the
+/// current user owns and that nobody else can write is trusted: another user could have planted
+/// it (its checksums prove nothing against a deliberate writer). Throws Error(Io) saying why.
+void checkTrusted(const std::string& path, const struct stat& st) {
+    if (st.st_uid != ::geteuid())
+        throwError(ErrorKind::Io, path,
+                   "not trusted as a prepared cache: it belongs to " + userName(st.st_uid) +
+                       ", not to the current user " + userName(::geteuid()));
+    if (st.st_mode & (S_IWGRP | S_IWOTH)) {
+        char mode[8];
+        std::snprintf(mode, sizeof mode, "%04o", unsigned(st.st_mode & 07777));
+        throwError(ErrorKind::Io, path,
+                   std::string("not trusted as a prepared cache: its group or other users may "
+                               "write it (mode ") +
+                       mode + ")");
+    }
+}
+
 /// A file opened for reading, closed on scope exit.
 struct InputFile {
     std::FILE* f = nullptr;
     std::string path;
     std::uint64_t size = 0;
 
-    explicit InputFile(const std::string& p) : path(p) {
-        f = std::fopen(p.c_str(), "rb");
-        if (!f) throwError(ErrorKind::Io, p, std::string("cannot open: ") + std::strerror(errno));
+    /// Opens p, refusing anything but a regular file before it could block (a FIFO opened
+    /// for reading waits for a writer); a cache must also be trusted (checkTrusted).
+    InputFile(const std::string& p, bool cache) : path(p) {
+        const int fd = ::open(p.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+        if (fd < 0)
+            throwError(ErrorKind::Io, p, std::string("cannot open: ") + std::strerror(errno));
         struct stat st;
-        if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-            std::fclose(f);
-            throwError(ErrorKind::Io, p, "not a regular file");
+        if (::fstat(fd, &st) != 0) {
+            const int err = errno;
+            ::close(fd);
+            throwError(ErrorKind::Io, p, std::string("cannot stat: ") + std::strerror(err));
+        }
+        if (!S_ISREG(st.st_mode)) {
+            ::close(fd);
+            throwError(ErrorKind::Io, p,
+                       std::string("not a regular file (") + fileType(st.st_mode) + ")" +
+                           (cache ? ": a prepared cache must be a file" : ""));
+        }
+        if (cache) {
+            try {
+                checkTrusted(p, st);
+            } catch (...) {
+                ::close(fd);
+                throw;
+            }
+        }
+        ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+        f = ::fdopen(fd, "rb");
+        if (!f) {
+            const int err = errno;
+            ::close(fd);
+            throwError(ErrorKind::Io, p, std::string("cannot open: ") + std::strerror(err));
         }
         size = static_cast<std::uint64_t>(st.st_size);
     }
@@ -292,6 +359,39 @@ struct InputFile {
         }
     }
 };
+
+/// True when every coordinate is finite (an empty box keeps its finite +-FLT_MAX corners).
+bool finite(Vec3f v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+bool finite(const Bounds3f& b) {
+    return finite(b.lo) && finite(b.hi);
+}
+
+/// The header's counts and geometry, checked as a mesh's would be (a crafted file's header CRC
+/// matches whatever it says): cell counts within 32-bit cell ids (so the arrays' expected
+/// lengths cannot overflow), bounds and the frame finite, the scale positive.
+void checkHeaderScalars(const ParsedHeader& h, const std::string& path) {
+    const TetMesh& t = h.mesh.tets;
+    const auto bad = [&](const std::string& what) {
+        throwError(
+            ErrorKind::Parse, path,
+            "the prepared cache's header is invalid: " + what + " (a damaged or crafted file)");
+    };
+    const std::uint64_t counts[4] = {h.tetCount, t.pyramidCount, t.wedgeCount, t.hexCount};
+    std::uint64_t cells = 0;
+    for (std::uint64_t c : counts) {
+        if (c >= kNoTet) bad("a cell count of " + std::to_string(c) + " (at most 2^32 - 2)");
+        cells += c;
+    }
+    if (cells >= kNoTet) bad(std::to_string(cells) + " cells (at most 2^32 - 2)");
+    if (!finite(h.header.source.bounds) || !finite(t.bounds) || !finite(t.frame.origin) ||
+        (h.mesh.kd && !finite(h.mesh.kd->bounds)))
+        bad("bounds that are not finite");
+    if ((h.mesh.seeds || h.mesh.macro) && !h.mesh.kd) bad("grids without k-d partitions");
+    if (!(std::isfinite(t.frame.scale) && t.frame.scale > 0.0))
+        bad("the frame's scale is " + std::to_string(t.frame.scale));
+}
 
 ParsedHeader parseHeader(InputFile& in) {
     const std::string& path = in.path;
@@ -379,8 +479,17 @@ ParsedHeader parseHeader(InputFile& in) {
         e.count = r.pod<std::uint64_t>("the array table");
         e.offset = r.pod<std::uint64_t>("the array table");
         e.crc = r.pod<std::uint32_t>("the array table");
+        // Element sizes are those of the structs (at most a BVH node's 32 bytes); a count
+        // must fit the file (so the byte count below cannot overflow).
+        if (e.elementSize == 0 || e.elementSize > 1024 || e.count > in.size / e.elementSize)
+            throwParseError(path, atByte(kPreambleBytes + r.pos),
+                            "array '" + e.name + "' of " + std::to_string(e.count) +
+                                " elements of " + std::to_string(e.elementSize) +
+                                " bytes does not fit the file's " + std::to_string(in.size) +
+                                " bytes (a damaged or crafted file)");
         out.table.push_back(std::move(e));
     }
+    checkHeaderScalars(out, path);
     h.cells = out.tetCount + t.pyramidCount + t.wedgeCount + t.hexCount;
     for (const ArrayEntry& e : out.table) h.arrayBytes += e.elementSize * e.count;
     return out;
@@ -454,12 +563,35 @@ bool cellIds(const std::uint32_t* ids, std::uint64_t n, std::uint64_t cells) {
     return bad == 0;
 }
 
-/// True when every grid's cells lie within `cells` entries.
-bool gridsWithin(const std::vector<PartitionGrid>& grids, std::uint64_t cells) {
-    for (const PartitionGrid& g : grids)
-        if (std::uint64_t(g.first) + std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2] > cells)
-            return false;
-    return true;
+/// Why grids laid out as layoutPartitionGrids does are not, over an array of `cells` entries
+/// (empty when they are): every side 1 to kMaxGridSide (cellIndex clamps to dims - 1), each
+/// grid's cells right after the previous grid's, all of them exactly the array and within
+/// 32-bit indices (the kernels' index arithmetic), origin finite, cells per unit not negative.
+std::string gridsMalformed(const std::vector<PartitionGrid>& grids, std::uint64_t cells) {
+    std::uint64_t total = 0;
+    for (std::size_t p = 0; p < grids.size(); ++p) {
+        const PartitionGrid& g = grids[p];
+        const std::string which = "grid " + std::to_string(p);
+        for (int a = 0; a < 3; ++a) {
+            if (g.dims[a] < 1 || g.dims[a] > kMaxGridSide)
+                return which + " has " + std::to_string(g.dims[a]) + " cells on axis " +
+                       std::to_string(a) + " (1 to " + std::to_string(kMaxGridSide) + ")";
+            if (std::isnan(g.cellsPerUnit[a]) || g.cellsPerUnit[a] < 0.f)
+                return which + " has a negative or NaN cell size";
+        }
+        if (!finite(g.lo)) return which + " has an origin that is not finite";
+        if (g.first != total)
+            return which + " starts at cell " + std::to_string(g.first) +
+                   ", not right after the "
+                   "previous grid (" +
+                   std::to_string(total) + ")";
+        total += std::uint64_t(g.dims[0]) * g.dims[1] * g.dims[2];
+        if (total >= 0xffffffffull) return "the grids' cells exceed 32-bit indices";
+    }
+    if (total != cells)
+        return "the grids hold " + std::to_string(total) + " cells, the array " +
+               std::to_string(cells);
+    return "";
 }
 
 /// Every index the kernels follow lies in range: corners in their block, neighbour codes, escapes
@@ -492,7 +624,14 @@ void checkIndices(const PreparedMesh& m, std::uint64_t tetCount, const std::stri
     expect(cellIds(nb.escapes.data(), nb.escapes.size(), cells) &&
                cellIds(nb.native.data(), nb.native.size(), cells),
            path, "a face neighbour is not a cell");
-    expect(bvhWellFormed(m.cellTree.nodes, cells), path, "the cell tree is malformed");
+    // The cell tree's leaves are cell ranges (buildCellTree), or name cells through primIds.
+    const Bvh& tree = m.cellTree;
+    expect(tree.primIds.empty() ? bvhWellFormed(tree.nodes, cells)
+                                : bvhWellFormed(tree.nodes, tree.primIds.size()) &&
+                                      cellIds(tree.primIds.data(), tree.primIds.size(), cells) &&
+                                      std::find(tree.primIds.begin(), tree.primIds.end(), kNoTet) ==
+                                          tree.primIds.end(),
+           path, "the cell tree is malformed");
     expect(bvhWellFormed(m.bvh.nodes, m.bvh.primIds.size()) &&
                cellIds(m.bvh.primIds.data(), m.bvh.primIds.size(), cells) &&
                std::find(m.bvh.primIds.begin(), m.bvh.primIds.end(), kNoTet) == m.bvh.primIds.end(),
@@ -501,12 +640,8 @@ void checkIndices(const PreparedMesh& m, std::uint64_t tetCount, const std::stri
         expect(kdWellFormed(m.kd->nodes, m.kd->partitions.size()), path,
                "the k-d tree is malformed");
         if (m.seeds)
-            expect(gridsWithin(m.seeds->grids, m.seeds->seeds.size()) &&
-                       cellIds(m.seeds->seeds.data(), m.seeds->seeds.size(), cells),
-                   path, "the seed grids name cells or seeds out of range");
-        if (m.macro)
-            expect(gridsWithin(m.macro->grids, m.macro->cells.size()), path,
-                   "the macrocell grids reach beyond their cells");
+            expect(cellIds(m.seeds->seeds.data(), m.seeds->seeds.size(), cells), path,
+                   "a seed is not a cell");
     }
 }
 
@@ -542,6 +677,9 @@ void checkConsistent(const PreparedMesh& m, std::uint64_t tetCount, const std::s
     if (!m.neighborCodes.escapeBase.empty())
         expect(m.neighborCodes.escapeBase.back() == m.neighborCodes.escapes.size(), path,
                "neighbors.escapeBase does not end at the escapes' count");
+    const std::vector<std::uint32_t>& eb = m.neighborCodes.escapeBase;
+    for (std::size_t b = 0; b + 1 < eb.size(); ++b)
+        expect(eb[b] <= eb[b + 1], path, "neighbors.escapeBase is not increasing");
     expect(m.neighborCodes.native.size() == 5 * (t.pyramidCount + t.wedgeCount) + 6 * t.hexCount,
            path, "neighbors.native does not hold one entry per native face");
     if (m.kd) {
@@ -549,16 +687,21 @@ void checkConsistent(const PreparedMesh& m, std::uint64_t tetCount, const std::s
         expect(m.gradientSpread.size() == n, path, "gradientSpread is not one per partition");
         expect(m.partitionNan.empty() || m.partitionNan.size() == n, path,
                "partitionNan is not one per partition");
-        if (m.seeds)
-            expect(m.seeds->grids.size() == n &&
-                       m.seeds->seeds.size() == gridCellCount(m.seeds->grids),
-                   path, "the seed grids do not match the partitions");
-        if (m.macro)
-            expect(m.macro->grids.size() == n &&
-                       m.macro->cells.size() == gridCellCount(m.macro->grids) &&
-                       (m.macro->nanCells.empty() ||
-                        m.macro->nanCells.size() == m.macro->cells.size()),
-                   path, "the macrocell grids do not match the partitions");
+        for (const KdPartition& part : m.kd->partitions)
+            expect(finite(part.box), path, "a partition's box is not finite");
+        if (m.seeds) {
+            expect(m.seeds->grids.size() == n, path, "the seed grids do not match the partitions");
+            const std::string why = gridsMalformed(m.seeds->grids, m.seeds->seeds.size());
+            expect(why.empty(), path, "the seed grids are malformed: " + why);
+        }
+        if (m.macro) {
+            expect(m.macro->grids.size() == n, path,
+                   "the macrocell grids do not match the partitions");
+            const std::string why = gridsMalformed(m.macro->grids, m.macro->cells.size());
+            expect(why.empty(), path, "the macrocell grids are malformed: " + why);
+            expect(m.macro->nanCells.empty() || m.macro->nanCells.size() == m.macro->cells.size(),
+                   path, "macro.nanCells is not one per macrocell");
+        }
     }
 }
 
@@ -577,7 +720,7 @@ CacheKey makeCacheKey(const std::string& meshPath, const std::string& fieldSpec,
     if (ec) throwError(ErrorKind::Io, meshPath, "cannot resolve the path: " + ec.message());
     k.sourcePath = canonical.string();
     {
-        InputFile in(k.sourcePath);
+        InputFile in(k.sourcePath, false);
         struct stat st;
         if (stat(k.sourcePath.c_str(), &st) != 0)
             throwError(ErrorKind::Io, meshPath,
@@ -675,6 +818,7 @@ std::uint64_t writePreparedCache(const PreparedMesh& mesh, const CacheKey& key,
     UVR_CHECK(header.size() == headerLength, "the prepared cache's header changed length");
 
     OutputFile out(path);
+    out.denyOthersWrite();  // a reader trusts no cache that others may write
     unsigned char pre[kPreambleBytes] = {};
     std::memcpy(pre, kPreparedCacheMagic, 8);
     const std::uint32_t version = kPreparedCacheVersion;
@@ -703,14 +847,14 @@ std::uint64_t writePreparedCache(const PreparedMesh& mesh, const CacheKey& key,
 }
 
 CacheHeader readPreparedCacheHeader(const std::string& path) {
-    InputFile in(path);
+    InputFile in(path, true);
     return parseHeader(in).header;
 }
 
 PreparedMesh readPreparedCache(const std::string& path, const CacheKey& expected,
                                LoadBudget& budget, CacheHeader* header,
                                const std::function<void(double)>& progress) {
-    InputFile in(path);
+    InputFile in(path, true);
     ParsedHeader parsed = parseHeader(in);
     if (header) *header = parsed.header;
     const std::string why = cacheKeyMismatch(parsed.header.key, expected);
@@ -741,6 +885,11 @@ PreparedMesh readPreparedCache(const std::string& path, const CacheKey& expected
                        "array '" + e.name + "' of " + std::to_string(e.count) + " elements at " +
                            atByte(e.offset) + " reaches beyond the file's " +
                            std::to_string(in.size) + " bytes (truncated?)");
+        // Every index into an array is 32-bit (cell ids, block bases, node and grid indices).
+        if (e.count > 0xffffffffull)
+            throwError(ErrorKind::Parse, path,
+                       "array '" + e.name + "' of " + std::to_string(e.count) +
+                           " elements: more than 32-bit indices reach (a damaged or crafted file)");
         budget.charge(path, "array '" + e.name + "'", e.count, sizeof(T));
         v.resize(e.count);
         const std::uint64_t bytes = e.count * sizeof(T);

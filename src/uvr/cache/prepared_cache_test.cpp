@@ -4,8 +4,13 @@
 #include <gmock/gmock.h>
 #include <zlib.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <thread>
 
 #include "test_support.h"
@@ -250,7 +255,7 @@ TEST(PreparedCache, CraftedIndicesWithMatchingChecksumsAreRefused) {
         {"tets.tetCorners", 10, 0xffffull, 2, "corner lies outside its block"},
         {"neighbors.tetCodes", 6, 0x2000ull + 30000, 2, "neighbour code lies outside its block"},
         {"cellTree.nodes", 24, 0xfffffff0ull, 4, "the cell tree is malformed"},
-        {"seeds.seeds", 0, 0x7fffffffull, 4, "name cells or seeds out of range"},
+        {"seeds.seeds", 0, 0x7fffffffull, 4, "a seed is not a cell"},
     };
     for (const Case& k : cases) {
         std::string bytes = good;
@@ -264,6 +269,153 @@ TEST(PreparedCache, CraftedIndicesWithMatchingChecksumsAreRefused) {
     testing::writeFile(c.path, good);
     LoadBudget budget;
     EXPECT_NO_THROW(readPreparedCache(c.path, c.key, budget));
+}
+
+TEST(PreparedCache, EveryCraftedFieldWithMatchingChecksumsIsRefused) {
+    // A deliberate writer: the cache writer itself, handed a prepared mesh with one field
+    // changed, so that every checksum matches (a CRC proves nothing against such a file).
+    // Three blocks of tetrahedra (escape bases to cross), partitions, seeds and macrocells.
+    const std::string dir = testing::scratchDir();
+    ProceduralSpec spec;
+    spec.targetCells = 20000;
+    const Mesh mesh = generateMesh(spec);
+    const PrepareOptions options = bothMethods();
+    const PreparedMesh fresh = prepareMesh(mesh, selectScalarField(mesh, {}), options);
+    ASSERT_GE(fresh.neighborCodes.escapeBase.size(), 3u);
+    ASSERT_TRUE(fresh.kd && fresh.seeds && fresh.macro);
+    ASSERT_GE(fresh.kd->partitions.size(), 2u);
+    const CacheKey key = makeCacheKey(sourceFile(dir), "", "", options);
+    const std::string path = dir + "/c.uvrprep";
+    const float nan = std::nanf("");
+    struct Case {
+        const char* what;
+        std::function<void(PreparedMesh&)> craft;
+        const char* message;
+    };
+    const Case cases[] = {
+        // Header scalars.
+        {"a pyramid count beyond 32-bit ids",
+         [](PreparedMesh& m) { m.tets.pyramidCount = 1ull << 62; },
+         "a cell count of 4611686018427387904"},
+        {"infinite bounds", [](PreparedMesh& m) { m.tets.bounds.hi.x = INFINITY; },
+         "bounds that are not finite"},
+        {"NaN k-d bounds", [=](PreparedMesh& m) { m.kd->bounds.lo.y = nan; },
+         "bounds that are not finite"},
+        {"a zero scale", [](PreparedMesh& m) { m.tets.frame.scale = 0.0; }, "the frame's scale"},
+        {"seeds without partitions",
+         [](PreparedMesh& m) {
+             m.kd.reset();
+             m.macro.reset();
+         },
+         "grids without k-d partitions"},
+        // The seed grids (the dims[0] = 0: cellIndex clamped to 4294967295).
+        {"a seed grid of 0 cells across", [](PreparedMesh& m) { m.seeds->grids[0].dims[0] = 0; },
+         "the seed grids are malformed: grid 0 has 0 cells on axis 0"},
+        {"a seed grid too wide", [](PreparedMesh& m) { m.seeds->grids[0].dims[1] = 5000; },
+         "grid 0 has 5000 cells on axis 1 (1 to 1024)"},
+        {"seed grids overlapping", [](PreparedMesh& m) { m.seeds->grids[1].first -= 1; },
+         "grid 1 starts at cell"},
+        {"a NaN seed grid origin", [=](PreparedMesh& m) { m.seeds->grids[1].lo.z = nan; },
+         "grid 1 has an origin that is not finite"},
+        {"a negative cell size", [](PreparedMesh& m) { m.seeds->grids[0].cellsPerUnit.x = -1.f; },
+         "grid 0 has a negative or NaN cell size"},
+        {"a seed missing", [](PreparedMesh& m) { m.seeds->seeds.pop_back(); },
+         "the seed grids are malformed: the grids hold"},
+        {"a seed grid missing", [](PreparedMesh& m) { m.seeds->grids.pop_back(); },
+         "the seed grids do not match the partitions"},
+        // The macrocell grids.
+        {"a macrocell grid of 0 cells", [](PreparedMesh& m) { m.macro->grids.back().dims[2] = 0; },
+         "the macrocell grids are malformed"},
+        {"a macrocell missing", [](PreparedMesh& m) { m.macro->cells.pop_back(); },
+         "the macrocell grids are malformed: the grids hold"},
+        {"NaN flags of another length", [](PreparedMesh& m) { m.macro->nanCells.assign(3, 1); },
+         "macro.nanCells is not one per macrocell"},
+        // Partitions.
+        {"a NaN partition box", [=](PreparedMesh& m) { m.kd->partitions[0].box.lo.x = nan; },
+         "a partition's box is not finite"},
+        {"a k-d leaf beyond the partitions",
+         [](PreparedMesh& m) {
+             for (KdNode& n : m.kd->nodes)
+                 if (n.isLeaf()) n.bits = (1000000u << 2) | 3u;
+         },
+         "the k-d tree is malformed"},
+        {"a gradient spread missing", [](PreparedMesh& m) { m.gradientSpread.pop_back(); },
+         "gradientSpread is not one per partition"},
+        {"NaN flags of partitions", [](PreparedMesh& m) { m.partitionNan.assign(1, 1); },
+         "partitionNan is not one per partition"},
+        // Tetrahedra, blocks and neighbours.
+        {"a block base going back",
+         [](PreparedMesh& m) { m.tets.blockVertexBase[1] = m.tets.blockVertexBase[2] + 1; },
+         "tets.blockVertexBase is not increasing"},
+        {"an escape base going back",
+         [](PreparedMesh& m) {
+             m.neighborCodes.escapeBase[1] = m.neighborCodes.escapeBase.back() + 100000;
+         },
+         "neighbors.escapeBase is not increasing"},
+        {"an escape naming no cell", [](PreparedMesh& m) { m.neighborCodes.escapes[0] = 4000000; },
+         "a face neighbour is not a cell"},
+        {"a corner missing", [](PreparedMesh& m) { m.tets.tetCorners.pop_back(); },
+         "tets.tetCorners does not hold one entry per tetrahedron"},
+        // Trees.
+        {"cell tree ids naming no cell",
+         [](PreparedMesh& m) { m.cellTree.primIds.assign(64, 7000000); },
+         "the cell tree is malformed"},
+        {"a mesh BVH id naming no cell", [](PreparedMesh& m) { m.bvh.primIds[0] = 7000000; },
+         "the mesh BVH is malformed"},
+    };
+    for (const Case& k : cases) {
+        PreparedMesh crafted = fresh;
+        k.craft(crafted);
+        writePreparedCache(crafted, key, {}, path);
+        const Error e = catchError([&] {
+            LoadBudget budget;
+            readPreparedCache(path, key, budget);
+        });
+        EXPECT_EQ(e.kind(), ErrorKind::Parse) << k.what << ": " << e.what();
+        EXPECT_THAT(e.what(), HasSubstr(k.message)) << k.what;
+        EXPECT_THAT(e.what(), HasSubstr(path)) << k.what;
+    }
+    writePreparedCache(fresh, key, {}, path);
+    LoadBudget budget;
+    EXPECT_NO_THROW(readPreparedCache(path, key, budget));
+}
+
+TEST(PreparedCache, FilesOfOtherUsersWritableByOthersOrNotRegularAreNotTrusted) {
+    const SmallCache c;
+    const auto both = [&] {
+        const Error header = catchError([&] { readPreparedCacheHeader(c.path); });
+        const Error full = c.readError();
+        EXPECT_EQ(std::string(header.what()), full.what());
+        return full;
+    };
+    // Writable by its group or by everyone.
+    for (mode_t mode : {0664, 0646}) {
+        ASSERT_EQ(::chmod(c.path.c_str(), mode), 0);
+        const Error e = both();
+        EXPECT_EQ(e.kind(), ErrorKind::Io);
+        EXPECT_THAT(e.what(), HasSubstr(c.path + ": not trusted as a prepared cache: its group or "
+                                                 "other users may write it"));
+    }
+    ASSERT_EQ(::chmod(c.path.c_str(), 0644), 0);
+    LoadBudget budget;
+    EXPECT_NO_THROW(readPreparedCache(c.path, c.key, budget));
+    // Another user's.
+    if (::geteuid() == 0) {
+        ASSERT_EQ(::chown(c.path.c_str(), 65534, 65534), 0);
+        EXPECT_THAT(both().what(), HasSubstr("not trusted as a prepared cache: it belongs to uid "
+                                             "65534"));
+    }
+    // A FIFO is refused before it is opened for reading (which would wait for a writer).
+    const std::string fifo = c.dir + "/fifo.uvrprep";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const Error e = catchError([&] { readPreparedCacheHeader(fifo); });
+    EXPECT_EQ(e.kind(), ErrorKind::Io);
+    EXPECT_THAT(e.what(), HasSubstr(fifo + ": not a regular file (a FIFO)"));
+    EXPECT_THAT(catchError([&] { readPreparedCacheHeader("/dev/zero"); }).what(),
+                HasSubstr("not a regular file (a character device)"));
+    // A FIFO as the mesh of a key is refused likewise.
+    EXPECT_THAT(catchError([&] { makeCacheKey(fifo, "", "", {}); }).what(),
+                HasSubstr("not a regular file (a FIFO)"));
 }
 
 TEST(PreparedCache, TheBudgetIsChargedBeforeAllocating) {

@@ -2,6 +2,7 @@
 #include "uvr/core/output_file.h"
 
 #include <fcntl.h>
+#include <pwd.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -97,6 +98,39 @@ bool fileIdentity(const std::string& path, dev_t& dev, ino_t& ino, mode_t* mode 
     return true;
 }
 
+/// "uid N (name)" for messages.
+std::string userName(uid_t uid) {
+    std::string out = "uid " + std::to_string(uid);
+    struct passwd pw, *found = nullptr;
+    char buf[1024];
+    if (::getpwuid_r(uid, &pw, buf, sizeof buf, &found) == 0 && found)
+        out += std::string(" (") + found->pw_name + ")";
+    return out;
+}
+
+/// The kernel's rule for shared folders (fs.protected_symlinks, fs.protected_regular and
+/// fs.protected_fifos), applied here since uvr follows the links itself: in a folder that is
+/// sticky and writable by everyone (/tmp), a symbolic link is followed, and an existing file
+/// replaced or written, only when it belongs to the current effective user or to the folder's
+/// owner. Anything else may have been planted by another user to redirect the output. Throws
+/// Error(Io) naming the entry, its owner and the folder.
+void checkSharedFolderEntry(const std::string& shown, const std::string& entry,
+                            const struct stat& st) {
+    const std::string folder = folderOf(entry);
+    struct stat dir;
+    if (::stat(folder.c_str(), &dir) != 0)
+        ioError(shown, "cannot write: folder '" + folder + "'", errno);
+    if ((dir.st_mode & (S_ISVTX | S_IWOTH)) != (S_ISVTX | S_IWOTH)) return;
+    if (st.st_uid == ::geteuid() || st.st_uid == dir.st_uid) return;
+    const bool link = S_ISLNK(st.st_mode);
+    throwError(ErrorKind::Io, shown,
+               std::string(link ? "refusing to follow the symbolic link '"
+                                : "refusing to replace or write '") +
+                   entry + "' owned by " + userName(st.st_uid) + " in the shared folder '" +
+                   folder + "' (sticky, writable by everyone, owned by " + userName(dir.st_uid) +
+                   "): another user may have planted it; remove it or name another output");
+}
+
 }  // namespace
 
 OutputTarget resolveOutput(const std::string& path) {
@@ -122,6 +156,8 @@ OutputTarget resolveOutput(const std::string& path) {
             if (errno != ENOENT) ioError(path, "cannot write", errno);
             break;
         }
+        // Every link of the chain and the file it ends at pass the shared-folder rule.
+        checkSharedFolderEntry(path, p, st);
         if (!S_ISLNK(st.st_mode)) {
             exists = true;
             break;
@@ -259,7 +295,7 @@ void OutputFile::finish() {
     flush();
     if (target_.kind == OutputKind::Atomic) {
         // The replaced file's permissions (and owner, where permitted), or the umask's.
-        ::fchmod(fd_, static_cast<mode_t>(target_.mode));
+        ::fchmod(fd_, static_cast<mode_t>(target_.mode & (denyOthersWrite_ ? ~022u : ~0u)));
         if (target_.exists) {
             struct stat st;
             if (::fstat(fd_, &st) == 0 && (st.st_uid != target_.uid || st.st_gid != target_.gid))

@@ -32,7 +32,11 @@ struct OutputTarget {
 
 /// Resolves an output path and checks that it can be written: "-" is standard output (refused
 /// when it is a terminal); a folder, a block device or a terminal is refused; an atomic output
-/// needs an existing, writable folder. Throws Error(Io) or Error(Argument) naming the path.
+/// needs an existing, writable folder. In a folder that is sticky and writable by everyone
+/// (/tmp), a symbolic link of the chain or the existing file it ends at must belong to the
+/// current effective user or to the folder's owner (the kernel's protected_symlinks and
+/// protected_regular rules: uvr follows the links itself, so the kernel's cannot apply).
+/// Throws Error(Io) or Error(Argument) naming the path.
 OutputTarget resolveOutput(const std::string& path);
 
 /// One output being written. Bytes are buffered and every write is checked (a full disk, a
@@ -62,6 +66,9 @@ public:
     void commit();
     /// The path as given.
     const std::string& path() const { return target_.path; }
+    /// The written file will not be writable by its group or others, whatever the umask or the
+    /// replaced file's mode (for files whose readers trust only such files: prepared caches).
+    void denyOthersWrite() { denyOthersWrite_ = true; }
 
 private:
     void flush();
@@ -78,6 +85,7 @@ private:
     std::uint64_t written_ = 0;
     bool finished_ = false;
     bool committed_ = false;
+    bool denyOthersWrite_ = false;
 };
 
 /// Writes an output through write(out) and commits it; on any exception the output is abandoned

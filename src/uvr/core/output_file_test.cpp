@@ -116,6 +116,83 @@ TEST(OutputFile, SymbolicLinksAreWrittenThroughAndKept) {
                          "too many levels of symbolic links"));
 }
 
+/// A folder like /tmp: sticky and writable by everyone.
+std::string sharedFolder(const std::string& parent) {
+    const std::string dir = parent + "/shared";
+    fs::create_directories(dir);
+    EXPECT_EQ(::chmod(dir.c_str(), 01777), 0);
+    return dir;
+}
+
+constexpr uid_t kOtherUser = 65534;  // nobody
+
+TEST(OutputFile, LinksPlantedByAnotherUserInASharedFolderAreNotFollowed) {
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root to give a link to another user";
+    const std::string dir = testing::scratchDir();
+    const std::string shared = sharedFolder(dir);
+    const std::string victim = testing::writeFile(dir + "/victim", "precious");
+    const std::string link = shared + "/frame_0000.png";
+    fs::create_symlink(victim, link);
+    ASSERT_EQ(::lchown(link.c_str(), kOtherUser, kOtherUser), 0);
+    const std::string error = errorOf([&] { writeTextOutput(link, "png"); });
+    EXPECT_TRUE(contains(error, "refusing to follow the symbolic link '" + link + "'")) << error;
+    EXPECT_TRUE(contains(error, "owned by uid 65534")) << error;
+    EXPECT_TRUE(contains(error, "in the shared folder '" + shared + "'")) << error;
+    EXPECT_EQ(testing::readFile(victim), "precious");
+    EXPECT_EQ(listing(shared), std::vector<std::string>{"frame_0000.png"});
+    EXPECT_TRUE(fs::is_symlink(link));
+
+    // At every link of a chain: our own link to the planted one is refused too.
+    const std::string own = shared + "/own.png";
+    fs::create_symlink(link, own);
+    EXPECT_TRUE(contains(errorOf([&] { writeTextOutput(own, "png"); }),
+                         "refusing to follow the symbolic link '" + link + "'"));
+    EXPECT_EQ(testing::readFile(victim), "precious");
+
+    // A link of the current user, or of the folder's owner, is followed.
+    ASSERT_EQ(::lchown(link.c_str(), 0, 0), 0);
+    writeTextOutput(own, "mine");
+    EXPECT_EQ(testing::readFile(victim), "mine");
+    const std::string owned = dir + "/owned";
+    fs::create_directories(owned);
+    ASSERT_EQ(::chmod(owned.c_str(), 01777), 0);
+    ASSERT_EQ(::chown(owned.c_str(), kOtherUser, kOtherUser), 0);
+    fs::create_symlink(victim, owned + "/theirs.png");
+    ASSERT_EQ(::lchown((owned + "/theirs.png").c_str(), kOtherUser, kOtherUser), 0);
+    writeTextOutput(owned + "/theirs.png", "folder owner's link");
+    EXPECT_EQ(testing::readFile(victim), "folder owner's link");
+
+    // Outside sticky world-writable folders the rule does not apply (as in the kernel).
+    const std::string open = dir + "/open";
+    fs::create_directories(open);
+    ASSERT_EQ(::chmod(open.c_str(), 0777), 0);
+    fs::create_symlink(victim, open + "/x.png");
+    ASSERT_EQ(::lchown((open + "/x.png").c_str(), kOtherUser, kOtherUser), 0);
+    writeTextOutput(open + "/x.png", "not shared");
+    EXPECT_EQ(testing::readFile(victim), "not shared");
+}
+
+TEST(OutputFile, FilesAndFifosOfAnotherUserInASharedFolderAreNotReplacedOrWritten) {
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root to give a file to another user";
+    const std::string shared = sharedFolder(testing::scratchDir());
+    const std::string file = testing::writeFile(shared + "/out.png", "theirs");
+    ASSERT_EQ(::chown(file.c_str(), kOtherUser, kOtherUser), 0);
+    const std::string error = errorOf([&] { writeTextOutput(file, "ours"); });
+    EXPECT_TRUE(contains(error, "refusing to replace or write '" + file + "' owned by uid 65534"))
+        << error;
+    EXPECT_EQ(testing::readFile(file), "theirs");
+    // A FIFO: refused before it is opened (which would block and hand the output to its reader).
+    const std::string fifo = shared + "/pipe";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0666), 0);
+    ASSERT_EQ(::chown(fifo.c_str(), kOtherUser, kOtherUser), 0);
+    EXPECT_TRUE(contains(errorOf([&] { writeTextOutput(fifo, "ours"); }), "refusing to replace"));
+    EXPECT_EQ(listing(shared), (std::vector<std::string>{"out.png", "pipe"}));
+    // The user's own file there is replaced as usual.
+    ASSERT_EQ(::chown(file.c_str(), 0, 0), 0);
+    writeTextOutput(file, "ours");
+    EXPECT_EQ(testing::readFile(file), "ours");
+}
+
 TEST(OutputFile, LongNamesFitBecauseTheTemporaryNameIsShort) {
     const std::string dir = testing::scratchDir();
     const std::string path = dir + "/" + std::string(251, 'n') + ".png";  // 255 bytes

@@ -294,6 +294,11 @@ inline constexpr std::uint64_t kFrameBytesPerPixel = 24;
 /// Host bytes per pixel of a sample-count heat map written as a PNG (float image and 8-bit rows),
 /// counted over the image and its legend.
 inline constexpr std::uint64_t kHeatmapBytesPerPixel = 20;
+/// Image-buffer bytes one frame (or a command's frames held together) may take unless a memory
+/// limit is given explicitly: 2 GiB, an 8192 x 8192 frame (1.5 GiB) with room. A frame's memory
+/// and time grow with its pixels whatever the mesh (16384 x 16384 of five tetrahedra: 6 GiB and
+/// a minute), so larger frames must be asked for with an explicit limit.
+inline constexpr std::uint64_t kDefaultFrameMemoryBytes = 2ull << 30;
 /// Host bytes prepareMesh needs per tetrahedron, an upper estimate for memory limits: the
 /// tetrahedra, the BVH with its build arrays, the neighbours, partitions and seed grids took
 /// 120 to 130 bytes on 4-million-tetrahedron procedural meshes.
