@@ -2,7 +2,6 @@
 #include "uvr/cache/prepared_cache.h"
 
 #include <fcntl.h>
-#include <pwd.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -17,6 +16,7 @@
 #include <optional>
 #include <type_traits>
 
+#include "uvr/core/file_util.h"
 #include "uvr/core/output_file.h"
 
 namespace uvr {
@@ -258,34 +258,14 @@ std::string headerBytes(const PreparedMesh& m, const CacheKey& key, const Source
     return w.bytes;
 }
 
-/// What a file is, for messages.
-const char* fileType(mode_t mode) {
-    if (S_ISDIR(mode)) return "a folder";
-    if (S_ISFIFO(mode)) return "a FIFO";
-    if (S_ISCHR(mode)) return "a character device";
-    if (S_ISBLK(mode)) return "a block device";
-    if (S_ISSOCK(mode)) return "a socket";
-    return "not a regular file";
-}
-
-/// "uid N (name)" for messages.
-std::string userName(uid_t uid) {
-    std::string out = "uid " + std::to_string(uid);
-    struct passwd pw, *found = nullptr;
-    char buf[1024];
-    if (::getpwuid_r(uid, &pw, buf, sizeof buf, &found) == 0 && found)
-        out += std::string(" (") + found->pw_name + ")";
-    return out;
-}
-
 /// A prepared cache is code-like input (its arrays steer the kernels), so only a file that the
 /// current user owns and that nobody else can write is trusted: another user could have planted
 /// it (its checksums prove nothing against a deliberate writer). Throws Error(Io) saying why.
 void checkTrusted(const std::string& path, const struct stat& st) {
     if (st.st_uid != ::geteuid())
         throwError(ErrorKind::Io, path,
-                   "not trusted as a prepared cache: it belongs to " + userName(st.st_uid) +
-                       ", not to the current user " + userName(::geteuid()));
+                   "not trusted as a prepared cache: it belongs to " + describeUser(st.st_uid) +
+                       ", not to the current user " + describeUser(::geteuid()));
     if (st.st_mode & (S_IWGRP | S_IWOTH)) {
         char mode[8];
         std::snprintf(mode, sizeof mode, "%04o", unsigned(st.st_mode & 07777));
@@ -317,7 +297,7 @@ struct InputFile {
         if (!S_ISREG(st.st_mode)) {
             ::close(fd);
             throwError(ErrorKind::Io, p,
-                       std::string("not a regular file (") + fileType(st.st_mode) + ")" +
+                       std::string("not a regular file (") + describeFileType(st.st_mode) + ")" +
                            (cache ? ": a prepared cache must be a file" : ""));
         }
         if (cache) {

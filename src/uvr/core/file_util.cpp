@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/core/file_util.h"
 
+#include <pwd.h>
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -69,6 +72,25 @@ void checkAllocation(const std::string& file, const std::string& what, std::uint
                        std::to_string(elementSize) + " bytes exceed the memory limit of " +
                        std::to_string(limitBytes) + " bytes");
     }
+}
+
+std::string describeUser(std::uint32_t uid) {
+    std::string out = "uid " + std::to_string(uid);
+    struct passwd pw, *found = nullptr;
+    char buf[1024];
+    if (::getpwuid_r(static_cast<uid_t>(uid), &pw, buf, sizeof buf, &found) == 0 && found)
+        out += std::string(" (") + found->pw_name + ")";
+    return out;
+}
+
+const char* describeFileType(std::uint32_t mode) {
+    const auto m = static_cast<mode_t>(mode);
+    if (S_ISDIR(m)) return "a folder";
+    if (S_ISFIFO(m)) return "a FIFO";
+    if (S_ISCHR(m)) return "a character device";
+    if (S_ISBLK(m)) return "a block device";
+    if (S_ISSOCK(m)) return "a socket";
+    return "not a regular file";
 }
 
 }  // namespace uvr

@@ -17,6 +17,13 @@ std::vector<char> readFileBytes(const std::string& path, std::uint64_t maxBytes 
 /// pipe would block and a device has no size); a missing file is left to the caller's open.
 void checkRegularFile(const std::string& path);
 
+/// "uid N (name)" for messages naming a file's owner (the name where the system knows it).
+std::string describeUser(std::uint32_t uid);
+
+/// What a file of stat mode `mode` is, for messages: "a folder", "a FIFO", "a character device",
+/// "a block device", "a socket", else "not a regular file".
+const char* describeFileType(std::uint32_t mode);
+
 /// Size of a file in bytes; throws Error(Io) when it cannot be opened.
 std::uint64_t fileSize(const std::string& path);
 

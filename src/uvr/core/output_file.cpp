@@ -2,7 +2,6 @@
 #include "uvr/core/output_file.h"
 
 #include <fcntl.h>
-#include <pwd.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -16,6 +15,7 @@
 #include <filesystem>
 
 #include "uvr/core/error.h"
+#include "uvr/core/file_util.h"
 
 namespace uvr {
 
@@ -98,16 +98,6 @@ bool fileIdentity(const std::string& path, dev_t& dev, ino_t& ino, mode_t* mode 
     return true;
 }
 
-/// "uid N (name)" for messages.
-std::string userName(uid_t uid) {
-    std::string out = "uid " + std::to_string(uid);
-    struct passwd pw, *found = nullptr;
-    char buf[1024];
-    if (::getpwuid_r(uid, &pw, buf, sizeof buf, &found) == 0 && found)
-        out += std::string(" (") + found->pw_name + ")";
-    return out;
-}
-
 /// The kernel's rule for shared folders (fs.protected_symlinks, fs.protected_regular and
 /// fs.protected_fifos), applied here since uvr follows the links itself: in a folder that is
 /// sticky and writable by everyone (/tmp), a symbolic link is followed, and an existing file
@@ -126,8 +116,9 @@ void checkSharedFolderEntry(const std::string& shown, const std::string& entry,
     throwError(ErrorKind::Io, shown,
                std::string(link ? "refusing to follow the symbolic link '"
                                 : "refusing to replace or write '") +
-                   entry + "' owned by " + userName(st.st_uid) + " in the shared folder '" +
-                   folder + "' (sticky, writable by everyone, owned by " + userName(dir.st_uid) +
+                   entry + "' owned by " + describeUser(st.st_uid) + " in the shared folder '" +
+                   folder + "' (sticky, writable by everyone, owned by " +
+                   describeUser(dir.st_uid) +
                    "): another user may have planted it; remove it or name another output");
 }
 

@@ -226,24 +226,10 @@ TEST(HostileLibraryFiles, Netcdf4ExodusExternalLinkIsRefused) {
 
 // --- Files the libraries crash or hang on ------------------------------------------------------
 
-/// Shortens the probes' time limit for one test (hangs cost that long each).
-class ShortProbes {
-public:
-    explicit ShortProbes(double seconds) : saved_(probeLimits()) {
-        ProbeLimits limits = saved_;
-        limits.seconds = seconds;
-        setProbeLimits(limits);
-    }
-    ~ShortProbes() { setProbeLimits(saved_); }
-
-private:
-    ProbeLimits saved_;
-};
-
 TEST(HostileLibraryFiles, FilesTheLibrariesCrashOnGiveAnError) {
     REQUIRE_LIBRARIES();
     const std::string folder = std::string(UVR_FUZZ_REGRESSIONS_DIR) + "/netcdf_hdf5";
-    const ShortProbes shortProbes(5);
+    const ScopedProbeSeconds shortProbes(5);
     std::size_t files = 0;
     for (const auto& entry : std::filesystem::directory_iterator(folder)) {
         if (entry.path().extension() == ".md") continue;
@@ -372,7 +358,7 @@ TEST(HostileLibraryFiles, MutatedRealFilesGiveErrorsNotCrashes) {
     }
     const char* env = std::getenv("UVR_MUTATIONS");
     const std::size_t perBase = env ? std::strtoull(env, nullptr, 10) : 60;
-    const ShortProbes shortProbes(env ? 10 : 2);
+    const ScopedProbeSeconds shortProbes(env ? 10 : 2);
     ReadOptions options;
     options.maxMemoryBytes = 1ull << 30;
     std::map<std::string, std::size_t> outcomes;

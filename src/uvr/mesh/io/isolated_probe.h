@@ -29,6 +29,23 @@ ProbeLimits probeLimits();
 /// Replaces the limits of every later probe (tests shorten the time; fuzzers may run in-process).
 void setProbeLimits(const ProbeLimits& limits);
 
+/// Sets the probes' time limit for its own lifetime and then restores the limits it found (tests
+/// shorten the wait for a hanging library this way).
+class ScopedProbeSeconds {
+public:
+    explicit ScopedProbeSeconds(double seconds) : saved_(probeLimits()) {
+        ProbeLimits limits = saved_;
+        limits.seconds = seconds;
+        setProbeLimits(limits);
+    }
+    ~ScopedProbeSeconds() { setProbeLimits(saved_); }
+    ScopedProbeSeconds(const ScopedProbeSeconds&) = delete;
+    ScopedProbeSeconds& operator=(const ScopedProbeSeconds&) = delete;
+
+private:
+    ProbeLimits saved_;
+};
+
 /// Runs probe (which calls the library `library` on `file`) in a forked child under
 /// probeLimits(), and returns when it succeeded. A uvr::Error thrown by probe is thrown again
 /// here (same kind and message); another exception becomes Error(Resource) (the child's memory

@@ -18,20 +18,6 @@ namespace {
 
 using testing::catchError;
 
-/// Shortens the probes' time limit for one test and restores it after.
-class ShortProbes {
-public:
-    explicit ShortProbes(double seconds) : saved_(probeLimits()) {
-        ProbeLimits limits = saved_;
-        limits.seconds = seconds;
-        setProbeLimits(limits);
-    }
-    ~ShortProbes() { setProbeLimits(saved_); }
-
-private:
-    ProbeLimits saved_;
-};
-
 TEST(IsolatedProbe, SuccessReturns) {
     const FormatLibraryLock lock;
     runIsolatedProbe("f.e", "netCDF", [] {});
@@ -52,7 +38,7 @@ TEST(IsolatedProbe, ACrashIsAParseErrorNamingFileAndLibrary) {
 }
 
 TEST(IsolatedProbe, AHangIsKilledAfterTheTimeLimit) {
-    const ShortProbes shortProbes(0.5);
+    const ScopedProbeSeconds shortProbes(0.5);
     const FormatLibraryLock lock;
     const Error e = catchError([] {
         runIsolatedProbe("loop.e", "HDF5", [] {
