@@ -824,9 +824,10 @@ TEST(Cli, CameraAndMemoryErrorsNameTheFile) {
     if (testing::underAddressSanitizer()) return;
     const std::string mesh =
         testing::writeFile(dir + "/m.vtk", fiveTetCube("f", "0 1 2 3 4 5 6 7"));
-    const CliRun r = uvr(
-        "-q render " + mesh + " --device cpu --threads 2 --size 12000x12000 -o " + dir + "/o.png",
-        dir, "ulimit -v 1000000; ");
+    const CliRun r =
+        uvr("-q render " + mesh +
+                " --device cpu --threads 2 --size 12000x12000 --max-memory 8G -o " + dir + "/o.png",
+            dir, "ulimit -v 1000000; ");
     expectOneLineError(r, {"uvr: error: " + mesh + ": "}, "out of memory");
     if (r.err.find("out of memory") != std::string::npos) {
         EXPECT_NE(r.err.find(mesh + ": out of memory while rendering it at 12000x12000"),
