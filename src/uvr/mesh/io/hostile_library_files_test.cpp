@@ -253,9 +253,14 @@ TEST(HostileLibraryFiles, TheCliExitsWithTwoWhenALibraryCrashes) {
         SCOPED_TRACE(name);
         const std::string log = dir + "/info.log";
         // (The library's SIGSEGV killed uvr: the shell's status 139.)
-        EXPECT_EQ(testing::runCommand(testing::uvrBinary() + " info " + folder + name + " > " +
-                                      log + " 2>&1"),
-                  2);
+        const int status = testing::runCommand(testing::uvrBinary() + " info " + folder + name +
+                                               " > " + log + " 2>&1");
+        if (testing::underAddressSanitizer() && status == 0) {
+            // The crash reads garbage whose contents depend on the allocator: under the
+            // sanitizer's allocator these files may read without one. Never a signal, though.
+            continue;
+        }
+        EXPECT_EQ(status, 2);
         // (signal 11 in a release build; a sanitizer's allocator may end the child itself.)
         expectIn(testing::readFile(log), "uvr: error: " + folder + name + ": the " + library +
                                              " library failed on this file (");

@@ -708,7 +708,10 @@ TEST(VtuAmplification, LzmaBlockTableDeclaringGigabytesTouchesOnlyWhatItDecodes)
     EXPECT_THAT(read.error,
                 HasSubstr("LZMA block 0 of DataArray 'Points' is corrupt (not an xz stream)"));
     ASSERT_GE(read.growthKiB, 0) << "the reading process died";
-    EXPECT_LT(read.growthKiB, 256 * 1024) << "KiB of resident memory for a 66 KB file";
+    // AddressSanitizer keeps up to 256 MiB of freed memory in quarantine; the old reader grew
+    // by 2.1 GB either way.
+    const long limitKiB = testing::underAddressSanitizer() ? 768 * 1024 : 256 * 1024;
+    EXPECT_LT(read.growthKiB, limitKiB) << "KiB of resident memory for a 66 KB file";
 }
 
 TEST(VtuAmplification, LzmaBlockReusedByThreeThousandPiecesIsRefused) {
