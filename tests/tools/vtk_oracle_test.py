@@ -14,9 +14,10 @@ Cases: Blunt Fin (density) and the Oxygen Post (speed), each with two transfer f
 (tests/data/oracle/*.json: a cool-to-warm Diverging map with an opacity ramp, a black-body Lab
 map with two opacity bands) and three views (ParaView's reset camera orbited with --azimuth 35
 --elevation 25, each tool doing its own orbit; a ParaView .pvcc camera; the orbit in parallel
-projection, --parallel, with the reset camera's parallel scale). uvr renders each case
-with every method in --methods; those in --assert-methods must reach --min-ssim, the others
-are reported. Images go to a temporary folder removed at the end (unless --keep).
+projection, --parallel, with the reset camera's parallel scale). uvr prepares each mesh once
+per method (`uvr prepare`, a cache in the temporary folder) and renders each case with every
+method in --methods from it; those in --assert-methods must reach --min-ssim, the others are
+reported. Images go to a temporary folder removed at the end (unless --keep).
 
 Exit status: 0 all asserted comparisons pass, 1 one fails, 77 skipped (a mesh missing from the
 data folder, no VTK/scikit-image in this Python, or no X display and no xvfb-run).
@@ -79,6 +80,23 @@ def ssim(path_a, path_b):
                                        use_sample_covariance=False, data_range=255))
 
 
+def prepared(uvr, mesh_path, field, method, work, caches, failures):
+    """The prepared cache of (mesh, field, method), written by `uvr prepare` into work once, so
+    each of the case's renders reads it instead of reading and preparing the mesh again; None
+    (and a failure) when prepare fails."""
+    key = (mesh_path, field, method)
+    if key not in caches:
+        path = os.path.join(work, f"{os.path.basename(mesh_path)}.{method}.uvrprep")
+        cmd = [uvr, "-q", "prepare", mesh_path, "-o", path, "--field", field,
+               "--method", method]
+        run = subprocess.run(cmd, capture_output=True, text=True)
+        if run.returncode != 0:
+            failures.append(f"{' '.join(cmd)} exited {run.returncode}: {run.stderr.strip()}")
+            path = None
+        caches[key] = path
+    return caches[key]
+
+
 def main():
     parser = argparse.ArgumentParser(
         description="uvr against VTK's Bunyk ray caster on real meshes (SSIM).")
@@ -124,6 +142,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     failures = []
     rows = []
+    caches = {}
     started = time.monotonic()
     try:
         for name, mesh_file, field, pvcc in MESHES:
@@ -149,8 +168,12 @@ def main():
                     t0 = time.monotonic()
                     for method in methods:
                         out = f"{stem}_uvr_{method}.png"
+                        cache = prepared(args.uvr, mesh_path, field, method, work, caches,
+                                         failures)
+                        if cache is None:
+                            continue
                         cmd = [args.uvr, "-q", "render", mesh_path, "-o", out,
-                               "--method", method] + flags
+                               "--method", method, "--cache", cache] + flags
                         run = subprocess.run(cmd, capture_output=True, text=True)
                         if run.returncode != 0:
                             failures.append(f"{case}: {' '.join(cmd)} exited {run.returncode}: "
