@@ -26,7 +26,7 @@ struct Variant {
     // Results.
     double medianSeconds = 0.0;
     std::uint64_t samples = 0;
-    double ssim = 1.0, psnr = 0.0;
+    ImageComparison cmp;  ///< against the exact image (exact's own: identical)
     RenderResult last;
 };
 
@@ -57,8 +57,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "bench",
         "Time reference, skipping only, adaptive only, both, and an s2 sweep on one mesh; "
-        "print time per frame, samples, speed-up over the reference and SSIM against the exact "
-        "integrator's image");
+        "print time per frame, samples, speed-up over the reference, and SSIM, the 99.9th "
+        "percentile and maximum of the per-pixel difference and the seams against the exact "
+        "integrator's image (the CSV and JSON add the pixels off and speckle)");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     auto repeat = std::make_shared<int>(5);
@@ -173,7 +174,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         exact.last = renderer.render(exact.settings);
         exact.medianSeconds = exact.last.stats.seconds;
         exact.samples = exact.last.stats.samples;  // tetrahedra crossed
-        exact.psnr = INFINITY;
+        exact.cmp.ssim = 1.0;
+        exact.cmp.psnr = INFINITY;
         const Rgb8Image yardstick = toRgb8(exact.last.image, bg);
         if (!images->empty()) writePng(*images + "/exact.png", exact.last.image, background);
         // Render: one warm-up frame, then `repeat` timed frames per variant.
@@ -192,9 +194,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             if (first)
                 for (std::uint32_t c : v.last.sampleCounts) heatmapMax = std::max(heatmapMax, c);
             first = false;
-            const ImageComparison cmp = compareImages(yardstick, toRgb8(v.last.image, bg));
-            v.ssim = cmp.ssim;
-            v.psnr = cmp.psnr;
+            v.cmp = compareImages(yardstick, toRgb8(v.last.image, bg));
             if (!images->empty()) {
                 const std::string stem = *images + "/" + v.file;
                 writePng(stem + ".png", v.last.image, background);
@@ -221,19 +221,21 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             printable(*file).c_str(), describeCells(prepared.tets).c_str(),
             prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
             ruleText.c_str(), where.c_str(), *repeat);
-        std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s\n", "configuration", "s2/s1", "ms/frame",
-                    "samples", "spp", renderer.gpu() ? "Msps" : "Msps/core", "speed-up",
-                    "SSIM/exact");
+        std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s %6s %5s %5s\n", "configuration", "s2/s1",
+                    "ms/frame", "samples", "spp", renderer.gpu() ? "Msps" : "Msps/core", "speed-up",
+                    "SSIM/exact", "p99.9", "max", "seams");
         std::vector<const Variant*> rows{&exact};  // exact's samples are tetrahedra crossed
         for (const Variant& v : variants) rows.push_back(&v);
         for (const Variant* row : rows) {
             const Variant& v = *row;
             const double pixels = double(base.width) * base.height;
-            std::printf("%-22s %8s %10.2f %12llu %9.2f %9.1f %7.2fx %8.4f\n", v.name.c_str(),
+            std::printf("%-22s %8s %10.2f %12llu %9.2f %9.1f %7.2fx %10.4f %6.1f %5g %5d\n",
+                        v.name.c_str(),
                         v.s2Factor > 0 ? std::to_string(v.s2Factor).substr(0, 5).c_str() : "-",
                         v.medianSeconds * 1e3, static_cast<unsigned long long>(v.samples),
                         v.samples / pixels, v.samples / v.medianSeconds / units / 1e6,
-                        refTime / v.medianSeconds, v.ssim);
+                        refTime / v.medianSeconds, v.cmp.ssim, v.cmp.p999Difference,
+                        v.cmp.maxAbsDifference, v.cmp.seamCount);
         }
         std::printf("transfer-function update: %.3f ms for %zu partitions\n",
                     variants.back().last.setup.tfUpdateSeconds * 1e3,
@@ -264,12 +266,17 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             writeOutput(*csv, [&](OutputFile& csvFile) {
                 std::ostringstream out;
                 out << "configuration,s2_over_s1,seconds_per_frame,samples,samples_per_pixel,"
-                       "speedup,ssim,psnr\n";
+                       "speedup,ssim,psnr";
+                for (const ComparisonField& f : differenceFields(ImageComparison{}))
+                    out << ',' << f.name;
+                out << '\n';
                 for (const Variant* row : rows) {
                     const Variant& v = *row;
                     out << '"' << v.name << "\"," << v.s2Factor << ',' << v.medianSeconds << ','
                         << v.samples << ',' << v.samples / (double(base.width) * base.height) << ','
-                        << refTime / v.medianSeconds << ',' << v.ssim << ',' << v.psnr << '\n';
+                        << refTime / v.medianSeconds << ',' << v.cmp.ssim << ',' << v.cmp.psnr;
+                    for (const ComparisonField& f : differenceFields(v.cmp)) out << ',' << f.value;
+                    out << '\n';
                 }
                 csvFile.write(out.str());
             });
@@ -306,8 +313,12 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                                           {"seconds_per_frame", v.medianSeconds},
                                           {"samples", v.samples},
                                           {"speedup", refTime / v.medianSeconds},
-                                          {"ssim", v.ssim},
-                                          {"psnr", v.psnr}};
+                                          {"ssim", v.cmp.ssim},
+                                          {"psnr", v.cmp.psnr}};
+                    for (const ComparisonField& f : differenceFields(v.cmp)) {
+                        row[f.name] = f.integer ? nlohmann::json(static_cast<long long>(f.value))
+                                                : nlohmann::json(f.value);
+                    }
                     if (!images->empty()) row["image"] = v.file;  // <file>.png, <file>_samples.png
                     j["rows"].push_back(row);
                 }

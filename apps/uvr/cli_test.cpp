@@ -568,6 +568,17 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     EXPECT_LT(ref, 1.0);
     EXPECT_NEAR(j["rows"][1]["ssim"].get<double>(), ref, 0.005);
     EXPECT_TRUE(std::filesystem::exists(dir + "/exact.png"));
+    // The per-pixel measures against exact (issue 29), by their one name, in JSON, CSV, text.
+    for (const ComparisonField& f : differenceFields(ImageComparison{})) {
+        EXPECT_TRUE(j["rows"][0].contains(f.name)) << f.name;
+        EXPECT_NE(testing::readFile(dir + "/b.csv").find(std::string(",") + f.name),
+                  std::string::npos)
+            << f.name;
+    }
+    EXPECT_GE(j["rows"][0]["p999_difference"].get<double>(), 0.0);
+    EXPECT_LE(j["rows"][0]["p999_difference"].get<double>(),
+              j["rows"][0]["max_abs_difference"].get<double>());
+    EXPECT_NE(r.out.find("p99.9"), std::string::npos) << r.out;
     // What bench/plot_bench.py draws from: each row's images and the heat maps' scale.
     EXPECT_EQ(j["rows"][0]["image"], "reference");
     EXPECT_EQ(j["images"], dir);
