@@ -181,9 +181,6 @@ TEST(PartitionShading, NormalisedVarianceMapsToTheStepRange) {
     EXPECT_LT(f.tfUpdateSeconds, 1.0);
 }
 
-}  // namespace
-}  // namespace uvr
-
 /// The 99.9th percentile and the maximum over pixels of the largest per-channel difference of
 /// two images in premultiplied 8-bit levels (r, g, b premultiplied, and alpha).
 std::pair<float, float> levelDifferences(const Image& a, const Image& b) {
@@ -227,3 +224,6 @@ TEST(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
         EXPECT_LE(max, std::max(24.f, refMax + 1.f)) << c.file << " (reference " << refMax << ")";
     }
 }
+
+}  // namespace
+}  // namespace uvr
