@@ -170,6 +170,12 @@ struct PartitionSceneView {
 /// a long step never reaches deep into a macrocell that needs short ones); a sample in a
 /// transparent macrocell is not located: the run of samples ends there (as at a skipped
 /// partition) and the next sample is the first grid point past the macrocell.
+///
+/// At the mesh's boundary (issue 29) long steps behave as the reference's: every piece has a
+/// sample at its last grid point K1 - 1 (the run's last share is one s1, never a long step past
+/// a curved boundary to the end of the piece's box), and a sample outside the mesh is followed
+/// by one s1 on (or by the first grid point past its seed-grid cell when that holds no cell), so
+/// a grazing ray's short chord is not stepped over.
 template <bool kNative = true>
 UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
                                              RayCounters& counters) {
@@ -224,15 +230,20 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             mPiece = shade.step / s1;  // step in grid units (1 for s1)
             macro = scene.macro.grids && shade.byMacroCells;
             kStop = k1;
-            // Pre-integrated steps longer than s1 divide the piece evenly into at least two
-            // (but no step below s1): the piece's last sample then owns a step's length at most,
-            // and a piece of a linear field is integrated exactly. (Macrocell steps end at the
-            // macrocells instead.)
+            // Pre-integrated steps longer than s1 divide the piece up to its last grid point
+            // K1 - 1 evenly into at least two (but no step below s1), and a sample sits there:
+            // the piece's last sample owns one s1 as the reference's does, so a run never
+            // extends a long step past the mesh's boundary to the piece's end (the end of the
+            // shrunk box lies outside a curved boundary; the next sample, in another piece,
+            // may be far), and a boundary inside the piece is bisected for as usual. A piece of
+            // a linear field is integrated exactly. (Macrocell steps end at the macrocells and
+            // at K1 - 1 instead.)
             if (!macro && preintegrated && mPiece > 1.f) {
-                const float span = k1 - k;
+                const float span = k1 - 1.f - k;
                 const float parts = fmaxf(2.f, ceilf(span / mPiece));
                 mPiece = fmaxf(1.f, span / parts);
-                kStop = k1 - 0.5f * mPiece;  // rounding in k += m must not add a sample at k1
+                // Rounding in k += m must neither drop the sample at K1 - 1 nor add one past it.
+                kStop = k1 - 1.f + 0.5f * mPiece;
             }
             continue;
         }
@@ -269,8 +280,6 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 kNext = fminf(k + m, kPast);
             }
         }
-        const float length = ((kNext < k1 ? kNext : k1) - k) * s1;
-        k = kNext;
         ++counters.samples;
         // Point location: a walk from the previous sample's tetrahedron (short steps), else
         // from the seed of the sample's grid cell (none: no cell of the partition is near, the
@@ -288,6 +297,23 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (tet == kNoTet && !emptySpace)
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
+        // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
+        // short chord through the mesh, which the reference's s1 steps see: the next sample is
+        // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
+        // Inside, long steps go on; leaving the mesh is bisected for below.
+        if (tet == kNoTet && !endsRun && kNext - kSample > 1.f) {
+            kNext = kSample + 1.f;
+            if (emptySpace) {
+                const PartitionGrid& g = scene.seeds.grids[p];
+                std::uint32_t idx[3];
+                for (int a = 0; a < 3; ++a) idx[a] = SeedGridView::cellIndex(g, a, pos[a]);
+                kNext = fmaxf(kNext, ceilf(gridCellExit(g, idx, ray.org, inv) / s1));
+            }
+        }
+        // A sample at the piece's last grid point K1 - 1 (see the piece's steps above).
+        if (kSample < k1 - 1.f && kNext > k1 - 1.f) kNext = k1 - 1.f;
+        const float length = ((kNext < k1 ? kNext : k1) - kSample) * s1;
+        k = kNext;
         if (preintegrated) {
             // A step longer than s1 from inside the mesh to outside it, or back in: the mesh's
             // boundary lies somewhere in the step. Bisect for it with point locations (walks
