@@ -8,13 +8,14 @@ tetrahedron; vtk_oracle.py) under the same flags, and checks that they agree to 
 Usage: vtk_oracle_test.py --uvr PATH/TO/uvr --data SHARED_DATA_DIR
                           [--methods exact,reference,adaptive] [--assert-methods exact]
                           [--size 256x256] [--min-ssim 0.99] [--cases REGEX] [--keep DIR]
-                          [--oracle-flags='--opacity-model attenuation']
+                          [--opacity-law attenuation|transmittance] [--oracle-flags=...]
 
 Cases: Blunt Fin (density) and the Oxygen Post (speed), each with two transfer functions
 (tests/data/oracle/*.json: a cool-to-warm Diverging map with an opacity ramp, a black-body Lab
 map with two opacity bands) and three views (ParaView's reset camera orbited with --azimuth 35
 --elevation 25, each tool doing its own orbit; a ParaView .pvcc camera; the orbit in parallel
-projection, --parallel, with the reset camera's parallel scale). uvr renders each case
+projection, --parallel, with the reset camera's parallel scale), under --opacity-law (both tools
+read the transfer function's opacity by the same law; default attenuation). uvr renders each case
 with every method in --methods; those in --assert-methods must reach --min-ssim, the others
 are reported. Images go to a temporary folder removed at the end (unless --keep).
 
@@ -93,8 +94,12 @@ def main():
     parser.add_argument("--cases", default="", help="only cases whose name matches this regex")
     parser.add_argument("--keep", help="write the images here and keep them")
     parser.add_argument("--oracle-flags", default="",
-                        help="more vtk_oracle.py flags, e.g. '--opacity-model attenuation' or "
-                             "'--integrator partial' (what each convention is worth)")
+                        help="more vtk_oracle.py flags, e.g. '--opacity-law transmittance' "
+                             "(VTK's reading against uvr's other law) or '--integrator partial' "
+                             "(what each convention is worth)")
+    parser.add_argument("--opacity-law", default="attenuation",
+                        choices=["attenuation", "transmittance"],
+                        help="the opacity law both tools render with (default attenuation)")
     args = parser.parse_args()
     methods = [m for m in args.methods.split(",") if m]
     asserted = {m for m in args.assert_methods.split(",") if m}
@@ -135,7 +140,8 @@ def main():
                     if not re.search(args.cases, case):
                         continue
                     flags = ["--field", field, "--tf", os.path.join(ORACLE_DATA, tf),
-                             "--size", args.size, "--background", "0,0,0"] + view_flags
+                             "--size", args.size, "--background", "0,0,0",
+                             "--opacity-law", args.opacity_law] + view_flags
                     stem = os.path.join(work, case.replace("/", "_"))
                     oracle_args = vtk_oracle.make_parser().parse_args(
                         [mesh_path, "-o", stem + "_vtk.png"] + flags +
