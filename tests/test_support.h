@@ -5,7 +5,9 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/vec.h"
+#include "uvr/tf/tf_table.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +18,16 @@
 #include <sys/wait.h>
 
 namespace uvr::testing {
+
+/// Opacity of a path `length` long through a medium of constant transfer-function opacity alpha
+/// per opacity unit `unit` under a law, in double: 1 - exp(-alpha L / u) (attenuation), 1 - (1 -
+/// alpha)^(L / u) (transmittance). The closed form the integrators are held to.
+inline double slabOpacity(double alpha, double length, double unit,
+                          OpacityLaw law = kDefaultOpacityLaw) {
+    length = length > 0.0 ? length : 0.0;
+    if (law == OpacityLaw::Attenuation) return -std::expm1(-alpha * length / unit);
+    return alpha >= 1.0 ? (length > 0.0 ? 1.0 : 0.0) : 1.0 - std::pow(1.0 - alpha, length / unit);
+}
 
 /// Path of a real mesh in ../shared/data; the test is skipped when the folder is absent.
 /// The folder is UVR_SHARED_DATA_DIR, or the environment variable UVR_SHARED_DATA when set (for

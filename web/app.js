@@ -48,7 +48,7 @@ function send(message) {
 
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
-                    "opacity_unit", "step"];
+                    "opacity_unit", "opacity_law", "step"];
 
 /// Sends a `set` changing `changes` (state keys with full values, plus `preset` or
 /// `colormap_json`), applies the state keys locally and returns its seq.
@@ -442,6 +442,7 @@ function updateControls() {
     $("quality").disabled = !adaptive;
     if (document.activeElement !== $("quality")) $("quality").value = sliderFromQuality(s.quality);
     $("quality-value").textContent = fmt(s.quality, 4);
+    if (s.opacity_law) $("opacity-law").value = s.opacity_law;
     $("heatmap").checked = !!s.heatmap;
     fillTime(s.step || 0);
     fillSizes(s.size);
@@ -485,6 +486,7 @@ $("field").addEventListener("change", (e) => {
     sendSet({field: e.target.value});
 });
 $("method").addEventListener("change", (e) => sendSet({method: e.target.value}));
+$("opacity-law").addEventListener("change", (e) => sendSet({opacity_law: e.target.value}));
 
 let qualityFrame = 0;
 $("quality").addEventListener("input", (e) => {

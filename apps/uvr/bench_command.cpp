@@ -300,6 +300,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["quality"] = base.quality;
                 j["power"] = base.power;
                 j["sampling"] = base.preintegrated ? "preintegrated" : "point";
+                j["opacity_law"] = opacityLawName(base.opacityLaw);
                 j["threads"] = threads;
                 j["device"] = where;
                 j["repeat"] = *repeat;

@@ -287,6 +287,17 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "Distance over which a TF opacity applies (default: ParaView's "
                    "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))")
         ->check(positiveNumber());
+    app.add_option("--opacity-law", opacityLaw,
+                   std::string("How a TF opacity a per opacity unit u absorbs: ") +
+                       opacityLawName(OpacityLaw::Attenuation) +
+                       " (extinction a / u, as ParaView's and VTK's unstructured volume mappers: "
+                       "a slab L thick has opacity 1 - exp(-a L / u)) or " +
+                       opacityLawName(OpacityLaw::Transmittance) +
+                       " (extinction -ln(1 - a) / u: opacity 1 - (1 - a)^(L / u), a = 1 "
+                       "opaque at once; docs/TRANSFER_FUNCTIONS.md)")
+        ->check(CLI::IsMember({std::string(opacityLawName(OpacityLaw::Attenuation)),
+                               std::string(opacityLawName(OpacityLaw::Transmittance))}))
+        ->capture_default_str();
     if (oneFrame) addMethodOption(app, method);
     app.add_option("--sampling", sampling,
                    "Reference and adaptive: preintegrated (integrate between consecutive samples, "
@@ -399,6 +410,8 @@ RenderSettings RenderFlags::baseSettings() const {
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
+    if (!parseOpacityLaw(opacityLaw.c_str(), s.opacityLaw))
+        badFlag("--opacity-law", opacityLaw, "attenuation or transmittance");
     s.method = method == "adaptive" ? RenderMethod::Partitions
                : method == "exact"  ? RenderMethod::Exact
                                     : RenderMethod::Reference;
@@ -994,6 +1007,7 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
         const auto number = fileNumber;
         j["step"] = number(result.setup.params.step / frame.scale);
         j["opacity_unit"] = number(result.setup.params.opacityUnit / frame.scale);
+        j["opacity_law"] = opacityLawName(settings.opacityLaw);
         j["range"] = {result.setup.rangeLo, result.setup.rangeHi};
         j["log_scale"] = settings.tf.logScale;
         j["tf_table_entries"] = result.setup.tfTable.size();

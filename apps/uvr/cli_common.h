@@ -101,6 +101,7 @@ struct RenderFlags {
     bool jitter = false;  ///< jittered sub-pixel rays (needs supersample > 1)
     float step = 0.f;
     float opacityUnit = 0.f;
+    std::string opacityLaw = opacityLawName(kDefaultOpacityLaw);
     std::string method = "adaptive";
     std::string stepRule = "error";
     std::optional<float> quality;  ///< unset: kDefaultQuality

@@ -213,6 +213,35 @@ TEST(Cli, StepRuleQualityAndSamplingFlags) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/y.png"));
 }
 
+TEST(Cli, OpacityLawFlag) {
+    // --opacity-law picks how opacity absorbs (default attenuation, in the stats); a slab of
+    // constant opacity 1 per unit is translucent under attenuation and opaque under
+    // transmittance.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string spx =
+        testing::sharedData("spx.vtk") + " --size 48x48 --opacity constant:1 --opacity-unit 1e6";
+    std::string law[2];
+    int i = 0;
+    for (const char* flags : {"", " --opacity-law transmittance"}) {
+        const CliRun r = uvr("-q render " + spx + flags + " -o l.png --stats s.json", dir);
+        ASSERT_EQ(r.code, 0) << flags << ": " << r.err;
+        std::ifstream stats(dir + "/s.json");
+        law[i] = nlohmann::json::parse(stats)["opacity_law"].get<std::string>();
+        const Image img = readPng(dir + "/l.png");
+        // The centre's ray crosses far less than the 1e6 opacity unit.
+        if (i++ == 0)
+            EXPECT_LT(img.at(24, 24).w, 0.01f);
+        else
+            EXPECT_EQ(img.at(24, 24).w, 1.f);
+    }
+    EXPECT_EQ(law[0], "attenuation");
+    EXPECT_EQ(law[1], "transmittance");
+    expectOneLineError(uvr("-q render " + spx + " --opacity-law linear -o y.png", dir),
+                       {"--opacity-law"}, "linear");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/y.png"));
+}
+
 TEST(Cli, ExactMethodAgreesWithTheReferenceAtASixteenthOfItsStep) {
     // The Oxygen Post has seams of unshared faces (its O-grid): rays that cross them are located
     // again, never dropped, so exact equals the converged fixed-step image.

@@ -133,6 +133,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         s.field = flags->field;
         s.method = settings.method;
         s.quality = settings.quality;
+        s.opacityLaw = settings.opacityLaw;
         s.width = settings.width;
         s.height = settings.height;
         s.opacityUnit = settings.opacityUnit > 0.f

@@ -344,8 +344,13 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       int width, int height, const std::string& method, const std::string& sampling,
                       const std::string& stepRule, float quality, float step, float maxStep,
                       float opacityUnit, float power, bool skip, bool adaptive, int supersample,
-                      bool jitter) {
+                      bool jitter, const std::string& opacityLaw) {
     RenderSettings s;
+    if (!parseOpacityLaw(opacityLaw.c_str(), s.opacityLaw))
+        raise(ErrorKind::Argument, std::string("opacity_law: expected '") +
+                                       opacityLawName(OpacityLaw::Attenuation) + "' or '" +
+                                       opacityLawName(OpacityLaw::Transmittance) + "', got '" +
+                                       opacityLaw + "'");
     s.method = parseMethod(method);
     if (sampling != "preintegrated" && sampling != "point")
         raise(ErrorKind::Argument,
@@ -387,6 +392,7 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
     stats["tf_update_seconds"] = r.setup.tfUpdateSeconds;
     stats["step"] = r.setup.params.step / scale;
     stats["opacity_unit"] = r.setup.params.opacityUnit / scale;
+    stats["opacity_law"] = opacityLawName(r.setup.opacityLaw);
     stats["range"] = py::make_tuple(r.setup.rangeLo, r.setup.rangeHi);
     stats["method"] = method;
     stats["device"] = self.renderer->deviceName();
@@ -786,7 +792,8 @@ PYBIND11_MODULE(_uvr, m) {
              py::arg("sampling") = "preintegrated", py::arg("step_rule") = "error",
              py::arg("quality") = kDefaultQuality, py::arg("step") = 0.f, py::arg("max_step") = 0.f,
              py::arg("opacity_unit") = 0.f, py::arg("power") = 2.f, py::arg("skip") = true,
-             py::arg("adaptive") = true, py::arg("supersample") = 1, py::arg("jitter") = false)
+             py::arg("adaptive") = true, py::arg("supersample") = 1, py::arg("jitter") = false,
+             py::arg("opacity_law") = opacityLawName(kDefaultOpacityLaw))
         .def_property_readonly("device",
                                [](const PyRenderer& r) { return r.renderer->deviceName(); })
         .def_property_readonly("device_description",

@@ -28,6 +28,7 @@ def python_frame(renderer, **kw):
      dict(field="pressure:cell", method="exact", tf="Turbo")),
     ("fire_ug.vtu", ["--opacity", "step:0.5:0.8", "--background", "1,1,1", "--quality", "0.999"],
      dict(opacity="step:0.5:0.8", background=(1, 1, 1), quality=0.999)),
+    ("tetraMesh.vtk", ["--opacity-law", "transmittance"], dict(opacity_law="transmittance")),
 ], ids=lambda c: c[0])
 def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     name, flags, kwargs = case
@@ -142,6 +143,8 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(camera="front")
     with pytest.raises(uvr.ArgumentError, match="opacity"):
         r.render(opacity="wobbly")
+    with pytest.raises(uvr.ArgumentError, match="opacity_law: expected 'attenuation' or"):
+        r.render(opacity_law="linear")
     with pytest.raises(uvr.ArgumentError, match="position equal|focal"):
         r.render(camera=uvr.Camera(position=(0, 0, 0), focal_point=(0, 0, 0)))
     with pytest.raises(uvr.ArgumentError, match="device: expected auto, cpu or cuda"):

@@ -183,7 +183,7 @@ class Renderer:
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
                sampling="preintegrated", step_rule="error", step=None, max_step=None,
                opacity_unit=None, power=None, skip=True, adaptive=True, supersample=1,
-               jitter=False):
+               jitter=False, opacity_law=None):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
         ``.stats`` and ``.sample_counts``.
 
@@ -192,8 +192,9 @@ class Renderer:
         values the transfer function spans (default: the field's); `camera` a uvr.Camera
         (default: ParaView's reset camera), then `azimuth`/`elevation`/`zoom`; `size` (w, h);
         `method` "adaptive", "reference" or "exact"; `quality` the adaptive method's SSIM target
-        (0.99); `field` switches to another field or new values first (set_field). The same
-        settings give the CLI's pixels.
+        (0.99); `opacity_law` "attenuation" (the default, ParaView's unstructured mappers) or
+        "transmittance" (docs/TRANSFER_FUNCTIONS.md); `field` switches to another field or new
+        values first (set_field). The same settings give the CLI's pixels.
         """
         if field is not None and (not isinstance(field, str) or field != self._field_key):
             self.set_field(field)
@@ -233,7 +234,8 @@ class Renderer:
             quality=0.99 if quality is None else float(quality), step=float(step or 0.0),
             max_step=float(max_step or 0.0), opacity_unit=float(opacity_unit or 0.0),
             power=2.0 if power is None else float(power), skip=bool(skip),
-            adaptive=bool(adaptive), supersample=int(supersample), jitter=bool(jitter))
+            adaptive=bool(adaptive), supersample=int(supersample), jitter=bool(jitter),
+            **({} if opacity_law is None else {"opacity_law": str(opacity_law)}))
         return Image(pixels, stats=stats, sample_counts=counts,
                      background=_background(background))
 

@@ -9,7 +9,7 @@ integrated in closed form by vtkUnstructuredGridLinearRayIntegrator, Williams, M
                 [--opacity-unit U] [--camera FILE.pvcc | --camera-position X,Y,Z
                 --camera-focal X,Y,Z] [--camera-up X,Y,Z] [--view-angle DEG]
                 [--parallel] [--parallel-scale S] [--azimuth DEG] [--elevation DEG]
-                [--size WxH] [--background R,G,B]
+                [--size WxH] [--background R,G,B] [--opacity-law attenuation|transmittance]
 
 Run it with Debian's /usr/bin/python3 (python3-vtk9, numpy). VTK 9.1's X11 render window needs
 an X display even off-screen: where there is none, run it under `xvfb-run -a`.
@@ -21,13 +21,13 @@ integration", src/uvr/render/camera.cpp, src/uvr/tf/paraview_json.cpp):
   range); values beyond the range take the ends' colour and opacity. Colours are interpolated in
   the JSON's ColorSpace (RGB, Lab, Diverging, HSV) by vtkColorTransferFunction.
 - opacity: an opacity alpha applies per --opacity-unit u (ParaView's ScalarOpacityUnitDistance,
-  the same default). uvr's model is the extinction kappa = -ln(1 - alpha) / u with emission
-  colour * kappa; VTK's unstructured integrators read opacity / u as the attenuation, linear
-  between control points. So the oracle hands VTK -ln(1 - alpha(x)) as its "opacity", on knots
-  dense enough for linear interpolation (--opacity-model attenuation: alpha itself, VTK's own
-  reading of a ParaView transfer function, to see how much the models differ). The colour goes
-  to VTK at the same knots: its integrators split segments only at the colour function's
-  control points and read the opacity function only there (see resample).
+  the same default) under uvr's --opacity-law: attenuation (the default) is the extinction
+  alpha / u, VTK's unstructured integrators' own reading (linear between control points);
+  transmittance is -ln(1 - alpha) / u, so the oracle then hands VTK -ln(1 - alpha(x)) as its
+  "opacity". Either way the emission is colour * extinction, and the function goes to VTK on
+  knots dense enough for linear interpolation. The colour goes to VTK at the same knots: its
+  integrators split segments only at the colour function's control points and read the opacity
+  function only there (see resample).
 - mesh: other cells are split into tetrahedra; zero-volume tetrahedra are dropped, as uvr does
   (the Bunyk caster loses the rays that meet one).
 - camera: a .pvcc file (position, focal point, view up, vertical view angle, and its parallel
@@ -246,7 +246,7 @@ def resample(colour, opacity, knots, lo, hi, model, tolerance):
     linearly. So both are given here at the same knots: the transfer function's own and, between
     them, as many more (by bisection) as keep the linear interpolation of the colour (evaluated
     in the map's colour space) and of the attenuation (the opacity itself for "attenuation",
-    -ln(1 - alpha) for "extinction") within tolerance of the curve (relative where the
+    -ln(1 - alpha) for "transmittance") within tolerance of the curve (relative where the
     attenuation exceeds 1)."""
     # An opacity of 1 has infinite extinction: 1 - 1e-7 leaves 1e-7 of the light after one unit.
     max_alpha = 1.0 - 1e-7
@@ -463,7 +463,7 @@ def render(args, mesh=None):
     colour, colour_knots = build_colour(space, rgb, to_value)
     opacity, opacity_knots = build_opacity(points, to_value)
     colour, attenuation = resample(colour, opacity, colour_knots + opacity_knots, lo, hi,
-                                   args.opacity_model, args.tolerance)
+                                   args.opacity_law, args.tolerance)
 
     prop = vtk.vtkVolumeProperty()
     prop.SetColor(colour)
@@ -571,10 +571,11 @@ def make_parser():
     parser.add_argument("--size", default="1024x1024", help="image size WIDTHxHEIGHT")
     parser.add_argument("--background", default="0,0,0",
                         help="background colour r,g,b in [0, 1] (default black)")
-    parser.add_argument("--opacity-model", choices=["extinction", "attenuation"],
-                        default="extinction",
-                        help="extinction: -ln(1 - alpha) / unit, uvr's model (default); "
-                             "attenuation: alpha / unit, VTK's unstructured integrators' own")
+    parser.add_argument("--opacity-law", choices=["attenuation", "transmittance"],
+                        default="attenuation",
+                        help="as uvr's --opacity-law: attenuation, alpha / unit, VTK's "
+                             "unstructured integrators' own (default); transmittance: "
+                             "-ln(1 - alpha) / unit")
     parser.add_argument("--tolerance", type=float, default=1e-3,
                         help="largest error of VTK's linear interpolation of colour and "
                              "attenuation between the knots it is given (default 1e-3)")

@@ -528,6 +528,10 @@ def save_and_reproduce(page, uvr, downloads, tmp):
     from selenium.webdriver.common.by import By
     for name in os.listdir(downloads):
         os.remove(os.path.join(downloads, name))
+    # The other opacity law: the saved PNG and the exported command both follow it.
+    page.js("const s = document.getElementById('opacity-law'); s.value = 'transmittance';"
+            " s.dispatchEvent(new Event('change'));")
+    page.wait("v.state.opacity_law === 'transmittance'", 10, "the state with the other law")
     state = page.hook("state")
     page.d.find_element(By.ID, "save-png").click()
     wait_file(os.path.join(downloads, "uvr-view.png"))
@@ -550,6 +554,8 @@ def save_and_reproduce(page, uvr, downloads, tmp):
     args = shlex.split(command)
     check(args[:2] == ["uvr", "render"], f"the command does not start with 'uvr render': {command}")
     check(tf_file in args and camera_file in args, "the command does not name the exported files")
+    check("--opacity-law" in args and args[args.index("--opacity-law") + 1] == "transmittance",
+          f"the command does not carry the opacity law: {command}")
     # Run it here: our uvr, the output in tmp, on the CPU like the server.
     args[0] = uvr
     out = os.path.join(tmp, "reproduced.png")

@@ -362,8 +362,7 @@ void CudaScene::updateShading(RenderResult& result) {
     FrameSetup& f = result.setup;
     const std::uint32_t n = static_cast<std::uint32_t>(d.mesh.kd->partitions.size());
     // Range tables of the baked table (O(entries log entries) on the host, ~100 KB up).
-    const TfTableView hostTable{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
-                                f.rangeHi};
+    const TfTableView hostTable = f.tfView();
     const TfRangeTables tables(hostTable);
     d.tfPrefix.upload(tables.prefix, "the transfer-function prefix sums");
     d.tfMaxLevels.upload(tables.maxLevels, "the transfer-function maxima");

@@ -360,7 +360,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc);
         } else if (tet != kNoTet) {
             const Vec4f c = tf.sample(v);
-            const float a = correctOpacity(c.w, length, unit);
+            const float a = correctOpacity(c.w, length, unit, tf.law);
             if (a > 0.f) compositeFrontToBack(acc, c.xyz(), a);
         }
         opaque = acc.w >= stopAlpha;

@@ -18,16 +18,24 @@ namespace {
 
 using testing::boxSpan;
 
+/// Extinction per opacity unit of an opacity under a law, in double (opacity 1 under
+/// transmittance: infinite).
+double extinction(double alpha, OpacityLaw law) {
+    return law == OpacityLaw::Attenuation ? alpha : -std::log1p(-alpha);
+}
+
 /// The model by brute force: a fine front-to-back composition over n steps of the marchers'
-/// corrected opacity 1 - (1 - alpha)^(h / unit), in double (in float, 1 - (1 - alpha)^1e-5 is
-/// mostly rounding); its error falls as 1 / n.
+/// corrected opacity 1 - exp(-kappa h) under the table's law, in double (in float,
+/// 1 - (1 - alpha)^1e-5 is mostly rounding); its error falls as 1 / n.
 Vec4f fineComposite(const TfTableView& tf, float s0, float s1, double len, double unit, int n) {
     double acc[4] = {0.0, 0.0, 0.0, 0.0};
     const double h = len / n;
     for (int i = 0; i < n; ++i) {
         const float s = static_cast<float>(s0 + (s1 - s0) * (i + 0.5) / n);
         const Vec4f c = tf.sample(s);
-        const double a = c.w >= 1.f ? 1.0 : -std::expm1(h / unit * std::log1p(-double(c.w)));
+        const double a = c.w >= 1.f && tf.law == OpacityLaw::Transmittance
+                             ? 1.0
+                             : -std::expm1(-h / unit * extinction(c.w, tf.law));
         const double w = (1.0 - acc[3]) * a;
         acc[0] += w * c.x, acc[1] += w * c.y, acc[2] += w * c.z, acc[3] += w;
     }
@@ -42,41 +50,78 @@ void expectNear(Vec4f a, Vec4f b, float tol, const std::string& what) {
 }
 
 TEST(ExactIntegrator, ConstantOpacityIsTheClosedForm) {
-    // alpha 0.3 per unit 0.5 over 1.7: 1 - 0.7^(1.7 / 0.5); the colour is c times that.
-    for (const double a : {0.0, 1e-6, 0.3, 0.999}) {
-        Vec4f acc(0.f, 0.f, 0.f, 0.f);
-        segment::compositePiece(Vec3f(0.2f, 0.4f, 0.8f), a, Vec3f(0.2f, 0.4f, 0.8f), a, 1.7, 0.5,
-                                acc);
-        const double want = 1.0 - std::pow(1.0 - a, 1.7 / 0.5);
-        EXPECT_NEAR(acc.w, want, 1e-6) << a;
-        EXPECT_NEAR(acc.x, 0.2 * want, 1e-6) << a;
-        EXPECT_NEAR(acc.z, 0.8 * want, 1e-6) << a;
-    }
-    // Opacity 1 over an interval: opaque at once, in the colour at its start.
+    // alpha a per unit 0.5 over 1.7: 1 - (1 - a)^(1.7 / 0.5) under transmittance, 1 - exp(-a *
+    // 1.7 / 0.5) under attenuation; the colour is c times that; in double and in float.
+    for (const OpacityLaw law : {OpacityLaw::Attenuation, OpacityLaw::Transmittance})
+        for (const double a : {0.0, 1e-6, 0.3, 0.999}) {
+            const double want = law == OpacityLaw::Transmittance
+                                    ? 1.0 - std::pow(1.0 - a, 1.7 / 0.5)
+                                    : -std::expm1(-a * 1.7 / 0.5);
+            const std::string what = std::string(opacityLawName(law)) + " " + std::to_string(a);
+            Vec4f acc(0.f, 0.f, 0.f, 0.f);
+            segment::compositePiece(Vec3f(0.2f, 0.4f, 0.8f), a, Vec3f(0.2f, 0.4f, 0.8f), a, 1.7,
+                                    0.5, law, acc);
+            EXPECT_NEAR(acc.w, want, 1e-6) << what;
+            EXPECT_NEAR(acc.x, 0.2 * want, 1e-6) << what;
+            EXPECT_NEAR(acc.z, 0.8 * want, 1e-6) << what;
+            Vec4f fast(0.f, 0.f, 0.f, 0.f);
+            segment::compositePieceFast(Vec3f(0.2f, 0.4f, 0.8f), float(a), Vec3f(0.2f, 0.4f, 0.8f),
+                                        float(a), 1.7f, 0.5f, law, fast);
+            EXPECT_NEAR(fast.w, want, 1e-6) << what;
+            EXPECT_NEAR(fast.z, 0.8 * want, 1e-6) << what;
+        }
+    // Opacity 1 over an interval: under transmittance opaque at once, in the colour at its
+    // start; under attenuation an extinction of 1 per unit (0.1 of a unit: 1 - e^-0.1).
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
-    segment::compositePiece(Vec3f(1.f, 0.f, 0.f), 1.0, Vec3f(0.f, 1.f, 0.f), 1.0, 0.1, 1.0, acc);
+    segment::compositePiece(Vec3f(1.f, 0.f, 0.f), 1.0, Vec3f(0.f, 1.f, 0.f), 1.0, 0.1, 1.0,
+                            OpacityLaw::Transmittance, acc);
     expectNear(acc, Vec4f(1.f, 0.f, 0.f, 1.f), 0.f, "opaque");
+    for (const bool fast : {false, true}) {
+        Vec4f one(0.f, 0.f, 0.f, 0.f);
+        if (fast)
+            segment::compositePieceFast(Vec3f(1.f, 0.f, 0.f), 1.f, Vec3f(1.f, 0.f, 0.f), 1.f, 0.1f,
+                                        1.f, OpacityLaw::Attenuation, one);
+        else
+            segment::compositePiece(Vec3f(1.f, 0.f, 0.f), 1.0, Vec3f(1.f, 0.f, 0.f), 1.0, 0.1, 1.0,
+                                    OpacityLaw::Attenuation, one);
+        const double want = -std::expm1(-0.1);
+        expectNear(one, Vec4f(float(want), 0.f, 0.f, float(want)), 1e-6f, "attenuation at 1");
+    }
 }
 
 TEST(ExactIntegrator, LinearOpacityAndColourMatchBruteForce) {
     // A two-entry table: colour and opacity linear in the value, so one piece; the brute force
     // converges to the same integral.
+    // Both laws, in double and in float (the renderers' pieces).
     const std::vector<Vec4f> entries{Vec4f(1.f, 0.f, 0.f, 0.05f), Vec4f(0.f, 0.f, 1.f, 0.95f)};
-    const TfTableView tf{entries.data(), 2, 0.f, 1.f};
-    for (const auto& [s0, s1, len] : {std::tuple{0.f, 1.f, 2.0}, std::tuple{1.f, 0.f, 0.3},
-                                      std::tuple{0.2f, 0.7f, 5.0}, std::tuple{0.5f, 0.5f, 1.0}}) {
-        Vec4f acc(0.f, 0.f, 0.f, 0.f);
-        segment::integrate(tf, s0, s1, len, 0.4, acc);
-        const Vec4f want = fineComposite(tf, s0, s1, len, 0.4, 400000);
-        expectNear(acc, want, 2e-5f, "segment " + std::to_string(s0) + " -> " + std::to_string(s1));
+    for (const OpacityLaw law : {OpacityLaw::Attenuation, OpacityLaw::Transmittance}) {
+        TfTableView tf{entries.data(), 2, 0.f, 1.f};
+        tf.law = law;
+        for (const auto& [s0, s1, len] : {std::tuple{0.f, 1.f, 2.0}, std::tuple{1.f, 0.f, 0.3},
+                                          std::tuple{0.2f, 0.7f, 5.0}, std::tuple{0.5f, 0.5f, 1.0}})
+            for (const bool fast : {false, true}) {
+                Vec4f acc(0.f, 0.f, 0.f, 0.f);
+                segment::integrate(tf, s0, s1, len, 0.4, acc, fast);
+                const Vec4f want = fineComposite(tf, s0, s1, len, 0.4, 400000);
+                expectNear(acc, want, fast ? 1e-4f : 2e-5f,
+                           std::string(opacityLawName(law)) + (fast ? " fast" : "") + " segment " +
+                               std::to_string(s0) + " -> " + std::to_string(s1));
+            }
     }
-    // An opacity reaching 1 at one end: finite optical depth (ln w is integrable at 0).
+    // An opacity reaching 1 at one end: finite optical depth under both laws (under
+    // transmittance ln w is integrable at 0).
     const std::vector<Vec4f> toOne{Vec4f(1.f, 1.f, 1.f, 0.f), Vec4f(1.f, 1.f, 1.f, 1.f)};
-    const TfTableView tfOne{toOne.data(), 2, 0.f, 1.f};
+    TfTableView tfOne{toOne.data(), 2, 0.f, 1.f};
+    tfOne.law = OpacityLaw::Transmittance;
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
     segment::integrate(tfOne, 0.f, 1.f, 0.2, 1.0, acc);
     // -integral_0^1 ln(1 - x) dx * 0.2 = 0.2: alpha = 1 - e^-0.2.
     EXPECT_NEAR(acc.w, 1.0 - std::exp(-0.2), 1e-6);
+    // Attenuation: integral_0^1 x dx * 0.2 = 0.1.
+    tfOne.law = OpacityLaw::Attenuation;
+    acc = Vec4f(0.f, 0.f, 0.f, 0.f);
+    segment::integrate(tfOne, 0.f, 1.f, 0.2, 1.0, acc);
+    EXPECT_NEAR(acc.w, 1.0 - std::exp(-0.1), 1e-6);
 }
 
 TEST(ExactIntegrator, TransferFunctionStepInsideOneSegmentIsNotMissed) {
@@ -90,7 +135,7 @@ TEST(ExactIntegrator, TransferFunctionStepInsideOneSegmentIsNotMissed) {
     segment::integrate(view, 0.f, 1.f, 1.0, 1.0, acc);
     // 0.02 of the segment at alpha 0.9 per unit, plus the two 1e-4 ramps (about half each).
     const double inBand = 0.02 + 1e-4;
-    EXPECT_NEAR(acc.w, 1.0 - std::pow(0.1, inBand), 2e-3);
+    EXPECT_NEAR(acc.w, -std::expm1(-0.9 * inBand), 2e-3);
     const Vec4f brute = fineComposite(view, 0.f, 1.f, 1.0, 1.0, 2000000);
     EXPECT_NEAR(acc.w, brute.w, 1e-4);
 }
@@ -114,8 +159,9 @@ RenderSettings exactSettings(const Bounds3f& box, int size) {
 }
 
 /// For a constant field under constant opacity 0.2 per unit 0.5 filling the boxes: the largest
-/// difference of a pixel's alpha from 1 - 0.8^(chord / 0.5), the chord summed over the boxes;
-/// meetingAll receives the number of pixels whose ray meets every box.
+/// difference of a pixel's alpha from 1 - exp(-kappa chord), kappa the extinction of 0.2 / 0.5
+/// under the settings' law, the chord summed over the boxes; meetingAll receives the number of
+/// pixels whose ray meets every box.
 double worstChordError(const RenderResult& r, const RenderSettings& s,
                        const std::vector<Bounds3f>& boxes, int& meetingAll) {
     double worst = 0.0;
@@ -130,14 +176,14 @@ double worstChordError(const RenderResult& r, const RenderSettings& s,
                 if (boxSpan(box, ray, t0, t1)) chord += t1 - t0, ++met;
             }
             meetingAll += met == int(boxes.size());
-            const double want = 1.0 - std::pow(0.8, chord / 0.5);
+            const double want = -std::expm1(-extinction(0.2, s.opacityLaw) * chord / 0.5);
             worst = std::max(worst, double(std::fabs(r.image.at(x, y).w - want)));
         }
     return worst;
 }
 
 TEST(ExactIntegrator, ConstantFieldThroughJitteredGridIsTheChordLength) {
-    // Every pixel: alpha = 1 - (1 - 0.2)^(chord / 0.5), the chord through the box; no sampling
+    // Every pixel: alpha = 1 - exp(-kappa chord), the chord through the box; no sampling
     // band, no cracks between the 6 * 6^3 jittered tetrahedra.
     const Bounds3f box{Vec3f(0.f), Vec3f(1.f)};
     const PreparedMesh pm = preparedGrid(

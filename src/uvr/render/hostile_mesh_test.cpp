@@ -4,9 +4,9 @@
 // to 1e6, a camera inside the volume, rays running exactly along k-d split planes, faces and
 // edges. The oracle: a constant field under a constant transfer function has an exact image. Every
 // integrator composites the reference grid points t = k * s1 inside the mesh's box (the partition
-// integrator's steps add up to the same distance), so a pixel's opacity is 1 - (1 - a)^(n s1 /
-// unit) for the n grid points in the ray's span of the (convex) mesh: one sample lost in a crack
-// between cells (the start of a streak) or a NaN fails it.
+// integrator's steps add up to the same distance), so a pixel's opacity is the slab opacity of a
+// over n s1 for the n grid points in the ray's span of the (convex) mesh: one sample lost in a
+// crack between cells (the start of a streak) or a NaN fails it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -113,9 +113,9 @@ RenderSettings constantSettings(const Camera& camera, int width, int height) {
     return s;
 }
 
-/// Opacity of a path of length L through the constant medium.
+/// Opacity of a path of length L through the constant medium (the default opacity law).
 double exactAlpha(double length, double unit) {
-    return 1.0 - std::pow(1.0 - kAlpha, std::max(length, 0.0) / unit);
+    return testing::slabOpacity(kAlpha, length, unit);
 }
 
 /// The ray's span [t0, t1] inside the box from the origin on (double precision); false if none.

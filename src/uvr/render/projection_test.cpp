@@ -48,10 +48,11 @@ RenderSettings halfOpacity(RenderMethod method) {
     return s;
 }
 
-/// Alpha of a ray crossing the unit cube along an axis: 1 - (1 - 0.5)^(1 / 1).
-constexpr float kThroughAlpha = 0.5f;
+/// Alpha of a ray crossing the unit cube along an axis: opacity 0.5 per unit 1 over 1 (the default
+/// law).
+const float kThroughAlpha = float(testing::slabOpacity(0.5, 1.0, 1.0));
 /// Tolerance on it: the sample-based methods' last sample owns up to a step (1/148 of the
-/// cube's diagonal by default) past the mesh, at most 0.6 ln 2 / 148 of alpha.
+/// cube's diagonal by default) past the mesh, at most 0.6 / 148 of alpha.
 constexpr float kAlphaTol = 5e-3f;
 
 /// A parallel camera looking down -z at (cx, cy) with 2 * scale world units over `height`
@@ -106,7 +107,7 @@ TEST(CameraRender, ParallelCameraInsideOrFarFromTheMeshSeesWhatLiesInFrontOfItsP
         s.camera->position.z = 0.25f;
         s.camera->focalPoint.z = -3.f;
         const RenderResult inside = renderCpu(mesh, s);
-        const float quarter = 1.f - std::pow(0.5f, 0.25f);
+        const float quarter = float(testing::slabOpacity(0.5, 0.25, 1.0));
         for (const Vec4f& p : inside.image.pixels)
             EXPECT_NEAR(p.w, quarter, kAlphaTol) << methodName(method);
         // Behind the mesh, looking away from it: nothing.

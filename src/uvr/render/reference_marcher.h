@@ -39,11 +39,13 @@ struct RayCounters {
     LocateCounters locate;
 };
 
-/// Opacity of a sample taken over distance `step` for a TF opacity `alpha` defined per `unit`:
-/// 1 - (1 - alpha)^(step / unit) (opacity correction).
-UVR_HOST_DEVICE inline float correctOpacity(float alpha, float step, float unit) {
-    if (alpha >= 1.f) return 1.f;
+/// Opacity of a sample taken over distance `step` for a TF opacity `alpha` defined per `unit`
+/// under a law (opacity correction): 1 - exp(-alpha step / unit) (attenuation), 1 - (1 -
+/// alpha)^(step / unit) (transmittance).
+UVR_HOST_DEVICE inline float correctOpacity(float alpha, float step, float unit, OpacityLaw law) {
     if (alpha <= 0.f) return 0.f;
+    if (law == OpacityLaw::Attenuation) return -expm1f(-(alpha < 1.f ? alpha : 1.f) * step / unit);
+    if (alpha >= 1.f) return 1.f;
     return 1.f - powf(1.f - alpha, step / unit);
 }
 
@@ -146,7 +148,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc);
         } else if (tet != kNoTet) {
             const Vec4f c = scene.tf.sample(v);
-            const float a = correctOpacity(c.w, s, unit);
+            const float a = correctOpacity(c.w, s, unit, scene.tf.law);
             if (a > 0.f) compositeFrontToBack(acc, c.xyz(), a);
         }
         opaque = acc.w >= scene.params.terminationAlpha;

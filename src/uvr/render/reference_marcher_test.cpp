@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "test_meshes.h"
+#include "test_support.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/render/frame_kernel.h"
 
@@ -47,21 +48,35 @@ int gridSamples(float t0, float t1, float s) {
 }
 
 TEST(ReferenceMarcher, ConstantMediumMatchesBeerLambert) {
-    // Opacity 0.3 per unit 0.5: over length L the exact opacity is 1 - 0.7^(L / 0.5).
+    // Opacity 0.3 per unit 0.5: over length L the exact opacity is 1 - exp(-0.3 L / 0.5)
+    // (attenuation) or 1 - 0.7^(L / 0.5) (transmittance); point samples and pre-integration.
     const float step = 0.01f, unit = 0.5f;
-    Fixture f(twoCubes(), Vec4f(1.f, 0.5f, 0.25f, 0.3f), step, unit);
-    f.scene.params.terminationAlpha = 1.f;
-    // Ray along +x through both cubes (y, z inside): crosses 2 units of medium and the gap.
-    const Ray ray{{-0.5f, 0.37f, 0.61f}, {1.f, 0.f, 0.f}};
-    RayCounters counters;
-    const Vec4f c = marchReference(f.scene, ray, counters);
-    const int inFirst = gridSamples(0.5f, 1.5f, step), inSecond = gridSamples(2.5f, 3.5f, step);
-    const float expected = 1.f - std::pow(0.7f, (inFirst + inSecond) * step / unit);
-    EXPECT_NEAR(c.w, expected, 1e-4f);
-    EXPECT_NEAR(c.w, 1.f - std::pow(0.7f, 2.f / unit), 0.01f);  // the continuous answer
-    EXPECT_NEAR(c.x / c.w, 1.f, 1e-5f);  // premultiplied colour over alpha is the TF colour
-    EXPECT_NEAR(c.y / c.w, 0.5f, 1e-5f);
-    EXPECT_EQ(counters.samples, static_cast<std::uint32_t>(gridSamples(0.5f, 3.5f, step)));
+    for (const OpacityLaw law : {OpacityLaw::Attenuation, OpacityLaw::Transmittance})
+        for (const bool preintegrated : {true, false}) {
+            const std::string what =
+                std::string(opacityLawName(law)) + (preintegrated ? " preintegrated" : " point");
+            Fixture f(twoCubes(), Vec4f(1.f, 0.5f, 0.25f, 0.3f), step, unit);
+            f.scene.tf.law = law;
+            f.scene.params.terminationAlpha = 1.f;
+            f.scene.params.preintegrated = preintegrated;
+            // Ray along +x through both cubes (y, z inside): crosses 2 units of medium and the
+            // gap.
+            const Ray ray{{-0.5f, 0.37f, 0.61f}, {1.f, 0.f, 0.f}};
+            RayCounters counters;
+            const Vec4f c = marchReference(f.scene, ray, counters);
+            const int inFirst = gridSamples(0.5f, 1.5f, step),
+                      inSecond = gridSamples(2.5f, 3.5f, step);
+            if (!preintegrated)
+                EXPECT_NEAR(c.w, testing::slabOpacity(0.3, (inFirst + inSecond) * step, unit, law),
+                            1e-4f)
+                    << what;
+            // The continuous answer.
+            EXPECT_NEAR(c.w, testing::slabOpacity(0.3, 2.0, unit, law), 0.01f) << what;
+            EXPECT_NEAR(c.x / c.w, 1.f, 1e-5f) << what;   // premultiplied colour over alpha is the
+            EXPECT_NEAR(c.y / c.w, 0.5f, 1e-5f) << what;  // TF colour
+            EXPECT_EQ(counters.samples, static_cast<std::uint32_t>(gridSamples(0.5f, 3.5f, step)))
+                << what;
+        }
 }
 
 TEST(ReferenceMarcher, GapsAndMissesAreTransparent) {
@@ -78,14 +93,26 @@ TEST(ReferenceMarcher, GapsAndMissesAreTransparent) {
 
 TEST(ReferenceMarcher, EarlyTerminationStopsAtOpacity) {
     Fixture f(twoCubes(), Vec4f(1.f, 1.f, 1.f, 1.f), 0.01f, 1.f);
-    // A point sample is opaque at once; a pre-integrated segment once the second sample closes
-    // it.
+    // Opacity 1 under the transmittance law: a point sample is opaque at once; a pre-integrated
+    // segment once the second sample closes it.
+    f.scene.tf.law = OpacityLaw::Transmittance;
     for (const bool preintegrated : {false, true}) {
         f.scene.params.preintegrated = preintegrated;
         RayCounters counters;
         const Vec4f c = marchReference(f.scene, {{-0.5f, 0.4f, 0.4f}, {1.f, 0.f, 0.f}}, counters);
         EXPECT_FLOAT_EQ(c.w, 1.f);
         EXPECT_EQ(counters.samples, preintegrated ? 2u : 1u);
+    }
+    // Under attenuation opacity 1 is an extinction of 1 per unit: the two unit cubes leave
+    // e^-2 of the light, the ray runs through both.
+    f.scene.tf.law = OpacityLaw::Attenuation;
+    f.scene.params.terminationAlpha = 1.f;
+    for (const bool preintegrated : {false, true}) {
+        f.scene.params.preintegrated = preintegrated;
+        RayCounters counters;
+        const Vec4f c = marchReference(f.scene, {{-0.5f, 0.4f, 0.4f}, {1.f, 0.f, 0.f}}, counters);
+        EXPECT_NEAR(c.w, testing::slabOpacity(1.0, 2.0, 1.0), 0.01f);
+        EXPECT_EQ(counters.samples, static_cast<std::uint32_t>(gridSamples(0.5f, 3.5f, 0.01f)));
     }
 }
 

@@ -382,11 +382,18 @@ bool usesMacroCells(const PreparedMesh& mesh, const StepRuleParams& rule) {
     return mesh.macro && rule.rule == StepRule::ErrorBound && rule.adaptive;
 }
 
+TfTableView FrameSetup::tfView() const {
+    TfTableView t{tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi,
+                  tfBreaks.data()};
+    t.nan = tfNan;
+    t.law = opacityLaw;
+    return t;
+}
+
 SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     SceneView v;
     v.locator = mesh.locator();
-    v.tf = {tfTable.data(), static_cast<int>(tfTable.size()), rangeLo, rangeHi, tfBreaks.data()};
-    v.tf.nan = tfNan;
+    v.tf = tfView();
     v.bounds = mesh.tets.bounds;
     v.params = params;
     return v;
@@ -496,6 +503,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
     f.tfNan = Vec4f(settings.tf.nanColor.x, settings.tf.nanColor.y, settings.tf.nanColor.z,
                     settings.tf.nanOpacity);
+    f.opacityLaw = settings.opacityLaw;
     const float aspect = float(settings.width) / float(settings.height);
     // Settings are in the file's units; the prepared mesh is in rendering units (mesh.tets.frame:
     // the identity unless the mesh is very large, very small or far from the origin).
@@ -617,8 +625,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         static_cast<float>((double(f.rangeHi) - double(f.rangeLo)) / (f.tfTable.size() - 1));
     if (settings.method == RenderMethod::Partitions && shadePartitions) {
         const auto start = std::chrono::steady_clock::now();
-        const TfTableView table{f.tfTable.data(), static_cast<int>(f.tfTable.size()), f.rangeLo,
-                                f.rangeHi};
+        const TfTableView table = f.tfView();
         const TfRangeTables ranges(table);
         f.shading =
             computePartitionShading(*mesh.kd, mesh.gradientSpread, ranges.view(table), f.stepRule);

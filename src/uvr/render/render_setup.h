@@ -245,6 +245,9 @@ struct RenderSettings {
     std::optional<std::pair<float, float>> range;  ///< default: the field's finite range
     float step = 0.f;                              ///< s1; 0 = defaultStep
     float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
+    /// How the transfer function's opacities become extinction (default: ParaView's reading for
+    /// unstructured data).
+    OpacityLaw opacityLaw = kDefaultOpacityLaw;
     float terminationAlpha = 0.99f;
     /// Entries of the baked transfer function (a log-scale one gets more: logTableSize).
     int tfTableSize = 1024;
@@ -331,8 +334,9 @@ bool usesMacroCells(const PreparedMesh& mesh, const StepRuleParams& rule);
 /// Host-side frame state built from settings: the baked table, the camera and the parameters.
 struct FrameSetup {
     std::vector<Vec4f> tfTable;
-    Vec4f tfNan;                            ///< colour and opacity of NaN values (TfTableView::nan)
-    std::vector<std::int32_t> tfBreaks;     ///< tfTableBreaks of tfTable
+    Vec4f tfNan;                         ///< colour and opacity of NaN values (TfTableView::nan)
+    std::vector<std::int32_t> tfBreaks;  ///< tfTableBreaks of tfTable
+    OpacityLaw opacityLaw = kDefaultOpacityLaw;  ///< RenderSettings::opacityLaw
     StepRuleParams stepRule;                ///< the partition method's step rule and its inputs
     std::vector<PartitionShading> shading;  ///< per partition (partition method only)
     /// Per macrocell (partition method with usesMacroCells; empty otherwise).
@@ -353,6 +357,8 @@ struct FrameSetup {
     /// end.
     std::vector<std::string> notes;
 
+    /// The baked table as a view (host pointers); the setup must outlive it.
+    TfTableView tfView() const;
     /// Scene view over a prepared mesh; both must outlive it.
     SceneView scene(const PreparedMesh& mesh) const;
     /// Partition scene view (the mesh must have partitions); both must outlive it.

@@ -6,13 +6,15 @@
 // between consecutive samples (pre-integration: a transfer-function feature between two samples
 // is integrated, never missed).
 //
-// A transfer-function opacity alpha per opacity unit u is the extinction kappa(s) = -ln(1 -
-// alpha(s)) / u (the point samplers' opacity correction 1 - (1 - alpha)^(step / u) is exactly
-// exp(-kappa step)), and the emission is c(s) kappa(s). The transfer function is the baked
-// table, linear between its breakpoints (tfTableBreaks). So a segment splits at the breakpoints
-// it crosses into pieces where colour and opacity are linear in the distance t:
-// - the optical depth of a piece is closed-form: with w(t) = 1 - alpha(t) linear,
-//   integral of -ln w dt = t * (-(F(w) - F(w0)) / (w - w0)), F(w) = w ln w - w;
+// A transfer-function opacity alpha per opacity unit u is an extinction kappa(s) by the table's
+// OpacityLaw: alpha / u (attenuation, ParaView's unstructured mappers) or -ln(1 - alpha) / u
+// (transmittance: the point samplers' opacity correction 1 - (1 - alpha)^(step / u) is exactly
+// exp(-kappa step)); the emission is c(s) kappa(s). The transfer function is the baked table,
+// linear between its breakpoints (tfTableBreaks). So a segment splits at the breakpoints it
+// crosses into pieces where colour and opacity are linear in the distance t:
+// - the optical depth of a piece is closed-form: under attenuation kappa is linear, the depth
+//   quadratic, t (alpha(0) + alpha(t)) / (2 u); under transmittance, with w(t) = 1 - alpha(t)
+//   linear, integral of -ln w dt = t * (-(F(w) - F(w0)) / (w - w0)), F(w) = w ln w - w;
 // - the colour is integrated by parts, c kappa T = -c dT/dt with c linear: c0 - c1 T(L) + c' *
 //   integral of T, and the mean transmittance of the piece by composite Gauss-Legendre quadrature
 //   of the closed-form T (smooth and monotone), to about 1e-9.
@@ -40,13 +42,14 @@ UVR_HOST_DEVICE inline double meanLog(double w0, double w1) {
 }
 
 /// Optical depth from 0 to t of a piece of length len whose opacity runs linearly from a0 to a1
-/// (both below 1 or one of them 1), per opacity unit `unit`.
-UVR_HOST_DEVICE inline double opticalDepth(double a0, double a1, double len, double t,
-                                           double unit) {
+/// (in [0, 1]; under transmittance both below 1 or one of them 1), per opacity unit `unit`.
+UVR_HOST_DEVICE inline double opticalDepth(double a0, double a1, double len, double t, double unit,
+                                           OpacityLaw law) {
     if (t <= 0.0) return 0.0;
-    const double w0 = 1.0 - a0;
-    const double wt = 1.0 - (a0 + (a1 - a0) * (t / len));
-    return -t * meanLog(w0, wt > 0.0 ? wt : 0.0) / unit;
+    const double at = a0 + (a1 - a0) * (t / len);
+    if (law == OpacityLaw::Attenuation) return t * 0.5 * (a0 + at) / unit;
+    const double wt = 1.0 - at;
+    return -t * meanLog(1.0 - a0, wt > 0.0 ? wt : 0.0) / unit;
 }
 
 /// Mean transmittance (1 / len) * integral of exp(-tau(t)) over a piece of constant extinction
@@ -59,13 +62,13 @@ UVR_HOST_DEVICE inline double meanTransmittanceConstant(double tau) {
 /// tauEnd in all): beyond optical depth 40 nothing is left, so 4-point Gauss-Legendre quadrature
 /// spans [0, tStop] with about one sub-interval per 0.25 of optical depth.
 UVR_HOST_DEVICE inline double meanTransmittance(double a0, double a1, double len, double unit,
-                                                double tauEnd) {
+                                                double tauEnd, OpacityLaw law) {
     double tStop = len;
     if (tauEnd > 40.0) {
         double lo = 0.0, hi = len;  // tau is increasing: bisect tau(t) = 40
         for (int i = 0; i < 60; ++i) {
             const double mid = 0.5 * (lo + hi);
-            (opticalDepth(a0, a1, len, mid, unit) < 40.0 ? lo : hi) = mid;
+            (opticalDepth(a0, a1, len, mid, unit, law) < 40.0 ? lo : hi) = mid;
         }
         tStop = hi;
     }
@@ -83,31 +86,32 @@ UVR_HOST_DEVICE inline double meanTransmittance(double a0, double a1, double len
         const double mid = (p + 0.5) * h;
         for (int k = 0; k < 4; ++k)
             integral +=
-                wgt[k] * 0.5 * h * exp(-opticalDepth(a0, a1, len, mid + 0.5 * h * x[k], unit));
+                wgt[k] * 0.5 * h * exp(-opticalDepth(a0, a1, len, mid + 0.5 * h * x[k], unit, law));
     }
     return integral / len;
 }
 
 /// Composites a piece of length len, colour and opacity linear from c0, a0 to c1, a1, into the
-/// premultiplied accumulator (front to back).
+/// premultiplied accumulator (front to back), opacity read by `law`.
 UVR_HOST_DEVICE inline void compositePiece(Vec3f c0, double a0, Vec3f c1, double a1, double len,
-                                           double unit, Vec4f& acc) {
+                                           double unit, OpacityLaw law, Vec4f& acc) {
     if (!(len > 0.0)) return;
     a0 = a0 > 0.0 ? (a0 < 1.0 ? a0 : 1.0) : 0.0;
     a1 = a1 > 0.0 ? (a1 < 1.0 ? a1 : 1.0) : 0.0;
     if (a0 == 0.0 && a1 == 0.0) return;
     const double remaining = 1.0 - acc.w;
-    if (a0 >= 1.0 && a1 >= 1.0) {  // infinite extinction: opaque at once
+    if (law == OpacityLaw::Transmittance && a0 >= 1.0 && a1 >= 1.0) {
+        // Infinite extinction: opaque at once.
         acc.x += static_cast<float>(remaining * c0.x);
         acc.y += static_cast<float>(remaining * c0.y);
         acc.z += static_cast<float>(remaining * c0.z);
         acc.w = 1.f;
         return;
     }
-    const double tauEnd = opticalDepth(a0, a1, len, len, unit);
+    const double tauEnd = opticalDepth(a0, a1, len, len, unit, law);
     const double transEnd = exp(-tauEnd);
-    const double mean =
-        a0 == a1 ? meanTransmittanceConstant(tauEnd) : meanTransmittance(a0, a1, len, unit, tauEnd);
+    const double mean = a0 == a1 ? meanTransmittanceConstant(tauEnd)
+                                 : meanTransmittance(a0, a1, len, unit, tauEnd, law);
     // Colour by parts: c0 (1 - M) + c1 (M - T(len)).
     const double k0 = remaining * (1.0 - mean), k1 = remaining * (mean - transEnd);
     acc.x += static_cast<float>(k0 * c0.x + k1 * c1.x);
@@ -145,40 +149,49 @@ inline constexpr int kFastMaxParts = 16;
 /// sub-intervals of at most about 0.5 optical depth (at most 16). Within 1e-3 of compositePiece;
 /// pieces deeper than kFastMaxDepth call it.
 UVR_HOST_DEVICE inline void compositePieceFast(Vec3f c0, float a0, Vec3f c1, float a1, float len,
-                                               float unit, Vec4f& acc) {
+                                               float unit, OpacityLaw law, Vec4f& acc) {
     a0 = a0 > 0.f ? (a0 < 1.f ? a0 : 1.f) : 0.f;
     a1 = a1 > 0.f ? (a1 < 1.f ? a1 : 1.f) : 0.f;
     if (a0 == 0.f && a1 == 0.f) return;
     if (!(len > 0.f)) return;
+    const bool attenuation = law == OpacityLaw::Attenuation;
     const float w0 = 1.f - a0, w1 = 1.f - a1;
     const float scale = len / unit;
-    const float f0 = entropyF(w0);
-    const float tauEnd = -scale * meanLogF(w0, f0, w1);
-    if (!(tauEnd <= kFastMaxDepth) || (w0 == 0.f && w1 == 0.f)) {
-        compositePiece(c0, a0, c1, a1, len, unit, acc);
+    // Attenuation: tau(u) = scale u (a0 + (a1 - a0) u / 2); transmittance: tau(u) = -scale u
+    // meanLog(w0, w(u)).
+    const float f0 = attenuation ? 0.f : entropyF(w0);
+    const float tauEnd = attenuation ? scale * 0.5f * (a0 + a1) : -scale * meanLogF(w0, f0, w1);
+    if (!(tauEnd <= kFastMaxDepth) || (!attenuation && w0 == 0.f && w1 == 0.f)) {
+        compositePiece(c0, a0, c1, a1, len, unit, law, acc);
         return;
     }
     const float transEnd = expf(-tauEnd);
     float mean;
-    if (w0 == w1) {
+    if (a0 == a1) {
         mean = tauEnd > 1e-6f ? -expm1f(-tauEnd) / tauEnd : 1.f - 0.5f * tauEnd;
     } else {
         // Composite 3-point Gauss-Legendre over n sub-intervals (no node at the ends, where the
-        // extinction -ln w may be singular): T(u) = exp(-tau(u)), tau(u) = -scale u meanLog(w0,
-        // w(u)); n from the larger extinction at the ends, so no sub-interval is deeper than
-        // about 0.5 (at most kFastMaxParts).
-        const float kMax = -logf(fmaxf(fminf(w0, w1), 1e-30f));
+        // transmittance law's extinction -ln w may be singular); n from the larger extinction at
+        // the ends, so no sub-interval is deeper than about 0.5 (at most kFastMaxParts).
+        const float kMax = attenuation ? fmaxf(a0, a1) : -logf(fmaxf(fminf(w0, w1), 1e-30f));
         const float parts = ceilf(2.f * scale * kMax);
         const int n = parts <= 1.f ? 1 : (parts < kFastMaxParts ? int(parts) : kFastMaxParts);
         const float h = 1.f / static_cast<float>(n);
         const float x[3] = {0.1127016654f, 0.5f, 0.8872983346f};
         const float wgt[3] = {5.f / 18.f, 8.f / 18.f, 5.f / 18.f};
+        const float halfSlope = 0.5f * (a1 - a0);
         float sum = 0.f;
         for (int j = 0; j < n; ++j)
             for (int q = 0; q < 3; ++q) {
                 const float u = (static_cast<float>(j) + x[q]) * h;
-                const float w = w0 + (w1 - w0) * u;
-                sum += wgt[q] * expf(scale * u * meanLogF(w0, f0, w > 0.f ? w : 0.f));
+                float logT;
+                if (attenuation) {
+                    logT = -scale * u * (a0 + halfSlope * u);
+                } else {
+                    const float w = w0 + (w1 - w0) * u;
+                    logT = scale * u * meanLogF(w0, f0, w > 0.f ? w : 0.f);
+                }
+                sum += wgt[q] * expf(logT);
             }
         mean = sum * h;
     }
@@ -202,12 +215,12 @@ UVR_HOST_DEVICE inline Vec4f tableAt(const TfTableView& tf, double g) {
 }
 
 /// Integrates a segment of length len along which the scalar runs linearly from s0 to s1
-/// through the transfer function, split at the table's breakpoints it crosses (every entry when
-/// the table has none), into acc; fast: each piece by compositePieceFast (in float, what the
-/// renderers use), else by compositePiece (in double). A NaN end makes the whole segment take
-/// the NaN entry tf.nan (constant; transparent at NaN opacity 0): inside a linear tetrahedron
-/// with a NaN vertex the field is NaN everywhere, and between samples the NaN region's edge is
-/// placed at the segment's near end, as a point sample there would be.
+/// through the transfer function (its opacities read by tf.law), split at the table's breakpoints
+/// it crosses (every entry when the table has none), into acc; fast: each piece by
+/// compositePieceFast (in float, what the renderers use), else by compositePiece (in double). A NaN
+/// end makes the whole segment take the NaN entry tf.nan (constant; transparent at NaN opacity 0):
+/// inside a linear tetrahedron with a NaN vertex the field is NaN everywhere, and between samples
+/// the NaN region's edge is placed at the segment's near end, as a point sample there would be.
 UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s1, double len,
                                       double unit, Vec4f& acc, bool fast = false) {
     if (!(len > 0.0) || tf.count < 1) return;
@@ -254,9 +267,9 @@ UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s
         const Vec4f e1 = dg == 0.0 ? e0 : tableAt(tf, g0 + dg * uNext);
         if (fast)
             compositePieceFast(e0.xyz(), e0.w, e1.xyz(), e1.w, float((uNext - u) * len),
-                               float(unit), acc);
+                               float(unit), tf.law, acc);
         else
-            compositePiece(e0.xyz(), e0.w, e1.xyz(), e1.w, (uNext - u) * len, unit, acc);
+            compositePiece(e0.xyz(), e0.w, e1.xyz(), e1.w, (uNext - u) * len, unit, tf.law, acc);
         e0 = e1;
         u = uNext;
     }

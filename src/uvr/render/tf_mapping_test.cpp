@@ -9,6 +9,7 @@
 #include <string>
 
 #include "test_meshes.h"
+#include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/field_select.h"
@@ -62,8 +63,9 @@ TEST(TfMapping, LogScaleMovesAnOpacityBandWhereLog10PutsIt) {
                                               std::to_string(int(method)) + " pixel " +
                                               std::to_string(x) + "," + std::to_string(y);
                     if (lo > x0 + 0.02 && hi < x1 - 0.02) {
-                        // Wholly in the band: 1 - 0.5^(chord / unit).
-                        const double want = 1.0 - std::pow(0.5, (t1 - t0) / s.opacityUnit);
+                        // Wholly in the band: the slab opacity of 0.5 per unit over the chord.
+                        const double want =
+                            testing::slabOpacity(0.5, t1 - t0, s.opacityUnit, s.opacityLaw);
                         EXPECT_NEAR(alpha, want, 0.02) << where;
                         ++inside;
                     } else if (hi < x0 - 0.02 || lo > x1 + 0.02) {
@@ -155,7 +157,7 @@ TEST(TfMapping, NanValuesTakeTheNanColourInEveryIntegrator) {
                         double t0, t1;
                         const double chord = boxSpan(seen, ray, t0, t1) ? t1 - t0 : 0.0;
                         const double want =
-                            1.0 - std::pow(1.0 - alphaPerUnit, chord / s.opacityUnit);
+                            testing::slabOpacity(alphaPerUnit, chord, s.opacityUnit, s.opacityLaw);
                         const Vec4f px = r.image.pixels[y * s.width + x];
                         worst = std::max(worst, std::fabs(px.w - want));
                         if (c.nanOpacity > 0.f) {

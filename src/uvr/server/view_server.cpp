@@ -909,6 +909,8 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
         args.insert(args.end(), {"--quality", fmtExact(s.quality)});
     args.insert(args.end(), {"--size", std::to_string(s.width) + "x" + std::to_string(s.height),
                              "--opacity-unit", fmtExact(s.opacityUnit)});
+    if (s.opacityLaw != kDefaultOpacityLaw)
+        args.insert(args.end(), {"--opacity-law", opacityLawName(s.opacityLaw)});
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
     args.insert(args.end(), {"-o", "uvr-view.png"});
     std::string command;

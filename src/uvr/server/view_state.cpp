@@ -215,6 +215,7 @@ Json toJson(const ViewState& s) {
             {"heatmap", s.heatmap},
             {"size", {s.width, s.height}},
             {"opacity_unit", s.opacityUnit},
+            {"opacity_law", opacityLawName(s.opacityLaw)},
             {"step", s.step}};
 }
 
@@ -321,10 +322,16 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
         } else if (k == "opacity_unit") {
             next.opacityUnit = finiteFloat(k, v);
             if (!(next.opacityUnit > 0.f)) bad(k, "a positive length", v);
+        } else if (k == "opacity_law") {
+            if (!v.is_string() || !parseOpacityLaw(v.get<std::string>().c_str(), next.opacityLaw))
+                bad(k,
+                    std::string("\"") + opacityLawName(OpacityLaw::Attenuation) + "\" or \"" +
+                        opacityLawName(OpacityLaw::Transmittance) + "\"",
+                    v);
         } else {
             bad("set",
                 "state keys (camera, tf, range, field, method, quality, heatmap, size, "
-                "opacity_unit, step, preset, colormap_json), not \"" +
+                "opacity_unit, opacity_law, step, preset, colormap_json), not \"" +
                     printableShort(k, 40) + "\"",
                 message);
         }
@@ -349,6 +356,7 @@ RenderSettings frameSettings(const ViewState& state, const RenderSettings& base,
     s.method = state.method;
     s.quality = state.quality;
     s.opacityUnit = state.opacityUnit;
+    s.opacityLaw = state.opacityLaw;
     scale = std::max(scale, 1);
     s.width = std::max(1, state.width / scale);
     s.height = std::max(1, state.height / scale);

@@ -31,7 +31,8 @@ struct ViewState {
     bool heatmap = false;  ///< show samples per pixel instead of the volume
     int width = 1024, height = 1024;
     float opacityUnit = 1.f;  ///< ParaView's ScalarOpacityUnitDistance, in file units
-    std::size_t step = 0;     ///< the time step shown (0 for a file without time steps)
+    OpacityLaw opacityLaw = kDefaultOpacityLaw;  ///< how opacities become extinction
+    std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
 };
 
 /// "adaptive", "reference" or "exact" (the --method names).
@@ -50,7 +51,7 @@ struct SetResult {
 };
 
 /// Applies the state keys of a `set` message (camera, tf, range, field, method, quality,
-/// heatmap, size, opacity_unit, step (below stepCount), preset, colormap_json and
+/// heatmap, size, opacity_unit, opacity_law, step (below stepCount), preset, colormap_json and
 /// colormap_name) to `state`, all or
 /// nothing: on any bad value it throws Error(Argument) (Error(Parse) for a malformed uploaded
 /// colour map) naming the key and what was expected, and leaves `state` unchanged. Unknown keys
@@ -60,7 +61,8 @@ SetResult applySet(ViewState& state, const nlohmann::json& message, std::size_t 
 
 /// The render settings of a frame of the state: `base` (what the command line set beyond the
 /// state: steps, sampling, rule) with the state's camera, transfer function, range, method,
-/// quality and opacity unit, at the state's size divided by `scale` (at least 1 pixel a side).
+/// quality, opacity unit and opacity law, at the state's size divided by `scale` (at least 1 pixel
+/// a side).
 RenderSettings frameSettings(const ViewState& state, const RenderSettings& base, int scale = 1);
 
 }  // namespace uvr::server

@@ -61,7 +61,8 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
                       {"quality", 0.95},
                       {"heatmap", true},
                       {"size", {320, 200}},
-                      {"opacity_unit", 0.25}};
+                      {"opacity_unit", 0.25},
+                      {"opacity_law", "transmittance"}};
     const SetResult r = applySet(s, msg);
     EXPECT_FALSE(r.fieldChanged);
     EXPECT_TRUE(r.rangeGiven);
@@ -73,6 +74,7 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     ASSERT_EQ(s.tf.opacities.size(), 3u);
     EXPECT_FLOAT_EQ(s.tf.opacityAt(0.25f), 0.5f);
     EXPECT_EQ(s.method, RenderMethod::Exact);
+    EXPECT_EQ(s.opacityLaw, OpacityLaw::Transmittance);
     EXPECT_TRUE(s.heatmap);
     EXPECT_EQ(s.width, 320);
     EXPECT_EQ(s.height, 200);
@@ -92,6 +94,7 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     ASSERT_TRUE(f.range);
     EXPECT_EQ(f.range->second, 4.f);
     EXPECT_EQ(f.opacityUnit, 0.25f);
+    EXPECT_EQ(f.opacityLaw, OpacityLaw::Transmittance);
 }
 
 TEST(ViewState, PresetsAndUploadedColourMapsReplaceColoursAndAskForTheStateBack) {
@@ -137,6 +140,8 @@ TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
     EXPECT_THAT(refusal({{"size", {8, 100}}}), HasSubstr("\"size\""));
     EXPECT_THAT(refusal({{"size", {100.5, 100}}}), HasSubstr("\"size\""));
     EXPECT_THAT(refusal({{"opacity_unit", -1}}), HasSubstr("opacity_unit"));
+    EXPECT_THAT(refusal({{"opacity_law", "linear"}}), HasSubstr("\"opacity_law\""));
+    EXPECT_THAT(refusal({{"opacity_law", 1}}), HasSubstr("\"opacity_law\""));
     EXPECT_THAT(refusal({{"field", "density:sideways"}}), HasSubstr("sideways"));
     EXPECT_THAT(refusal({{"preset", "no-such-map"}}), HasSubstr("no-such-map"));
     EXPECT_THAT(refusal({{"colormap_json", "{not json"}}), HasSubstr("the uploaded colour map"));

@@ -24,7 +24,7 @@ TfRangeTables::TfRangeTables(const TfTableView& table) {
         maxLevels[i] = e.w;
         if (i + 1 == n) break;
         const Vec4f f = table.entries[i + 1];
-        const float te = opticalDepthPerUnit(e.w), tf = opticalDepthPerUnit(f.w);
+        const float te = extinctionPerUnit(e.w, table.law), tf = extinctionPerUnit(f.w, table.law);
         float rate = std::fabs(tf - te);
         for (int c = 0; c < 3; ++c) rate = std::fmax(rate, std::fabs(f[c] * tf - e[c] * te));
         rateLevels[i] = rate;

@@ -15,18 +15,12 @@ namespace uvr {
 struct RangeStats {
     float maxOpacity = 0.f;  ///< largest opacity the transfer function takes over the range
     float variance = 0.f;    ///< Var(r) + Var(g) + Var(b) + Var(a) over the range's table entries
-    /// Largest change per table entry, over the range, of the optical depth per opacity unit
-    /// tau = -ln(1 - alpha) and of each colour channel times it (the emission): how fast the
-    /// transfer function can change what a ray sees (the error-bound step rule).
+    /// Largest change per table entry, over the range, of the extinction per opacity unit
+    /// (extinctionPerUnit under the table's law) and of each colour channel times it (the
+    /// emission): how fast the transfer function can change what a ray sees (the error-bound
+    /// step rule).
     float maxRate = 0.f;
 };
-
-/// Optical depth per opacity unit of a table opacity, -ln(1 - alpha), with alpha capped at
-/// 1 - 1e-6 (an opacity of 1 is opaque at once; 13.8 is as good as infinite for a rate).
-UVR_HOST_DEVICE inline float opticalDepthPerUnit(float alpha) {
-    const float a = alpha < 0.999999f ? (alpha > 0.f ? alpha : 0.f) : 0.999999f;
-    return -log1pf(-a);
-}
 
 /// Plain-data tables for O(1) range statistics of a baked transfer function: prefix sums of
 /// r, g, b, a and r^2 + g^2 + b^2 + a^2 (double) and sparse tables of opacity maxima and of rate

@@ -43,7 +43,7 @@ float bruteForceRate(const TfTableView& t, float lo, float hi) {
                               (i + 2 == t.count && f0 >= float(i + 1));
         if (!overlaps) continue;
         const Vec4f a = t.entries[i], b = t.entries[i + 1];
-        const float ta = opticalDepthPerUnit(a.w), tb = opticalDepthPerUnit(b.w);
+        const float ta = extinctionPerUnit(a.w, t.law), tb = extinctionPerUnit(b.w, t.law);
         rate = std::max(rate, std::fabs(tb - ta));
         for (int c = 0; c < 3; ++c) rate = std::max(rate, std::fabs(b[c] * tb - a[c] * ta));
     }
@@ -56,7 +56,8 @@ TEST(RangeStats, MatchBruteForceOnRandomTablesAndRanges) {
     for (int count : {2, 3, 17, 256, 1000}) {
         std::vector<Vec4f> e(count);
         for (auto& v : e) v = Vec4f(u(rng), u(rng), u(rng), u(rng) < 0.3f ? 0.f : u(rng));
-        const TfTableView table{e.data(), count, -2.f, 5.f};
+        TfTableView table{e.data(), count, -2.f, 5.f};
+        table.law = count % 2 ? OpacityLaw::Transmittance : OpacityLaw::Attenuation;
         const TfRangeTables tables(table);
         const TfRangeView view = tables.view(table);
         for (int i = 0; i < 2000; ++i) {
@@ -84,11 +85,12 @@ TEST(RangeStats, ConstantTableHasZeroVarianceAndRampMaxIsTheUpperEnd) {
 }
 
 TEST(RangeStats, RateIsTheSteepestChangeOfOpticalDepthOrEmission) {
-    // Opacity 0 up to entry 50, 0.5 from entry 51: the rate is -ln(0.5) (times the white colour)
-    // on the piece 50-51 and 0 elsewhere.
+    // Opacity 0 up to entry 50, 0.5 from entry 51: under transmittance the rate is -ln(0.5)
+    // (times the white colour) on the piece 50-51 and 0 elsewhere.
     std::vector<Vec4f> step(101, Vec4f(1.f, 1.f, 1.f, 0.f));
     for (int i = 51; i <= 100; ++i) step[i].w = 0.5f;
-    const TfTableView t{step.data(), 101, 0.f, 1.f};
+    TfTableView t{step.data(), 101, 0.f, 1.f};
+    t.law = OpacityLaw::Transmittance;
     const TfRangeTables tables(t);
     EXPECT_FLOAT_EQ(tables.view(t).query(0.1f, 0.9f).maxRate, std::log(2.f));
     EXPECT_FLOAT_EQ(tables.view(t).query(0.505f, 0.505f).maxRate, std::log(2.f));
@@ -98,6 +100,12 @@ TEST(RangeStats, RateIsTheSteepestChangeOfOpticalDepthOrEmission) {
     step[100].w = 1.f;
     const TfRangeTables capped(t);
     EXPECT_NEAR(capped.view(t).query(0.95f, 1.f).maxRate, -std::log(1e-6f) - std::log(2.f), 0.1f);
+    // Under attenuation the extinction is the opacity itself: 0.5 on the step, 1 - 0.5 at the
+    // end.
+    t.law = OpacityLaw::Attenuation;
+    const TfRangeTables attenuation(t);
+    EXPECT_FLOAT_EQ(attenuation.view(t).query(0.1f, 0.9f).maxRate, 0.5f);
+    EXPECT_FLOAT_EQ(attenuation.view(t).query(0.95f, 1.f).maxRate, 0.5f);
 }
 
 TEST(TfTablePosition, AnyInputGivesAPositionInsideTheTable) {

@@ -3,8 +3,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace uvr {
+
+const char* opacityLawName(OpacityLaw law) {
+    return law == OpacityLaw::Attenuation ? "attenuation" : "transmittance";
+}
+
+bool parseOpacityLaw(const char* name, OpacityLaw& law) {
+    for (OpacityLaw l : {OpacityLaw::Attenuation, OpacityLaw::Transmittance})
+        if (name && std::strcmp(name, opacityLawName(l)) == 0) {
+            law = l;
+            return true;
+        }
+    return false;
+}
 
 std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count, float tolerance) {
     std::vector<std::int32_t> out(2 * static_cast<std::size_t>(std::max(count, 0)), 0);

@@ -26,8 +26,43 @@ UVR_HOST_DEVICE inline float tfTablePosition(float v, float lo, float hi, int co
     return count > 1 ? t * static_cast<float>(count - 1) : 0.f;
 }
 
+/// How a transfer-function opacity alpha per opacity unit u becomes the extinction kappa (optical
+/// depth per distance) along a ray; the emission is colour * kappa under both (docs/METHOD.md,
+/// "Opacity law").
+enum class OpacityLaw : std::uint8_t {
+    /// kappa = alpha / u, linear between the transfer function's breakpoints: VTK's and
+    /// ParaView's unstructured volume mappers (projected tetrahedra, Bunyk's ray caster). A slab L
+    /// thick of constant alpha has opacity 1 - exp(-alpha L / u); alpha = 1 is finite.
+    Attenuation,
+    /// kappa = -ln(1 - alpha) / u: a slab L thick has opacity 1 - (1 - alpha)^(L / u) (the
+    /// opacity correction of image-data ray casters: alpha is the opacity of one unit); alpha = 1
+    /// is opaque at once.
+    Transmittance,
+};
+
+/// The default law: what ParaView shows for unstructured data.
+inline constexpr OpacityLaw kDefaultOpacityLaw = OpacityLaw::Attenuation;
+
+/// Largest table opacity the transmittance law reads as finite: -ln(1e-6) = 13.8 optical depth
+/// per unit (as good as infinite for a rate).
+inline constexpr float kMaxFiniteOpacity = 0.999999f;
+
+/// Extinction per opacity unit, kappa u, of a table opacity alpha (clamped to [0, 1]) under a
+/// law; under the transmittance law alpha is capped at kMaxFiniteOpacity.
+UVR_HOST_DEVICE inline float extinctionPerUnit(float alpha, OpacityLaw law) {
+    const float a = alpha > 0.f ? (alpha < 1.f ? alpha : 1.f) : 0.f;
+    if (law == OpacityLaw::Attenuation) return a;
+    return -log1pf(-(a < kMaxFiniteOpacity ? a : kMaxFiniteOpacity));
+}
+
+/// The law's name as the front ends spell it ("attenuation", "transmittance").
+const char* opacityLawName(OpacityLaw law);
+
+/// The law of a name (opacityLawName's), false for any other name.
+bool parseOpacityLaw(const char* name, OpacityLaw& law);
+
 /// A baked transfer function: count RGBA entries spread evenly over the value range [lo, hi];
-/// alpha is opacity per opacity unit distance. Plain data, usable on CPU and GPU.
+/// alpha is opacity per opacity unit distance, read by `law`. Plain data, usable on CPU and GPU.
 struct TfTableView {
     const Vec4f* entries = nullptr;
     int count = 0;
@@ -41,6 +76,8 @@ struct TfTableView {
     /// Colour and opacity of NaN values (TransferFunction::nanColor, nanOpacity); opacity 0
     /// keeps NaN regions invisible.
     Vec4f nan = Vec4f(0.f, 0.f, 0.f, 0.f);
+    /// How the opacities become extinction.
+    OpacityLaw law = kDefaultOpacityLaw;
 
     /// The first breakpoint (a table position) above position g in [0, count - 1).
     UVR_HOST_DEVICE int breakAbove(double g) const {
