@@ -35,6 +35,9 @@ struct PrepareOptions {
     bool macroGrids = true;       ///< with partitions: the macrocells the error-bound rule steps by
     TetrahedralizeOptions cells;  ///< native cells or the split into tetrahedra
     KdBuildOptions kd;
+    /// With partitions: cells per leaf of the cell tree (buildCellTree); the CPU's small leaves
+    /// by default, kCellTreeLeaf where the renderer is a GPU (RendererOptions::prepareOptions).
+    std::uint32_t cellTreeLeaf = kCpuCellTreeLeaf;
     /// When set, the mesh BVH is an LBVH from this builder (buildLbvhCuda: on the GPU, in
     /// seconds for 100M+ tetrahedra); else a binned SAH tree built on the CPU threads.
     LbvhBuilder lbvh;
