@@ -98,15 +98,24 @@ struct Bvh {
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
 
-/// Cells per leaf of the cell tree (buildCellTree): searches are rare (walks and seeds locate
-/// almost every sample), so large leaves cost little time and keep the tree at 2 bytes per cell.
+/// Cells per leaf of the cell tree (buildCellTree) for rendering on a GPU: searches are rare
+/// there (walks and seeds locate almost every sample inside the mesh), so large leaves cost
+/// little time and keep the tree at 2 bytes per cell.
 inline constexpr std::uint32_t kCellTreeLeaf = 32;
+
+/// Cells per leaf of the cell tree for rendering on the CPU (PrepareOptions::cellTreeLeaf's
+/// default): a sample outside a non-convex mesh is searched for, and the search tests every cell
+/// of every leaf whose box holds it; with 32-cell leaves, whose boxes overlap, that was 3/4 of
+/// the CPU's render time (SPX, 12,936 tetrahedra: 4.2M searches at about 4 us each, against the
+/// reference's 0.2 us in its SAH tree). Leaves of 2 cells cost 32 bytes per cell (one 32-byte
+/// node per cell) against 2 at 32 (PERFORMANCE.md, "CPU: the cell tree's leaves").
+inline constexpr std::uint32_t kCpuCellTreeLeaf = 2;
 
 /// A BVH whose leaves are runs of `leafCells` consecutive cell ids, without primitive ids (a
 /// leaf holds cells [first, first + count)): a balanced binary tree over the runs, siblings
 /// adjacent. Over cells in Morton order (sortCellsSpatially) the runs are compact. Parallel;
 /// `progress` hears the fraction done.
-Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells = kCellTreeLeaf,
+Bvh buildCellTree(const TetMesh& mesh, std::uint32_t leafCells = kCpuCellTreeLeaf,
                   const FractionFn& progress = {});
 
 /// Bounding box and box centre of every cell of a mesh (resizes both arrays); parallel.

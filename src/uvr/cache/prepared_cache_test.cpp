@@ -116,6 +116,9 @@ TEST(PreparedCache, HoldsAboutThirtyBytesPerTetrahedronForTheAdaptiveMethod) {
     const Mesh mesh = generateMesh(spec);
     PrepareOptions options;
     options.meshBvh = false;  // what --method adaptive prepares
+    // For a GPU renderer (RendererOptions::prepareOptions): the CPU's cell tree of 2-cell leaves
+    // adds 32 bytes per cell (kCpuCellTreeLeaf).
+    options.cellTreeLeaf = kCellTreeLeaf;
     const PreparedMesh fresh = prepareMesh(mesh, selectScalarField(mesh, {}), options);
     const std::uint64_t bytes = writePreparedCache(
         fresh, makeCacheKey(sourceFile(dir), "", "", options), {}, dir + "/c.uvrprep");

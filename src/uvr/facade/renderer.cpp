@@ -50,6 +50,7 @@ PrepareOptions RendererOptions::prepareOptions() const {
         o.kd.leafCells = leafCells;
     else if (renderOnCuda)
         o.kd.leafCells = kCudaDefaultLeafCells;
+    if (renderOnCuda) o.cellTreeLeaf = kCellTreeLeaf;  // memory-lean; searches are rare there
     return o;
 }
 

@@ -90,7 +90,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     // only the cells) and then the neighbours' codes on threads of their own.
     std::future<std::pair<Bvh, double>> cellTree;
     if (faceMatcher && options.partitions)
-        cellTree = beside([&tets = out.tets] { return buildCellTree(tets); });
+        cellTree = beside(
+            [&tets = out.tets, leaf = options.cellTreeLeaf] { return buildCellTree(tets, leaf); });
     start = std::chrono::steady_clock::now();
     if (progress)
         progress(faceMatcher ? "finding face neighbours (on " + options.builderDevice +
@@ -140,7 +141,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         } else {
             if (progress) progress("building the cell tree");
             start = std::chrono::steady_clock::now();
-            out.cellTree = buildCellTree(out.tets, kCellTreeLeaf, progress.fraction);
+            out.cellTree = buildCellTree(out.tets, options.cellTreeLeaf, progress.fraction);
             out.phaseSeconds.emplace_back("cell_tree", secondsSince(start));
         }
         if (options.seedGrids) {

@@ -29,10 +29,13 @@ namespace uvr {
 
 /// What prepareMesh builds besides the cells, BVH and neighbours.
 struct PrepareOptions {
-    bool meshBvh = true;          ///< build the BVH over all cells the reference marcher needs
-    bool partitions = true;       ///< build the k-d partitions the partition integrator needs
-    bool seedGrids = true;        ///< with partitions: the seed grids that long steps locate from
-    bool macroGrids = true;       ///< with partitions: the macrocells the error-bound rule steps by
+    bool meshBvh = true;     ///< build the BVH over all cells the reference marcher needs
+    bool partitions = true;  ///< build the k-d partitions the partition integrator needs
+    bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
+    bool macroGrids = true;  ///< with partitions: the macrocells the error-bound rule steps by
+    /// With partitions: cells per leaf of the cell tree (buildCellTree); the CPU's small leaves
+    /// by default, kCellTreeLeaf where the renderer is a GPU (RendererOptions::prepareOptions).
+    std::uint32_t cellTreeLeaf = kCpuCellTreeLeaf;
     TetrahedralizeOptions cells;  ///< native cells or the split into tetrahedra
     KdBuildOptions kd;
     /// When set, the mesh BVH is an LBVH from this builder (buildLbvhCuda: on the GPU, in
