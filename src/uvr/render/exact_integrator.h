@@ -141,6 +141,15 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     float cv[kMaxCellCorners];
     const int n = mesh.gather(t, x, cv);
     const CellKind k = mesh.kind(t);
+    // The shape functions are a convex combination: the value lies within the corners' (as
+    // TetSpan::valueAt's). Unclamped, float rounding put it an ulp above the range's top on a
+    // wall at the field's maximum: a real sliver past the table's last entry, which under the
+    // transmittance law at opacity 1 made the ray opaque (speckle on disk_out_ref.ex2).
+    float cvLo = cv[0], cvHi = cv[0];
+    for (int i = 1; i < n; ++i) {
+        cvLo = cv[i] < cvLo ? cv[i] : cvLo;
+        cvHi = cv[i] > cvHi ? cv[i] : cvHi;
+    }
     Vec3f rst = cellCentreParametric(k);
     auto valueAt = [&](double tp) {
         const Vec3f p = ray.at(static_cast<float>(tp));
@@ -150,7 +159,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         shapeFunctions(k, c.x, c.y, c.z, w);
         float v = 0.f;
         for (int i = 0; i < n; ++i) v += w[i] * cv[i];
-        return v;
+        return v < cvLo ? cvLo : (v > cvHi ? cvHi : v);  // NaN stays NaN
     };
     const float vMid = valueAt(0.5 * (t0 + t1));
     const Vec3f rstMid = rst;

@@ -124,6 +124,42 @@ TEST(ExactIntegrator, LinearOpacityAndColourMatchBruteForce) {
     EXPECT_NEAR(acc.w, 1.0 - std::exp(-0.1), 1e-6);
 }
 
+TEST(ExactIntegrator, ASegmentEndingAtTheRangesTopIsNotMadeOpaqueByRounding) {
+    // Issue 29: rays of disk_out_ref.ex2 ending on the hot wall (Temp at its maximum, opacity 1
+    // there) turned opaque at once under the transmittance law in split cells, not in native
+    // ones: with s1 the range's top in float, the table walk left a sliver of about 1e-16 of the
+    // segment past the last entry, a piece of opacity 1 at both ends. The integral of -ln(1 - a)
+    // is finite; the segment must read as the one ending a hair below the top, and as the
+    // closed form, in double and in float.
+    TransferFunction tf = transferFunctionPreset("grayscale");
+    applyOpacitySpec(tf, "0:0,1:1");
+    const float lo = 293.15f, hi = 913.15f;
+    const std::vector<Vec4f> table = tf.bakeOverRange(1024, lo, hi);
+    const std::vector<std::int32_t> breaks = tfTableBreaks(table.data(), 1024);
+    for (const bool withBreaks : {false, true}) {
+        TfTableView view{table.data(), 1024, lo, hi};
+        view.law = OpacityLaw::Transmittance;
+        if (withBreaks) view.breaks = breaks.data();
+        for (const auto& [s0, len] : {std::pair{911.334595f, 0.00478162326},
+                                      std::pair{902.846f, 0.023174}, std::pair{600.f, 0.5}})
+            for (const bool fast : {false, true}) {
+                const std::string what =
+                    std::to_string(s0) + (fast ? " fast" : "") + (withBreaks ? " breaks" : "");
+                Vec4f top(0.f, 0.f, 0.f, 0.5f), below(0.f, 0.f, 0.f, 0.5f);
+                segment::integrate(view, s0, hi, len, 1.3249257802963257, top, fast);
+                segment::integrate(view, s0, std::nextafter(hi, 0.f), len, 1.3249257802963257,
+                                   below, fast);
+                EXPECT_LT(top.w, 0.99f) << what;
+                expectNear(top, below, 1e-5f, what);
+                // The closed form: opacity a = (s - lo) / (hi - lo), linear along the segment
+                // to 1, so w = 1 - a runs from w0 to 0 and the mean of -ln w is 1 - ln w0.
+                const double w0 = 1.0 - (double(s0) - lo) / (double(hi) - lo);
+                const double tau = len / 1.3249257802963257 * (1.0 - std::log(w0));
+                EXPECT_NEAR(top.w, 0.5 - 0.5 * std::expm1(-tau), 1e-4) << what << " closed form";
+            }
+    }
+}
+
 TEST(ExactIntegrator, TransferFunctionStepInsideOneSegmentIsNotMissed) {
     // A narrow opacity band (0 outside [0.49, 0.51] of the range, 0.9 inside) crossed by one
     // segment: a point sample every 0.1 of the range misses it; the exact integral does not.

@@ -265,11 +265,18 @@ UVR_HOST_DEVICE inline void integrate(const TfTableView& tf, double s0, double s
         // A constant value (dg 0, also a NaN end) keeps its entry: no second lookup, and no
         // flag live across the loop.
         const Vec4f e1 = dg == 0.0 ? e0 : tableAt(tf, g0 + dg * uNext);
-        if (fast)
-            compositePieceFast(e0.xyz(), e0.w, e1.xyz(), e1.w, float((uNext - u) * len),
-                               float(unit), tf.law, acc);
-        else
-            compositePiece(e0.xyz(), e0.w, e1.xyz(), e1.w, (uNext - u) * len, unit, tf.law, acc);
+        // A sliver below 1e-9 of the segment (the forced advance above, or what rounding leaves
+        // past the table's last entry when s1 is the range's top) is rounding, not path: at
+        // opacity 1 under the transmittance law it would make the ray opaque at once (speckle
+        // where a ray ends on a wall at the field's maximum), elsewhere it adds nothing.
+        if (uNext - u > 1e-9) {
+            if (fast)
+                compositePieceFast(e0.xyz(), e0.w, e1.xyz(), e1.w, float((uNext - u) * len),
+                                   float(unit), tf.law, acc);
+            else
+                compositePiece(e0.xyz(), e0.w, e1.xyz(), e1.w, (uNext - u) * len, unit, tf.law,
+                               acc);
+        }
         e0 = e1;
         u = uNext;
     }
