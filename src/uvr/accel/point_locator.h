@@ -40,8 +40,16 @@ struct TetLocator {
     template <bool kNative = true>
     UVR_HOST_DEVICE bool inside(std::uint32_t t, Vec3f p, float bary[4]) const {
         if (kNative && t >= mesh.tetCount) {
+            // A cell lies within its corners' box (its map is a convex combination of them):
+            // outside it, as the BVH's leaves allow (two cells a leaf on the CPU), p needs no
+            // Newton's method (several steps from the centre before it gives up).
+            Vec3f x[kMaxCellCorners];
+            const int n = mesh.gather(t, x);
+            Bounds3f box;
+            for (int i = 0; i < n; ++i) box.extend(x[i]);
+            if (!boxHoldsPoint(box, p)) return false;
             float excess;
-            nativeStep(t, p, bary, excess);
+            nativeStepAt(mesh.kind(t), x, p, bary, excess);
             return excess <= kBaryEpsilon;
         }
         BlockVertex x[4];
@@ -60,7 +68,12 @@ struct TetLocator {
                                    bool fromGuess = false) const {
         Vec3f x[kMaxCellCorners];
         mesh.gather(t, x);
-        const CellKind k = mesh.kind(t);
+        return nativeStepAt(mesh.kind(t), x, p, bary, excess, fromGuess);
+    }
+
+    /// nativeStep of a cell of kind k with corners x (gathered).
+    UVR_HOST_DEVICE static int nativeStepAt(CellKind k, const Vec3f* x, Vec3f p, float bary[4],
+                                            float& excess, bool fromGuess = false) {
         Vec3f rst(0.f);
         if (fromGuess) {
             // A guess from elsewhere (another kind's coordinates, NaN) starts from the centre.

@@ -185,16 +185,19 @@ inline constexpr int kNewtonIterations = 12;
 /// the parametric unit box after kNewtonGiveUpAfter + 1 steps (it is not in the cell).
 inline constexpr int kNewtonGiveUpAfter = 2;
 inline constexpr float kNewtonGiveUpOutside = 0.5f;
+/// A Newton step at most this long (in parametric units) ends cellParametric: the iterate it
+/// gives is within about its square, 1e-6, of the root (below the 1e-5 residual test).
+inline constexpr float kNewtonQuadraticStep = 1e-3f;
 
 /// Parametric coordinates rst of point p in the cell of kind k with corners x[0..n-1]: the
 /// inverse of the isoparametric map by Newton's method from the parametric centre (or, with
 /// fromGuess, from rst as given: a nearby point's coordinates), in
 /// coordinates relative to corner 0 (for precision), each step's iterate kept within [-1, 2] (a
 /// far point's iteration cannot run away). Returns true when the residual fell below 1e-5 of the
-/// cell's size (or the step below 1e-6); false for a point the map does not reach from the
-/// centre (far outside a distorted cell, or a singular Jacobian) or whose iterate is still far
-/// outside after a few steps (kNewtonGiveUpOutside), with rst the last iterate.
-/// Exact for tetrahedra and parallelepipeds in one step; a few steps otherwise.
+/// cell's size (or a step fell below kNewtonQuadraticStep); false for a point the map does not
+/// reach from the centre (far outside a distorted cell, or a singular Jacobian) or whose iterate is
+/// still far outside after a few steps (kNewtonGiveUpOutside), with rst the last iterate. Exact for
+/// tetrahedra and parallelepipeds in one step; a few steps otherwise.
 UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, Vec3f& rst,
                                            bool fromGuess = false) {
     Vec3f e[kMaxCellCorners];
@@ -203,7 +206,7 @@ UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, 
     e[0] = Vec3f(0.f);
     for (int i = 1; i < n; ++i) {
         e[i] = x[i] - x[0];
-        size = fmaxf(size, fmaxf(fabsf(e[i].x), fmaxf(fabsf(e[i].y), fabsf(e[i].z))));
+        size = maxf(size, maxf(fabsf(e[i].x), maxf(fabsf(e[i].y), fabsf(e[i].z))));
     }
     const Vec3f q = p - x[0];
     if (!fromGuess) rst = cellCentreParametric(k);
@@ -220,24 +223,26 @@ UVR_HOST_DEVICE inline bool cellParametric(CellKind k, const Vec3f* x, Vec3f p, 
         const float inv = -1.f / det;
         const Vec3f d(dot(f, c0) * inv, dot(jr, cross(f, jt)) * inv, dot(jr, cross(js, f)) * inv);
         rst = rst + d;
-        rst = Vec3f(fminf(fmaxf(rst.x, -1.f), 2.f), fminf(fmaxf(rst.y, -1.f), 2.f),
-                    fminf(fmaxf(rst.z, -1.f), 2.f));
+        rst = Vec3f(minf(maxf(rst.x, -1.f), 2.f), minf(maxf(rst.y, -1.f), 2.f),
+                    minf(maxf(rst.z, -1.f), 2.f));
         const float residual =
-            isFinite(f) ? fmaxf(fabsf(f.x), fmaxf(fabsf(f.y), fabsf(f.z))) : INFINITY;
-        const float moved = fmaxf(fabsf(d.x), fmaxf(fabsf(d.y), fabsf(d.z)));
-        converged = residual <= tol || moved <= 1e-6f || !(moved == moved);
+            isFinite(f) ? maxf(fabsf(f.x), maxf(fabsf(f.y), fabsf(f.z))) : INFINITY;
+        const float moved = maxf(fabsf(d.x), maxf(fabsf(d.y), fabsf(d.z)));
+        // A step this small leaves an error of about its square (Newton converges
+        // quadratically): accept the new iterate without another map evaluation.
+        converged = residual <= tol || moved <= kNewtonQuadraticStep || !(moved == moved);
         if (!(moved == moved)) return false;  // NaN
         // Far outside after a few steps: not in the cell (a walk needs only the direction, and
         // a point outside may take every iteration to settle).
-        const float outside = fmaxf(fmaxf(fmaxf(-rst.x, rst.x - 1.f), fmaxf(-rst.y, rst.y - 1.f)),
-                                    fmaxf(-rst.z, rst.z - 1.f));
+        const float outside = maxf(maxf(maxf(-rst.x, rst.x - 1.f), maxf(-rst.y, rst.y - 1.f)),
+                                   maxf(-rst.z, rst.z - 1.f));
         if (!converged && it >= kNewtonGiveUpAfter && outside > kNewtonGiveUpOutside) return false;
     }
     if (!converged) {  // the last step's residual
         Vec3f f, jr, js, jt;
         cellMap(k, e, rst, f, jr, js, jt);
         f = f - q;
-        converged = isFinite(f) && fmaxf(fabsf(f.x), fmaxf(fabsf(f.y), fabsf(f.z))) <= tol;
+        converged = isFinite(f) && maxf(fabsf(f.x), maxf(fabsf(f.y), fabsf(f.z))) <= tol;
     }
     return converged;
 }
