@@ -875,7 +875,19 @@ PYBIND11_MODULE(_uvr, m) {
         [](const py::handle& a, const py::handle& b, std::array<float, 3> background) {
             const ImageComparison c = compareImages(toRgb8(imageOf(a), vec3(background)),
                                                     toRgb8(imageOf(b), vec3(background)));
-            return py::make_tuple(c.ssim, c.psnr);
+            // The keys of `uvr compare --json`: SSIM, PSNR (None when identical) and the
+            // per-pixel measures under differenceFields' names.
+            py::dict d;
+            d["ssim"] = c.ssim;
+            py::list channels;
+            for (double v : c.ssimChannel) channels.append(v);
+            d["ssim_channels"] = channels;
+            d["psnr"] =
+                std::isinf(c.psnr) ? py::object(py::none()) : py::object(py::float_(c.psnr));
+            for (const ComparisonField& f : differenceFields(c))
+                d[f.name] = f.integer ? py::object(py::int_(static_cast<long long>(f.value)))
+                                      : py::object(py::float_(f.value));
+            return d;
         },
         py::arg("a"), py::arg("b"), py::arg("background") = std::array<float, 3>{0.f, 0.f, 0.f});
     m.def("write_text", &writeText, py::arg("path"), py::arg("text"));

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Rendering: the CLI's pixels, time steps without rebuilding, the GIL, bad arguments."""
 
+import json
 import threading
 import time
 
@@ -117,6 +118,36 @@ def test_images_are_arrays_that_display_themselves(data_dir):
     assert {"seconds", "samples", "samples_per_pixel", "partitions_visited"} <= set(img.stats)
     crop = img[2:5]
     assert crop.stats is img.stats
+
+
+def test_compare_report_gives_the_worst_pixels_under_the_clis_keys(cli, tmp_path):
+    # A grey ramp, and the same with one pixel 40/255 brighter and a 3x3 block 10/255 darker:
+    # the maximum is 40, 10 pixels are off by more than 4/255, the odd pixel is speckle.
+    h, w = 48, 64
+    a = np.zeros((h, w, 4), np.float32)
+    a[..., :3] = (np.arange(w, dtype=np.float32) / (w - 1) * 0.5 + 0.2)[None, :, None]
+    a[..., 3] = 1.0
+    b = a.copy()
+    b[20, 30, :3] += 40 / 255
+    b[5:8, 5:8, :3] -= 10 / 255
+    a, b = uvr.Image(a), uvr.Image(b)
+    r = uvr.compare_report(a, b)
+    assert r["max_abs_difference"] == 40
+    assert r["fraction_off"] == pytest.approx(10 / (h * w))
+    assert r["speckle_fraction"] > 0 and r["seam_count"] == 0
+    assert isinstance(r["seam_count"], int) and 0.9 < r["ssim"] < 1
+    assert uvr.compare(a, b) == (r["ssim"], r["psnr"])
+    same = uvr.compare_report(a, a)
+    assert same["psnr"] is None and same["max_abs_difference"] == 0
+    assert uvr.compare(a, a) == (1.0, float("inf"))
+    # The CLI's JSON of the same PNGs: the same keys and values.
+    a.save(tmp_path / "a.png")
+    b.save(tmp_path / "b.png")
+    j = json.loads(cli("compare", "--json", tmp_path / "a.png", tmp_path / "b.png").stdout)
+    for key, value in r.items():
+        assert j[key] == pytest.approx(value), key
+    with pytest.raises(uvr.ArgumentError):
+        uvr.compare_report(a, uvr.Image(np.zeros((h, w + 1, 4), np.float32)))
 
 
 def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):

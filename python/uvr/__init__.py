@@ -10,7 +10,7 @@ files. docs/PYTHON.md is the guide.
 import os as _os
 
 from . import _uvr
-from ._image import Image, compare, contact_sheet, read_png
+from ._image import Image, compare, compare_report, contact_sheet, read_png
 from ._mesh import Mesh, Series, as_mesh, from_meshio, from_vtk, read
 from ._render import Renderer, render, transfer_function
 from ._uvr import (ArgumentError, Camera, Error, FileError, InternalError, ParseError,
@@ -18,9 +18,9 @@ from ._uvr import (ArgumentError, Camera, Error, FileError, InternalError, Parse
 
 __all__ = ["ArgumentError", "Camera", "Error", "FileError", "Image", "InternalError", "Mesh",
            "ParseError", "Renderer", "ResourceError", "Series", "TransferFunction",
-           "UnsupportedError", "ValidationError", "as_mesh", "compare", "contact_sheet", "cuda_available",
-           "from_meshio", "from_vtk", "presets", "read", "read_png", "render",
-           "transfer_function"]
+           "UnsupportedError", "ValidationError", "as_mesh", "compare", "compare_report",
+           "contact_sheet", "cuda_available", "from_meshio", "from_vtk", "presets", "read",
+           "read_png", "render", "transfer_function"]
 
 
 def presets():

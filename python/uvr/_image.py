@@ -81,7 +81,18 @@ def read_png(path):
 
 
 def compare(a, b, background=(0.0, 0.0, 0.0)):
-    """(SSIM, PSNR) of two images composited over a background, as ``uvr compare`` computes."""
+    """(SSIM, PSNR) of two images composited over a background, as ``uvr compare`` computes
+    (PSNR is infinite for identical images). ``compare_report`` gives every measure."""
+    r = compare_report(a, b, background)
+    return r["ssim"], float("inf") if r["psnr"] is None else r["psnr"]
+
+
+def compare_report(a, b, background=(0.0, 0.0, 0.0)):
+    """Every measure of ``uvr compare --json`` for reference `a` and image `b` composited over a
+    background, under the same keys: ``ssim``, ``ssim_channels``, ``psnr`` (None when identical)
+    and the per-pixel ones, ``p999_difference`` and ``max_abs_difference`` (8-bit levels),
+    ``fraction_off`` (pixels off by more than 4/255), ``seam_count``, ``seam_pixels``,
+    ``longest_seam`` and ``speckle_fraction`` (docs/METHOD.md, "Evaluation tools")."""
     return _uvr.compare_images(_plain(a), _plain(b), tuple(background))
 
 
