@@ -37,6 +37,11 @@ inline std::string sharedData(const std::string& name) {
     return std::string(env ? env : UVR_SHARED_DATA_DIR) + "/" + name;
 }
 
+/// ParaView's tutorial data disk_out_ref.ex2 (7,472 hexahedra, Exodus II), as Debian's mayavi2
+/// package ships it (scripts/install-deps.sh installs it; tests skip it when absent).
+inline constexpr const char* kDiskOutRef =
+    "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
+
 /// True when the shared data folder is present (tests that need it GTEST_SKIP otherwise).
 inline bool haveSharedData() {
     return std::filesystem::exists(sharedData("spx.vtk"));

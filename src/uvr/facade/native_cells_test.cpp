@@ -226,8 +226,7 @@ TEST(NativeCells, RealHexahedralFilesNativeAgainstSplit) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     std::vector<std::string> files = {testing::sharedData("hexa.vtk"),
                                       testing::sharedData("fire_ug.vtu")};
-    // ParaView's tutorial data as Debian's mayavi2 ships it (Exodus II, hexahedra).
-    const std::string disk = "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
+    const std::string disk = testing::kDiskOutRef;
     if (exodusSupported() && std::ifstream(disk).good()) files.push_back(disk);
     for (const std::string& file : files) {
         const char* name = file.c_str();
@@ -257,7 +256,7 @@ TEST(NativeCells, ExactOnADiskHotWallHasNoSpeckleUnderEitherLaw) {
     // ulp past the range's top, the split's where the table walk left a sliver there. Salt and
     // pepper against the split: 99.9th percentile 26-67/255, max 54-77/255 at 384x384 (4-9 and
     // at most 12 now: trilinear against linear cells). Native and split exact must agree.
-    const std::string disk = "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
+    const std::string disk = testing::kDiskOutRef;
     if (!exodusSupported() || !std::ifstream(disk).good()) GTEST_SKIP() << "no " << disk;
     const Mesh m = readMesh(disk);
     const ScalarField f = selectScalarField(m, parseFieldSpec("Temp"));

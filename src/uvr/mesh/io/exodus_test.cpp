@@ -27,8 +27,7 @@ namespace {
 
 using testing::catchError;
 
-/// ParaView's tutorial data, as Debian's mayavi2 package ships it.
-const char* const kDiskOutRef = "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
+using testing::kDiskOutRef;
 
 /// Skips the test unless this uvr reads Exodus files.
 #define REQUIRE_EXODUS()                                                \

@@ -38,8 +38,7 @@ using testing::catchError;
 
 #if defined(UVR_HAVE_NETCDF) && defined(UVR_HAS_HDF5)
 
-/// ParaView's tutorial data, as Debian's mayavi2 package ships it.
-const char* const kDiskOutRef = "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
+using testing::kDiskOutRef;
 
 #define REQUIRE_LIBRARIES()                                         \
     do {                                                            \
