@@ -61,7 +61,7 @@ struct MethodCase {
 };
 
 /// The methods compared, exact first (the yardstick).
-std::vector<MethodCase> kMethods = {
+std::vector<MethodCase> kMatrixMethods = {
     {"exact", RenderMethod::Exact, StepRule::ErrorBound, true},
     {"reference", RenderMethod::Reference, StepRule::ErrorBound, true},
     {"adaptive", RenderMethod::Partitions, StepRule::ErrorBound, true},
@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
         for (float q : qualities) {
             char name[64];
             std::snprintf(name, sizeof name, "adaptive, quality %g", double(q));
-            kMethods.push_back({name, RenderMethod::Partitions, StepRule::ErrorBound, true, q});
+            kMatrixMethods.push_back({name, RenderMethod::Partitions, StepRule::ErrorBound, true, q});
         }
         const bool cuda = device == "cuda";
         std::filesystem::create_directories(out);
@@ -230,7 +230,7 @@ int main(int argc, char** argv) {
                         orbitCamera(resetCamera(mesh.bounds(), 1.f), vc.azimuth, vc.elevation);
                     Image exact;
                     Rgb8Image exact8;
-                    for (const MethodCase& mcase : kMethods) {
+                    for (const MethodCase& mcase : kMatrixMethods) {
                         s.method = mcase.method;
                         s.stepRule = mcase.rule;
                         s.preintegrated = mcase.preintegrated;
@@ -268,7 +268,7 @@ int main(int argc, char** argv) {
                         rows.push_back(row);
                     }
                     std::printf("  %-12s %-8s", tc.name.c_str(), vc.name.c_str());
-                    for (std::size_t i = rows.size() - kMethods.size() + 1; i < rows.size(); ++i)
+                    for (std::size_t i = rows.size() - kMatrixMethods.size() + 1; i < rows.size(); ++i)
                         std::printf(" %.4f/%g", rows[i].cmp.ssim, rows[i].cmp.p999Difference);
                     std::printf("\n");
                     std::fflush(stdout);
@@ -303,35 +303,35 @@ int main(int argc, char** argv) {
         md << "| method | worst SSIM | median SSIM | cases < 0.98 | worst case | worst p99.9 | "
               "worst max | cases with seams | worst p99.9 case |\n"
               "|---|---|---|---|---|---|---|---|---|\n";
-        for (std::size_t m = 1; m < kMethods.size(); ++m) {
+        for (std::size_t m = 1; m < kMatrixMethods.size(); ++m) {
             std::vector<double> ssims;
             int below = 0, seamed = 0;
             double worstMax = 0.0;
             for (const Row& r : rows)
-                if (r.method == kMethods[m].name) {
+                if (r.method == kMatrixMethods[m].name) {
                     ssims.push_back(r.cmp.ssim);
                     below += r.cmp.ssim < 0.98;
                     seamed += r.cmp.seamCount > 0;
                     worstMax = std::max(worstMax, r.cmp.maxAbsDifference);
                 }
-            const Row& w = worstRow[kMethods[m].name];
-            const Row& wp = worstP999Row[kMethods[m].name];
+            const Row& w = worstRow[kMatrixMethods[m].name];
+            const Row& wp = worstP999Row[kMatrixMethods[m].name];
             char line[1024];
             std::snprintf(line, sizeof line,
                           "| %s | %.4f | %.4f | %d of %zu | %s, %s, %s | %g | %g | %d | %s, %s, "
                           "%s |\n",
-                          kMethods[m].name.c_str(), w.cmp.ssim, median(ssims), below, ssims.size(),
+                          kMatrixMethods[m].name.c_str(), w.cmp.ssim, median(ssims), below, ssims.size(),
                           w.mesh.c_str(), w.tf.c_str(), w.view.c_str(), wp.cmp.p999Difference,
                           worstMax, seamed, wp.mesh.c_str(), wp.tf.c_str(), wp.view.c_str());
             md << line;
         }
         // Per mesh: the worst SSIM of each method, then each method's median time and the
-        // median speed-up of the others over the reference (row order is kMethods' per case).
-        const std::size_t nm = kMethods.size();
+        // median speed-up of the others over the reference (row order is kMatrixMethods' per case).
+        const std::size_t nm = kMatrixMethods.size();
         md << "\n| mesh |";
-        for (std::size_t m = 1; m < nm; ++m) md << " worst SSIM: " << kMethods[m].name << " |";
-        for (std::size_t m = 0; m < nm; ++m) md << " ms: " << kMethods[m].name << " |";
-        for (std::size_t m = 2; m < nm; ++m) md << " speed-up: " << kMethods[m].name << " |";
+        for (std::size_t m = 1; m < nm; ++m) md << " worst SSIM: " << kMatrixMethods[m].name << " |";
+        for (std::size_t m = 0; m < nm; ++m) md << " ms: " << kMatrixMethods[m].name << " |";
+        for (std::size_t m = 2; m < nm; ++m) md << " speed-up: " << kMatrixMethods[m].name << " |";
         md << "\n|---|";
         for (std::size_t m = 1; m < 3 * nm - 2; ++m) md << "---|";
         md << "\n";

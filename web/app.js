@@ -404,7 +404,7 @@ function fillSelectors(info) {
     const field = $("field");
     field.replaceChildren(...fieldList.map((e) => new Option(e.label, e.spec)));
     const method = $("method");
-    method.replaceChildren(...(info.methods || ["adaptive", "reference", "exact"])
+    method.replaceChildren(...(info.methods || ["auto", "adaptive", "reference", "exact"])
         .map((m) => new Option(m, m)));
     const preset = $("preset");
     preset.replaceChildren(...(info.presets || []).map((p) => new Option(p, p)));
@@ -756,7 +756,10 @@ function updateFrameStats(header) {
     $("stat-frame").textContent =
         `${header.full ? "full" : "reduced"} ${header.width}×${header.height} ${header.format}`;
     const device = s.device || (session.info && session.info.device) || "–";
-    $("stat-device").textContent = s.method ? `${device} · ${s.method}` : device;
+    // Under "auto" the frame says which method it picked (and why, on hover).
+    const picked = $("method").value === "auto" && s.method ? `auto → ${s.method}` : s.method;
+    $("stat-device").textContent = picked ? `${device} · ${picked}` : device;
+    $("stat-device").title = s.method_reason || "";
 }
 
 // Frames per second: frames received over the last second, refreshed 4 times a second.

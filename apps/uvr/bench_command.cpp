@@ -155,6 +155,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             add("paper: variance, point", RenderMethod::Partitions, true, true, defaultS2);
         paper.settings.preintegrated = false;
         paper.settings.stepRule = StepRule::Variance;
+        // The default: what --method auto renders this mesh with here (the row names it).
+        add("auto", RenderMethod::Auto, true, true, base.maxStep);
         for (double f : *sweep) {
             char name[64];
             std::snprintf(name, sizeof name, "both, s2 = %g s1", f);
@@ -190,6 +192,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 times.push_back(v.last.stats.seconds);
             }
             v.medianSeconds = median(times);
+            if (v.settings.method == RenderMethod::Auto)
+                v.name = std::string("auto: ") + methodName(v.last.setup.method.method);
             v.samples = v.last.stats.samples;
             if (first)
                 for (std::uint32_t c : v.last.sampleCounts) heatmapMax = std::max(heatmapMax, c);

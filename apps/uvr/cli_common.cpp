@@ -224,11 +224,12 @@ CLI::Validator positiveNumber() {
 
 void addMethodOption(CLI::App& app, std::string& method) {
     app.add_option("--method", method,
-                   "Integrator: adaptive (k-d partitions and macrocells: space skipping, "
-                   "error-bounded adaptive steps; Morrical et al. 2019 and beyond), "
-                   "reference (fixed step s1 everywhere) or exact (no sampling: every "
-                   "tetrahedron's segment integrated exactly)")
-        ->check(CLI::IsMember({"reference", "adaptive", "exact"}))
+                   "Integrator: auto (the default: exact where a ray crosses few cells, so that "
+                   "it is the faster, else adaptive; adaptive whenever a flag tunes sampling), "
+                   "adaptive (k-d partitions and macrocells: space skipping, error-bounded "
+                   "adaptive steps; Morrical et al. 2019 and beyond), reference (fixed step s1 "
+                   "everywhere) or exact (no sampling: every cell's segment integrated exactly)")
+        ->check(CLI::IsMember(methodNames()))
         ->capture_default_str();
 }
 
@@ -412,9 +413,7 @@ RenderSettings RenderFlags::baseSettings() const {
     s.opacityUnit = opacityUnit;
     if (!parseOpacityLaw(opacityLaw.c_str(), s.opacityLaw))
         badFlag("--opacity-law", opacityLaw, "attenuation or transmittance");
-    s.method = method == "adaptive" ? RenderMethod::Partitions
-               : method == "exact"  ? RenderMethod::Exact
-                                    : RenderMethod::Reference;
+    s.method = requestedMethod();
     s.maxStep = maxStep;
     if (power) s.power = *power;
     s.stepRule = stepRule == "variance" ? StepRule::Variance : StepRule::ErrorBound;
@@ -422,9 +421,7 @@ RenderSettings RenderFlags::baseSettings() const {
     s.preintegrated = sampling == "preintegrated";
     s.skip = !noSkip;
     s.adaptive = !noAdaptive;
-    if (s.method != RenderMethod::Partitions &&
-        (noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid || quality || power ||
-         stepRule != "error"))
+    if (s.method != RenderMethod::Partitions && tunesPartitions())
         throwError(ErrorKind::Argument, "",
                    "--no-skip, --no-adaptive, --max-step, --step-rule, --quality, --power, "
                    "--leaf-cells and --no-seed-grid need --method adaptive");
@@ -648,12 +645,27 @@ void RenderFlags::checkFiles(const std::string& meshFile) const {
     for (const NamedFile& out : outputs()) resolveOutput(out.path);
 }
 
+RenderMethod RenderFlags::requestedMethod() const {
+    const RenderMethod m = parseMethod(method).value_or(RenderMethod::Auto);
+    if (m == RenderMethod::Auto && (tunesPartitions() || step > 0.f || sampling != "preintegrated"))
+        return RenderMethod::Partitions;
+    return m;
+}
+
+bool RenderFlags::tunesPartitions() const {
+    return noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid || quality || power ||
+           stepRule != "error";
+}
+
 RendererOptions RenderFlags::rendererOptions(bool withReference) const {
     RendererOptions o;
     o.device = parseDevice(device, "--device");
     o.buildDevice = parseDevice(buildDevice, "--build-device");
-    o.partitions = method == "adaptive";
-    o.meshBvh = !o.partitions || withReference;  // the partition integrator uses its own BVHs
+    const RenderMethod m = requestedMethod();
+    o.partitions = m == RenderMethod::Partitions;
+    o.forAuto = m == RenderMethod::Auto;
+    // The partition integrator uses its own BVHs.
+    o.meshBvh = m == RenderMethod::Reference || m == RenderMethod::Exact || withReference;
     o.seedGrids = !noSeedGrid;
     o.splitCells = splitCells;
     o.leafCells = leafCells;
@@ -878,7 +890,8 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
         static_cast<unsigned long long>(result.stats.samples), result.stats.meanSamplesPerPixel(),
         result.setup.params.step / result.setup.frame.scale);
     ctx.step(line);
-    if (settings.method == RenderMethod::Partitions) {
+    if (!result.setup.method.reason.empty()) ctx.step(result.setup.method.reason);
+    if (result.setup.method.method == RenderMethod::Partitions) {
         std::snprintf(line, sizeof line,
                       "%zu partitions (built in %.3f s); transfer-function update %.3f ms; "
                       "%.1f partitions visited and %.1f skipped per pixel",
@@ -938,8 +951,13 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
         }
         j["threads"] = cpu::threadCount();
         if (!flags.heatmapFile.empty()) j["heatmap_max"] = heatmapTop;
-        j["method"] = flags.method;
-        if (settings.method != RenderMethod::Exact) j["sampling"] = flags.sampling;
+        // The method that rendered; with auto, also what was asked and why.
+        j["method"] = methodName(result.setup.method.method);
+        if (!result.setup.method.reason.empty()) {
+            j["method_asked"] = flags.method;
+            j["method_reason"] = result.setup.method.reason;
+        }
+        if (result.setup.method.method != RenderMethod::Exact) j["sampling"] = flags.sampling;
         if (prepared.kd) {
             const KdPartitions& kd = *prepared.kd;
             std::vector<std::uint32_t> sizes;

@@ -102,7 +102,7 @@ struct RenderFlags {
     float step = 0.f;
     float opacityUnit = 0.f;
     std::string opacityLaw = opacityLawName(kDefaultOpacityLaw);
-    std::string method = "adaptive";
+    std::string method = methodName(RenderMethod::Auto);
     std::string stepRule = "error";
     std::optional<float> quality;  ///< unset: kDefaultQuality
     std::string sampling = "preintegrated";
@@ -153,9 +153,17 @@ struct RenderFlags {
     /// Checks before any work that every output can be written and that none names an input
     /// (the mesh file, when not empty, or a file the flags read) or another output.
     void checkFiles(const std::string& meshFile) const;
+    /// The method the flags ask for: --method's, except that auto with a flag only the sampling
+    /// methods read (--quality, --step, --sampling point, --no-skip, --leaf-cells, ...) is the
+    /// adaptive method those flags tune (tunesAdaptive, over flags).
+    RenderMethod requestedMethod() const;
+    /// True when a flag of the adaptive method alone is given (--quality, --no-skip,
+    /// --leaf-cells, ...: those that need --method adaptive).
+    bool tunesPartitions() const;
     /// What the renderer prepares and where (--device, --build-device, --leaf-cells,
     /// --no-seed-grid): partitions only for the adaptive method, the mesh BVH only for the
-    /// reference and exact methods, or also with the adaptive method when withReference.
+    /// reference and exact methods, what auto picks for auto (PrepareOptions::forAuto), and the
+    /// mesh BVH also when withReference.
     RendererOptions rendererOptions(bool withReference = false) const;
 };
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // End-to-end tests of the uvr command-line tool: exit codes, messages, outputs.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -28,6 +29,8 @@
 namespace uvr {
 namespace {
 
+using ::testing::HasSubstr;
+using ::testing::Not;
 using cli_testing::CliRun;
 using cli_testing::expectOneLineError;
 using cli_testing::lineCount;
@@ -297,7 +300,7 @@ TEST(Cli, RenderNamesEveryPreparationPhaseInALog) {
     const std::string dir = testing::scratchDir();
     CliRun r = uvr("-q generate shell --cells 5000 -o " + dir + "/s.uvrm", dir);
     ASSERT_EQ(r.code, 0) << r.err;
-    r = uvr("render " + dir + "/s.uvrm --size 32x32 -o " + dir + "/s.png", dir);
+    r = uvr("render " + dir + "/s.uvrm --size 32x32 -o " + dir + "/s.png --method adaptive", dir);
     ASSERT_EQ(r.code, 0) << r.err;
     std::size_t at = 0;
     for (const char* line :
@@ -312,6 +315,12 @@ TEST(Cli, RenderNamesEveryPreparationPhaseInALog) {
     }
     EXPECT_EQ(r.err.find(": done ("), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+    // The default (auto) builds only what its pick renders with, and says why it picked it.
+    r = uvr("render " + dir + "/s.uvrm --size 32x32 -o " + dir + "/s.png", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("uvr: building the BVH over 6084 cells\n"));
+    EXPECT_THAT(r.err, Not(HasSubstr("k-d partitions")));
+    EXPECT_THAT(r.err, HasSubstr("uvr: auto: exact (about 12 cells per ray, at most 32 on the CPU)"));
 }
 
 TEST(Cli, GenerateMixedCells) {
@@ -409,14 +418,42 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
                   dir)
                   .code,
               2);
-    // Adaptive is the default method (issue 11: it meets the quality bar).
+    // The default is auto (issue 29): on SPX's 12,936 tetrahedra a ray crosses few cells, so it
+    // renders exact (faster there, and the truth); a flag tuning sampling makes it adaptive.
     ASSERT_EQ(uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
                       "/c.png --size 32x32 --stats " + dir + "/c.json",
                   dir)
                   .code,
               0);
     std::ifstream defaults(dir + "/c.json");
-    EXPECT_EQ(nlohmann::json::parse(defaults)["method"], "adaptive");
+    const auto d = nlohmann::json::parse(defaults);
+    EXPECT_EQ(d["method"], "exact");
+    EXPECT_EQ(d["method_asked"], "auto");
+    EXPECT_THAT(d["method_reason"].get<std::string>(),
+                HasSubstr("auto: exact (about 13.2 cells per ray, at most 32 on the CPU)"));
+    EXPECT_FALSE(d.contains("partitions"));  // only what exact needs was prepared
+    for (const char* tuning : {"--quality 0.995", "--step 0.05", "--sampling point", "--no-skip"}) {
+        ASSERT_EQ(uvr("-q render " + testing::sharedData("spx.vtk") + " -o " + dir +
+                          "/c.png --size 32x32 --stats " + dir + "/c.json " + tuning,
+                      dir)
+                      .code,
+                  0)
+            << tuning;
+        std::ifstream tuned(dir + "/c.json");
+        const auto t = nlohmann::json::parse(tuned);
+        EXPECT_EQ(t["method"], "adaptive") << tuning;
+        EXPECT_TRUE(t.contains("partitions")) << tuning;
+    }
+    // Many cells per ray: adaptive (Blunt Fin, 187,395 tetrahedra: about 70).
+    ASSERT_EQ(uvr("-q render " + testing::sharedData("bluntfin_tets.vtk") + " -o " + dir +
+                      "/c.png --size 32x32 --stats " + dir + "/c.json",
+                  dir)
+                  .code,
+              0);
+    std::ifstream fin(dir + "/c.json");
+    const auto b = nlohmann::json::parse(fin);
+    EXPECT_EQ(b["method"], "adaptive");
+    EXPECT_THAT(b["method_reason"].get<std::string>(), HasSubstr("more than 32 on the CPU"));
 }
 
 TEST(Cli, FlagsThatWouldBeIgnoredOrMeanNothingAreRefused) {
@@ -582,11 +619,12 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     ASSERT_EQ(r.code, 0) << r.err;
     for (const char* row :
          {"exact (1 frame)", "reference", "skipping only", "adaptive only", "skipping + adaptive",
-          "reference, point", "paper: variance, point", "both, s2 = 2 s1", "both, s2 = 4 s1"})
+          "reference, point", "paper: variance, point", "auto: exact", "both, s2 = 2 s1",
+          "both, s2 = 4 s1"})
         EXPECT_NE(r.out.find(row), std::string::npos) << row;
     std::ifstream in(dir + "/b.json");
     const auto j = nlohmann::json::parse(in);
-    ASSERT_EQ(j["rows"].size(), 8u);
+    ASSERT_EQ(j["rows"].size(), 9u);
     EXPECT_EQ(j["step_rule"], "error");
     EXPECT_EQ(j["sampling"], "preintegrated");
     EXPECT_EQ(j["ssim_against"], "exact");
@@ -596,6 +634,9 @@ TEST(Cli, BenchPrintsEveryConfigurationAndWritesItsFiles) {
     EXPECT_GE(ref, 0.98);
     EXPECT_LT(ref, 1.0);
     EXPECT_NEAR(j["rows"][1]["ssim"].get<double>(), ref, 0.005);
+    // The default's row: auto picks exact on SPX, so its image is the yardstick's.
+    EXPECT_EQ(j["rows"][6]["configuration"], "auto: exact");
+    EXPECT_EQ(j["rows"][6]["max_abs_difference"].get<double>(), 0.0);
     EXPECT_TRUE(std::filesystem::exists(dir + "/exact.png"));
     // The per-pixel measures against exact (issue 29), by their one name, in JSON, CSV, text.
     for (const ComparisonField& f : differenceFields(ImageComparison{})) {

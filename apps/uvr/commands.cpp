@@ -244,8 +244,9 @@ void addInfoCommand(CLI::App& app, Context& ctx) {
 void addRenderCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "render",
-        "Render a mesh file to a PNG with the adaptive partition method (the default), the "
-        "fixed-step reference or the exact integrator (--method), on the CPU or a GPU");
+        "Render a mesh file to a PNG with the exact integrator where a ray crosses few cells and "
+        "the adaptive partition method elsewhere (the default, --method auto), or the method "
+        "--method names, on the CPU or a GPU");
     auto file = std::make_shared<std::string>();
     auto flags = std::make_shared<RenderFlags>();
     auto steps = std::make_shared<StepFlags>();

@@ -67,7 +67,8 @@ void addPrepareCommand(CLI::App& app, Context& ctx) {
             throwError(ErrorKind::Unsupported, *file,
                        "uvr prepare takes a single mesh file: a cache's key covers one file, "
                        "and this one names others (a series, .pvd or .pvtu)");
-        if ((flags->leafCells || flags->noSeedGrid) && flags->method != "adaptive")
+        if ((flags->leafCells || flags->noSeedGrid) &&
+            flags->requestedMethod() != RenderMethod::Partitions)
             throwError(ErrorKind::Argument, "",
                        "--leaf-cells and --no-seed-grid need --method adaptive");
         const std::string cache = output->empty() ? *file + kPreparedCacheSuffix : *output;

@@ -325,12 +325,9 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
 
 // ---- Rendering ----
 
-RenderMethod parseMethod(const std::string& s) {
-    if (s == "adaptive") return RenderMethod::Partitions;
-    if (s == "reference") return RenderMethod::Reference;
-    if (s == "exact") return RenderMethod::Exact;
-    raise(ErrorKind::Argument,
-          "method: expected 'adaptive', 'reference' or 'exact', got '" + s + "'");
+RenderMethod methodNamed(const std::string& s) {
+    if (const std::optional<RenderMethod> m = parseMethod(s)) return *m;
+    raise(ErrorKind::Argument, "method: expected " + methodChoices() + ", got '" + s + "'");
 }
 
 /// The renderer object of the library with the GIL released around its long calls.
@@ -351,7 +348,7 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                                        opacityLawName(OpacityLaw::Attenuation) + "' or '" +
                                        opacityLawName(OpacityLaw::Transmittance) + "', got '" +
                                        opacityLaw + "'");
-    s.method = parseMethod(method);
+    s.method = methodNamed(method);
     if (sampling != "preintegrated" && sampling != "point")
         raise(ErrorKind::Argument,
               "sampling: expected 'preintegrated' or 'point', got '" + sampling + "'");
@@ -394,7 +391,8 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
     stats["opacity_unit"] = r.setup.params.opacityUnit / scale;
     stats["opacity_law"] = opacityLawName(r.setup.opacityLaw);
     stats["range"] = py::make_tuple(r.setup.rangeLo, r.setup.rangeHi);
-    stats["method"] = method;
+    stats["method"] = methodName(r.setup.method.method);  // auto resolved
+    if (!r.setup.method.reason.empty()) stats["method_reason"] = r.setup.method.reason;
     stats["device"] = self.renderer->deviceName();
     stats["width"] = width;
     stats["height"] = height;
@@ -436,6 +434,8 @@ PYBIND11_MODULE(_uvr, m) {
     using namespace uvr;
     using namespace uvr::python;
     m.doc() = "uvr's compiled core (a thin layer over the C++ library); use the uvr package.";
+    // The integrators' names, the default first (the library's one list: kMethods).
+    m.attr("METHODS") = methodNames();
 
     // Exceptions.
     gExceptions.base = addException(m, "Error", nullptr, "Base of every error uvr raises.");
@@ -748,13 +748,16 @@ PYBIND11_MODULE(_uvr, m) {
         .def(py::init([](const MeshData& mesh, const std::string& name,
                          const std::string& association, const py::handle& values,
                          const std::string& device, const std::string& buildDevice,
-                         std::uint32_t leafCells, bool meshBvh, bool seedGrids, bool splitCells) {
+                         std::uint32_t leafCells, bool meshBvh, bool seedGrids, bool splitCells,
+                         bool partitions, bool forAuto) {
                  ScalarField field = scalarField(name, association, values);
                  RendererOptions o;
                  o.device = parseDevice(device, "device");
                  o.buildDevice = parseDevice(buildDevice, "build_device");
                  o.leafCells = leafCells;
                  o.meshBvh = meshBvh;
+                 o.partitions = partitions;
+                 o.forAuto = forAuto;
                  o.seedGrids = seedGrids;
                  o.splitCells = splitCells;
                  // The mesh's points and cells as they are now (a borrowed mesh's copied and
@@ -777,7 +780,8 @@ PYBIND11_MODULE(_uvr, m) {
              py::arg("mesh"), py::arg("name"), py::arg("association"), py::arg("values"),
              py::arg("device") = "auto", py::arg("build_device") = "auto",
              py::arg("leaf_cells") = 0, py::arg("mesh_bvh") = true, py::arg("seed_grids") = true,
-             py::arg("split_cells") = false)
+             py::arg("split_cells") = false, py::arg("partitions") = true,
+             py::arg("for_auto") = false)
         .def(
             "set_field_values",
             [](PyRenderer& self, const std::string& name, const std::string& association,
@@ -788,7 +792,8 @@ PYBIND11_MODULE(_uvr, m) {
             },
             py::arg("name"), py::arg("association"), py::arg("values"))
         .def("render", &renderFrame, py::arg("tf"), py::arg("range"), py::arg("camera"),
-             py::arg("width"), py::arg("height"), py::arg("method") = "adaptive",
+             py::arg("width"), py::arg("height"),
+             py::arg("method") = methodName(RenderSettings{}.method),
              py::arg("sampling") = "preintegrated", py::arg("step_rule") = "error",
              py::arg("quality") = kDefaultQuality, py::arg("step") = 0.f, py::arg("max_step") = 0.f,
              py::arg("opacity_unit") = 0.f, py::arg("power") = 2.f, py::arg("skip") = true,

@@ -44,6 +44,29 @@ def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     assert img.stats["samples"] > 0
 
 
+def test_auto_is_the_default_and_says_what_it_rendered_with(data_dir):
+    # The library's one list of methods, the default first.
+    assert uvr._uvr.METHODS == ["auto", "adaptive", "reference", "exact"]
+    spx = data_dir / "spx.vtk"
+    img = uvr.render(spx, size=(32, 32), device="cpu")
+    assert img.stats["method"] == "exact"  # few cells per ray: exact is the faster there
+    assert "about 13.2 cells per ray, at most 32 on the CPU" in img.stats["method_reason"]
+    # An argument tuning sampling makes auto the adaptive method it tunes.
+    tuned = uvr.render(spx, size=(32, 32), device="cpu", quality=0.995)
+    assert tuned.stats["method"] == "adaptive"
+    assert "tune its sampling" in tuned.stats["method_reason"]
+    # A renderer prepared for adaptive alone renders auto with what it has, and says so.
+    r = uvr.Renderer(spx, device="cpu", methods=("adaptive",))
+    only = r.render(size=(32, 32))
+    assert only.stats["method"] == "adaptive"
+    assert "the mesh BVH exact needs was not prepared" in only.stats["method_reason"]
+    assert "method_reason" not in r.render(size=(32, 32), method="adaptive").stats
+    with pytest.raises(uvr.ArgumentError, match=r"method: expected one of \['auto', .*'fast'"):
+        uvr.render(spx, size=(32, 32), device="cpu", method="fast")
+    with pytest.raises(uvr.ArgumentError, match="auto, adaptive, reference or exact, got 'fast'"):
+        r.render(size=(32, 32), method="fast")
+
+
 def test_hexahedra_render_natively_unless_split_as_the_cli_does(data_dir, cli, tmp_path):
     native = uvr.Renderer(data_dir / "hexa.vtk", device="cpu")
     split = uvr.Renderer(data_dir / "hexa.vtk", device="cpu", split_cells=True)

@@ -51,7 +51,7 @@ class Renderer:
     """
 
     def __init__(self, mesh, field=None, device="auto", *, build_device="auto", leaf_cells=0,
-                 methods=("adaptive", "reference", "exact"), seed_grids=True, split_cells=False,
+                 methods=tuple(_uvr.METHODS), seed_grids=True, split_cells=False,
                  association=None):
         self.series = mesh if isinstance(mesh, Series) else None
         self._step = 0
@@ -68,15 +68,17 @@ class Renderer:
         self.mesh = mesh
         try:
             name, assoc, values = self._field(field, association)
-            unknown = set(methods) - {"adaptive", "reference", "exact"}
+            unknown = set(methods) - set(_uvr.METHODS)
             if unknown:
-                raise _uvr.ArgumentError(f"methods: unknown {sorted(unknown)}; expected "
-                                         "'adaptive', 'reference' or 'exact'")
+                raise _uvr.ArgumentError(f"methods: unknown {sorted(unknown)}; expected some of "
+                                         f"{_uvr.METHODS}")
             self._core = _uvr.Renderer(self.mesh._data, name, assoc, values, device,
                                        build_device, int(leaf_cells),
                                        mesh_bvh="reference" in methods or "exact" in methods,
                                        seed_grids=bool(seed_grids),
-                                       split_cells=bool(self._options["split_cells"]))
+                                       split_cells=bool(self._options["split_cells"]),
+                                       partitions="adaptive" in methods,
+                                       for_auto="auto" in methods)
         except BaseException:
             self.mesh = previous  # a failed new step leaves the renderer as it was
             raise
@@ -179,7 +181,7 @@ class Renderer:
         return cam.zoom(zoom) if zoom != 1.0 else cam
 
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
-               size=(512, 512), method="adaptive", quality=None, *, azimuth=0.0,
+               size=(512, 512), method=_uvr.METHODS[0], quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
                sampling="preintegrated", step_rule="error", step=None, max_step=None,
                opacity_unit=None, power=None, skip=True, adaptive=True, supersample=1,
@@ -191,7 +193,10 @@ class Renderer:
         TransferFunction; `opacity` an opacity spec or (x, alpha) pairs; `range` (lo, hi) the
         values the transfer function spans (default: the field's); `camera` a uvr.Camera
         (default: ParaView's reset camera), then `azimuth`/`elevation`/`zoom`; `size` (w, h);
-        `method` "adaptive", "reference" or "exact"; `quality` the adaptive method's SSIM target
+        `method` one of uvr.METHODS: "auto" (the default: exact where a ray crosses few cells,
+        else adaptive, as ``uvr render``; adaptive whenever an argument tunes sampling),
+        "adaptive", "reference" or "exact" (``image.stats["method"]`` says which rendered, and
+        ``["method_reason"]`` why under auto); `quality` the adaptive method's SSIM target
         (0.99); `opacity_law` "attenuation" (the default, ParaView's unstructured mappers) or
         "transmittance" (docs/TRANSFER_FUNCTIONS.md); `field` switches to another field or new
         values first (set_field). The same settings give the CLI's pixels.
@@ -226,7 +231,10 @@ class Renderer:
                 camera = camera.orbit(azimuth, elevation)
             if zoom != 1.0:
                 camera = camera.zoom(zoom)
-        if method not in self._methods:
+        # "auto" renders with whatever was prepared (its pick, else the other of exact and
+        # adaptive; the stats say which).
+        # (An unknown name gets the library's message from the core.)
+        if method != "auto" and method in _uvr.METHODS and method not in self._methods:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
                                      f"{self._methods!r} when the Renderer was made)")
         pixels, counts, stats = self._core.render(
@@ -245,10 +253,23 @@ class Renderer:
                 f"field {i['field']} ({i['field_association']}), on {self.device})")
 
 
+# Arguments of Renderer.render that tune sampling, with their defaults: given otherwise, "auto"
+# renders the adaptive method they tune (the library's tunesAdaptive).
+_SAMPLING_DEFAULTS = {"quality": None, "step": None, "max_step": None, "power": None,
+                      "sampling": "preintegrated", "step_rule": "error", "skip": True,
+                      "adaptive": True}
+
+
 def render(mesh, **kwargs):
     """One frame of a mesh: Renderer(mesh, field, device).render(**kwargs) (prepares only what
-    the method needs)."""
+    the method needs: under "auto", what it picks, or the adaptive method's partitions when an
+    argument tunes sampling)."""
     field = kwargs.pop("field", None)
     device = kwargs.pop("device", "auto")
-    method = kwargs.get("method", "adaptive")
-    return Renderer(mesh, field, device, methods=(method,)).render(**kwargs)
+    method = kwargs.get("method", _uvr.METHODS[0])
+    if method not in _uvr.METHODS:
+        raise _uvr.ArgumentError(f"method: expected one of {_uvr.METHODS}, got {method!r}")
+    prepare = method
+    if method == "auto" and any(kwargs.get(k, d) != d for k, d in _SAMPLING_DEFAULTS.items()):
+        prepare = "adaptive"
+    return Renderer(mesh, field, device, methods=(method, prepare)).render(**kwargs)

@@ -330,6 +330,17 @@ def first_frame(page):
     check(n > 40, f"the first frame is (nearly) all black: {n} of 4096 pixels lit")
     check(page.js("return document.getElementById('stat-render-ms').textContent") != "–",
           "the status panel shows no frame time")
+    # The default method is auto, listed first; the status says what it picked and, on hover,
+    # why (the frame's stats).
+    methods = page.js("return [...document.getElementById('method').options].map(o => o.value)")
+    check(methods == ["auto", "adaptive", "reference", "exact"], f"the method list is {methods}")
+    check(state["method"] == "auto", f"the starting method is {state['method']}, not auto")
+    picked = frame["stats"].get("method")
+    device = page.js("return document.getElementById('stat-device').textContent")
+    check(picked in ("exact", "adaptive") and f"auto → {picked}" in device,
+          f"the status shows '{device}' for a frame rendered by {picked}")
+    reason = page.js("return document.getElementById('stat-device').title")
+    check(reason.startswith("auto: " + picked), f"the status's hover text is '{reason}'")
     page.screenshot("first-frame")
 
 

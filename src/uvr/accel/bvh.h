@@ -98,9 +98,10 @@ struct Bvh {
 Bvh buildBvh(std::span<const Bounds3f> boxes, std::span<const Vec3f> centers,
              const BvhBuildOptions& options = {});
 
-/// Cells per leaf of the cell tree (buildCellTree) for rendering on a GPU: searches are rare
-/// there (walks and seeds locate almost every sample inside the mesh), so large leaves cost
-/// little time and keep the tree at 2 bytes per cell.
+/// Cells per leaf of the cell tree (buildCellTree) for rendering large meshes on a GPU: searches
+/// are rare there (walks and seeds locate almost every sample inside the mesh), so large leaves
+/// cost little time and keep the tree at 2 bytes per cell. Meshes of up to 2^24 cells keep
+/// kCpuCellTreeLeaf's (prepareMesh): there searches are not rare.
 inline constexpr std::uint32_t kCellTreeLeaf = 32;
 
 /// Cells per leaf of the cell tree for rendering on the CPU (PrepareOptions::cellTreeLeaf's

@@ -182,7 +182,7 @@ void writeKey(HeaderWriter& w, const CacheKey& k) {
     w.str(k.fieldSpec);
     w.str(k.step);
     w.flag(k.splitCells), w.flag(k.partitions), w.flag(k.meshBvh), w.flag(k.seedGrids);
-    w.flag(k.macroGrids);
+    w.flag(k.macroGrids), w.flag(k.forAuto), w.flag(k.autoOnGpu);
     w.pod(k.leafCells);
 }
 
@@ -195,7 +195,7 @@ CacheKey readKey(HeaderReader& r) {
     k.fieldSpec = r.str("the field");
     k.step = r.str("the time step");
     k.splitCells = r.flag(), k.partitions = r.flag(), k.meshBvh = r.flag();
-    k.seedGrids = r.flag(), k.macroGrids = r.flag();
+    k.seedGrids = r.flag(), k.macroGrids = r.flag(), k.forAuto = r.flag(), k.autoOnGpu = r.flag();
     k.leafCells = r.pod<std::uint32_t>("the leaf size");
     return k;
 }
@@ -720,6 +720,8 @@ CacheKey makeCacheKey(const std::string& meshPath, const std::string& fieldSpec,
     k.splitCells = options.cells.splitCells;
     k.partitions = options.partitions;
     k.meshBvh = options.meshBvh;
+    k.forAuto = options.forAuto;
+    k.autoOnGpu = options.forAuto && options.autoOnGpu;
     k.seedGrids = options.seedGrids;
     k.macroGrids = options.macroGrids;
     k.leafCells = options.kd.leafCells;
@@ -749,18 +751,25 @@ std::string cacheKeyMismatch(const CacheKey& s, const CacheKey& e) {
     if (s.splitCells != e.splitCells)
         return "it was prepared " + yesNo(s.splitCells) + " --split-cells, this asks " +
                yesNo(e.splitCells);
-    if (s.partitions != e.partitions || s.meshBvh != e.meshBvh) {
+    if (s.partitions != e.partitions || s.meshBvh != e.meshBvh || s.forAuto != e.forAuto) {
         const auto method = [](const CacheKey& k) {
-            return std::string(k.partitions ? "partitions (--method adaptive)" : "no partitions") +
-                   (k.meshBvh ? " and the mesh BVH (--method reference/exact)" : "");
+            std::string what =
+                k.partitions ? "partitions (--method adaptive)" : std::string("no partitions");
+            if (k.meshBvh) what += " and the mesh BVH (--method reference/exact)";
+            if (k.forAuto) what += " and what --method auto renders with";
+            return what;
         };
         return "it holds " + method(s) + ", this needs " + method(e);
     }
-    if (s.partitions && s.leafCells != e.leafCells)
+    if (s.autoOnGpu != e.autoOnGpu)
+        return std::string("it holds what --method auto renders with on the ") +
+               (s.autoOnGpu ? "GPU" : "CPU") + ", this renders on the " +
+               (e.autoOnGpu ? "GPU" : "CPU");
+    if ((s.partitions || s.forAuto) && s.leafCells != e.leafCells)
         return "its partitions hold up to " + std::to_string(s.leafCells) +
                " cells (--leaf-cells), this asks for " + std::to_string(e.leafCells) +
                " (the default differs between --device cpu and cuda)";
-    if (s.partitions && s.seedGrids != e.seedGrids)
+    if ((s.partitions || s.forAuto) && s.seedGrids != e.seedGrids)
         return "it was prepared " + yesNo(s.seedGrids) + " seed grids, this asks " +
                yesNo(e.seedGrids) + " (--no-seed-grid)";
     if (s.partitions && s.macroGrids != e.macroGrids)

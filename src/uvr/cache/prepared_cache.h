@@ -20,7 +20,7 @@ namespace uvr {
 /// First 8 bytes of a prepared cache file.
 inline constexpr char kPreparedCacheMagic[8] = {'U', 'V', 'R', 'P', 'R', 'E', 'P', '\0'};
 /// The format version this uvr writes and reads (any other is refused).
-inline constexpr std::uint32_t kPreparedCacheVersion = 1;
+inline constexpr std::uint32_t kPreparedCacheVersion = 2;
 /// The default cache of a mesh file: MESH + this suffix.
 inline constexpr const char* kPreparedCacheSuffix = ".uvrprep";
 
@@ -37,6 +37,8 @@ struct CacheKey {
     bool splitCells = false;         ///< PrepareOptions::cells.splitCells
     bool partitions = true;          ///< PrepareOptions::partitions
     bool meshBvh = true;             ///< PrepareOptions::meshBvh
+    bool forAuto = false;            ///< PrepareOptions::forAuto (and autoOnGpu below)
+    bool autoOnGpu = false;          ///< PrepareOptions::autoOnGpu, with forAuto
     bool seedGrids = true;           ///< PrepareOptions::seedGrids
     bool macroGrids = true;          ///< PrepareOptions::macroGrids
     std::uint32_t leafCells = 0;     ///< PrepareOptions::kd.leafCells

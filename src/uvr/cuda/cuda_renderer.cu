@@ -418,7 +418,7 @@ void CudaScene::updateShading(RenderResult& result) {
 RenderResult CudaScene::render(const RenderSettings& settings) {
     Impl& d = *impl_;
     RenderResult result;
-    result.setup = makeFrameSetup(d.mesh, settings, /*shadePartitions=*/false);
+    result.setup = makeFrameSetup(d.mesh, settings, /*gpu=*/true);
     // Transfer-function state: the only per-change upload (a few kilobytes).
     d.tfTable.upload(result.setup.tfTable, "the transfer function");
     d.tfBreaks.upload(result.setup.tfBreaks, "the transfer function's breakpoints");
@@ -431,7 +431,8 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);
-    const bool partitions = settings.method == RenderMethod::Partitions;
+    const RenderMethod method = result.setup.method.method;
+    const bool partitions = method == RenderMethod::Partitions;
     if (partitions && !d.mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
     // The transfer function's partition shading is timed on its own (tfUpdateSeconds), as on
@@ -442,13 +443,13 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaEventCreate(&end));
     UVR_CUDA_CHECK(cudaEventRecord(begin));
     const bool native = d.mesh.tets.hasNative();
-    if (settings.method == RenderMethod::Reference) {
+    if (method == RenderMethod::Reference) {
         dispatchNative(native, [&](auto kNative) {
             cuda::launchFrame(grid, block, frame,
                               ReferenceMarch<kNative()>{d.deviceScene(result.setup)},
                               d.totals.data());
         });
-    } else if (settings.method == RenderMethod::Exact) {
+    } else if (method == RenderMethod::Exact) {
         dispatchNative(native, [&](auto kNative) {
             cuda::launchFrame(grid, block, frame,
                               ExactMarch<kNative()>{d.deviceScene(result.setup)}, d.totals.data());

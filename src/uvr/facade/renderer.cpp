@@ -43,6 +43,8 @@ PrepareOptions RendererOptions::prepareOptions() const {
     }
     o.partitions = partitions;
     o.meshBvh = meshBvh;
+    o.forAuto = forAuto;
+    o.autoOnGpu = renderOnCuda;
     o.seedGrids = seedGrids;
     o.cells.splitCells = splitCells;
     o.afterSplit = afterSplit;
@@ -50,7 +52,8 @@ PrepareOptions RendererOptions::prepareOptions() const {
         o.kd.leafCells = leafCells;
     else if (renderOnCuda)
         o.kd.leafCells = kCudaDefaultLeafCells;
-    if (renderOnCuda) o.cellTreeLeaf = kCellTreeLeaf;  // memory-lean; searches are rare there
+    // Memory-lean on large meshes (prepareMesh keeps the CPU's leaves on small ones).
+    if (renderOnCuda) o.cellTreeLeaf = kCellTreeLeaf;
     return o;
 }
 
@@ -88,6 +91,10 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
 Renderer::Renderer(PreparedMesh prepared, Device device)
     : prepared_(std::make_unique<PreparedMesh>(std::move(prepared))) {
     checkDeviceUsable(device);
+    // RenderMethod::Auto's choice for this device, made once (a cache holds none).
+    const bool cuda = resolvesToCuda(device);
+    if (!prepared_->autoChoice || prepared_->autoChoice->gpu != cuda)
+        prepared_->autoChoice = autoMethod(prepared_->tets, cuda);
     gpu_ = uploadIf(device, *prepared_);
 }
 

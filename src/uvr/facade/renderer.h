@@ -36,6 +36,9 @@ struct RendererOptions {
     Device buildDevice = Device::Auto;
     bool partitions = true;  ///< the k-d partitions of RenderMethod::Partitions
     bool meshBvh = true;     ///< the mesh BVH of RenderMethod::Reference and Exact
+    /// Also what RenderMethod::Auto renders with on this device (PrepareOptions::forAuto): a
+    /// front end whose frames are all Auto sets this and neither of the two above.
+    bool forAuto = false;
     bool seedGrids = true;   ///< with partitions: seed grids for long steps
     /// Split pyramids, wedges and hexahedra into tetrahedra instead of rendering them natively.
     bool splitCells = false;

@@ -59,6 +59,7 @@ TEST(FrameWork, AbsurdStepsAreRefusedNamingAStepThatIsAccepted) {
 TEST(FrameWork, CpuRenderReportsIncreasingFractionsEndingWithOne) {
     const PreparedMesh mesh = unitCubes();
     RenderSettings s;
+    s.method = RenderMethod::Partitions;
     s.tf = transferFunctionPreset("viridis");
     s.width = 61;
     s.height = 47;  // 8 x 6 tiles of 8x8

@@ -102,6 +102,7 @@ void addKuhnTets(Mesh& m, const std::uint32_t cube[8]) {
 /// path counts.
 RenderSettings constantSettings(const Camera& camera, int width, int height) {
     RenderSettings s;
+    s.method = RenderMethod::Partitions;  // the sampled method (tests of every method set theirs)
     s.width = width;
     s.height = height;
     s.camera = camera;
@@ -169,7 +170,7 @@ struct Method {
     RenderMethod method;
     bool adaptive;
 };
-const Method kMethods[] = {{"reference", RenderMethod::Reference, false},
+const Method kEachMethod[] = {{"reference", RenderMethod::Reference, false},
                            {"partitions", RenderMethod::Partitions, false},
                            {"partitions+adaptive", RenderMethod::Partitions, true}};
 
@@ -201,7 +202,7 @@ int badPixels(const PreparedMesh& pm, RenderSettings s, const Bounds3f& box, con
 /// number of pixels the mesh covers (so a test can insist that it saw the mesh).
 int renderAndCheck(const PreparedMesh& pm, const RenderSettings& s, const Bounds3f& box) {
     int covered = 0;
-    for (const Method& method : kMethods) {
+    for (const Method& method : kEachMethod) {
         std::string first;
         EXPECT_EQ(badPixels(pm, s, box, method, covered, first), 0) << method.name << ": " << first;
     }
@@ -231,7 +232,7 @@ TEST(HostileMesh, OracleSeesAMissingCell) {
     for (std::uint64_t c = 0; c < full.cellCount(); ++c)
         if (c != 62) m.addCell(CellType::Hexahedron, full.cell(c));  // cell (2, 2, 2)
     const PreparedMesh pm = prepare(m);
-    for (const Method& method : kMethods) {
+    for (const Method& method : kEachMethod) {
         int covered = 0;
         std::string first;
         EXPECT_GT(badPixels(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox, method,
@@ -366,7 +367,7 @@ TEST(HostileMesh, RaysExactlyAlongFacesEdgesAndSplitPlanesLoseNothing) {
         const PreparedMesh pm = prepare(m, 16);
         ASSERT_TRUE(pm.kd.has_value());
         ASSERT_GT(pm.kd->partitions.size(), 8u);
-        for (const Method& method : kMethods) {
+        for (const Method& method : kEachMethod) {
             RenderSettings s = constantSettings(resetCamera(box, 1.f), 8, 8);
             s.method = method.method;
             s.adaptive = method.adaptive;
@@ -433,7 +434,7 @@ TEST(HostileMesh, FieldSpanningTheFloatRangeRendersLikeTheSameFieldScaledDown) {
     s.camera = obliqueCamera(kUnitBox);
     s.tf = transferFunctionPreset("viridis");
     applyOpacitySpec(s.tf, "0:0.1,0.5:0.9,1:0.3");
-    for (const Method& method : kMethods) {
+    for (const Method& method : kEachMethod) {
         s.method = method.method;
         s.adaptive = method.adaptive;
         const RenderResult want = renderCpu(prepare(unit, 4), s);
@@ -499,7 +500,7 @@ TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
     s.height = 20;
     s.tf = transferFunctionPreset("viridis");
     applyOpacitySpec(s.tf, "0:0.1,0.5:0.9,1:0.3");
-    for (const Method& method : kMethods) {
+    for (const Method& method : kEachMethod) {
         s.method = method.method;
         s.adaptive = method.adaptive;
         for (const bool explicitCamera : {false, true}) {
@@ -592,7 +593,7 @@ TEST(HostileMesh, MeshWithNothingToRenderIsRefusedOrTransparent) {
         const PreparedMesh pm = prepare(m);
         ASSERT_TRUE(pm.tets.tets.empty());
         RenderSettings s = constantSettings(obliqueCamera(kUnitBox), 8, 8);
-        for (const Method& method : kMethods) {
+        for (const Method& method : kEachMethod) {
             s.method = method.method;
             s.adaptive = method.adaptive;
             const RenderResult r = renderCpu(pm, s);

@@ -27,14 +27,8 @@ PreparedMesh unitCube() {
     return prepareMesh(m, selectScalarField(m, {}), o);
 }
 
-constexpr RenderMethod kMethods[] = {RenderMethod::Reference, RenderMethod::Partitions,
+constexpr RenderMethod kEachMethod[] = {RenderMethod::Reference, RenderMethod::Partitions,
                                      RenderMethod::Exact};
-
-const char* methodName(RenderMethod m) {
-    return m == RenderMethod::Reference ? "reference"
-           : m == RenderMethod::Exact   ? "exact"
-                                        : "adaptive";
-}
 
 /// Constant opacity 0.5 per unit length 1 over the cube's field, nothing terminating early.
 RenderSettings halfOpacity(RenderMethod method) {
@@ -72,7 +66,7 @@ TEST(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
     // [-0.5, 1.5] and y in [-0.25, 1.25], so the cube covers columns 10..29 and rows 5..24
     // exactly, its faces on pixel boundaries; every ray inside crosses depth 1.
     const PreparedMesh mesh = unitCube();
-    for (RenderMethod method : kMethods) {
+    for (RenderMethod method : kEachMethod) {
         RenderSettings s = halfOpacity(method);
         s.width = 40, s.height = 30;
         s.camera = parallelDownZ(0.5f, 0.5f, 0.75f);
@@ -93,7 +87,7 @@ TEST(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
 
 TEST(CameraRender, ParallelCameraInsideOrFarFromTheMeshSeesWhatLiesInFrontOfItsPlane) {
     const PreparedMesh mesh = unitCube();
-    for (RenderMethod method : kMethods) {
+    for (RenderMethod method : kEachMethod) {
         RenderSettings s = halfOpacity(method);
         s.width = s.height = 8;
         // Far out: the rays start at the mesh (the same image as from near by).
@@ -188,7 +182,7 @@ TEST(Supersample, EdgePixelsApproachTheTrueFractionalCoverage) {
     // 1/N (stratified: at most 1/(2N) per axis), jittered ones within about 2/N.
     const PreparedMesh mesh = unitCube();
     const float pixel = 0.05f;
-    for (RenderMethod method : kMethods) {
+    for (RenderMethod method : kEachMethod) {
         for (int n : {1, 4, 8}) {
             for (bool jitter : {false, true}) {
                 if (n == 1 && jitter) continue;

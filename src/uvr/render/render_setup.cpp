@@ -32,6 +32,14 @@ auto beside(Fn fn) {
     });
 }
 
+/// Meshes of up to this many cells get cell-tree leaves of at most kCpuCellTreeLeaf whatever
+/// PrepareOptions::cellTreeLeaf asks (the GPU's kCellTreeLeaf): on small non-convex meshes
+/// searches are not rare (SPX: one sample in five on an H200; disk_out_ref.ex2: one in seven),
+/// and 32-cell leaves made the GPU's adaptive frame 1.4-5.4x slower there (SPX 40.8 -> 7.6 ms,
+/// Oxygen Post 15.4 -> 5.6 ms; docs/PERFORMANCE.md, "The default method"). 2-cell leaves cost
+/// 32 bytes per cell against 2: at most 512 MiB here.
+constexpr std::uint64_t kSmallCellTreeCells = std::uint64_t(1) << 24;
+
 }  // namespace
 
 PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
@@ -56,8 +64,16 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     std::vector<std::uint32_t> welded;
     if (welding.valid()) welded = std::move(welding.get().first);  // before the points are freed
     if (options.afterSplit) options.afterSplit();
+    out.autoChoice = autoMethod(out.tets, options.autoOnGpu);
     out.splitSeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
+    // What RenderMethod::Auto renders with, besides what was asked for.
+    const bool forExact = options.forAuto && out.autoChoice->method == RenderMethod::Exact;
+    const bool withBvh = options.meshBvh || forExact;
+    const bool withPartitions = options.partitions || (options.forAuto && !forExact);
+    const std::uint32_t cellTreeLeaf = out.tets.cellCount() <= kSmallCellTreeCells
+                                           ? std::min(options.cellTreeLeaf, kCpuCellTreeLeaf)
+                                           : options.cellTreeLeaf;
 
     // The other builders too, by the cells of the split.
     const bool elsewhere = out.tets.cellCount() >= options.builderMinTets;
@@ -69,7 +85,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         elsewhere && options.macroGrids ? options.macroBuilder : nullptr;
     out.builtElsewhere =
         elsewhere && (lbvh || splitter || faceMatcher || seedBuilder || macroBuilder);
-    if (options.meshBvh) {
+    if (withBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
             progress("building the BVH over " + std::to_string(out.tets.cellCount()) + " cells" +
@@ -89,9 +105,9 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     // While the GPU finds the neighbours and partitions, the CPU builds the cell tree (it needs
     // only the cells) and then the neighbours' codes on threads of their own.
     std::future<std::pair<Bvh, double>> cellTree;
-    if (faceMatcher && options.partitions)
+    if (faceMatcher && withPartitions)
         cellTree = beside(
-            [&tets = out.tets, leaf = options.cellTreeLeaf] { return buildCellTree(tets, leaf); });
+            [&tets = out.tets, leaf = cellTreeLeaf] { return buildCellTree(tets, leaf); });
     start = std::chrono::steady_clock::now();
     if (progress)
         progress(faceMatcher ? "finding face neighbours (on " + options.builderDevice +
@@ -119,7 +135,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     out.adjacencySeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("neighbours", out.adjacencySeconds);
 
-    if (options.partitions) {
+    if (withPartitions) {
         if (progress)
             progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
                      " cells each" + (splitter ? ", on " + options.builderDevice : std::string()) +
@@ -141,7 +157,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         } else {
             if (progress) progress("building the cell tree");
             start = std::chrono::steady_clock::now();
-            out.cellTree = buildCellTree(out.tets, options.cellTreeLeaf, progress.fraction);
+            out.cellTree = buildCellTree(out.tets, cellTreeLeaf, progress.fraction);
             out.phaseSeconds.emplace_back("cell_tree", secondsSince(start));
         }
         if (options.seedGrids) {
@@ -317,6 +333,30 @@ std::string fmtValue(double v) {
 
 }  // namespace
 
+bool tunesAdaptive(const RenderSettings& s) {
+    const RenderSettings d;
+    return s.stepRule != d.stepRule || s.quality != d.quality || s.preintegrated != d.preintegrated ||
+           s.maxStep != d.maxStep || s.power != d.power || s.skip != d.skip ||
+           s.adaptive != d.adaptive || s.step != d.step;
+}
+
+ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu) {
+    if (settings.method != RenderMethod::Auto) return {settings.method, ""};
+    if (tunesAdaptive(settings))
+        return {RenderMethod::Partitions, "auto: adaptive (the settings tune its sampling)"};
+    const AutoMethodChoice choice = mesh.autoChoice && mesh.autoChoice->gpu == gpu
+                                        ? *mesh.autoChoice
+                                        : autoMethod(mesh.tets, gpu);
+    const bool bvh = !mesh.bvh.nodes.empty(), kd = mesh.kd.has_value();
+    if (choice.method == RenderMethod::Exact && !bvh && kd)
+        return {RenderMethod::Partitions,
+                choice.reason() + "; adaptive: the mesh BVH exact needs was not prepared"};
+    if (choice.method == RenderMethod::Partitions && !kd && bvh)
+        return {RenderMethod::Exact,
+                choice.reason() + "; exact: the partitions adaptive needs were not prepared"};
+    return {choice.method, choice.reason()};
+}
+
 void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;
@@ -469,10 +509,11 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
 
 }  // namespace
 
-FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
-                          bool shadePartitions) {
+FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu) {
     validateSettings(settings);
     FrameSetup f;
+    f.method = resolveMethod(mesh, settings, gpu);
+    const RenderMethod method = f.method.method;
     f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
     f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
     // The baked table: linear in the value over [rangeLo, rangeHi]; a log-scale function is
@@ -608,14 +649,13 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     }
     validateCamera(f.camera);
     f.rays = makeCameraRays(f.camera, settings.width, settings.height, nearDistance);
-    if (settings.method == RenderMethod::Partitions && !mesh.kd)
+    if (method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
-    if (settings.method != RenderMethod::Partitions && mesh.bvh.nodes.empty() &&
+    if (method != RenderMethod::Partitions && mesh.bvh.nodes.empty() &&
         mesh.tets.cellCount() != 0)
-        throwError(
-            ErrorKind::Argument, "",
-            std::string(settings.method == RenderMethod::Exact ? "the exact" : "the reference") +
-                " method needs the mesh BVH");
+        throwError(ErrorKind::Argument, "",
+                   std::string(method == RenderMethod::Exact ? "the exact" : "the reference") +
+                       " method needs the mesh BVH");
     f.stepRule.rule = settings.stepRule;
     f.stepRule.adaptive = settings.adaptive;
     f.stepRule.s1 = f.params.step;
@@ -624,7 +664,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.stepRule.tolerance = toleranceForQuality(settings.quality);
     f.stepRule.valuePerEntry =
         static_cast<float>((double(f.rangeHi) - double(f.rangeLo)) / (f.tfTable.size() - 1));
-    if (settings.method == RenderMethod::Partitions && shadePartitions) {
+    if (method == RenderMethod::Partitions && !gpu) {
         const auto start = std::chrono::steady_clock::now();
         const TfTableView table = f.tfView();
         const TfRangeTables ranges(table);

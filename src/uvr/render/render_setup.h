@@ -23,6 +23,7 @@
 #include "uvr/render/frame_kernel.h"
 #include "uvr/render/image.h"
 #include "uvr/render/reference_marcher.h"
+#include "uvr/render/render_method.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {
@@ -31,10 +32,18 @@ namespace uvr {
 struct PrepareOptions {
     bool meshBvh = true;     ///< build the BVH over all cells the reference marcher needs
     bool partitions = true;  ///< build the k-d partitions the partition integrator needs
+    /// Also what RenderMethod::Auto renders with (autoMethod for the device autoOnGpu names,
+    /// decided once the cells are split): the mesh BVH or the partitions. A front end whose
+    /// frames are all Auto sets this and neither meshBvh nor partitions.
+    bool forAuto = false;
+    /// The device PreparedMesh::autoChoice is made for: the GPU (else the CPU).
+    bool autoOnGpu = false;
     bool seedGrids = true;   ///< with partitions: the seed grids that long steps locate from
     bool macroGrids = true;  ///< with partitions: the macrocells the error-bound rule steps by
     /// With partitions: cells per leaf of the cell tree (buildCellTree); the CPU's small leaves
     /// by default, kCellTreeLeaf where the renderer is a GPU (RendererOptions::prepareOptions).
+    /// Meshes of up to 2^24 cells get leaves of at most kCpuCellTreeLeaf whatever this asks
+    /// (searches are not rare on small non-convex meshes: prepareMesh).
     std::uint32_t cellTreeLeaf = kCpuCellTreeLeaf;
     TetrahedralizeOptions cells;  ///< native cells or the split into tetrahedra
     KdBuildOptions kd;
@@ -89,6 +98,9 @@ struct PreparedMesh {
     /// empty when the field has none.
     std::vector<std::uint8_t> partitionNan;
     std::uint64_t sourceCells = 0;  ///< cells of the mesh before splitting
+    /// What RenderMethod::Auto renders it with on PrepareOptions::autoOnGpu's device (made once
+    /// the cells are split; resolveMethod makes it again for the other device).
+    std::optional<AutoMethodChoice> autoChoice;
     double splitSeconds = 0.0;      ///< time to split cells (or keep them native)
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
@@ -205,13 +217,6 @@ inline constexpr double kMinDefaultStepFraction = 1e-4;
 /// ParaView's default ScalarOpacityUnitDistance: bounds diagonal / cbrt(cell count).
 float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount);
 
-/// Which integrator renders a frame.
-enum class RenderMethod {
-    Reference,   ///< fixed step s1 through the whole volume (the yardstick)
-    Partitions,  ///< k-d partitions with space skipping and adaptive steps (Morrical et al. 2019)
-    Exact,       ///< no sampling: each cell's segment integrated (the ground truth)
-};
-
 /// Default --quality: the error-bound rule's SSIM target against the exact integrator.
 inline constexpr float kDefaultQuality = 0.99f;
 /// Range of --quality.
@@ -229,7 +234,7 @@ float toleranceForQuality(float quality);
 
 /// What to render and how.
 struct RenderSettings {
-    RenderMethod method = RenderMethod::Partitions;
+    RenderMethod method = RenderMethod::Auto;
     StepRule stepRule = StepRule::ErrorBound;  ///< how the partition method picks steps
     /// The error-bound rule's target: the SSIM against the exact integrator that it aims at for
     /// typical data (toleranceForQuality), in [kMinQuality, kMaxQuality].
@@ -274,6 +279,21 @@ inline constexpr int kMaxSupersample = 8;
 /// side, non-finite or non-positive step or opacity unit, bad range, bad camera, supersample
 /// outside [1, kMaxSupersample].
 void validateSettings(const RenderSettings& settings);
+
+/// True when settings tune what only the sampling methods read, away from RenderSettings'
+/// defaults (the step rule, quality, power, point sampling, s1 or s2, skipping or adaptive steps
+/// off): RenderMethod::Auto then renders the adaptive method they tune.
+bool tunesAdaptive(const RenderSettings& settings);
+
+/// The method a frame renders with, and why when settings.method is Auto.
+struct ResolvedMethod {
+    RenderMethod method = RenderMethod::Partitions;
+    std::string reason;  ///< with RenderMethod::Auto: one line (AutoMethodChoice::reason), else ""
+};
+/// settings.method, or for RenderMethod::Auto: the adaptive method when tunesAdaptive, else
+/// mesh.autoChoice (made for the GPU when gpu, else the CPU; made now when it was made for the
+/// other or not at all), the other of exact and adaptive where only its structures are prepared.
+ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu);
 
 /// Most samples one ray may take across the mesh bounds' diagonal at the step s1: the default
 /// step takes 2 to 3 samples per cell, so this is a step 40 times finer than the default on a
@@ -359,6 +379,9 @@ struct FrameSetup {
     /// CLI prints them as warnings): a log range moved off 0, a log table too coarse at its low
     /// end.
     std::vector<std::string> notes;
+    /// The method the frame renders with (resolveMethod: RenderMethod::Auto resolved) and, for
+    /// Auto, why.
+    ResolvedMethod method;
 
     /// The baked table as a view (host pointers); the setup must outlive it.
     TfTableView tfView() const;
@@ -381,11 +404,11 @@ inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup&
                      settings.jitter && settings.supersample > 1};
 }
 
-/// Resolves defaults and validates; throws Error(Argument) on bad settings. For the partition
-/// method it also computes the per-partition shading on the host unless shadePartitions is false
-/// (the CUDA backend computes it on the GPU).
+/// Resolves defaults (the method for the GPU when gpu, else the CPU: resolveMethod) and
+/// validates; throws Error(Argument) on bad settings. For the partition method on the CPU it also
+/// computes the per-partition shading (the CUDA backend computes it on the GPU).
 FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
-                          bool shadePartitions = true);
+                          bool gpu = false);
 
 /// Statistics of one rendered frame.
 struct RenderStats {

@@ -905,7 +905,10 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
                              fmtExact(s.range.first) + "," + fmtExact(s.range.second), "--method",
                              methodName(s.method)});
-    if (s.method == RenderMethod::Partitions)
+    // The quality tunes the adaptive method; under auto, a quality moved off the default is what
+    // made the frames adaptive (tunesAdaptive), so it travels too.
+    if (s.method == RenderMethod::Partitions ||
+        (s.method == RenderMethod::Auto && s.quality != kDefaultQuality))
         args.insert(args.end(), {"--quality", fmtExact(s.quality)});
     args.insert(args.end(), {"--size", std::to_string(s.width) + "x" + std::to_string(s.height),
                              "--opacity-unit", fmtExact(s.opacityUnit)});
@@ -1098,8 +1101,10 @@ void ViewServer::Impl::renderLoop() {
                            double(result.stats.partitionsVisited) / pixels},
                           {"partitions_skipped_per_pixel",
                            double(result.stats.partitionsSkipped) / pixels},
-                          {"method", methodName(state.method)},
+                          {"method", methodName(result.setup.method.method)},
                           {"device", renderer->deviceName()}}}};
+                if (!result.setup.method.reason.empty())
+                    meta["stats"]["method_reason"] = result.setup.method.reason;
                 if (!result.setup.notes.empty()) meta["notes"] = result.setup.notes;
             }
             meta["width"] = image.width;
@@ -1332,7 +1337,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                   {"bounds", {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}}},
                   {"fields", fields},
                   {"presets", presets},
-                  {"methods", {"adaptive", "reference", "exact"}},
+                  {"methods", methodNames()},
                   {"device", device},
                   {"load_seconds", d.scene.loadSeconds},
                   {"prepare_seconds", prepareSeconds},

@@ -389,8 +389,19 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_NEAR(cam.position.z, state["state"]["camera"]["position"][2].get<double>(), 1e-4);
     const std::string cmd = ex["command"];
     EXPECT_THAT(cmd, HasSubstr("uvr render grid.vtk --tf uvr-tf.json --camera uvr-camera.pvcc "
-                               "--range -2.5,2.5 --method adaptive --quality 0.99"));
+                               "--range -2.5,2.5 --method auto --size 64x48"));
     EXPECT_THAT(cmd, HasSubstr("--size 64x48 --opacity-unit 0.5 --step 0.01 -o uvr-view.png"));
+    // The adaptive method exports its quality; so does auto with a quality of its own (which
+    // makes its frames adaptive).
+    c.send({{"type", "set"}, {"method", "adaptive"}});
+    c.send({{"type", "export"}});
+    EXPECT_THAT(c.until("export")["command"].get<std::string>(),
+                HasSubstr("--method adaptive --quality 0.99 --size"));
+    c.send({{"type", "set"}, {"method", "auto"}, {"quality", 0.995}});
+    c.send({{"type", "export"}});
+    EXPECT_THAT(c.until("export")["command"].get<std::string>(),
+                HasSubstr("--method auto --quality 0.995 --size"));
+    c.send({{"type", "set"}, {"quality", 0.99}});
     // A log scale over a range from 0 exports the range the frames map (AdjustRangeForLog).
     c.send({{"type", "set"}, {"range", {0, 2}}, {"tf", {{"log", true}}}});
     c.send({{"type", "export"}});

@@ -177,17 +177,6 @@ void applyTf(TransferFunction& tf, const Json& v) {
 
 }  // namespace
 
-const char* methodName(RenderMethod method) {
-    switch (method) {
-        case RenderMethod::Reference:
-            return "reference";
-        case RenderMethod::Exact:
-            return "exact";
-        default:
-            return "adaptive";
-    }
-}
-
 Json toJson(const ViewState& s) {
     auto vec = [](Vec3f v) { return Json::array({v.x, v.y, v.z}); };
     Json colors = Json::array(), opacity = Json::array();
@@ -285,15 +274,10 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             result.fieldChanged = v.get<std::string>() != next.field;
             next.field = v.get<std::string>();
         } else if (k == "method") {
-            const std::string m = v.is_string() ? v.get<std::string>() : "";
-            if (m == "adaptive")
-                next.method = RenderMethod::Partitions;
-            else if (m == "reference")
-                next.method = RenderMethod::Reference;
-            else if (m == "exact")
-                next.method = RenderMethod::Exact;
-            else
-                bad(k, "\"adaptive\", \"reference\" or \"exact\"", v);
+            const std::optional<RenderMethod> m =
+                v.is_string() ? parseMethod(v.get<std::string>()) : std::nullopt;
+            if (!m) bad(k, methodChoices() + " (quoted)", v);
+            next.method = *m;
         } else if (k == "quality") {
             next.quality = floatIn(k, v, kMinQuality, kMaxQuality);
         } else if (k == "heatmap") {

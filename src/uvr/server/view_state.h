@@ -26,7 +26,7 @@ struct ViewState {
     TransferFunction tf;
     std::pair<float, float> range{0.f, 1.f};  ///< the data range the transfer function spans
     std::string field;                        ///< as --field takes it
-    RenderMethod method = RenderMethod::Partitions;
+    RenderMethod method = RenderMethod::Auto;
     float quality = kDefaultQuality;
     bool heatmap = false;  ///< show samples per pixel instead of the volume
     int width = 1024, height = 1024;
@@ -34,9 +34,6 @@ struct ViewState {
     OpacityLaw opacityLaw = kDefaultOpacityLaw;  ///< how opacities become extinction
     std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
 };
-
-/// "adaptive", "reference" or "exact" (the --method names).
-const char* methodName(RenderMethod method);
 
 /// The state as the protocol's JSON object.
 nlohmann::json toJson(const ViewState& state);

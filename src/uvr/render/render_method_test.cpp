@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/render/render_method.h"
+
+#include <gmock/gmock.h>
+
+#include "test_meshes.h"
+#include "test_support.h"
+#include "uvr/cpu/cpu_renderer.h"
+#include "uvr/facade/renderer.h"
+#include "uvr/render/render_setup.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+
+/// A k x k x k grid of unit-spaced hexahedra over [0, k]^3, native or split into tetrahedra.
+PreparedMesh hexGrid(int k, bool split = false, const PrepareOptions& base = {}) {
+    const Mesh m = testing::makeHexGrid(
+        k, 0.f, float(k), [](Vec3f p) { return p.x + 2.f * p.y - p.z; });
+    PrepareOptions o = base;
+    o.cells.splitCells = split;
+    return prepareMesh(m, selectScalarField(m, {}), o);
+}
+
+TEST(RenderMethod, NamesRoundTripAndTheDefaultIsAutoListedFirst) {
+    for (const MethodName& m : kMethods) {
+        EXPECT_STREQ(methodName(m.method), m.name);
+        ASSERT_TRUE(parseMethod(m.name));
+        EXPECT_EQ(*parseMethod(m.name), m.method);
+    }
+    EXPECT_FALSE(parseMethod("fast"));
+    EXPECT_FALSE(parseMethod("Adaptive"));
+    EXPECT_EQ(kMethods[0].method, RenderSettings{}.method);
+    EXPECT_EQ(RenderSettings{}.method, RenderMethod::Auto);
+    EXPECT_EQ(methodChoices(), "auto, adaptive, reference or exact");
+    EXPECT_EQ(methodNames(), (std::vector<std::string>{"auto", "adaptive", "reference", "exact"}));
+}
+
+TEST(RenderMethod, CellsPerRayOfAGridOfCubesIsItsSide) {
+    // Cauchy's formula, exactly: k^3 cubes of surface 6 over a box of surface 6 k^2 give k, the
+    // cells a ray parallel to an axis crosses. A native cell counts its cost; the split counts
+    // the tetrahedra's own faces, inner ones included, so more.
+    for (int k : {1, 3, 7}) {
+        const PreparedMesh native = hexGrid(k);
+        EXPECT_NEAR(exactCellsPerRay(native.tets, 1.0), k, 1e-4 * k) << k;
+        EXPECT_NEAR(exactCellsPerRay(native.tets, 4.0), 4.0 * k, 4e-4 * k) << k;
+        const PreparedMesh split = hexGrid(k, /*split=*/true);
+        EXPECT_GT(exactCellsPerRay(split.tets, 4.0), 1.5 * k) << k;  // cost 4 is for native only
+        EXPECT_LT(exactCellsPerRay(split.tets, 4.0), 4.0 * k) << k;
+    }
+    // Past kAutoSampleCells cells the estimate samples: 48^3 = 110,592 cubes, still 48.
+    EXPECT_NEAR(exactCellsPerRay(hexGrid(48).tets, 1.0), 48.0, 0.05);
+    EXPECT_EQ(exactCellsPerRay(TetMesh{}, 1.0), 0.0);
+}
+
+TEST(RenderMethod, CellsPerRayIsTheMeanCrossingsOfAnExactFrame) {
+    // What the rule estimates is what the exact integrator does: parallel rays face-on through
+    // the 6^3 grid cross exactly 6 cells each.
+    const PreparedMesh pm = hexGrid(6);
+    RenderSettings s;
+    s.method = RenderMethod::Exact;
+    s.tf = transferFunctionPreset("viridis");
+    s.terminationAlpha = 1.f;  // every crossing counts
+    s.width = s.height = 24;
+    Camera c = resetCamera(pm.tets.bounds, 1.f);
+    c.parallelProjection = true;
+    c.parallelScale = 2.f;  // inside the grid's face: every ray crosses it
+    s.camera = c;
+    const RenderResult r = renderCpu(pm, s);
+    EXPECT_NEAR(r.stats.meanSamplesPerRay(), exactCellsPerRay(pm.tets, 1.0), 0.05);
+}
+
+TEST(RenderMethod, AutoPicksExactForFewCellsPerRayByTheDevicesLimits) {
+    // 6 native hexahedra a side: 6 x 4 = 24 <= 32; 10: 40 > 32 (both devices measure 32 today).
+    const AutoMethodChoice small = autoMethod(hexGrid(6).tets, /*gpu=*/false);
+    EXPECT_EQ(small.method, RenderMethod::Exact);
+    EXPECT_NEAR(small.cellsPerRay, 24.0, 1e-3);
+    EXPECT_EQ(small.reason(), "auto: exact (about 24 cells per ray, at most 32 on the CPU)");
+    const PreparedMesh ten = hexGrid(10);
+    const AutoMethodChoice cpu = autoMethod(ten.tets, false), gpu = autoMethod(ten.tets, true);
+    EXPECT_EQ(cpu.method, RenderMethod::Partitions);
+    EXPECT_EQ(cpu.reason(), "auto: adaptive (about 40 cells per ray, more than 32 on the CPU)");
+    EXPECT_EQ(gpu.method, RenderMethod::Partitions);
+    EXPECT_TRUE(gpu.gpu);
+    EXPECT_EQ(gpu.reason(), "auto: adaptive (about 40 cells per ray, more than 32 on the GPU)");
+    EXPECT_EQ(autoMethod(hexGrid(6).tets, true).method, RenderMethod::Exact);
+    // Split into tetrahedra, a crossing costs one.
+    EXPECT_EQ(autoMethod(hexGrid(10, true).tets, false).method, RenderMethod::Exact);
+}
+
+TEST(RenderMethod, PreparingForAutoBuildsOnlyWhatItsPickRendersWith) {
+    PrepareOptions o;
+    o.meshBvh = o.partitions = false;
+    o.forAuto = true;
+    const PreparedMesh exact = hexGrid(4, false, o), adaptive = hexGrid(12, false, o);
+    ASSERT_TRUE(exact.autoChoice && adaptive.autoChoice);
+    EXPECT_EQ(exact.autoChoice->method, RenderMethod::Exact);
+    EXPECT_FALSE(exact.bvh.nodes.empty());
+    EXPECT_FALSE(exact.kd);
+    EXPECT_EQ(adaptive.autoChoice->method, RenderMethod::Partitions);
+    EXPECT_TRUE(adaptive.bvh.nodes.empty());
+    EXPECT_TRUE(adaptive.kd);
+    // Auto renders them so: exact's frame is the explicit exact frame, bit for bit.
+    RenderSettings s;
+    s.width = s.height = 32;
+    s.tf = transferFunctionPreset("viridis");
+    const RenderResult a = renderCpu(exact, s);
+    EXPECT_EQ(a.setup.method.method, RenderMethod::Exact);
+    EXPECT_THAT(a.setup.method.reason, HasSubstr("auto: exact"));
+    s.method = RenderMethod::Exact;
+    const RenderResult e = renderCpu(exact, s);
+    EXPECT_TRUE(testing::sameBytes(a.image.pixels, e.image.pixels));
+    EXPECT_TRUE(e.setup.method.reason.empty());
+    s.method = RenderMethod::Auto;
+    EXPECT_EQ(renderCpu(adaptive, s).setup.method.method, RenderMethod::Partitions);
+}
+
+TEST(RenderMethod, AutoFollowsSamplingSettingsAndWhatWasPrepared) {
+    const PreparedMesh both = hexGrid(4);  // the default preparation: both structures
+    RenderSettings s;
+    EXPECT_EQ(resolveMethod(both, s, false).method, RenderMethod::Exact);
+    // A setting only the sampling methods read makes auto the adaptive method it tunes.
+    const auto tuned = [&](auto change) {
+        RenderSettings t;
+        change(t);
+        EXPECT_TRUE(tunesAdaptive(t));
+        const ResolvedMethod r = resolveMethod(both, t, false);
+        EXPECT_EQ(r.method, RenderMethod::Partitions);
+        EXPECT_THAT(r.reason, HasSubstr("tune its sampling"));
+    };
+    tuned([](RenderSettings& t) { t.quality = 0.999f; });
+    tuned([](RenderSettings& t) { t.step = 0.1f; });
+    tuned([](RenderSettings& t) { t.maxStep = 1.f; });
+    tuned([](RenderSettings& t) { t.preintegrated = false; });
+    tuned([](RenderSettings& t) { t.stepRule = StepRule::Variance; });
+    tuned([](RenderSettings& t) { t.power = 3.f; });
+    tuned([](RenderSettings& t) { t.skip = false; });
+    tuned([](RenderSettings& t) { t.adaptive = false; });
+    EXPECT_FALSE(tunesAdaptive(RenderSettings{}));
+    // Without the structures of its pick, the other of exact and adaptive, and it says so.
+    PrepareOptions o;
+    o.meshBvh = false;
+    const ResolvedMethod noBvh = resolveMethod(hexGrid(4, false, o), s, false);
+    EXPECT_EQ(noBvh.method, RenderMethod::Partitions);
+    EXPECT_THAT(noBvh.reason, HasSubstr("the mesh BVH exact needs was not prepared"));
+    o = {};
+    o.partitions = false;
+    const ResolvedMethod noKd = resolveMethod(hexGrid(12, false, o), s, false);
+    EXPECT_EQ(noKd.method, RenderMethod::Exact);
+    EXPECT_THAT(noKd.reason, HasSubstr("the partitions adaptive needs were not prepared"));
+    // A method asked for by name is rendered as asked.
+    for (RenderMethod m : {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
+        s.method = m;
+        EXPECT_EQ(resolveMethod(both, s, false).method, m);
+    }
+}
+
+TEST(RenderMethod, TheRendererDecidesForItsDevice) {
+    const Mesh m = testing::makeHexGrid(10, 0.f, 10.f, [](Vec3f p) { return p.x; });
+    RendererOptions o;
+    o.device = Device::Cpu;
+    o.partitions = o.meshBvh = false;
+    o.forAuto = true;
+    Renderer r(m, selectScalarField(m, {}), o);
+    ASSERT_TRUE(r.prepared().autoChoice);
+    EXPECT_FALSE(r.prepared().autoChoice->gpu);
+    EXPECT_EQ(r.prepared().autoChoice->method, RenderMethod::Partitions);  // 40 > 32
+    RenderSettings s;
+    s.tf = transferFunctionPreset("viridis");
+    s.width = s.height = 16;
+    EXPECT_EQ(r.render(s).setup.method.method, RenderMethod::Partitions);
+}
+
+}  // namespace
+}  // namespace uvr
