@@ -144,6 +144,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         // Every method can be picked in the page: the server prepares for all of them, in the
         // background once it listens, showing the steps in the log and the page.
         scene.rendererOptions = flags->rendererOptions(true);
+        scene.rendererOptions.partitions = scene.rendererOptions.meshBvh = true;
         if (resolvesToCuda(scene.rendererOptions.device))
             ctx.step("GPU: " + cudaDeviceDescription());
         scene.base = settings;

@@ -342,6 +342,15 @@ def first_frame(page):
     reason = page.js("return document.getElementById('stat-device').title")
     check(reason.startswith("auto: " + picked), f"the status's hover text is '{reason}'")
     page.screenshot("first-frame")
+    # Every method renders from the page (the server prepares for all of them), then auto again.
+    for m in ("adaptive", "reference", "exact", "auto"):
+        page.js("const s = document.getElementById('method'); s.value = arguments[0];"
+                " s.dispatchEvent(new Event('change'));", m)
+        rendered = picked if m == "auto" else m
+        page.wait(f"v.state.method === '{m}' && v.lastFrame && v.lastFrame.full && "
+                  f"v.lastFrame.stats && v.lastFrame.stats.method === '{rendered}'", 30,
+                  f"a full frame of the {m} method")
+        check(not page.hook("lastError"), f"the {m} method gave an error: {page.hook('lastError')}")
 
 
 def rotate(page):
