@@ -165,7 +165,8 @@ int main(int argc, char** argv) {
         for (float q : qualities) {
             char name[64];
             std::snprintf(name, sizeof name, "adaptive, quality %g", double(q));
-            kMatrixMethods.push_back({name, RenderMethod::Partitions, StepRule::ErrorBound, true, q});
+            kMatrixMethods.push_back(
+                {name, RenderMethod::Partitions, StepRule::ErrorBound, true, q});
         }
         const bool cuda = device == "cuda";
         std::filesystem::create_directories(out);
@@ -268,7 +269,8 @@ int main(int argc, char** argv) {
                         rows.push_back(row);
                     }
                     std::printf("  %-12s %-8s", tc.name.c_str(), vc.name.c_str());
-                    for (std::size_t i = rows.size() - kMatrixMethods.size() + 1; i < rows.size(); ++i)
+                    for (std::size_t i = rows.size() - kMatrixMethods.size() + 1; i < rows.size();
+                         ++i)
                         std::printf(" %.4f/%g", rows[i].cmp.ssim, rows[i].cmp.p999Difference);
                     std::printf("\n");
                     std::fflush(stdout);
@@ -320,16 +322,18 @@ int main(int argc, char** argv) {
             std::snprintf(line, sizeof line,
                           "| %s | %.4f | %.4f | %d of %zu | %s, %s, %s | %g | %g | %d | %s, %s, "
                           "%s |\n",
-                          kMatrixMethods[m].name.c_str(), w.cmp.ssim, median(ssims), below, ssims.size(),
-                          w.mesh.c_str(), w.tf.c_str(), w.view.c_str(), wp.cmp.p999Difference,
-                          worstMax, seamed, wp.mesh.c_str(), wp.tf.c_str(), wp.view.c_str());
+                          kMatrixMethods[m].name.c_str(), w.cmp.ssim, median(ssims), below,
+                          ssims.size(), w.mesh.c_str(), w.tf.c_str(), w.view.c_str(),
+                          wp.cmp.p999Difference, worstMax, seamed, wp.mesh.c_str(), wp.tf.c_str(),
+                          wp.view.c_str());
             md << line;
         }
         // Per mesh: the worst SSIM of each method, then each method's median time and the
         // median speed-up of the others over the reference (row order is kMatrixMethods' per case).
         const std::size_t nm = kMatrixMethods.size();
         md << "\n| mesh |";
-        for (std::size_t m = 1; m < nm; ++m) md << " worst SSIM: " << kMatrixMethods[m].name << " |";
+        for (std::size_t m = 1; m < nm; ++m)
+            md << " worst SSIM: " << kMatrixMethods[m].name << " |";
         for (std::size_t m = 0; m < nm; ++m) md << " ms: " << kMatrixMethods[m].name << " |";
         for (std::size_t m = 2; m < nm; ++m) md << " speed-up: " << kMatrixMethods[m].name << " |";
         md << "\n|---|";

@@ -39,7 +39,7 @@ struct RendererOptions {
     /// Also what RenderMethod::Auto renders with on this device (PrepareOptions::forAuto): a
     /// front end whose frames are all Auto sets this and neither of the two above.
     bool forAuto = false;
-    bool seedGrids = true;   ///< with partitions: seed grids for long steps
+    bool seedGrids = true;  ///< with partitions: seed grids for long steps
     /// Split pyramids, wedges and hexahedra into tetrahedra instead of rendering them natively.
     bool splitCells = false;
     std::uint32_t leafCells = 0;  ///< cells per k-d partition; 0: the device's default

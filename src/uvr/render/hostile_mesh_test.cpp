@@ -171,8 +171,8 @@ struct Method {
     bool adaptive;
 };
 const Method kEachMethod[] = {{"reference", RenderMethod::Reference, false},
-                           {"partitions", RenderMethod::Partitions, false},
-                           {"partitions+adaptive", RenderMethod::Partitions, true}};
+                              {"partitions", RenderMethod::Partitions, false},
+                              {"partitions+adaptive", RenderMethod::Partitions, true}};
 
 /// Renders the frame with one integrator and counts the pixels off the oracle for a convex mesh
 /// filling `box`; covered receives the number of pixels whose ray meets the box, first the first

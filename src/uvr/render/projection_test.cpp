@@ -28,7 +28,7 @@ PreparedMesh unitCube() {
 }
 
 constexpr RenderMethod kEachMethod[] = {RenderMethod::Reference, RenderMethod::Partitions,
-                                     RenderMethod::Exact};
+                                        RenderMethod::Exact};
 
 /// Constant opacity 0.5 per unit length 1 over the cube's field, nothing terminating early.
 RenderSettings halfOpacity(RenderMethod method) {

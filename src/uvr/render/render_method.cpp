@@ -30,7 +30,9 @@ std::optional<RenderMethod> parseMethod(std::string_view name) {
 std::string methodChoices() {
     std::string out;
     for (std::size_t i = 0; i < kMethods.size(); ++i)
-        out += (i == 0 ? "" : i + 1 == kMethods.size() ? " or " : ", ") +
+        out += (i == 0                     ? ""
+                : i + 1 == kMethods.size() ? " or "
+                                           : ", ") +
                std::string(kMethods[i].name);
     return out;
 }
@@ -45,8 +47,8 @@ double cellSurface(CellKind k, const Vec3f* x) {
         const std::uint32_t face = packedFace(k, f);
         const Vec3f a = x[faceCorner(face, 0)], b = x[faceCorner(face, 1)],
                     c = x[faceCorner(face, 2)];
-        const Vec3f n = faceSize(face) == 3 ? cross(b - a, c - a)
-                                            : cross(c - a, x[faceCorner(face, 3)] - b);
+        const Vec3f n =
+            faceSize(face) == 3 ? cross(b - a, c - a) : cross(c - a, x[faceCorner(face, 3)] - b);
         area += 0.5 * std::sqrt(double(n.x) * n.x + double(n.y) * n.y + double(n.z) * n.z);
     }
     return area;

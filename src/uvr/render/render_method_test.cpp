@@ -16,8 +16,8 @@ using ::testing::HasSubstr;
 
 /// A k x k x k grid of unit-spaced hexahedra over [0, k]^3, native or split into tetrahedra.
 PreparedMesh hexGrid(int k, bool split = false, const PrepareOptions& base = {}) {
-    const Mesh m = testing::makeHexGrid(
-        k, 0.f, float(k), [](Vec3f p) { return p.x + 2.f * p.y - p.z; });
+    const Mesh m =
+        testing::makeHexGrid(k, 0.f, float(k), [](Vec3f p) { return p.x + 2.f * p.y - p.z; });
     PrepareOptions o = base;
     o.cells.splitCells = split;
     return prepareMesh(m, selectScalarField(m, {}), o);
@@ -150,7 +150,8 @@ TEST(RenderMethod, AutoFollowsSamplingSettingsAndWhatWasPrepared) {
     EXPECT_EQ(noKd.method, RenderMethod::Exact);
     EXPECT_THAT(noKd.reason, HasSubstr("the partitions adaptive needs were not prepared"));
     // A method asked for by name is rendered as asked.
-    for (RenderMethod m : {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
+    for (RenderMethod m :
+         {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
         s.method = m;
         EXPECT_EQ(resolveMethod(both, s, false).method, m);
     }

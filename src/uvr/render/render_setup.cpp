@@ -106,8 +106,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     // only the cells) and then the neighbours' codes on threads of their own.
     std::future<std::pair<Bvh, double>> cellTree;
     if (faceMatcher && withPartitions)
-        cellTree = beside(
-            [&tets = out.tets, leaf = cellTreeLeaf] { return buildCellTree(tets, leaf); });
+        cellTree =
+            beside([&tets = out.tets, leaf = cellTreeLeaf] { return buildCellTree(tets, leaf); });
     start = std::chrono::steady_clock::now();
     if (progress)
         progress(faceMatcher ? "finding face neighbours (on " + options.builderDevice +
@@ -335,9 +335,9 @@ std::string fmtValue(double v) {
 
 bool tunesAdaptive(const RenderSettings& s) {
     const RenderSettings d;
-    return s.stepRule != d.stepRule || s.quality != d.quality || s.preintegrated != d.preintegrated ||
-           s.maxStep != d.maxStep || s.power != d.power || s.skip != d.skip ||
-           s.adaptive != d.adaptive || s.step != d.step;
+    return s.stepRule != d.stepRule || s.quality != d.quality ||
+           s.preintegrated != d.preintegrated || s.maxStep != d.maxStep || s.power != d.power ||
+           s.skip != d.skip || s.adaptive != d.adaptive || s.step != d.step;
 }
 
 ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu) {
@@ -651,8 +651,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.rays = makeCameraRays(f.camera, settings.width, settings.height, nearDistance);
     if (method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
-    if (method != RenderMethod::Partitions && mesh.bvh.nodes.empty() &&
-        mesh.tets.cellCount() != 0)
+    if (method != RenderMethod::Partitions && mesh.bvh.nodes.empty() && mesh.tets.cellCount() != 0)
         throwError(ErrorKind::Argument, "",
                    std::string(method == RenderMethod::Exact ? "the exact" : "the reference") +
                        " method needs the mesh BVH");
