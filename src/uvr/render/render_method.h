@@ -2,17 +2,17 @@
 #pragma once
 
 // The integrators a frame renders with, their names in every front end, and RenderMethod::Auto,
-// the default of every front end (issue 29): the exact integrator where it
-// is the faster method, the adaptive partition method elsewhere. Exact is the yardstick the
-// others are measured against, so where it is also faster nothing is lost by rendering it.
+// the default of every front end (issue 29): the exact integrator where it is the faster method,
+// the adaptive partition method elsewhere. Exact is the yardstick the others are measured
+// against, so where it is also faster nothing is lost by rendering it.
 //
-// Its cost is the cells a ray crosses (it walks all of them, whatever the transfer function);
-// the adaptive method's is its samples, which grow with the image rather than the mesh. So the
-// rule looks at the mesh only: exactCellsPerRay estimates the crossings before anything but the
-// split is built, and autoMethod compares them with a per-device limit measured on the shared
-// meshes (docs/PERFORMANCE.md, "The default method"). The choice is made once per prepared
-// mesh: it does not change with the camera or the transfer function, and the same command gives
-// the same picture every run.
+// Exact's cost per ray is the cells the ray crosses (it walks all of them, whatever the transfer
+// function); the adaptive method's is its samples, a few tens at the defaults whatever the
+// mesh's size. So the rule looks at the mesh only: exactCellsPerRay estimates the crossings before
+// anything but the split is built, and autoMethod compares them with a per-device limit measured on
+// the shared meshes (docs/PERFORMANCE.md, "The default method"). The choice is made once per
+// prepared mesh: it does not change with the camera or the transfer function, and the same command
+// gives the same picture every run.
 
 #include <array>
 #include <cstdint>
