@@ -39,7 +39,7 @@ inline constexpr int kBvhMaxDepth = 96;
 inline constexpr float kBoxPointTolerance = 4e-5f;
 
 /// True when p lies in b grown by kBoxPointTolerance times b's largest extent.
-UVR_HOST_DEVICE inline bool boxHoldsPoint(const Bounds3f& b, Vec3f p) {
+UVR_HOST_DEVICE UVR_INLINE bool boxHoldsPoint(const Bounds3f& b, Vec3f p) {
     const Vec3f e = b.extent();
     const float m = e.x > e.y ? (e.x > e.z ? e.x : e.z) : (e.y > e.z ? e.y : e.z);
     const float pad = kBoxPointTolerance * m;

@@ -109,8 +109,8 @@ struct TetLocator {
     /// the tetrahedron containing p, or kNoTet when the walk leaves the mesh, meets a degenerate
     /// tetrahedron or runs out of steps (or start is kNoTet, or there are no neighbours).
     template <bool kNative = true>
-    UVR_HOST_DEVICE std::uint32_t walk(Vec3f p, std::uint32_t start, float bary[4],
-                                       LocateCounters& counters) const {
+    UVR_HOST_DEVICE UVR_INLINE std::uint32_t walk(Vec3f p, std::uint32_t start, float bary[4],
+                                                  LocateCounters& counters) const {
         if (start == kNoTet || !neighbors.present()) return kNoTet;
         std::uint32_t t = start;
         for (int step = 0; step < maxWalkSteps; ++step) {

@@ -15,8 +15,8 @@ UVR_HOST_DEVICE inline float signedVolume6(Vec3f a, Vec3f b, Vec3f c, Vec3f d) {
 /// Barycentric coordinates of p in a positively oriented tetrahedron (a, b, c, d), computed as
 /// ratios of sub-volumes relative to a (for precision); bary[i] weighs vertex i. Returns false
 /// for a degenerate (zero-volume) tetrahedron.
-UVR_HOST_DEVICE inline bool tetBarycentrics(Vec3f p, Vec3f a, Vec3f b, Vec3f c, Vec3f d,
-                                            float bary[4]) {
+UVR_HOST_DEVICE UVR_INLINE bool tetBarycentrics(Vec3f p, Vec3f a, Vec3f b, Vec3f c, Vec3f d,
+                                                float bary[4]) {
     const Vec3f ab = b - a, ac = c - a, ad = d - a, ap = p - a;
     const Vec3f cAcAd = cross(ac, ad);
     const float vol = dot(ab, cAcAd);

@@ -114,7 +114,7 @@ struct TetMeshView {
     /// True when the mesh has native cells.
     UVR_HOST_DEVICE bool hasNative() const { return pyramidCount + wedgeCount + hexCount > 0; }
     /// Tetrahedron t's corners (positions and point values) from its block.
-    UVR_HOST_DEVICE void tetVertices(std::uint64_t t, BlockVertex out[4]) const {
+    UVR_HOST_DEVICE UVR_INLINE void tetVertices(std::uint64_t t, BlockVertex out[4]) const {
         const TetCorners16 c = tetCorners[t];
         const BlockVertex* base = blockVertices + blockVertexBase[t >> kTetBlockBits];
         for (int k = 0; k < 4; ++k) out[k] = base[c.v[k]];
