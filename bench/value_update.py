@@ -33,4 +33,4 @@ for name in ("bluntfin_tets.vtk", "post_tets.vtk"):
     frame = r.render(size=(256, 256), range=(-1, 1), azimuth=30)
     i = r.info
     print(f"| {name} | {i['tetrahedra']} | {i['partitions']} | {prepare:.3f} | "
-          f"{np.median(updates) * 1e3:.1f} | {frame.stats['seconds'] * 1e3:.1f} |")
+          f"{np.median(updates) * 1e3:.1f} | {frame.stats['render_seconds'] * 1e3:.1f} |")

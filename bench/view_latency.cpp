@@ -155,9 +155,9 @@ int main(int argc, char** argv) {
                 const std::uint64_t seq = j["seq"];
                 if (auto it = sent.find(seq); it != sent.end() && seq >= 100) {
                     latency.push_back(ms(now - it->second));
-                    renderMs.push_back(j["stats"]["render_ms"].get<double>());
-                    frameMs.push_back(j["stats"]["frame_ms"].get<double>());
-                    encodeMs.push_back(j["stats"]["encode_ms"].get<double>());
+                    renderMs.push_back(j["stats"]["render_seconds"].get<double>() * 1e3);
+                    frameMs.push_back(j["stats"]["frame_seconds"].get<double>() * 1e3);
+                    encodeMs.push_back(j["stats"]["encode_seconds"].get<double>() * 1e3);
                     bytes.push_back(j["stats"]["bytes"].get<double>());
                     scale.push_back(j["scale"].get<double>());
                     ++frames;

@@ -748,11 +748,13 @@ async function copyCommand(text) {
 function updateFrameStats(header) {
     const s = header.stats || {};
     const num = (v, d = 1) => (Number.isFinite(v) ? v.toFixed(d) : "–");
-    $("stat-render-ms").textContent = `${num(s.render_ms)} ms`;
-    $("stat-spp").textContent = num(s.samples_per_pixel);
+    // The library's frame report (docs/STATS.md): seconds, and counts over the whole frame.
+    const pixels = s.image ? s.image.width * s.image.height : NaN;
+    $("stat-render-ms").textContent = `${num(s.render_seconds * 1e3)} ms`;
+    $("stat-spp").textContent = num(s.mean_samples_per_pixel);
     $("stat-partitions").textContent =
-        `${num(s.partitions_visited_per_pixel)} visited / ` +
-        `${num(s.partitions_skipped_per_pixel)} skipped`;
+        `${num(s.partitions_visited / pixels)} visited / ` +
+        `${num(s.partitions_skipped / pixels)} skipped`;
     $("stat-frame").textContent =
         `${header.full ? "full" : "reduced"} ${header.width}×${header.height} ${header.format}`;
     const device = s.device || (session.info && session.info.device) || "–";

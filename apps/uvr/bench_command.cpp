@@ -300,10 +300,10 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["image"] = {base.width, base.height};
                 j["supersample"] = base.supersample;  // samples per pixel sum its rays
                 j["s1"] = s1;
-                j["step_rule"] = base.stepRule == StepRule::ErrorBound ? "error" : "variance";
+                j["step_rule"] = stepRuleName(base.stepRule);
                 j["quality"] = base.quality;
                 j["power"] = base.power;
-                j["sampling"] = base.preintegrated ? "preintegrated" : "point";
+                j["sampling"] = samplingName(base.preintegrated);
                 j["opacity_law"] = opacityLawName(base.opacityLaw);
                 j["threads"] = threads;
                 j["device"] = where;

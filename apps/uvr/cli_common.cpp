@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -26,12 +25,6 @@ namespace uvr::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-/// A length or coordinate in the file's units for JSON: a float where it fits (as the file gives
-/// them), else a double (the default camera of a mesh near 1e38 lies beyond float's range).
-nlohmann::json fileNumber(double v) {
-    return std::fabs(v) <= FLT_MAX ? nlohmann::json(static_cast<float>(v)) : nlohmann::json(v);
-}
 
 [[noreturn]] void badFlag(const std::string& flag, const std::string& text,
                           const std::string& what) {
@@ -305,14 +298,15 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "the scalar linear from one to the next: no transfer-function feature is "
                    "missed) or point (point samples with opacity correction, as in Morrical et "
                    "al. 2019)")
-        ->check(CLI::IsMember({"preintegrated", "point"}))
+        ->check(CLI::IsMember({std::string(samplingName(true)), std::string(samplingName(false))}))
         ->capture_default_str();
     app.add_option("--step-rule", stepRule,
                    "Adaptive: how each partition's step is chosen: error (bounded integration "
                    "error from the transfer function's rate of change and the field's gradients; "
                    "--quality) or variance (Morrical et al. 2019's normalised colour variance; "
                    "--power)")
-        ->check(CLI::IsMember({"error", "variance"}))
+        ->check(CLI::IsMember({std::string(stepRuleName(StepRule::ErrorBound)),
+                               std::string(stepRuleName(StepRule::Variance))}))
         ->capture_default_str();
     {
         char help[200];
@@ -931,116 +925,19 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
                  std::to_string(heatmapTop) + " (top)");
     }
     if (!flags.statsFile.empty()) {
-        nlohmann::json j;
+        // The library's frame report, and what only the CLI knows: the file, its counts and
+        // check, the prepared cache, the heat map's scale.
+        nlohmann::json j = frameReport(renderer, settings, result);
         j["source"] = source;
-        j["field"] = field.name;
-        j["field_association"] = associationName(field.association);
-        j["device"] = renderer.deviceName();
-        if (renderer.gpu()) {
-            j["gpu"] = {{"description", cudaDeviceDescription()},
-                        {"geometry_bytes", renderer.gpu()->geometryBytes()},
-                        {"bytes_per_cell",
-                         double(renderer.gpu()->geometryBytes()) /
-                             double(std::max<std::uint64_t>(1, prepared.tets.cellCount()))},
-                        // Per tetrahedron of the split (the cells' tetrahedra when split):
-                        // comparable between native and split cells.
-                        {"bytes_per_tetrahedron",
-                         double(renderer.gpu()->geometryBytes()) /
-                             double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
-                        {"upload_seconds", renderer.gpu()->uploadSeconds()}};
-        }
-        j["threads"] = cpu::threadCount();
         if (!flags.heatmapFile.empty()) j["heatmap_max"] = heatmapTop;
-        // The method that rendered; with auto, also what was asked and why.
-        j["method"] = methodName(result.setup.method.method);
-        if (!result.setup.method.reason.empty()) {
-            j["method_asked"] = flags.method;
-            j["method_reason"] = result.setup.method.reason;
-        }
-        if (result.setup.method.method != RenderMethod::Exact) j["sampling"] = flags.sampling;
-        if (prepared.kd) {
-            const KdPartitions& kd = *prepared.kd;
-            std::vector<std::uint32_t> sizes;
-            for (const KdPartition& p : kd.partitions) sizes.push_back(p.cellCount);
-            std::sort(sizes.begin(), sizes.end());
-            j["partitions"] = {
-                {"count", kd.partitions.size()},
-                {"build_seconds", kd.buildSeconds},
-                {"cells_min", sizes.empty() ? 0 : sizes.front()},
-                {"cells_median", sizes.empty() ? 0 : sizes[sizes.size() / 2]},
-                {"cells_max", sizes.empty() ? 0 : sizes.back()},
-                {"duplication_factor", kd.duplicationFactor(prepared.tets.cellCount())},
-                {"leaf_cells", prepared.kd->leafCells}};
-            if (prepared.seeds)
-                j["seed_grids"] = {{"cells", prepared.seeds->seeds.size()},
-                                   {"bytes", prepared.seeds->bytes()},
-                                   {"build_seconds", prepared.seeds->buildSeconds}};
-            j["tf_update_seconds"] = result.setup.tfUpdateSeconds;
-            j["max_step"] = fileNumber(result.setup.maxStep / result.setup.frame.scale);
-            j["step_rule"] = flags.stepRule;
-            if (settings.stepRule == StepRule::ErrorBound) {
-                j["quality"] = settings.quality;
-                j["tolerance"] = result.setup.stepRule.tolerance;
-            } else {
-                j["power"] = settings.power;
-            }
-            j["skip"] = settings.skip;
-            j["adaptive"] = settings.adaptive;
-            j["partitions_visited"] = result.stats.partitionsVisited;
-            j["partitions_skipped"] = result.stats.partitionsSkipped;
-        }
-        j["image"] = {{"width", settings.width}, {"height", settings.height}};
-        // Anti-aliasing: a pixel's samples are summed over its supersample^2 rays.
-        j["supersample"] = settings.supersample;
-        if (settings.supersample > 1) j["jitter"] = settings.jitter;
-        j["rays"] = result.stats.rays();
-        j["mesh"] = {
-            {"points", src.summary.points},           {"cells", src.summary.cells},
-            {"tetrahedra", prepared.tets.tetCount()}, {"pyramids", prepared.tets.pyramidCount},
-            {"wedges", prepared.tets.wedgeCount},     {"hexahedra", prepared.tets.hexCount}};
-        // Every phase of the preparation, the check of the mesh first ("adjacency" is the
-        // neighbours' old name).
+        j["mesh"]["points"] = src.summary.points;
+        j["mesh"]["cells"] = src.summary.cells;
         j["prepared_cache"] = {{"used", !src.cacheFile.empty()}};
         if (!src.cacheFile.empty()) {
             j["prepared_cache"]["file"] = src.cacheFile;
             j["prepared_cache"]["read_seconds"] = src.cacheReadSeconds;
         }
-        j["prepare_seconds"] = {{"check", src.checkSeconds},
-                                {"bvh", prepared.bvhSeconds},
-                                {"adjacency", prepared.adjacencySeconds}};
-        for (const auto& [phase, seconds] : prepared.phaseSeconds)
-            j["prepare_seconds"][phase] = seconds;
-        j["render_seconds"] = result.stats.seconds;
-        j["samples"] = result.stats.samples;
-        j["mean_samples_per_pixel"] = result.stats.meanSamplesPerPixel();
-        j["mean_samples_per_ray"] = result.stats.meanSamplesPerRay();
-        j["max_samples_per_pixel"] =
-            *std::max_element(result.sampleCounts.begin(), result.sampleCounts.end());
-        j["samples_per_second"] =
-            result.stats.seconds > 0 ? double(result.stats.samples) / result.stats.seconds : 0.0;
-        j["walk_steps"] = result.stats.walkSteps;
-        j["bvh_queries"] = result.stats.bvhQueries;
-        // Lengths and positions in the file's units (the mesh may render scaled and moved).
-        const MeshFrame& frame = result.setup.frame;
-        const auto number = fileNumber;
-        j["step"] = number(result.setup.params.step / frame.scale);
-        j["opacity_unit"] = number(result.setup.params.opacityUnit / frame.scale);
-        j["opacity_law"] = opacityLawName(settings.opacityLaw);
-        j["range"] = {result.setup.rangeLo, result.setup.rangeHi};
-        j["log_scale"] = settings.tf.logScale;
-        j["tf_table_entries"] = result.setup.tfTable.size();
-        const Camera& c = result.setup.camera;
-        double position[3], focal[3];
-        frame.toFile(c.position, position);
-        frame.toFile(c.focalPoint, focal);
-        j["camera"] = {
-            {"position", {number(position[0]), number(position[1]), number(position[2])}},
-            {"focal_point", {number(focal[0]), number(focal[1]), number(focal[2])}},
-            {"view_up", {c.viewUp.x, c.viewUp.y, c.viewUp.z}},
-            {"view_angle", c.viewAngle},
-            {"parallel_projection", c.parallelProjection}};
-        if (c.parallelProjection)
-            j["camera"]["parallel_scale"] = number(c.parallelScale / frame.scale);
+        j["prepare_seconds"]["check"] = src.checkSeconds;
         outputs.push_back(std::make_unique<OutputFile>(flags.statsFile));
         outputs.back()->write(jsonText(j) + "\n");
     }

@@ -47,6 +47,6 @@ renderer = uvr.Renderer(mesh)
 img = renderer.render(tf="Viridis", opacity="0:0,0.3:0,1:0.8", size=(320, 320), azimuth=35,
                       elevation=25)
 img.save(out / "numpy_render.png", background=(1, 1, 1))
-print(f"numpy_render.png: {img.stats['samples_per_pixel']:.1f} samples per pixel, "
-      f"{img.stats['seconds'] * 1e3:.1f} ms on {renderer.device}")
+print(f"numpy_render.png: {img.stats['mean_samples_per_pixel']:.1f} samples per pixel, "
+      f"{img.stats['render_seconds'] * 1e3:.1f} ms on {renderer.device}")
 assert img[..., 3].max() > 0.5, "the blobs should be visible"

@@ -25,7 +25,7 @@ frames = []
 for centre in (0.15, 0.3, 0.45, 0.6, 0.75, 0.9):
     band = f"0:0,{centre - 0.08:.2f}:0,{centre:.2f}:0.9,{centre + 0.08:.2f}:0,1:0"
     frames.append(renderer.render(tf="Turbo", opacity=band, camera=camera, size=(200, 200)))
-    print(f"band at {centre:.2f}: {frames[-1].stats['seconds'] * 1e3:.1f} ms, transfer-function "
+    print(f"band at {centre:.2f}: {frames[-1].stats['render_seconds'] * 1e3:.1f} ms, transfer-function "
           f"update {frames[-1].stats['tf_update_seconds'] * 1e3:.2f} ms")
 sheet = uvr.contact_sheet(frames, columns=3, background=(1, 1, 1))
 sheet.save(out / "tf_sweep.png")

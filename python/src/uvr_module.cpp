@@ -374,33 +374,10 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
         py::gil_scoped_release release;
         r = self.renderer->render(s);
     }
-    const PreparedMesh& prepared = self.renderer->prepared();
-    const double scale = r.setup.frame.scale;
-    py::dict stats;
-    stats["seconds"] = r.stats.seconds;
-    stats["samples"] = r.stats.samples;
-    stats["samples_per_pixel"] = r.stats.meanSamplesPerPixel();
-    stats["samples_per_ray"] = r.stats.meanSamplesPerRay();
-    stats["rays"] = r.stats.rays();
-    stats["walk_steps"] = r.stats.walkSteps;
-    stats["bvh_queries"] = r.stats.bvhQueries;
-    stats["partitions_visited"] = r.stats.partitionsVisited;
-    stats["partitions_skipped"] = r.stats.partitionsSkipped;
-    stats["tf_update_seconds"] = r.setup.tfUpdateSeconds;
-    stats["step"] = r.setup.params.step / scale;
-    stats["opacity_unit"] = r.setup.params.opacityUnit / scale;
-    stats["opacity_law"] = opacityLawName(r.setup.opacityLaw);
-    stats["range"] = py::make_tuple(r.setup.rangeLo, r.setup.rangeHi);
-    stats["method"] = methodName(r.setup.method.method);  // auto resolved
-    if (!r.setup.method.reason.empty()) stats["method_reason"] = r.setup.method.reason;
-    stats["device"] = self.renderer->deviceName();
-    stats["width"] = width;
-    stats["height"] = height;
-    stats["supersample"] = supersample;
-    stats["field"] = prepared.tets.fieldName;
-    stats["field_association"] = associationName(prepared.tets.association);
-    stats["notes"] = r.setup.notes;
-    stats["empty_frame"] = explainEmptyFrame(prepared, s, r);
+    // The library's frame report (the CLI's --stats, the viewer's frame messages), as a dict.
+    py::object stats = py::module_::import("json").attr("loads")(
+        frameReport(*self.renderer, s, r)
+            .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
     const auto h = static_cast<py::ssize_t>(height), w = static_cast<py::ssize_t>(width);
     py::array pixels = vectorArray<float>(std::move(r.image.pixels), {h, w, 4});
     py::array counts = vectorArray<std::uint32_t>(std::move(r.sampleCounts), {h, w});

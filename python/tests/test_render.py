@@ -138,7 +138,7 @@ def test_images_are_arrays_that_display_themselves(data_dir):
     assert img._repr_png_()[:8] == b"\x89PNG\r\n\x1a\n"
     assert img.to_uint8().shape == (10, 20, 4) and img.to_uint8((0, 0, 0)).shape == (10, 20, 3)
     assert img.sample_counts.shape == (10, 20)
-    assert {"seconds", "samples", "samples_per_pixel", "partitions_visited"} <= set(img.stats)
+    assert {"render_seconds", "samples", "mean_samples_per_pixel", "rays", "method"} <= set(img.stats)
     crop = img[2:5]
     assert crop.stats is img.stats
 

@@ -11,6 +11,7 @@
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/facade/frame_report.h"
 #include "uvr/facade/renderer.h"
 #include "uvr/facade/series_player.h"
 #include "uvr/mesh/field_select.h"

@@ -324,7 +324,7 @@ def first_frame(page):
           f"the first full frame is {frame['width']}x{frame['height']}, the state's size "
           f"{state['size']}")
     check(frame["format"] == "png", f"a full frame in {frame['format']}, not png")
-    for key in ("render_ms", "samples_per_pixel"):
+    for key in ("render_seconds", "mean_samples_per_pixel", "frame_seconds", "method"):
         check(key in frame.get("stats", {}), f"the frame's stats have no {key}")
     mean, n = mean_rgb(page.pixels())
     check(n > 40, f"the first frame is (nearly) all black: {n} of 4096 pixels lit")

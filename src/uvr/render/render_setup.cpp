@@ -357,6 +357,14 @@ ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& set
     return {choice.method, choice.reason()};
 }
 
+const char* stepRuleName(StepRule rule) {
+    return rule == StepRule::Variance ? "variance" : "error";
+}
+
+const char* samplingName(bool preintegrated) {
+    return preintegrated ? "preintegrated" : "point";
+}
+
 void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;

@@ -272,6 +272,11 @@ struct RenderSettings {
     std::function<void(double)> progress;
 };
 
+/// The names every front end and report gives the step rules ("error", "variance") and the
+/// sampling (RenderSettings::preintegrated: "preintegrated", else "point").
+const char* stepRuleName(StepRule rule);
+const char* samplingName(bool preintegrated);
+
 /// Largest RenderSettings::supersample: 8 x 8 = 64 rays per pixel.
 inline constexpr int kMaxSupersample = 8;
 

@@ -26,6 +26,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/text.h"
+#include "uvr/facade/frame_report.h"
 #include "uvr/mesh/cell_types.h"
 #include "uvr/render/heatmap.h"
 #include "uvr/render/image.h"
@@ -1063,8 +1064,7 @@ void ViewServer::Impl::renderLoop() {
                 frameSettings(state, scene.base, kind == Kind::Snapshot ? 1 : scale);
             const auto frameStart = Clock::now();
             const RenderResult result = renderer->render(settings);
-            const double renderMs = result.stats.seconds * 1e3;
-            const double frameMs = secondsSince(frameStart) * 1e3;
+            const double frameSeconds = secondsSince(frameStart);
             const auto encodeStart = Clock::now();
             Image image =
                 state.heatmap && kind != Kind::Snapshot
@@ -1079,32 +1079,22 @@ void ViewServer::Impl::renderLoop() {
                 bytes = encodeJpeg(image, bg, opt.jpegQuality), format = "jpeg";
             else
                 bytes = encodePng(image, bg, 1);
-            const double encodeMs = secondsSince(encodeStart) * 1e3;
+            const double encodeSeconds = secondsSince(encodeStart);
             const double pixels = double(settings.width) * settings.height;
             Json meta;
             if (kind == Kind::Snapshot) {
                 meta = {{"type", "snapshot"}, {"format", "png"}};
             } else {
-                const double spp = result.stats.meanSamplesPerPixel();
-                meta = {{"type", "frame"},
-                        {"seq", seq},
-                        {"format", format},
-                        {"full", kind == Kind::Full},
-                        {"scale", scale},
-                        {"stats",
-                         {{"render_ms", renderMs},
-                          {"frame_ms", frameMs},
-                          {"encode_ms", encodeMs},
-                          {"bytes", bytes.size()},
-                          {"samples_per_pixel", spp},
-                          {"partitions_visited_per_pixel",
-                           double(result.stats.partitionsVisited) / pixels},
-                          {"partitions_skipped_per_pixel",
-                           double(result.stats.partitionsSkipped) / pixels},
-                          {"method", methodName(result.setup.method.method)},
-                          {"device", renderer->deviceName()}}}};
-                if (!result.setup.method.reason.empty())
-                    meta["stats"]["method_reason"] = result.setup.method.reason;
+                // The library's frame report (the CLI's --stats, Python's stats), and what only
+                // the server knows: the whole render call (setup, kernel, read-back), the
+                // encoding and the bytes sent.
+                Json stats = frameReport(*renderer, settings, result);
+                stats["frame_seconds"] = frameSeconds;
+                stats["encode_seconds"] = encodeSeconds;
+                stats["bytes"] = bytes.size();
+                meta = {{"type", "frame"},  {"seq", seq},
+                        {"format", format}, {"full", kind == Kind::Full},
+                        {"scale", scale},   {"stats", std::move(stats)}};
                 if (!result.setup.notes.empty()) meta["notes"] = result.setup.notes;
             }
             meta["width"] = image.width;
@@ -1113,7 +1103,8 @@ void ViewServer::Impl::renderLoop() {
                 std::lock_guard slk(m);
                 // What a frame costs here: the render call (setup, kernel, read-back) and the
                 // encoding, per pixel.
-                const double perPixel = (frameMs + encodeMs) / std::max(1.0, pixels);
+                const double perPixel =
+                    (frameSeconds + encodeSeconds) * 1e3 / std::max(1.0, pixels);
                 s->msPerPixel = s->msPerPixel > 0.0 ? 0.5 * (s->msPerPixel + perPixel) : perPixel;
             }
             post([meta = meta.dump(), bytes = std::move(bytes)](Session& c) mutable {

@@ -213,7 +213,7 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
     EXPECT_TRUE(f["full"].get<bool>());
     EXPECT_EQ(f["format"], "png");
     EXPECT_EQ(f["width"], 64);
-    EXPECT_GT(f["stats"]["samples_per_pixel"].get<double>(), 0.0);
+    EXPECT_GT(f["stats"]["mean_samples_per_pixel"].get<double>(), 0.0);
     EXPECT_EQ(f["stats"]["device"], "cpu");
     EXPECT_TRUE(isPng(c.lastBinary()));
     // The scene came unprepared: the server prepared it at start, and the tab knows the result
