@@ -12,7 +12,7 @@
 # Python tests; liblz4-dev and liblzma-dev read and write LZ4/LZMA-compressed .vtu (optional);
 # libnetcdf-dev reads Exodus II files, and mayavi2 ships ParaView's disk_out_ref.ex2 the Exodus
 # tests read; libhdf5-dev reads and writes VTKHDF files (optional in CMake) and python3-h5py
-# writes their test files.
+# writes their test files; clang-format-14 checks the sources' style (tests/tools/check_format.sh).
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make pkg-config
@@ -22,7 +22,7 @@ PACKAGES="g++ cmake make pkg-config
   libboost-dev libturbojpeg0-dev
   libnetcdf-dev mayavi2
   libgtest-dev libbenchmark-dev
-  clang libclang-rt-14-dev libomp-dev
+  clang libclang-rt-14-dev libomp-dev clang-format-14
   python3 python3-numpy python3-vtk9 python3-meshio python3-skimage
   python3-dev pybind11-dev python3-pytest python3-matplotlib
   xvfb xauth

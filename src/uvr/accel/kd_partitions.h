@@ -204,7 +204,6 @@ struct KdBuildOptions {
 /// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its
 /// cells (a cell straddling a split goes to both sides), shrunk box and value range. (Samples
 /// the walks do not locate search the cell tree, buildCellTree: the partitions keep no BVHs.)
-/// its cells for point location restricted to the partition.
 struct KdPartitions {
     std::vector<KdNode> nodes;
     std::vector<KdPartition> partitions;
