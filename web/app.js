@@ -403,9 +403,20 @@ function fillSelectors(info) {
     fieldList = fieldEntries(info.fields || []);
     const field = $("field");
     field.replaceChildren(...fieldList.map((e) => new Option(e.label, e.spec)));
-    const method = $("method");
-    method.replaceChildren(...(info.methods || ["auto", "adaptive", "reference", "exact"])
-        .map((m) => new Option(m, m)));
+    // The library's settings vocabulary: choices, ranges and docs of the controls.
+    const setting = (name) => (info.settings || []).find((d) => d.name === name) || {};
+    for (const [id, name] of [["method", "method"], ["opacity-law", "opacity_law"]]) {
+        const d = setting(name);
+        const choices = d.choices || (name === "method" ? info.methods : []) || [];
+        if (choices.length) $(id).replaceChildren(...choices.map((c) => new Option(c, c)));
+        if (d.doc) $(id).closest("label").title = d.doc;
+    }
+    const quality = setting("quality");
+    if (Number.isFinite(quality.min) && Number.isFinite(quality.max)) {
+        $("quality").min = sliderFromQuality(quality.min);
+        $("quality").max = sliderFromQuality(quality.max);
+    }
+    if (quality.doc) $("quality").closest("label").title = quality.doc;
     const preset = $("preset");
     preset.replaceChildren(...(info.presets || []).map((p) => new Option(p, p)));
     const limits = info.limits || {};

@@ -256,7 +256,7 @@ TEST(CliCamera, SupersampleAveragesRaysAndStatesItsCounts) {
     // Out of range, or --jitter without rays to move: one line.
     for (const char* n : {"0", "9", "-2"})
         expectOneLineError(uvr(render + dir + "/x.png --supersample " + n, dir),
-                           {std::string("--supersample ") + n, "expected 1 to 8"}, n);
+                           {std::string("--supersample ") + n, "expected an integer in [1, 8]"}, n);
     expectOneLineError(uvr(render + dir + "/x.png --jitter", dir),
                        {"--jitter", "--supersample 2 or more"}, "jitter alone");
     // Every flag has its help.

@@ -222,7 +222,7 @@ void addMethodOption(CLI::App& app, std::string& method) {
                    "adaptive (k-d partitions and macrocells: space skipping, error-bounded "
                    "adaptive steps; Morrical et al. 2019 and beyond), reference (fixed step s1 "
                    "everywhere) or exact (no sampling: every cell's segment integrated exactly)")
-        ->check(CLI::IsMember(methodNames()))
+        ->check(CLI::IsMember(settingNamed("method").choices))
         ->capture_default_str();
 }
 
@@ -289,8 +289,7 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                        opacityLawName(OpacityLaw::Transmittance) +
                        " (extinction -ln(1 - a) / u: opacity 1 - (1 - a)^(L / u), a = 1 "
                        "opaque at once; docs/TRANSFER_FUNCTIONS.md)")
-        ->check(CLI::IsMember({std::string(opacityLawName(OpacityLaw::Attenuation)),
-                               std::string(opacityLawName(OpacityLaw::Transmittance))}))
+        ->check(CLI::IsMember(settingNamed("opacity_law").choices))
         ->capture_default_str();
     if (oneFrame) addMethodOption(app, method);
     app.add_option("--sampling", sampling,
@@ -298,15 +297,14 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                    "the scalar linear from one to the next: no transfer-function feature is "
                    "missed) or point (point samples with opacity correction, as in Morrical et "
                    "al. 2019)")
-        ->check(CLI::IsMember({std::string(samplingName(true)), std::string(samplingName(false))}))
+        ->check(CLI::IsMember(settingNamed("sampling").choices))
         ->capture_default_str();
     app.add_option("--step-rule", stepRule,
                    "Adaptive: how each partition's step is chosen: error (bounded integration "
                    "error from the transfer function's rate of change and the field's gradients; "
                    "--quality) or variance (Morrical et al. 2019's normalised colour variance; "
                    "--power)")
-        ->check(CLI::IsMember({std::string(stepRuleName(StepRule::ErrorBound)),
-                               std::string(stepRuleName(StepRule::Variance))}))
+        ->check(CLI::IsMember(settingNamed("step_rule").choices))
         ->capture_default_str();
     {
         char help[200];
@@ -405,14 +403,15 @@ RenderSettings RenderFlags::baseSettings() const {
     if (!range.empty()) s.range = parseRange("--range", range);
     s.step = step;
     s.opacityUnit = opacityUnit;
-    if (!parseOpacityLaw(opacityLaw.c_str(), s.opacityLaw))
-        badFlag("--opacity-law", opacityLaw, "attenuation or transmittance");
+    // The settings of the library's vocabulary are checked there (main re-spells its errors
+    // with the flags).
+    applySetting(s, "opacity_law", opacityLaw);
     s.method = requestedMethod();
     s.maxStep = maxStep;
-    if (power) s.power = *power;
-    s.stepRule = stepRule == "variance" ? StepRule::Variance : StepRule::ErrorBound;
-    if (quality) s.quality = *quality;
-    s.preintegrated = sampling == "preintegrated";
+    if (power) applySetting(s, "power", *power);
+    applySetting(s, "step_rule", stepRule);
+    if (quality) applySetting(s, "quality", *quality);
+    applySetting(s, "sampling", sampling);
     s.skip = !noSkip;
     s.adaptive = !noAdaptive;
     if (s.method != RenderMethod::Partitions && tunesPartitions())
@@ -433,15 +432,11 @@ RenderSettings RenderFlags::baseSettings() const {
         throwError(ErrorKind::Argument, "",
                    "--sampling applies to the reference and adaptive methods; exact does not "
                    "sample");
-    if (!(supersample >= 1 && supersample <= kMaxSupersample))
-        throwError(ErrorKind::Argument, "",
-                   "--supersample " + std::to_string(supersample) + ": expected 1 to " +
-                       std::to_string(kMaxSupersample) + " (N x N rays per pixel)");
+    applySetting(s, "supersample", supersample);
     if (jitter && supersample < 2)
         throwError(ErrorKind::Argument, "",
                    "--jitter moves the rays of --supersample N inside the pixel: it needs "
                    "--supersample 2 or more");
-    s.supersample = supersample;
     s.jitter = jitter;
     return s;
 }

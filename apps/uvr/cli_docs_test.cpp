@@ -13,6 +13,7 @@
 
 #include "cli_test_support.h"
 #include "test_support.h"
+#include "uvr/render/settings_vocabulary.h"
 
 namespace uvr {
 namespace {
@@ -56,6 +57,22 @@ private:
     std::string dir_;
     std::map<std::string, std::set<std::string>> cache_;
 };
+
+TEST(CliDocs, EverySettingOfTheLibrarysVocabularyIsARenderFlagWithItsChoices) {
+    const std::string dir = testing::scratchDir();
+    const CliRun help = uvr("render --help", dir);
+    ASSERT_EQ(help.code, 0);
+    HelpIndex index(dir);
+    for (const SettingDef& d : settingsVocabulary()) {
+        EXPECT_TRUE(index.knows("render", cliFlag(d))) << d.name;
+        if (d.type != SettingType::Choice) continue;
+        // CLI11 lists a flag's choices as {a,b,c}: the vocabulary's, in its order.
+        std::string choices;
+        for (const std::string& c : d.choices) choices += (choices.empty() ? "" : ",") + c;
+        EXPECT_NE(help.out.find(cliFlag(d) + " TEXT:{" + choices + "}"), std::string::npos)
+            << d.name << ": " << choices;
+    }
+}
 
 TEST(CliDocs, EveryCommandLineInTheReadmeAndDocsParses) {
     const std::string dir = testing::scratchDir();

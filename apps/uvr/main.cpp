@@ -62,6 +62,12 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "uvr: error: %s\n",
                      printable(cli::describeParseError(app, args, e)).c_str());
         return 2;
+    } catch (const SettingError& e) {
+        // The library names a setting in neutral words: here, by its flag (--max-step -2: ...).
+        const SettingDef* def = findSetting(e.setting());
+        const std::string text = def ? e.spelledAs(cliFlag(*def), " ") : e.what();
+        std::fprintf(stderr, "uvr: error: %s\n", printable(text).c_str());
+        return 2;
     } catch (const Error& e) {
         // Messages quote names from files: escaped, they stay one line.
         std::fprintf(stderr, "uvr: error: %s\n", printable(e.what()).c_str());

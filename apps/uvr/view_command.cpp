@@ -131,14 +131,14 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         s.tf = settings.tf;
         s.range = settings.range.value_or(finiteRange(field.values));
         s.field = flags->field;
-        s.method = settings.method;
-        s.quality = settings.quality;
-        s.opacityLaw = settings.opacityLaw;
+        // The page's settings start as the command line set them (or their defaults).
+        for (const char* name : server::kViewerSettings)
+            s.settings[name] = settingNamed(name).get(settings);
+        s.settings["opacity_unit"] = settings.opacityUnit > 0.f
+                                         ? settings.opacityUnit
+                                         : defaultOpacityUnit(report.bounds, mesh->cellCount());
         s.width = settings.width;
         s.height = settings.height;
-        s.opacityUnit = settings.opacityUnit > 0.f
-                            ? settings.opacityUnit
-                            : defaultOpacityUnit(report.bounds, mesh->cellCount());
         scene.mesh = mesh;
         scene.bounds = report.bounds;
         // Every method can be picked in the page: the server prepares for all of them, in the

@@ -325,9 +325,31 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
 
 // ---- Rendering ----
 
-RenderMethod methodNamed(const std::string& s) {
-    if (const std::optional<RenderMethod> m = parseMethod(s)) return *m;
-    raise(ErrorKind::Argument, "method: expected " + methodChoices() + ", got '" + s + "'");
+/// A Python value as the settings vocabulary reads it: None, bool, int, float (numpy scalars
+/// too) or str; anything else as its float() when it has one.
+nlohmann::json settingValue(const py::handle& v) {
+    if (v.is_none()) return nullptr;
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::hasattr(v, "__index__")) {  // int, numpy integers
+        const py::object i = py::module_::import("operator").attr("index")(v);
+        try {
+            return i.cast<std::int64_t>();
+        } catch (const py::cast_error&) {
+            return py::str(i).cast<std::string>();  // beyond 64 bits: refused as written
+        }
+    }
+    if (py::hasattr(v, "__float__")) return v.cast<double>();  // numpy floats
+    return py::str(py::repr(v)).cast<std::string>();           // refused as what it is
+}
+
+/// RenderSettings from a dict of the settings vocabulary (settings_vocabulary.h): each key a
+/// setting's name, each value checked there; the library's SettingError says what is wrong.
+RenderSettings settingsOf(const py::dict& settings) {
+    RenderSettings s;
+    for (const auto& [k, v] : settings)
+        applySetting(s, py::str(k).cast<std::string>(), settingValue(v));
+    return s;
 }
 
 /// The renderer object of the library with the GIL released around its long calls.
@@ -338,37 +360,12 @@ struct PyRenderer {
 /// One frame: (pixels (h, w, 4) float32 premultiplied, sample counts (h, w) uint32, stats).
 py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
-                      int width, int height, const std::string& method, const std::string& sampling,
-                      const std::string& stepRule, float quality, float step, float maxStep,
-                      float opacityUnit, float power, bool skip, bool adaptive, int supersample,
-                      bool jitter, const std::string& opacityLaw) {
-    RenderSettings s;
-    if (!parseOpacityLaw(opacityLaw.c_str(), s.opacityLaw))
-        raise(ErrorKind::Argument, std::string("opacity_law: expected '") +
-                                       opacityLawName(OpacityLaw::Attenuation) + "' or '" +
-                                       opacityLawName(OpacityLaw::Transmittance) + "', got '" +
-                                       opacityLaw + "'");
-    s.method = methodNamed(method);
-    if (sampling != "preintegrated" && sampling != "point")
-        raise(ErrorKind::Argument,
-              "sampling: expected 'preintegrated' or 'point', got '" + sampling + "'");
-    s.preintegrated = sampling == "preintegrated";
-    if (stepRule != "error" && stepRule != "variance")
-        raise(ErrorKind::Argument,
-              "step_rule: expected 'error' or 'variance', got '" + stepRule + "'");
-    s.stepRule = stepRule == "error" ? StepRule::ErrorBound : StepRule::Variance;
-    s.quality = quality;
-    toleranceForQuality(quality);  // refuses a quality out of range, naming it
+                      int width, int height, const py::dict& settings) {
+    RenderSettings s = settingsOf(settings);
     s.width = width, s.height = height;
     s.tf = tf;
     s.range = range;
     s.camera = camera;
-    s.step = step, s.maxStep = maxStep, s.opacityUnit = opacityUnit, s.power = power;
-    s.skip = skip, s.adaptive = adaptive;
-    if (!(supersample >= 1 && supersample <= kMaxSupersample))
-        raise(ErrorKind::Argument, "supersample " + std::to_string(supersample) +
-                                       ": expected 1 to " + std::to_string(kMaxSupersample));
-    s.supersample = supersample, s.jitter = jitter;
     RenderResult r;
     {
         py::gil_scoped_release release;
@@ -413,6 +410,17 @@ PYBIND11_MODULE(_uvr, m) {
     m.doc() = "uvr's compiled core (a thin layer over the C++ library); use the uvr package.";
     // The integrators' names, the default first (the library's one list: kMethods).
     m.attr("METHODS") = methodNames();
+    // The settings vocabulary (settings_vocabulary.h): name, type, doc, default, choices or range.
+    m.attr("SETTINGS") = py::module_::import("json").attr("loads")(settingsVocabularyJson().dump());
+    m.def(
+        "check_settings", [](const py::dict& settings) { settingsOf(settings); },
+        py::arg("settings"),
+        "Raises ArgumentError naming the first setting of the dict that the vocabulary refuses.");
+    m.def(
+        "tunes_adaptive",
+        [](const py::dict& settings) { return tunesAdaptive(settingsOf(settings)); },
+        py::arg("settings"),
+        "True when the settings tune the sampling methods: method 'auto' then renders adaptive.");
 
     // Exceptions.
     gExceptions.base = addException(m, "Error", nullptr, "Base of every error uvr raises.");
@@ -434,6 +442,11 @@ PYBIND11_MODULE(_uvr, m) {
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
+        } catch (const SettingError& e) {
+            // Python's spelling: the keyword and its value (quality=1.5: expected ...).
+            const std::string text =
+                findSetting(e.setting()) ? e.spelledAs(e.setting(), "=") : e.what();
+            PyErr_SetString(gExceptions.byKind[static_cast<int>(e.kind())], text.c_str());
         } catch (const Error& e) {
             PyErr_SetString(gExceptions.byKind[static_cast<int>(e.kind())], e.what());
         }
@@ -769,13 +782,7 @@ PYBIND11_MODULE(_uvr, m) {
             },
             py::arg("name"), py::arg("association"), py::arg("values"))
         .def("render", &renderFrame, py::arg("tf"), py::arg("range"), py::arg("camera"),
-             py::arg("width"), py::arg("height"),
-             py::arg("method") = methodName(RenderSettings{}.method),
-             py::arg("sampling") = "preintegrated", py::arg("step_rule") = "error",
-             py::arg("quality") = kDefaultQuality, py::arg("step") = 0.f, py::arg("max_step") = 0.f,
-             py::arg("opacity_unit") = 0.f, py::arg("power") = 2.f, py::arg("skip") = true,
-             py::arg("adaptive") = true, py::arg("supersample") = 1, py::arg("jitter") = false,
-             py::arg("opacity_law") = opacityLawName(kDefaultOpacityLaw))
+             py::arg("width"), py::arg("height"), py::arg("settings") = py::dict())
         .def_property_readonly("device",
                                [](const PyRenderer& r) { return r.renderer->deviceName(); })
         .def_property_readonly("device_description",

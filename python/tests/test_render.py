@@ -61,9 +61,10 @@ def test_auto_is_the_default_and_says_what_it_rendered_with(data_dir):
     assert only.stats["method"] == "adaptive"
     assert "the mesh BVH exact needs was not prepared" in only.stats["method_reason"]
     assert "method_reason" not in r.render(size=(32, 32), method="adaptive").stats
-    with pytest.raises(uvr.ArgumentError, match=r"method: expected one of \['auto', .*'fast'"):
+    expected = "method='fast': expected 'auto', 'adaptive', 'reference' or 'exact'"
+    with pytest.raises(uvr.ArgumentError, match=expected):
         uvr.render(spx, size=(32, 32), device="cpu", method="fast")
-    with pytest.raises(uvr.ArgumentError, match="auto, adaptive, reference or exact, got 'fast'"):
+    with pytest.raises(uvr.ArgumentError, match=expected):
         r.render(size=(32, 32), method="fast")
 
 
@@ -181,8 +182,17 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(size=5)
     with pytest.raises(uvr.ArgumentError, match="methods: unknown"):
         uvr.Renderer(data_dir / "tetraMesh.vtk", methods=("fast",))
-    with pytest.raises(uvr.ArgumentError, match="--quality"):
+    # The library's messages in Python's spelling: the keyword, not a CLI flag.
+    with pytest.raises(uvr.ArgumentError, match=r"^quality=2\.0: expected a number in \[0\.5, 0\.9999\]$"):
         r.render(quality=2.0)
+    with pytest.raises(uvr.ArgumentError, match=r"^supersample=9: expected an integer in \[1, 8\]$"):
+        r.render(supersample=9)
+    with pytest.raises(uvr.ArgumentError, match=r"^step=-1\.0: expected a positive finite number$"):
+        r.render(step=-1.0)
+    with pytest.raises(uvr.ArgumentError, match=r"^skip='no': expected true or false$"):
+        r.render(skip="no")
+    with pytest.raises(uvr.ArgumentError, match="'qualty': not a setting; the settings are 'method'"):
+        r.render(qualty=0.9)
     with pytest.raises(uvr.ArgumentError, match="'nope' not found; available: scalars"):
         r.render(field="nope")
     with pytest.raises(uvr.ArgumentError, match="field: expected 55 point values or 160 cell"):
@@ -197,7 +207,7 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(camera="front")
     with pytest.raises(uvr.ArgumentError, match="opacity"):
         r.render(opacity="wobbly")
-    with pytest.raises(uvr.ArgumentError, match="opacity_law: expected 'attenuation' or"):
+    with pytest.raises(uvr.ArgumentError, match="opacity_law='linear': expected 'attenuation' or"):
         r.render(opacity_law="linear")
     with pytest.raises(uvr.ArgumentError, match="position equal|focal"):
         r.render(camera=uvr.Camera(position=(0, 0, 0), focal_point=(0, 0, 0)))
@@ -208,3 +218,23 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
             uvr.Renderer(data_dir / "tetraMesh.vtk", device="cuda")
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0
+
+
+def test_the_settings_vocabulary_is_the_librarys(data_dir):
+    names = [d["name"] for d in uvr.SETTINGS]
+    assert names[:3] == ["method", "sampling", "step_rule"] and len(set(names)) == len(names)
+    quality = next(d for d in uvr.SETTINGS if d["name"] == "quality")
+    assert quality["default"] == pytest.approx(0.99) and quality["min"] == 0.5
+    assert quality["tunes_adaptive"]
+    # Every setting is a keyword of render, documented in its docstring.
+    for name in names:
+        assert f"        {name} (" in uvr.Renderer.render.__doc__, name
+    # numpy scalars are numbers; a value of another type is refused by name.
+    r = uvr.Renderer(data_dir / "tetraMesh.vtk", device="cpu", methods=("adaptive",))
+    img = r.render(size=(16, 16), method="adaptive", quality=np.float32(0.995),
+                   supersample=np.int64(2), step=None)
+    assert img.stats["quality"] == pytest.approx(0.995) and img.stats["supersample"] == 2
+    with pytest.raises(uvr.ArgumentError, match=r"^power='\[2\]': expected a number in \[1, 64\]$"):
+        r.render(power=[2])
+    assert uvr._uvr.tunes_adaptive({"quality": 0.995})
+    assert not uvr._uvr.tunes_adaptive({"quality": 0.99, "supersample": 4})

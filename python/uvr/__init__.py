@@ -13,10 +13,10 @@ from . import _uvr
 from ._image import Image, compare, compare_report, contact_sheet, read_png
 from ._mesh import Mesh, Series, as_mesh, from_meshio, from_vtk, read
 from ._render import Renderer, render, transfer_function
-from ._uvr import (ArgumentError, Camera, Error, FileError, InternalError, ParseError,
+from ._uvr import (SETTINGS, ArgumentError, Camera, Error, FileError, InternalError, ParseError,
                    ResourceError, TransferFunction, UnsupportedError, ValidationError)
 
-__all__ = ["ArgumentError", "Camera", "Error", "FileError", "Image", "InternalError", "Mesh",
+__all__ = ["SETTINGS", "ArgumentError", "Camera", "Error", "FileError", "Image", "InternalError", "Mesh",
            "ParseError", "Renderer", "ResourceError", "Series", "TransferFunction",
            "UnsupportedError", "ValidationError", "as_mesh", "compare", "compare_report",
            "contact_sheet", "cuda_available", "from_meshio", "from_vtk", "presets", "read",

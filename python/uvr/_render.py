@@ -181,11 +181,9 @@ class Renderer:
         return cam.zoom(zoom) if zoom != 1.0 else cam
 
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
-               size=(512, 512), method=_uvr.METHODS[0], quality=None, *, azimuth=0.0,
+               size=(512, 512), method=None, quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
-               sampling="preintegrated", step_rule="error", step=None, max_step=None,
-               opacity_unit=None, power=None, skip=True, adaptive=True, supersample=1,
-               jitter=False, opacity_law=None):
+               **settings):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
         ``.stats`` and ``.sample_counts``.
 
@@ -200,6 +198,9 @@ class Renderer:
         (0.99); `opacity_law` "attenuation" (the default, ParaView's unstructured mappers) or
         "transmittance" (docs/TRANSFER_FUNCTIONS.md); `field` switches to another field or new
         values first (set_field). The same settings give the CLI's pixels.
+
+        The other keywords are the library's settings (uvr.SETTINGS, each named, defaulted and
+        checked there once; None means the default), listed below.
         """
         if field is not None and (not isinstance(field, str) or field != self._field_key):
             self.set_field(field)
@@ -233,17 +234,12 @@ class Renderer:
                 camera = camera.zoom(zoom)
         # "auto" renders with whatever was prepared (its pick, else the other of exact and
         # adaptive; the stats say which).
-        # (An unknown name gets the library's message from the core.)
+        settings = _settings(method=method, quality=quality, **settings)
+        method = settings.get("method", "auto")
         if method != "auto" and method in _uvr.METHODS and method not in self._methods:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
                                      f"{self._methods!r} when the Renderer was made)")
-        pixels, counts, stats = self._core.render(
-            t, range, camera, w, h, method=method, sampling=sampling, step_rule=step_rule,
-            quality=0.99 if quality is None else float(quality), step=float(step or 0.0),
-            max_step=float(max_step or 0.0), opacity_unit=float(opacity_unit or 0.0),
-            power=2.0 if power is None else float(power), skip=bool(skip),
-            adaptive=bool(adaptive), supersample=int(supersample), jitter=bool(jitter),
-            **({} if opacity_law is None else {"opacity_law": str(opacity_law)}))
+        pixels, counts, stats = self._core.render(t, range, camera, w, h, settings)
         return Image(pixels, stats=stats, sample_counts=counts,
                      background=_background(background))
 
@@ -253,11 +249,26 @@ class Renderer:
                 f"field {i['field']} ({i['field_association']}), on {self.device})")
 
 
-# Arguments of Renderer.render that tune sampling, with their defaults: given otherwise, "auto"
-# renders the adaptive method they tune (the library's tunesAdaptive).
-_SAMPLING_DEFAULTS = {"quality": None, "step": None, "max_step": None, "power": None,
-                      "sampling": "preintegrated", "step_rule": "error", "skip": True,
-                      "adaptive": True}
+def _settings(**kwargs):
+    """The settings of the vocabulary among keyword arguments, None (the default) left out;
+    checked by the library, whose message names the first bad one (quality=1.5: ...)."""
+    settings = {k: v for k, v in kwargs.items() if v is not None}
+    _uvr.check_settings(settings)
+    return settings
+
+
+def _settings_doc():
+    """Renderer.render's docstring lines for the settings vocabulary."""
+    lines = []
+    for d in _uvr.SETTINGS:
+        what = (" | ".join(repr(c) for c in d["choices"]) if d["type"] == "choice"
+                else d["type"])
+        default = "per mesh" if d["default"] is None else repr(d["default"])
+        lines.append(f"        {d['name']} ({what}, default {default}): {d['doc']}")
+    return "\n".join(lines)
+
+
+Renderer.render.__doc__ += "\n" + _settings_doc() + "\n"
 
 
 def render(mesh, **kwargs):
@@ -266,10 +277,9 @@ def render(mesh, **kwargs):
     argument tunes sampling)."""
     field = kwargs.pop("field", None)
     device = kwargs.pop("device", "auto")
-    method = kwargs.get("method", _uvr.METHODS[0])
-    if method not in _uvr.METHODS:
-        raise _uvr.ArgumentError(f"method: expected one of {_uvr.METHODS}, got {method!r}")
-    prepare = method
-    if method == "auto" and any(kwargs.get(k, d) != d for k, d in _SAMPLING_DEFAULTS.items()):
-        prepare = "adaptive"
+    names = {d["name"] for d in _uvr.SETTINGS}
+    settings = _settings(**{k: v for k, v in kwargs.items() if k in names})
+    method = settings.get("method", "auto")
+    # Under "auto", what a frame of these settings renders with (the library's tunesAdaptive).
+    prepare = "adaptive" if method == "auto" and _uvr.tunes_adaptive(settings) else method
     return Renderer(mesh, field, device, methods=(method, prepare)).render(**kwargs)

@@ -29,4 +29,5 @@
 #include "uvr/render/image.h"
 #include "uvr/render/image_metrics.h"
 #include "uvr/render/render_setup.h"
+#include "uvr/render/settings_vocabulary.h"
 #include "uvr/tf/transfer_function.h"

@@ -240,9 +240,9 @@ TEST(Supersample, OutOfRangeIsRefusedAndCountsInTheWorkEstimate) {
         s.supersample = n;
         const Error e = testing::catchError([&] { (void)makeFrameSetup(mesh, s); });
         EXPECT_EQ(e.kind(), ErrorKind::Argument);
-        EXPECT_NE(std::string(e.what()).find("--supersample " + std::to_string(n)),
-                  std::string::npos)
-            << e.what();
+        // The library names the setting in neutral words (each front end re-spells it).
+        EXPECT_EQ(std::string(e.what()),
+                  "supersample " + std::to_string(n) + ": expected an integer in [1, 8]");
     }
     // 16384^2 pixels x 64 rays x 100 samples per ray is beyond 10^12 samples.
     s.width = s.height = 16384;

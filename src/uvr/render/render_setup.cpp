@@ -12,6 +12,7 @@
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
 #include "uvr/mesh/tet_math.h"
+#include "uvr/render/settings_vocabulary.h"
 #include "uvr/tf/tf_table.h"
 
 namespace uvr {
@@ -287,10 +288,7 @@ std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitio
 }
 
 float toleranceForQuality(float quality) {
-    if (!(quality >= kMinQuality && quality <= kMaxQuality))
-        throwError(ErrorKind::Argument, "",
-                   "--quality " + std::to_string(quality) + ": expected a number in [" +
-                       std::to_string(kMinQuality) + ", " + std::to_string(kMaxQuality) + "]");
+    checkSetting(settingNamed("quality"), quality);  // SettingError out of range
     return kToleranceScale * (1.f - quality);
 }
 
@@ -335,9 +333,9 @@ std::string fmtValue(double v) {
 
 bool tunesAdaptive(const RenderSettings& s) {
     const RenderSettings d;
-    return s.stepRule != d.stepRule || s.quality != d.quality ||
-           s.preintegrated != d.preintegrated || s.maxStep != d.maxStep || s.power != d.power ||
-           s.skip != d.skip || s.adaptive != d.adaptive || s.step != d.step;
+    for (const SettingDef& def : settingsVocabulary())
+        if (def.tunesAdaptive && def.get(s) != def.get(d)) return true;
+    return false;
 }
 
 ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu) {
@@ -371,30 +369,19 @@ void validateSettings(const RenderSettings& s) {
     if (s.width < 1 || s.height < 1 || s.width > kMaxSide || s.height > kMaxSide)
         bad("--size " + std::to_string(s.width) + "x" + std::to_string(s.height) +
             ": each side must be between 1 and " + std::to_string(kMaxSide));
-    if (!std::isfinite(s.step) || s.step < 0.f)
-        bad("--step " + std::to_string(s.step) + ": expected a positive finite distance");
-    if (!std::isfinite(s.opacityUnit) || s.opacityUnit < 0.f)
-        bad("--opacity-unit " + std::to_string(s.opacityUnit) +
-            ": expected a positive finite distance");
+    // Every setting of the vocabulary within its range (SettingError names it).
+    for (const SettingDef& def : settingsVocabulary()) checkSetting(def, def.get(s));
     if (!(s.terminationAlpha > 0.f && s.terminationAlpha <= 1.f))
         bad("early termination threshold must lie in (0, 1]");
     if (s.range && !(std::isfinite(s.range->first) && std::isfinite(s.range->second) &&
                      s.range->first <= s.range->second))
         bad("--range " + std::to_string(s.range->first) + "," + std::to_string(s.range->second) +
             ": expected finite lo <= hi");
-    if (!std::isfinite(s.maxStep) || s.maxStep < 0.f)
-        bad("--max-step " + std::to_string(s.maxStep) + ": expected a positive finite distance");
-    if (!(s.power >= 1.f && s.power <= 64.f))
-        bad("--power " + std::to_string(s.power) + ": expected a number in [1, 64]");
     if (s.tfTableSize < 2 || s.tfTableSize > (1 << 20))
         bad("transfer function table size out of range");
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
-    if (!(s.supersample >= 1 && s.supersample <= kMaxSupersample))
-        bad("--supersample " + std::to_string(s.supersample) + ": expected 1 to " +
-            std::to_string(kMaxSupersample) + " (N x N rays per pixel)");
-    toleranceForQuality(s.quality);                            // throws for a quality out of range
     if (s.tf.logScale && s.range && !(s.range->second > 0.f))  // the field's range: at setup
         refuseLogRange("--range ", s.range->first, s.range->second);
 }

@@ -30,6 +30,7 @@
 #include "uvr/mesh/cell_types.h"
 #include "uvr/render/heatmap.h"
 #include "uvr/render/image.h"
+#include "uvr/render/settings_vocabulary.h"
 #include "uvr/server/frame_codec.h"
 #include "uvr/server/web_assets.h"
 #include "uvr/tf/transfer_function.h"
@@ -894,6 +895,15 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
     return fields[key] = std::move(entry);
 }
 
+/// The vocabulary's entries of the settings the page sets (kViewerSettings): their choices,
+/// ranges and docs for its controls.
+static Json viewerVocabulary() {
+    Json out = Json::array();
+    for (const Json& d : settingsVocabularyJson())
+        if (isViewerSetting(d["name"].get<std::string>())) out.push_back(d);
+    return out;
+}
+
 Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     ViewState s = state;
     // A log scale over a range from 0 or below maps as the frames do (ParaView's
@@ -903,18 +913,20 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     std::vector<std::string> args = {"uvr", "render", scene.file};
     if (stepCount() > 1) args.insert(args.end(), {"--step-index", std::to_string(s.step)});
     if (!s.field.empty()) args.insert(args.end(), {"--field", s.field});
+    // The state's settings as the frames use them (the command line's where the page set none).
+    const RenderSettings f = frameSettings(s, scene.base);
     args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
                              fmtExact(s.range.first) + "," + fmtExact(s.range.second), "--method",
-                             methodName(s.method)});
+                             methodName(f.method)});
     // The quality tunes the adaptive method; under auto, a quality moved off the default is what
     // made the frames adaptive (tunesAdaptive), so it travels too.
-    if (s.method == RenderMethod::Partitions ||
-        (s.method == RenderMethod::Auto && s.quality != kDefaultQuality))
-        args.insert(args.end(), {"--quality", fmtExact(s.quality)});
+    if (f.method == RenderMethod::Partitions ||
+        (f.method == RenderMethod::Auto && f.quality != kDefaultQuality))
+        args.insert(args.end(), {"--quality", fmtExact(f.quality)});
     args.insert(args.end(), {"--size", std::to_string(s.width) + "x" + std::to_string(s.height),
-                             "--opacity-unit", fmtExact(s.opacityUnit)});
-    if (s.opacityLaw != kDefaultOpacityLaw)
-        args.insert(args.end(), {"--opacity-law", opacityLawName(s.opacityLaw)});
+                             "--opacity-unit", fmtExact(f.opacityUnit)});
+    if (f.opacityLaw != kDefaultOpacityLaw)
+        args.insert(args.end(), {"--opacity-law", opacityLawName(f.opacityLaw)});
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
     args.insert(args.end(), {"-o", "uvr-view.png"});
     std::string command;
@@ -1329,6 +1341,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                   {"fields", fields},
                   {"presets", presets},
                   {"methods", methodNames()},
+                  {"settings", viewerVocabulary()},
                   {"device", device},
                   {"load_seconds", d.scene.loadSeconds},
                   {"prepare_seconds", prepareSeconds},

@@ -65,7 +65,7 @@ std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
     s.range = {-3.f, 3.f};
     s.width = 64;
     s.height = 48;
-    s.opacityUnit = 0.5f;
+    s.settings["opacity_unit"] = 0.5;
     scene.commandFlags = {"--step", "0.01"};
     o.port = 0;
     auto server = std::make_unique<ViewServer>(std::move(scene), o, std::move(log));

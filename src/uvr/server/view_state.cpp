@@ -8,6 +8,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/text.h"
+#include "uvr/render/settings_vocabulary.h"
 
 namespace uvr::server {
 
@@ -182,30 +183,38 @@ Json toJson(const ViewState& s) {
     Json colors = Json::array(), opacity = Json::array();
     for (const ColorPoint& c : s.tf.colors) colors.push_back({c.x, c.rgb.x, c.rgb.y, c.rgb.z});
     for (const OpacityPoint& o : s.tf.opacities) opacity.push_back({o.x, o.alpha});
-    return {{"camera",
-             {{"position", vec(s.camera.position)},
-              {"focal_point", vec(s.camera.focalPoint)},
-              {"view_up", vec(s.camera.viewUp)},
-              {"view_angle", s.camera.viewAngle},
-              {"parallel", s.camera.parallelProjection},
-              {"parallel_scale", s.camera.parallelScale}}},
-            {"tf",
-             {{"name", s.tf.name},
-              {"color_space", colorSpaceName(s.tf.colorSpace)},
-              {"colors", colors},
-              {"opacity", opacity},
-              {"log", s.tf.logScale},
-              {"nan_color", vec(s.tf.nanColor)},
-              {"nan_opacity", s.tf.nanOpacity}}},
-            {"range", {s.range.first, s.range.second}},
-            {"field", s.field},
-            {"method", methodName(s.method)},
-            {"quality", s.quality},
-            {"heatmap", s.heatmap},
-            {"size", {s.width, s.height}},
-            {"opacity_unit", s.opacityUnit},
-            {"opacity_law", opacityLawName(s.opacityLaw)},
-            {"step", s.step}};
+    Json j = {{"camera",
+               {{"position", vec(s.camera.position)},
+                {"focal_point", vec(s.camera.focalPoint)},
+                {"view_up", vec(s.camera.viewUp)},
+                {"view_angle", s.camera.viewAngle},
+                {"parallel", s.camera.parallelProjection},
+                {"parallel_scale", s.camera.parallelScale}}},
+              {"tf",
+               {{"name", s.tf.name},
+                {"color_space", colorSpaceName(s.tf.colorSpace)},
+                {"colors", colors},
+                {"opacity", opacity},
+                {"log", s.tf.logScale},
+                {"nan_color", vec(s.tf.nanColor)},
+                {"nan_opacity", s.tf.nanOpacity}}},
+              {"range", {s.range.first, s.range.second}},
+              {"field", s.field},
+              {"heatmap", s.heatmap},
+              {"size", {s.width, s.height}},
+              {"step", s.step}};
+    // The viewer's settings of the vocabulary, as set (the command line's where absent).
+    for (const char* name : kViewerSettings) {
+        const auto it = s.settings.find(name);
+        j[name] = it != s.settings.end() ? *it : settingDefault(settingNamed(name));
+    }
+    return j;
+}
+
+bool isViewerSetting(std::string_view name) {
+    for (const char* n : kViewerSettings)
+        if (name == n) return true;
+    return false;
 }
 
 SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount) {
@@ -273,13 +282,14 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             parseFieldSpec(v.get<std::string>());  // a malformed suffix fails here
             result.fieldChanged = v.get<std::string>() != next.field;
             next.field = v.get<std::string>();
-        } else if (k == "method") {
-            const std::optional<RenderMethod> m =
-                v.is_string() ? parseMethod(v.get<std::string>()) : std::nullopt;
-            if (!m) bad(k, methodChoices() + " (quoted)", v);
-            next.method = *m;
-        } else if (k == "quality") {
-            next.quality = floatIn(k, v, kMinQuality, kMaxQuality);
+        } else if (isViewerSetting(k)) {
+            // The vocabulary checks it; the page reads the key as it sent it.
+            try {
+                checkSetting(settingNamed(k), v);
+            } catch (const SettingError& e) {
+                throwError(ErrorKind::Argument, "", e.spelledAs("\"" + k + "\":", " "));
+            }
+            next.settings[k] = v;
         } else if (k == "heatmap") {
             next.heatmap = boolean(k, v);
         } else if (k == "size") {
@@ -303,15 +313,6 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
                                    : "a time step from 0 to " + std::to_string(stepCount - 1),
                     v);
             next.step = v.get<std::size_t>();
-        } else if (k == "opacity_unit") {
-            next.opacityUnit = finiteFloat(k, v);
-            if (!(next.opacityUnit > 0.f)) bad(k, "a positive length", v);
-        } else if (k == "opacity_law") {
-            if (!v.is_string() || !parseOpacityLaw(v.get<std::string>().c_str(), next.opacityLaw))
-                bad(k,
-                    std::string("\"") + opacityLawName(OpacityLaw::Attenuation) + "\" or \"" +
-                        opacityLawName(OpacityLaw::Transmittance) + "\"",
-                    v);
         } else {
             bad("set",
                 "state keys (camera, tf, range, field, method, quality, heatmap, size, "
@@ -337,10 +338,7 @@ RenderSettings frameSettings(const ViewState& state, const RenderSettings& base,
     s.camera = state.camera;
     s.tf = state.tf;
     s.range = state.range;
-    s.method = state.method;
-    s.quality = state.quality;
-    s.opacityUnit = state.opacityUnit;
-    s.opacityLaw = state.opacityLaw;
+    for (const auto& [name, value] : state.settings.items()) applySetting(s, name, value);
     scale = std::max(scale, 1);
     s.width = std::max(1, state.width / scale);
     s.height = std::max(1, state.height / scale);

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <string>
 #include <utility>
 
@@ -19,6 +20,15 @@ inline constexpr int kMaxViewSize = 4096;
 /// a colour map).
 inline constexpr std::size_t kMaxTfPoints = 4096;
 
+/// The settings of the library's vocabulary (settings_vocabulary.h) that the page sets, by name:
+/// a setting joins the viewer with its name here and a control on the page (which reads its
+/// choices, range and doc from the `info` message). The others are the command line's.
+inline constexpr std::array<const char*, 4> kViewerSettings{"method", "quality", "opacity_unit",
+                                                            "opacity_law"};
+
+/// True for a name of kViewerSettings.
+bool isViewerSetting(std::string_view name);
+
 /// What one browser tab looks at (docs/VIEWER.md, "The session state"): everything a frame
 /// depends on that the page may change. Positions are in the file's coordinates.
 struct ViewState {
@@ -26,12 +36,12 @@ struct ViewState {
     TransferFunction tf;
     std::pair<float, float> range{0.f, 1.f};  ///< the data range the transfer function spans
     std::string field;                        ///< as --field takes it
-    RenderMethod method = RenderMethod::Auto;
-    float quality = kDefaultQuality;
+    /// The values of kViewerSettings, as the vocabulary writes them (checked when set); a
+    /// setting absent here is the command line's. The server sets opacity_unit to ParaView's
+    /// ScalarOpacityUnitDistance (file units) when the command line gives none.
+    nlohmann::json settings = nlohmann::json::object();
     bool heatmap = false;  ///< show samples per pixel instead of the volume
     int width = 1024, height = 1024;
-    float opacityUnit = 1.f;  ///< ParaView's ScalarOpacityUnitDistance, in file units
-    OpacityLaw opacityLaw = kDefaultOpacityLaw;  ///< how opacities become extinction
     std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
 };
 
@@ -57,9 +67,8 @@ struct SetResult {
 SetResult applySet(ViewState& state, const nlohmann::json& message, std::size_t stepCount = 1);
 
 /// The render settings of a frame of the state: `base` (what the command line set beyond the
-/// state: steps, sampling, rule) with the state's camera, transfer function, range, method,
-/// quality, opacity unit and opacity law, at the state's size divided by `scale` (at least 1 pixel
-/// a side).
+/// state: steps, sampling, rule) with the state's camera, transfer function, range and settings,
+/// at the state's size divided by `scale` (at least 1 pixel a side).
 RenderSettings frameSettings(const ViewState& state, const RenderSettings& base, int scale = 1);
 
 }  // namespace uvr::server

@@ -18,7 +18,7 @@ ViewState startState() {
     s.tf = transferFunctionPreset("cool-to-warm");
     s.range = {0.f, 2.f};
     s.field = "density";
-    s.opacityUnit = 0.5f;
+    s.settings["opacity_unit"] = 0.5;
     return s;
 }
 
@@ -73,8 +73,8 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     EXPECT_EQ(s.tf.colorSpace, ColorSpace::Lab);
     ASSERT_EQ(s.tf.opacities.size(), 3u);
     EXPECT_FLOAT_EQ(s.tf.opacityAt(0.25f), 0.5f);
-    EXPECT_EQ(s.method, RenderMethod::Exact);
-    EXPECT_EQ(s.opacityLaw, OpacityLaw::Transmittance);
+    EXPECT_EQ(s.settings["method"], "exact");
+    EXPECT_EQ(s.settings["opacity_law"], "transmittance");
     EXPECT_TRUE(s.heatmap);
     EXPECT_EQ(s.width, 320);
     EXPECT_EQ(s.height, 200);
@@ -136,7 +136,8 @@ TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
     EXPECT_THAT(refusal({{"range", {2, 1}}}), HasSubstr("lo < hi"));
     EXPECT_THAT(refusal({{"range", {0, "1"}}}), HasSubstr("range[1]"));
     EXPECT_THAT(refusal({{"method", "fast"}}), HasSubstr("\"method\""));
-    EXPECT_THAT(refusal({{"quality", 1.5}}), HasSubstr("\"quality\""));
+    // The vocabulary's check, in the page's spelling of the key.
+    EXPECT_EQ(refusal({{"quality", 1.5}}), "\"quality\": 1.5: expected a number in [0.5, 0.9999]");
     EXPECT_THAT(refusal({{"size", {8, 100}}}), HasSubstr("\"size\""));
     EXPECT_THAT(refusal({{"size", {100.5, 100}}}), HasSubstr("\"size\""));
     EXPECT_THAT(refusal({{"opacity_unit", -1}}), HasSubstr("opacity_unit"));

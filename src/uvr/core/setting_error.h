@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <string>
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+/// An Argument error about one setting's value, in neutral words: the setting's name (as the
+/// settings vocabulary spells it: `quality`, `max_step`), the value as given and what was
+/// expected. what() reads "quality 1.5: expected a number in [0.5, 0.9999]"; a front end says
+/// it in its own spelling (spelledAs: the CLI's `--quality 1.5: ...`, Python's
+/// `quality=1.5: ...`).
+class SettingError : public Error {
+public:
+    SettingError(std::string setting, std::string value, std::string expected);
+    const std::string& setting() const { return setting_; }
+    const std::string& value() const { return value_; }
+    const std::string& expected() const { return expected_; }
+    /// The message with the setting named `name` and `separator` before the value: ("--quality",
+    /// " ") gives "--quality 1.5: expected ...", ("quality", "=") "quality=1.5: expected ...".
+    std::string spelledAs(const std::string& name, const std::string& separator) const;
+
+private:
+    std::string setting_, value_, expected_;
+};
+
+}  // namespace uvr

@@ -1,0 +1,283 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/render/settings_vocabulary.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "uvr/core/error.h"
+#include "uvr/core/text.h"
+
+namespace uvr {
+
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A number as messages write it (%g).
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+/// A per-mesh default length: null while 0 (anything else is checked as given).
+Json lengthOrNull(float v) {
+    return v == 0.f ? Json(nullptr) : Json(v);
+}
+float lengthOf(const Json& v) {
+    return v.is_null() ? 0.f : v.get<float>();
+}
+
+SettingDef setting(const char* name, SettingType type, const char* doc) {
+    SettingDef d;
+    d.name = name, d.type = type, d.doc = doc;
+    return d;
+}
+
+std::vector<SettingDef> makeVocabulary() {
+    std::vector<SettingDef> v;
+    SettingDef method =
+        setting("method", SettingType::Choice,
+                "Integrator: auto (exact where a ray crosses few cells, else adaptive), "
+                "adaptive, reference or exact");
+    method.choices = methodNames();
+    method.get = [](const RenderSettings& s) { return Json(methodName(s.method)); };
+    method.set = [](RenderSettings& s, const Json& x) {
+        s.method = *parseMethod(x.get<std::string>());
+    };
+    v.push_back(method);
+
+    SettingDef sampling =
+        setting("sampling", SettingType::Choice,
+                "Reference and adaptive: preintegrated (between consecutive samples) or "
+                "point (point samples with opacity correction, Morrical et al. 2019)");
+    sampling.choices = {samplingName(true), samplingName(false)};
+    sampling.tunesAdaptive = true;
+    sampling.get = [](const RenderSettings& s) { return Json(samplingName(s.preintegrated)); };
+    sampling.set = [](RenderSettings& s, const Json& x) {
+        s.preintegrated = x.get<std::string>() == samplingName(true);
+    };
+    v.push_back(sampling);
+
+    SettingDef rule =
+        setting("step_rule", SettingType::Choice,
+                "Adaptive: each partition's step from a bound on the integration error "
+                "(error; quality) or from the colour variance (variance; power)");
+    rule.choices = {stepRuleName(StepRule::ErrorBound), stepRuleName(StepRule::Variance)};
+    rule.tunesAdaptive = true;
+    rule.get = [](const RenderSettings& s) { return Json(stepRuleName(s.stepRule)); };
+    rule.set = [](RenderSettings& s, const Json& x) {
+        s.stepRule = x.get<std::string>() == stepRuleName(StepRule::Variance)
+                         ? StepRule::Variance
+                         : StepRule::ErrorBound;
+    };
+    v.push_back(rule);
+
+    SettingDef quality =
+        setting("quality", SettingType::Number,
+                "Adaptive, error rule: the SSIM against the exact integrator to aim at");
+    quality.min = kMinQuality, quality.max = kMaxQuality;
+    quality.tunesAdaptive = true;
+    quality.get = [](const RenderSettings& s) { return Json(s.quality); };
+    quality.set = [](RenderSettings& s, const Json& x) { s.quality = x.get<float>(); };
+    v.push_back(quality);
+
+    SettingDef step =
+        setting("step", SettingType::Number,
+                "Sample spacing s1 in the file's units (default: half the cube root of the "
+                "mean tetrahedron volume)");
+    step.min = 0.0, step.max = kInf, step.minOpen = true, step.nullDefault = true;
+    step.tunesAdaptive = true;
+    step.get = [](const RenderSettings& s) { return lengthOrNull(s.step); };
+    step.set = [](RenderSettings& s, const Json& x) { s.step = lengthOf(x); };
+    v.push_back(step);
+
+    SettingDef maxStep =
+        setting("max_step", SettingType::Number,
+                "Adaptive: the largest step s2 in the file's units (default: 16 s1)");
+    maxStep.min = 0.0, maxStep.max = kInf, maxStep.minOpen = true, maxStep.nullDefault = true;
+    maxStep.tunesAdaptive = true;
+    maxStep.get = [](const RenderSettings& s) { return lengthOrNull(s.maxStep); };
+    maxStep.set = [](RenderSettings& s, const Json& x) { s.maxStep = lengthOf(x); };
+    v.push_back(maxStep);
+
+    SettingDef power = setting("power", SettingType::Number,
+                               "Adaptive, variance rule: the power p of the step formula");
+    power.min = 1.0, power.max = 64.0;
+    power.tunesAdaptive = true;
+    power.get = [](const RenderSettings& s) { return Json(s.power); };
+    power.set = [](RenderSettings& s, const Json& x) { s.power = x.get<float>(); };
+    v.push_back(power);
+
+    SettingDef unit =
+        setting("opacity_unit", SettingType::Number,
+                "Distance over which a transfer-function opacity applies, in the file's "
+                "units (default: ParaView's, the bounds' diagonal over the cube root of the "
+                "cells)");
+    unit.min = 0.0, unit.max = kInf, unit.minOpen = true, unit.nullDefault = true;
+    unit.get = [](const RenderSettings& s) { return lengthOrNull(s.opacityUnit); };
+    unit.set = [](RenderSettings& s, const Json& x) { s.opacityUnit = lengthOf(x); };
+    v.push_back(unit);
+
+    SettingDef law = setting("opacity_law", SettingType::Choice,
+                             "How an opacity per opacity unit absorbs: attenuation (ParaView's "
+                             "unstructured mappers) or transmittance");
+    law.choices = {
+        opacityLawName(kDefaultOpacityLaw),
+        opacityLawName(kDefaultOpacityLaw == OpacityLaw::Attenuation ? OpacityLaw::Transmittance
+                                                                     : OpacityLaw::Attenuation)};
+    law.get = [](const RenderSettings& s) { return Json(opacityLawName(s.opacityLaw)); };
+    law.set = [](RenderSettings& s, const Json& x) {
+        parseOpacityLaw(x.get<std::string>().c_str(), s.opacityLaw);
+    };
+    v.push_back(law);
+
+    SettingDef skip =
+        setting("skip", SettingType::Flag,
+                "Adaptive: skip partitions and macrocells the transfer function makes "
+                "transparent");
+    skip.tunesAdaptive = true;
+    skip.get = [](const RenderSettings& s) { return Json(s.skip); };
+    skip.set = [](RenderSettings& s, const Json& x) { s.skip = x.get<bool>(); };
+    v.push_back(skip);
+
+    SettingDef adaptive = setting("adaptive", SettingType::Flag,
+                                  "Adaptive: adaptive steps (false: every partition at s1)");
+    adaptive.tunesAdaptive = true;
+    adaptive.get = [](const RenderSettings& s) { return Json(s.adaptive); };
+    adaptive.set = [](RenderSettings& s, const Json& x) { s.adaptive = x.get<bool>(); };
+    v.push_back(adaptive);
+
+    SettingDef supersample = setting("supersample", SettingType::Integer,
+                                     "Anti-aliasing: N x N rays per pixel, their colours averaged");
+    supersample.min = 1.0, supersample.max = double(kMaxSupersample);
+    supersample.get = [](const RenderSettings& s) { return Json(s.supersample); };
+    supersample.set = [](RenderSettings& s, const Json& x) { s.supersample = x.get<int>(); };
+    v.push_back(supersample);
+
+    SettingDef jitter =
+        setting("jitter", SettingType::Flag,
+                "With supersample: each ray at a fixed pseudo-random place in its cell of "
+                "the N x N grid");
+    jitter.get = [](const RenderSettings& s) { return Json(s.jitter); };
+    jitter.set = [](RenderSettings& s, const Json& x) { s.jitter = x.get<bool>(); };
+    v.push_back(jitter);
+    return v;
+}
+
+/// "'a', 'b' or 'c'".
+std::string choiceList(const std::vector<std::string>& choices) {
+    std::string out;
+    for (std::size_t i = 0; i < choices.size(); ++i) {
+        if (i > 0) out += i + 1 == choices.size() ? " or " : ", ";
+        out += "'" + choices[i] + "'";
+    }
+    return out;
+}
+
+/// What a Number or Integer setting expects, in words.
+std::string rangeText(const SettingDef& d) {
+    const char* what = d.type == SettingType::Integer ? "an integer" : "a number";
+    if (d.minOpen && d.min == 0.0 && d.max == kInf) return "a positive finite number";
+    return std::string(what) + " in [" + number(d.min) + ", " + number(d.max) + "]";
+}
+
+}  // namespace
+
+const std::vector<SettingDef>& settingsVocabulary() {
+    static const std::vector<SettingDef> vocabulary = makeVocabulary();
+    return vocabulary;
+}
+
+const SettingDef* findSetting(std::string_view name) {
+    for (const SettingDef& d : settingsVocabulary())
+        if (name == d.name) return &d;
+    return nullptr;
+}
+
+const SettingDef& settingNamed(std::string_view name) {
+    if (const SettingDef* d = findSetting(name)) return *d;
+    std::vector<std::string> names;
+    for (const SettingDef& d : settingsVocabulary()) names.emplace_back(d.name);
+    throw SettingError("setting", "'" + printableShort(name) + "'",
+                       "not a setting; the settings are " + choiceList(names));
+}
+
+std::string settingValueText(const Json& value) {
+    if (value.is_string()) return "'" + printableShort(value.get_ref<const std::string&>()) + "'";
+    return printableShort(value.dump(-1, ' ', false, Json::error_handler_t::replace));
+}
+
+void checkSetting(const SettingDef& d, const Json& value) {
+    auto refuse = [&](const std::string& expected) {
+        throw SettingError(d.name, settingValueText(value), "expected " + expected);
+    };
+    switch (d.type) {
+        case SettingType::Choice:
+            if (!value.is_string()) refuse(choiceList(d.choices));
+            for (const std::string& c : d.choices)
+                if (value.get_ref<const std::string&>() == c) return;
+            refuse(choiceList(d.choices));
+            return;
+        case SettingType::Flag:
+            if (!value.is_boolean()) refuse("true or false");
+            return;
+        case SettingType::Number:
+        case SettingType::Integer: {
+            if (value.is_null() && d.nullDefault) return;
+            const bool integer = d.type == SettingType::Integer;
+            if (!value.is_number() || (integer && !value.is_number_integer())) refuse(rangeText(d));
+            const double x = value.get<double>();
+            const bool above = d.minOpen ? x > d.min : x >= d.min;
+            // A number a float holds (the settings are float): no overflow to infinity.
+            const double limit = integer ? d.max : std::min(d.max, double(FLT_MAX));
+            if (!(std::isfinite(x) && above && x <= limit)) refuse(rangeText(d));
+            return;
+        }
+    }
+}
+
+void applySetting(RenderSettings& settings, std::string_view name, const Json& value) {
+    const SettingDef& d = settingNamed(name);
+    checkSetting(d, value);
+    d.set(settings, value);
+}
+
+Json settingDefault(const SettingDef& d) {
+    return d.get(RenderSettings{});
+}
+
+std::string cliFlag(const SettingDef& d) {
+    const bool negated = d.type == SettingType::Flag && settingDefault(d) == true;
+    std::string flag = std::string(negated ? "--no-" : "--") + d.name;
+    for (char& c : flag)
+        if (c == '_') c = '-';
+    return flag;
+}
+
+Json settingsVocabularyJson() {
+    Json out = Json::array();
+    for (const SettingDef& d : settingsVocabulary()) {
+        static const char* const kTypes[] = {"choice", "number", "integer", "flag"};
+        Json j = {{"name", d.name},
+                  {"type", kTypes[int(d.type)]},
+                  {"doc", d.doc},
+                  {"default", settingDefault(d)},
+                  {"tunes_adaptive", d.tunesAdaptive}};
+        if (d.type == SettingType::Choice) j["choices"] = d.choices;
+        if (d.type == SettingType::Number || d.type == SettingType::Integer) {
+            j["min"] = d.min;
+            if (std::isfinite(d.max)) j["max"] = d.max;  // else none
+            j["min_open"] = d.minOpen;
+        }
+        out.push_back(std::move(j));
+    }
+    return out;
+}
+
+}  // namespace uvr

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "uvr/core/setting_error.h"
+#include "uvr/render/render_setup.h"
+
+namespace uvr {
+
+/// How a setting's value is written.
+enum class SettingType {
+    Choice,   ///< one name of a list ("adaptive")
+    Number,   ///< a finite number within [min, max] (above min when minOpen)
+    Integer,  ///< an integer within [min, max]
+    Flag,     ///< true or false
+};
+
+/// One setting of RenderSettings as every front end names, defaults, documents and checks it
+/// (issue 30: "one vocabulary"). Its name is Python's keyword, the viewer's state key and the
+/// frame report's key; the CLI's flag is the name with '-' for '_' (cliFlag). The table
+/// (settingsVocabulary) defines each once; adding a setting is one entry there and its controls.
+struct SettingDef {
+    const char* name;
+    SettingType type;
+    const char* doc;                   ///< one line, in neutral words
+    std::vector<std::string> choices;  ///< Choice: every name, the default first
+    double min = 0.0, max = 0.0;       ///< Number, Integer: the range
+    bool minOpen = false;              ///< Number: the value must lie above min
+    /// Number: JSON null (Python's None, the CLI's absent flag) is the default, worked out per
+    /// mesh ("default" in docs); an explicit value must then lie in range.
+    bool nullDefault = false;
+    /// A value other than the default tunes the sampling methods: RenderMethod::Auto then renders
+    /// the adaptive method it tunes (tunesAdaptive).
+    bool tunesAdaptive = false;
+    /// The setting's value in `s` as JSON (a name, number or boolean; null for a per-mesh
+    /// default).
+    nlohmann::json (*get)(const RenderSettings& s) = nullptr;
+    /// Stores a value checkSetting accepted (JSON null: the default).
+    void (*set)(RenderSettings& s, const nlohmann::json& value) = nullptr;
+};
+
+/// Every setting of the vocabulary: method, sampling, step_rule, quality, step, max_step, power,
+/// opacity_unit, opacity_law, skip, adaptive, supersample, jitter.
+const std::vector<SettingDef>& settingsVocabulary();
+
+/// The setting called `name`, or null.
+const SettingDef* findSetting(std::string_view name);
+
+/// The setting called `name`; throws SettingError naming the known ones otherwise.
+const SettingDef& settingNamed(std::string_view name);
+
+/// Throws SettingError (an Argument error) when `value` is not a value of `def`: a name of its
+/// choices, a finite number in range (an integer for Integer), a boolean; JSON null only where
+/// nullDefault. The message names the setting and the value, and says what was expected.
+void checkSetting(const SettingDef& def, const nlohmann::json& value);
+
+/// Checks `value` (checkSetting) and stores it into `settings`.
+void applySetting(RenderSettings& settings, std::string_view name, const nlohmann::json& value);
+
+/// The default value of `def` (RenderSettings' own).
+nlohmann::json settingDefault(const SettingDef& def);
+
+/// The CLI's flag of a setting: "--" and the name with '-' for '_' ("--max-step"); a flag that
+/// is on by default is turned off by "--no-" and its name ("--no-skip").
+std::string cliFlag(const SettingDef& def);
+
+/// The vocabulary as JSON for a page or a binding: per setting its name, type, doc, default and
+/// choices or range.
+nlohmann::json settingsVocabularyJson();
+
+/// A value as a message quotes it: a string as 'text', anything else as JSON.
+std::string settingValueText(const nlohmann::json& value);
+
+}  // namespace uvr

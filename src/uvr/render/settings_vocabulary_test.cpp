@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/render/settings_vocabulary.h"
+
+#include <gmock/gmock.h>
+
+#include <cmath>
+#include <set>
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+using Json = nlohmann::json;
+
+/// A value of d other than its default.
+Json otherValue(const SettingDef& d) {
+    switch (d.type) {
+        case SettingType::Choice:
+            return d.choices.back();
+        case SettingType::Flag:
+            return !settingDefault(d).get<bool>();
+        case SettingType::Integer:
+            return static_cast<int>(d.max);
+        case SettingType::Number:
+            return std::isfinite(d.max) ? 0.5 * (d.min + d.max) : d.min + 0.25;
+    }
+    return nullptr;
+}
+
+/// The SettingError that applying value to a default RenderSettings throws.
+SettingError refusal(const std::string& name, const Json& value) {
+    RenderSettings s;
+    try {
+        applySetting(s, name, value);
+    } catch (const SettingError& e) {
+        return e;
+    }
+    ADD_FAILURE() << name << " accepted " << value.dump();
+    return SettingError("", "", "");
+}
+
+TEST(SettingsVocabulary, EachSettingOnceWithItsDefaultFirstAndAccepted) {
+    std::set<std::string> names;
+    for (const SettingDef& d : settingsVocabulary()) {
+        EXPECT_TRUE(names.insert(d.name).second) << d.name;
+        EXPECT_NE(std::string(d.doc), "") << d.name;
+        EXPECT_EQ(findSetting(d.name), &d);
+        EXPECT_NO_THROW(checkSetting(d, settingDefault(d))) << d.name;
+        if (d.type == SettingType::Choice) {
+            EXPECT_EQ(settingDefault(d), d.choices.front());
+        }
+    }
+    EXPECT_EQ(findSetting("qualty"), nullptr);
+    // The library's defaults, as every front end now shows them.
+    EXPECT_EQ(settingDefault(settingNamed("method")), "auto");
+    EXPECT_FLOAT_EQ(settingDefault(settingNamed("quality")).get<float>(), kDefaultQuality);
+    EXPECT_TRUE(settingDefault(settingNamed("step")).is_null());  // worked out per mesh
+    EXPECT_EQ(cliFlag(settingNamed("max_step")), "--max-step");
+    EXPECT_EQ(cliFlag(settingNamed("skip")), "--no-skip");
+    EXPECT_EQ(cliFlag(settingNamed("jitter")), "--jitter");
+}
+
+TEST(SettingsVocabulary, AValueStoredIsTheValueReadBack) {
+    for (const SettingDef& d : settingsVocabulary()) {
+        RenderSettings s;
+        const Json v = otherValue(d);
+        applySetting(s, d.name, v);
+        if (v.is_number_float())
+            EXPECT_FLOAT_EQ(d.get(s).get<float>(), v.get<float>()) << d.name;
+        else
+            EXPECT_EQ(d.get(s), v) << d.name;
+        EXPECT_NE(d.get(s), settingDefault(d)) << d.name;
+    }
+    RenderSettings s;
+    applySetting(s, "step", 0.5);
+    applySetting(s, "step", nullptr);  // back to the per-mesh default
+    EXPECT_EQ(s.step, 0.f);
+}
+
+TEST(SettingsVocabulary, TunesAdaptiveIsWhatTheTableSays) {
+    EXPECT_FALSE(tunesAdaptive(RenderSettings{}));
+    for (const SettingDef& d : settingsVocabulary()) {
+        RenderSettings s;
+        applySetting(s, d.name, otherValue(d));
+        EXPECT_EQ(tunesAdaptive(s), d.tunesAdaptive) << d.name;
+    }
+    RenderSettings s;
+    s.quality = kDefaultQuality;  // the default given explicitly tunes nothing
+    EXPECT_FALSE(tunesAdaptive(s));
+}
+
+TEST(SettingsVocabulary, BadValuesNameTheSettingTheValueAndWhatWasExpected) {
+    EXPECT_STREQ(refusal("quality", 1.5).what(), "quality 1.5: expected a number in [0.5, 0.9999]");
+    EXPECT_STREQ(refusal("method", "fast").what(),
+                 "method 'fast': expected 'auto', 'adaptive', 'reference' or 'exact'");
+    EXPECT_STREQ(refusal("step", 0).what(), "step 0: expected a positive finite number");
+    EXPECT_STREQ(refusal("step", -1).what(), "step -1: expected a positive finite number");
+    EXPECT_STREQ(refusal("supersample", 9).what(), "supersample 9: expected an integer in [1, 8]");
+    EXPECT_STREQ(refusal("supersample", 2.5).what(),
+                 "supersample 2.5: expected an integer in [1, 8]");
+    EXPECT_STREQ(refusal("skip", "yes").what(), "skip 'yes': expected true or false");
+    EXPECT_STREQ(refusal("power", nullptr).what(), "power null: expected a number in [1, 64]");
+    EXPECT_THAT(refusal("opacity_law", 3).what(),
+                HasSubstr("expected 'attenuation' or 'transmittance'"));
+    EXPECT_THAT(refusal("max_step", 1e39).what(), HasSubstr("expected a positive finite number"));
+    const SettingError unknown = refusal("qualty", 0.9);
+    EXPECT_EQ(unknown.setting(), "setting");
+    EXPECT_THAT(unknown.what(), HasSubstr("'qualty': not a setting; the settings are 'method'"));
+    EXPECT_EQ(unknown.kind(), ErrorKind::Argument);
+    // Each front end in its own spelling.
+    const SettingError e = refusal("max_step", -2);
+    EXPECT_EQ(e.spelledAs(cliFlag(settingNamed(e.setting())), " "),
+              "--max-step -2: expected a positive finite number");
+    EXPECT_EQ(e.spelledAs(e.setting(), "="), "max_step=-2: expected a positive finite number");
+}
+
+TEST(SettingsVocabulary, ValidateSettingsChecksEverySettingOfTheTable) {
+    RenderSettings s;
+    s.tf = transferFunctionPreset("viridis");
+    s.supersample = 9;
+    try {
+        validateSettings(s);
+        FAIL() << "supersample 9 passed";
+    } catch (const SettingError& e) {
+        EXPECT_EQ(e.setting(), "supersample");
+    }
+    s.supersample = 1;
+    s.opacityUnit = NAN;
+    EXPECT_THROW(validateSettings(s), SettingError);
+    s.opacityUnit = 0.f;
+    EXPECT_NO_THROW(validateSettings(s));
+}
+
+TEST(SettingsVocabulary, TheJsonFormListsEverySettingWithItsDefaultAndRange) {
+    const Json j = settingsVocabularyJson();
+    ASSERT_EQ(j.size(), settingsVocabulary().size());
+    for (const Json& d : j) {
+        const SettingDef& def = settingNamed(d["name"].get<std::string>());
+        EXPECT_EQ(d["default"], settingDefault(def));
+        EXPECT_EQ(d["tunes_adaptive"], def.tunesAdaptive);
+    }
+    EXPECT_EQ(j[0]["name"], "method");
+    EXPECT_EQ(j[0]["choices"][0], "auto");
+    const SettingDef& q = settingNamed("quality");
+    const Json* quality = nullptr;
+    for (const Json& d : j)
+        if (d["name"] == "quality") quality = &d;
+    ASSERT_NE(quality, nullptr);
+    EXPECT_EQ((*quality)["min"], q.min);
+    EXPECT_EQ((*quality)["max"], q.max);
+}
+
+}  // namespace
+}  // namespace uvr
