@@ -243,7 +243,9 @@ int main(int argc, char** argv) {
                             r = cuda ? gpu->render(s) : renderCpu(pm, s);
                             if (!cuda || i > 0) times.push_back(r.stats.seconds);
                         }
-                        Row row{mc.name, tc.name, vc.name, mcase.name};
+                        Row row;
+                        row.mesh = mc.name, row.tf = tc.name, row.view = vc.name;
+                        row.method = mcase.name;
                         row.ms = median(times) * 1e3;
                         row.samples = r.stats.samples;
                         if (mcase.method == RenderMethod::Exact) {

@@ -426,8 +426,8 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
                                    "/c.png --size 32x32 --stats " + dir + "/c.json " + flags,
                                dir);
         EXPECT_EQ(run.code, 0) << flags << ": " << run.err;
-        std::ifstream in(dir + "/c.json");
-        return run.code == 0 ? nlohmann::json::parse(in) : nlohmann::json::object();
+        std::ifstream file(dir + "/c.json");
+        return run.code == 0 ? nlohmann::json::parse(file) : nlohmann::json::object();
     };
     const auto d = statsOf("spx.vtk", "");
     EXPECT_EQ(d.value("method", ""), "exact");

@@ -191,16 +191,13 @@ class Renderer:
         TransferFunction; `opacity` an opacity spec or (x, alpha) pairs; `range` (lo, hi) the
         values the transfer function spans (default: the field's); `camera` a uvr.Camera
         (default: ParaView's reset camera), then `azimuth`/`elevation`/`zoom`; `size` (w, h);
-        `method` one of uvr.METHODS: "auto" (the default: exact where a ray crosses few cells,
-        else adaptive, as ``uvr render``; adaptive whenever an argument tunes sampling),
-        "adaptive", "reference" or "exact" (``image.stats["method"]`` says which rendered, and
-        ``["method_reason"]`` why under auto); `quality` the adaptive method's SSIM target
-        (0.99); `opacity_law` "attenuation" (the default, ParaView's unstructured mappers) or
-        "transmittance" (docs/TRANSFER_FUNCTIONS.md); `field` switches to another field or new
-        values first (set_field). The same settings give the CLI's pixels.
+        `field` switches to another field or new values first (set_field). The same settings
+        give the CLI's pixels.
 
-        The other keywords are the library's settings (uvr.SETTINGS, each named, defaulted and
-        checked there once; None means the default), listed below.
+        `method`, `quality` and the other keywords are the library's settings (uvr.SETTINGS,
+        each named, defaulted and checked there once; None means the default), listed below.
+        Under method "auto" ``image.stats["method"]`` says which method rendered and
+        ``["method_reason"]`` why.
         """
         if field is not None and (not isinstance(field, str) or field != self._field_key):
             self.set_field(field)

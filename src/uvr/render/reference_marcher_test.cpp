@@ -66,10 +66,11 @@ TEST(ReferenceMarcher, ConstantMediumMatchesBeerLambert) {
             const Vec4f c = marchReference(f.scene, ray, counters);
             const int inFirst = gridSamples(0.5f, 1.5f, step),
                       inSecond = gridSamples(2.5f, 3.5f, step);
-            if (!preintegrated)
+            if (!preintegrated) {
                 EXPECT_NEAR(c.w, testing::slabOpacity(0.3, (inFirst + inSecond) * step, unit, law),
                             1e-4f)
                     << what;
+            }
             // The continuous answer.
             EXPECT_NEAR(c.w, testing::slabOpacity(0.3, 2.0, unit, law), 0.01f) << what;
             EXPECT_NEAR(c.x / c.w, 1.f, 1e-5f) << what;   // premultiplied colour over alpha is the

@@ -314,11 +314,10 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
                     v);
             next.step = v.get<std::size_t>();
         } else {
-            bad("set",
-                "state keys (camera, tf, range, field, method, quality, heatmap, size, "
-                "opacity_unit, opacity_law, step, preset, colormap_json), not \"" +
-                    printableShort(k, 40) + "\"",
-                message);
+            std::string keys =
+                "camera, tf, range, field, heatmap, size, step, preset, colormap_json";
+            for (const char* name : kViewerSettings) keys += std::string(", ") + name;
+            bad("set", "state keys (" + keys + "), not \"" + printableShort(k, 40) + "\"", message);
         }
     }
     // A log scale over a range from 0 or below maps from min(hi / 10^4, 1), as ParaView does

@@ -184,7 +184,7 @@ TEST(TimeSeries, CollectionsNamingCollectionsAreRefusedWhereverTheStepIsRead) {
                           "/c_1.pvd is itself a ParaView collection"));
     // Naming itself through './', 'sub/../' (whether sub exists or not) or a hard link.
     fs::create_directories(dir + "/sub");
-    for (const std::string& self : {"./dot.pvd", "sub/../dot.pvd", "none/../dot.pvd"}) {
+    for (const std::string self : {"./dot.pvd", "sub/../dot.pvd", "none/../dot.pvd"}) {
         SCOPED_TRACE(self);
         const std::string path = collection("dot.pvd", {"a.vtu", self});
         EXPECT_THAT(catchError([&] { openMeshSeries(path); }).what(),
