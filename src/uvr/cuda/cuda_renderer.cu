@@ -195,30 +195,8 @@ std::string cudaDeviceDescription() {
 
 struct CudaScene::Impl {
     const PreparedMesh& mesh;
-    // The kernels' mesh (PreparedMesh::kernelMesh): points and values only where native cells
-    // or cell data need them; tetrahedra by blocks.
-    cuda::DeviceArray<Vec3f> points;
-    cuda::DeviceArray<std::uint32_t> nativeCorners;  ///< empty without native cells
-    cuda::DeviceArray<float> values;
-    cuda::DeviceArray<TetCorners16> tetCorners;
-    cuda::DeviceArray<BlockVertex> blockVertices;
-    cuda::DeviceArray<std::uint32_t> blockVertexBase;
-    cuda::DeviceArray<NeighborCodes> neighborCodes;
-    cuda::DeviceArray<std::uint32_t> neighborEscapes;
-    cuda::DeviceArray<std::uint32_t> neighborEscapeBase;
-    cuda::DeviceArray<std::uint32_t> nativeNeighbors;
-    cuda::DeviceArray<BvhNode> bvhNodes;
-    cuda::DeviceArray<std::uint32_t> bvhPrims;
-    cuda::DeviceArray<KdNode> kdNodes;
-    cuda::DeviceArray<KdPartition> partitions;
-    cuda::DeviceArray<float> gradientSpread;
-    cuda::DeviceArray<std::uint8_t> partitionNan;  ///< empty when the field has no NaN
-    cuda::DeviceArray<BvhNode> cellTreeNodes;
-    cuda::DeviceArray<PartitionGrid> seedGrids;
-    cuda::DeviceArray<std::uint32_t> seeds;
-    cuda::DeviceArray<PartitionGrid> macroGrids;
-    cuda::DeviceArray<MacroCell> macroCells;
-    cuda::DeviceArray<std::uint8_t> macroNan;  ///< empty when the field has no NaN
+    /// The prepared mesh's arrays (scene_arrays.h: declared and bound to the mesh once).
+    SceneArrays<cuda::DeviceArray> a;
     // Per frame / transfer function.
     cuda::DeviceArray<Vec4f> tfTable;
     cuda::DeviceArray<std::int32_t> tfBreaks;
@@ -238,46 +216,36 @@ struct CudaScene::Impl {
 
     explicit Impl(const PreparedMesh& m) : mesh(m) {}
 
-    /// Uploads the arrays that depend on the field's values (the constructor's and
-    /// updateValues' one code path); a NaN flag array the field no longer needs is freed.
-    void uploadValues() {
-        const TetMeshView kernel = mesh.kernelMesh();
-        if (kernel.values)
-            values.upload(mesh.tets.values, "the field values");
-        else
-            values.clear();
-        blockVertices.upload(mesh.tets.blockVertices, "the tetrahedra's vertices");
-        if (mesh.kd) {
-            partitions.upload(mesh.kd->partitions, "the partitions");
-            gradientSpread.upload(mesh.gradientSpread, "the partition gradient spreads");
-            if (!mesh.partitionNan.empty())
-                partitionNan.upload(mesh.partitionNan, "the partitions' NaN flags");
-            else
-                partitionNan.clear();
-        }
-        if (mesh.macro) {
-            macroCells.upload(mesh.macro->cells, "the macrocells");
-            if (!mesh.macro->nanCells.empty())
-                macroNan.upload(mesh.macro->nanCells, "the macrocells' NaN flags");
-            else
-                macroNan.clear();
-        }
+    /// Uploads the arrays of `use` (forEachSceneArray; the constructor's and updateValues' one
+    /// code path); one the mesh no longer has (a NaN flag array the field no longer needs) is
+    /// freed. `uploaded` hears each array's upload.
+    template <class Done>
+    void upload(ArrayUse use, Done&& uploaded) {
+        forEachSceneArray(mesh, a,
+                          [&](auto& device, const auto* host, const char* name, ArrayUse u) {
+                              if (u != use) return;
+                              if (host)
+                                  device.upload(*host, name);
+                              else
+                                  device.clear();
+                              uploaded();
+                          });
     }
 
     /// The host scene view with every pointer replaced by its device copy.
     SceneView deviceScene(const FrameSetup& setup) const {
         SceneView v = setup.scene(mesh);
         TetMeshView& m = v.locator.mesh;
-        m.points = points.data();
-        m.nativeCorners = nativeCorners.data();
-        m.values = values.data();
-        m.tetCorners = tetCorners.data();
-        m.blockVertices = blockVertices.data();
-        m.blockVertexBase = blockVertexBase.data();
-        v.locator.bvh.nodes = bvhNodes.data();
-        v.locator.bvh.primIds = bvhPrims.data();
-        v.locator.neighbors = {neighborCodes.data(), neighborEscapes.data(),
-                               neighborEscapeBase.data(), nativeNeighbors.data()};
+        m.points = a.points.data();
+        m.nativeCorners = a.nativeCorners.data();
+        m.values = a.values.data();
+        m.tetCorners = a.tetCorners.data();
+        m.blockVertices = a.blockVertices.data();
+        m.blockVertexBase = a.blockVertexBase.data();
+        v.locator.bvh.nodes = a.bvhNodes.data();
+        v.locator.bvh.primIds = a.bvhPrims.data();
+        v.locator.neighbors = {a.neighborCodes.data(), a.neighborEscapes.data(),
+                               a.neighborEscapeBase.data(), a.nativeNeighbors.data()};
         v.tf.entries = tfTable.data();
         v.tf.breaks = tfBreaks.data();
         return v;
@@ -294,32 +262,8 @@ CudaScene::CudaScene(const PreparedMesh& mesh, const FractionFn& progress)
     auto uploaded = [&] {
         if (progress) progress(std::min(0.99, double(geometryBytes()) / total));
     };
-    if (mesh.tets.hasNative()) {
-        d.points.upload(mesh.tets.points, "the mesh points");
-        d.nativeCorners.upload(mesh.tets.nativeCorners, "the native cells");
-    }
-    d.tetCorners.upload(mesh.tets.tetCorners, "the tetrahedra");
-    d.blockVertexBase.upload(mesh.tets.blockVertexBase, "the tetrahedra's blocks");
-    uploaded();
-    const CompactNeighbors& nb = mesh.neighborCodes;
-    d.neighborCodes.upload(nb.tetCodes, "the face neighbours");
-    d.neighborEscapes.upload(nb.escapes, "the face neighbours across blocks");
-    d.neighborEscapeBase.upload(nb.escapeBase, "the face neighbours' blocks");
-    d.nativeNeighbors.upload(nb.native, "the native cells' face neighbours");
-    uploaded();
-    d.bvhNodes.upload(mesh.bvh.nodes, "the BVH nodes");
-    d.bvhPrims.upload(mesh.bvh.primIds, "the BVH primitive ids");
-    if (mesh.kd) {
-        d.kdNodes.upload(mesh.kd->nodes, "the k-d nodes");
-        d.cellTreeNodes.upload(mesh.cellTree.nodes, "the cell tree");
-    }
-    if (mesh.seeds) {
-        d.seedGrids.upload(mesh.seeds->grids, "the seed grids");
-        d.seeds.upload(mesh.seeds->seeds, "the seeds");
-    }
-    if (mesh.macro) d.macroGrids.upload(mesh.macro->grids, "the macrocell grids");
-    uploaded();
-    d.uploadValues();
+    d.upload(ArrayUse::Geometry, uploaded);
+    d.upload(ArrayUse::Values, uploaded);
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     d.uploadSeconds =
@@ -331,13 +275,11 @@ CudaScene::~CudaScene() = default;
 
 std::uint64_t CudaScene::geometryBytes() const {
     const Impl& d = *impl_;
-    return d.points.bytes() + d.nativeCorners.bytes() + d.values.bytes() + d.tetCorners.bytes() +
-           d.blockVertices.bytes() + d.blockVertexBase.bytes() + d.neighborCodes.bytes() +
-           d.neighborEscapes.bytes() + d.neighborEscapeBase.bytes() + d.nativeNeighbors.bytes() +
-           d.bvhNodes.bytes() + d.bvhPrims.bytes() + d.kdNodes.bytes() + d.partitions.bytes() +
-           d.gradientSpread.bytes() + d.cellTreeNodes.bytes() + d.seedGrids.bytes() +
-           d.seeds.bytes() + d.macroGrids.bytes() + d.macroCells.bytes() + d.partitionNan.bytes() +
-           d.macroNan.bytes();
+    std::uint64_t n = 0;
+    forEachSceneArray(d.mesh, d.a, [&](const auto& device, const auto*, const char*, ArrayUse) {
+        n += device.bytes();
+    });
+    return n;
 }
 
 double CudaScene::uploadSeconds() const {
@@ -346,7 +288,7 @@ double CudaScene::uploadSeconds() const {
 
 void CudaScene::updateValues() {
     const auto start = std::chrono::steady_clock::now();
-    impl_->uploadValues();
+    impl_->upload(ArrayUse::Values, [] {});
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     impl_->valueUploadSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -378,15 +320,15 @@ void CudaScene::updateShading(RenderResult& result) {
     d.shading.reserve(n, "the partition shading");
     const int block = 256;
     const int grid = static_cast<int>((n + block - 1) / block);
-    cuda::partitionStatsKernel<<<grid, block>>>(range, d.partitions.data(), n,
+    cuda::partitionStatsKernel<<<grid, block>>>(range, d.a.partitions.data(), n,
                                                 d.partitionStats.data(), d.varianceBounds.data());
     UVR_CUDA_CHECK(cudaGetLastError());
-    cuda::partitionShadeKernel<<<grid, block>>>(d.partitionStats.data(), d.gradientSpread.data(), n,
-                                                d.varianceBounds.data(), f.stepRule,
+    cuda::partitionShadeKernel<<<grid, block>>>(d.partitionStats.data(), d.a.gradientSpread.data(),
+                                                n, d.varianceBounds.data(), f.stepRule,
                                                 d.shading.data());
     UVR_CUDA_CHECK(cudaGetLastError());
     if (!d.mesh.partitionNan.empty()) {
-        cuda::nanShadeKernel<<<grid, block>>>(d.partitionNan.data(), n, f.tfNan.w, f.stepRule.s1,
+        cuda::nanShadeKernel<<<grid, block>>>(d.a.partitionNan.data(), n, f.tfNan.w, f.stepRule.s1,
                                               d.shading.data());
         UVR_CUDA_CHECK(cudaGetLastError());
     }
@@ -396,14 +338,14 @@ void CudaScene::updateShading(RenderResult& result) {
         const std::uint32_t m = static_cast<std::uint32_t>(d.mesh.macro->cells.size());
         d.macroShading.reserve(m, "the macrocell shading");
         cuda::macroShadeKernel<<<(m + block - 1) / block, block>>>(
-            range, d.macroCells.data(), m, f.stepRule, d.macroShading.data());
+            range, d.a.macroCells.data(), m, f.stepRule, d.macroShading.data());
         UVR_CUDA_CHECK(cudaGetLastError());
         if (!d.mesh.macro->nanCells.empty()) {
             cuda::nanShadeKernel<<<(m + block - 1) / block, block>>>(
-                d.macroNan.data(), m, f.tfNan.w, f.stepRule.s1, d.macroShading.data());
+                d.a.macroNan.data(), m, f.tfNan.w, f.stepRule.s1, d.macroShading.data());
             UVR_CUDA_CHECK(cudaGetLastError());
         }
-        cuda::macroChoiceKernel<<<grid, block>>>(d.macroGrids.data(), d.macroShading.data(), n,
+        cuda::macroChoiceKernel<<<grid, block>>>(d.a.macroGrids.data(), d.macroShading.data(), n,
                                                  d.shading.data());
         UVR_CUDA_CHECK(cudaGetLastError());
         d.macroActive = true;
@@ -457,13 +399,13 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     } else {
         PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
         scene.base = d.deviceScene(result.setup);
-        scene.kd.nodes = d.kdNodes.data();
-        scene.kd.partitions = d.partitions.data();
-        scene.cells.nodes = d.cellTreeNodes.data();
+        scene.kd.nodes = d.a.kdNodes.data();
+        scene.kd.partitions = d.a.partitions.data();
+        scene.cells.nodes = d.a.cellTreeNodes.data();
         scene.shading = d.shading.data();
-        if (d.macroActive) scene.macro = {d.macroGrids.data(), d.macroShading.data()};
+        if (d.macroActive) scene.macro = {d.a.macroGrids.data(), d.macroShading.data()};
         if (d.mesh.seeds)
-            scene.seeds = {d.seedGrids.data(), d.seeds.data()};
+            scene.seeds = {d.a.seedGrids.data(), d.a.seeds.data()};
         else
             scene.longStep = INFINITY;  // without seeds, walking beats divergent BVH searches
         scene.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;

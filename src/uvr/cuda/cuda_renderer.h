@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <type_traits>
 
+#include "uvr/cuda/scene_arrays.h"
 #include "uvr/render/render_setup.h"
 
 namespace uvr {
@@ -31,29 +31,6 @@ void startCudaWarmUp();
 
 /// Waits for startCudaWarmUp's thread when one runs (call it before the process exits).
 void finishCudaWarmUp();
-
-/// Bytes a CudaScene of the mesh holds on the GPU (its geometryBytes once uploaded), known
-/// before the upload: for progress lines.
-inline std::uint64_t cudaSceneBytes(const PreparedMesh& mesh) {
-    const auto bytes = [](const auto& v) {
-        return std::uint64_t(v.size()) * sizeof(typename std::decay_t<decltype(v)>::value_type);
-    };
-    const TetMeshView kernel = mesh.kernelMesh();
-    const CompactNeighbors& nb = mesh.neighborCodes;
-    std::uint64_t n = bytes(mesh.tets.tetCorners) + bytes(mesh.tets.blockVertices) +
-                      bytes(mesh.tets.blockVertexBase) + bytes(nb.tetCodes) + bytes(nb.escapes) +
-                      bytes(nb.escapeBase) + bytes(nb.native) + bytes(mesh.bvh.nodes) +
-                      bytes(mesh.bvh.primIds);
-    if (mesh.tets.hasNative()) n += bytes(mesh.tets.points) + bytes(mesh.tets.nativeCorners);
-    if (kernel.values) n += bytes(mesh.tets.values);
-    if (mesh.kd)
-        n += bytes(mesh.kd->nodes) + bytes(mesh.cellTree.nodes) + bytes(mesh.kd->partitions) +
-             bytes(mesh.gradientSpread) + bytes(mesh.partitionNan);
-    if (mesh.seeds) n += bytes(mesh.seeds->grids) + bytes(mesh.seeds->seeds);
-    if (mesh.macro)
-        n += bytes(mesh.macro->grids) + bytes(mesh.macro->cells) + bytes(mesh.macro->nanCells);
-    return n;
-}
 
 /// A prepared mesh resident on the GPU: geometry, BVH, neighbours and partitions are uploaded
 /// once; each render uploads only the baked transfer function and per-partition shading, so
