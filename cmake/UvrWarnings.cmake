@@ -1,7 +1,11 @@
 # SPDX-License-Identifier: MIT
 # Warnings for the project's own targets, as one INTERFACE target.
 add_library(uvr_warnings INTERFACE)
+option(UVR_WERROR "Treat the project's warnings as errors (the asan preset, which CI builds)" OFF)
 target_compile_options(uvr_warnings INTERFACE
     $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow>
+    # The host side of the CUDA sources, through nvcc.
+    $<$<COMPILE_LANGUAGE:CUDA>:-Xcompiler=-Wall,-Wextra,-Wshadow>
+    $<$<AND:$<COMPILE_LANGUAGE:CXX>,$<BOOL:${UVR_WERROR}>>:-Werror>
     # GCC 12 reports false -Wrestrict positives inside libstdc++'s std::string (GCC bug 105329).
     $<$<AND:$<COMPILE_LANGUAGE:CXX>,$<CXX_COMPILER_ID:GNU>>:-Wno-restrict>)

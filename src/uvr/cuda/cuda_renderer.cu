@@ -186,7 +186,7 @@ std::string cudaDeviceDescription() {
     }
     cudaDeviceProp prop{};
     UVR_CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
-    char buf[256];
+    char buf[sizeof prop.name + 128];  // the name, up to 256 bytes, and the figures
     std::snprintf(buf, sizeof buf, "%s, %.1f GiB, compute capability %d.%d, %d SMs", prop.name,
                   prop.totalGlobalMem / 1073741824.0, prop.major, prop.minor,
                   prop.multiProcessorCount);
