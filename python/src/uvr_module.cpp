@@ -325,11 +325,14 @@ py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::s
 
 // ---- Rendering ----
 
-/// A Python value as the settings vocabulary reads it: None, bool, int, float (numpy scalars
-/// too) or str; anything else as its float() when it has one.
+/// A Python value as the settings vocabulary reads it: None, bool, int, float or str (numpy
+/// scalars too); anything else as its repr, which the vocabulary refuses naming it.
 nlohmann::json settingValue(const py::handle& v) {
     if (v.is_none()) return nullptr;
     if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
+    // numpy booleans (their __index__ would read them as 0 and 1)
+    if (py::hasattr(v, "dtype") && py::str(v.attr("dtype").attr("kind")).cast<std::string>() == "b")
+        return py::reinterpret_borrow<py::object>(v).attr("__bool__")().cast<bool>();
     if (py::isinstance<py::str>(v)) return v.cast<std::string>();
     if (py::hasattr(v, "__index__")) {  // int, numpy integers
         const py::object i = py::module_::import("operator").attr("index")(v);

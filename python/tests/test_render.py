@@ -236,5 +236,6 @@ def test_the_settings_vocabulary_is_the_librarys(data_dir):
     assert img.stats["quality"] == pytest.approx(0.995) and img.stats["supersample"] == 2
     with pytest.raises(uvr.ArgumentError, match=r"^power='\[2\]': expected a number in \[1, 64\]$"):
         r.render(power=[2])
+    assert r.render(size=(8, 8), method="adaptive", skip=np.bool_(False)).stats["skip"] is False
     assert uvr._uvr.tunes_adaptive({"quality": 0.995})
     assert not uvr._uvr.tunes_adaptive({"quality": 0.99, "supersample": 4})

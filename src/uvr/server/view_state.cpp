@@ -203,7 +203,8 @@ Json toJson(const ViewState& s) {
               {"heatmap", s.heatmap},
               {"size", {s.width, s.height}},
               {"step", s.step}};
-    // The viewer's settings of the vocabulary, as set (the command line's where absent).
+    // The viewer's settings of the vocabulary as set (`uvr view` starts every tab with all of
+    // them from its command line; the library's default for one a state does not hold).
     for (const char* name : kViewerSettings) {
         const auto it = s.settings.find(name);
         j[name] = it != s.settings.end() ? *it : settingDefault(settingNamed(name));
