@@ -346,6 +346,12 @@ nlohmann::json settingValue(const py::handle& v) {
     return py::str(py::repr(v)).cast<std::string>();           // refused as what it is
 }
 
+/// A JSON value of the library (a frame report, the settings vocabulary) as Python objects.
+py::object fromJson(const nlohmann::json& j) {
+    return py::module_::import("json").attr("loads")(
+        j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
 /// RenderSettings from a dict of the settings vocabulary (settings_vocabulary.h): each key a
 /// setting's name, each value checked there; the library's SettingError says what is wrong.
 RenderSettings settingsOf(const py::dict& settings) {
@@ -375,9 +381,7 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
         r = self.renderer->render(s);
     }
     // The library's frame report (the CLI's --stats, the viewer's frame messages), as a dict.
-    py::object stats = py::module_::import("json").attr("loads")(
-        frameReport(*self.renderer, s, r)
-            .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+    py::object stats = fromJson(frameReport(*self.renderer, s, r));
     const auto h = static_cast<py::ssize_t>(height), w = static_cast<py::ssize_t>(width);
     py::array pixels = vectorArray<float>(std::move(r.image.pixels), {h, w, 4});
     py::array counts = vectorArray<std::uint32_t>(std::move(r.sampleCounts), {h, w});
@@ -414,7 +418,7 @@ PYBIND11_MODULE(_uvr, m) {
     // The integrators' names, the default first (the library's one list: kMethods).
     m.attr("METHODS") = methodNames();
     // The settings vocabulary (settings_vocabulary.h): name, type, doc, default, choices or range.
-    m.attr("SETTINGS") = py::module_::import("json").attr("loads")(settingsVocabularyJson().dump());
+    m.attr("SETTINGS") = fromJson(settingsVocabularyJson());
     m.def(
         "check_settings", [](const py::dict& settings) { settingsOf(settings); },
         py::arg("settings"),

@@ -27,16 +27,6 @@ std::optional<RenderMethod> parseMethod(std::string_view name) {
     return std::nullopt;
 }
 
-std::string methodChoices() {
-    std::string out;
-    for (std::size_t i = 0; i < kMethods.size(); ++i)
-        out += (i == 0                     ? ""
-                : i + 1 == kMethods.size() ? " or "
-                                           : ", ") +
-               std::string(kMethods[i].name);
-    return out;
-}
-
 namespace {
 
 /// Surface area of a cell of kind k with corners x: its faces', a quadrilateral's as half the

@@ -52,8 +52,6 @@ std::vector<std::string> methodNames();
 const char* methodName(RenderMethod method);
 /// The method of a name in kMethods; nullopt for any other.
 std::optional<RenderMethod> parseMethod(std::string_view name);
-/// "auto, adaptive, reference or exact" (for messages).
-std::string methodChoices();
 
 /// At most this many cells, evenly spread, are measured by exactCellsPerRay.
 inline constexpr std::uint64_t kAutoSampleCells = 1u << 16;
