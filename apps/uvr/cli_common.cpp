@@ -17,6 +17,7 @@
 
 #include "progress.h"
 #include "uvr/core/host_memory.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 
@@ -61,12 +62,42 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
 
 }  // namespace
 
+namespace {
+
+/// The long option `name` ("--max-step") of `app` or of one of its subcommands, or nullptr.
+const CLI::Option* findFlag(const CLI::App& app, const std::string& name) {
+    if (const CLI::Option* o = app.get_option_no_throw(name)) return o;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+        if (const CLI::Option* o = findFlag(*sub, name)) return o;
+    return nullptr;
+}
+
+}  // namespace
+
+std::string Context::spell(const std::string& message) const {
+    return respellMentions(message, [this](std::string_view setting) {
+        std::string flag = "--" + std::string(setting);
+        std::replace(flag.begin(), flag.end(), '_', '-');
+        if (app && !findFlag(*app, flag) && findFlag(*app, "--no-" + flag.substr(2)))
+            flag = "--no-" + flag.substr(2);
+        return flag;
+    });
+}
+
+std::string Context::spell(const Error& error) const {
+    const auto* setting = dynamic_cast<const SettingError*>(&error);
+    if (!setting) return spell(std::string(error.what()));
+    const SettingDef* def = findSetting(setting->setting());
+    return spell(
+        setting->spelledAs(def ? cliFlag(*def) : spell("`" + setting->setting() + "`"), " "));
+}
+
 void Context::step(const std::string& message) const {
-    if (!quiet) printStderrLine("uvr: " + printable(message));
+    if (!quiet) printStderrLine("uvr: " + printable(spell(message)));
 }
 
 void Context::warn(const std::string& message) const {
-    printStderrLine("uvr: warning: " + printable(message));
+    printStderrLine("uvr: warning: " + printable(spell(message)));
 }
 
 void Context::done(const std::string& message, Clock::time_point start) const {

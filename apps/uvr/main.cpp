@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     app.fallthrough();  // -q works after the subcommand too
     app.set_version_flag("--version", "uvr 0.1.0");
     cli::Context ctx;
+    ctx.app = &app;
     app.add_flag("-q,--quiet", ctx.quiet, "No progress messages on stderr");
     std::string maxMemory;
     const cli::MemoryDefault memoryDefault = cli::defaultMaxMemory();
@@ -62,15 +63,10 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "uvr: error: %s\n",
                      printable(cli::describeParseError(app, args, e)).c_str());
         return 2;
-    } catch (const SettingError& e) {
-        // The library names a setting in neutral words: here, by its flag (--max-step -2: ...).
-        const SettingDef* def = findSetting(e.setting());
-        const std::string text = def ? e.spelledAs(cliFlag(*def), " ") : e.what();
-        std::fprintf(stderr, "uvr: error: %s\n", printable(text).c_str());
-        return 2;
     } catch (const Error& e) {
-        // Messages quote names from files: escaped, they stay one line.
-        std::fprintf(stderr, "uvr: error: %s\n", printable(e.what()).c_str());
+        // The library names settings in neutral words: here, by their flags (--max-step -2:
+        // ...). Messages quote names from files: escaped, they stay one line.
+        std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.spell(e)).c_str());
         return e.kind() == ErrorKind::Internal ? 70 : 2;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.outOfMemoryMessage()).c_str());

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "uvr/core/setting_error.h"
 #include "uvr/mesh/io/vtk_cells.h"
 #include "uvr/uvr.h"
 
@@ -347,6 +348,20 @@ nlohmann::json settingValue(const py::handle& v) {
 }
 
 /// A JSON value of the library (a frame report, the settings vocabulary) as Python objects.
+/// The keyword a library setting has in this module, where it differs from the setting's name.
+std::string pythonName(const std::string& setting) {
+    if (setting == "log") return "log_scale";
+    if (setting == "seed_grid") return "seed_grids";
+    return setting;
+}
+
+/// A library message in Python's spelling: each setting it mentions as its keyword (`log_scale`).
+std::string pythonSpelling(const std::string& message) {
+    return respellMentions(message, [](std::string_view setting) {
+        return "`" + pythonName(std::string(setting)) + "`";
+    });
+}
+
 py::object fromJson(const nlohmann::json& j) {
     return py::module_::import("json").attr("loads")(
         j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
@@ -451,11 +466,11 @@ PYBIND11_MODULE(_uvr, m) {
             if (p) std::rethrow_exception(p);
         } catch (const SettingError& e) {
             // Python's spelling: the keyword and its value (quality=1.5: expected ...).
-            const std::string text =
-                findSetting(e.setting()) ? e.spelledAs(e.setting(), "=") : e.what();
+            const std::string text = pythonSpelling(e.spelledAs(pythonName(e.setting()), "="));
             PyErr_SetString(gExceptions.byKind[static_cast<int>(e.kind())], text.c_str());
         } catch (const Error& e) {
-            PyErr_SetString(gExceptions.byKind[static_cast<int>(e.kind())], e.what());
+            PyErr_SetString(gExceptions.byKind[static_cast<int>(e.kind())],
+                            pythonSpelling(e.what()).c_str());
         }
     });
 

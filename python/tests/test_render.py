@@ -176,7 +176,7 @@ def test_compare_report_gives_the_worst_pixels_under_the_clis_keys(cli, tmp_path
 
 def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
     r = uvr.Renderer(data_dir / "tetraMesh.vtk", device="cpu")
-    with pytest.raises(uvr.ArgumentError, match="--size 0x10"):
+    with pytest.raises(uvr.ArgumentError, match=r"^size=0x10: each side must be between 1 and"):
         r.render(size=(0, 10))
     with pytest.raises(uvr.ArgumentError, match="size: expected"):
         r.render(size=5)
@@ -193,19 +193,21 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(skip="no")
     with pytest.raises(uvr.ArgumentError, match="'qualty': not a setting; the settings are 'method'"):
         r.render(qualty=0.9)
-    with pytest.raises(uvr.ArgumentError, match="'nope' not found; available: scalars"):
+    with pytest.raises(uvr.ArgumentError, match="^field='nope': not found; available: scalars"):
         r.render(field="nope")
     with pytest.raises(uvr.ArgumentError, match="field: expected 55 point values or 160 cell"):
         r.render(field=np.zeros(7))
-    with pytest.raises(uvr.ArgumentError, match="--range"):
+    with pytest.raises(uvr.ArgumentError, match=r"^range=2,1: expected finite lo <= hi$"):
         r.render(range=(2, 1))
+    with pytest.raises(uvr.ArgumentError, match=r"^`log_scale` needs positive values: `range`"):
+        r.render(range=(-2, -1), log_scale=True)
     with pytest.raises(uvr.ArgumentError, match="unknown"):
         r.render(tf="no such map")
     with pytest.raises(uvr.FileError):
         r.render(tf="/nonexistent/map.json")
     with pytest.raises(TypeError, match="camera: expected a uvr.Camera"):
         r.render(camera="front")
-    with pytest.raises(uvr.ArgumentError, match="opacity"):
+    with pytest.raises(uvr.ArgumentError, match="^opacity=\"wobbly\": "):
         r.render(opacity="wobbly")
     with pytest.raises(uvr.ArgumentError, match="opacity_law='linear': expected 'attenuation' or"):
         r.render(opacity_law="linear")
@@ -214,7 +216,7 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
     with pytest.raises(uvr.ArgumentError, match="device: expected auto, cpu or cuda"):
         uvr.Renderer(data_dir / "tetraMesh.vtk", device="tpu")
     if not uvr.cuda_available():
-        with pytest.raises(uvr.UnsupportedError):
+        with pytest.raises(uvr.UnsupportedError, match="^device='?cuda'?: "):
             uvr.Renderer(data_dir / "tetraMesh.vtk", device="cuda")
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0

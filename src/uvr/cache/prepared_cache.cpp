@@ -743,35 +743,35 @@ std::string cacheKeyMismatch(const CacheKey& s, const CacheKey& e) {
     if (s.fingerprint != e.fingerprint)
         return "the mesh changed since the cache was prepared (its first or last MiB differ)";
     if (s.fieldSpec != e.fieldSpec)
-        return "it was prepared for --field " + quoted(s.fieldSpec, "(the default)") +
+        return "it was prepared for `field` " + quoted(s.fieldSpec, "(the default)") +
                ", this asks for " + quoted(e.fieldSpec, "the default field");
     if (s.step != e.step)
         return "it was prepared for the time step " + quoted(s.step, "(the first)") +
                ", this asks for " + quoted(e.step, "the first");
     if (s.splitCells != e.splitCells)
-        return "it was prepared " + yesNo(s.splitCells) + " --split-cells, this asks " +
+        return "it was prepared " + yesNo(s.splitCells) + " `split_cells`, this asks " +
                yesNo(e.splitCells);
     if (s.partitions != e.partitions || s.meshBvh != e.meshBvh || s.forAuto != e.forAuto) {
         const auto method = [](const CacheKey& k) {
             std::string what =
-                k.partitions ? "partitions (--method adaptive)" : std::string("no partitions");
-            if (k.meshBvh) what += " and the mesh BVH (--method reference/exact)";
-            if (k.forAuto) what += " and what --method auto renders with";
+                k.partitions ? "partitions (`method` adaptive)" : std::string("no partitions");
+            if (k.meshBvh) what += " and the mesh BVH (`method` reference/exact)";
+            if (k.forAuto) what += " and what `method` auto renders with";
             return what;
         };
         return "it holds " + method(s) + ", this needs " + method(e);
     }
     if (s.autoOnGpu != e.autoOnGpu)
-        return std::string("it holds what --method auto renders with on the ") +
+        return std::string("it holds what `method` auto renders with on the ") +
                (s.autoOnGpu ? "GPU" : "CPU") + ", this renders on the " +
                (e.autoOnGpu ? "GPU" : "CPU");
     if ((s.partitions || s.forAuto) && s.leafCells != e.leafCells)
         return "its partitions hold up to " + std::to_string(s.leafCells) +
-               " cells (--leaf-cells), this asks for " + std::to_string(e.leafCells) +
-               " (the default differs between --device cpu and cuda)";
+               " cells (`leaf_cells`), this asks for " + std::to_string(e.leafCells) +
+               " (the default differs between `device` cpu and cuda)";
     if ((s.partitions || s.forAuto) && s.seedGrids != e.seedGrids)
         return "it was prepared " + yesNo(s.seedGrids) + " seed grids, this asks " +
-               yesNo(e.seedGrids) + " (--no-seed-grid)";
+               yesNo(e.seedGrids) + " (`seed_grid`)";
     if (s.partitions && s.macroGrids != e.macroGrids)
         return "it was prepared " + yesNo(s.macroGrids) + " macrocell grids, this asks " +
                yesNo(e.macroGrids);

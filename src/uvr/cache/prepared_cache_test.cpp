@@ -475,13 +475,13 @@ TEST(PreparedCache, StaleOrForeignKeysAreRefusedWithTheReason) {
     EXPECT_THAT(staleReason(c, k), HasSubstr("time step"));
     k = c.key;
     k.leafCells = 128;
-    EXPECT_THAT(staleReason(c, k), HasSubstr("up to 64 cells (--leaf-cells), this asks for 128"));
+    EXPECT_THAT(staleReason(c, k), HasSubstr("up to 64 cells (`leaf_cells`), this asks for 128"));
     k = c.key;
     k.meshBvh = false;
     EXPECT_THAT(staleReason(c, k), HasSubstr("mesh BVH"));
     k = c.key;
     k.splitCells = true;
-    EXPECT_THAT(staleReason(c, k), HasSubstr("--split-cells"));
+    EXPECT_THAT(staleReason(c, k), HasSubstr("without `split_cells`"));
     EXPECT_EQ(cacheKeyMismatch(c.key, c.key), "");
 }
 

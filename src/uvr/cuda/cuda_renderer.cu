@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "uvr/core/error.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/cuda/cuda_check.h"
 #include "uvr/render/frame_kernel.h"
 
@@ -255,7 +256,7 @@ struct CudaScene::Impl {
 CudaScene::CudaScene(const PreparedMesh& mesh, const FractionFn& progress)
     : impl_(std::make_unique<Impl>(mesh)) {
     if (!cudaDeviceAvailable())
-        throwError(ErrorKind::Unsupported, "", "--device cuda: no CUDA device found");
+        throw SettingError("device", "cuda", "no CUDA device found", ErrorKind::Unsupported);
     const auto start = std::chrono::steady_clock::now();
     Impl& d = *impl_;
     const double total = double(std::max<std::uint64_t>(1, cudaSceneBytes(mesh)));

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The CUDA entry points of a build without CUDA (UVR_ENABLE_CUDA=OFF): no device, clear errors.
 #include "uvr/core/error.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
 
@@ -10,9 +11,10 @@ namespace {
 
 /// The error of every GPU builder here.
 [[noreturn]] void noCudaBuilders() {
-    throwError(ErrorKind::Unsupported, "",
-               "--build-device cuda: this uvr was built without CUDA (configure with a CUDA "
-               "compiler and UVR_ENABLE_CUDA=ON)");
+    throw SettingError("build_device", "cuda",
+                       "this uvr was built without CUDA (configure with a CUDA compiler and "
+                       "UVR_ENABLE_CUDA=ON)",
+                       ErrorKind::Unsupported);
 }
 
 }  // namespace
@@ -32,9 +34,10 @@ void startCudaWarmUp() {}
 void finishCudaWarmUp() {}
 
 CudaScene::CudaScene(const PreparedMesh&, const FractionFn&) {
-    throwError(ErrorKind::Unsupported, "",
-               "--device cuda: this uvr was built without CUDA (configure with a CUDA compiler "
-               "and UVR_ENABLE_CUDA=ON)");
+    throw SettingError("device", "cuda",
+                       "this uvr was built without CUDA (configure with a CUDA compiler and "
+                       "UVR_ENABLE_CUDA=ON)",
+                       ErrorKind::Unsupported);
 }
 
 CudaScene::~CudaScene() = default;

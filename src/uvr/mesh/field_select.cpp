@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "uvr/core/error.h"
+#include "uvr/core/setting_error.h"
 
 namespace uvr {
 
@@ -32,9 +33,10 @@ FieldSpec parseFieldSpec(const std::string& text) {
             spec.component = std::stoi(part);
             spec.selectsComponent = true;
         } else {
-            throwError(ErrorKind::Argument, "",
-                       "--field '" + text + "': unknown qualifier '" + part +
-                           "' (expected point, cell, magnitude, x, y, z or a component number)");
+            throw SettingError(
+                "field", "'" + text + "'",
+                "unknown qualifier '" + part +
+                    "' (expected point, cell, magnitude, x, y, z or a component number)");
         }
         pos = next;
     }
@@ -121,41 +123,42 @@ FieldChoice resolveField(const std::vector<FieldInfo>& fields, const FieldSpec& 
             pointMatches += f.association == Association::Point;
         }
         if (!index)
-            throwError(ErrorKind::Argument, "",
-                       "--field '" + spec.name +
-                           (spec.association ? std::string(":") + associationName(*spec.association)
-                                             : "") +
-                           "' not found; " + describe());
+            throw SettingError(
+                "field",
+                "'" + spec.name +
+                    (spec.association ? std::string(":") + associationName(*spec.association)
+                                      : "") +
+                    "'",
+                "not found; " + describe());
         if (matches == 2 && pointMatches == 1) {
             // The name exists as point and cell data: the point data, as ParaView prefers it.
             for (std::size_t i = 0; i < fields.size(); ++i)
                 if (fields[i].name == spec.name && fields[i].association == Association::Point)
                     index = i;
-            choice = "point data; the file also has cell data of this name: --field " + spec.name +
+            choice = "point data; the file also has cell data of this name: `field` " + spec.name +
                      ":cell selects it";
         } else if (matches > 1) {
             const int cellMatches = matches - pointMatches;
             const std::string points = std::to_string(pointMatches) + " point";
             const std::string cells = std::to_string(cellMatches) + " cell";
-            throwError(ErrorKind::Argument, "",
-                       "--field '" + spec.name + "': " +
-                           (cellMatches == 0    ? points
-                            : pointMatches == 0 ? cells
-                                                : points + " and " + cells) +
-                           " fields have this name and --field cannot tell them apart; rename "
-                           "them in the file");
+            throw SettingError(
+                "field", "'" + spec.name + "'",
+                (cellMatches == 0    ? points
+                 : pointMatches == 0 ? cells
+                                     : points + " and " + cells) +
+                    " fields have this name and a field spec cannot tell them apart; rename "
+                    "them in the file");
         }
     }
     if (spec.selectsComponent && fields[*index].components == 1)
-        throwError(ErrorKind::Argument, "",
-                   "--field '" + spec.name +
-                       "': a scalar field; :x, :y, :z, :magnitude and a "
-                       "component number select from vector fields (leave the qualifier out)");
+        throw SettingError("field", "'" + spec.name + "'",
+                           "a scalar field; :x, :y, :z, :magnitude and a "
+                           "component number select from vector fields (leave the qualifier out)");
     if (spec.component >= fields[*index].components)
-        throwError(ErrorKind::Argument, "",
-                   "--field '" + fields[*index].name + "': component " +
-                       std::to_string(spec.component) + " does not exist (the field has " +
-                       std::to_string(fields[*index].components) + ")");
+        throw SettingError("field", "'" + fields[*index].name + "'",
+                           "component " + std::to_string(spec.component) +
+                               " does not exist (the field has " +
+                               std::to_string(fields[*index].components) + ")");
     return {*index, std::move(choice)};
 }
 
@@ -177,9 +180,10 @@ ScalarField scalarFieldOf(const MeshView& mesh, const Field& fieldRef, int compo
               "field '" << field->name << "' holds " << field->values.size() << " values for "
                         << tuples << " tuples");
     if (component >= field->components)
-        throwError(ErrorKind::Argument, "",
-                   "--field '" + field->name + "': component " + std::to_string(component) +
-                       " does not exist (the field has " + std::to_string(field->components) + ")");
+        throw SettingError("field", "'" + field->name + "'",
+                           "component " + std::to_string(component) +
+                               " does not exist (the field has " +
+                               std::to_string(field->components) + ")");
     ScalarField out;
     out.name = field->name;
     out.association = field->association;

@@ -48,7 +48,7 @@ TEST(FieldSelect, ANameOfPointAndCellDataMeansThePointData) {
     const ScalarField p = selectScalarField(m, parseFieldSpec("p"));
     EXPECT_EQ(p.association, Association::Point);
     EXPECT_EQ(p.values, (std::vector<float>{1, 2, 3, 4}));
-    EXPECT_NE(p.choice.find("--field p:cell"), std::string::npos) << p.choice;
+    EXPECT_NE(p.choice.find("`field` p:cell"), std::string::npos) << p.choice;
     EXPECT_EQ(p.describe(), "p (point data)");
 }
 

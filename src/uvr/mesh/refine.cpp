@@ -10,6 +10,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/scratch_vector.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/mesh/io/native.h"
 #include "uvr/mesh/tet_mesh.h"
 
@@ -287,9 +288,8 @@ struct Prepared {
 Prepared prepare(const Mesh& mesh, int levels, const std::function<void(const std::string&)>& say,
                  RefineProgress& progress) {
     if (levels < 0 || levels > kMaxRefineLevels)
-        throwError(ErrorKind::Argument, "",
-                   "--levels " + std::to_string(levels) + ": expected 0 to " +
-                       std::to_string(kMaxRefineLevels));
+        throw SettingError("levels", std::to_string(levels),
+                           "expected 0 to " + std::to_string(kMaxRefineLevels));
     const std::int64_t cellCount = static_cast<std::int64_t>(mesh.cellCount());
     // Step 1: split cells into tetrahedra (two passes over fixed chunks: count, then fill).
     say("splitting " + std::to_string(cellCount) + " cells into tetrahedra");

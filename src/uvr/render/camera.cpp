@@ -43,7 +43,7 @@ Vec3f toFloat(Vec3d v, const std::string& what) {
             throwError(ErrorKind::Argument, "",
                        what + " would lie at " + buf +
                            ", beyond float32 range (3.4e38): rescale the mesh or give "
-                           "--camera-position and --camera-focal");
+                           "`camera_position` and `camera_focal`");
         }
     return {float(v.x), float(v.y), float(v.z)};
 }

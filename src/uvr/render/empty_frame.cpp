@@ -53,9 +53,9 @@ std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& se
     if (!inView)
         return std::string(
                    "the image is empty: the mesh is not in view, or smaller than a pixel (no "
-                   "pixel's ray meets its bounds); check the camera (--camera, "
-                   "--camera-position/--camera-focal, --azimuth, --elevation, ") +
-               (f.camera.parallelProjection ? "--parallel-scale" : "--view-angle") + ")";
+                   "pixel's ray meets its bounds); check the camera (`camera`, "
+                   "`camera_position`/`camera_focal`, `azimuth`, `elevation`, ") +
+               (f.camera.parallelProjection ? "`parallel_scale`" : "`view_angle`") + ")";
     // The values the kernels read: the blocks' vertices hold a tetrahedral mesh's point values
     // where `values` is not kept (a mesh read from a prepared cache).
     double lo = INFINITY, hi = -INFINITY;
@@ -69,21 +69,21 @@ std::string explainEmptyFrame(const PreparedMesh& mesh, const RenderSettings& se
     if (!(lo <= hi)) return "the image is empty: the field has no finite value";
     if (maxOpacityOver(f, lo, hi) > 0.f)
         return "the image is empty: every pixel's opacity is below half an 8-bit level; raise "
-               "the opacity (--opacity) or --opacity-unit";
+               "the opacity (`opacity`) or `opacity_unit`";
     // The transfer function is transparent over the field's values: say why.
     if (lo == hi)
         return "the image is empty: the field is constant (" + fmt(lo) +
                "), and the transfer function's opacity at that value is 0";
     if (settings.range &&
         (double(settings.range->second) < lo || double(settings.range->first) > hi))
-        return "the image is empty: --range " + fmt(settings.range->first) + "," +
+        return "the image is empty: `range` " + fmt(settings.range->first) + "," +
                fmt(settings.range->second) + " misses the field's values [" + fmt(lo) + ", " +
                fmt(hi) +
                "], which all take the transfer function's end opacity (0 here); use a range "
                "inside the field's";
     return "the image is empty: the transfer function's opacity is 0 over all the field's "
            "values [" +
-           fmt(lo) + ", " + fmt(hi) + "]; check --opacity and --range";
+           fmt(lo) + ", " + fmt(hi) + "]; check `opacity` and `range`";
 }
 
 }  // namespace uvr

@@ -249,7 +249,7 @@ TEST(Supersample, OutOfRangeIsRefusedAndCountsInTheWorkEstimate) {
     s.supersample = 8;
     s.step = std::sqrt(3.f) / 100.f;
     const Error e = testing::catchError([&] { (void)makeFrameSetup(mesh, s); });
-    EXPECT_NE(std::string(e.what()).find("64 rays (--supersample 8)"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("64 rays (`supersample` 8)"), std::string::npos)
         << e.what();
     s.supersample = 1;
     EXPECT_NO_THROW((void)makeFrameSetup(mesh, s));

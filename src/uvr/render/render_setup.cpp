@@ -11,6 +11,7 @@
 
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/mesh/tet_math.h"
 #include "uvr/render/settings_vocabulary.h"
 #include "uvr/tf/tf_table.h"
@@ -321,12 +322,14 @@ std::string fmtValue(double v) {
     return buf;
 }
 
-/// Refuses a log-scale mapping over a range with no positive value (`which`: "--range " or "the
-/// field's range ").
-[[noreturn]] void refuseLogRange(const std::string& which, double lo, double hi) {
+/// Refuses a log-scale mapping over a range with no positive value (`given`: the range is the
+/// `range` setting, else the field's).
+[[noreturn]] void refuseLogRange(bool given, double lo, double hi) {
+    const std::string range = "[" + fmtValue(lo) + ", " + fmtValue(hi) + "]";
     throwError(ErrorKind::Argument, "",
-               "--log needs positive values: " + which + "[" + fmtValue(lo) + ", " + fmtValue(hi) +
-                   "] has none; give --range LO,HI with 0 < LO <= HI");
+               "`log` needs positive values: " +
+                   (given ? "`range` " + range : "the field's range " + range) +
+                   " has none; give `range` LO,HI with 0 < LO <= HI");
 }
 
 }  // namespace
@@ -367,23 +370,23 @@ void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;
     if (s.width < 1 || s.height < 1 || s.width > kMaxSide || s.height > kMaxSide)
-        bad("--size " + std::to_string(s.width) + "x" + std::to_string(s.height) +
-            ": each side must be between 1 and " + std::to_string(kMaxSide));
+        throw SettingError("size", std::to_string(s.width) + "x" + std::to_string(s.height),
+                           "each side must be between 1 and " + std::to_string(kMaxSide));
     // Every setting of the vocabulary within its range (SettingError names it).
     for (const SettingDef& def : settingsVocabulary()) checkSetting(def, def.get(s));
     if (!(s.terminationAlpha > 0.f && s.terminationAlpha <= 1.f))
         bad("early termination threshold must lie in (0, 1]");
     if (s.range && !(std::isfinite(s.range->first) && std::isfinite(s.range->second) &&
                      s.range->first <= s.range->second))
-        bad("--range " + std::to_string(s.range->first) + "," + std::to_string(s.range->second) +
-            ": expected finite lo <= hi");
+        throw SettingError("range", fmtValue(s.range->first) + "," + fmtValue(s.range->second),
+                           "expected finite lo <= hi");
     if (s.tfTableSize < 2 || s.tfTableSize > (1 << 20))
         bad("transfer function table size out of range");
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
     if (s.tf.logScale && s.range && !(s.range->second > 0.f))  // the field's range: at setup
-        refuseLogRange("--range ", s.range->first, s.range->second);
+        refuseLogRange(true, s.range->first, s.range->second);
 }
 
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
@@ -482,21 +485,21 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
         std::max(diagonal / kMaxSamplesPerRay, diagonal * pixels / kMaxFrameSamples);
     const double scale = std::pow(10.0, std::floor(std::log10(least)) - 1.0);
     const double suggest = std::ceil(least / scale * 1.0001) * scale;
-    const std::string what = settings.step > 0.f ? "--step " + fmtG(step * unit)
+    const std::string what = settings.step > 0.f ? "`step` " + fmtG(step * unit)
                                                  : "the default step " + fmtG(step * unit) +
                                                        " (from the mean cell size)";
     throwError(ErrorKind::Argument, "",
                what + " would take up to " + fmtG(w.samples) + " samples (" +
                    std::to_string(settings.width) + "x" + std::to_string(settings.height) +
                    " pixels x " +
-                   (raysPerPixel > 1 ? std::to_string(raysPerPixel) + " rays (--supersample " +
+                   (raysPerPixel > 1 ? std::to_string(raysPerPixel) + " rays (`supersample` " +
                                            std::to_string(settings.supersample) + ") x "
                                      : std::string()) +
                    fmtG(w.samplesPerRay) + " per ray across the bounds' diagonal " +
                    fmtG(diagonal) + "), more than the " +
                    (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
                                                         : "10^12 samples per frame") +
-                   " allowed: use --step " + fmtG(suggest) + " or larger" +
+                   " allowed: use `step` " + fmtG(suggest) + " or larger" +
                    (settings.step > 0.f
                         ? " (the default here is " + fmtG(defaultStep(mesh.tets) * unit) + ")"
                         : std::string()));
@@ -516,25 +519,25 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     int tableSize = settings.tfTableSize;
     if (settings.tf.logScale) {
         const std::string range = "[" + fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) + "]";
-        const std::string which = settings.range ? "--range " : "the field's range ";
-        if (!(f.rangeHi > 0.f)) refuseLogRange(which, f.rangeLo, f.rangeHi);
+        const std::string which = settings.range ? "`range` " : "the field's range ";
+        if (!(f.rangeHi > 0.f)) refuseLogRange(settings.range.has_value(), f.rangeLo, f.rangeHi);
         if (!(f.rangeLo > 0.f)) {
             f.rangeLo = std::fmin(f.rangeHi * 1e-4f, 1.f);  // ParaView's AdjustRangeForLog
-            f.notes.push_back("--log: " + which + range + " is not positive; mapping [" +
+            f.notes.push_back("`log`: " + which + range + " is not positive; mapping [" +
                               fmtValue(f.rangeLo) + ", " + fmtValue(f.rangeHi) +
                               "] as ParaView does (values below take the lowest colour; "
-                              "set the range with --range LO,HI)");
+                              "set the range with `range` LO,HI)");
         }
         tableSize = logTableSize(settings.tfTableSize, f.rangeLo, f.rangeHi);
         // Below `resolved` one table step spans more than 1 / 255 of the log range: 8-bit
         // colour bands may show there (said when that is more than the range's lowest octave).
         const double resolved = logTableResolvedFrom(tableSize, 256, f.rangeLo, f.rangeHi);
         if (resolved > 2.0 * f.rangeLo)
-            f.notes.push_back("--log over " + fmtG(std::log10(double(f.rangeHi) / f.rangeLo)) +
+            f.notes.push_back("`log` over " + fmtG(std::log10(double(f.rangeHi) / f.rangeLo)) +
                               " decades: the " + std::to_string(tableSize) +
                               "-entry table steps by more than 1/255 of the log range below "
                               "value " +
-                              fmtValue(resolved) + " (narrow the range with --range LO,HI)");
+                              fmtValue(resolved) + " (narrow the range with `range` LO,HI)");
     }
     f.tfTable = settings.tf.bakeOverRange(tableSize, f.rangeLo, f.rangeHi);
     f.tfBreaks = tfTableBreaks(f.tfTable.data(), static_cast<int>(f.tfTable.size()));
@@ -552,28 +555,27 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         throwError(ErrorKind::Argument, "",
                    "the mesh has no cell of non-zero volume (every cell is flat or uses NaN/Inf "
                    "points): nothing to render");
-    const auto toLocal = [&](float length, const char* flag) {
+    const auto toLocal = [&](float length, const char* setting) {
         const double v = double(length) * frame.scale;
         if (!frame.identity() && !(v >= double(FLT_MIN) && v <= double(FLT_MAX)))
-            throwError(ErrorKind::Argument, "",
-                       std::string(flag) + " " + fmtG(length) +
-                           ": out of float32 range against the mesh, which renders scaled by " +
-                           fmtG(frame.scale) + " (it is " + fmtG(bounds.diagonal() / frame.scale) +
-                           " across)");
+            throw SettingError(setting, fmtG(length),
+                               "out of float32 range against the mesh, which renders scaled by " +
+                                   fmtG(frame.scale) + " (it is " +
+                                   fmtG(bounds.diagonal() / frame.scale) + " across)");
         return static_cast<float>(v);
     };
-    f.params.step = settings.step > 0.f ? toLocal(settings.step, "--step") : defaultStep(mesh.tets);
+    f.params.step = settings.step > 0.f ? toLocal(settings.step, "step") : defaultStep(mesh.tets);
     f.params.opacityUnit = settings.opacityUnit > 0.f
-                               ? toLocal(settings.opacityUnit, "--opacity-unit")
+                               ? toLocal(settings.opacityUnit, "opacity_unit")
                                : defaultOpacityUnit(bounds, mesh.sourceCells);
     f.params.terminationAlpha = settings.terminationAlpha;
     f.params.preintegrated = settings.preintegrated;
-    f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "--max-step")
+    f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_step")
                                        : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
-        throwError(ErrorKind::Argument, "",
-                   "--max-step " + fmtG(f.maxStep / frame.scale) + " is below --step " +
-                       fmtG(f.params.step / frame.scale) + " (s2 must be >= s1)");
+        throw SettingError(
+            "max_step", fmtG(f.maxStep / frame.scale),
+            "below `step` " + fmtG(f.params.step / frame.scale) + " (s2 must be >= s1)");
     // The camera in rendering units (the reset camera is in them already), in double until it
     // is known to fit float.
     const Camera given = settings.camera ? *settings.camera : resetCamera(bounds, aspect);
@@ -619,12 +621,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                        parallel ? "the mesh is " + fmtG(steps) + " steps of " +
                                       fmtG(f.params.step / frame.scale) +
                                       " deep along the view direction (at most 16 million): use "
-                                      "a larger --step"
+                                      "a larger `step`"
                                 : "the camera is " + fmtG(steps) + " steps of " +
                                       fmtG(f.params.step / frame.scale) +
                                       " from the far side of the mesh (at most 16 million): move "
-                                      "the camera closer (and widen --view-angle) or use a "
-                                      "larger --step");
+                                      "the camera closer (and widen `view_angle`) or use a "
+                                      "larger `step`");
     }
     f.camera = given;
     f.camera.position = Vec3f(float(position[0]), float(position[1]), float(position[2]));

@@ -89,7 +89,7 @@ TEST(TfMapping, LogScaleRangeFromZeroStartsWhereParaViewStartsIt) {
     FrameSetup f = makeFrameSetup(pm, s);
     EXPECT_FLOAT_EQ(f.rangeLo, 0.1f);
     ASSERT_FALSE(f.notes.empty());
-    EXPECT_NE(f.notes[0].find("--range [0, 1000] is not positive; mapping [0.1, 1000]"),
+    EXPECT_NE(f.notes[0].find("`range` [0, 1000] is not positive; mapping [0.1, 1000]"),
               std::string::npos)
         << f.notes[0];
     s.range = std::make_pair(-5.f, 0.f);
@@ -98,8 +98,8 @@ TEST(TfMapping, LogScaleRangeFromZeroStartsWhereParaViewStartsIt) {
         ADD_FAILURE() << "a range with no positive value was accepted";
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Argument);
-        EXPECT_NE(std::string(e.what()).find("--log needs positive values: --range [-5, 0] has "
-                                             "none; give --range LO,HI with 0 < LO <= HI"),
+        EXPECT_NE(std::string(e.what()).find("`log` needs positive values: `range` [-5, 0] has "
+                                             "none; give `range` LO,HI with 0 < LO <= HI"),
                   std::string::npos)
             << e.what();
     }

@@ -916,17 +916,20 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     // The state's settings as the frames use them (the command line's where the page set none).
     const RenderSettings f = frameSettings(s, scene.base);
     args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
-                             fmtExact(s.range.first) + "," + fmtExact(s.range.second), "--method",
-                             methodName(f.method)});
-    // The quality tunes the adaptive method; under auto, a quality moved off the default is what
-    // made the frames adaptive (tunesAdaptive), so it travels too.
-    if (f.method == RenderMethod::Partitions ||
-        (f.method == RenderMethod::Auto && f.quality != kDefaultQuality))
-        args.insert(args.end(), {"--quality", fmtExact(f.quality)});
-    args.insert(args.end(), {"--size", std::to_string(s.width) + "x" + std::to_string(s.height),
-                             "--opacity-unit", fmtExact(f.opacityUnit)});
-    if (f.opacityLaw != kDefaultOpacityLaw)
-        args.insert(args.end(), {"--opacity-law", opacityLawName(f.opacityLaw)});
+                             fmtExact(s.range.first) + "," + fmtExact(s.range.second), "--size",
+                             std::to_string(s.width) + "x" + std::to_string(s.height)});
+    // The page's settings by their flags: the method always, the others where they are not the
+    // default (the opacity unit always is: the server sets it to ParaView's), and what tunes the
+    // adaptive method when it renders.
+    for (const char* name : kViewerSettings) {
+        const SettingDef& def = settingNamed(name);
+        const Json value = def.get(f);
+        if (std::string_view(def.name) != "method" && value == settingDefault(def) &&
+            !(def.tunesAdaptive && f.method == RenderMethod::Partitions))
+            continue;
+        args.push_back(cliFlag(def));
+        args.push_back(value.is_string() ? value.get<std::string>() : fmtExact(value.get<float>()));
+    }
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
     args.insert(args.end(), {"-o", "uvr-view.png"});
     std::string command;
@@ -1227,7 +1230,7 @@ net::ip::address hostAddress(const ServerOptions& o) {
     if (ec)
         throwError(
             ErrorKind::Argument, "",
-            "--host " + printableShort(o.host, 60) + ": not an IP address (" + ec.message() + ")");
+            "`host` " + printableShort(o.host, 60) + ": not an IP address (" + ec.message() + ")");
     return address;
 }
 
@@ -1255,7 +1258,7 @@ void checkServerOptions(const ServerOptions& o, bool tryAddress) {
                         });
         if (!ok)
             throwError(ErrorKind::Argument, "",
-                       "--token: expected " + std::to_string(kMinTokenLength) +
+                       "`token`: expected " + std::to_string(kMinTokenLength) +
                            " or more characters from A-Z, a-z, 0-9, _ and -");
     }
     if (o.maxSessions < 1 || o.maxMessagesPerSecond < 1 || o.maxScale < 1 || o.maxConnections < 1 ||

@@ -389,18 +389,18 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_NEAR(cam.position.z, state["state"]["camera"]["position"][2].get<double>(), 1e-4);
     const std::string cmd = ex["command"];
     EXPECT_THAT(cmd, HasSubstr("uvr render grid.vtk --tf uvr-tf.json --camera uvr-camera.pvcc "
-                               "--range -2.5,2.5 --method auto --size 64x48"));
-    EXPECT_THAT(cmd, HasSubstr("--size 64x48 --opacity-unit 0.5 --step 0.01 -o uvr-view.png"));
+                               "--range -2.5,2.5 --size 64x48 --method auto --opacity-unit 0.5 "
+                               "--step 0.01 -o uvr-view.png"));
     // The adaptive method exports its quality; so does auto with a quality of its own (which
     // makes its frames adaptive).
     c.send({{"type", "set"}, {"method", "adaptive"}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
-                HasSubstr("--method adaptive --quality 0.99 --size"));
+                HasSubstr("--method adaptive --quality 0.99 --opacity-unit"));
     c.send({{"type", "set"}, {"method", "auto"}, {"quality", 0.995}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
-                HasSubstr("--method auto --quality 0.995 --size"));
+                HasSubstr("--method auto --quality 0.995 --opacity-unit"));
     c.send({{"type", "set"}, {"quality", 0.99}});
     // A log scale over a range from 0 exports the range the frames map (AdjustRangeForLog).
     c.send({{"type", "set"}, {"range", {0, 2}}, {"tf", {{"log", true}}}});
@@ -603,13 +603,13 @@ TEST(ViewServer, StopClosesConnectionsAndBadOptionsAreRefused) {
     };
     ServerOptions shortToken;
     shortToken.token = "abc";
-    EXPECT_THAT(refused(shortToken), HasSubstr("--token"));
+    EXPECT_THAT(refused(shortToken), HasSubstr("`token`"));
     ServerOptions oddToken;
     oddToken.token = "0123456789abcdef;rm";
-    EXPECT_THAT(refused(oddToken), HasSubstr("--token"));
+    EXPECT_THAT(refused(oddToken), HasSubstr("`token`"));
     ServerOptions badHost;
     badHost.host = "not-an-address";
-    EXPECT_THAT(refused(badHost), HasSubstr("--host not-an-address"));
+    EXPECT_THAT(refused(badHost), HasSubstr("`host` not-an-address"));
     // A port in use is found before any work, and by start.
     auto busy = startServer();
     ServerOptions same;

@@ -279,7 +279,7 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             result.rangeGiven = true;
         } else if (k == "field") {
             if (!v.is_string() || v.get<std::string>().size() > 1024)
-                bad(k, "a field spec as --field takes it", v);
+                bad(k, "a field spec (\"pressure\", \"velocity:magnitude\", \"T:cell\")", v);
             parseFieldSpec(v.get<std::string>());  // a malformed suffix fails here
             result.fieldChanged = v.get<std::string>() != next.field;
             next.field = v.get<std::string>();

@@ -233,7 +233,7 @@ std::size_t selectMap(const std::string& path, const Json& maps, const std::stri
     if (name.empty()) {
         if (maps.size() == 1) return 0;
         throwError(ErrorKind::Argument, path,
-                   "holds " + std::to_string(maps.size()) + " colour maps: pick one with --tf " +
+                   "holds " + std::to_string(maps.size()) + " colour maps: pick one with `tf` " +
                        path + ":NAME, one of " + quotedNames(names, 10) + " (" + listing + ")");
     }
     for (std::size_t i = 0; i < names.size(); ++i)

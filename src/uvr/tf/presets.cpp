@@ -673,7 +673,7 @@ TransferFunction transferFunctionPreset(const std::string& name) {
                "unknown transfer function preset \"" + printableShort(name, 60) + "\"" +
                    (suggest.empty() ? "" : "; did you mean " + suggest + "?") +
                    " (`uvr presets` lists the " + std::to_string(std::size(kPresets)) +
-                   " presets; --tf also takes a ParaView colour-map .json file)");
+                   " presets; `tf` also takes a ParaView colour-map .json file)");
 }
 
 }  // namespace uvr

@@ -11,6 +11,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/core/text.h"
 
 namespace uvr {
@@ -134,10 +135,10 @@ Vec3f interpolateDiverging(Vec3f a, Vec3f b, double f) {
 }
 
 [[noreturn]] void badSpec(const std::string& spec, const std::string& why) {
-    throwError(ErrorKind::Argument, "",
-               "--opacity \"" + printableShort(spec, 60) + "\": " + printableShort(why, 100) +
-                   "; expected \"ramp\", \"ramp:A\", \"constant:A\", \"step:T[:A]\" or "
-                   "\"x0:a0,x1:a1,...\" with numbers in [0, 1]");
+    throw SettingError("opacity", "\"" + printableShort(spec, 60) + "\"",
+                       printableShort(why, 100) +
+                           "; expected \"ramp\", \"ramp:A\", \"constant:A\", \"step:T[:A]\" or "
+                           "\"x0:a0,x1:a1,...\" with numbers in [0, 1]");
 }
 
 /// Parses a whole string as a finite number in [0, 1].
@@ -234,7 +235,7 @@ std::vector<Vec4f> TransferFunction::bakeOverRange(int n, double lo, double hi) 
     }
     if (!(lo > 0.0) || !(hi >= lo) || !std::isfinite(hi))
         throwError(ErrorKind::Argument, "",
-                   "--log needs a positive value range, got [" + std::to_string(lo) + ", " +
+                   "`log` needs a positive value range, got [" + std::to_string(lo) + ", " +
                        std::to_string(hi) + "]");
     std::vector<Vec4f> table(static_cast<size_t>(n));
     const double logLo = std::log10(lo), logWidth = std::log10(hi) - logLo;
@@ -318,7 +319,7 @@ TransferFunction loadTransferFunction(const std::string& presetOrPath) {
                    "lists the built-in presets)");
     if (file->second.empty() && presetOrPath.size() > path.size())
         throwError(ErrorKind::Argument, path,
-                   "empty colour-map name after ':' in --tf " + presetOrPath);
+                   "empty colour-map name after ':' in `tf` " + presetOrPath);
     return loadParaViewColorMap(path, name);
 }
 

@@ -561,7 +561,7 @@ TEST(TransferFunction, PresetsFilePicksMapsByName) {
     // Without a name a file of several maps is refused, naming them.
     Error e = catchError([&] { loadTransferFunction(path); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
-    EXPECT_THAT(e.what(), HasSubstr(path + ": holds 4 colour maps: pick one with --tf " + path +
+    EXPECT_THAT(e.what(), HasSubstr(path + ": holds 4 colour maps: pick one with `tf` " + path +
                                     ":NAME, one of \"Deep Sea\", \"Ember Ramp\", \"Decades\", "
                                     "\"Site Classes\""));
     EXPECT_THAT(e.what(), HasSubstr("`uvr presets " + path + "` lists them"));

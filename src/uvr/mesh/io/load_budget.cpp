@@ -26,7 +26,7 @@ void LoadBudget::check(const std::string& file, const std::string& what, std::ui
             what + " needs " + need + " bytes, which " +
                 (used_ ? "with the " + std::to_string(used_) + " bytes this load holds so far "
                        : std::string()) +
-                "exceed the memory limit of " + std::to_string(limit_) + " bytes (--max-memory)");
+                "exceed the memory limit of " + std::to_string(limit_) + " bytes (`max_memory`)");
     }
 }
 

@@ -20,7 +20,7 @@ TEST(LoadBudget, ChargesUpToTheLimitAndNamesTheTotal) {
         EXPECT_EQ(e.kind(), ErrorKind::Resource);
         EXPECT_EQ(std::string(e.what()),
                   "f.vtu: Piece 1: DataArray 'p' needs 404 bytes, which with the 600 bytes this "
-                  "load holds so far exceed the memory limit of 1000 bytes (--max-memory)");
+                  "load holds so far exceed the memory limit of 1000 bytes (`max_memory`)");
     }
     budget.release(200);
     budget.charge("f.vtu", "again", 100, 4);
@@ -51,7 +51,7 @@ TEST(LoadBudget, ReadFileChargedRefusesAFileAboveTheLimitWithoutReadingIt) {
     } catch (const Error& e) {
         EXPECT_EQ(std::string(e.what()), path +
                                              ": the file needs 300 bytes, which exceed the "
-                                             "memory limit of 299 bytes (--max-memory)");
+                                             "memory limit of 299 bytes (`max_memory`)");
     }
     LoadBudget enough(300);
     EXPECT_EQ(readFileCharged(path, enough).size(), 300u);

@@ -13,6 +13,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/setting_error.h"
 #include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/mesh_reader.h"
@@ -52,7 +53,8 @@ bool sameGeometry(const MeshView& a, const MeshView& b) {
 }
 
 std::size_t stepAtTime(const std::vector<double>& times, double t) {
-    if (!std::isfinite(t)) throwError(ErrorKind::Argument, "", "--time: expected a finite number");
+    if (!std::isfinite(t))
+        throw SettingError("time", std::to_string(t), "expected a finite number");
     std::size_t best = 0;
     for (std::size_t i = 0; i < times.size(); ++i)
         if (times[i] <= t && times[i] >= times[best]) best = i;

@@ -661,7 +661,7 @@ TEST(VtkLegacyLimits, AFileLargerThanTheMemoryLimitIsRefusedUnread) {
         EXPECT_EQ(e.kind(), ErrorKind::Resource);
         EXPECT_EQ(std::string(e.what()), path +
                                              ": the file needs 2147483648 bytes, which exceed "
-                                             "the memory limit of 67108864 bytes (--max-memory)");
+                                             "the memory limit of 67108864 bytes (`max_memory`)");
     }
     std::filesystem::remove(path);
 }
@@ -686,7 +686,7 @@ TEST(VtkLegacyLimits, TheLimitBoundsAllArraysTogether) {
         EXPECT_EQ(e.kind(), ErrorKind::Resource);
         EXPECT_THAT(e.what(), HasSubstr(path + ": tuples of SCALARS 'f"));
         EXPECT_THAT(e.what(), HasSubstr("needs 4000 bytes, which with the "));
-        EXPECT_THAT(e.what(), HasSubstr("exceed the memory limit of 300000 bytes (--max-memory)"));
+        EXPECT_THAT(e.what(), HasSubstr("exceed the memory limit of 300000 bytes (`max_memory`)"));
     }
     options.maxMemoryBytes = 0;
     EXPECT_EQ(readVtkLegacy(path, options).fields.size(), 40u);

@@ -631,7 +631,7 @@ TEST(VtuAmplification, OneBlockReusedByManyPiecesIsRefusedBeforeDecodingItAgain)
                  "Pieces) needs 48000000 bytes, which with the " +
                  std::to_string(text.size()) +
                  " bytes this load holds so far exceed the "
-                 "memory limit of 4194304 bytes (--max-memory)"});
+                 "memory limit of 4194304 bytes (`max_memory`)"});
     // One piece is a legitimate file (its 1.2 MB of zeros compress 1000:1).
     const std::string one = testing::writeFile(
         dir + "/one.vtu", appendedZlibVtu(pointsPiece(100000), zlibZerosPayload(1200000)));
