@@ -33,9 +33,9 @@
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/procedural.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/render/image.h"
 #include "uvr/render/image_metrics.h"
-#include "uvr/render/render_setup.h"
 
 namespace {
 

@@ -30,8 +30,8 @@
 #include "uvr/mesh/procedural.h"
 #include "uvr/mesh/validate.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/render/image.h"
-#include "uvr/render/render_setup.h"
 #include "uvr/tf/transfer_function.h"
 
 #ifdef UVR_HAVE_NETCDF

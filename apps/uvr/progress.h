@@ -10,7 +10,7 @@
 #include <string>
 #include <thread>
 
-#include "uvr/render/render_setup.h"
+#include "uvr/prepare/prepared_mesh.h"
 
 namespace uvr::cli {
 

@@ -21,6 +21,7 @@ LADDER = [
     ["mesh"],
     ["accel"],
     ["tf"],
+    ["prepare"],
     ["render"],
     ["cpu", "cuda", "annotate", "cache"],
     ["facade"],

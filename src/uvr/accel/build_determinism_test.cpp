@@ -16,7 +16,7 @@
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/cpu/threads.h"
 #include "uvr/mesh/procedural.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "test_meshes.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

@@ -10,8 +10,8 @@
 #include "uvr/accel/point_locator.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/render/image_metrics.h"
-#include "uvr/render/render_setup.h"
 
 namespace uvr {
 namespace {

@@ -12,7 +12,7 @@
 #include "test_meshes.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/mesh/tet_math.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "uvr/accel/point_locator.h"
 #include "uvr/mesh/procedural.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

@@ -13,7 +13,7 @@
 #include "uvr/core/error.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/load_budget.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/prepare/prepared_mesh.h"
 
 namespace uvr {
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 
 namespace uvr {
 
@@ -207,6 +208,12 @@ std::vector<std::string> closeMatches(const std::string& word,
         if (std::find(out.begin(), out.end(), s.second) == out.end()) out.push_back(s.second);
     }
     return out;
+}
+
+std::string formatG(double value, int significant) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.*g", significant, value);
+    return buf;
 }
 
 }  // namespace uvr

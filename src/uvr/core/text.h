@@ -30,6 +30,9 @@ std::string encodeUtf8(std::u32string_view text);
 /// U+10FFFF).
 bool isValidUtf8(std::string_view text);
 
+/// A number for a message: printf's "%.Ng" with `significant` digits ("0.0173", "1.72e+12").
+std::string formatG(double value, int significant);
+
 /// "UTF-32" or "UTF-16" when the start of a text file is in one of those encodings (a byte-order
 /// mark, or NUL bytes among the first four, which UTF-8 text never has), else nullptr. Readers of
 /// UTF-8 formats use it to refuse such files with a clear message.

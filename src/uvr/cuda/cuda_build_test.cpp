@@ -16,8 +16,8 @@
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/procedural.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/render/image_metrics.h"
-#include "uvr/render/render_setup.h"
 
 namespace uvr {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "uvr/cuda/scene_arrays.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "uvr/render/render_setup.h"
+#include "uvr/prepare/prepared_mesh.h"
 
 namespace uvr {
 

@@ -8,7 +8,7 @@
 
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 

@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 

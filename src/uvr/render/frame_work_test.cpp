@@ -11,7 +11,7 @@
 #include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {

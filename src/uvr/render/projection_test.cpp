@@ -13,7 +13,7 @@
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/render/frame_kernel.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {

@@ -8,36 +8,11 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/scene_view.h"
 #include "uvr/render/segment_integral.h"
 #include "uvr/tf/tf_table.h"
 
 namespace uvr {
-
-/// Compositing parameters shared by every integrator.
-struct MarchParams {
-    float step = 0.f;                ///< sample spacing s1 along the ray (world units)
-    float opacityUnit = 1.f;         ///< distance over which a TF opacity applies (ParaView's unit)
-    float terminationAlpha = 0.99f;  ///< early ray termination threshold on accumulated opacity
-    /// Integrate between consecutive samples with the scalar linear from one to the next
-    /// (SampleSegments) instead of point samples with opacity correction.
-    bool preintegrated = true;
-};
-
-/// Everything a ray needs, as plain data for CPU and GPU.
-struct SceneView {
-    TetLocator locator;
-    TfTableView tf;
-    Bounds3f bounds;
-    MarchParams params;
-};
-
-/// Per-ray counters.
-struct RayCounters {
-    std::uint32_t samples = 0;            ///< samples taken (point locations)
-    std::uint32_t partitionsVisited = 0;  ///< k-d partitions the ray entered
-    std::uint32_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
-    LocateCounters locate;
-};
 
 /// Opacity of a sample taken over distance `step` for a TF opacity `alpha` defined per `unit`
 /// under a law (opacity correction): 1 - exp(-alpha step / unit) (attenuation), 1 - (1 -

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "uvr/core/setting_error.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 

@@ -14,7 +14,7 @@
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/render/camera.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

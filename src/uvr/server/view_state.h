@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "uvr/render/camera.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr::server {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "uvr/render/render_method.h"
+#include "uvr/prepare/render_method.h"
 
 #include <algorithm>
 #include <cmath>

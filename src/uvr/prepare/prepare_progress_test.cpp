@@ -15,7 +15,7 @@
 
 #include "uvr/cpu/threads.h"
 #include "uvr/mesh/procedural.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "uvr/render/render_method.h"
+#include "uvr/prepare/render_method.h"
 
 #include <gmock/gmock.h>
 
@@ -7,7 +7,7 @@
 #include "test_support.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/facade/renderer.h"
-#include "uvr/render/render_setup.h"
+#include "uvr/render/frame_setup.h"
 
 namespace uvr {
 namespace {

@@ -1,0 +1,306 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/prepare/prepared_mesh.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <future>
+#include <string>
+
+#include "uvr/accel/tet_adjacency.h"
+#include "uvr/core/error.h"
+#include "uvr/mesh/tet_math.h"
+
+namespace uvr {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Runs fn on a thread of its own (with its own OpenMP team), timed: CPU work beside the GPU's.
+template <class Fn>
+auto beside(Fn fn) {
+    return std::async(std::launch::async, [fn = std::move(fn)] {
+        const auto start = std::chrono::steady_clock::now();
+        auto result = fn();
+        return std::make_pair(std::move(result), secondsSince(start));
+    });
+}
+
+/// Meshes of up to this many cells get cell-tree leaves of at most kCpuCellTreeLeaf whatever
+/// PrepareOptions::cellTreeLeaf asks (the GPU's kCellTreeLeaf): on small non-convex meshes
+/// searches are not rare (SPX: one sample in five on an H200; disk_out_ref.ex2: one in seven),
+/// and 32-cell leaves made the GPU's adaptive frame 1.4-5.4x slower there (SPX 40.8 -> 7.6 ms,
+/// Oxygen Post 15.4 -> 5.6 ms; docs/PERFORMANCE.md, "The default method"). 2-cell leaves cost
+/// 32 bytes per cell against 2: at most 512 MiB here.
+constexpr std::uint64_t kSmallCellTreeCells = std::uint64_t(1) << 24;
+
+}  // namespace
+
+PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
+                         const PrepareOptions& options, const ProgressFn& progress) {
+    PreparedMesh out;
+    out.sourceCells = mesh.cellCount();
+    auto start = std::chrono::steady_clock::now();
+    if (progress)
+        progress(options.cells.splitCells
+                     ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
+                     : "preparing " + std::to_string(mesh.cellCount()) + " cells");
+    TetrahedralizeOptions cells = options.cells;
+    // The builders (the GPU's) only where the mesh is large enough to pay.
+    const bool large = mesh.cellCount() >= options.builderMinTets;
+    if (!large) cells.sorter = nullptr;
+    // For the face neighbours found elsewhere, the points' welded ids (coincidentPointIds) on a
+    // thread of their own beside the split, which keeps the points' numbering.
+    std::future<std::pair<std::vector<std::uint32_t>, double>> welding;
+    if (large && options.faceMatcher)
+        welding = beside([points = mesh.points] { return coincidentPointIds(points); });
+    out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
+    std::vector<std::uint32_t> welded;
+    if (welding.valid()) welded = std::move(welding.get().first);  // before the points are freed
+    if (options.afterSplit) options.afterSplit();
+    out.autoChoice = autoMethod(out.tets, options.autoOnGpu);
+    out.splitSeconds = secondsSince(start);
+    out.phaseSeconds.emplace_back("split", out.splitSeconds);
+    // What RenderMethod::Auto renders with, besides what was asked for.
+    const bool forExact = options.forAuto && out.autoChoice->method == RenderMethod::Exact;
+    const bool withBvh = options.meshBvh || forExact;
+    const bool withPartitions = options.partitions || (options.forAuto && !forExact);
+    const std::uint32_t cellTreeLeaf = out.tets.cellCount() <= kSmallCellTreeCells
+                                           ? std::min(options.cellTreeLeaf, kCpuCellTreeLeaf)
+                                           : options.cellTreeLeaf;
+
+    // The other builders too, by the cells of the split.
+    const bool elsewhere = out.tets.cellCount() >= options.builderMinTets;
+    const LbvhBuilder lbvh = elsewhere ? options.lbvh : nullptr;
+    const KdSplitter splitter = elsewhere ? options.kdSplitter : nullptr;
+    const auto faceMatcher = elsewhere ? options.faceMatcher : nullptr;
+    const SeedBuilder seedBuilder = elsewhere ? options.seedBuilder : nullptr;
+    const MacroBuilder macroBuilder =
+        elsewhere && options.macroGrids ? options.macroBuilder : nullptr;
+    out.builtElsewhere =
+        elsewhere && (lbvh || splitter || faceMatcher || seedBuilder || macroBuilder);
+    if (withBvh) {
+        start = std::chrono::steady_clock::now();
+        if (progress)
+            progress("building the BVH over " + std::to_string(out.tets.cellCount()) + " cells" +
+                     (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
+        if (lbvh) {
+            out.bvh = buildMeshLbvh(out.tets, lbvh);
+        } else {
+            std::vector<Bounds3f> boxes;
+            std::vector<Vec3f> centers;
+            tetBoxesAndCenters(out.tets, boxes, centers);
+            out.bvh = buildBvh(boxes, centers);
+        }
+        out.bvhSeconds = secondsSince(start);
+        out.phaseSeconds.emplace_back("bvh", out.bvhSeconds);
+    }
+
+    // While the GPU finds the neighbours and partitions, the CPU builds the cell tree (it needs
+    // only the cells) and then the neighbours' codes on threads of their own.
+    std::future<std::pair<Bvh, double>> cellTree;
+    if (faceMatcher && withPartitions)
+        cellTree =
+            beside([&tets = out.tets, leaf = cellTreeLeaf] { return buildCellTree(tets, leaf); });
+    start = std::chrono::steady_clock::now();
+    if (progress)
+        progress(faceMatcher ? "finding face neighbours (on " + options.builderDevice +
+                                   (cellTree.valid() ? "; the cell tree beside it)" : ")")
+                             : std::string("finding face neighbours"));
+    // On the CPU their codes take 0.74 of 4.91 seconds at 100M tetrahedra.
+    constexpr double kNeighborsEnd = 4.17 / 4.91;
+    std::future<std::pair<CompactNeighbors, double>> codes;
+    if (faceMatcher) {
+        // Welded again where the split moved the points into a frame (equal points stay equal,
+        // but the weld is of the points the matcher reads), or where none were welded.
+        if (welded.size() != out.tets.points.size() || !out.tets.frame.identity())
+            welded = coincidentPointIds(out.tets.points);
+        out.neighbors = faceMatcher(out.tets, welded, progress.fraction);
+        welded = {};
+        codes = beside([&tets = out.tets, &neighbors = out.neighbors] {
+            return compactNeighbors(tets, neighbors);
+        });
+    } else {
+        out.neighbors =
+            buildTetNeighbors(out.tets, subRange(progress.fraction, 0.0, kNeighborsEnd));
+        out.neighborCodes = compactNeighbors(out.tets, out.neighbors,
+                                             subRange(progress.fraction, kNeighborsEnd, 1.0));
+    }
+    out.adjacencySeconds = secondsSince(start);
+    out.phaseSeconds.emplace_back("neighbours", out.adjacencySeconds);
+
+    if (withPartitions) {
+        if (progress)
+            progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
+                     " cells each" + (splitter ? ", on " + options.builderDevice : std::string()) +
+                     ")");
+        KdBuildOptions kd = options.kd;
+        // The leaf size counts tetrahedra of the split: native cells fill a leaf as the
+        // tetrahedra they stand for would (partitions of the same size in space).
+        if (out.tets.hasNative())
+            kd.leafCells = static_cast<std::uint32_t>(
+                std::max(1.0, std::round(kd.leafCells / out.tets.meanSplitTets())));
+        if (splitter) kd.splitter = splitter;
+        start = std::chrono::steady_clock::now();
+        out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
+        out.phaseSeconds.emplace_back("partitions", secondsSince(start));
+        if (cellTree.valid()) {
+            auto [tree, seconds] = cellTree.get();
+            out.cellTree = std::move(tree);
+            out.phaseSeconds.emplace_back("cell_tree", seconds);
+        } else {
+            if (progress) progress("building the cell tree");
+            start = std::chrono::steady_clock::now();
+            out.cellTree = buildCellTree(out.tets, cellTreeLeaf, progress.fraction);
+            out.phaseSeconds.emplace_back("cell_tree", secondsSince(start));
+        }
+        if (options.seedGrids) {
+            if (progress)
+                progress("building seed grids" +
+                         (seedBuilder ? " (on " + options.builderDevice + ")" : std::string()));
+            start = std::chrono::steady_clock::now();
+            out.seeds =
+                seedBuilder
+                    ? seedBuilder(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction)
+                    : buildSeedGrids(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction);
+            out.phaseSeconds.emplace_back("seed_grids", secondsSince(start));
+        }
+        if (macroBuilder) {
+            if (progress)
+                progress("building macrocell grids and gradient spreads (on " +
+                         options.builderDevice + ")");
+            start = std::chrono::steady_clock::now();
+            MacroBuild built = macroBuilder(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,
+                                            progress.fraction);
+            out.gradientSpread = std::move(built.gradientSpread);
+            out.macro = std::move(built.macro);
+            out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
+        } else {
+            if (progress) progress("measuring the partitions' gradient spreads");
+            start = std::chrono::steady_clock::now();
+            out.gradientSpread = partitionGradientSpread(out.tets, *out.kd, progress.fraction);
+            out.phaseSeconds.emplace_back("gradient_spreads", secondsSince(start));
+        }
+        if (progress) progress("looking for NaN values");
+        start = std::chrono::steady_clock::now();
+        out.partitionNan = partitionNanFlags(out.tets, *out.kd);
+        out.phaseSeconds.emplace_back("nan_flags", secondsSince(start));
+        if (options.macroGrids && !macroBuilder) {
+            if (progress) progress("building macrocell grids");
+            start = std::chrono::steady_clock::now();
+            out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,
+                                        progress.fraction);
+            out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
+        }
+    }
+    if (codes.valid()) {
+        auto [made, seconds] = codes.get();
+        out.neighborCodes = std::move(made);
+        out.phaseSeconds.emplace_back("neighbour_codes", seconds);
+    }
+    return out;
+}
+
+void updateFieldValues(PreparedMesh& mesh, const ScalarField& field) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!mesh.cacheFile.empty())
+        throwError(ErrorKind::Argument, mesh.cacheFile,
+                   "prepared from the cache " + mesh.cacheFile +
+                       ", which holds only what rendering reads: change fields (or time steps) by "
+                       "preparing from the mesh");
+    // Checked before anything changes (assignTetValues checks it too).
+    const bool cellData = field.association == Association::Cell;
+    const std::uint64_t expected = cellData ? mesh.sourceCells : mesh.tets.points.size();
+    if (field.values.size() != expected)
+        throwError(ErrorKind::Argument, "",
+                   "new values of field '" + field.name +
+                       "': " + std::to_string(field.values.size()) + " " +
+                       associationName(field.association) + " values, expected " +
+                       std::to_string(expected) + " (one per " + (cellData ? "cell" : "point") +
+                       " of the prepared mesh)");
+    assignTetValues(mesh.tets, field);
+    if (mesh.kd) {
+        computePartitionValueRanges(mesh.tets, *mesh.kd);
+        mesh.gradientSpread = partitionGradientSpread(mesh.tets, *mesh.kd);
+        mesh.partitionNan = partitionNanFlags(mesh.tets, *mesh.kd);
+        if (mesh.macro) fillMacroCells(mesh.tets, *mesh.kd, mesh.neighbors, *mesh.macro);
+    }
+    ++mesh.valueUpdates;
+    mesh.valueUpdateSeconds = secondsSince(start);
+}
+
+std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartitions& kd) {
+    const auto isNan = [](float v) { return v != v; };
+    if (std::none_of(tets.values.begin(), tets.values.end(), isNan)) return {};
+    const bool cellData = tets.association == Association::Cell;
+    std::vector<std::uint8_t> out(kd.partitions.size(), 0);
+    const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+    const TetMeshView view = tets.view();
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::int64_t p = 0; p < n; ++p) {
+        const KdPartition& part = kd.partitions[p];
+        bool nan = false;
+        for (std::uint32_t i = 0; i < part.cellCount && !nan; ++i) {
+            const std::uint32_t t = kd.cells[part.firstCell + i];
+            if (cellData) {
+                nan = isNan(tets.values[t]);
+            } else {
+                std::uint32_t ids[kMaxCellCorners];
+                const int corners = view.corners(t, ids);
+                for (int k = 0; k < corners; ++k) nan = nan || isNan(tets.values[ids[k]]);
+            }
+        }
+        out[p] = nan;
+    }
+    return out;
+}
+
+std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitions& kd,
+                                           const FractionFn& progress) {
+    const std::int64_t n = static_cast<std::int64_t>(kd.partitions.size());
+    std::vector<float> out(n, 0.f);
+    ProgressCounter done(progress, n);
+    if (tets.association == Association::Cell) {
+        for (std::int64_t p = 0; p < n; ++p)
+            if (kd.partitions[p].cellCount > 0) out[p] = INFINITY;
+        done.finish();
+        return out;
+    }
+    const TetMeshView view = tets.view();
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::int64_t p = 0; p < n; ++p) {
+        const KdPartition& part = kd.partitions[p];
+        Bounds3f box;
+        for (std::uint32_t i = 0; i < part.cellCount; ++i)
+            box.extend(cellGradientBounds(view, kd.cells[part.firstCell + i]));
+        out[p] = box.empty() ? 0.f : length(box.hi - box.lo);
+        done.add();
+    }
+    done.finish();
+    return out;
+}
+
+PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field) {
+    const PrepareOptions defaults;
+    return prepareMesh(mesh, field, defaults);
+}
+
+float defaultStep(const TetMesh& mesh) {
+    const double diagonal = mesh.bounds.diagonal();
+    if (mesh.cellCount() == 0 || !(mesh.totalVolume > 0.0))
+        return diagonal > 0.0 ? static_cast<float>(0.01 * diagonal) : 1.f;
+    const double mean = 0.5 * std::cbrt(mesh.totalVolume / double(mesh.splitTetCount()));
+    const double step = std::min(mean, diagonal / kMinSamplesPerDiagonal);
+    return static_cast<float>(std::max(step, kMinDefaultStepFraction * diagonal));
+}
+
+float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount) {
+    const double d = bounds.diagonal();
+    if (cellCount == 0 || !(d > 0.0)) return 1.f;
+    return static_cast<float>(d / std::cbrt(double(cellCount)));
+}
+
+}  // namespace uvr

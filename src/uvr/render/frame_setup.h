@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The frame setup: settings resolved against a prepared mesh (the method, the baked transfer
+// function, the camera in the mesh's units, the partitions' shading), and what a frame returns.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "uvr/accel/kd_partitions.h"
+#include "uvr/accel/macro_grid.h"
+#include "uvr/prepare/prepared_mesh.h"
+#include "uvr/render/adaptive_marcher.h"
+#include "uvr/render/camera.h"
+#include "uvr/render/frame_kernel.h"
+#include "uvr/render/image.h"
+#include "uvr/render/render_settings.h"
+#include "uvr/render/scene_view.h"
+
+namespace uvr {
+
+/// The method a frame renders with, and why when settings.method is Auto.
+struct ResolvedMethod {
+    RenderMethod method = RenderMethod::Partitions;
+    std::string reason;  ///< with RenderMethod::Auto: one line (AutoMethodChoice::reason), else ""
+};
+/// settings.method, or for RenderMethod::Auto: the adaptive method when tunesAdaptive, else
+/// mesh.autoChoice (made for the GPU when gpu, else the CPU; made now when it was made for the
+/// other or not at all), the other of exact and adaptive where only its structures are prepared.
+ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu);
+
+/// Most samples one ray may take across the mesh bounds' diagonal at the step s1: the default
+/// step takes 2 to 3 samples per cell, so this is a step 40 times finer than the default on a
+/// mesh of a billion cells; finer steps are far smaller than any cell and change nothing seen.
+inline constexpr double kMaxSamplesPerRay = 1e5;
+/// Most samples a frame may take (pixels x samples per ray): about an hour for 16 CPU cores
+/// (2e7 samples per second each), minutes on a GPU.
+inline constexpr double kMaxFrameSamples = 1e12;
+
+/// Upper bound on the work of a frame: every ray crossing the bounds' whole diagonal.
+struct FrameWork {
+    double samplesPerRay = 0.0;  ///< bounds diagonal / step
+    double samples = 0.0;        ///< pixels x rays per pixel x samplesPerRay
+};
+
+/// The work estimate of a width x height frame of the bounds at a step, with raysPerPixel rays
+/// per pixel (supersample squared).
+FrameWork estimateFrameWork(const Bounds3f& bounds, float step, int width, int height,
+                            int raysPerPixel = 1);
+
+/// Host bytes per pixel of a frame rendered and written as a PNG: the float image (16), the
+/// per-pixel sample counts (4) and the PNG's 8-bit rows (4).
+inline constexpr std::uint64_t kFrameBytesPerPixel = 24;
+/// Host bytes per pixel of a sample-count heat map written as a PNG (float image and 8-bit rows),
+/// counted over the image and its legend.
+inline constexpr std::uint64_t kHeatmapBytesPerPixel = 20;
+/// Image-buffer bytes one frame (or a command's frames held together) may take unless a memory
+/// limit is given explicitly: 2 GiB, an 8192 x 8192 frame (1.5 GiB) with room. A frame's memory
+/// and time grow with its pixels whatever the mesh (16384 x 16384 of five tetrahedra: 6 GiB and
+/// a minute), so larger frames must be asked for with an explicit limit.
+inline constexpr std::uint64_t kDefaultFrameMemoryBytes = 2ull << 30;
+
+/// Per-partition shading for a transfer function (Morrical et al. 2019, Sec. 2.1): each
+/// partition's maximum opacity, rate and colour variance over its value range (O(1) per
+/// partition from the table's range statistics, independent of cell count) and its step by the
+/// rule (shadePartition; for the variance rule the variances are normalised to [0, 1] by the
+/// minimum and maximum over the visible partitions).
+std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
+                                                      const std::vector<float>& gradientSpread,
+                                                      const TfRangeView& range,
+                                                      const StepRuleParams& rule);
+
+/// Per-macrocell shading for a transfer function and the error-bound rule: each macrocell's
+/// maximum opacity over its value range and its step (shadePartition); an empty macrocell is
+/// transparent.
+std::vector<PartitionShading> computeMacroShading(const MacroGrids& macro, const TfRangeView& range,
+                                                  const StepRuleParams& rule);
+
+/// Whether the partition method steps by macrocells for these settings: the error-bound rule
+/// with adaptive steps on a mesh with macrocell grids (the paper's variance rule and "skipping
+/// only" keep one step per partition).
+bool usesMacroCells(const PreparedMesh& mesh, const StepRuleParams& rule);
+
+/// Host-side frame state built from settings: the baked table, the camera and the parameters.
+struct FrameSetup {
+    std::vector<Vec4f> tfTable;
+    Vec4f tfNan;                         ///< colour and opacity of NaN values (TfTableView::nan)
+    std::vector<std::int32_t> tfBreaks;  ///< tfTableBreaks of tfTable
+    OpacityLaw opacityLaw = kDefaultOpacityLaw;  ///< RenderSettings::opacityLaw
+    StepRuleParams stepRule;                ///< the partition method's step rule and its inputs
+    std::vector<PartitionShading> shading;  ///< per partition (partition method only)
+    /// Per macrocell (partition method with usesMacroCells; empty otherwise).
+    std::vector<PartitionShading> macroShading;
+    double tfUpdateSeconds = 0.0;  ///< range tables + shading of all partitions and macrocells
+    float maxStep = 0.f;           ///< s2 in effect
+    /// The prepared mesh's frame: camera, rays, params and maxStep are in its rendering units
+    /// (lengths divided by frame.scale are in the file's units).
+    MeshFrame frame;
+    Camera camera;
+    CameraRays rays;
+    MarchParams params;
+    /// The value range the table spans: the settings' or the field's; with a log-scale transfer
+    /// function one from 0 or below starts at min(hi / 10^4, 1) (ParaView's AdjustRangeForLog).
+    float rangeLo = 0.f, rangeHi = 1.f;
+    /// What the setup changed or could not do as asked, one sentence each, for the user (the
+    /// CLI prints them as warnings): a log range moved off 0, a log table too coarse at its low
+    /// end.
+    std::vector<std::string> notes;
+    /// The method the frame renders with (resolveMethod: RenderMethod::Auto resolved) and, for
+    /// Auto, why.
+    ResolvedMethod method;
+
+    /// The baked table as a view (host pointers); the setup must outlive it.
+    TfTableView tfView() const;
+    /// Scene view over a prepared mesh; both must outlive it.
+    SceneView scene(const PreparedMesh& mesh) const;
+    /// Partition scene view (the mesh must have partitions); both must outlive it.
+    PartitionSceneView partitionScene(const PreparedMesh& mesh, bool skip) const;
+};
+
+/// The frame's output buffers and rays for the shared pixel kernel (both backends): pixels and
+/// counts hold width * height entries on the device that renders.
+inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup& setup,
+                               Vec4f* pixels, std::uint32_t* sampleCounts) {
+    return FrameView{pixels,
+                     sampleCounts,
+                     settings.width,
+                     settings.height,
+                     setup.rays,
+                     settings.supersample,
+                     settings.jitter && settings.supersample > 1};
+}
+
+/// Resolves defaults (the method for the GPU when gpu, else the CPU: resolveMethod) and
+/// validates; throws Error(Argument) on bad settings. For the partition method on the CPU it also
+/// computes the per-partition shading (the CUDA backend computes it on the GPU).
+FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings,
+                          bool gpu = false);
+
+/// Statistics of one rendered frame.
+struct RenderStats {
+    double seconds = 0.0;                 ///< wall time of the frame (rendering only)
+    std::uint64_t samples = 0;            ///< samples taken
+    std::uint64_t walkSteps = 0;          ///< cells tested while walking
+    std::uint64_t bvhQueries = 0;         ///< point locations that fell back to the BVH
+    std::uint64_t partitionsVisited = 0;  ///< partitions entered by rays (partition method)
+    std::uint64_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
+    int width = 0, height = 0;
+    int supersample = 1;  ///< N x N rays per pixel
+
+    /// Adds another frame part's counters.
+    void merge(const RenderStats& o) {
+        samples += o.samples;
+        walkSteps += o.walkSteps;
+        bvhQueries += o.bvhQueries;
+        partitionsVisited += o.partitionsVisited;
+        partitionsSkipped += o.partitionsSkipped;
+    }
+    /// Adds one ray's counters.
+    void add(const RayCounters& c) {
+        samples += c.samples;
+        walkSteps += c.locate.walkSteps;
+        bvhQueries += c.locate.bvhQueries;
+        partitionsVisited += c.partitionsVisited;
+        partitionsSkipped += c.partitionsSkipped;
+    }
+    /// Samples per pixel (summed over its rays), averaged over the image.
+    double meanSamplesPerPixel() const {
+        return width > 0 && height > 0 ? static_cast<double>(samples) / (double(width) * height)
+                                       : 0.0;
+    }
+    /// Rays traced: pixels x supersample^2.
+    std::uint64_t rays() const {
+        return static_cast<std::uint64_t>(width > 0 ? width : 0) *
+               static_cast<std::uint64_t>(height > 0 ? height : 0) *
+               static_cast<std::uint64_t>(supersample) * static_cast<std::uint64_t>(supersample);
+    }
+    /// Samples per ray, averaged over the rays.
+    double meanSamplesPerRay() const {
+        return rays() > 0 ? static_cast<double>(samples) / static_cast<double>(rays()) : 0.0;
+    }
+};
+
+/// A rendered frame: image, per-pixel sample counts, statistics.
+struct RenderResult {
+    Image image;
+    std::vector<std::uint32_t> sampleCounts;  ///< per pixel, row-major
+    RenderStats stats;
+    FrameSetup setup;
+};
+
+}  // namespace uvr

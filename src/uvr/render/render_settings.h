@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// What a frame renders and how (RenderSettings), with the defaults and checks every front end
+// shares; settings_vocabulary.h names, types and documents the settings the front ends set.
+
+#include <functional>
+#include <optional>
+#include <utility>
+
+#include "uvr/prepare/render_method.h"
+#include "uvr/render/adaptive_marcher.h"
+#include "uvr/render/camera.h"
+#include "uvr/tf/transfer_function.h"
+
+namespace uvr {
+
+/// Default quality: the error-bound rule's SSIM target against the exact integrator.
+inline constexpr float kDefaultQuality = 0.99f;
+/// Range of the quality.
+inline constexpr float kMinQuality = 0.5f;
+inline constexpr float kMaxQuality = 0.9999f;
+
+/// Tolerance per unit of (1 - quality) (toleranceForQuality).
+inline constexpr float kToleranceScale = 5.f;
+
+/// The error-bound rule's tolerance (StepRuleParams::tolerance, optical depth error per opacity
+/// unit) for a quality: measured on the evaluation matrix (docs/PERFORMANCE.md), the worst-case
+/// SSIM against exact stays at or above the quality for tolerance kToleranceScale * (1 -
+/// quality).
+float toleranceForQuality(float quality);
+
+/// What to render and how.
+struct RenderSettings {
+    RenderMethod method = RenderMethod::Auto;
+    StepRule stepRule = StepRule::ErrorBound;  ///< how the partition method picks steps
+    /// The error-bound rule's target: the SSIM against the exact integrator that it aims at for
+    /// typical data (toleranceForQuality), in [kMinQuality, kMaxQuality].
+    float quality = kDefaultQuality;
+    /// Sample-based methods integrate between consecutive samples (false: point samples with
+    /// opacity correction, as in Morrical et al. 2019).
+    bool preintegrated = true;
+    float maxStep = 0.f;   ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1
+    float power = 2.f;     ///< variance rule: adaptive power p >= 1
+    bool skip = true;      ///< skip partitions of zero maximum opacity
+    bool adaptive = true;  ///< adaptive steps (false: every partition at s1)
+    int width = 1024;
+    int height = 1024;
+    std::optional<Camera> camera;  ///< default: resetCamera on the mesh bounds
+    TransferFunction tf;
+    std::optional<std::pair<float, float>> range;  ///< default: the field's finite range
+    float step = 0.f;                              ///< s1; 0 = defaultStep
+    float opacityUnit = 0.f;                       ///< 0 = defaultOpacityUnit
+    /// How the transfer function's opacities become extinction (default: ParaView's reading for
+    /// unstructured data).
+    OpacityLaw opacityLaw = kDefaultOpacityLaw;
+    float terminationAlpha = 0.99f;
+    /// Entries of the baked transfer function (a log-scale one gets more: logTableSize).
+    int tfTableSize = 1024;
+    /// Anti-aliasing: N x N rays per pixel (N in [1, kMaxSupersample]), their premultiplied
+    /// colours averaged; a pixel's sample count is the sum over its rays. 1: one ray through
+    /// the pixel's centre.
+    int supersample = 1;
+    /// With supersample > 1: each ray at a fixed hashed position inside its cell of the N x N
+    /// grid instead of its centre (deterministic: the same rays every frame, on every device).
+    bool jitter = false;
+    /// Called during a CPU render with the fraction of the frame done, increasing, the last call
+    /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
+    /// is one launch and reports nothing.)
+    std::function<void(double)> progress;
+};
+
+/// The names every front end and report gives the step rules ("error", "variance") and the
+/// sampling (RenderSettings::preintegrated: "preintegrated", else "point").
+const char* stepRuleName(StepRule rule);
+const char* samplingName(bool preintegrated);
+
+/// Largest RenderSettings::supersample: 8 x 8 = 64 rays per pixel.
+inline constexpr int kMaxSupersample = 8;
+
+/// Throws Error(Argument) for settings that cannot render: image size outside [1, 16384] per
+/// side, non-finite or non-positive step or opacity unit, bad range, bad camera, supersample
+/// outside [1, kMaxSupersample].
+void validateSettings(const RenderSettings& settings);
+
+/// True when settings tune what only the sampling methods read, away from RenderSettings'
+/// defaults (the step rule, quality, power, point sampling, s1 or s2, skipping or adaptive steps
+/// off): RenderMethod::Auto then renders the adaptive method they tune.
+bool tunesAdaptive(const RenderSettings& settings);
+
+/// Throws the Argument error of a log-scale mapping over a range with no positive value [lo, hi]:
+/// the `range` setting's when `given`, else the field's.
+[[noreturn]] void refuseLogRange(bool given, double lo, double hi);
+
+/// Default s2 / s1 of the adaptive step.
+inline constexpr float kDefaultMaxStepFactor = 16.f;
+
+}  // namespace uvr
