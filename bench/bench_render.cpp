@@ -7,6 +7,7 @@
 #include <map>
 
 #include "uvr/accel/tet_adjacency.h"
+#include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cpu/threads.h"
 #include "uvr/uvr.h"
 

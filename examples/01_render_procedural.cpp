@@ -12,14 +12,17 @@ int main(int argc, char** argv) {
         spec.targetCells = 20000;
         const uvr::Mesh mesh = uvr::generateMesh(spec);
         const uvr::ScalarField field = uvr::selectScalarField(mesh, uvr::parseFieldSpec("jet"));
-        const uvr::PreparedMesh prepared = uvr::prepareMesh(mesh, field);
+        uvr::RendererOptions options;  // prepared once; any number of frames
+        options.device = uvr::Device::Cpu;
+        uvr::Renderer renderer(mesh, field, options);
 
         uvr::RenderSettings settings;
+        settings.method = uvr::RenderMethod::Reference;
         settings.width = 256;
         settings.height = 256;
         settings.tf = uvr::transferFunctionPreset("black-body");
         uvr::applyOpacitySpec(settings.tf, "0:0,0.3:0.05,1:1");
-        const uvr::RenderResult result = uvr::renderCpu(prepared, settings);
+        const uvr::RenderResult result = renderer.render(settings);
         uvr::writePng(out, result.image, uvr::Vec3f(0.1f, 0.1f, 0.12f));
         std::printf("%s: %llu samples, %.1f per pixel, %.3f s\n", out,
                     static_cast<unsigned long long>(result.stats.samples),

@@ -217,8 +217,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         const double refTime = variants.front().medianSeconds;
         // Samples per second per CPU core, or for the whole GPU.
         const std::string where =
-            renderer.gpu() ? cudaDeviceDescription() : std::to_string(threads) + " CPU thread(s)";
-        const int units = renderer.gpu() ? 1 : threads;
+            renderer.onGpu() ? cudaDeviceDescription() : std::to_string(threads) + " CPU thread(s)";
+        const int units = renderer.onGpu() ? 1 : threads;
         std::printf(
             "%s: %s, %zu partitions (%.2f s to build), %dx%d, s1 = %g, "
             "step rule %s, %s, median of %d frames\n",
@@ -226,8 +226,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             prepared.kd->partitions.size(), prepared.kd->buildSeconds, base.width, base.height, s1,
             ruleText.c_str(), where.c_str(), *repeat);
         std::printf("%-22s %8s %10s %12s %9s %9s %8s %8s %6s %5s %5s\n", "configuration", "s2/s1",
-                    "ms/frame", "samples", "spp", renderer.gpu() ? "Msps" : "Msps/core", "speed-up",
-                    "SSIM/exact", "p99.9", "max", "seams");
+                    "ms/frame", "samples", "spp", renderer.onGpu() ? "Msps" : "Msps/core",
+                    "speed-up", "SSIM/exact", "p99.9", "max", "seams");
         std::vector<const Variant*> rows{&exact};  // exact's samples are tetrahedra crossed
         for (const Variant& v : variants) rows.push_back(&v);
         for (const Variant* row : rows) {
@@ -251,12 +251,12 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             threads, prepared.builtElsewhere ? "the GPU" : "the CPU", prepared.splitSeconds,
             prepared.bvhSeconds, prepared.adjacencySeconds, prepared.kd->buildSeconds,
             prepared.kd->treeSeconds, seedSeconds);
-        if (renderer.gpu()) {
+        if (const std::optional<GpuResidency> gpu = renderer.gpuResidency()) {
             // The mesh BVH serves only the reference; `uvr render --method adaptive` leaves it out.
             // Per cell, and per tetrahedron of the split (comparable between native and split).
             const double cells = double(std::max<std::uint64_t>(1, prepared.tets.cellCount()));
             const double tets = double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()));
-            const double all = double(renderer.gpu()->geometryBytes());
+            const double all = double(gpu->geometryBytes);
             const double meshBvh = double(prepared.bvh.nodes.size() * sizeof(BvhNode) +
                                           prepared.bvh.primIds.size() * sizeof(std::uint32_t));
             std::printf(

@@ -704,14 +704,14 @@ namespace {
 
 /// Prints what was uploaded to the GPU, when the renderer renders there.
 void reportUpload(const Renderer& renderer, const Context& ctx) {
-    const CudaScene* gpu = renderer.gpu();
+    const std::optional<GpuResidency> gpu = renderer.gpuResidency();
     if (!gpu) return;
     char line[160];
     std::snprintf(line, sizeof line, "uploaded %.1f MiB to the GPU (%.1f bytes per cell) in %.3f s",
-                  gpu->geometryBytes() / 1048576.0,
-                  double(gpu->geometryBytes()) /
+                  gpu->geometryBytes / 1048576.0,
+                  double(gpu->geometryBytes) /
                       double(std::max<std::uint64_t>(1, renderer.prepared().tets.cellCount())),
-                  gpu->uploadSeconds());
+                  gpu->uploadSeconds);
     ctx.step(line);
 }
 

@@ -831,9 +831,9 @@ PYBIND11_MODULE(_uvr, m) {
             d["bvh_seconds"] = p.bvhSeconds;
             d["value_updates"] = p.valueUpdates;
             d["value_update_seconds"] = p.valueUpdateSeconds;
-            if (r.renderer->gpu()) {
-                d["gpu_geometry_bytes"] = r.renderer->gpu()->geometryBytes();
-                d["gpu_value_upload_seconds"] = r.renderer->gpu()->valueUploadSeconds();
+            if (const std::optional<GpuResidency> gpu = r.renderer->gpuResidency()) {
+                d["gpu_geometry_bytes"] = gpu->geometryBytes;
+                d["gpu_value_upload_seconds"] = gpu->valueUploadSeconds;
             }
             return d;
         });

@@ -11,7 +11,8 @@
 namespace uvr::cuda {
 
 /// Throws uvr::Error for a failed CUDA call: Error(Resource) with the free and total device
-/// memory for out-of-memory, Error(Internal) with the call text, file and line otherwise.
+/// memory for out-of-memory, Error(Internal) with the call text, file and line (none when file is
+/// null: a named kernel) otherwise.
 void check(cudaError_t status, const char* call, const char* file, int line);
 
 /// Throws Error(Resource) naming what could not be allocated, its size and the free memory.

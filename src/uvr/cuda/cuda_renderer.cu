@@ -11,6 +11,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/setting_error.h"
 #include "uvr/cuda/cuda_check.h"
+#include "uvr/cuda/launch.cuh"
 #include "uvr/render/frame_kernel.h"
 
 namespace uvr {
@@ -20,8 +21,10 @@ namespace cuda {
 void check(cudaError_t status, const char* call, const char* file, int line) {
     if (status == cudaSuccess) return;
     if (status == cudaErrorMemoryAllocation) outOfMemory(call, 0);
-    throw Error(ErrorKind::Internal, std::string("CUDA error in ") + call + " at " + file + ":" +
-                                         std::to_string(line) + ": " + cudaGetErrorString(status));
+    const std::string where =
+        file ? std::string(" at ") + file + ":" + std::to_string(line) : std::string();
+    throw Error(ErrorKind::Internal,
+                std::string("CUDA error in ") + call + where + ": " + cudaGetErrorString(status));
 }
 
 void outOfMemory(const std::string& what, std::size_t bytes) {
@@ -71,63 +74,78 @@ __global__ void __launch_bounds__(kFrameBlock, kFrameBlocksPerSm)
 template <class March>
 void launchFrame(dim3 grid, dim3 block, const FrameView& frame, const March& march,
                  unsigned long long* totals) {
+    const auto start = std::chrono::steady_clock::now();
     if (frame.supersample == 1)
         frameKernel<false><<<grid, block>>>(frame, march, totals);
     else
         frameKernel<true><<<grid, block>>>(frame, march, totals);
+    finishLaunch("frame", std::uint64_t(frame.width) * std::uint64_t(frame.height), start);
 }
 
-/// Transfer-function update, pass 1 (one thread per partition): range statistics, and the
+/// Transfer-function update, pass 1 (one element per partition): range statistics, and the
 /// minimum and maximum variance over the visible partitions (as ordered bit patterns: variances
 /// are non-negative, so their float bits order like unsigned integers).
-__global__ void partitionStatsKernel(TfRangeView range, const KdPartition* partitions,
-                                     std::uint32_t count, RangeStats* stats,
-                                     unsigned* varianceBounds) {
-    const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
-    if (p >= count) return;
-    const RangeStats st = range.query(partitions[p].valueMin, partitions[p].valueMax);
-    stats[p] = st;
-    if (st.maxOpacity > 0.f) {
-        atomicMin(&varianceBounds[0], __float_as_uint(st.variance));
-        atomicMax(&varianceBounds[1], __float_as_uint(st.variance));
+struct PartitionStats {
+    TfRangeView range;
+    const KdPartition* partitions;
+    RangeStats* stats;
+    unsigned* varianceBounds;
+    __device__ void operator()(std::uint64_t p) const {
+        const RangeStats st = range.query(partitions[p].valueMin, partitions[p].valueMax);
+        stats[p] = st;
+        if (st.maxOpacity > 0.f) {
+            atomicMin(&varianceBounds[0], __float_as_uint(st.variance));
+            atomicMax(&varianceBounds[1], __float_as_uint(st.variance));
+        }
     }
-}
+};
 
 /// Transfer-function update, pass 2: the shared per-partition shading.
-__global__ void partitionShadeKernel(const RangeStats* stats, const float* gradientSpread,
-                                     std::uint32_t count, const unsigned* varianceBounds,
-                                     StepRuleParams rule, PartitionShading* shading) {
-    const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
-    if (p >= count) return;
-    const float lo = __uint_as_float(varianceBounds[0]), hi = __uint_as_float(varianceBounds[1]);
-    shading[p] = shadePartition(stats[p], gradientSpread[p], lo, hi, rule);
-}
+struct PartitionShade {
+    const RangeStats* stats;
+    const float* gradientSpread;
+    const unsigned* varianceBounds;
+    StepRuleParams rule;
+    PartitionShading* shading;
+    __device__ void operator()(std::uint64_t p) const {
+        const float lo = __uint_as_float(varianceBounds[0]);
+        const float hi = __uint_as_float(varianceBounds[1]);
+        shading[p] = shadePartition(stats[p], gradientSpread[p], lo, hi, rule);
+    }
+};
 
-/// Transfer-function update, macrocells (one thread per macrocell): the error-bound shading.
-__global__ void macroShadeKernel(TfRangeView range, const MacroCell* cells, std::uint32_t count,
-                                 StepRuleParams rule, PartitionShading* shading) {
-    const std::uint32_t c = blockIdx.x * blockDim.x + threadIdx.x;
-    if (c >= count) return;
-    shading[c] = shadeMacroCell(cells[c], range, rule);
-}
+/// Transfer-function update, macrocells (one element per macrocell): the error-bound shading.
+struct MacroShade {
+    TfRangeView range;
+    const MacroCell* cells;
+    StepRuleParams rule;
+    PartitionShading* shading;
+    __device__ void operator()(std::uint64_t c) const {
+        shading[c] = shadeMacroCell(cells[c], range, rule);
+    }
+};
 
-/// Transfer-function update, NaN values (one thread per partition or macrocell): the shading of
-/// those holding visible NaN values (shadeNan).
-__global__ void nanShadeKernel(const std::uint8_t* flags, std::uint32_t count, float nanAlpha,
-                               float s1, PartitionShading* shading) {
-    const std::uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= count || !flags[i]) return;
-    shadeNan(shading[i], nanAlpha, s1);
-}
+/// Transfer-function update, NaN values (one element per partition or macrocell): the shading
+/// of those holding visible NaN values (shadeNan).
+struct NanShade {
+    const std::uint8_t* flags;
+    float nanAlpha, s1;
+    PartitionShading* shading;
+    __device__ void operator()(std::uint64_t i) const {
+        if (flags[i]) shadeNan(shading[i], nanAlpha, s1);
+    }
+};
 
-/// Transfer-function update, last pass (one thread per partition): whether each partition
+/// Transfer-function update, last pass (one element per partition): whether each partition
 /// marches by its macrocells.
-__global__ void macroChoiceKernel(const PartitionGrid* grids, const PartitionShading* cells,
-                                  std::uint32_t count, PartitionShading* shading) {
-    const std::uint32_t p = blockIdx.x * blockDim.x + threadIdx.x;
-    if (p >= count) return;
-    shading[p].byMacroCells = macroCellsPay(grids[p], cells, shading[p]);
-}
+struct MacroChoice {
+    const PartitionGrid* grids;
+    const PartitionShading* cells;
+    PartitionShading* shading;
+    __device__ void operator()(std::uint64_t p) const {
+        shading[p].byMacroCells = macroCellsPay(grids[p], cells, shading[p]);
+    }
+};
 
 }  // namespace
 }  // namespace cuda
@@ -319,36 +337,32 @@ void CudaScene::updateShading(RenderResult& result) {
     d.partitionStats.reserve(n, "the partition statistics");
     d.varianceBounds.upload(std::vector<unsigned>{0x7f800000u, 0u}, "the variance bounds");
     d.shading.reserve(n, "the partition shading");
-    const int block = 256;
-    const int grid = static_cast<int>((n + block - 1) / block);
-    cuda::partitionStatsKernel<<<grid, block>>>(range, d.a.partitions.data(), n,
-                                                d.partitionStats.data(), d.varianceBounds.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
-    cuda::partitionShadeKernel<<<grid, block>>>(d.partitionStats.data(), d.a.gradientSpread.data(),
-                                                n, d.varianceBounds.data(), f.stepRule,
-                                                d.shading.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
-    if (!d.mesh.partitionNan.empty()) {
-        cuda::nanShadeKernel<<<grid, block>>>(d.a.partitionNan.data(), n, f.tfNan.w, f.stepRule.s1,
-                                              d.shading.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
-    }
+    cuda::forEachElement("partition statistics", n,
+                         cuda::PartitionStats{range, d.a.partitions.data(), d.partitionStats.data(),
+                                              d.varianceBounds.data()});
+    cuda::forEachElement(
+        "partition shading", n,
+        cuda::PartitionShade{d.partitionStats.data(), d.a.gradientSpread.data(),
+                             d.varianceBounds.data(), f.stepRule, d.shading.data()});
+    if (!d.mesh.partitionNan.empty())
+        cuda::forEachElement(
+            "partition NaN shading", n,
+            cuda::NanShade{d.a.partitionNan.data(), f.tfNan.w, f.stepRule.s1, d.shading.data()});
     // The macrocells' shading stays on the GPU.
     d.macroActive = false;
     if (usesMacroCells(d.mesh, f.stepRule)) {
         const std::uint32_t m = static_cast<std::uint32_t>(d.mesh.macro->cells.size());
         d.macroShading.reserve(m, "the macrocell shading");
-        cuda::macroShadeKernel<<<(m + block - 1) / block, block>>>(
-            range, d.a.macroCells.data(), m, f.stepRule, d.macroShading.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
-        if (!d.mesh.macro->nanCells.empty()) {
-            cuda::nanShadeKernel<<<(m + block - 1) / block, block>>>(
-                d.a.macroNan.data(), m, f.tfNan.w, f.stepRule.s1, d.macroShading.data());
-            UVR_CUDA_CHECK(cudaGetLastError());
-        }
-        cuda::macroChoiceKernel<<<grid, block>>>(d.a.macroGrids.data(), d.macroShading.data(), n,
-                                                 d.shading.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
+        cuda::forEachElement(
+            "macrocell shading", m,
+            cuda::MacroShade{range, d.a.macroCells.data(), f.stepRule, d.macroShading.data()});
+        if (!d.mesh.macro->nanCells.empty())
+            cuda::forEachElement("macrocell NaN shading", m,
+                                 cuda::NanShade{d.a.macroNan.data(), f.tfNan.w, f.stepRule.s1,
+                                                d.macroShading.data()});
+        cuda::forEachElement(
+            "macrocell choice", n,
+            cuda::MacroChoice{d.a.macroGrids.data(), d.macroShading.data(), d.shading.data()});
         d.macroActive = true;
     }
     f.shading.resize(n);
@@ -415,7 +429,6 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
                               d.totals.data());
         });
     }
-    UVR_CUDA_CHECK(cudaGetLastError());
     UVR_CUDA_CHECK(cudaEventRecord(end));
     UVR_CUDA_CHECK(cudaEventSynchronize(end));
     float ms = 0.f;

@@ -22,16 +22,6 @@ namespace {
 /// Elements per thread of the bounds pass (runs of one node's cells are reduced locally first).
 constexpr std::uint64_t kBoundsChunk = 256;
 
-/// Cell boxes, and the first level: every cell in node 0.
-__global__ void boxesKernel(TetMeshView mesh, std::uint64_t n, Bounds3f* boxes,
-                            std::uint32_t* cells, std::uint32_t* nodeOf) {
-    const std::uint64_t t = globalThread();
-    if (t >= n) return;
-    boxes[t] = mesh.cellBounds(t);
-    cells[t] = static_cast<std::uint32_t>(t);
-    nodeOf[t] = 0;
-}
-
 /// Adds a box to node s's bounds, kept as six order-preserving keys (atomic min / max).
 __device__ void flushBounds(const Bounds3f& b, std::uint32_t* keys) {
     for (int a = 0; a < 3; ++a) {
@@ -40,12 +30,12 @@ __device__ void flushBounds(const Bounds3f& b, std::uint32_t* keys) {
     }
 }
 
-/// Bounds of each node's cells: a chunk of consecutive elements per thread, flushed whenever the
-/// node changes.
-__global__ void boundsKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
-                             std::uint64_t count, const Bounds3f* boxes, std::uint32_t* keys) {
-    const std::uint64_t begin = globalThread() * kBoundsChunk;
-    if (begin >= count) return;
+/// Bounds of each node's cells over one chunk of kBoundsChunk consecutive elements, flushed
+/// whenever the node changes.
+__device__ void chunkBounds(std::uint64_t chunk, const std::uint32_t* cells,
+                            const std::uint32_t* nodeOf, std::uint64_t count, const Bounds3f* boxes,
+                            std::uint32_t* keys) {
+    const std::uint64_t begin = chunk * kBoundsChunk;
     const std::uint64_t end = begin + kBoundsChunk < count ? begin + kBoundsChunk : count;
     std::uint32_t node = nodeOf[begin];
     Bounds3f b;
@@ -60,51 +50,6 @@ __global__ void boundsKernel(const std::uint32_t* cells, const std::uint32_t* no
     flushBounds(b, keys + 6 * node);
 }
 
-/// Sort keys: the node in the high word, the cell centre on the node's axis in the low.
-__global__ void centreKeysKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
-                                 std::uint64_t count, const Bounds3f* boxes,
-                                 const std::uint32_t* axis, std::uint64_t* keys) {
-    const std::uint64_t i = globalThread();
-    if (i >= count) return;
-    const std::uint32_t s = nodeOf[i];
-    keys[i] = (static_cast<std::uint64_t>(s) << 32) |
-              kdsplit::floatKey(boxes[cells[i]].center()[axis[s]]);
-}
-
-/// Each node's median centre: the (count / 2)-th smallest, as the CPU's selection picks.
-__global__ void medianKernel(const std::uint64_t* sortedKeys, const std::uint64_t* begin,
-                             std::uint32_t nodes, float* plane) {
-    const std::uint64_t s = globalThread();
-    if (s >= nodes) return;
-    const std::uint64_t count = begin[s + 1] - begin[s];
-    plane[s] = kdsplit::keyFloat(static_cast<std::uint32_t>(sortedKeys[begin[s] + count / 2]));
-}
-
-/// Which side(s) of its node's plane each cell goes to (nodes not splitting: neither).
-__global__ void sidesKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
-                            std::uint64_t count, const Bounds3f* boxes, const std::uint32_t* axis,
-                            const float* plane, const std::uint32_t* splitting,
-                            std::uint32_t* below, std::uint32_t* above) {
-    const std::uint64_t i = globalThread();
-    if (i >= count) return;
-    const std::uint32_t s = nodeOf[i];
-    const Bounds3f& box = boxes[cells[i]];
-    below[i] = splitting[s] && kdsplit::goesBelow(box, static_cast<int>(axis[s]), plane[s]);
-    above[i] = splitting[s] && kdsplit::goesAbove(box, static_cast<int>(axis[s]), plane[s]);
-}
-
-/// Per node: how many cells go below and above (differences of the exclusive scans).
-__global__ void sideCountsKernel(const std::uint32_t* belowScan, const std::uint32_t* aboveScan,
-                                 const std::uint64_t* begin, std::uint32_t nodes,
-                                 std::uint64_t* counts) {
-    const std::uint64_t s = globalThread();
-    if (s >= nodes) return;
-    counts[4 * s + 0] = belowScan[begin[s]];
-    counts[4 * s + 1] = belowScan[begin[s + 1]] - belowScan[begin[s]];
-    counts[4 * s + 2] = aboveScan[begin[s]];
-    counts[4 * s + 3] = aboveScan[begin[s + 1]] - aboveScan[begin[s]];
-}
-
 /// Where a split node's children go in the next level.
 struct ChildPlace {
     std::uint64_t belowBegin, aboveBegin;  ///< first element of each child
@@ -112,28 +57,6 @@ struct ChildPlace {
     std::uint32_t below, above;            ///< the children's indices in the next level
     std::uint32_t split;                   ///< 0: the node became a leaf
 };
-
-/// Order-preserving scatter of the cells of split nodes into the next level.
-__global__ void scatterKernel(const std::uint32_t* cells, const std::uint32_t* nodeOf,
-                              std::uint64_t count, const std::uint32_t* below,
-                              const std::uint32_t* above, const std::uint32_t* belowScan,
-                              const std::uint32_t* aboveScan, const ChildPlace* places,
-                              std::uint32_t* nextCells, std::uint32_t* nextNodeOf) {
-    const std::uint64_t i = globalThread();
-    if (i >= count) return;
-    const ChildPlace& p = places[nodeOf[i]];
-    if (!p.split) return;
-    if (below[i]) {
-        const std::uint64_t k = p.belowBegin + belowScan[i] - p.belowBase;
-        nextCells[k] = cells[i];
-        nextNodeOf[k] = p.below;
-    }
-    if (above[i]) {
-        const std::uint64_t k = p.aboveBegin + aboveScan[i] - p.aboveBase;
-        nextCells[k] = cells[i];
-        nextNodeOf[k] = p.above;
-    }
-}
 
 /// Exclusive sum of count + 1 flags (the last is 0): scan[count] is the total.
 void exclusiveSum(const std::uint32_t* in, std::uint32_t* out, std::uint64_t count,
@@ -184,9 +107,14 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
         TetMeshView view = mesh.view();
         view.points = points.data(), view.tets = tets.data(), view.values = nullptr;
         view.nativeCorners = nativeCorners.data();
-        cuda::boxesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(view, n, boxes.data(), cells.data(),
-                                                                nodeOf.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
+        // Cell boxes, and the first level: every cell in node 0.
+        Bounds3f* b = boxes.data();
+        std::uint32_t *c = cells.data(), *o = nodeOf.data();
+        cuda::forEachElement("k-d cell boxes", n, [=] __device__(std::uint64_t t) {
+            b[t] = view.cellBounds(t);
+            c[t] = static_cast<std::uint32_t>(t);
+            o[t] = 0;
+        });
         UVR_CUDA_CHECK(cudaDeviceSynchronize());
     }
     cuda::DeviceArray<std::uint64_t> keys[2], begin, counts;
@@ -206,10 +134,16 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             for (int a = 0; a < 3; ++a)
                 hostKeys[6 * s + a] = 0xffffffffu, hostKeys[6 * s + 3 + a] = 0;
         boundKeys.upload(hostKeys, "the node bounds (GPU k-d build)");
-        cuda::boundsKernel<<<cuda::blocksFor((count + cuda::kBoundsChunk - 1) / cuda::kBoundsChunk),
-                             cuda::kBlock>>>(cells.data(), nodeOf.data(), count, boxes.data(),
-                                             boundKeys.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
+        {
+            const std::uint32_t *c = cells.data(), *o = nodeOf.data();
+            const Bounds3f* b = boxes.data();
+            std::uint32_t* k = boundKeys.data();
+            cuda::forEachElement("k-d node bounds",
+                                 (count + cuda::kBoundsChunk - 1) / cuda::kBoundsChunk,
+                                 [=] __device__(std::uint64_t chunk) {
+                                     cuda::chunkBounds(chunk, c, o, count, b, k);
+                                 });
+        }
         boundKeys.download(hostKeys.data(), hostKeys.size());
         std::vector<Bounds3f> shrunk(m);
         std::vector<std::uint32_t> hostAxis(m), hostSplitting(m);
@@ -235,9 +169,15 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             splitting.upload(hostSplitting, "the split flags (GPU k-d build)");
             keys[0].reserve(count, "the centre keys (GPU k-d build)");
             keys[1].reserve(count, "the sorted centre keys (GPU k-d build)");
-            cuda::centreKeysKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(
-                cells.data(), nodeOf.data(), count, boxes.data(), axis.data(), keys[0].data());
-            UVR_CUDA_CHECK(cudaGetLastError());
+            // Sort keys: the node in the high word, the cell centre on the node's axis in the low.
+            const std::uint32_t *c = cells.data(), *o = nodeOf.data(), *ax = axis.data();
+            const Bounds3f* b = boxes.data();
+            std::uint64_t* k = keys[0].data();
+            cuda::forEachElement("k-d centre keys", count, [=] __device__(std::uint64_t i) {
+                const std::uint32_t s = o[i];
+                k[i] = (static_cast<std::uint64_t>(s) << 32) |
+                       kdsplit::floatKey(b[c[i]].center()[ax[s]]);
+            });
             cub::DoubleBuffer<std::uint64_t> keyBuffer(keys[0].data(), keys[1].data());
             const int endBit = 32 + std::bit_width(m - 1);
             cuda::withScratch(temp, "the radix sort's scratch (GPU k-d build)",
@@ -246,9 +186,15 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
                                                                         count, 0, endBit);
                               });
             planes.reserve(m, "the split planes (GPU k-d build)");
-            cuda::medianKernel<<<cuda::blocksFor(m), cuda::kBlock>>>(
-                keyBuffer.Current(), begin.data(), m, planes.data());
-            UVR_CUDA_CHECK(cudaGetLastError());
+            // Each node's median centre: the (count / 2)-th smallest, as the CPU's selection
+            // picks.
+            const std::uint64_t *sorted = keyBuffer.Current(), *first = begin.data();
+            float* pl = planes.data();
+            cuda::forEachElement("k-d medians", m, [=] __device__(std::uint64_t s) {
+                const std::uint64_t cellsOfNode = first[s + 1] - first[s];
+                pl[s] = kdsplit::keyFloat(
+                    static_cast<std::uint32_t>(sorted[first[s] + cellsOfNode / 2]));
+            });
             planes.download(hostPlanes.data(), m);
             // Sides and their counts.
             below.reserve(count + 1, "the below flags (GPU k-d build)");
@@ -257,16 +203,27 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             aboveScan.reserve(count + 1, "the above offsets (GPU k-d build)");
             UVR_CUDA_CHECK(cudaMemset(below.data() + count, 0, sizeof(std::uint32_t)));
             UVR_CUDA_CHECK(cudaMemset(above.data() + count, 0, sizeof(std::uint32_t)));
-            cuda::sidesKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(
-                cells.data(), nodeOf.data(), count, boxes.data(), axis.data(), planes.data(),
-                splitting.data(), below.data(), above.data());
-            UVR_CUDA_CHECK(cudaGetLastError());
+            // Which side(s) of its node's plane each cell goes to (nodes not splitting: neither).
+            const std::uint32_t* split = splitting.data();
+            std::uint32_t *lo = below.data(), *hi = above.data();
+            cuda::forEachElement("k-d sides", count, [=] __device__(std::uint64_t i) {
+                const std::uint32_t s = o[i];
+                const Bounds3f& box = b[c[i]];
+                lo[i] = split[s] && kdsplit::goesBelow(box, static_cast<int>(ax[s]), pl[s]);
+                hi[i] = split[s] && kdsplit::goesAbove(box, static_cast<int>(ax[s]), pl[s]);
+            });
             cuda::exclusiveSum(below.data(), belowScan.data(), count, temp);
             cuda::exclusiveSum(above.data(), aboveScan.data(), count, temp);
             counts.reserve(4 * std::size_t(m), "the side counts (GPU k-d build)");
-            cuda::sideCountsKernel<<<cuda::blocksFor(m), cuda::kBlock>>>(
-                belowScan.data(), aboveScan.data(), begin.data(), m, counts.data());
-            UVR_CUDA_CHECK(cudaGetLastError());
+            // Per node: how many cells go below and above (differences of the exclusive scans).
+            const std::uint32_t *bs = belowScan.data(), *as = aboveScan.data();
+            std::uint64_t* n4 = counts.data();
+            cuda::forEachElement("k-d side counts", m, [=] __device__(std::uint64_t s) {
+                n4[4 * s + 0] = bs[first[s]];
+                n4[4 * s + 1] = bs[first[s + 1]] - bs[first[s]];
+                n4[4 * s + 2] = as[first[s]];
+                n4[4 * s + 3] = as[first[s + 1]] - as[first[s]];
+            });
             counts.download(hostCounts.data(), hostCounts.size());
         }
         // The host decides each node: split (children to the next level) or leaf (its cells,
@@ -323,10 +280,27 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
         places.upload(hostPlaces, "the child places (GPU k-d build)");
         nextCells.reserve(nextCount, "the next level's cells (GPU k-d build)");
         nextNodeOf.reserve(nextCount, "the next level's nodes (GPU k-d build)");
-        cuda::scatterKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(
-            cells.data(), nodeOf.data(), count, below.data(), above.data(), belowScan.data(),
-            aboveScan.data(), places.data(), nextCells.data(), nextNodeOf.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
+        {
+            // Order-preserving scatter of the cells of split nodes into the next level.
+            const std::uint32_t *c = cells.data(), *o = nodeOf.data(), *lo = below.data(),
+                                *hi = above.data(), *bs = belowScan.data(), *as = aboveScan.data();
+            const cuda::ChildPlace* pl = places.data();
+            std::uint32_t *nc = nextCells.data(), *no = nextNodeOf.data();
+            cuda::forEachElement("k-d scatter", count, [=] __device__(std::uint64_t i) {
+                const cuda::ChildPlace& p = pl[o[i]];
+                if (!p.split) return;
+                if (lo[i]) {
+                    const std::uint64_t k = p.belowBegin + bs[i] - p.belowBase;
+                    nc[k] = c[i];
+                    no[k] = p.below;
+                }
+                if (hi[i]) {
+                    const std::uint64_t k = p.aboveBegin + as[i] - p.aboveBase;
+                    nc[k] = c[i];
+                    no[k] = p.above;
+                }
+            });
+        }
         cells.swap(nextCells);
         nodeOf.swap(nextNodeOf);
         level = std::move(next);

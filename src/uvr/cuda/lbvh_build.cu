@@ -17,51 +17,10 @@ namespace uvr {
 namespace cuda {
 namespace {
 
-/// Step 1: Morton keys of the primitives, and their positions.
-__global__ void keysKernel(LbvhBuildView v, std::uint64_t n, std::uint64_t* keys,
-                           std::uint32_t* positions) {
-    const std::uint64_t i = globalThread();
-    if (i >= n) return;
-    keys[i] = v.mortonKey(i, v.segmentOf(i));
-    positions[i] = static_cast<std::uint32_t>(i);
-}
-
-/// The segment of each primitive, in the current order.
-__global__ void segmentKeysKernel(LbvhBuildView v, std::uint64_t n, const std::uint32_t* positions,
-                                  std::uint32_t* segmentKeys) {
-    const std::uint64_t k = globalThread();
-    if (k < n) segmentKeys[k] = v.segmentOf(positions[k]);
-}
-
-/// The Morton keys in the final order (v.order).
-__global__ void sortedKeysKernel(LbvhBuildView v, std::uint64_t n, std::uint64_t* keys) {
-    const std::uint64_t k = globalThread();
-    if (k < n) keys[k] = v.mortonKey(v.order[k], v.segmentOf(k));
-}
-
-/// Step 2 of buildLbvhCpu: kept[g + 1] = element g is a kept inner node.
-__global__ void keptKernel(LbvhBuildView v, std::uint64_t n, std::uint32_t* kept) {
-    const std::uint64_t g = globalThread();
-    if (g < n) kept[g + 1] = v.keepsInner(static_cast<std::int64_t>(g));
-}
-
-/// Each segment's root (and single leaf).
-__global__ void rootsKernel(LbvhBuildView v) {
-    const std::uint64_t s = globalThread();
-    if (s < v.segments) v.placeRoot(static_cast<std::uint32_t>(s));
-}
-
-/// Step 3 of buildLbvhCpu: kept inner nodes name their children.
-__global__ void childrenKernel(LbvhBuildView v, std::uint64_t n) {
-    const std::uint64_t g = globalThread();
-    if (g < n && v.kept(static_cast<std::int64_t>(g))) v.nameChildren(static_cast<std::int64_t>(g));
-}
-
 /// Step 4 of buildLbvhCpu: the refit, counting arrivals atomically and reading boxes other
 /// threads wrote through L2 (not this SM's L1).
-__global__ void refitKernel(LbvhBuildView v, std::uint64_t n, unsigned* arrived) {
-    const std::uint64_t g = globalThread();
-    if (g >= n || !v.kept(static_cast<std::int64_t>(g))) return;
+__device__ void refitNode(const LbvhBuildView& v, std::uint64_t g, unsigned* arrived) {
+    if (!v.kept(static_cast<std::int64_t>(g))) return;
     auto firstArrival = [arrived](std::uint32_t p) {
         __threadfence();  // this subtree's boxes before the count
         const bool first = atomicAdd(&arrived[p], 1u) == 0;
@@ -115,8 +74,6 @@ LbvhResult buildLbvhCuda(const LbvhInput& input) {
     v.segments = segments;
     v.leafSize = input.leafSize;
     v.occupiedBefore = occupiedBefore.data();
-    using cuda::kBlock;
-    const int grid = cuda::blocksFor(n);
     // Step 1: the order of the primitives by (segment, Morton key, position): a stable radix sort
     // by key, then a stable one by segment (ties keep their order, as the CPU's sort of
     // (key, position) pairs within each segment does).
@@ -135,17 +92,26 @@ LbvhResult buildLbvhCuda(const LbvhInput& input) {
     cuda::DeviceArray<std::uint64_t> keys[2];
     keys[0].reserve(n, "the Morton keys (GPU build)");
     keys[1].reserve(n, "the sorted Morton keys (GPU build)");
-    cuda::keysKernel<<<grid, kBlock>>>(v, n, keys[0].data(), positions[0].data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    // The primitives' Morton keys, and their positions.
+    {
+        std::uint64_t* k = keys[0].data();
+        std::uint32_t* p = positions[0].data();
+        cuda::forEachElement("lbvh keys", n, [=] __device__(std::uint64_t i) {
+            k[i] = v.mortonKey(i, v.segmentOf(i));
+            p[i] = static_cast<std::uint32_t>(i);
+        });
+    }
     cub::DoubleBuffer<std::uint64_t> keyBuffer(keys[0].data(), keys[1].data());
     sort(keyBuffer, 63);
     if (segments > 1) {
         cuda::DeviceArray<std::uint32_t> segmentKeys[2];
         segmentKeys[0].reserve(n, "the segment keys (GPU build)");
         segmentKeys[1].reserve(n, "the sorted segment keys (GPU build)");
-        cuda::segmentKeysKernel<<<grid, kBlock>>>(v, n, positionBuffer.Current(),
-                                                  segmentKeys[0].data());
-        UVR_CUDA_CHECK(cudaGetLastError());
+        // The segment of each primitive, in the current order.
+        const std::uint32_t* p = positionBuffer.Current();
+        std::uint32_t* k = segmentKeys[0].data();
+        cuda::forEachElement("lbvh segment keys", n,
+                             [=] __device__(std::uint64_t i) { k[i] = v.segmentOf(p[i]); });
         cub::DoubleBuffer<std::uint32_t> segmentBuffer(segmentKeys[0].data(),
                                                        segmentKeys[1].data());
         sort(segmentBuffer, std::bit_width(segments - 1));
@@ -155,8 +121,13 @@ LbvhResult buildLbvhCuda(const LbvhInput& input) {
     cuda::DeviceArray<std::uint64_t>& sortedKeys = keys[keyBuffer.selector];
     keys[1 - keyBuffer.selector].clear();
     v.order = order.data();
-    cuda::sortedKeysKernel<<<grid, kBlock>>>(v, n, sortedKeys.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    // The Morton keys in the final order (v.order).
+    {
+        std::uint64_t* k = sortedKeys.data();
+        cuda::forEachElement("lbvh sorted keys", n, [=] __device__(std::uint64_t i) {
+            k[i] = v.mortonKey(v.order[i], v.segmentOf(i));
+        });
+    }
     // Steps 2-4 (LbvhBuildView): kept inner nodes, their ranks (an exclusive scan: kept[0] = 0)
     // and the roots; children; the refit.
     cuda::DeviceArray<std::uint32_t> kept, rank, roots, innerSlot, innerParent;
@@ -172,8 +143,13 @@ LbvhResult buildLbvhCuda(const LbvhInput& input) {
     v.innerSlot = innerSlot.data();
     v.innerParent = innerParent.data();
     UVR_CUDA_CHECK(cudaMemset(kept.data(), 0, sizeof(std::uint32_t)));
-    cuda::keptKernel<<<grid, kBlock>>>(v, n, kept.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    // Step 2 of buildLbvhCpu: kept[g + 1] = element g is a kept inner node.
+    {
+        std::uint32_t* k = kept.data();
+        cuda::forEachElement("lbvh kept nodes", n, [=] __device__(std::uint64_t g) {
+            k[g + 1] = v.keepsInner(static_cast<std::int64_t>(g));
+        });
+    }
     cuda::withScratch(
         temp, "the scan's scratch (GPU build)", [&](void* scratch, std::size_t& bytes) {
             return cub::DeviceScan::InclusiveSum(scratch, bytes, kept.data(), rank.data(), n + 1);
@@ -186,14 +162,21 @@ LbvhResult buildLbvhCuda(const LbvhInput& input) {
     cuda::DeviceArray<BvhNode> nodes;
     nodes.reserve(nodeCount, "the BVH nodes (GPU build)");
     v.nodes = nodes.data();
-    cuda::rootsKernel<<<cuda::blocksFor(segments), kBlock>>>(v);
-    UVR_CUDA_CHECK(cudaGetLastError());
-    cuda::childrenKernel<<<grid, kBlock>>>(v, n);
-    UVR_CUDA_CHECK(cudaGetLastError());
+    // Each segment's root (and single leaf); step 3 of buildLbvhCpu: kept inner nodes name
+    // their children.
+    cuda::forEachElement("lbvh roots", segments, [=] __device__(std::uint64_t s) {
+        v.placeRoot(static_cast<std::uint32_t>(s));
+    });
+    cuda::forEachElement("lbvh children", n, [=] __device__(std::uint64_t g) {
+        if (v.kept(static_cast<std::int64_t>(g))) v.nameChildren(static_cast<std::int64_t>(g));
+    });
     arrived.reserve(n, "the refit counters (GPU build)");
     UVR_CUDA_CHECK(cudaMemset(arrived.data(), 0, n * sizeof(unsigned)));
-    cuda::refitKernel<<<grid, kBlock>>>(v, n, arrived.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    {
+        unsigned* a = arrived.data();
+        cuda::forEachElement("lbvh refit", n,
+                             [=] __device__(std::uint64_t g) { cuda::refitNode(v, g, a); });
+    }
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     out.nodes.resize(nodeCount);
     out.order.resize(n);

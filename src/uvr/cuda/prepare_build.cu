@@ -59,10 +59,8 @@ __device__ std::uint32_t cellOfSlot(const TetMeshView& m, std::uint64_t s) {
 }
 
 /// Faces per smallest welded vertex.
-__global__ void countFacesKernel(TetMeshView m, const std::uint32_t* canon,
-                                 unsigned long long* counts) {
-    const std::uint64_t c = globalThread();
-    if (c >= m.cellCount()) return;
+__device__ void countFaces(std::uint64_t c, TetMeshView m, const std::uint32_t* canon,
+                           unsigned long long* counts) {
     const int faces = kindFaces(m.kind(c));
     for (int i = 0; i < faces; ++i) {
         std::uint32_t f[4];
@@ -72,12 +70,10 @@ __global__ void countFacesKernel(TetMeshView m, const std::uint32_t* canon,
 }
 
 /// Faces whose smallest vertex lies in [lo, hi) into their buckets (entries from offset `base`),
-/// in any order: matchKernel's rule does not depend on it.
-__global__ void scatterFacesKernel(TetMeshView m, const std::uint32_t* canon, std::uint32_t lo,
-                                   std::uint32_t hi, unsigned long long base,
-                                   unsigned long long* fill, FaceEntry* entries) {
-    const std::uint64_t c = globalThread();
-    if (c >= m.cellCount()) return;
+/// in any order: matchFaces' rule does not depend on it.
+__device__ void scatterFaces(std::uint64_t c, TetMeshView m, const std::uint32_t* canon,
+                             std::uint32_t lo, std::uint32_t hi, unsigned long long base,
+                             unsigned long long* fill, FaceEntry* entries) {
     const int faces = kindFaces(m.kind(c));
     const std::uint64_t first = m.faceBase(c);
     for (int i = 0; i < faces; ++i) {
@@ -89,13 +85,12 @@ __global__ void scatterFacesKernel(TetMeshView m, const std::uint32_t* canon, st
     }
 }
 
-/// Per vertex of [lo, hi): each face of its bucket with exactly one equal face gets that face's
-/// cell as its neighbour (a face shared by three or more cells stays a boundary, as on the CPU).
-__global__ void matchKernel(TetMeshView m, std::uint32_t lo, std::uint32_t hi,
-                            const unsigned long long* offsets, unsigned long long base,
-                            const FaceEntry* entries, std::uint32_t* neighbors) {
-    const std::uint64_t v = lo + globalThread();
-    if (v >= hi) return;
+/// Vertex v (of a pass's range): each face of its bucket with exactly one equal face gets that
+/// face's cell as its neighbour (a face shared by three or more cells stays a boundary, as on the
+/// CPU).
+__device__ void matchFaces(std::uint64_t v, TetMeshView m, const unsigned long long* offsets,
+                           unsigned long long base, const FaceEntry* entries,
+                           std::uint32_t* neighbors) {
     const std::uint64_t begin = offsets[v] - base, end = offsets[v + 1] - base;
     for (std::uint64_t i = begin; i < end; ++i) {
         const FaceEntry e = entries[i];
@@ -129,14 +124,6 @@ __global__ void seedKernel(TetLocator locator, const KdPartition* partitions,
             });
 }
 
-/// Best keys to seeds (the key's low half; kNoTet where no cell offered one).
-__global__ void seedsFromKeysKernel(const unsigned long long* best, std::uint64_t n,
-                                    std::uint32_t* seeds) {
-    const std::uint64_t i = globalThread();
-    if (i >= n) return;
-    seeds[i] = best[i] == ~0ull ? kNoTet : static_cast<std::uint32_t>(best[i]);
-}
-
 /// Order-preserving keys of a box's corners, folded into six keys (atomic min / max).
 __device__ void foldBox(const Bounds3f& b, std::uint32_t* keys) {
     for (int a = 0; a < 3; ++a) {
@@ -155,16 +142,17 @@ __device__ Bounds3f unfoldBox(const std::uint32_t* keys) {
     return b;
 }
 
+/// Empty boxes and ranges as keys: lows at +infinity, highs at -infinity, over `count` keys of
+/// `perItem` each (the first half lows).
+void clearKeys(const char* name, std::uint32_t* keys, std::uint64_t count, int perItem) {
+    forEachElement(name, count, [=] __device__(std::uint64_t i) {
+        const int k = static_cast<int>(i % perItem);
+        keys[i] = kdsplit::floatKey(k < perItem / 2 ? INFINITY : -INFINITY);
+    });
+}
+
 /// Macrocell flags.
 constexpr std::uint32_t kUnboundedSpread = 1u, kHasNan = 2u;
-
-/// Empty boxes and ranges as keys: lows at +infinity, highs at -infinity.
-__global__ void clearKeysKernel(std::uint32_t* keys, std::uint64_t count, int perItem) {
-    const std::uint64_t i = globalThread();
-    if (i >= count) return;
-    const int k = static_cast<int>(i % perItem);
-    keys[i] = kdsplit::floatKey(k < perItem / 2 ? INFINITY : -INFINITY);
-}
 
 /// Macrocells and partition gradient boxes: one block per partition, its threads over the
 /// partition's cells, each folding its MacroContribution into the macrocells its box overlaps
@@ -198,11 +186,9 @@ __global__ void macroKernel(TetMeshView m, const KdPartition* partitions,
 }
 
 /// Macrocells from their keys and flags (fillMacroCells' last step).
-__global__ void macroCellsKernel(const std::uint32_t* rangeKeys, const std::uint32_t* gradientKeys,
-                                 const std::uint32_t* flags, std::uint64_t count,
-                                 MacroCell* cells) {
-    const std::uint64_t c = globalThread();
-    if (c >= count) return;
+__device__ void macroCellOf(std::uint64_t c, const std::uint32_t* rangeKeys,
+                            const std::uint32_t* gradientKeys, const std::uint32_t* flags,
+                            MacroCell* cells) {
     MacroCell m;
     m.valueMin = kdsplit::keyFloat(rangeKeys[2 * c]);
     m.valueMax = kdsplit::keyFloat(rangeKeys[2 * c + 1]);
@@ -212,12 +198,6 @@ __global__ void macroCellsKernel(const std::uint32_t* rangeKeys, const std::uint
     else if (!gradients.empty())
         m.gradientSpread = length(gradients.hi - gradients.lo);
     cells[c] = m;
-}
-
-/// Positions 0, 1, ..., n - 1.
-__global__ void iotaKernel(std::uint32_t* out, std::uint64_t n) {
-    const std::uint64_t i = globalThread();
-    if (i < n) out[i] = static_cast<std::uint32_t>(i);
 }
 
 /// Throws Error(Unsupported) naming the build when no CUDA device is present.
@@ -280,8 +260,12 @@ void sortCellKeysCuda(const std::uint64_t* keys, std::uint64_t count, std::uint3
     keyArrays[1].reserve(count, "the sorted Morton keys (GPU sort)");
     positions[0].reserve(count, "the cells' positions (GPU sort)");
     positions[1].reserve(count, "the sorted positions (GPU sort)");
-    cuda::iotaKernel<<<cuda::blocksFor(count), cuda::kBlock>>>(positions[0].data(), count);
-    UVR_CUDA_CHECK(cudaGetLastError());
+    {
+        std::uint32_t* p = positions[0].data();
+        cuda::forEachElement("cell sort positions", count, [=] __device__(std::uint64_t i) {
+            p[i] = static_cast<std::uint32_t>(i);
+        });
+    }
     cub::DoubleBuffer<std::uint64_t> keyBuffer(keyArrays[0].data(), keyArrays[1].data());
     cub::DoubleBuffer<std::uint32_t> positionBuffer(positions[0].data(), positions[1].data());
     cuda::withScratch(temp, "the radix sort's scratch (GPU sort)", [&](void* s, std::size_t& b) {
@@ -329,9 +313,13 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, const Frac
     view.tets = tets.data(), view.nativeCorners = nativeCorners.data();
     view.points = nullptr, view.values = nullptr, view.tetCorners = nullptr;
     view.blockVertices = nullptr, view.blockVertexBase = nullptr;
-    cuda::countFacesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(view, canonIds.data(),
-                                                                 counts.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    const std::uint32_t* canon = canonIds.data();
+    {
+        unsigned long long* faces = counts.data();
+        cuda::forEachElement("face counts", n, [=] __device__(std::uint64_t c) {
+            cuda::countFaces(c, view, canon, faces);
+        });
+    }
     cuda::withScratch(
         temp, "the scan's scratch (GPU face neighbours)", [&](void* s, std::size_t& b) {
             return cub::DeviceScan::ExclusiveSum(s, b, counts.data(), offsets.data(), points + 1);
@@ -359,14 +347,18 @@ std::vector<std::uint32_t> buildTetNeighborsCuda(const TetMesh& mesh, const Frac
         hi = std::max(hi, lo + 1);
         UVR_CHECK(hostOffsets[hi] - base <= most,
                   "one vertex has more faces than the GPU holds: " << hostOffsets[hi] - base);
-        cuda::scatterFacesKernel<<<cuda::blocksFor(n), cuda::kBlock>>>(
-            view, canonIds.data(), static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi),
-            base, counts.data(), entries.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
-        cuda::matchKernel<<<cuda::blocksFor(hi - lo), cuda::kBlock>>>(
-            view, static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi), offsets.data(),
-            base, entries.data(), table.data());
-        UVR_CUDA_CHECK(cudaGetLastError());
+        const std::uint32_t first = static_cast<std::uint32_t>(lo),
+                            last = static_cast<std::uint32_t>(hi);
+        unsigned long long* fill = counts.data();
+        const unsigned long long* offset = offsets.data();
+        cuda::FaceEntry* faces = entries.data();
+        std::uint32_t* neighbours = table.data();
+        cuda::forEachElement("face scatter", n, [=] __device__(std::uint64_t c) {
+            cuda::scatterFaces(c, view, canon, first, last, base, fill, faces);
+        });
+        cuda::forEachElement("face matches", hi - lo, [=] __device__(std::uint64_t v) {
+            cuda::matchFaces(first + v, view, offset, base, faces, neighbours);
+        });
         lo = hi;
         if (progress) {
             UVR_CUDA_CHECK(cudaDeviceSynchronize());
@@ -402,13 +394,19 @@ SeedGrids buildSeedGridsCuda(const TetMesh& mesh, const KdPartitions& kd, float 
     UVR_CUDA_CHECK(cudaMemset(best.data(), 0xff, cells * sizeof(unsigned long long)));
     if (progress) progress(0.5);
     const TetLocator locator{device.view, {}, {}};
+    const auto seedStart = std::chrono::steady_clock::now();
     cuda::seedKernel<<<static_cast<unsigned>(kd.partitions.size()), cuda::kBlock>>>(
         locator, partitions.data(), kdCells.data(), grids.data(), best.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    cuda::finishLaunch("seed keys", kd.partitions.size(), seedStart);
     seeds.reserve(cells, "the seeds (GPU seed grids)");
-    cuda::seedsFromKeysKernel<<<cuda::blocksFor(cells), cuda::kBlock>>>(best.data(), cells,
-                                                                        seeds.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    {
+        // Best keys to seeds (the key's low half; kNoTet where no cell offered one).
+        const unsigned long long* keys = best.data();
+        std::uint32_t* seed = seeds.data();
+        cuda::forEachElement("seeds", cells, [=] __device__(std::uint64_t i) {
+            seed[i] = keys[i] == ~0ull ? kNoTet : static_cast<std::uint32_t>(keys[i]);
+        });
+    }
     seeds.download(out.seeds.data(), cells);
     if (progress) progress(1.0);
     out.buildSeconds =
@@ -462,23 +460,25 @@ MacroBuild buildMacroGridsCuda(const TetMesh& mesh, const KdPartitions& kd,
     gradientKeys.reserve(6 * cells, "the macrocells' gradients (GPU macrocells)");
     flags.reserve(cells, "the macrocells' flags (GPU macrocells)");
     partitionKeys.reserve(6 * parts, "the partitions' gradients (GPU macrocells)");
-    cuda::clearKeysKernel<<<cuda::blocksFor(2 * cells), cuda::kBlock>>>(rangeKeys.data(), 2 * cells,
-                                                                        2);
-    cuda::clearKeysKernel<<<cuda::blocksFor(6 * cells), cuda::kBlock>>>(gradientKeys.data(),
-                                                                        6 * cells, 6);
-    cuda::clearKeysKernel<<<cuda::blocksFor(6 * parts), cuda::kBlock>>>(partitionKeys.data(),
-                                                                        6 * parts, 6);
-    UVR_CUDA_CHECK(cudaGetLastError());
+    cuda::clearKeys("macrocell range keys", rangeKeys.data(), 2 * cells, 2);
+    cuda::clearKeys("macrocell gradient keys", gradientKeys.data(), 6 * cells, 6);
+    cuda::clearKeys("partition gradient keys", partitionKeys.data(), 6 * parts, 6);
     UVR_CUDA_CHECK(cudaMemset(flags.data(), 0, cells * sizeof(std::uint32_t)));
     if (progress) progress(0.5);
+    const auto macroStart = std::chrono::steady_clock::now();
     cuda::macroKernel<<<static_cast<unsigned>(parts), cuda::kBlock>>>(
         view, partitions.data(), kdCells.data(), grids.data(), boundaryFlags.data(), anyNan,
         rangeKeys.data(), gradientKeys.data(), flags.data(), partitionKeys.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    cuda::finishLaunch("macrocell keys", parts, macroStart);
     macroCells.reserve(cells, "the macrocells (GPU macrocells)");
-    cuda::macroCellsKernel<<<cuda::blocksFor(cells), cuda::kBlock>>>(
-        rangeKeys.data(), gradientKeys.data(), flags.data(), cells, macroCells.data());
-    UVR_CUDA_CHECK(cudaGetLastError());
+    {
+        const std::uint32_t *ranges = rangeKeys.data(), *gradients = gradientKeys.data(),
+                            *cellFlags = flags.data();
+        MacroCell* macro = macroCells.data();
+        cuda::forEachElement("macrocells", cells, [=] __device__(std::uint64_t c) {
+            cuda::macroCellOf(c, ranges, gradients, cellFlags, macro);
+        });
+    }
     macroCells.download(out.macro.cells.data(), cells);
     if (anyNan) {
         std::vector<std::uint32_t> hostFlags(cells);

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "uvr/cpu/threads.h"
-#include "uvr/cuda/cuda_renderer.h"
+#include "uvr/cuda/cuda_device.h"
 #include "uvr/render/empty_frame.h"
 
 namespace uvr {
@@ -51,17 +51,17 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     j["field"] = prepared.tets.fieldName;
     j["field_association"] = associationName(prepared.tets.association);
     j["device"] = renderer.deviceName();
-    if (const CudaScene* gpu = renderer.gpu()) {
-        const double bytes = double(gpu->geometryBytes());
+    if (const std::optional<GpuResidency> gpu = renderer.gpuResidency()) {
+        const double bytes = double(gpu->geometryBytes);
         j["gpu"] = {{"description", cudaDeviceDescription()},
-                    {"geometry_bytes", gpu->geometryBytes()},
+                    {"geometry_bytes", gpu->geometryBytes},
                     {"bytes_per_cell",
                      bytes / double(std::max<std::uint64_t>(1, prepared.tets.cellCount()))},
                     // Per tetrahedron of the split (the cells' tetrahedra when split): comparable
                     // between native and split cells.
                     {"bytes_per_tetrahedron",
                      bytes / double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
-                    {"upload_seconds", gpu->uploadSeconds()}};
+                    {"upload_seconds", gpu->uploadSeconds}};
     }
     j["threads"] = cpu::threadCount();
     // The method that rendered; with auto, also what was asked and why.

@@ -109,6 +109,11 @@ void Renderer::setFieldValues(const ScalarField& field) {
     if (gpu_) gpu_->updateValues();
 }
 
+std::optional<GpuResidency> Renderer::gpuResidency() const {
+    if (!gpu_) return std::nullopt;
+    return GpuResidency{gpu_->geometryBytes(), gpu_->uploadSeconds(), gpu_->valueUploadSeconds()};
+}
+
 std::string Renderer::deviceDescription() const {
     if (gpu_) return cudaDeviceDescription();
     return "CPU, " + std::to_string(cpu::threadCount()) + " threads";

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "uvr/mesh/field_select.h"
@@ -52,6 +53,14 @@ struct RendererOptions {
     PrepareOptions prepareOptions() const;
 };
 
+/// What a renderer holds on the GPU (Renderer::gpuResidency), for reports.
+struct GpuResidency {
+    /// Bytes of device memory holding the mesh, BVH, neighbours and partitions.
+    std::uint64_t geometryBytes = 0;
+    double uploadSeconds = 0.0;       ///< the upload's time
+    double valueUploadSeconds = 0.0;  ///< the last setFieldValues' upload of new values
+};
+
 /// The one renderer object of the library: a mesh prepared once for one field (tetrahedra,
 /// BVHs, neighbours, partitions), resident on the GPU when it renders there, rendering any
 /// number of frames. Camera, transfer function, range, method and quality are per-frame
@@ -91,8 +100,8 @@ public:
     const char* deviceName() const { return gpu_ ? "cuda" : "cpu"; }
     /// One line naming the device: the GPU and its memory, or the CPU threads.
     std::string deviceDescription() const;
-    /// The GPU copy of the mesh when rendering on the GPU, else null.
-    const CudaScene* gpu() const { return gpu_.get(); }
+    /// What the renderer holds on the GPU when it renders there (else nothing).
+    std::optional<GpuResidency> gpuResidency() const;
     /// Seconds the preparation took (0 for a mesh prepared elsewhere).
     double prepareSeconds() const { return prepareSeconds_; }
 

@@ -268,11 +268,12 @@ TEST(Renderer, OnTheGpuSetFieldValuesGivesTheFramesOfAFreshUpload) {
     o.device = Device::Cuda;
     o.leafCells = 64;
     Renderer updated(m0, f0, o);
-    const std::uint64_t bytes = updated.gpu()->geometryBytes();
+    const std::uint64_t bytes = updated.gpuResidency()->geometryBytes;
     updated.setFieldValues(f1);
-    EXPECT_EQ(updated.gpu()->geometryBytes(), bytes + updated.prepared().partitionNan.size() +
-                                                  updated.prepared().macro->nanCells.size());
-    EXPECT_GT(updated.gpu()->valueUploadSeconds(), 0.0);
+    EXPECT_EQ(
+        updated.gpuResidency()->geometryBytes,
+        bytes + updated.prepared().partitionNan.size() + updated.prepared().macro->nanCells.size());
+    EXPECT_GT(updated.gpuResidency()->valueUploadSeconds, 0.0);
     Renderer fresh(m1, f1, o);
     for (RenderMethod method :
          {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {

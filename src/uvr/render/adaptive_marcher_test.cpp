@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/cpu/cpu_renderer.h"
@@ -57,6 +58,10 @@ float maxDifference(const Image& a, const Image& b) {
     return d;
 }
 
+/// PartitionIntegrator's frames render on every device (tests/on_each_device.h).
+class PartitionIntegrator : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(PartitionIntegrator);
+
 TEST(AdaptiveStep, FormulaEnds) {
     EXPECT_FLOAT_EQ(adaptiveStep(1.f, 0.1f, 0.8f, 2.f), 0.1f);
     EXPECT_FLOAT_EQ(adaptiveStep(0.f, 0.1f, 0.8f, 2.f), 0.8f);
@@ -65,16 +70,16 @@ TEST(AdaptiveStep, FormulaEnds) {
     EXPECT_GT(adaptiveStep(0.5f, 0.1f, 0.8f, 1.f), adaptiveStep(0.5f, 0.1f, 0.8f, 4.f));
 }
 
-TEST(PartitionIntegrator, EqualStepsReproduceTheReference) {
+TEST_P(PartitionIntegrator, EqualStepsReproduceTheReference) {
     const PreparedMesh pm = jitteredGrid();
     RenderSettings ref = baseSettings();
-    const RenderResult r = renderCpu(pm, ref);
+    const RenderResult r = render(pm, ref);
     for (bool skip : {true, false}) {
         RenderSettings s = ref;
         s.method = RenderMethod::Partitions;
         s.skip = skip;
         s.adaptive = false;  // every partition at s1: the reference's samples
-        const RenderResult p = renderCpu(pm, s);
+        const RenderResult p = render(pm, s);
         EXPECT_LT(maxDifference(r.image, p.image), 1e-4f) << "skip " << skip;
         if (skip) {
             EXPECT_LT(p.stats.samples, r.stats.samples);  // transparent partitions skipped
@@ -86,17 +91,17 @@ TEST(PartitionIntegrator, EqualStepsReproduceTheReference) {
         // Also with s2 == s1 and adaptivity on.
         s.adaptive = true;
         s.maxStep = r.setup.params.step;
-        EXPECT_LT(maxDifference(r.image, renderCpu(pm, s).image), 1e-4f);
+        EXPECT_LT(maxDifference(r.image, render(pm, s).image), 1e-4f);
     }
 }
 
-TEST(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
+TEST_P(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
     const PreparedMesh pm = jitteredGrid();
     RenderSettings s = baseSettings();
-    const RenderResult r = renderCpu(pm, s);
+    const RenderResult r = render(pm, s);
     s.method = RenderMethod::Partitions;
     s.maxStep = 4.f * r.setup.params.step;
-    const RenderResult a = renderCpu(pm, s);
+    const RenderResult a = render(pm, s);
     EXPECT_LT(a.stats.samples, r.stats.samples);
     EXPECT_LT(meanDifference(r.image, a.image), 0.01f);
     for (const PartitionShading& sh : a.setup.shading) {
@@ -107,7 +112,7 @@ TEST(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
 
 // The correctness bar of the method: with s1 == s2 the partition integrator reproduces the
 // reference (any loss comes from the adaptive step only), on every real mesh.
-TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
+TEST_P(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     for (const char* name :
          {"spx.vtk", "post.vtk", "tetraMesh.vtk", "bluntfin_tets.vtk", "post_tets.vtk",
@@ -124,12 +129,12 @@ TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
         s.tf = transferFunctionPreset("viridis");
         applyOpacitySpec(s.tf, "0:0,1:0.5");
         s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), 30.f, 20.f);
-        const RenderResult ref = renderCpu(pm, s);
+        const RenderResult ref = render(pm, s);
         s.method = RenderMethod::Partitions;
         for (bool adaptive : {false, true}) {
             s.adaptive = adaptive;
             s.maxStep = ref.setup.params.step;  // s2 == s1
-            const RenderResult p = renderCpu(pm, s);
+            const RenderResult p = render(pm, s);
             const double ssim = compareImages(toRgb8(ref.image), toRgb8(p.image)).ssim;
             EXPECT_GE(ssim, 0.995) << name << (adaptive ? " adaptive" : " skipping only");
             EXPECT_LT(maxDifference(ref.image, p.image), 2e-3f) << name;
@@ -140,7 +145,7 @@ TEST(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
 
 // The partition integrator locates with the partitions' own BVHs and seed grids: preparing
 // without the mesh BVH (less memory) gives the same image, and the reference is refused there.
-TEST(PartitionIntegrator, NeedsNoMeshBvh) {
+TEST_P(PartitionIntegrator, NeedsNoMeshBvh) {
     Mesh m = testing::makeHexGrid(
         10, -1.f, 1.f, [](Vec3f p) { return std::sin(3 * p.x) * std::cos(2 * p.y) + p.z; }, 0.3f);
     PrepareOptions o;
@@ -150,9 +155,9 @@ TEST(PartitionIntegrator, NeedsNoMeshBvh) {
     const PreparedMesh without = prepareMesh(m, selectScalarField(m, {}), o);
     EXPECT_TRUE(without.bvh.nodes.empty());
     RenderSettings s = baseSettings();
-    EXPECT_THROW(renderCpu(without, s), Error);
+    EXPECT_THROW(render(without, s), Error);
     s.method = RenderMethod::Partitions;
-    const RenderResult a = renderCpu(with, s), b = renderCpu(without, s);
+    const RenderResult a = render(with, s), b = render(without, s);
     EXPECT_EQ(a.stats.samples, b.stats.samples);
     EXPECT_LT(maxDifference(a.image, b.image), 1e-6f);
 }
@@ -199,7 +204,7 @@ std::pair<float, float> levelDifferences(const Image& a, const Image& b) {
 // curved boundary). The 99.9th percentile within 4 levels and the maximum within 24, or no worse
 // than the reference's where its s1 steps miss as much (the cylinder's end cap, Blunt Fin's
 // silhouette).
-TEST(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
+TEST_P(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     struct Case {
         const char* file;
@@ -216,11 +221,11 @@ TEST(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
         s.tf = transferFunctionPreset(c.tf);
         s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), c.azimuth, c.elevation);
         s.method = RenderMethod::Exact;
-        const Image exact = renderCpu(pm, s).image;
+        const Image exact = render(pm, s).image;
         s.method = RenderMethod::Reference;
-        const auto [refP999, refMax] = levelDifferences(exact, renderCpu(pm, s).image);
+        const auto [refP999, refMax] = levelDifferences(exact, render(pm, s).image);
         s.method = RenderMethod::Partitions;  // the default: error-bound steps, macrocells
-        const auto [p999, max] = levelDifferences(exact, renderCpu(pm, s).image);
+        const auto [p999, max] = levelDifferences(exact, render(pm, s).image);
         EXPECT_LE(p999, std::max(4.f, refP999 + 1.f)) << c.file << " (reference " << refP999 << ")";
         EXPECT_LE(max, std::max(24.f, refMax + 1.f)) << c.file << " (reference " << refMax << ")";
     }
@@ -232,7 +237,7 @@ TEST(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
 // reference's s1 steps against exact (99.9th percentile), with fewer samples. Before the rule:
 // 79 and 50 levels, maximum 181 and 154; now 10 at 30 degrees against the reference's 6: steps
 // from inside to inside across a concave gap of the shell are still not bisected.
-TEST(PartitionIntegrator, LongStepsAtCurvedBoundariesStayNearTheReference) {
+TEST_P(PartitionIntegrator, LongStepsAtCurvedBoundariesStayNearTheReference) {
     ProceduralSpec spec;
     spec.shape = ProceduralShape::Shell;
     spec.targetCells = 20000;
@@ -246,12 +251,12 @@ TEST(PartitionIntegrator, LongStepsAtCurvedBoundariesStayNearTheReference) {
         s.tf = transferFunctionPreset("viridis");
         applyOpacitySpec(s.tf, "0:0.2,1:0.6");
         s.method = RenderMethod::Exact;
-        const Image exact = renderCpu(pm, s).image;
+        const Image exact = render(pm, s).image;
         s.method = RenderMethod::Reference;
-        const RenderResult ref = renderCpu(pm, s);
+        const RenderResult ref = render(pm, s);
         const auto [refP999, refMax] = levelDifferences(exact, ref.image);
         s.method = RenderMethod::Partitions;
-        const RenderResult a = renderCpu(pm, s);
+        const RenderResult a = render(pm, s);
         const auto [p999, max] = levelDifferences(exact, a.image);
         EXPECT_LE(p999, 2.f * refP999) << azimuth;
         EXPECT_LE(max, std::max(24.f, refMax + 1.f)) << azimuth;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <vector>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/field_select.h"
@@ -218,21 +219,25 @@ double worstChordError(const RenderResult& r, const RenderSettings& s,
     return worst;
 }
 
-TEST(ExactIntegrator, ConstantFieldThroughJitteredGridIsTheChordLength) {
+/// Frames of the exact integrator, on every device (tests/on_each_device.h).
+class ExactFrame : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(ExactFrame);
+
+TEST_P(ExactFrame, ConstantFieldThroughJitteredGridIsTheChordLength) {
     // Every pixel: alpha = 1 - exp(-kappa chord), the chord through the box; no sampling
     // band, no cracks between the 6 * 6^3 jittered tetrahedra.
     const Bounds3f box{Vec3f(0.f), Vec3f(1.f)};
     const PreparedMesh pm = preparedGrid(
         6, 0.f, 1.f, [](Vec3f) { return 1.f; }, 0.3f);
     const RenderSettings s = exactSettings(box, 48);
-    const RenderResult r = renderCpu(pm, s);
+    const RenderResult r = render(pm, s);
     int covered = 0;
     const double worst = worstChordError(r, s, {box}, covered);
     EXPECT_GT(covered, 1000);
     EXPECT_LT(worst, 1e-4);
 }
 
-TEST(ExactIntegrator, RaysLeavingANonConvexMeshAndReenteringKeepBothParts) {
+TEST_P(ExactFrame, RaysLeavingANonConvexMeshAndReenteringKeepBothParts) {
     // Two unit cubes with a gap of 0.5 between them along x: rays through both integrate both.
     Mesh a = testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; });
     const Mesh b = testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; });
@@ -250,14 +255,14 @@ TEST(ExactIntegrator, RaysLeavingANonConvexMeshAndReenteringKeepBothParts) {
     RenderSettings s = exactSettings(Bounds3f{Vec3f(0.f), Vec3f(2.5f, 1.f, 1.f)}, 48);
     s.camera = orbitCamera(resetCamera(Bounds3f{Vec3f(0.f), Vec3f(2.5f, 1.f, 1.f)}, 1.f), 70.f,
                            10.f);  // looking mostly along x, through both cubes
-    const RenderResult r = renderCpu(pm, s);
+    const RenderResult r = render(pm, s);
     int both = 0;
     const double worst = worstChordError(r, s, {boxA, boxB}, both);
     EXPECT_GT(both, 100);
     EXPECT_LT(worst, 1e-4);
 }
 
-TEST(ExactIntegrator, LinearFieldMatchesTheReferenceAtATinyStep) {
+TEST_P(ExactFrame, LinearFieldMatchesTheReferenceAtATinyStep) {
     // A linear field under a ramp with two bands: the fixed-step reference converges to the
     // exact image as its step shrinks (its error falls about linearly with the step).
     const Bounds3f box{Vec3f(-1.f), Vec3f(1.f)};
@@ -265,14 +270,14 @@ TEST(ExactIntegrator, LinearFieldMatchesTheReferenceAtATinyStep) {
         5, -1.f, 1.f, [](Vec3f p) { return p.x + 2.f * p.y - p.z; }, 0.25f);
     RenderSettings s = exactSettings(box, 32);
     applyOpacitySpec(s.tf, "0:0,0.3:0.6,0.35:0,0.6:0,0.7:0.8,0.8:0,1:0.2");
-    const RenderResult e = renderCpu(pm, s);
+    const RenderResult e = render(pm, s);
     double errCoarse = 0.0, errFine = 0.0;
     for (const float factor : {1.f, 1.f / 32.f}) {
         RenderSettings ref = s;
         ref.method = RenderMethod::Reference;
         ref.step = defaultStep(pm.tets) * factor;
         ref.terminationAlpha = 1.f;
-        const RenderResult r = renderCpu(pm, ref);
+        const RenderResult r = render(pm, ref);
         double worst = 0.0;
         for (std::size_t i = 0; i < r.image.pixels.size(); ++i)
             for (int c = 0; c < 4; ++c) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/accel/lbvh.h"
@@ -174,14 +175,14 @@ const Method kEachMethod[] = {{"reference", RenderMethod::Reference, false},
                               {"partitions", RenderMethod::Partitions, false},
                               {"partitions+adaptive", RenderMethod::Partitions, true}};
 
-/// Renders the frame with one integrator and counts the pixels off the oracle for a convex mesh
-/// filling `box`; covered receives the number of pixels whose ray meets the box, first the first
-/// mismatch.
-int badPixels(const PreparedMesh& pm, RenderSettings s, const Bounds3f& box, const Method& method,
-              int& covered, std::string& first) {
+/// Renders the frame with one integrator on `device` and counts the pixels off the oracle for a
+/// convex mesh filling `box`; covered receives the number of pixels whose ray meets the box, first
+/// the first mismatch.
+int badPixels(testing::TestDevice device, const PreparedMesh& pm, RenderSettings s,
+              const Bounds3f& box, const Method& method, int& covered, std::string& first) {
     s.method = method.method;
     s.adaptive = method.adaptive;
-    const RenderResult r = renderCpu(pm, s);
+    const RenderResult r = testing::renderOn(device, pm, s);
     int bad = 0;
     covered = 0;
     for (int y = 0; y < s.height; ++y)
@@ -198,13 +199,15 @@ int badPixels(const PreparedMesh& pm, RenderSettings s, const Bounds3f& box, con
     return bad;
 }
 
-/// Renders the frame with every integrator and expects every pixel on the oracle; returns the
-/// number of pixels the mesh covers (so a test can insist that it saw the mesh).
-int renderAndCheck(const PreparedMesh& pm, const RenderSettings& s, const Bounds3f& box) {
+/// Renders the frame with every integrator on `device` and expects every pixel on the oracle;
+/// returns the number of pixels the mesh covers (so a test can insist that it saw the mesh).
+int renderAndCheck(testing::TestDevice device, const PreparedMesh& pm, const RenderSettings& s,
+                   const Bounds3f& box) {
     int covered = 0;
     for (const Method& method : kEachMethod) {
         std::string first;
-        EXPECT_EQ(badPixels(pm, s, box, method, covered, first), 0) << method.name << ": " << first;
+        EXPECT_EQ(badPixels(device, pm, s, box, method, covered, first), 0)
+            << method.name << ": " << first;
     }
     return covered;
 }
@@ -222,7 +225,11 @@ Camera obliqueCamera(const Bounds3f& box) {
     return orbitCamera(resetCamera(box, 1.f), 33.f, 27.f);
 }
 
-TEST(HostileMesh, OracleSeesAMissingCell) {
+/// The suite's frames render on every device (tests/on_each_device.h).
+class HostileMesh : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(HostileMesh);
+
+TEST_P(HostileMesh, OracleSeesAMissingCell) {
     // The check itself: a grid with one interior hexahedron left out (a hole the rays cross)
     // must fail the oracle in every integrator.
     Mesh full = hexGridOnPlanes(uniformPlanes(5, 0.f, 1.f));
@@ -235,14 +242,14 @@ TEST(HostileMesh, OracleSeesAMissingCell) {
     for (const Method& method : kEachMethod) {
         int covered = 0;
         std::string first;
-        EXPECT_GT(badPixels(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox, method,
-                            covered, first),
+        EXPECT_GT(badPixels(device(), pm, constantSettings(obliqueCamera(kUnitBox), 41, 37),
+                            kUnitBox, method, covered, first),
                   3)
             << method.name;
     }
 }
 
-TEST(HostileMesh, DegenerateAndInvertedCellsRenderTheExactImage) {
+TEST_P(HostileMesh, DegenerateAndInvertedCellsRenderTheExactImage) {
     // A 4^3 grid of Kuhn tetrahedra (half of them listed inverted), plus zero-volume cells on
     // internal faces: a flat tetrahedron on a face square, a needle with three collinear corners.
     const Planes planes = uniformPlanes(4, 0.f, 1.f);
@@ -260,13 +267,14 @@ TEST(HostileMesh, DegenerateAndInvertedCellsRenderTheExactImage) {
     m.fields.push_back({"f", Association::Point, 1, std::vector<float>(m.points.size(), 1.f)});
     for (const bool lbvh : {false, true}) {  // SAH trees, linear BVHs
         const PreparedMesh pm = prepare(m, 32, lbvh);
-        EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox),
+        EXPECT_GT(renderAndCheck(device(), pm, constantSettings(obliqueCamera(kUnitBox), 41, 37),
+                                 kUnitBox),
                   500)
             << (lbvh ? "LBVH" : "SAH");
     }
 }
 
-TEST(HostileMesh, CoincidentPointsRenderTheExactImage) {
+TEST_P(HostileMesh, CoincidentPointsRenderTheExactImage) {
     // Every cell has its own copies of its corners: no shared point ids, every shared face is a
     // pair of coincident triangles (face neighbours are found by position, buildTetNeighbors).
     const Mesh grid = hexGridOnPlanes(uniformPlanes(5, 0.f, 1.f));
@@ -282,23 +290,24 @@ TEST(HostileMesh, CoincidentPointsRenderTheExactImage) {
     m.fields.push_back({"f", Association::Point, 1, std::vector<float>(m.points.size(), 1.f)});
     for (const bool lbvh : {false, true}) {  // SAH trees, linear BVHs
         const PreparedMesh pm = prepare(m, 32, lbvh);
-        EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(kUnitBox), 41, 37), kUnitBox),
+        EXPECT_GT(renderAndCheck(device(), pm, constantSettings(obliqueCamera(kUnitBox), 41, 37),
+                                 kUnitBox),
                   500)
             << (lbvh ? "LBVH" : "SAH");
     }
 }
 
-TEST(HostileMesh, CellsFromMicrometreToMegametreRenderTheExactImage) {
+TEST_P(HostileMesh, CellsFromMicrometreToMegametreRenderTheExactImage) {
     // Planes 0, 1e-6, 1e-5, ..., 1e6 on every axis: cubes of 1e-6 beside slabs 1e12 times wider.
     Planes planes{0.f};
     for (int e = -6; e <= 6; ++e) planes.push_back(std::pow(10.f, float(e)));
     const Bounds3f box{{0.f, 0.f, 0.f}, {1e6f, 1e6f, 1e6f}};
     const Mesh m = hexGridOnPlanes(planes);
-    EXPECT_GT(renderAndCheck(prepare(m, 32, /*lbvh=*/true),
+    EXPECT_GT(renderAndCheck(device(), prepare(m, 32, /*lbvh=*/true),
                              constantSettings(obliqueCamera(box), 41, 37), box),
               500);
     const PreparedMesh pm = prepare(m);
-    EXPECT_GT(renderAndCheck(pm, constantSettings(obliqueCamera(box), 41, 37), box), 500);
+    EXPECT_GT(renderAndCheck(device(), pm, constantSettings(obliqueCamera(box), 41, 37), box), 500);
     // Also at a step resolving the small cells near the origin, looking at that corner.
     Camera close;
     close.position = {-2e-5f, -1e-5f, -3e-5f};
@@ -308,21 +317,21 @@ TEST(HostileMesh, CellsFromMicrometreToMegametreRenderTheExactImage) {
     s.opacityUnit = 1e-5f;
     // Steps this fine over a 1e6 mesh are refused (too many samples per ray, and the camera too
     // many steps away for a float grid count): a clear error, not an endless render.
-    const Error e = testing::catchError([&] { (void)renderCpu(pm, s); });
+    const Error e = testing::catchError([&] { (void)render(pm, s); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
     EXPECT_NE(std::string(e.what()).find("a larger `step`"), std::string::npos) << e.what();
 }
 
-TEST(HostileMesh, CameraInsideTheVolumeSeesItsPathToTheBoundary) {
+TEST_P(HostileMesh, CameraInsideTheVolumeSeesItsPathToTheBoundary) {
     const PreparedMesh pm = prepare(hexGridOnPlanes(uniformPlanes(6, 0.f, 1.f)));
     Camera inside;
     inside.position = {0.41f, 0.53f, 0.37f};
     inside.focalPoint = {0.9f, 0.8f, 0.1f};
     inside.viewAngle = 100.f;
-    EXPECT_EQ(renderAndCheck(pm, constantSettings(inside, 33, 29), kUnitBox), 33 * 29);
+    EXPECT_EQ(renderAndCheck(device(), pm, constantSettings(inside, 33, 29), kUnitBox), 33 * 29);
 }
 
-TEST(HostileMesh, FarCameraFinishesOrIsRefused) {
+TEST_P(HostileMesh, FarCameraFinishesOrIsRefused) {
     // The sample grid counts steps from the camera: 1e6 units away at a step of ~0.04, a float
     // counter would stop advancing (k + 1 == k above 2^24) and the render would never end.
     const PreparedMesh pm = prepare(hexGridOnPlanes(uniformPlanes(6, 0.f, 1.f)));
@@ -332,14 +341,14 @@ TEST(HostileMesh, FarCameraFinishesOrIsRefused) {
     far.viewAngle = 5e-5f;
     const RenderSettings s = constantSettings(far, 9, 9);
     try {
-        (void)renderAndCheck(pm, s, kUnitBox);
+        (void)renderAndCheck(device(), pm, s, kUnitBox);
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Argument) << e.what();
         EXPECT_NE(std::string(e.what()).find("camera"), std::string::npos) << e.what();
     }
 }
 
-TEST(HostileMesh, AxisAlignedCameraOnARegularGridHasNoStreaks) {
+TEST_P(HostileMesh, AxisAlignedCameraOnARegularGridHasNoStreaks) {
     // The image's middle row and column of rays run (nearly) in grid planes, which are cell
     // faces and k-d split planes; every other ray crosses them at grid edges.
     const Bounds3f box{{0.f, 0.f, 0.f}, {8.f, 8.f, 8.f}};
@@ -351,11 +360,11 @@ TEST(HostileMesh, AxisAlignedCameraOnARegularGridHasNoStreaks) {
         c.position[axis] += 30.f;
         c.viewUp = axis == 1 ? Vec3f(0.f, 0.f, 1.f) : Vec3f(0.f, 1.f, 0.f);
         SCOPED_TRACE("axis " + std::to_string(axis));
-        EXPECT_GT(renderAndCheck(pm, constantSettings(c, 33, 33), box), 300);
+        EXPECT_GT(renderAndCheck(device(), pm, constantSettings(c, 33, 33), box), 300);
     }
 }
 
-TEST(HostileMesh, RaysExactlyAlongFacesEdgesAndSplitPlanesLoseNothing) {
+TEST(HostileMeshRays, RaysExactlyAlongFacesEdgesAndSplitPlanesLoseNothing) {
     // Rays with exactly axis-aligned or in-plane diagonal directions, started on grid planes
     // (integers and half-integers): along cell faces, along cell edges, through grid vertices,
     // in the k-d split planes, through the marchers directly so the directions are exact.
@@ -419,7 +428,7 @@ TEST(HostileMesh, RaysExactlyAlongFacesEdgesAndSplitPlanesLoseNothing) {
     }
 }
 
-TEST(HostileMesh, FieldSpanningTheFloatRangeRendersLikeTheSameFieldScaledDown) {
+TEST_P(HostileMesh, FieldSpanningTheFloatRangeRendersLikeTheSameFieldScaledDown) {
     // A linear field from -S to S over a 2^3 hexahedron grid: the transfer function spans the
     // field's range, so the image must not depend on S. At S = 3e38 and FLT_MAX the range's
     // width overflows float (it used to make the table index NaN and crash every integrator).
@@ -437,9 +446,9 @@ TEST(HostileMesh, FieldSpanningTheFloatRangeRendersLikeTheSameFieldScaledDown) {
     for (const Method& method : kEachMethod) {
         s.method = method.method;
         s.adaptive = method.adaptive;
-        const RenderResult want = renderCpu(prepare(unit, 4), s);
+        const RenderResult want = render(prepare(unit, 4), s);
         for (const float scale : {3e38f, std::numeric_limits<float>::max()}) {
-            const RenderResult got = renderCpu(prepare(meshScaled(scale), 4), s);
+            const RenderResult got = render(prepare(meshScaled(scale), 4), s);
             EXPECT_EQ(got.setup.rangeLo, -scale);
             EXPECT_EQ(got.setup.rangeHi, scale);
             int visible = 0;
@@ -472,7 +481,7 @@ Mesh gridScaledAndMoved(float scale, Vec3f offset) {
     return m;
 }
 
-TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
+TEST_P(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
     // Coordinates near 1e38 (its default camera lies beyond float's range), 1e-30 and 1e-42
     // (denormal: cubed edges underflow float), and meshes far from the origin for their size
     // (float spacing 1/8 at 2^20): each renders scaled by a power of two and moved exactly onto
@@ -506,7 +515,7 @@ TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
         for (const bool explicitCamera : {false, true}) {
             RenderSettings want = s;
             if (explicitCamera) want.camera = oblique;
-            const RenderResult w = renderCpu(unitPm, want);
+            const RenderResult w = render(unitPm, want);
             int visible = 0;
             for (int y = 0; y < s.height; ++y)
                 for (int x = 0; x < s.width; ++x) visible += w.image.at(x, y).w > 0.05f;
@@ -523,7 +532,7 @@ TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
                     got.camera->position = oblique.position * c.scale + c.offset;
                     got.camera->focalPoint = oblique.focalPoint * c.scale + c.offset;
                 }
-                const RenderResult g = renderCpu(pm, got);
+                const RenderResult g = render(pm, got);
                 const std::string what = std::string(method.name) + " scale " +
                                          std::to_string(std::log2(c.scale)) +
                                          (explicitCamera ? " explicit camera" : " default camera");
@@ -542,14 +551,14 @@ TEST(HostileMesh, MeshesAtTheEdgesOfFloatRenderLikeTheUnitMesh) {
     }
 }
 
-TEST(HostileMesh, CameraFarFromATinyMeshIsRefusedInStepsItCanCount) {
+TEST_P(HostileMesh, CameraFarFromATinyMeshIsRefusedInStepsItCanCount) {
     // A mesh 1e-30 across and a camera 1 away: 1.9e32 steps (of the diagonal / 256), which
     // overflowed the message's integer ("the camera is -9223372036854775808 steps of 0.000000").
     const PreparedMesh pm = prepare(gridScaledAndMoved(std::ldexp(1.f, -100), Vec3f(0.f)));
     Camera far;
     far.position = {0.f, 0.f, 1.f};
     const RenderSettings s = constantSettings(far, 8, 8);
-    const Error e = testing::catchError([&] { (void)renderCpu(pm, s); });
+    const Error e = testing::catchError([&] { (void)render(pm, s); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
     const std::string what = e.what();
     EXPECT_NE(what.find("the camera is 1.87e+32 steps of 5.34e-33 from the far side"),
@@ -557,7 +566,7 @@ TEST(HostileMesh, CameraFarFromATinyMeshIsRefusedInStepsItCanCount) {
         << what;
 }
 
-TEST(HostileMesh, ThinSlabRendersTheExactImage) {
+TEST_P(HostileMesh, ThinSlabRendersTheExactImage) {
     // A slab 1e-6 thick (its cells 1e-6 of their width, well above the zero-volume threshold),
     // seen edge-on: rays along the middle row run inside it.
     Mesh m = hexGridOnPlanes(uniformPlanes(4, 0.f, 1.f));
@@ -569,14 +578,14 @@ TEST(HostileMesh, ThinSlabRendersTheExactImage) {
     edgeOn.position = {-1.2f, -0.7f, 0.5e-6f};
     edgeOn.focalPoint = {0.5f, 0.5f, 0.5e-6f};
     edgeOn.viewUp = {0.f, 0.f, 1.f};
-    EXPECT_GT(renderAndCheck(pm, constantSettings(edgeOn, 21, 9), box), 10);
+    EXPECT_GT(renderAndCheck(device(), pm, constantSettings(edgeOn, 21, 9), box), 10);
     // The default camera looks through it (at most one sample per ray): it renders.
     RenderSettings s = constantSettings(edgeOn, 21, 9);
     s.camera.reset();
-    EXPECT_NO_THROW((void)renderCpu(pm, s));
+    EXPECT_NO_THROW((void)render(pm, s));
 }
 
-TEST(HostileMesh, MeshWithNothingToRenderIsRefusedOrTransparent) {
+TEST_P(HostileMesh, MeshWithNothingToRenderIsRefusedOrTransparent) {
     // One sliver 1e-7 thick (below the zero-volume threshold: its volume is rounding noise in
     // float) and four identical points: no tetrahedron is left. The default camera has nothing
     // to frame (it used to say "cannot reset the camera to empty or non-finite bounds"); a
@@ -596,18 +605,18 @@ TEST(HostileMesh, MeshWithNothingToRenderIsRefusedOrTransparent) {
         for (const Method& method : kEachMethod) {
             s.method = method.method;
             s.adaptive = method.adaptive;
-            const RenderResult r = renderCpu(pm, s);
+            const RenderResult r = render(pm, s);
             for (int y = 0; y < 8; ++y)
                 for (int x = 0; x < 8; ++x) EXPECT_EQ(r.image.at(x, y).w, 0.f) << method.name;
         }
         s.camera.reset();
-        const Error e = testing::catchError([&] { (void)renderCpu(pm, s); });
+        const Error e = testing::catchError([&] { (void)render(pm, s); });
         EXPECT_NE(std::string(e.what()).find("no cell of non-zero volume"), std::string::npos)
             << e.what();
     }
 }
 
-TEST(HostileMesh, DefaultStepOfAMeshOfSliversIsAtLeastATenThousandthOfTheDiagonal) {
+TEST(HostileMeshSetup, DefaultStepOfAMeshOfSliversIsAtLeastATenThousandthOfTheDiagonal) {
     TetMesh t;
     t.tets.resize(1000);
     t.totalVolume = 1e-12;  // mean 1e-15: a step of 5e-6 without the floor

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -57,7 +58,23 @@ RenderSettings bandSettings(const char* opacity, float step) {
     return s;
 }
 
-TEST(Preintegration, BandBetweenTwoSamplesIsIntegratedNotMissed) {
+/// Preintegration's frames render on every device (tests/on_each_device.h).
+class Preintegration : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(Preintegration);
+
+/// OpacityLawFrames's frames render on every device (tests/on_each_device.h).
+class OpacityLawFrames : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(OpacityLawFrames);
+
+/// ErrorBoundRule's frames render on every device (tests/on_each_device.h).
+class ErrorBoundRule : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(ErrorBoundRule);
+
+/// MacroCells's frames render on every device (tests/on_each_device.h).
+class MacroCells : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(MacroCells);
+
+TEST_P(Preintegration, BandBetweenTwoSamplesIsIntegratedNotMissed) {
     // v = z, samples 0.1 apart along the central ray at z = 3 - 0.1 k: the band [0.52, 0.58]
     // lies between the samples at z = 0.5 and 0.6. Point samples miss it; pre-integration is
     // exact for a linear field (the tails beyond the band are transparent).
@@ -65,23 +82,23 @@ TEST(Preintegration, BandBetweenTwoSamplesIsIntegratedNotMissed) {
     RenderSettings s = bandSettings("0:0,0.52:0,0.53:0.8,0.57:0.8,0.58:0,1:0", 0.1f);
     RenderSettings e = s;
     e.method = RenderMethod::Exact;
-    const RenderResult exact = renderCpu(pm, e);
+    const RenderResult exact = render(pm, e);
     const Vec4f centre = exact.image.at(12, 12);
     EXPECT_GT(centre.w, 0.3f);  // 0.05 through the band at 0.8 per 0.1: about 0.6
     s.preintegrated = false;
-    EXPECT_LT(renderCpu(pm, s).image.at(12, 12).w, 0.05f);  // missed or nearly
+    EXPECT_LT(render(pm, s).image.at(12, 12).w, 0.05f);  // missed or nearly
     s.preintegrated = true;
-    const RenderResult ref = renderCpu(pm, s);
+    const RenderResult ref = render(pm, s);
     EXPECT_LT(maxDifference(ref.image, exact.image), 2e-4f);
     // The partition method too, at every rule (the variance rule's steps are up to 16 s1).
     s.method = RenderMethod::Partitions;
     for (const StepRule rule : {StepRule::ErrorBound, StepRule::Variance}) {
         s.stepRule = rule;
-        EXPECT_LT(maxDifference(renderCpu(pm, s).image, exact.image), 2e-4f);
+        EXPECT_LT(maxDifference(render(pm, s).image, exact.image), 2e-4f);
     }
 }
 
-TEST(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
+TEST_P(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
     // A linear field has no gradient spread: the error-bound rule gives every visible partition
     // s2, and pre-integration along linear segments (and the runs' last slopes) is still exact.
     const PreparedMesh pm = cube([](Vec3f p) { return 0.3f * p.x + 0.5f * p.y + p.z; }, 64, 6);
@@ -89,17 +106,17 @@ TEST(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
     s.range = std::pair{0.f, 1.8f};
     RenderSettings e = s;
     e.method = RenderMethod::Exact;
-    const RenderResult exact = renderCpu(pm, e);
+    const RenderResult exact = render(pm, e);
     s.method = RenderMethod::Partitions;
     s.maxStep = 0.3f;  // 15 s1
-    const RenderResult a = renderCpu(pm, s);
+    const RenderResult a = render(pm, s);
     for (const PartitionShading& sh : a.setup.shading) {
         if (sh.maxOpacity > 0.f) {
             EXPECT_FLOAT_EQ(sh.step, 0.3f);
         }
     }
     s.method = RenderMethod::Reference;
-    const RenderResult r = renderCpu(pm, s);
+    const RenderResult r = render(pm, s);
     EXPECT_LT(a.stats.samples * 3, r.stats.samples);
     // Inside the mesh both are exact; where a ray leaves it, the last sample owns the distance
     // to the grid point after the exit (as a point sample does), the same for both methods, so
@@ -108,7 +125,7 @@ TEST(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
     EXPECT_GT(compareImages(toRgb8(exact.image), toRgb8(r.image)).ssim, 0.99);
 }
 
-TEST(Preintegration, FastPiecesMatchTheClosedForm) {
+TEST(PreintegrationMath, FastPiecesMatchTheClosedForm) {
     // The sample-based methods' float pieces against the exact integrator's double ones: within
     // 1e-3 at every optical depth (deep pieces fall back), with opacities of 0, near 1 and 1 at
     // either end, nearly equal ends, and from any accumulated opacity.
@@ -155,7 +172,7 @@ std::vector<int> sortedPixelDifferences(const Image& a, const Image& b) {
 // between opaque and not (banding, dark dots, white dashes; 177/255 between methods, issue 29).
 // Under the default attenuation law it is an extinction like any other: every method agrees
 // with exact to the issue's bounds (99.9th percentile <= 4/255, maximum <= 24/255).
-TEST(OpacityLaw, TetraMeshOpacityOneAgreesWithExactInEveryMethod) {
+TEST_P(OpacityLawFrames, TetraMeshOpacityOneAgreesWithExactInEveryMethod) {
     if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
     const Mesh mesh = readMesh(testing::sharedData("tetraMesh.vtk"));
     const PreparedMesh pm = prepareMesh(mesh, selectScalarField(mesh, {}));
@@ -166,10 +183,10 @@ TEST(OpacityLaw, TetraMeshOpacityOneAgreesWithExactInEveryMethod) {
         applyOpacitySpec(s.tf, "ramp");
         s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), azimuth, elevation);
         s.method = RenderMethod::Exact;
-        const RenderResult exact = renderCpu(pm, s);
+        const RenderResult exact = render(pm, s);
         for (const RenderMethod method : {RenderMethod::Reference, RenderMethod::Partitions}) {
             s.method = method;
-            const RenderResult r = renderCpu(pm, s);
+            const RenderResult r = render(pm, s);
             const std::vector<int> d = sortedPixelDifferences(exact.image, r.image);
             const std::string what =
                 std::string(method == RenderMethod::Reference ? "reference" : "adaptive") +
@@ -225,7 +242,7 @@ TEST(PartitionGradientSpread, BoundsTheGradientsOfTheCells) {
     for (float spread : cc.gradientSpread) EXPECT_EQ(spread, INFINITY);
 }
 
-TEST(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
+TEST_P(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
     // A smooth non-linear field under a two-band transfer function: the default quality's rule
     // stays as close to exact as the reference and takes fewer samples; a lower quality takes
     // fewer still.
@@ -239,12 +256,12 @@ TEST(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
     applyOpacitySpec(s.tf, "0:0,0.3:0,0.35:0.7,0.4:0,0.6:0,0.65:0.9,0.7:0,1:0.1");
     RenderSettings e = s;
     e.method = RenderMethod::Exact;
-    const Rgb8Image exact = toRgb8(renderCpu(pm, e).image);
-    const RenderResult ref = renderCpu(pm, s);
+    const Rgb8Image exact = toRgb8(render(pm, e).image);
+    const RenderResult ref = render(pm, s);
     s.method = RenderMethod::Partitions;
-    const RenderResult good = renderCpu(pm, s);
+    const RenderResult good = render(pm, s);
     s.quality = 0.9f;
-    const RenderResult rough = renderCpu(pm, s);
+    const RenderResult rough = render(pm, s);
     // On a mesh of 10^3 cells the reference's step is a 36th of the depth, and where rays enter
     // and leave the mesh its samples own up to a step beyond it: that is most of its difference.
     const double refSsim = compareImages(exact, toRgb8(ref.image)).ssim;
@@ -258,7 +275,7 @@ TEST(ErrorBoundRule, SmoothFieldMeetsTheTargetWithFewerSamples) {
     EXPECT_LT(rough.stats.samples, good.stats.samples);
 }
 
-TEST(MacroCells, SkipTransparentSpaceAndStepLongWithTheImageOfExact) {
+TEST_P(MacroCells, SkipTransparentSpaceAndStepLongWithTheImageOfExact) {
     // A smooth field on the non-convex shell (empty macrocells in its hole, a silhouette all
     // round): under a narrow band most macrocells are transparent and skipped (half the samples
     // or fewer); under ramps (where partitions may keep their own steps) as under the band, the
@@ -281,10 +298,10 @@ TEST(MacroCells, SkipTransparentSpaceAndStepLongWithTheImageOfExact) {
             s.tf = transferFunctionPreset("viridis");
             applyOpacitySpec(s.tf, opacity);
             s.method = RenderMethod::Exact;
-            const Rgb8Image exact = toRgb8(renderCpu(pm, s).image);
+            const Rgb8Image exact = toRgb8(render(pm, s).image);
             s.method = RenderMethod::Partitions;
-            const RenderResult macro = renderCpu(pm, s);
-            const RenderResult partitions = renderCpu(plain, s);
+            const RenderResult macro = render(pm, s);
+            const RenderResult partitions = render(plain, s);
             const std::string what = std::string(opacity) + " at " + std::to_string(azimuth);
             EXPECT_GE(compareImages(exact, toRgb8(macro.image)).ssim, 0.99) << what;
             if (opacity[4] == '0') {  // the band: partitions march by their macrocells
@@ -296,7 +313,7 @@ TEST(MacroCells, SkipTransparentSpaceAndStepLongWithTheImageOfExact) {
         }
 }
 
-TEST(ErrorBoundRule, QualityOutOfRangeIsRefused) {
+TEST(ErrorBoundRuleSetup, QualityOutOfRangeIsRefused) {
     EXPECT_THROW(toleranceForQuality(1.f), Error);
     EXPECT_THROW(toleranceForQuality(0.f), Error);
     EXPECT_THROW(toleranceForQuality(NAN), Error);

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -30,7 +31,11 @@ PreparedMesh linearXGrid() {
     return prepareMesh(m, selectScalarField(m, {}), options);
 }
 
-TEST(TfMapping, LogScaleMovesAnOpacityBandWhereLog10PutsIt) {
+/// TfMapping's frames render on every device (tests/on_each_device.h).
+class TfMapping : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(TfMapping);
+
+TEST_P(TfMapping, LogScaleMovesAnOpacityBandWhereLog10PutsIt) {
     const PreparedMesh pm = linearXGrid();
     ASSERT_GT(pm.kd->partitions.size(), 8u);
     RenderSettings s;
@@ -48,7 +53,7 @@ TEST(TfMapping, LogScaleMovesAnOpacityBandWhereLog10PutsIt) {
         for (const RenderMethod method :
              {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
             s.method = method;
-            const RenderResult r = renderCpu(pm, s);
+            const RenderResult r = render(pm, s);
             EXPECT_GE(r.setup.tfTable.size(), log ? 1024u * 16 : 1024u) << "table entries";
             int inside = 0, outside = 0;
             for (int y = 0; y < s.height; ++y)
@@ -79,7 +84,7 @@ TEST(TfMapping, LogScaleMovesAnOpacityBandWhereLog10PutsIt) {
     }
 }
 
-TEST(TfMapping, LogScaleRangeFromZeroStartsWhereParaViewStartsIt) {
+TEST(TfMappingSetup, LogScaleRangeFromZeroStartsWhereParaViewStartsIt) {
     const PreparedMesh pm = linearXGrid();
     RenderSettings s;
     s.width = s.height = 8;
@@ -116,7 +121,7 @@ PreparedMesh halfNanGrid() {
     return prepareMesh(m, selectScalarField(m, {}), options);
 }
 
-TEST(TfMapping, NanValuesTakeTheNanColourInEveryIntegrator) {
+TEST_P(TfMapping, NanValuesTakeTheNanColourInEveryIntegrator) {
     const PreparedMesh pm = halfNanGrid();
     ASSERT_FALSE(pm.partitionNan.empty());
     ASSERT_TRUE(pm.macro && !pm.macro->nanCells.empty());
@@ -146,7 +151,7 @@ TEST(TfMapping, NanValuesTakeTheNanColourInEveryIntegrator) {
                 if (method == RenderMethod::Exact && !pre) continue;
                 s.method = method;
                 s.preintegrated = pre;
-                const RenderResult r = renderCpu(pm, s);
+                const RenderResult r = render(pm, s);
                 // Sample-based methods place the NaN region's edge to within a step s1.
                 const double tol = method == RenderMethod::Exact ? 2e-3 : 0.03;
                 double worst = 0.0;
