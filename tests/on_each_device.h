@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <string>
 
 #include "uvr/cpu/cpu_renderer.h"
@@ -43,6 +44,11 @@ protected:
         return renderOn(GetParam(), mesh, settings);
     }
 };
+
+/// How gtest prints the parameter ("cpu", "cuda") in test listings and failures.
+inline void PrintTo(TestDevice device, std::ostream* os) {
+    *os << (device == TestDevice::Cpu ? "cpu" : "cuda");
+}
 
 /// The name of an instance: "Cpu" or "Cuda".
 inline std::string testDeviceName(const ::testing::TestParamInfo<TestDevice>& info) {

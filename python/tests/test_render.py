@@ -216,7 +216,7 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
     with pytest.raises(uvr.ArgumentError, match="device: expected auto, cpu or cuda"):
         uvr.Renderer(data_dir / "tetraMesh.vtk", device="tpu")
     if not uvr.cuda_available():
-        with pytest.raises(uvr.UnsupportedError, match="^device='?cuda'?: "):
+        with pytest.raises(uvr.UnsupportedError, match="no CUDA device"):
             uvr.Renderer(data_dir / "tetraMesh.vtk", device="cuda")
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0

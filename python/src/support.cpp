@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: MIT
+// The helpers the binding's parts share (support.h).
+#include "support.h"
+
+namespace uvr::python {
+
+ExceptionClasses gExceptions;
+
+PyObject* addException(py::module_& m, const char* name, PyObject* builtin, const char* doc) {
+    py::tuple bases = builtin ? py::make_tuple(py::handle(gExceptions.base), py::handle(builtin))
+                              : py::make_tuple(py::handle(PyExc_Exception));
+    const std::string qualified = std::string("uvr._uvr.") + name;
+    PyObject* cls = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases.ptr(), nullptr);
+    if (!cls) throw py::error_already_set();
+    m.add_object(name, py::handle(cls));  // the module holds a reference; cls is never freed
+    return cls;
+}
+
+[[noreturn]] void raise(ErrorKind kind, const std::string& message) {
+    throw Error(kind, message);
+}
+
+void checkShape(const py::array& a, std::initializer_list<py::ssize_t> shape,
+                const std::string& what) {
+    bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());
+    std::string expected = "(";
+    int i = 0;
+    for (py::ssize_t s : shape) {
+        if (i) expected += ", ";
+        expected += s < 0 ? "n" : std::to_string(s);
+        if (ok && s >= 0 && a.shape(i) != s) ok = false;
+        ++i;
+    }
+    expected += shape.size() == 1 ? ",)" : ")";
+    if (ok) return;
+    std::string got = "(";
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) got += (k ? ", " : "") + std::to_string(a.shape(k));
+    got += a.ndim() == 1 ? ",)" : ")";
+    raise(ErrorKind::Argument, what + ": expected shape " + expected + ", got " + got);
+}
+
+Image imageOf(const py::handle& pixels) {
+    auto a = exactArray<float>(pixels, "image");
+    checkShape(a, {-1, -1, 4}, "image");
+    Image image(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
+    std::memcpy(static_cast<void*>(image.pixels.data()), a.data(),
+                image.pixels.size() * sizeof(Vec4f));
+    return image;
+}
+
+Vec3f vec3(const std::array<float, 3>& a) {
+    return {a[0], a[1], a[2]};
+}
+
+std::array<float, 3> arr3(Vec3f v) {
+    return {v.x, v.y, v.z};
+}
+
+MeshView borrowedView(const py::object (&arrays)[4]) {
+    auto p = exactArray<float>(arrays[0], "points");
+    checkShape(p, {-1, 3}, "points");
+    auto t = exactArray<std::uint8_t>(arrays[1], "types");
+    checkShape(t, {-1}, "types");
+    auto o = exactArray<std::uint64_t>(arrays[2], "offsets");
+    checkShape(o, {t.shape(0) + 1}, "offsets (one more than the cells)");
+    auto c = exactArray<std::uint32_t>(arrays[3], "connectivity");
+    checkShape(c, {-1}, "connectivity");
+    MeshView v;
+    v.points = {reinterpret_cast<const Vec3f*>(p.data()), static_cast<std::size_t>(p.shape(0))};
+    v.cellTypes = {reinterpret_cast<const CellType*>(t.data()),
+                   static_cast<std::size_t>(t.shape(0))};
+    v.cellOffsets = {o.data(), static_cast<std::size_t>(o.shape(0))};
+    v.cellIndices = {c.data(), static_cast<std::size_t>(c.shape(0))};
+    return v;
+}
+
+std::shared_ptr<const Mesh> cellsNow(const MeshData& d) {
+    if (d.owned) return d.owned;
+    return changedSinceMesh([&] {
+        const MeshView v = borrowedView(d.arrays);
+        auto copy = std::make_shared<Mesh>();
+        copy->points.assign(v.points.begin(), v.points.end());
+        copy->cellTypes.assign(v.cellTypes.begin(), v.cellTypes.end());
+        copy->cellOffsets.assign(v.cellOffsets.begin(), v.cellOffsets.end());
+        copy->cellIndices.assign(v.cellIndices.begin(), v.cellIndices.end());
+        py::gil_scoped_release release;
+        validateCells(*copy, "");
+        return std::shared_ptr<const Mesh>(std::move(copy));
+    });
+}
+
+MeshView shapesNow(const MeshData& d) {
+    if (d.owned) return *d.owned;
+    return changedSinceMesh([&] { return borrowedView(d.arrays); });
+}
+
+std::unique_ptr<MeshData> borrowMesh(const py::handle& points, const py::handle& types,
+                                     const py::handle& offsets, const py::handle& connectivity) {
+    auto out = std::make_unique<MeshData>();
+    out->arrays[0] = py::reinterpret_borrow<py::object>(points);
+    out->arrays[1] = py::reinterpret_borrow<py::object>(types);
+    out->arrays[2] = py::reinterpret_borrow<py::object>(offsets);
+    out->arrays[3] = py::reinterpret_borrow<py::object>(connectivity);
+    validateCells(borrowedView(out->arrays), "");
+    return out;
+}
+
+std::unique_ptr<MeshData> convertMesh(const py::handle& points, const py::handle& types,
+                                      const py::handle& offsets, const py::handle& connectivity) {
+    auto p = exactArray<float>(points, "points");
+    checkShape(p, {-1, 3}, "points");
+    auto t = exactArray<std::int32_t>(types, "types");
+    checkShape(t, {-1}, "types");
+    auto o = exactArray<std::int64_t>(offsets, "offsets");
+    checkShape(o, {t.shape(0) + 1}, "offsets (one more than the cells)");
+    auto c = exactArray<std::int64_t>(connectivity, "connectivity");
+    checkShape(c, {-1}, "connectivity");
+    auto mesh = std::make_shared<Mesh>();
+    mesh->points.assign(reinterpret_cast<const Vec3f*>(p.data()),
+                        reinterpret_cast<const Vec3f*>(p.data()) + p.shape(0));
+    VtkCellArrays cells;
+    cells.types.assign(t.data(), t.data() + t.shape(0));
+    cells.offsets.assign(o.data(), o.data() + o.shape(0));
+    cells.connectivity.assign(c.data(), c.data() + c.shape(0));
+    if (!cells.offsets.empty() && cells.offsets[0] != 0)
+        raise(ErrorKind::Validation,
+              "cell 0: offset " + std::to_string(cells.offsets[0]) + ", expected 0");
+    appendVtkCells(cells, *mesh, "");
+    auto out = std::make_unique<MeshData>();
+    out->owned = std::move(mesh);
+    return out;
+}
+
+py::list ownedFields(const py::object& self, const MeshData& m) {
+    py::list out;
+    if (!m.owned) return out;
+    for (const Field& f : m.owned->fields) {
+        const auto n = static_cast<py::ssize_t>(f.tupleCount());
+        py::array a = f.components == 1 ? viewArray(f.values.data(), {n}, self)
+                                        : viewArray(f.values.data(), {n, f.components}, self);
+        out.append(py::make_tuple(f.name, associationName(f.association), a));
+    }
+    return out;
+}
+
+py::list fieldSetTuples(const py::object& self) {
+    py::list out;
+    for (const Field& f : self.cast<const FieldSet&>().fields) {
+        const auto n = static_cast<py::ssize_t>(f.tupleCount());
+        py::array a = f.components == 1 ? viewArray(f.values.data(), {n}, self)
+                                        : viewArray(f.values.data(), {n, f.components}, self);
+        out.append(py::make_tuple(f.name, associationName(f.association), a));
+    }
+    return out;
+}
+
+Association parseAssociation(const std::string& s, const std::string& what) {
+    if (s == "point") return Association::Point;
+    if (s == "cell") return Association::Cell;
+    raise(ErrorKind::Argument, what + ": expected 'point' or 'cell', got '" + s + "'");
+}
+
+ScalarField scalarField(const std::string& name, const std::string& association,
+                        const py::handle& values) {
+    auto a = exactArray<float>(values, "values");
+    checkShape(a, {-1}, "values");
+    ScalarField f;
+    f.name = name;
+    f.association = parseAssociation(association, "association");
+    f.values.assign(a.data(), a.data() + a.shape(0));
+    return f;
+}
+
+py::tuple selectField(const MeshData& mesh, const py::list& fields, const std::string& spec) {
+    const MeshView shapes = shapesNow(mesh);
+    std::vector<FieldInfo> infos;
+    std::vector<py::array_t<float, py::array::c_style>> arrays;
+    for (const py::handle& item : fields) {
+        const auto t = item.cast<py::tuple>();
+        const std::string name = t[0].cast<std::string>();
+        const Association assoc = parseAssociation(t[1].cast<std::string>(), "association");
+        auto a = exactArray<float>(t[2], "field '" + name + "'");
+        const std::uint64_t tuples =
+            assoc == Association::Point ? shapes.pointCount() : shapes.cellCount();
+        if (a.ndim() < 1 || a.ndim() > 2 || static_cast<std::uint64_t>(a.shape(0)) != tuples)
+            raise(ErrorKind::Argument,
+                  std::string(associationName(assoc)) + " field '" + name + "': expected " +
+                      std::to_string(tuples) + " tuples (one per " + associationName(assoc) +
+                      "), got an array of shape " + std::string(py::str(a.attr("shape"))));
+        infos.push_back({name, assoc, a.ndim() == 2 ? static_cast<int>(a.shape(1)) : 1});
+        arrays.push_back(a);
+    }
+    const FieldSpec parsed = parseFieldSpec(spec);
+    const FieldChoice choice = resolveField(infos, parsed);
+    const auto& a = arrays[choice.index];
+    Field f{infos[choice.index].name, infos[choice.index].association,
+            infos[choice.index].components, std::vector<float>(a.data(), a.data() + a.size())};
+    ScalarField s = scalarFieldOf(shapes, f, parsed.component);  // reads only the counts
+    const auto n = static_cast<py::ssize_t>(s.values.size());
+    return py::make_tuple(s.name, associationName(s.association),
+                          vectorArray<float>(std::move(s.values), {n}), choice.choice);
+}
+
+nlohmann::json settingValue(const py::handle& v) {
+    if (v.is_none()) return nullptr;
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
+    // numpy booleans (their __index__ would read them as 0 and 1)
+    if (py::hasattr(v, "dtype") && py::str(v.attr("dtype").attr("kind")).cast<std::string>() == "b")
+        return py::reinterpret_borrow<py::object>(v).attr("__bool__")().cast<bool>();
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::hasattr(v, "__index__")) {  // int, numpy integers
+        const py::object i = py::module_::import("operator").attr("index")(v);
+        try {
+            return i.cast<std::int64_t>();
+        } catch (const py::cast_error&) {
+            return py::str(i).cast<std::string>();  // beyond 64 bits: refused as written
+        }
+    }
+    if (py::hasattr(v, "__float__")) return v.cast<double>();  // numpy floats
+    return py::str(py::repr(v)).cast<std::string>();           // refused as what it is
+}
+
+std::string pythonName(const std::string& setting) {
+    if (setting == "log") return "log_scale";
+    if (setting == "seed_grid") return "seed_grids";
+    return setting;
+}
+
+std::string pythonSpelling(const std::string& message) {
+    return respellMentions(message, [](std::string_view setting) {
+        return "`" + pythonName(std::string(setting)) + "`";
+    });
+}
+
+py::object fromJson(const nlohmann::json& j) {
+    return py::module_::import("json").attr("loads")(
+        j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
+RenderSettings settingsOf(const py::dict& settings) {
+    RenderSettings s;
+    for (const auto& [k, v] : settings)
+        applySetting(s, py::str(k).cast<std::string>(), settingValue(v));
+    return s;
+}
+
+py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
+                      std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
+                      int width, int height, const py::dict& settings) {
+    RenderSettings s = settingsOf(settings);
+    s.width = width, s.height = height;
+    s.tf = tf;
+    s.range = range;
+    s.camera = camera;
+    RenderResult r;
+    {
+        py::gil_scoped_release release;
+        r = self.renderer->render(s);
+    }
+    // The library's frame report (the CLI's --stats, the viewer's frame messages), as a dict.
+    py::object stats = fromJson(frameReport(*self.renderer, s, r));
+    const auto h = static_cast<py::ssize_t>(height), w = static_cast<py::ssize_t>(width);
+    py::array pixels = vectorArray<float>(std::move(r.image.pixels), {h, w, 4});
+    py::array counts = vectorArray<std::uint32_t>(std::move(r.sampleCounts), {h, w});
+    return py::make_tuple(pixels, counts, stats);
+}
+
+py::tuple fileBounds(const PreparedMesh& p) {
+    double lo[3], hi[3];
+    p.tets.frame.toFile(p.tets.bounds.lo, lo);
+    p.tets.frame.toFile(p.tets.bounds.hi, hi);
+    return py::make_tuple(py::make_tuple(lo[0], lo[1], lo[2]), py::make_tuple(hi[0], hi[1], hi[2]));
+}
+
+Bounds3f boundsOf(const std::array<std::array<float, 3>, 2>& b) {
+    return {vec3(b[0]), vec3(b[1])};
+}
+
+void writeText(const std::string& path, const std::string& text) {
+    OutputFile out(path);
+    out.write(text);
+    out.commit();
+}
+
+}  // namespace uvr::python
