@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -61,7 +62,13 @@ Camera parallelDownZ(float cx, float cy, float scale) {
     return c;
 }
 
-TEST(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
+/// The frames of these suites render on every device (tests/on_each_device.h).
+class CameraRender : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(CameraRender);
+class Supersample : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(Supersample);
+
+TEST_P(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
     // 40 x 30 pixels of 0.05 (scale 0.75) centred on the cube's centre: the image spans x in
     // [-0.5, 1.5] and y in [-0.25, 1.25], so the cube covers columns 10..29 and rows 5..24
     // exactly, its faces on pixel boundaries; every ray inside crosses depth 1.
@@ -70,7 +77,7 @@ TEST(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
         RenderSettings s = halfOpacity(method);
         s.width = 40, s.height = 30;
         s.camera = parallelDownZ(0.5f, 0.5f, 0.75f);
-        const RenderResult r = renderCpu(mesh, s);
+        const RenderResult r = render(mesh, s);
         int wrong = 0;
         for (int y = 0; y < s.height; ++y)
             for (int x = 0; x < s.width; ++x) {
@@ -85,7 +92,7 @@ TEST(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
     }
 }
 
-TEST(CameraRender, ParallelCameraInsideOrFarFromTheMeshSeesWhatLiesInFrontOfItsPlane) {
+TEST_P(CameraRender, ParallelCameraInsideOrFarFromTheMeshSeesWhatLiesInFrontOfItsPlane) {
     const PreparedMesh mesh = unitCube();
     for (RenderMethod method : kEachMethod) {
         RenderSettings s = halfOpacity(method);
@@ -93,26 +100,26 @@ TEST(CameraRender, ParallelCameraInsideOrFarFromTheMeshSeesWhatLiesInFrontOfItsP
         // Far out: the rays start at the mesh (the same image as from near by).
         s.camera = parallelDownZ(0.5f, 0.5f, 0.25f);
         s.camera->position.z = 1e6f;
-        const RenderResult far = renderCpu(mesh, s);
+        const RenderResult far = render(mesh, s);
         for (const Vec4f& p : far.image.pixels)
             EXPECT_NEAR(p.w, kThroughAlpha, kAlphaTol) << methodName(method);
         // Inside, at z = 0.25 looking down -z: only the quarter of the depth in front of the
         // camera's plane is seen (VTK's near plane never lies behind the camera).
         s.camera->position.z = 0.25f;
         s.camera->focalPoint.z = -3.f;
-        const RenderResult inside = renderCpu(mesh, s);
+        const RenderResult inside = render(mesh, s);
         const float quarter = float(testing::slabOpacity(0.5, 0.25, 1.0));
         for (const Vec4f& p : inside.image.pixels)
             EXPECT_NEAR(p.w, quarter, kAlphaTol) << methodName(method);
         // Behind the mesh, looking away from it: nothing.
         s.camera->position.z = -0.5f;
         s.camera->focalPoint.z = -3.f;
-        const RenderResult away = renderCpu(mesh, s);
+        const RenderResult away = render(mesh, s);
         for (const Vec4f& p : away.image.pixels) EXPECT_EQ(p.w, 0.f) << methodName(method);
     }
 }
 
-TEST(CameraRender, ParallelCameraIsConvertedToAFramedMeshsUnits) {
+TEST_P(CameraRender, ParallelCameraIsConvertedToAFramedMeshsUnits) {
     // A cube moved to x = 1e5, and one scaled to 1e-9, render in frames of their own (moved to
     // the centre, scaled up): a parallel camera given in file units, its scale too, must see
     // them as it sees the unit cube.
@@ -135,7 +142,7 @@ TEST(CameraRender, ParallelCameraIsConvertedToAFramedMeshsUnits) {
                                cam.focalPoint.z * c.size);
         cam.parallelScale *= c.size;
         s.camera = cam;
-        const RenderResult r = renderCpu(mesh, s);
+        const RenderResult r = render(mesh, s);
         int wrong = 0;
         for (int y = 0; y < s.height; ++y)
             for (int x = 0; x < s.width; ++x) {
@@ -149,9 +156,10 @@ TEST(CameraRender, ParallelCameraIsConvertedToAFramedMeshsUnits) {
     }
 }
 
-TEST(Supersample, OneRayPerPixelIsTheCentreRayBitForBit) {
+TEST(SupersampleRays, OneRayPerPixelIsTheCentreRayBitForBit) {
     // --supersample 1 (the default) must be the single-ray image: every pixel equal, bit for
-    // bit, to its centre ray marched alone, and its count that ray's samples.
+    // bit, to its centre ray marched alone (on the CPU: the same compiler's code), and its count
+    // that ray's samples.
     const PreparedMesh mesh = unitCube();
     for (RenderMethod method : {RenderMethod::Reference, RenderMethod::Exact}) {
         RenderSettings s = halfOpacity(method);
@@ -173,7 +181,7 @@ TEST(Supersample, OneRayPerPixelIsTheCentreRayBitForBit) {
     }
 }
 
-TEST(Supersample, EdgePixelsApproachTheTrueFractionalCoverage) {
+TEST_P(Supersample, EdgePixelsApproachTheTrueFractionalCoverage) {
     // The parallel view of the cube shifted by 0.3 of a pixel to the left and 0.4 down: its left
     // edge crosses column 10 at 0.3 of the column's width (0.7 of it covered, the centre
     // inside) and its top edge crosses row 4 at 0.6 of the row's height from its top (0.4
@@ -191,7 +199,7 @@ TEST(Supersample, EdgePixelsApproachTheTrueFractionalCoverage) {
                 s.supersample = n;
                 s.jitter = jitter;
                 s.camera = parallelDownZ(0.5f - 0.3f * pixel, 0.5f - 0.4f * pixel, 0.75f);
-                const RenderResult r = renderCpu(mesh, s);
+                const RenderResult r = render(mesh, s);
                 const auto coverage = [&](int x, int y) {
                     return r.image.pixels[std::size_t(y) * s.width + x].w / kThroughAlpha;
                 };
@@ -216,23 +224,23 @@ TEST(Supersample, EdgePixelsApproachTheTrueFractionalCoverage) {
     }
 }
 
-TEST(Supersample, StatedExactlyForTheReferenceMarcher) {
+TEST_P(Supersample, StatedExactlyForTheReferenceMarcher) {
     // The reference marcher takes the same samples along every axis-parallel ray through the
     // cube: each inside pixel's count is N^2 times one ray's.
     const PreparedMesh mesh = unitCube();
     RenderSettings s = halfOpacity(RenderMethod::Reference);
     s.width = 40, s.height = 30;
     s.camera = parallelDownZ(0.5f, 0.5f, 0.75f);
-    const RenderResult one = renderCpu(mesh, s);
+    const RenderResult one = render(mesh, s);
     s.supersample = 3;
-    const RenderResult nine = renderCpu(mesh, s);
+    const RenderResult nine = render(mesh, s);
     const std::size_t centre = std::size_t(15) * s.width + 20;
     EXPECT_EQ(nine.sampleCounts[centre], 9u * one.sampleCounts[centre]);
     EXPECT_NEAR(nine.stats.meanSamplesPerRay(), one.stats.meanSamplesPerRay(), 1e-9);
     EXPECT_NEAR(nine.stats.meanSamplesPerPixel(), 9.0 * one.stats.meanSamplesPerPixel(), 1e-9);
 }
 
-TEST(Supersample, OutOfRangeIsRefusedAndCountsInTheWorkEstimate) {
+TEST(SupersampleSetup, OutOfRangeIsRefusedAndCountsInTheWorkEstimate) {
     const PreparedMesh mesh = unitCube();
     RenderSettings s = halfOpacity(RenderMethod::Reference);
     s.width = s.height = 8;
@@ -255,7 +263,7 @@ TEST(Supersample, OutOfRangeIsRefusedAndCountsInTheWorkEstimate) {
     EXPECT_NO_THROW((void)makeFrameSetup(mesh, s));
 }
 
-TEST(Supersample, ProgressStillAdvancesToOne) {
+TEST(SupersampleSetup, ProgressStillAdvancesToOne) {
     const PreparedMesh mesh = unitCube();
     RenderSettings s = halfOpacity(RenderMethod::Reference);
     s.width = s.height = 64;
