@@ -38,7 +38,6 @@ protected:
     }
     /// The device this instance runs on.
     TestDevice device() const { return GetParam(); }
-    bool onGpu() const { return GetParam() == TestDevice::Cuda; }
     /// A frame on this instance's device.
     RenderResult render(const PreparedMesh& mesh, const RenderSettings& settings) const {
         return renderOn(GetParam(), mesh, settings);

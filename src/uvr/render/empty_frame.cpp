@@ -2,15 +2,15 @@
 #include "uvr/render/empty_frame.h"
 
 #include <cmath>
-#include <cstdio>
+
+#include "uvr/core/text.h"
 
 namespace uvr {
 namespace {
 
+/// A value for a message (4 significant digits).
 std::string fmt(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", v);
-    return buf;
+    return formatG(v, 4);
 }
 
 /// Largest opacity of the baked table over the values [lo, hi] (values beyond the table's range

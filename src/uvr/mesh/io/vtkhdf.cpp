@@ -70,6 +70,16 @@ Mesh readVtkHdf(const std::string& path, const ReadOptions&) {
     throwNoHdf5(path);
 }
 
+void writeVtkHdf(const Mesh&, const std::string& path, const std::function<void(double)>&) {
+    throwNoHdf5(path);
+}
+
+void writeVtkHdfSeries(const Mesh&, const std::vector<double>&,
+                       const std::function<std::vector<Field>(std::size_t)>&,
+                       const std::string& path, const std::function<void(double)>&) {
+    throwNoHdf5(path);
+}
+
 #else  // UVR_HAS_HDF5
 
 namespace {

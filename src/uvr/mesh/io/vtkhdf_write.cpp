@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The VTKHDF UnstructuredGrid writer (docs/FORMATS.md, section VTKHDF): one mesh, or a time
-// series of its fields (a Steps group); the reader is vtkhdf.cpp.
+// series of its fields (a Steps group); the reader is vtkhdf.cpp, which also holds both's
+// stand-ins for a build without HDF5.
 #include <cstring>
 #include <functional>
 #include <set>
@@ -22,29 +23,7 @@
 
 namespace uvr {
 
-#ifndef UVR_HAS_HDF5
-
-namespace {
-
-[[noreturn]] void throwNoHdf5(const std::string& path) {
-    throwError(ErrorKind::Unsupported, path,
-               "this uvr was built without HDF5, which VTKHDF files need: install libhdf5-dev "
-               "and rebuild");
-}
-
-}  // namespace
-
-void writeVtkHdf(const Mesh&, const std::string& path, const std::function<void(double)>&) {
-    throwNoHdf5(path);
-}
-
-void writeVtkHdfSeries(const Mesh&, const std::vector<double>&,
-                       const std::function<std::vector<Field>(std::size_t)>&,
-                       const std::string& path, const std::function<void(double)>&) {
-    throwNoHdf5(path);
-}
-
-#else  // UVR_HAS_HDF5
+#ifdef UVR_HAS_HDF5
 
 namespace {
 
