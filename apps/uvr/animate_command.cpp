@@ -99,8 +99,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         ->required();
     cmd->add_option("-o,--output", *folder, "Folder for the frames (created when missing)")
         ->required();
-    flags->registerOn(*cmd, /*oneFrame=*/false);
-    addMethodOption(*cmd, flags->method);
+    flags->registerOn(*cmd, /*oneFrame=*/false, /*withMethod=*/true);
     cmd->add_flag("--legend", flags->legend,
                   "Draw a colour legend at the right edge of every frame (the field's name, the "
                   "colour map, ticks over the value range)");

@@ -68,7 +68,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
     auto json = std::make_shared<std::string>();
     auto images = std::make_shared<std::string>();
     cmd->add_option("FILE", *file, kMeshFileHelp)->required();
-    flags->registerOn(*cmd, false);
+    flags->registerOn(*cmd, /*oneFrame=*/false, /*withMethod=*/false);
     cmd->add_option("--repeat", *repeat, "Timed frames per configuration (median reported)")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
@@ -110,7 +110,8 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                            "--images: cannot make this folder" +
                                (ec ? ": " + ec.message() : std::string(" (a file has its name)")));
         }
-        flags->method = "adaptive";  // partitions are needed; variants pick their integrator
+        // Partitions are needed; the variants pick their integrators.
+        flags->vocabulary.set("method", methodName(RenderMethod::Partitions));
         flags->checkBeforeLoading(*file);
         const Mesh mesh = loadMesh(*file, ctx);
         const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));

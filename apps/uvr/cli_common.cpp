@@ -246,18 +246,7 @@ CLI::Validator positiveNumber() {
 
 }  // namespace
 
-void addMethodOption(CLI::App& app, std::string& method) {
-    app.add_option("--method", method,
-                   "Integrator: auto (the default: exact where a ray crosses few cells, so that "
-                   "it is the faster, else adaptive; adaptive whenever a flag tunes sampling), "
-                   "adaptive (k-d partitions and macrocells: space skipping, error-bounded "
-                   "adaptive steps; Morrical et al. 2019 and beyond), reference (fixed step s1 "
-                   "everywhere) or exact (no sampling: every cell's segment integrated exactly)")
-        ->check(CLI::IsMember(settingNamed("method").choices))
-        ->capture_default_str();
-}
-
-void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
+void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
     if (oneFrame)
         app.add_option("-o,--output", output,
                        "Output PNG file, or - for standard output (not a terminal)")
@@ -305,59 +294,11 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
         ->capture_default_str();
     app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees")
         ->capture_default_str();
-    app.add_option("--step", step,
-                   "Sample spacing s1 (default: 0.5 * cube root of the mean tetrahedron volume)")
-        ->check(positiveNumber());  // 0 means nothing: it is refused, not taken as the default
-    app.add_option("--opacity-unit", opacityUnit,
-                   "Distance over which a TF opacity applies (default: ParaView's "
-                   "ScalarOpacityUnitDistance, bounds diagonal / cbrt(cells))")
-        ->check(positiveNumber());
-    app.add_option("--opacity-law", opacityLaw,
-                   std::string("How a TF opacity a per opacity unit u absorbs: ") +
-                       opacityLawName(OpacityLaw::Attenuation) +
-                       " (extinction a / u, as ParaView's and VTK's unstructured volume mappers: "
-                       "a slab L thick has opacity 1 - exp(-a L / u)) or " +
-                       opacityLawName(OpacityLaw::Transmittance) +
-                       " (extinction -ln(1 - a) / u: opacity 1 - (1 - a)^(L / u), a = 1 "
-                       "opaque at once; docs/TRANSFER_FUNCTIONS.md)")
-        ->check(CLI::IsMember(settingNamed("opacity_law").choices))
-        ->capture_default_str();
-    if (oneFrame) addMethodOption(app, method);
-    app.add_option("--sampling", sampling,
-                   "Reference and adaptive: preintegrated (integrate between consecutive samples, "
-                   "the scalar linear from one to the next: no transfer-function feature is "
-                   "missed) or point (point samples with opacity correction, as in Morrical et "
-                   "al. 2019)")
-        ->check(CLI::IsMember(settingNamed("sampling").choices))
-        ->capture_default_str();
-    app.add_option("--step-rule", stepRule,
-                   "Adaptive: how each partition's step is chosen: error (bounded integration "
-                   "error from the transfer function's rate of change and the field's gradients; "
-                   "--quality) or variance (Morrical et al. 2019's normalised colour variance; "
-                   "--power)")
-        ->check(CLI::IsMember(settingNamed("step_rule").choices))
-        ->capture_default_str();
-    {
-        char help[200];
-        std::snprintf(help, sizeof help,
-                      "Adaptive, --step-rule error: the SSIM against the exact integrator to aim "
-                      "at, in [%g, %g] (default %g; docs/PERFORMANCE.md shows what it gives)",
-                      double(kMinQuality), double(kMaxQuality), double(kDefaultQuality));
-        app.add_option("--quality", quality, help);
-    }
-    app.add_option("--max-step", maxStep,
-                   "Adaptive: largest step s2 (default: " +
-                       std::to_string(static_cast<int>(kDefaultMaxStepFactor)) + " * s1)")
-        ->check(positiveNumber());
-    app.add_option("--power", power,
-                   "Adaptive, --step-rule variance: power p >= 1 of the step formula (default "
-                   "2)");
-    if (oneFrame) {
-        app.add_flag("--no-skip", noSkip,
-                     "Adaptive: also march partitions of zero opacity (\"adaptive only\")");
-        app.add_flag("--no-adaptive", noAdaptive,
-                     "Adaptive: every partition at s1 (\"skipping only\")");
-    }
+    // The library's settings, each once (the vocabulary): its name, doc, default and check.
+    std::vector<std::string> except;
+    if (!withMethod) except.push_back("method");
+    if (!oneFrame) except.insert(except.end(), {"skip", "adaptive"});
+    vocabulary.registerOn(app, except);
     app.add_option("--leaf-cells", leafCells,
                    "Adaptive: cells per k-d partition at most (default " +
                        std::to_string(KdBuildOptions{}.leafCells) + " on the CPU, " +
@@ -378,18 +319,6 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame) {
                        "Sample count at the top of the heat map scale (default: the frame's "
                        "maximum)");
     }
-    {
-        char help[240];
-        std::snprintf(help, sizeof help,
-                      "Anti-aliasing: N x N rays per pixel (1 to %d), their premultiplied colours "
-                      "averaged; a pixel's sample count (--heatmap, --stats) sums its rays "
-                      "(default 1: one ray through the pixel's centre)",
-                      kMaxSupersample);
-        app.add_option("--supersample", supersample, help)->capture_default_str();
-    }
-    app.add_flag("--jitter", jitter,
-                 "With --supersample N: each ray at a fixed pseudo-random place in its cell of "
-                 "the N x N grid instead of its centre (the same rays every run and device)");
     app.add_option("--background", background,
                    "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
         ->capture_default_str();
@@ -432,43 +361,25 @@ RenderSettings RenderFlags::baseSettings() const {
         s.tf.nanOpacity = withAlpha ? v[3] : 1.f;
     }
     if (!range.empty()) s.range = parseRange("--range", range);
-    s.step = step;
-    s.opacityUnit = opacityUnit;
     // The settings of the library's vocabulary are checked there (main re-spells its errors
     // with the flags).
-    applySetting(s, "opacity_law", opacityLaw);
+    vocabulary.applyTo(s);
     s.method = requestedMethod();
-    s.maxStep = maxStep;
-    if (power) applySetting(s, "power", *power);
-    applySetting(s, "step_rule", stepRule);
-    if (quality) applySetting(s, "quality", *quality);
-    applySetting(s, "sampling", sampling);
-    s.skip = !noSkip;
-    s.adaptive = !noAdaptive;
-    if (s.method != RenderMethod::Partitions && tunesPartitions())
-        throwError(ErrorKind::Argument, "",
-                   "--no-skip, --no-adaptive, --max-step, --step-rule, --quality, --power, "
-                   "--leaf-cells and --no-seed-grid need --method adaptive");
-    if (stepRule == "variance" && quality)
+    refuseIgnoredFlags();
+    if (s.stepRule == StepRule::Variance && vocabulary.given("quality"))
         throwError(ErrorKind::Argument, "",
                    "--quality sets the error rule's target: it needs "
                    "--step-rule error (the default), not variance");
-    if (stepRule == "error" && power)
+    if (s.stepRule == StepRule::ErrorBound && vocabulary.given("power"))
         throwError(ErrorKind::Argument, "",
                    "--power shapes the variance rule's step: it needs --step-rule variance");
     if (heatmapMax && heatmapFile.empty())
         throwError(ErrorKind::Argument, "",
                    "--heatmap-max sets the heat map's scale: it needs --heatmap FILE.png");
-    if (s.method == RenderMethod::Exact && sampling != "preintegrated")
-        throwError(ErrorKind::Argument, "",
-                   "--sampling applies to the reference and adaptive methods; exact does not "
-                   "sample");
-    applySetting(s, "supersample", supersample);
-    if (jitter && supersample < 2)
+    if (s.jitter && s.supersample < 2)
         throwError(ErrorKind::Argument, "",
                    "--jitter moves the rays of --supersample N inside the pixel: it needs "
                    "--supersample 2 or more");
-    s.jitter = jitter;
     return s;
 }
 
@@ -666,15 +577,40 @@ void RenderFlags::checkFiles(const std::string& meshFile) const {
 }
 
 RenderMethod RenderFlags::requestedMethod() const {
-    const RenderMethod m = parseMethod(method).value_or(RenderMethod::Auto);
-    if (m == RenderMethod::Auto && (tunesPartitions() || step > 0.f || sampling != "preintegrated"))
+    RenderSettings s;
+    vocabulary.applyTo(s);
+    if (s.method == RenderMethod::Auto && (tunesAdaptive(s) || leafCells || noSeedGrid))
         return RenderMethod::Partitions;
-    return m;
+    return s.method;
 }
 
-bool RenderFlags::tunesPartitions() const {
-    return noSkip || noAdaptive || maxStep > 0.f || leafCells || noSeedGrid || quality || power ||
-           stepRule != "error";
+void RenderFlags::refuseIgnoredFlags() const {
+    const RenderMethod m = requestedMethod();
+    std::vector<std::string> ignored;
+    // The methods that read them, when they agree ("reference or adaptive").
+    std::vector<RenderMethod> readers;
+    bool agree = true;
+    const auto note = [&](const std::string& flag, const std::vector<RenderMethod>& readBy) {
+        if (ignored.empty()) readers = readBy;
+        agree = agree && readers == readBy;
+        ignored.push_back(flag);
+    };
+    for (const SettingDef* def : vocabulary.ignoredBy(m)) note(cliFlag(*def), def->readBy);
+    if (m != RenderMethod::Partitions) {
+        if (leafCells) note("--leaf-cells", {RenderMethod::Partitions});
+        if (noSeedGrid) note("--no-seed-grid", {RenderMethod::Partitions});
+    }
+    if (ignored.empty()) return;
+    std::string list, methods;
+    for (std::size_t i = 0; i < ignored.size(); ++i)
+        list += (i == 0 ? "" : i + 1 == ignored.size() ? " and " : ", ") + ignored[i];
+    for (RenderMethod r : readers)
+        methods += std::string(methods.empty() ? "" : " or ") + methodName(r);
+    const bool one = ignored.size() == 1;
+    throwError(ErrorKind::Argument, "",
+               list + (one ? " is" : " are") + " not read by --method " + methodName(m) +
+                   (agree ? std::string(one ? ": it needs" : ": they need") + " --method " + methods
+                          : std::string(" (--help says which method reads each)")));
 }
 
 RendererOptions RenderFlags::rendererOptions(bool withReference) const {

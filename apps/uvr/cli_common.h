@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "setting_flags.h"
 #include "uvr/uvr.h"
 
 namespace uvr::cli {
@@ -104,18 +105,8 @@ struct RenderFlags {
     bool parallel = false;               ///< --parallel: parallel projection
     std::optional<float> parallelScale;  ///< unset: the camera file's, else the reset camera's
     float azimuth = 0.f, elevation = 0.f;
-    int supersample = 1;  ///< N x N rays per pixel
-    bool jitter = false;  ///< jittered sub-pixel rays (needs supersample > 1)
-    float step = 0.f;
-    float opacityUnit = 0.f;
-    std::string opacityLaw = opacityLawName(kDefaultOpacityLaw);
-    std::string method = methodName(RenderMethod::Auto);
-    std::string stepRule = "error";
-    std::optional<float> quality;  ///< unset: kDefaultQuality
-    std::string sampling = "preintegrated";
-    float maxStep = 0.f;
-    std::optional<float> power;  ///< unset: 2
-    bool noSkip = false, noAdaptive = false;
+    /// The settings of the library's vocabulary (--method, --quality, --step, ...).
+    SettingFlags vocabulary;
     std::uint32_t leafCells = 0;
     bool noSeedGrid = false;
     bool splitCells = false;
@@ -128,9 +119,9 @@ struct RenderFlags {
     std::string statsFile;
     int threads = 0;
 
-    /// Adds the flags to a subcommand; oneFrame adds those of a single render (output, method,
-    /// heat map, stats), which `bench` chooses itself.
-    void registerOn(CLI::App& app, bool oneFrame = true);
+    /// Adds the flags to a subcommand; oneFrame adds those of a single render (output, heat map,
+    /// stats, --no-skip, --no-adaptive), which `bench` chooses itself; withMethod adds --method.
+    void registerOn(CLI::App& app, bool oneFrame = true, bool withMethod = true);
     /// Parses the flags into render settings; the default camera fits the bounds (of the mesh
     /// named source, which an error resetting the camera names). Choices made for the user (a
     /// view up picked because the default one is parallel to the view direction) are appended
@@ -160,13 +151,14 @@ struct RenderFlags {
     /// Checks before any work that every output can be written and that none names an input
     /// (the mesh file, when not empty, or a file the flags read) or another output.
     void checkFiles(const std::string& meshFile) const;
-    /// The method the flags ask for: --method's, except that auto with a flag only the sampling
-    /// methods read (--quality, --step, --sampling point, --no-skip, --leaf-cells, ...) is the
-    /// adaptive method those flags tune (tunesAdaptive, over flags).
+    /// The method the flags ask for: --method's, except that auto with settings that tune
+    /// sampling (tunesAdaptive: --quality 0.995, --step, --sampling point, --no-skip, ...) or a
+    /// partition flag (--leaf-cells, --no-seed-grid) is the adaptive method they tune.
     RenderMethod requestedMethod() const;
-    /// True when a flag of the adaptive method alone is given (--quality, --no-skip,
-    /// --leaf-cells, ...: those that need --method adaptive).
-    bool tunesPartitions() const;
+    /// Refuses (Error(Argument), one line) flags that --method's integrator would ignore: a
+    /// setting it does not read (settingReadBy: --quality with --method reference, --sampling
+    /// with exact) and --leaf-cells or --no-seed-grid without the adaptive method.
+    void refuseIgnoredFlags() const;
     /// What the renderer prepares and where (--device, --build-device, --leaf-cells,
     /// --no-seed-grid): partitions only for the adaptive method, the mesh BVH only for the
     /// reference and exact methods, what auto picks for auto (PrepareOptions::forAuto), and the
@@ -277,8 +269,5 @@ void addPresetsCommand(CLI::App& app, Context& ctx);
 void addViewCommand(CLI::App& app, Context& ctx);
 void addAnimateCommand(CLI::App& app, Context& ctx);
 void addPrepareCommand(CLI::App& app, Context& ctx);
-
-/// Adds --method (adaptive, reference or exact) bound to `method`.
-void addMethodOption(CLI::App& app, std::string& method);
 
 }  // namespace uvr::cli

@@ -204,11 +204,12 @@ TEST(Cli, StepRuleQualityAndSamplingFlags) {
     const std::pair<const char*, const char*> bad[] = {
         {" --method adaptive --quality 1", "--quality"},
         {" --method adaptive --quality 0.2", "--quality"},
-        {" --method reference --quality 0.9", "need --method adaptive"},
+        {" --method reference --quality 0.9", "--quality is not read by --method reference"},
         {" --method adaptive --step-rule variance --quality 0.9", "--step-rule error"},
         {" --method adaptive --power 3", "--step-rule variance"},
         {" --method adaptive --step-rule fastest", "--step-rule"},
-        {" --method exact --sampling point", "exact does not sample"},
+        {" --method exact --sampling point",
+         "--sampling is not read by --method exact: it needs --method reference or adaptive"},
         {" --sampling linear", "--sampling"},
     };
     for (const auto& [flags, says] : bad)
@@ -262,7 +263,8 @@ TEST(Cli, ExactMethodAgreesWithTheReferenceAtASixteenthOfItsStep) {
         compareImages(toRgb8(readPng(dir + "/e.png")), toRgb8(readPng(dir + "/f.png")));
     EXPECT_GE(m.ssim, 0.999);
     expectOneLineError(uvr("-q render " + post + " --method exact --max-step 1 -o x.png", dir),
-                       {"need --method adaptive"}, "exact with --max-step");
+                       {"--max-step is not read by --method exact: it needs --method adaptive"},
+                       "exact with --max-step");
     // 0 means nothing: refused, not taken as the default.
     for (const char* flag : {"--step", "--opacity-unit", "--max-step"})
         expectOneLineError(uvr("-q render " + post + " " + flag + " 0 -o x.png", dir), {flag},
@@ -460,10 +462,18 @@ TEST(Cli, FlagsThatWouldBeIgnoredOrMeanNothingAreRefused) {
                        "magnitude of a scalar");
     expectOneLineError(uvr(render + "--background 1,2", dir),
                        {"--background '1,2'", "three finite numbers r,g,b"}, "--background");
-    expectOneLineError(uvr(render + "--step 0", dir), {"--step: must be a positive number, not 0"},
-                       "--step 0");
+    expectOneLineError(uvr(render + "--step 0", dir),
+                       {"--step 0: expected a positive finite number"}, "--step 0");
     expectOneLineError(uvr(render + "--opacity-unit 0", dir),
-                       {"--opacity-unit: must be a positive number"}, "--opacity-unit 0");
+                       {"--opacity-unit 0: expected a positive finite number"}, "--opacity-unit 0");
+    // Flags the method ignores, named together with the method that reads them.
+    expectOneLineError(uvr(render + "--method exact --sampling point --quality 0.9", dir),
+                       {"--sampling and --quality are not read by --method exact"},
+                       "two ignored flags");
+    expectOneLineError(uvr(render + "--method reference --leaf-cells 64 --no-skip", dir),
+                       {"--no-skip and --leaf-cells are not read by --method reference: they "
+                        "need --method adaptive"},
+                       "partition flags");
     // A vector's component and magnitude still work.
     EXPECT_EQ(uvr(render + "--field momentum:x", dir).code, 0);
     EXPECT_EQ(uvr(render + "--field momentum:magnitude", dir).code, 0);

@@ -38,7 +38,7 @@ void addPrepareCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("--field", flags->field,
                     "Field to prepare, as `render --field` names it (default: the first scalar "
                     "field); a render uses the cache only with the same --field");
-    addMethodOption(*cmd, flags->method);
+    flags->vocabulary.registerOnly(*cmd, {"method"});
     cmd->add_option("--leaf-cells", flags->leafCells,
                     "Adaptive: cells per k-d partition at most (default: the device's, as "
                     "render's)")
@@ -67,10 +67,7 @@ void addPrepareCommand(CLI::App& app, Context& ctx) {
             throwError(ErrorKind::Unsupported, *file,
                        "uvr prepare takes a single mesh file: a cache's key covers one file, "
                        "and this one names others (a series, .pvd or .pvtu)");
-        if ((flags->leafCells || flags->noSeedGrid) &&
-            flags->requestedMethod() != RenderMethod::Partitions)
-            throwError(ErrorKind::Argument, "",
-                       "--leaf-cells and --no-seed-grid need --method adaptive");
+        flags->refuseIgnoredFlags();
         const std::string cache = output->empty() ? *file + kPreparedCacheSuffix : *output;
         checkOutputsDistinct({{"the input mesh", *file}}, {{"-o", cache}});
         // The default cache is a file beside the mesh: anything else there (a FIFO, a device)

@@ -24,21 +24,13 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
         out.push_back(flag);
         if (!value.empty()) out.push_back(value);
     };
-    auto num = [](double v) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%.9g", v);
-        return std::string(buf);
-    };
-    if (f.step > 0.f) add("--step", num(f.step));
-    if (f.sampling != "preintegrated") add("--sampling", f.sampling);
-    if (f.stepRule != "error") add("--step-rule", f.stepRule);
-    if (f.maxStep > 0.f) add("--max-step", num(f.maxStep));
-    if (f.power) add("--power", num(*f.power));
+    // The settings the page has no control for, as given.
+    for (const SettingDef& def : settingsVocabulary())
+        if (f.vocabulary.given(def.name) && !server::isViewerSetting(def.name))
+            add(cliFlag(def).c_str(), f.vocabulary.text(def.name));
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
     if (f.splitCells) add("--split-cells", "");
-    if (f.supersample > 1) add("--supersample", std::to_string(f.supersample));
-    if (f.jitter) add("--jitter", "");
     if (!f.background.empty()) add("--background", f.background);
     return out;
 }
@@ -60,9 +52,8 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("FILE", *file,
                     std::string(kMeshFileHelp) + ": the page gets a time slider for a series")
         ->required();
-    flags->registerOn(*cmd, /*oneFrame=*/false);
+    flags->registerOn(*cmd, /*oneFrame=*/false, /*withMethod=*/true);
     steps->registerOn(*cmd);
-    addMethodOption(*cmd, flags->method);
     cmd->add_option("--host", options->first,
                     "IP address to listen on (localhost is 127.0.0.1; 0.0.0.0: every interface, "
                     "the token still applies)")

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include "uvr/core/error.h"
@@ -25,9 +27,18 @@ std::string number(double v) {
     return buf;
 }
 
+/// A float setting as JSON: the shortest decimal that reads back as the same float (0.99, not
+/// 0.9900000095367432), so that defaults and reports read as written.
+Json floatJson(float v) {
+    char buf[32];
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    if (ec != std::errc() || !std::isfinite(v)) return Json(double(v));
+    return Json(std::strtod(std::string(buf, end).c_str(), nullptr));
+}
+
 /// A per-mesh default length: null while 0 (anything else is checked as given).
 Json lengthOrNull(float v) {
-    return v == 0.f ? Json(nullptr) : Json(v);
+    return v == 0.f ? Json(nullptr) : floatJson(v);
 }
 float lengthOf(const Json& v) {
     return v.is_null() ? 0.f : v.get<float>();
@@ -45,6 +56,11 @@ std::vector<SettingDef> makeVocabulary() {
         setting("method", SettingType::Choice,
                 "Integrator: auto (exact where a ray crosses few cells, else adaptive), "
                 "adaptive, reference or exact");
+    method.detail =
+        "auto is adaptive whenever a setting tunes sampling; adaptive: k-d partitions and "
+        "macrocells, space skipping and error-bounded adaptive steps (Morrical et al. 2019 and "
+        "beyond); reference: the fixed step s1 everywhere; exact: no sampling, every cell's "
+        "segment integrated exactly";
     method.choices = methodNames();
     method.get = [](const RenderSettings& s) { return Json(methodName(s.method)); };
     method.set = [](RenderSettings& s, const Json& x) {
@@ -56,8 +72,12 @@ std::vector<SettingDef> makeVocabulary() {
         setting("sampling", SettingType::Choice,
                 "Reference and adaptive: preintegrated (between consecutive samples) or "
                 "point (point samples with opacity correction, Morrical et al. 2019)");
+    sampling.detail =
+        "preintegrated takes the scalar linear from one sample to the next: no "
+        "transfer-function feature is missed";
     sampling.choices = {samplingName(true), samplingName(false)};
     sampling.tunesAdaptive = true;
+    sampling.readBy = {RenderMethod::Reference, RenderMethod::Partitions};
     sampling.get = [](const RenderSettings& s) { return Json(samplingName(s.preintegrated)); };
     sampling.set = [](RenderSettings& s, const Json& x) {
         s.preintegrated = x.get<std::string>() == samplingName(true);
@@ -68,8 +88,13 @@ std::vector<SettingDef> makeVocabulary() {
         setting("step_rule", SettingType::Choice,
                 "Adaptive: each partition's step from a bound on the integration error "
                 "(error; quality) or from the colour variance (variance; power)");
+    rule.detail =
+        "error: a bounded integration error from the transfer function's rate of change and "
+        "the field's gradients (`quality`); variance: Morrical et al. 2019's normalised colour "
+        "variance (`power`)";
     rule.choices = {stepRuleName(StepRule::ErrorBound), stepRuleName(StepRule::Variance)};
     rule.tunesAdaptive = true;
+    rule.readBy = {RenderMethod::Partitions};
     rule.get = [](const RenderSettings& s) { return Json(stepRuleName(s.stepRule)); };
     rule.set = [](RenderSettings& s, const Json& x) {
         s.stepRule = x.get<std::string>() == stepRuleName(StepRule::Variance)
@@ -81,9 +106,12 @@ std::vector<SettingDef> makeVocabulary() {
     SettingDef quality =
         setting("quality", SettingType::Number,
                 "Adaptive, error rule: the SSIM against the exact integrator to aim at");
+    quality.detail =
+        "with `step_rule` error (the default); docs/PERFORMANCE.md shows what it gives";
     quality.min = kMinQuality, quality.max = kMaxQuality;
     quality.tunesAdaptive = true;
-    quality.get = [](const RenderSettings& s) { return Json(s.quality); };
+    quality.readBy = {RenderMethod::Partitions};
+    quality.get = [](const RenderSettings& s) { return floatJson(s.quality); };
     quality.set = [](RenderSettings& s, const Json& x) { s.quality = x.get<float>(); };
     v.push_back(quality);
 
@@ -102,15 +130,18 @@ std::vector<SettingDef> makeVocabulary() {
                 "Adaptive: the largest step s2 in the file's units (default: 16 s1)");
     maxStep.min = 0.0, maxStep.max = kInf, maxStep.minOpen = true, maxStep.nullDefault = true;
     maxStep.tunesAdaptive = true;
+    maxStep.readBy = {RenderMethod::Partitions};
     maxStep.get = [](const RenderSettings& s) { return lengthOrNull(s.maxStep); };
     maxStep.set = [](RenderSettings& s, const Json& x) { s.maxStep = lengthOf(x); };
     v.push_back(maxStep);
 
     SettingDef power = setting("power", SettingType::Number,
                                "Adaptive, variance rule: the power p of the step formula");
+    power.detail = "with `step_rule` variance";
     power.min = 1.0, power.max = 64.0;
     power.tunesAdaptive = true;
-    power.get = [](const RenderSettings& s) { return Json(s.power); };
+    power.readBy = {RenderMethod::Partitions};
+    power.get = [](const RenderSettings& s) { return floatJson(s.power); };
     power.set = [](RenderSettings& s, const Json& x) { s.power = x.get<float>(); };
     v.push_back(power);
 
@@ -127,6 +158,10 @@ std::vector<SettingDef> makeVocabulary() {
     SettingDef law = setting("opacity_law", SettingType::Choice,
                              "How an opacity per opacity unit absorbs: attenuation (ParaView's "
                              "unstructured mappers) or transmittance");
+    law.detail =
+        "attenuation: extinction a / u, so that a slab L thick has opacity 1 - exp(-a L / u); "
+        "transmittance: extinction -ln(1 - a) / u, opacity 1 - (1 - a)^(L / u), a = 1 opaque at "
+        "once (docs/TRANSFER_FUNCTIONS.md)";
     law.choices = {
         opacityLawName(kDefaultOpacityLaw),
         opacityLawName(kDefaultOpacityLaw == OpacityLaw::Attenuation ? OpacityLaw::Transmittance
@@ -141,20 +176,27 @@ std::vector<SettingDef> makeVocabulary() {
         setting("skip", SettingType::Flag,
                 "Adaptive: skip partitions and macrocells the transfer function makes "
                 "transparent");
+    skip.offDoc = "Adaptive: also march partitions of zero opacity (\"adaptive only\")";
     skip.tunesAdaptive = true;
+    skip.readBy = {RenderMethod::Partitions};
     skip.get = [](const RenderSettings& s) { return Json(s.skip); };
     skip.set = [](RenderSettings& s, const Json& x) { s.skip = x.get<bool>(); };
     v.push_back(skip);
 
     SettingDef adaptive = setting("adaptive", SettingType::Flag,
                                   "Adaptive: adaptive steps (false: every partition at s1)");
+    adaptive.offDoc = "Adaptive: every partition at s1 (\"skipping only\")";
     adaptive.tunesAdaptive = true;
+    adaptive.readBy = {RenderMethod::Partitions};
     adaptive.get = [](const RenderSettings& s) { return Json(s.adaptive); };
     adaptive.set = [](RenderSettings& s, const Json& x) { s.adaptive = x.get<bool>(); };
     v.push_back(adaptive);
 
     SettingDef supersample = setting("supersample", SettingType::Integer,
                                      "Anti-aliasing: N x N rays per pixel, their colours averaged");
+    supersample.detail =
+        "a pixel's sample count (heat map, statistics) sums its rays; 1: one ray through the "
+        "pixel's centre";
     supersample.min = 1.0, supersample.max = double(kMaxSupersample);
     supersample.get = [](const RenderSettings& s) { return Json(s.supersample); };
     supersample.set = [](RenderSettings& s, const Json& x) { s.supersample = x.get<int>(); };
@@ -164,6 +206,7 @@ std::vector<SettingDef> makeVocabulary() {
         setting("jitter", SettingType::Flag,
                 "With supersample: each ray at a fixed pseudo-random place in its cell of "
                 "the N x N grid");
+    jitter.detail = "the same rays every run and on every device";
     jitter.get = [](const RenderSettings& s) { return Json(s.jitter); };
     jitter.set = [](RenderSettings& s, const Json& x) { s.jitter = x.get<bool>(); };
     v.push_back(jitter);
@@ -248,6 +291,24 @@ void applySetting(RenderSettings& settings, std::string_view name, const Json& v
     d.set(settings, value);
 }
 
+bool settingReadBy(const SettingDef& d, RenderMethod method) {
+    return method == RenderMethod::Auto || d.readBy.empty() ||
+           std::find(d.readBy.begin(), d.readBy.end(), method) != d.readBy.end();
+}
+
+std::string settingExpectation(const SettingDef& d) {
+    switch (d.type) {
+        case SettingType::Choice:
+            return choiceList(d.choices);
+        case SettingType::Flag:
+            return "true or false";
+        case SettingType::Number:
+        case SettingType::Integer:
+            return rangeText(d);
+    }
+    return "";
+}
+
 Json settingDefault(const SettingDef& d) {
     return d.get(RenderSettings{});
 }
@@ -264,9 +325,13 @@ Json settingsVocabularyJson() {
     Json out = Json::array();
     for (const SettingDef& d : settingsVocabulary()) {
         static const char* const kTypes[] = {"choice", "number", "integer", "flag"};
+        Json readBy = Json::array();
+        for (RenderMethod m : d.readBy) readBy.push_back(methodName(m));
         Json j = {{"name", d.name},
                   {"type", kTypes[int(d.type)]},
                   {"doc", d.doc},
+                  {"detail", d.detail},
+                  {"read_by", readBy},
                   {"default", settingDefault(d)},
                   {"tunes_adaptive", d.tunesAdaptive}};
         if (d.type == SettingType::Choice) j["choices"] = d.choices;

@@ -27,7 +27,12 @@ enum class SettingType {
 struct SettingDef {
     const char* name;
     SettingType type;
-    const char* doc;                   ///< one line, in neutral words
+    const char* doc;  ///< one line, in neutral words
+    /// More of the doc for a command's help and the docs (may be empty), in neutral words:
+    /// another setting is named in backticks (`quality`) for each front end to spell.
+    const char* detail = "";
+    /// Flag on by default: what turning it off does (the CLI's "--no-" flag's help).
+    const char* offDoc = "";
     std::vector<std::string> choices;  ///< Choice: every name, the default first
     double min = 0.0, max = 0.0;       ///< Number, Integer: the range
     bool minOpen = false;              ///< Number: the value must lie above min
@@ -37,6 +42,9 @@ struct SettingDef {
     /// A value other than the default tunes the sampling methods: RenderMethod::Auto then renders
     /// the adaptive method it tunes (tunesAdaptive).
     bool tunesAdaptive = false;
+    /// The methods that read the setting (empty: every method); a front end may refuse a value
+    /// given for a method that ignores it (settingReadBy).
+    std::vector<RenderMethod> readBy;
     /// The setting's value in `s` as JSON (a name, number or boolean; null for a per-mesh
     /// default).
     nlohmann::json (*get)(const RenderSettings& s) = nullptr;
@@ -69,8 +77,15 @@ nlohmann::json settingDefault(const SettingDef& def);
 /// is on by default is turned off by "--no-" and its name ("--no-skip").
 std::string cliFlag(const SettingDef& def);
 
-/// The vocabulary as JSON for a page or a binding: per setting its name, type, doc, default and
-/// choices or range.
+/// True when `method` reads the setting (RenderMethod::Auto reads what any method reads).
+bool settingReadBy(const SettingDef& def, RenderMethod method);
+
+/// What a value of the setting must be, in words ("a number in [0.5, 0.9999]", "'point' or
+/// 'preintegrated'", "true or false"), as checkSetting's errors say it.
+std::string settingExpectation(const SettingDef& def);
+
+/// The vocabulary as JSON for a page or a binding: per setting its name, type, doc, detail,
+/// default, the methods that read it and its choices or range.
 nlohmann::json settingsVocabularyJson();
 
 /// A value as a message quotes it: a string as 'text', anything else as JSON.

@@ -150,6 +150,24 @@ TEST(SettingsVocabulary, TheJsonFormListsEverySettingWithItsDefaultAndRange) {
     ASSERT_NE(quality, nullptr);
     EXPECT_EQ((*quality)["min"], q.min);
     EXPECT_EQ((*quality)["max"], q.max);
+    EXPECT_EQ((*quality)["read_by"], Json::array({"adaptive"}));
+    // A float default is written as it reads (0.99, not the float's 0.9900000095367432).
+    EXPECT_EQ((*quality)["default"].dump(), "0.99");
+}
+
+TEST(SettingsVocabulary, SaysWhichMethodsReadEachSetting) {
+    // Auto reads what any method reads; a setting with no list is read by every method.
+    for (const SettingDef& d : settingsVocabulary()) {
+        EXPECT_TRUE(settingReadBy(d, RenderMethod::Auto)) << d.name;
+        for (RenderMethod m : d.readBy) EXPECT_NE(m, RenderMethod::Auto) << d.name;
+    }
+    EXPECT_FALSE(settingReadBy(settingNamed("quality"), RenderMethod::Reference));
+    EXPECT_TRUE(settingReadBy(settingNamed("quality"), RenderMethod::Partitions));
+    EXPECT_FALSE(settingReadBy(settingNamed("sampling"), RenderMethod::Exact));
+    EXPECT_TRUE(settingReadBy(settingNamed("sampling"), RenderMethod::Reference));
+    EXPECT_TRUE(settingReadBy(settingNamed("opacity_law"), RenderMethod::Exact));
+    EXPECT_EQ(settingExpectation(settingNamed("supersample")), "an integer in [1, 8]");
+    EXPECT_EQ(settingExpectation(settingNamed("skip")), "true or false");
 }
 
 }  // namespace
