@@ -32,6 +32,8 @@
 #include "uvr/render/image.h"
 #include "uvr/render/settings_vocabulary.h"
 #include "uvr/server/frame_codec.h"
+#include "uvr/server/frame_scheduler.h"
+#include "uvr/server/view_frame.h"
 #include "uvr/server/web_assets.h"
 #include "uvr/tf/transfer_function.h"
 
@@ -45,7 +47,6 @@ namespace websocket = beast::websocket;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Json = nlohmann::json;
-using Clock = std::chrono::steady_clock;
 
 /// Bins of the field histograms the page draws.
 constexpr int kHistogramBins = 256;
@@ -311,14 +312,8 @@ public:
     // State shared with the render thread, guarded by Impl::m.
     ViewState state;
     std::uint64_t seq = 0;
-    bool interactive = false;
-    Clock::time_point lastChange = Clock::now();
-    bool dirty = true;         ///< the state changed since the last frame started
-    bool inFlight = false;     ///< a frame is being rendered or sent
-    bool needsFull = false;    ///< the last frame was reduced: refine when still
-    bool snapshot = false;     ///< a snapshot was asked for
+    FrameDemand demand;        ///< what the tab asks of the render thread (frame_scheduler.h)
     bool resetRange = false;   ///< the field changed without a range: use the field's
-    double msPerPixel = 0.0;   ///< render time per pixel of recent frames (0: none yet)
     std::string histogramKey;  ///< the field whose histogram the tab has (Impl::fieldKey)
     std::string peer;
 
@@ -527,9 +522,7 @@ private:
     /// Records a change of the state (under Impl::m; checkChangeKeys passed).
     void markChanged(const Json& msg) {
         if (auto it = msg.find("seq"); it != msg.end()) seq = it->get<std::uint64_t>();
-        interactive = msg.value("interactive", false);
-        lastChange = Clock::now();
-        dirty = true;
+        demand.changed(msg.value("interactive", false), Clock::now());
     }
 
     void onSet(const Json& msg) {
@@ -588,7 +581,7 @@ private:
     void onSnapshot() {
         {
             std::lock_guard lk(server_.m);
-            snapshot = true;
+            demand.snapshot = true;
         }
         server_.cv.notify_all();
     }
@@ -692,7 +685,7 @@ private:
     void frameDone() {
         {
             std::lock_guard lk(server_.m);
-            inFlight = false;
+            demand.finished();
         }
         server_.cv.notify_all();
     }
@@ -985,62 +978,49 @@ void ViewServer::Impl::prepareAtStart() {
 
 void ViewServer::Impl::renderLoop() {
     prepareAtStart();
+    const ScheduleOptions schedule{std::chrono::milliseconds(opt.refineDelayMs), opt.targetFrameMs,
+                                   opt.maxScale};
+    const FrameEncoding encoding{scene.background, opt.jpegQuality};
     std::unique_lock lk(m);
     while (!stopping) {
-        // Step 1: the next connection with work, round robin: a snapshot, a changed state, or
-        // a reduced frame whose state has been still long enough to refine.
-        const auto now = Clock::now();
-        const auto refine = std::chrono::milliseconds(opt.refineDelayMs);
-        std::shared_ptr<Session> s;
-        enum class Kind { Reduced, Full, Snapshot } kind = Kind::Full;
-        auto next = Clock::time_point::max();
-        const std::size_t n = sessions.size();
-        for (std::size_t i = 0; i < n && !s; ++i) {
-            const std::size_t at = (roundRobin + i) % n;
-            auto c = sessions[at].lock();
-            if (!c || c->inFlight) continue;
-            if (c->snapshot)
-                s = c, kind = Kind::Snapshot;
-            else if (c->dirty)
-                s = c, kind = c->interactive ? Kind::Reduced : Kind::Full;
-            else if (c->needsFull && c->lastChange + refine <= now)
-                s = c, kind = Kind::Full;
-            else if (c->needsFull)
-                next = std::min(next, c->lastChange + refine);
-            if (s) roundRobin = at + 1;
-        }
-        if (!s) {
-            if (next == Clock::time_point::max())
+        // Step 1: the next tab with work (frame_scheduler.h), or wait for one.
+        std::vector<std::shared_ptr<Session>> live(sessions.size());
+        std::vector<const FrameDemand*> demands(sessions.size());
+        for (std::size_t i = 0; i < sessions.size(); ++i)
+            if ((live[i] = sessions[i].lock())) demands[i] = &live[i]->demand;
+        const FramePick pick = pickFrame(demands, roundRobin, Clock::now(), schedule);
+        // The last reference to a closed connection goes on the network thread, which owns its
+        // socket.
+        const auto release = [this](std::vector<std::shared_ptr<Session>>& refs) {
+            net::post(ioc, [refs = std::move(refs)] {});
+            refs.clear();
+        };
+        if (!pick.tab) {
+            release(live);
+            if (pick.wakeAt == Clock::time_point::max())
                 cv.wait(lk);
             else
-                cv.wait_until(lk, next);
+                cv.wait_until(lk, pick.wakeAt);
             continue;
         }
+        roundRobin = *pick.tab + 1;
+        std::shared_ptr<Session> s = live[*pick.tab];
+        release(live);
         // Step 2: take the state; newer changes wait for this frame to be sent.
+        const FrameKind kind = pick.kind;
         ViewState state = s->state;
         const std::uint64_t seq = s->seq;
-        if (kind == Kind::Snapshot) {
-            s->snapshot = false;
-        } else {
-            s->dirty = false;
-            s->needsFull = kind == Kind::Reduced;
-        }
-        s->inFlight = true;
+        const int scale =
+            kind == FrameKind::Reduced
+                ? reducedScale(s->demand.msPerPixel, double(state.width) * state.height, schedule)
+                : 1;
+        s->demand.start(kind);
         const bool resetRange = s->resetRange;
         const std::string histogramKey = s->histogramKey;
         s->resetRange = false;
-        int scale = 1;
-        if (kind == Kind::Reduced && s->msPerPixel > 0.0) {
-            const double pixels = double(state.width) * state.height;
-            while (scale < opt.maxScale &&
-                   s->msPerPixel * pixels / (double(scale) * scale) > opt.targetFrameMs)
-                ++scale;
-        } else if (kind == Kind::Reduced) {
-            scale = 2;  // no measurement yet
-        }
         lk.unlock();
 
-        // Step 3: render and encode outside the lock.
+        // Step 3: the field (prepared or swapped in), then the frame, outside the lock.
         std::weak_ptr<Session> weak = s;
         auto post = [&](std::function<void(Session&)> f) {
             net::post(ioc, [weak, f = std::move(f)] {
@@ -1075,54 +1055,13 @@ void ViewServer::Impl::renderLoop() {
                     c.sendText(st, "state");
                 });
             }
-            const RenderSettings settings =
-                frameSettings(state, scene.base, kind == Kind::Snapshot ? 1 : scale);
-            const auto frameStart = Clock::now();
-            const RenderResult result = renderer->render(settings);
-            const double frameSeconds = secondsSince(frameStart);
-            const auto encodeStart = Clock::now();
-            Image image =
-                state.heatmap && kind != Kind::Snapshot
-                    ? sampleHeatmap(result.sampleCounts, settings.width, settings.height, 0)
-                    : result.image;
-            const Vec3f bg = scene.background.value_or(Vec3f(0.f, 0.f, 0.f));
-            std::vector<std::uint8_t> bytes;
-            const char* format = "png";
-            if (kind == Kind::Snapshot)
-                bytes = encodePng(image, scene.background);
-            else if (kind == Kind::Reduced)
-                bytes = encodeJpeg(image, bg, opt.jpegQuality), format = "jpeg";
-            else
-                bytes = encodePng(image, bg, 1);
-            const double encodeSeconds = secondsSince(encodeStart);
-            const double pixels = double(settings.width) * settings.height;
-            Json meta;
-            if (kind == Kind::Snapshot) {
-                meta = {{"type", "snapshot"}, {"format", "png"}};
-            } else {
-                // The library's frame report (the CLI's --stats, Python's stats), and what only
-                // the server knows: the whole render call (setup, kernel, read-back), the
-                // encoding and the bytes sent.
-                Json stats = frameReport(*renderer, settings, result);
-                stats["frame_seconds"] = frameSeconds;
-                stats["encode_seconds"] = encodeSeconds;
-                stats["bytes"] = bytes.size();
-                meta = {{"type", "frame"},  {"seq", seq},
-                        {"format", format}, {"full", kind == Kind::Full},
-                        {"scale", scale},   {"stats", std::move(stats)}};
-                if (!result.setup.notes.empty()) meta["notes"] = result.setup.notes;
-            }
-            meta["width"] = image.width;
-            meta["height"] = image.height;
+            ViewFrame frame =
+                renderViewFrame(*renderer, state, scene.base, kind, scale, seq, encoding);
             {
                 std::lock_guard slk(m);
-                // What a frame costs here: the render call (setup, kernel, read-back) and the
-                // encoding, per pixel.
-                const double perPixel =
-                    (frameSeconds + encodeSeconds) * 1e3 / std::max(1.0, pixels);
-                s->msPerPixel = s->msPerPixel > 0.0 ? 0.5 * (s->msPerPixel + perPixel) : perPixel;
+                s->demand.measured(frame.msPerPixel);
             }
-            post([meta = meta.dump(), bytes = std::move(bytes)](Session& c) mutable {
+            post([meta = frame.meta.dump(), bytes = std::move(frame.bytes)](Session& c) mutable {
                 c.sendImage(meta, std::string(bytes.begin(), bytes.end()));
             });
             sent = true;
@@ -1137,7 +1076,7 @@ void ViewServer::Impl::renderLoop() {
             post([](Session& c) { c.sendError("failed (unknown exception)", "frame"); });
         }
         lk.lock();
-        if (!sent) s->inFlight = false;
+        if (!sent) s->demand.finished();
         // The last reference to a closed connection goes on the network thread, which owns
         // its socket.
         net::post(ioc, [s = std::move(s)] {});
