@@ -103,7 +103,7 @@ public:
     /// Asks a running server to stop (any thread).
     void stop();
 
-    /// The server's inside (view_server.cpp); opaque.
+    /// The server's inside (server_internal.h); opaque.
     struct Impl;
 
 private:
