@@ -251,22 +251,28 @@ struct CudaScene::Impl {
                           });
     }
 
-    /// The host scene view with every pointer replaced by its device copy.
+    /// The host scene view with every pointer replaced by its device copy (the mesh's arrays
+    /// through scene_arrays.h's table, the frame's transfer function here).
     SceneView deviceScene(const FrameSetup& setup) const {
         SceneView v = setup.scene(mesh);
-        TetMeshView& m = v.locator.mesh;
-        m.points = a.points.data();
-        m.nativeCorners = a.nativeCorners.data();
-        m.values = a.values.data();
-        m.tetCorners = a.tetCorners.data();
-        m.blockVertices = a.blockVertices.data();
-        m.blockVertexBase = a.blockVertexBase.data();
-        v.locator.bvh.nodes = a.bvhNodes.data();
-        v.locator.bvh.primIds = a.bvhPrims.data();
-        v.locator.neighbors = {a.neighborCodes.data(), a.neighborEscapes.data(),
-                               a.neighborEscapeBase.data(), a.nativeNeighbors.data()};
+        pointAtArrays(v, a);
         v.tf.entries = tfTable.data();
         v.tf.breaks = tfBreaks.data();
+        return v;
+    }
+
+    /// The adaptive method's view on the device: as deviceScene, with this frame's shading and
+    /// macrocells, and the GPU's walking limits.
+    PartitionSceneView devicePartitionScene(const FrameSetup& setup, bool skip) const {
+        PartitionSceneView v = setup.partitionScene(mesh, skip);
+        pointAtArrays(v, a);
+        v.base.tf.entries = tfTable.data();
+        v.base.tf.breaks = tfBreaks.data();
+        v.shading = shading.data();
+        v.macro = macroActive ? MacroShadingView{a.macroGrids.data(), macroShading.data()}
+                              : MacroShadingView{};
+        if (!mesh.seeds) v.longStep = INFINITY;  // without seeds, walking beats BVH searches
+        v.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;
         return v;
     }
 };
@@ -412,18 +418,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
                               ExactMarch<kNative()>{d.deviceScene(result.setup)}, d.totals.data());
         });
     } else {
-        PartitionSceneView scene = result.setup.partitionScene(d.mesh, settings.skip);
-        scene.base = d.deviceScene(result.setup);
-        scene.kd.nodes = d.a.kdNodes.data();
-        scene.kd.partitions = d.a.partitions.data();
-        scene.cells.nodes = d.a.cellTreeNodes.data();
-        scene.shading = d.shading.data();
-        if (d.macroActive) scene.macro = {d.a.macroGrids.data(), d.macroShading.data()};
-        if (d.mesh.seeds)
-            scene.seeds = {d.a.seedGrids.data(), d.a.seeds.data()};
-        else
-            scene.longStep = INFINITY;  // without seeds, walking beats divergent BVH searches
-        scene.base.locator.maxWalkSteps = cuda::kGpuMaxWalkSteps;
+        const PartitionSceneView scene = d.devicePartitionScene(result.setup, settings.skip);
         dispatchNative(native, [&](auto kNative) {
             cuda::launchFrame(grid, block, frame, PartitionMarch<kNative()>{scene},
                               d.totals.data());

@@ -5,6 +5,8 @@
 #include <type_traits>
 
 #include "uvr/prepare/prepared_mesh.h"
+#include "uvr/render/adaptive_marcher.h"
+#include "uvr/render/scene_view.h"
 
 namespace uvr {
 
@@ -77,6 +79,36 @@ void forEachSceneArray(const PreparedMesh& m, Arrays& a, F&& f) {
     f(a.macroCells, m.macro ? &m.macro->cells : nullptr, "the macrocells", U::Values);
     f(a.macroNan, m.macro && !m.macro->nanCells.empty() ? &m.macro->nanCells : nullptr,
       "the macrocells' NaN flags", U::Values);
+}
+
+/// Points a kernel's scene view (built on the host: counts, bounds, parameters) at the arrays'
+/// copies instead of the prepared mesh's vectors: the mesh, its BVH and face neighbours. The one
+/// place that says which array each pointer of a view reads; A<T> needs data().
+template <template <class> class A>
+void pointAtArrays(SceneView& v, const SceneArrays<A>& a) {
+    TetMeshView& m = v.locator.mesh;
+    m.points = a.points.data();
+    m.nativeCorners = a.nativeCorners.data();
+    m.values = a.values.data();
+    m.tetCorners = a.tetCorners.data();
+    m.blockVertices = a.blockVertices.data();
+    m.blockVertexBase = a.blockVertexBase.data();
+    v.locator.bvh.nodes = a.bvhNodes.data();
+    v.locator.bvh.primIds = a.bvhPrims.data();
+    v.locator.neighbors = {a.neighborCodes.data(), a.neighborEscapes.data(),
+                           a.neighborEscapeBase.data(), a.nativeNeighbors.data()};
+}
+
+/// pointAtArrays for the adaptive method's view: its base scene, the k-d tree, the cell tree and
+/// the seed grids (when the view has them). The per-frame shading and macrocells are the
+/// caller's.
+template <template <class> class A>
+void pointAtArrays(PartitionSceneView& v, const SceneArrays<A>& a) {
+    pointAtArrays(v.base, a);
+    v.kd.nodes = a.kdNodes.data();
+    v.kd.partitions = a.partitions.data();
+    v.cells.nodes = a.cellTreeNodes.data();
+    if (v.seeds.grids) v.seeds = {a.seedGrids.data(), a.seeds.data()};
 }
 
 /// Storage of nothing: SceneArrays<NoArray> walks the table without holding anything.
