@@ -33,7 +33,9 @@ TEST(Text, PrintableKeepsValidUtf8AndEscapesControlsAndBadBytes) {
 TEST(Text, PrintableShortCutsOnACharacterBoundary) {
     EXPECT_EQ(printableShort("short"), "short");
     EXPECT_EQ(printableShort(std::string(40, 'a')), std::string(40, 'a'));
-    EXPECT_EQ(printableShort(std::string(41, 'a')), std::string(37, 'a') + "...");
+    std::string dots(40, '.');  // 37 a's and "..." (not a + "...": GCC 12's -Warray-bounds)
+    dots.replace(0, 37, std::string(37, 'a'));
+    EXPECT_EQ(printableShort(std::string(41, 'a')), dots);
     EXPECT_EQ(printableShort(std::string(1000000, '\n'), 10), "\\n\\n\\n...");
     // A two-byte character is not cut in half.
     std::string accents;
