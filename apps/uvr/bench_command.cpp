@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_common.h"
+#include "render_pipeline.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 

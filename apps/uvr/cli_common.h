@@ -8,7 +8,6 @@
 #include <optional>
 #include <string>
 
-#include "setting_flags.h"
 #include "uvr/uvr.h"
 
 namespace uvr::cli {
@@ -83,93 +82,18 @@ struct MemoryDefault {
 /// (the larger of MemTotal and the hot-pluggable memory blocks, capped by a cgroup limit).
 MemoryDefault defaultMaxMemory();
 
+/// Throws Error(Argument): "FLAG 'TEXT': expected WHAT".
+[[noreturn]] void badFlag(const std::string& flag, const std::string& text,
+                          const std::string& what);
+/// Parses `count` comma-separated finite numbers for a flag; badFlag(flag, text, what) otherwise.
+std::vector<float> parseFloats(const std::string& flag, const std::string& text, std::size_t count,
+                               const std::string& what);
 /// Parses "x,y,z" for a flag; throws Error(Argument) naming the flag.
 Vec3f parseVec3(const std::string& flag, const std::string& text);
 /// Parses "lo,hi" for a flag; throws Error(Argument) naming the flag.
 std::pair<float, float> parseRange(const std::string& flag, const std::string& text);
 /// Parses "WxH" for a flag; throws Error(Argument) naming the flag.
 std::pair<int, int> parseSize(const std::string& flag, const std::string& text);
-
-/// Render options shared by `render` and `demo`, registered on a subcommand.
-struct RenderFlags {
-    std::string output;
-    std::string field;
-    std::string tf = "cool-to-warm";
-    std::optional<std::string> opacity;  ///< unset: the JSON's Points, else ramp
-    std::string range;
-    bool logScale = false;  ///< --log
-    std::string nanColor;   ///< --nan-color r,g,b[,a]; empty: the colour map's
-    std::string size = "1024x1024";
-    std::string cameraFile, cameraPosition, cameraFocal, cameraUp;
-    std::optional<float> viewAngle;
-    bool parallel = false;               ///< --parallel: parallel projection
-    std::optional<float> parallelScale;  ///< unset: the camera file's, else the reset camera's
-    float azimuth = 0.f, elevation = 0.f;
-    /// The settings of the library's vocabulary (--method, --quality, --step, ...).
-    SettingFlags vocabulary;
-    std::uint32_t leafCells = 0;
-    bool noSeedGrid = false;
-    bool splitCells = false;
-    std::string device = "auto";
-    std::string buildDevice = "auto";
-    std::string heatmapFile;
-    std::optional<std::uint32_t> heatmapMax;  ///< needs --heatmap; 0: the frame's maximum
-    std::string background;
-    bool legend = false;  ///< draw a colour legend (title, bar, ticks) at the right edge
-    std::string statsFile;
-    int threads = 0;
-
-    /// Adds the flags to a subcommand; oneFrame adds those of a single render (output, heat map,
-    /// stats, --no-skip, --no-adaptive), which `bench` chooses itself; withMethod adds --method.
-    void registerOn(CLI::App& app, bool oneFrame = true, bool withMethod = true);
-    /// Parses the flags into render settings; the default camera fits the bounds (of the mesh
-    /// named source, which an error resetting the camera names). Choices made for the user (a
-    /// view up picked because the default one is parallel to the view direction) are appended
-    /// to notes when given, for the caller to print.
-    RenderSettings settings(const Bounds3f& bounds, const std::string& source = "",
-                            std::vector<std::string>* notes = nullptr) const;
-    /// With --legend, the font it is drawn with (found through fontconfig), after checking that
-    /// --size leaves room for it; throws Error naming --legend and what is missing. Without
-    /// --legend, none.
-    std::optional<Font> legendFont() const;
-    /// Checks every flag that does not need the mesh (and, for a .uvrm meshFile, that --field
-    /// names one of the fields its header lists; with --legend, that a font is found), so that a
-    /// bad flag fails before minutes of reading; throws Error(Argument) as settings() would.
-    void checkBeforeLoading(const std::string& meshFile = "") const;
-    /// The --background colour, if given (checked to lie in [0, 1]).
-    std::optional<Vec3f> backgroundColor() const;
-    /// The camera flags' own checks (--parallel-scale without a parallel camera, --view-angle
-    /// with one or out of range, non-finite --azimuth/--elevation); fileParallel: the --camera
-    /// file is parallel. Run before loading and again by settings().
-    void checkCameraFlags(bool fileParallel) const;
-    /// The settings the flags give that do not depend on the mesh (no camera).
-    RenderSettings baseSettings() const;
-    /// The files a single render writes (-o, --heatmap, --stats), for checks before any work.
-    std::vector<NamedFile> outputs() const;
-    /// The files the flags read (--tf when it names a file, --camera).
-    std::vector<NamedFile> inputs() const;
-    /// Checks before any work that every output can be written and that none names an input
-    /// (the mesh file, when not empty, or a file the flags read) or another output.
-    void checkFiles(const std::string& meshFile) const;
-    /// The method the flags ask for: --method's, except that auto with settings that tune
-    /// sampling (tunesAdaptive: --quality 0.995, --step, --sampling point, --no-skip, ...) or a
-    /// partition flag (--leaf-cells, --no-seed-grid) is the adaptive method they tune.
-    RenderMethod requestedMethod() const;
-    /// Refuses (Error(Argument), one line) flags that --method's integrator would ignore: a
-    /// setting it does not read (settingReadBy: --quality with --method reference, --sampling
-    /// with exact) and --leaf-cells or --no-seed-grid without the adaptive method.
-    void refuseIgnoredFlags() const;
-    /// What the renderer prepares and where (--device, --build-device, --leaf-cells,
-    /// --no-seed-grid): partitions only for the adaptive method, the mesh BVH only for the
-    /// reference and exact methods, what auto picks for auto (PrepareOptions::forAuto), and the
-    /// mesh BVH also when withReference.
-    RendererOptions rendererOptions(bool withReference = false) const;
-};
-
-/// Prepares `field` of a mesh into a Renderer as the flags ask, with progress messages, and
-/// prints where it renders (the GPU, what was uploaded).
-std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
-                                       const RendererOptions& options, const Context& ctx);
 
 /// Help text of every command's mesh FILE argument.
 inline constexpr const char* kMeshFileHelp =
@@ -207,40 +131,6 @@ SourceSummary checkForRendering(const Mesh& mesh, const ScalarField& field,
 /// The time step the flags ask for, as a prepared cache's key records it ("" for the first).
 std::string stepKey(const StepFlags& steps);
 
-/// A prepared mesh's source, as a render reports it: the mesh file, its summary, and the
-/// prepared cache it came from (empty when prepared from the mesh).
-struct RenderSource {
-    std::string path;
-    SourceSummary summary;
-    double checkSeconds = 0.0;  ///< the mesh's check (0 from a cache)
-    std::string cacheFile;
-    double cacheReadSeconds = 0.0;
-};
-
-/// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its
-/// image carries the legend). The mesh is taken over and freed once its cells are split.
-RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const RenderFlags& flags,
-                            const Context& ctx);
-
-/// `render`'s --cache FILE and --no-cache.
-struct CacheFlags {
-    std::string file;  ///< --cache; empty: MESH.uvrprep when it exists
-    bool off = false;  ///< --no-cache
-    /// Adds the flags (exclusive) to a subcommand.
-    void registerOn(CLI::App& app);
-};
-
-/// Renders from a prepared cache instead of the mesh when one applies and writes the outputs as
-/// renderAndWrite does: --cache FILE (a mismatch or a damaged file is an error), else
-/// MESH.uvrprep when it exists (a stale or damaged one is set aside with a warning saying why:
-/// false is returned and the caller prepares from the mesh). False without a cache.
-bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
-                     const CacheFlags& cache, const Context& ctx);
-
-/// A Renderer over a mesh already prepared (read from a prepared cache) on `device`; prints
-/// where it renders as the other makeRenderer does.
-std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx);
-
 /// Refuses with Error(Resource) an estimate above --max-memory: "WHAT would need about N bytes,
 /// more than the --max-memory limit of M bytes" (what names the flags responsible).
 void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes);
@@ -248,13 +138,6 @@ void checkMemoryEstimate(const Context& ctx, const std::string& what, std::uint6
 /// checkMemoryEstimate for image buffers; without an explicit --max-memory they must also fit
 /// kDefaultFrameMemoryBytes (Error(Resource) naming the need, the limit and the flag).
 void checkFrameEstimate(const Context& ctx, const std::string& what, std::uint64_t bytes);
-
-/// Host bytes of `frames` frames at the flags' --size written as PNGs (with a heat map each when
-/// --heatmap is given), for checks before any work.
-std::uint64_t frameMemoryBytes(const RenderFlags& flags, std::uint64_t frames = 1);
-
-/// Checks before any work that the frame buffers of the flags' --size fit --max-memory.
-void checkFrameMemory(const RenderFlags& flags, const Context& ctx);
 
 /// Registers the subcommands.
 void addInfoCommand(CLI::App& app, Context& ctx);

@@ -8,6 +8,7 @@
 
 #include "cli_common.h"
 #include "progress.h"
+#include "render_pipeline.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
 

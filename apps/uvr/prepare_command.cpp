@@ -9,6 +9,7 @@
 
 #include "cli_common.h"
 #include "progress.h"
+#include "render_pipeline.h"
 
 namespace uvr::cli {
 

@@ -6,6 +6,7 @@
 
 #include "cli_common.h"
 #include "progress.h"
+#include "render_pipeline.h"
 
 #ifdef UVR_HAS_SERVER
 #include "uvr/server/view_server.h"

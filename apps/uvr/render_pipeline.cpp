@@ -1,0 +1,258 @@
+// SPDX-License-Identifier: MIT
+#include "render_pipeline.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "progress.h"
+
+namespace uvr::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+namespace {
+
+/// Prints what was uploaded to the GPU, when the renderer renders there.
+void reportUpload(const Renderer& renderer, const Context& ctx) {
+    const std::optional<GpuResidency> gpu = renderer.gpuResidency();
+    if (!gpu) return;
+    char line[160];
+    std::snprintf(line, sizeof line, "uploaded %.1f MiB to the GPU (%.1f bytes per cell) in %.3f s",
+                  gpu->geometryBytes / 1048576.0,
+                  double(gpu->geometryBytes) /
+                      double(std::max<std::uint64_t>(1, renderer.prepared().tets.cellCount())),
+                  gpu->uploadSeconds);
+    ctx.step(line);
+}
+
+}  // namespace
+
+std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
+                                       const RendererOptions& options, const Context& ctx) {
+    if (resolvesToCuda(options.device)) ctx.step("GPU: " + cudaDeviceDescription());
+    PhaseProgress phases(ctx);
+    auto renderer = std::make_unique<Renderer>(mesh, field, options, phases.callbacks());
+    phases.finish();
+    reportUpload(*renderer, ctx);
+    return renderer;
+}
+
+namespace {
+
+/// The settings of a render of `src`, checked; the camera fits the rendered cells (unused and
+/// NaN/Inf points and flat cells left out).
+RenderSettings checkedSettings(const RenderFlags& flags, const RenderSource& src,
+                               const Context& ctx) {
+    std::vector<std::string> notes;
+    RenderSettings settings = flags.settings(src.summary.bounds, src.path, &notes);
+    for (const std::string& note : notes) ctx.step("note: " + note);
+    validateSettings(settings);
+    return settings;
+}
+
+/// Renders a prepared mesh and writes the PNG, heat map and statistics: what a render from the
+/// mesh and one from a prepared cache share.
+RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
+                                    RenderSettings settings, const RenderOutputs& out,
+                                    const Context& ctx) {
+    const std::optional<Vec3f>& background = out.background;
+    const std::string& source = src.path;
+    const ScalarField field = src.summary.field();
+    const PreparedMesh& prepared = renderer.prepared();
+    ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
+             " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
+             (settings.supersample > 1
+                  ? " with " + std::to_string(settings.supersample) + "x" +
+                        std::to_string(settings.supersample) + " rays per pixel" +
+                        (settings.jitter ? " (jittered)" : "")
+                  : std::string()));
+    ctx.setActivity(source, "rendering it at " + std::to_string(settings.width) + "x" +
+                                std::to_string(settings.height));
+    RenderResult result;
+    {
+        Progress progress(ctx, "rendering", double(settings.width) * settings.height, "pixels");
+        settings.progress = progress.callback();
+        result = renderer.render(settings);
+        settings.progress = {};
+    }
+    ctx.setActivity(out.image, "writing the image");
+    char line[200];
+    std::snprintf(
+        line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
+        renderer.deviceName(), result.stats.seconds,
+        static_cast<unsigned long long>(result.stats.samples), result.stats.meanSamplesPerPixel(),
+        result.setup.params.step / result.setup.frame.scale);
+    ctx.step(line);
+    if (!result.setup.method.reason.empty()) ctx.step(result.setup.method.reason);
+    if (result.setup.method.method == RenderMethod::Partitions) {
+        std::snprintf(line, sizeof line,
+                      "%zu partitions (built in %.3f s); transfer-function update %.3f ms; "
+                      "%.1f partitions visited and %.1f skipped per pixel",
+                      prepared.kd->partitions.size(), prepared.kd->buildSeconds,
+                      result.setup.tfUpdateSeconds * 1e3,
+                      double(result.stats.partitionsVisited) / (settings.width * settings.height),
+                      double(result.stats.partitionsSkipped) / (settings.width * settings.height));
+        ctx.step(line);
+    }
+    for (const std::string& note : result.setup.notes) ctx.warn(source + ": " + note);
+    const std::string empty = explainEmptyFrame(prepared, settings, result);
+    if (!empty.empty()) ctx.warn(source + ": " + empty);
+    if (const std::optional<Font>& legendFont = out.legend) {
+        LegendStyle style;
+        style.background = background;
+        drawLegend(result.image, *legendFont, settings.tf, result.setup.rangeLo,
+                   result.setup.rangeHi, field.name, settings.tf.logScale, style);
+        ctx.step("drew the legend in " + legendFont->familyName() + " (" + legendFont->path() +
+                 ")");
+    }
+    // Every output is written first and committed after the last one succeeded: a failure (a
+    // full disk) leaves none of them behind.
+    std::vector<std::unique_ptr<OutputFile>> outputs;
+    outputs.push_back(std::make_unique<OutputFile>(out.image));
+    writePng(*outputs.back(), result.image, background);
+    // The heat map's scale: --heatmap-max, else the frame's largest count (at least 1).
+    std::uint32_t heatmapTop = out.heatmapMax.value_or(0);
+    if (heatmapTop == 0)
+        for (std::uint32_t c : result.sampleCounts) heatmapTop = std::max(heatmapTop, c);
+    heatmapTop = std::max<std::uint32_t>(heatmapTop, 1);
+    if (!out.heatmap.empty()) {
+        ctx.setActivity(out.heatmap, "writing the heat map");
+        outputs.push_back(std::make_unique<OutputFile>(out.heatmap));
+        writePng(*outputs.back(),
+                 sampleHeatmap(result.sampleCounts, settings.width, settings.height, heatmapTop));
+        ctx.step("heat map: the bar runs from 0 samples per pixel (black, bottom) to " +
+                 std::to_string(heatmapTop) + " (top)");
+    }
+    if (!out.stats.empty()) {
+        // The library's frame report, and what only the CLI knows: the file, its counts and
+        // check, the prepared cache, the heat map's scale.
+        nlohmann::json j = frameReport(renderer, settings, result);
+        j["source"] = source;
+        if (!out.heatmap.empty()) j["heatmap_max"] = heatmapTop;
+        j["mesh"]["points"] = src.summary.points;
+        j["mesh"]["cells"] = src.summary.cells;
+        j["prepared_cache"] = {{"used", !src.cacheFile.empty()}};
+        if (!src.cacheFile.empty()) {
+            j["prepared_cache"]["file"] = src.cacheFile;
+            j["prepared_cache"]["read_seconds"] = src.cacheReadSeconds;
+        }
+        j["prepare_seconds"]["check"] = src.checkSeconds;
+        outputs.push_back(std::make_unique<OutputFile>(out.stats));
+        outputs.back()->write(jsonText(j) + "\n");
+    }
+    for (const auto& file : outputs) file->finish();  // buffered bytes reach the disk (or fail)
+    for (const auto& file : outputs) {
+        file->commit();
+        ctx.step("wrote " + file->path());
+    }
+    return result;
+}
+
+}  // namespace
+
+RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const RenderFlags& flags,
+                            const Context& ctx) {
+    const RenderOutputs out = flags.renderOutputs();  // checked before the expensive work
+    const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags.field));
+    const auto start = Clock::now();
+    RenderSource src;
+    src.path = source;
+    src.summary = checkForRendering(mesh, field, source, ctx, &src.checkSeconds);
+    // Every flag is parsed before the expensive preparation, so a bad flag fails fast.
+    const RenderSettings settings = checkedSettings(flags, src, ctx);
+    ctx.setActivity(source, "preparing the mesh for rendering");
+    RendererOptions options = flags.rendererOptions();
+    // The mesh as read is not needed once split: freed then (a billion cells' arrays).
+    options.afterSplit = [&mesh] { mesh = Mesh(); };
+    const std::unique_ptr<Renderer> renderer = makeRenderer(mesh, field, options, ctx);
+    ctx.done("prepared " + describeCells(renderer->prepared().tets), start);
+    return renderPreparedAndWrite(*renderer, src, settings, out, ctx);
+}
+
+void CacheFlags::registerOn(CLI::App& app) {
+    auto* c = app.add_option("--cache", file,
+                             "Render from this prepared cache (`uvr prepare`) without reading the "
+                             "mesh; an error when it does not match the mesh and the flags "
+                             "(default: MESH.uvrprep when it exists and matches)");
+    auto* n = app.add_flag("--no-cache", off, "Ignore MESH.uvrprep: read and prepare the mesh");
+    c->excludes(n);
+}
+
+std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx) {
+    if (resolvesToCuda(device)) ctx.step("GPU: " + cudaDeviceDescription());
+    auto renderer = std::make_unique<Renderer>(std::move(prepared), device);
+    reportUpload(*renderer, ctx);
+    return renderer;
+}
+
+bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
+                     const CacheFlags& cache, const Context& ctx) {
+    const bool explicitCache = !cache.file.empty();
+    if (cache.off) return false;
+    const std::string path = explicitCache ? cache.file : meshFile + kPreparedCacheSuffix;
+    std::error_code ec;
+    if (!explicitCache && (!std::filesystem::is_regular_file(path, ec) ||
+                           !std::filesystem::is_regular_file(meshFile, ec)))
+        return false;
+    const auto start = Clock::now();
+    const RendererOptions options = flags.rendererOptions();
+    const CacheKey expected =
+        makeCacheKey(meshFile, flags.field, stepKey(steps), options.prepareOptions());
+    // A default cache that is stale, damaged or not trusted (another user's, or writable by
+    // others) is set aside with a warning saying why, and the mesh is prepared instead.
+    const auto notUsing = [&](const Error& e) {
+        const auto* stale = dynamic_cast<const StaleCacheError*>(&e);
+        return "not using the prepared cache " + path + ": " +
+               (stale ? stale->reason() : std::string(e.what())) +
+               "; preparing from the mesh (`uvr prepare` renews the cache)";
+    };
+    // The header first.
+    RenderSource src;
+    src.path = meshFile;
+    src.cacheFile = path;
+    PreparedMesh prepared;
+    try {
+        const CacheHeader header = readPreparedCacheHeader(path);
+        const std::string why = cacheKeyMismatch(header.key, expected);
+        if (!why.empty()) throw StaleCacheError(path, why);
+        src.summary = header.source;
+    } catch (const Error& e) {
+        if (explicitCache || e.kind() == ErrorKind::Resource) throw;
+        ctx.warn(notUsing(e));
+        return false;
+    }
+    const RenderOutputs out = flags.renderOutputs();
+    const RenderSettings settings = checkedSettings(flags, src, ctx);
+    ctx.setActivity(path, "reading the prepared cache");
+    try {
+        LoadBudget budget(ctx.maxMemoryBytes);
+        Progress progress(ctx, "reading the prepared cache " + path);
+        prepared = readPreparedCache(path, expected, budget, nullptr, progress.callback());
+    } catch (const Error& e) {
+        // Damage past the header (a truncated array, a failed CRC, a crafted index) sets a
+        // default cache aside as header damage does; memory limits stay errors.
+        if (explicitCache || e.kind() == ErrorKind::Resource) throw;
+        ctx.warn(notUsing(e));
+        return false;
+    }
+    src.cacheReadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    char line[64];
+    std::snprintf(line, sizeof line, " (read in %.3f s)", src.cacheReadSeconds);
+    ctx.step("using the prepared cache " + path + line + ": " + describeCells(prepared.tets) +
+             " prepared from " + meshFile);
+    for (const std::string& note : src.summary.notes) ctx.step("note: " + note);
+    for (const std::string& f : src.summary.findings) ctx.step("validation: " + f);
+    ctx.setActivity(path, "uploading the prepared mesh");
+    const std::unique_ptr<Renderer> renderer =
+        makeRenderer(std::move(prepared), options.device, ctx);
+    renderPreparedAndWrite(*renderer, src, settings, out, ctx);
+    return true;
+}
+
+}  // namespace uvr::cli

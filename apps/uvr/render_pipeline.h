@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// A render from the command line: the mesh (or its prepared cache) prepared into a Renderer,
+// rendered with the flags' settings and written with the flags' outputs.
+
+#include <memory>
+#include <string>
+
+#include "cli_common.h"
+#include "render_flags.h"
+
+namespace uvr::cli {
+
+/// Prepares `field` of a mesh into a Renderer as the flags ask, with progress messages, and
+/// prints where it renders (the GPU, what was uploaded).
+std::unique_ptr<Renderer> makeRenderer(const Mesh& mesh, const ScalarField& field,
+                                       const RendererOptions& options, const Context& ctx);
+
+/// A prepared mesh's source, as a render reports it: the mesh file, its summary, and the
+/// prepared cache it came from (empty when prepared from the mesh).
+struct RenderSource {
+    std::string path;
+    SourceSummary summary;
+    double checkSeconds = 0.0;  ///< the mesh's check (0 from a cache)
+    std::string cacheFile;
+    double cacheReadSeconds = 0.0;
+};
+
+/// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its
+/// image carries the legend). The mesh is taken over and freed once its cells are split.
+RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const RenderFlags& flags,
+                            const Context& ctx);
+
+/// `render`'s --cache FILE and --no-cache.
+struct CacheFlags {
+    std::string file;  ///< --cache; empty: MESH.uvrprep when it exists
+    bool off = false;  ///< --no-cache
+    /// Adds the flags (exclusive) to a subcommand.
+    void registerOn(CLI::App& app);
+};
+
+/// Renders from a prepared cache instead of the mesh when one applies and writes the outputs as
+/// renderAndWrite does: --cache FILE (a mismatch or a damaged file is an error), else
+/// MESH.uvrprep when it exists (a stale or damaged one is set aside with a warning saying why:
+/// false is returned and the caller prepares from the mesh). False without a cache.
+bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
+                     const CacheFlags& cache, const Context& ctx);
+
+/// A Renderer over a mesh already prepared (read from a prepared cache) on `device`; prints
+/// where it renders as the other makeRenderer does.
+std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx);
+
+}  // namespace uvr::cli
