@@ -80,6 +80,18 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
         ->capture_default_str();
     app.add_option("--elevation", elevation, "Rotate the camera about the right axis, degrees")
         ->capture_default_str();
+    app.add_option("--clip-plane,--clip-planes", clipPlanes,
+                   "Clip the volume by a plane through ox,oy,oz with normal nx,ny,nz (file "
+                   "coordinates): the side the normal points to is kept, every cell cut exactly "
+                   "at the plane; repeat for up to " +
+                       std::to_string(kMaxClipPlanes) + " planes")
+        ->type_name("OX,OY,OZ,NX,NY,NZ")
+        ->expected(1)  // one value per occurrence: the mesh file may follow
+        ->take_all();
+    app.add_option("--clip-box", clipBox,
+                   "Clip the volume to the box x0,y0,z0,x1,y1,z1 (file coordinates): only its "
+                   "inside is kept")
+        ->type_name("X0,Y0,Z0,X1,Y1,Z1");
     // The library's settings, each once (the vocabulary): its name, doc, default and check.
     std::vector<std::string> except;
     if (!withMethod) except.push_back("method");
@@ -147,6 +159,17 @@ RenderSettings RenderFlags::baseSettings() const {
         s.tf.nanOpacity = withAlpha ? v[3] : 1.f;
     }
     if (!range.empty()) s.range = parseRange("--range", range);
+    for (const std::string& text : clipPlanes) {
+        const std::vector<float> v = parseFloats("--clip-plane", text, 6,
+                                                 "ox,oy,oz,nx,ny,nz: a point of the plane and its "
+                                                 "normal, six finite numbers");
+        s.clipPlanes.push_back({Vec3f(v[0], v[1], v[2]), Vec3f(v[3], v[4], v[5])});
+    }
+    if (!clipBox.empty()) {
+        const std::vector<float> v =
+            parseFloats("--clip-box", clipBox, 6, "x0,y0,z0,x1,y1,z1: six finite numbers");
+        s.clipBox = Bounds3f{Vec3f(v[0], v[1], v[2]), Vec3f(v[3], v[4], v[5])};
+    }
     // The settings of the library's vocabulary are checked there (main re-spells its errors
     // with the flags).
     vocabulary.applyTo(s);

@@ -29,6 +29,8 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
     for (const SettingDef& def : settingsVocabulary())
         if (f.vocabulary.given(def.name) && !server::isViewerSetting(def.name))
             add(cliFlag(def).c_str(), f.vocabulary.text(def.name));
+    for (const std::string& plane : f.clipPlanes) add("--clip-plane", plane);
+    if (!f.clipBox.empty()) add("--clip-box", f.clipBox);
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
     if (f.splitCells) add("--split-cells", "");

@@ -96,6 +96,17 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     // Anti-aliasing: a pixel's samples are summed over its supersample^2 rays.
     j["supersample"] = settings.supersample;
     if (settings.supersample > 1) j["jitter"] = settings.jitter;
+    // Clipping, in the file's coordinates as given.
+    if (!settings.clipPlanes.empty()) {
+        nlohmann::json planes = nlohmann::json::array();
+        for (const ClipPlane& p : settings.clipPlanes)
+            planes.push_back(
+                {p.origin.x, p.origin.y, p.origin.z, p.normal.x, p.normal.y, p.normal.z});
+        j["clip_planes"] = std::move(planes);
+    }
+    if (settings.clipBox)
+        j["clip_box"] = {settings.clipBox->lo.x, settings.clipBox->lo.y, settings.clipBox->lo.z,
+                         settings.clipBox->hi.x, settings.clipBox->hi.y, settings.clipBox->hi.z};
     j["rays"] = result.stats.rays();
     j["mesh"] = {{"tetrahedra", prepared.tets.tetCount()},
                  {"pyramids", prepared.tets.pyramidCount},

@@ -184,6 +184,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     float tEnter = 0.f, tExit = INFINITY;
     if (scene.kd.partitionCount == 0 || !intersectBox(scene.kd.bounds, ray.org, inv, tEnter, tExit))
         return acc;
+    const ClipView& clip = scene.base.params.clip;
+    if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, tEnter, tExit)) return acc;
     const TetLocator& locator = scene.base.locator;
     const float s1 = scene.base.params.step;
     const float unit = scene.base.params.opacityUnit;

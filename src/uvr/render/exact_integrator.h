@@ -262,6 +262,12 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
     float b0 = 0.f, b1 = INFINITY;
     if (!intersectBox(scene.bounds, ray.org, inv, b0, b1)) return acc;
+    // Clipped: the ray starts at the region's entry (inside a cell, which is cut there) and
+    // stops at its exit.
+    const ClipView& clip = scene.params.clip;
+    const bool clipped = clip.active();
+    if (clipped && !clip.restrict(ray.org, ray.dir, inv, b0, b1)) return acc;
+    const double tStop = clipped ? double(b1) : INFINITY;
     const TetLocator& loc = scene.locator;
     // A gap this small between tetrahedra is rounding, not empty space.
     const double eps = 1e-6 * (double(scene.bounds.diagonal()) + double(b0));
@@ -279,12 +285,14 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
+    bool past = tet != kNoTet && t >= tStop;  // beyond the clip region's exit
     // A point field is continuous across a shared face: the value where the ray leaves one
     // tetrahedron is where it enters the next (when it continues through that face).
     bool haveEntry = false;
     float sEntry = 0.f;
-    for (std::uint32_t step = 0; tet != kNoTet && !opaque && step < kExactMaxSteps; ++step) {
-        const double tEnd = span.tOut;
+    for (std::uint32_t step = 0; tet != kNoTet && !opaque && !past && step < kExactMaxSteps;
+         ++step) {
+        const double tEnd = span.tOut < tStop ? span.tOut : tStop;
         bool exitValue = false;
         if (tEnd > t) {
             ++counters.samples;  // one segment per cell crossed
@@ -300,7 +308,8 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
             }
             opaque = acc.w >= segment::kOpacityEnd;
-            if (opaque) continue;
+            past = tEnd >= tStop;
+            if (opaque || past) continue;
             t = tEnd;
             sEntry = s1;
             // A NaN tetrahedron's exit value is not the next one's entry value (that one's
@@ -327,6 +336,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         if (tet != kNoTet) {
             if (continuous) span = exact::clipAny<kNative>(loc.mesh, tet, ray, true, t + eps);
             if (span.tIn > t) t = span.tIn;  // empty space before it
+            past = t >= tStop;
         }
     }
     return acc;

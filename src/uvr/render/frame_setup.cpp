@@ -212,6 +212,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                : defaultOpacityUnit(bounds, mesh.sourceCells);
     f.params.terminationAlpha = settings.terminationAlpha;
     f.params.preintegrated = settings.preintegrated;
+    f.params.clip = clipView(settings, frame);
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_step")
                                        : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)

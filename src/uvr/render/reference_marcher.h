@@ -103,6 +103,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     float t0 = 0.f, t1 = INFINITY;
     // An empty mesh has inverted bounds, which every ray would "cross" from -FLT_MAX to FLT_MAX.
     if (scene.bounds.empty() || !intersectBox(scene.bounds, ray.org, inv, t0, t1)) return acc;
+    if (scene.params.clip.active() && !scene.params.clip.restrict(ray.org, ray.dir, inv, t0, t1))
+        return acc;
     const float s = scene.params.step;
     // Global sample grid k * s, so every integrator that samples a span takes the same samples.
     float k = ceilf(t0 / s);

@@ -38,7 +38,9 @@ struct Fixture {
         scene.locator = mesh.locator();
         scene.tf = {table.data(), 2, 0.f, 2.f};
         scene.bounds = mesh.tets.bounds;
-        scene.params = {step, unit, 0.99f};
+        scene.params.step = step;
+        scene.params.opacityUnit = unit;
+        scene.params.terminationAlpha = 0.99f;
     }
 };
 

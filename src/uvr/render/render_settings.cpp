@@ -39,6 +39,42 @@ const char* samplingName(bool preintegrated) {
     return preintegrated ? "preintegrated" : "point";
 }
 
+ClipView clipView(const RenderSettings& s, const MeshFrame& frame) {
+    ClipView v;
+    for (const ClipPlane& p : s.clipPlanes) {
+        if (v.planeCount == kMaxClipPlanes) break;  // validateSettings refuses more
+        double o[3];
+        frame.toLocal(p.origin, o);
+        const float len = length(p.normal);
+        ClipPlane& q = v.planes[v.planeCount++];
+        q.origin = Vec3f(float(o[0]), float(o[1]), float(o[2]));
+        q.normal = len > 0.f ? p.normal / len : p.normal;
+    }
+    if (s.clipBox) {
+        double lo[3], hi[3];
+        frame.toLocal(s.clipBox->lo, lo);
+        frame.toLocal(s.clipBox->hi, hi);
+        v.hasBox = true;
+        v.box.lo = Vec3f(float(lo[0]), float(lo[1]), float(lo[2]));
+        v.box.hi = Vec3f(float(hi[0]), float(hi[1]), float(hi[2]));
+    }
+    return v;
+}
+
+std::string clipPlaneText(const ClipPlane& p) {
+    std::string out;
+    for (float x : {p.origin.x, p.origin.y, p.origin.z, p.normal.x, p.normal.y, p.normal.z})
+        out += (out.empty() ? "" : ",") + formatG(x, 6);
+    return out;
+}
+
+std::string clipBoxText(const Bounds3f& b) {
+    std::string out;
+    for (float x : {b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z})
+        out += (out.empty() ? "" : ",") + formatG(x, 6);
+    return out;
+}
+
 void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;
@@ -58,6 +94,18 @@ void validateSettings(const RenderSettings& s) {
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
+    if (s.clipPlanes.size() > std::size_t(kMaxClipPlanes))
+        throw SettingError("clip_planes", std::to_string(s.clipPlanes.size()) + " planes",
+                           "at most " + std::to_string(kMaxClipPlanes));
+    for (const ClipPlane& p : s.clipPlanes)
+        if (!isFinite(p.origin) || !isFinite(p.normal) || !(length(p.normal) > 0.f))
+            throw SettingError("clip_planes", clipPlaneText(p),
+                               "expected a finite origin and a finite normal other than 0,0,0");
+    if (s.clipBox && (!isFinite(s.clipBox->lo) || !isFinite(s.clipBox->hi) ||
+                      s.clipBox->lo.x > s.clipBox->hi.x || s.clipBox->lo.y > s.clipBox->hi.y ||
+                      s.clipBox->lo.z > s.clipBox->hi.z))
+        throw SettingError("clip_box", clipBoxText(*s.clipBox),
+                           "expected finite x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1, z0 <= z1");
     if (s.tf.logScale && s.range && !(s.range->second > 0.f))  // the field's range: at setup
         refuseLogRange(true, s.range->first, s.range->second);
 }

@@ -6,11 +6,15 @@
 
 #include <functional>
 #include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
+#include "uvr/mesh/tet_mesh.h"
 #include "uvr/prepare/render_method.h"
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/clip.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {
@@ -64,6 +68,11 @@ struct RenderSettings {
     /// With supersample > 1: each ray at a fixed hashed position inside its cell of the N x N
     /// grid instead of its centre (deterministic: the same rays every frame, on every device).
     bool jitter = false;
+    /// Clipping (issue 32), in the file's coordinates: up to kMaxClipPlanes planes, each keeping
+    /// the side its normal points to, and a box keeping its inside. Every method integrates only
+    /// the part of each ray inside all of them (the exact method cuts the cells there exactly).
+    std::vector<ClipPlane> clipPlanes;
+    std::optional<Bounds3f> clipBox;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)
@@ -74,6 +83,15 @@ struct RenderSettings {
 /// sampling (RenderSettings::preintegrated: "preintegrated", else "point").
 const char* stepRuleName(StepRule rule);
 const char* samplingName(bool preintegrated);
+
+/// The settings' clip planes and box in the rendering units of a mesh's frame (ClipView for the
+/// integrators; each normal of unit length).
+ClipView clipView(const RenderSettings& settings, const MeshFrame& frame);
+
+/// A clip plane as messages and reports write it: "ox,oy,oz,nx,ny,nz"; a clip box as
+/// "x0,y0,z0,x1,y1,z1".
+std::string clipPlaneText(const ClipPlane& plane);
+std::string clipBoxText(const Bounds3f& box);
 
 /// Largest RenderSettings::supersample: 8 x 8 = 64 rays per pixel.
 inline constexpr int kMaxSupersample = 8;

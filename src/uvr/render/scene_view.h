@@ -8,6 +8,7 @@
 
 #include "uvr/accel/point_locator.h"
 #include "uvr/core/bounds.h"
+#include "uvr/render/clip.h"
 #include "uvr/tf/tf_table.h"
 
 namespace uvr {
@@ -20,6 +21,8 @@ struct MarchParams {
     /// Integrate between consecutive samples with the scalar linear from one to the next
     /// (SampleSegments) instead of point samples with opacity correction.
     bool preintegrated = true;
+    /// The clip region: each ray integrates only its part inside (none: the whole ray).
+    ClipView clip;
 };
 
 /// Everything a ray needs, as plain data for CPU and GPU.
