@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 #pragma once
-// The viewer's server inside (not installed): ViewServer::Impl, shared by view_server.cpp (the
+// The viewer's server inside: ViewServer::Impl, shared by view_server.cpp (the
 // accept loop, the render thread, start and stop), session.cpp (one WebSocket connection) and
 // http_connection.cpp (one HTTP connection).
 
