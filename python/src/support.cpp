@@ -237,10 +237,64 @@ py::object fromJson(const nlohmann::json& j) {
         j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
+namespace {
+
+/// Six numbers from (a, b, c, d, e, f) or ((a, b, c), (d, e, f)); SettingError naming the
+/// setting and the value otherwise.
+std::array<float, 6> sixNumbers(const char* setting, const py::handle& v, const char* expected) {
+    const auto refuse = [&]() -> std::array<float, 6> {
+        throw SettingError(setting, py::str(py::repr(v)).cast<std::string>(), expected);
+    };
+    std::vector<float> out;
+    try {
+        for (const py::handle& item : py::iter(v)) {
+            if (py::isinstance<py::str>(item)) return refuse();
+            if (py::hasattr(item, "__float__")) {
+                out.push_back(item.cast<float>());
+                continue;
+            }
+            for (const py::handle& x : py::iter(item)) out.push_back(x.cast<float>());
+        }
+    } catch (const py::error_already_set&) {
+        return refuse();
+    } catch (const py::cast_error&) {
+        return refuse();
+    }
+    if (out.size() != 6) return refuse();
+    std::array<float, 6> a{};
+    std::copy(out.begin(), out.end(), a.begin());
+    return a;
+}
+
+}  // namespace
+
 RenderSettings settingsOf(const py::dict& settings) {
     RenderSettings s;
-    for (const auto& [k, v] : settings)
-        applySetting(s, py::str(k).cast<std::string>(), settingValue(v));
+    for (const auto& [k, v] : settings) {
+        const std::string key = py::str(k).cast<std::string>();
+        // The clip region (not scalar settings): planes as (origin, normal), a box as (lo, hi).
+        if (key == "clip_planes") {
+            if (py::isinstance<py::str>(v) || !py::hasattr(v, "__iter__"))
+                throw SettingError("clip_planes", py::str(py::repr(v)).cast<std::string>(),
+                                   "expected a list of planes, each (origin, normal)");
+            for (const py::handle& plane : py::iter(v)) {
+                const auto a = sixNumbers("clip_planes", plane,
+                                          "expected (origin, normal): six numbers, "
+                                          "((ox, oy, oz), (nx, ny, nz))");
+                s.clipPlanes.push_back({Vec3f(a[0], a[1], a[2]), Vec3f(a[3], a[4], a[5])});
+            }
+            continue;
+        }
+        if (key == "clip_box") {
+            const auto a = sixNumbers("clip_box", v,
+                                      "expected (lo, hi): six numbers, ((x0, y0, z0), (x1, y1, "
+                                      "z1))");
+            s.clipBox = Bounds3f{Vec3f(a[0], a[1], a[2]), Vec3f(a[3], a[4], a[5])};
+            continue;
+        }
+        applySetting(s, key, settingValue(v));
+    }
+    checkClip(s);
     return s;
 }
 

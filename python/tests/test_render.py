@@ -30,6 +30,10 @@ def python_frame(renderer, **kw):
     ("fire_ug.vtu", ["--opacity", "step:0.5:0.8", "--background", "1,1,1", "--quality", "0.999"],
      dict(opacity="step:0.5:0.8", background=(1, 1, 1), quality=0.999)),
     ("tetraMesh.vtk", ["--opacity-law", "transmittance"], dict(opacity_law="transmittance")),
+    ("bluntfin_tets.vtk", ["--clip-plane", "3,0,0,-1,0,0", "--clip-plane", "0,4,0,0,-1,0",
+                           "--clip-box", "-8,0,0,14,8,3", "--method", "exact"],
+     dict(clip_planes=[((3, 0, 0), (-1, 0, 0)), (0, 4, 0, 0, -1, 0)],
+          clip_box=((-8, 0, 0), (14, 8, 3)), method="exact")),
 ], ids=lambda c: c[0])
 def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     name, flags, kwargs = case
@@ -218,6 +222,19 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
     if not uvr.cuda_available():
         with pytest.raises(uvr.UnsupportedError, match="no CUDA device"):
             uvr.Renderer(data_dir / "tetraMesh.vtk", device="cuda")
+    # Clipping (issue 32): planes as (origin, normal), a box as (lo, hi).
+    with pytest.raises(uvr.ArgumentError, match=r"^clip_planes=\(1, 2, 3\): expected \(origin"):
+        r.render(clip_planes=[(1, 2, 3)])
+    with pytest.raises(uvr.ArgumentError, match=r"^clip_planes='x': expected a list of planes"):
+        r.render(clip_planes="x")
+    with pytest.raises(uvr.ArgumentError, match=r"^clip_planes=0,0,0,0,0,0: expected a finite"):
+        r.render(clip_planes=[((0, 0, 0), (0, 0, 0))])
+    with pytest.raises(uvr.ArgumentError, match=r"^clip_planes=7 planes: expected at most 6"):
+        r.render(clip_planes=[(0, 0, 0, 1, 0, 0)] * 7)
+    with pytest.raises(uvr.ArgumentError, match=r"^clip_box=1,0,0,0,1,1: expected finite"):
+        r.render(clip_box=((1, 0, 0), (0, 1, 1)))
+    with pytest.raises(uvr.ArgumentError, match=r"^clip_box=.*: expected \(lo, hi\)"):
+        r.render(clip_box=(0, 0, 0))
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0
 

@@ -94,9 +94,13 @@ void validateSettings(const RenderSettings& s) {
     if (s.tf.colors.empty() || s.tf.opacities.empty())
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
+    checkClip(s);
+}
+
+void checkClip(const RenderSettings& s) {
     if (s.clipPlanes.size() > std::size_t(kMaxClipPlanes))
         throw SettingError("clip_planes", std::to_string(s.clipPlanes.size()) + " planes",
-                           "at most " + std::to_string(kMaxClipPlanes));
+                           "expected at most " + std::to_string(kMaxClipPlanes));
     for (const ClipPlane& p : s.clipPlanes)
         if (!isFinite(p.origin) || !isFinite(p.normal) || !(length(p.normal) > 0.f))
             throw SettingError("clip_planes", clipPlaneText(p),

@@ -88,6 +88,11 @@ const char* samplingName(bool preintegrated);
 /// integrators; each normal of unit length).
 ClipView clipView(const RenderSettings& settings, const MeshFrame& frame);
 
+/// Throws SettingError (clip_planes, clip_box) for more than kMaxClipPlanes planes, a plane
+/// without a finite origin or a finite non-zero normal, or a box not finite with lo <= hi.
+/// (validateSettings calls it.)
+void checkClip(const RenderSettings& settings);
+
 /// A clip plane as messages and reports write it: "ox,oy,oz,nx,ny,nz"; a clip box as
 /// "x0,y0,z0,x1,y1,z1".
 std::string clipPlaneText(const ClipPlane& plane);
