@@ -473,6 +473,13 @@ TEST(Cli, ClipPlanesAndBoxCutTheVolumeAndAreReported) {
         sumWhole += whole.pixels[i].w, sumPart += part.pixels[i].w;
     EXPECT_LT(sumPart, 0.8 * sumWhole);
     EXPECT_GT(sumPart, 0.05 * sumWhole);
+    // Before the mesh file too: each --clip-plane takes one value.
+    const CliRun before = uvr("-q render --clip-plane 3,0,0,1,0,0 --clip-plane 0,4,0,0,-1,0 " +
+                                  testing::sharedData("bluntfin_tets.vtk") +
+                                  " --size 48x32 --method exact --azimuth 30 --elevation 20 "
+                                  "-o before.png",
+                              dir);
+    ASSERT_EQ(before.code, 0) << before.err;
     ASSERT_EQ(uvr(fin + "-o boxed.png --clip-box -100,-100,-100,100,100,100", dir).code, 0);
     const ImageComparison same = compareImages(toRgb8(whole), toRgb8(readPng(dir + "/boxed.png")));
     EXPECT_GE(same.ssim, 0.9999);

@@ -86,7 +86,7 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
                    "at the plane; repeat for up to " +
                        std::to_string(kMaxClipPlanes) + " planes")
         ->type_name("OX,OY,OZ,NX,NY,NZ")
-        ->expected(1)  // one value per occurrence: the mesh file may follow
+        ->allow_extra_args(false)  // one value per occurrence: the mesh file may follow
         ->take_all();
     app.add_option("--clip-box", clipBox,
                    "Clip the volume to the box x0,y0,z0,x1,y1,z1 (file coordinates): only its "
