@@ -48,7 +48,7 @@ function send(message) {
 
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
-                    "opacity_unit", "opacity_law", "step"];
+                    "opacity_unit", "opacity_law", "step", "clip_planes"];
 
 /// Sends a `set` changing `changes` (state keys with full values, plus `preset` or
 /// `colormap_json`), applies the state keys locally and returns its seq.
@@ -455,6 +455,7 @@ function updateControls() {
     $("quality-value").textContent = fmt(s.quality, 4);
     if (s.opacity_law) $("opacity-law").value = s.opacity_law;
     $("heatmap").checked = !!s.heatmap;
+    fillClip(s.clip_planes || []);
     fillTime(s.step || 0);
     fillSizes(s.size);
     // Transfer function.
@@ -517,6 +518,59 @@ $("quality").addEventListener("change", (e) => {
     sendSet({quality: qualityFromSlider(Number(e.target.value))});
 });
 $("heatmap").addEventListener("change", (e) => sendSet({heatmap: e.target.checked}));
+
+// ---- Clipping: one plane across an axis (the state holds up to six, from the command line too)
+
+/// The mesh's bounds from `info` ([[x0, y0, z0], [x1, y1, z1]]), or the unit box.
+function meshBounds() {
+    const b = session.info && session.info.bounds;
+    return b && b.length === 2 ? b : [[0, 0, 0], [1, 1, 1]];
+}
+
+/// The clip plane the controls describe: through the slider's fraction of the bounds along the
+/// axis, keeping the side above it (below it with flip); none when the axis is off.
+function clipPlanesFromControls() {
+    const axis = $("clip-axis").value;
+    if (axis === "") return [];
+    const a = Number(axis), [lo, hi] = meshBounds();
+    const origin = [0, 0, 0], normal = [0, 0, 0];
+    origin[a] = lo[a] + Number($("clip-pos").value) * (hi[a] - lo[a]);
+    normal[a] = $("clip-flip").checked ? -1 : 1;
+    return [[...origin, ...normal]];
+}
+
+/// Shows the state's clip planes: one across an axis in the controls, anything else as "custom".
+function fillClip(planes) {
+    const axis = $("clip-axis");
+    [...axis.options].filter((o) => o.value === "custom").forEach((o) => o.remove());
+    let value = "";
+    if (planes.length === 1) {
+        const p = planes[0];
+        const a = [0, 1, 2].find((i) => p[3 + i] !== 0 && p[3 + (i + 1) % 3] === 0 &&
+                                        p[3 + (i + 2) % 3] === 0);
+        if (a !== undefined) {
+            value = String(a);
+            const [lo, hi] = meshBounds();
+            if (document.activeElement !== $("clip-pos") && hi[a] > lo[a])
+                $("clip-pos").value = String((p[a] - lo[a]) / (hi[a] - lo[a]));
+            $("clip-flip").checked = p[3 + a] < 0;
+        }
+    }
+    if (planes.length > 0 && value === "") {
+        axis.add(new Option(`custom (${planes.length})`, "custom"));
+        value = "custom";
+    }
+    axis.value = value;
+    $("clip-pos").disabled = $("clip-flip").disabled = value === "" || value === "custom";
+}
+
+$("clip-axis").addEventListener("change", () => {
+    if ($("clip-axis").value !== "custom") sendSet({clip_planes: clipPlanesFromControls()});
+});
+$("clip-pos").addEventListener("input", () =>
+    sendSet({clip_planes: clipPlanesFromControls()}, true));
+$("clip-pos").addEventListener("change", () => sendSet({clip_planes: clipPlanesFromControls()}));
+$("clip-flip").addEventListener("change", () => sendSet({clip_planes: clipPlanesFromControls()}));
 
 // ---- Time steps ------------------------------------------------------------------------------
 

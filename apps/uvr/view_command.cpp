@@ -29,7 +29,7 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
     for (const SettingDef& def : settingsVocabulary())
         if (f.vocabulary.given(def.name) && !server::isViewerSetting(def.name))
             add(cliFlag(def).c_str(), f.vocabulary.text(def.name));
-    for (const std::string& plane : f.clipPlanes) add("--clip-plane", plane);
+    // The clip planes are the page's (ViewState::clipPlanes), the box the command line's.
     if (!f.clipBox.empty()) add("--clip-box", f.clipBox);
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
@@ -124,6 +124,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
             resetCamera(report.bounds, float(settings.width) / float(settings.height)));
         s.tf = settings.tf;
         s.range = settings.range.value_or(finiteRange(field.values));
+        s.clipPlanes = settings.clipPlanes;
         s.field = flags->field;
         // The page's settings start as the command line set them (or their defaults).
         for (const char* name : server::kViewerSettings)

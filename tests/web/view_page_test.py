@@ -286,6 +286,12 @@ def difference(a, b):
     return total / (len(a) * 3 / 4)
 
 
+def changed_pixels(a, b, by=8):
+    """Pixels of two pixel lists whose red, green or blue byte differs by more than `by`."""
+    return sum(1 for i in range(0, len(a), 4)
+               if max(abs(a[i + c] - b[i + c]) for c in range(3)) > by)
+
+
 def mean_rgb(pixels):
     """Mean colour of the pixels that are not (nearly) black."""
     sums, n = [0, 0, 0], 0
@@ -543,6 +549,36 @@ def png_size(path):
     return struct.unpack(">II", head[16:24])
 
 
+def clip(page):
+    step("a clip plane from the page's controls cuts the volume")
+    errors0 = page.hook("errorCount")
+    before = page.pixels()
+    bounds = page.hook("info")["bounds"]
+    page.js("const a = document.getElementById('clip-axis'); a.value = '0';"
+            " a.dispatchEvent(new Event('change'));")
+    page.js("const p = document.getElementById('clip-pos'); p.value = '0.6';"
+            " p.dispatchEvent(new Event('change'));")
+    page.wait_settled(page.hook("lastSeq"), 30, "the frame of the clipped volume")
+    planes = page.hook("state")["clip_planes"]
+    x = bounds[0][0] + 0.6 * (bounds[1][0] - bounds[0][0])
+    check(len(planes) == 1 and abs(planes[0][0] - x) < 1e-3 * abs(bounds[1][0] - bounds[0][0])
+          and planes[0][3:] == [1, 0, 0], f"the state's clip planes are {planes}, not x >= {x}")
+    cut = page.pixels()
+    page.screenshot("clip-plane")
+    check(changed_pixels(before, cut) > 40, "the clipped image looks like the whole volume "
+                                            f"({changed_pixels(before, cut)} of 4096 pixels "
+                                            "changed)")
+    check(not page.js("return document.getElementById('clip-pos').disabled"),
+          "the clip slider is disabled with an axis chosen")
+    # Flip keeps the other side: another image again.
+    page.js("const f = document.getElementById('clip-flip'); f.checked = true;"
+            " f.dispatchEvent(new Event('change'));")
+    page.wait_settled(page.hook("lastSeq"), 30, "the frame of the flipped clip")
+    check(page.hook("state")["clip_planes"][0][3:] == [-1, 0, 0], "flip kept the same side")
+    check(changed_pixels(cut, page.pixels()) > 40, "the flipped clip shows the same image")
+    check(page.hook("errorCount") == errors0, f"clipping gave an error: {page.hook('lastError')}")
+
+
 def save_and_reproduce(page, uvr, downloads, tmp):
     step("Save PNG, Export TF and camera, and the exported command")
     from selenium.webdriver.common.by import By
@@ -576,6 +612,7 @@ def save_and_reproduce(page, uvr, downloads, tmp):
     check(tf_file in args and camera_file in args, "the command does not name the exported files")
     check("--opacity-law" in args and args[args.index("--opacity-law") + 1] == "transmittance",
           f"the command does not carry the opacity law: {command}")
+    check("--clip-plane" in args, f"the command does not carry the page's clip plane: {command}")
     # Run it here: our uvr, the output in tmp, on the CPU like the server.
     args[0] = uvr
     out = os.path.join(tmp, "reproduced.png")
@@ -749,6 +786,7 @@ def main():
             load_colormap(page, tmp)
             bad_messages(page)
             flood(page)
+            clip(page)
             save_and_reproduce(page, args.uvr, downloads, tmp)
             page.screenshot("final")
             wrong_token_page(page)

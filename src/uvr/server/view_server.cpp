@@ -224,6 +224,14 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
         args.push_back(cliFlag(def));
         args.push_back(value.is_string() ? value.get<std::string>() : fmtExact(value.get<float>()));
     }
+    // The page's clip planes (the command line's clip box comes with its flags).
+    for (const ClipPlane& p : s.clipPlanes) {
+        std::string plane;
+        for (const float x :
+             {p.origin.x, p.origin.y, p.origin.z, p.normal.x, p.normal.y, p.normal.z})
+            plane += (plane.empty() ? "" : ",") + fmtExact(x);
+        args.insert(args.end(), {"--clip-plane", plane});
+    }
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
     args.insert(args.end(), {"-o", "uvr-view.png"});
     std::string command;

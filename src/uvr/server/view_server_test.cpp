@@ -393,6 +393,12 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
                                "--step 0.01 -o uvr-view.png"));
     // The adaptive method exports its quality; so does auto with a quality of its own (which
     // makes its frames adaptive).
+    // The page's clip planes export as flags.
+    c.send({{"type", "set"}, {"clip_planes", {{0.25, 0, 0, 1, 0, 0}}}});
+    c.send({{"type", "export"}});
+    EXPECT_THAT(c.until("export")["command"].get<std::string>(),
+                HasSubstr("--clip-plane 0.25,0,0,1,0,0 --step 0.01"));
+    c.send({{"type", "set"}, {"clip_planes", Json::array()}});
     c.send({{"type", "set"}, {"method", "adaptive"}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),

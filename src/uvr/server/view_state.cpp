@@ -115,6 +115,36 @@ std::vector<std::vector<float>> rows(const std::string& key, const Json& v, std:
     return out;
 }
 
+/// Clip planes [[ox, oy, oz, nx, ny, nz], ...], checked as the library checks them.
+std::vector<ClipPlane> clipPlanes(const std::string& key, const Json& v) {
+    const std::string shape = "at most " + std::to_string(kMaxClipPlanes) +
+                              " planes [ox, oy, oz, nx, ny, nz] (a point and the kept side's "
+                              "normal)";
+    if (!v.is_array() || v.size() > std::size_t(kMaxClipPlanes)) bad(key, shape, v);
+    RenderSettings s;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string where = key + "[" + std::to_string(i) + "]";
+        if (!v[i].is_array() || v[i].size() != 6) bad(where, "[ox, oy, oz, nx, ny, nz]", v[i]);
+        float x[6];
+        for (int c = 0; c < 6; ++c)
+            x[c] = finiteFloat(where + "[" + std::to_string(c) + "]", v[i][c]);
+        s.clipPlanes.push_back({Vec3f(x[0], x[1], x[2]), Vec3f(x[3], x[4], x[5])});
+    }
+    try {
+        checkClip(s);
+    } catch (const SettingError& e) {
+        throwError(ErrorKind::Argument, "", e.spelledAs("\"" + key + "\":", " "));
+    }
+    return s.clipPlanes;
+}
+
+Json clipPlanesJson(const std::vector<ClipPlane>& planes) {
+    Json out = Json::array();
+    for (const ClipPlane& p : planes)
+        out.push_back({p.origin.x, p.origin.y, p.origin.z, p.normal.x, p.normal.y, p.normal.z});
+    return out;
+}
+
 void applyCamera(Camera& cam, const Json& v) {
     for (const auto& [k, x] : object("camera", v).items()) {
         const std::string key = "camera." + k;
@@ -201,6 +231,7 @@ Json toJson(const ViewState& s) {
               {"range", {s.range.first, s.range.second}},
               {"field", s.field},
               {"heatmap", s.heatmap},
+              {"clip_planes", clipPlanesJson(s.clipPlanes)},
               {"size", {s.width, s.height}},
               {"step", s.step}};
     // The viewer's settings of the vocabulary as set (`uvr view` starts every tab with all of
@@ -293,6 +324,8 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.settings[k] = v;
         } else if (k == "heatmap") {
             next.heatmap = boolean(k, v);
+        } else if (k == "clip_planes") {
+            next.clipPlanes = clipPlanes(k, v);
         } else if (k == "size") {
             if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() ||
                 !v[1].is_number_integer())
@@ -316,7 +349,8 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.step = v.get<std::size_t>();
         } else {
             std::string keys =
-                "camera, tf, range, field, heatmap, size, step, preset, colormap_json";
+                "camera, tf, range, field, heatmap, clip_planes, size, step, preset, "
+                "colormap_json";
             for (const char* name : kViewerSettings) keys += std::string(", ") + name;
             bad("set", "state keys (" + keys + "), not \"" + printableShort(k, 40) + "\"", message);
         }
@@ -338,6 +372,7 @@ RenderSettings frameSettings(const ViewState& state, const RenderSettings& base,
     s.camera = state.camera;
     s.tf = state.tf;
     s.range = state.range;
+    s.clipPlanes = state.clipPlanes;
     for (const auto& [name, value] : state.settings.items()) applySetting(s, name, value);
     scale = std::max(scale, 1);
     s.width = std::max(1, state.width / scale);

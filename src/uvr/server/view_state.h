@@ -6,6 +6,7 @@
 #include <array>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "uvr/render/camera.h"
 #include "uvr/render/frame_setup.h"
@@ -41,6 +42,8 @@ struct ViewState {
     /// ScalarOpacityUnitDistance (file units) when the command line gives none.
     nlohmann::json settings = nlohmann::json::object();
     bool heatmap = false;  ///< show samples per pixel instead of the volume
+    /// Clip planes (file coordinates; RenderSettings::clipPlanes), up to kMaxClipPlanes.
+    std::vector<ClipPlane> clipPlanes;
     int width = 1024, height = 1024;
     std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
 };
@@ -58,8 +61,8 @@ struct SetResult {
 };
 
 /// Applies the state keys of a `set` message (camera, tf, range, field, method, quality,
-/// heatmap, size, opacity_unit, opacity_law, step (below stepCount), preset, colormap_json and
-/// colormap_name) to `state`, all or
+/// heatmap, clip_planes, size, opacity_unit, opacity_law, step (below stepCount), preset,
+/// colormap_json and colormap_name) to `state`, all or
 /// nothing: on any bad value it throws Error(Argument) (Error(Parse) for a malformed uploaded
 /// colour map) naming the key and what was expected, and leaves `state` unchanged. Unknown keys
 /// are refused too (a misspelt key must not pass silently); `type`, `seq` and `interactive`

@@ -60,6 +60,7 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
                       {"method", "exact"},
                       {"quality", 0.95},
                       {"heatmap", true},
+                      {"clip_planes", {{0.5, 0, 0, -2, 0, 0}}},
                       {"size", {320, 200}},
                       {"opacity_unit", 0.25},
                       {"opacity_law", "transmittance"}};
@@ -76,6 +77,8 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     EXPECT_EQ(s.settings["method"], "exact");
     EXPECT_EQ(s.settings["opacity_law"], "transmittance");
     EXPECT_TRUE(s.heatmap);
+    ASSERT_EQ(s.clipPlanes.size(), 1u);
+    EXPECT_EQ(s.clipPlanes[0].normal, Vec3f(-2.f, 0.f, 0.f));
     EXPECT_EQ(s.width, 320);
     EXPECT_EQ(s.height, 200);
     // The state's JSON is itself a valid set message that changes nothing.
@@ -95,6 +98,12 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     EXPECT_EQ(f.range->second, 4.f);
     EXPECT_EQ(f.opacityUnit, 0.25f);
     EXPECT_EQ(f.opacityLaw, OpacityLaw::Transmittance);
+    ASSERT_EQ(f.clipPlanes.size(), 1u);
+    EXPECT_EQ(f.clipPlanes[0].origin, Vec3f(0.5f, 0.f, 0.f));
+    // No clip planes: an empty list.
+    applySet(s, {{"clip_planes", Json::array()}});
+    EXPECT_TRUE(s.clipPlanes.empty());
+    EXPECT_EQ(toJson(s)["clip_planes"], Json::array());
 }
 
 TEST(ViewState, PresetsAndUploadedColourMapsReplaceColoursAndAskForTheStateBack) {
@@ -151,6 +160,17 @@ TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
                 HasSubstr("reaching above 0"));
     EXPECT_THAT(refusal({{"camrea", {}}}), HasSubstr("camrea"));
     EXPECT_THAT(refusal(Json::array({1, 2})), HasSubstr("object"));
+    EXPECT_THAT(refusal({{"clip_planes", {{0, 0, 0, 1, 0}}}}), HasSubstr("clip_planes[0]"));
+    EXPECT_THAT(refusal({{"clip_planes", {{0, 0, 0, 0, 0, 0}}}}),
+                HasSubstr("\"clip_planes\": 0,0,0,0,0,0: expected a finite origin"));
+    EXPECT_THAT(
+        refusal({{"clip_planes",
+                  Json::array({Json::array({0, 0, 0, 1, 0, 0}), Json::array({0, 0, 0, 1, 0, 0}),
+                               Json::array({0, 0, 0, 1, 0, 0}), Json::array({0, 0, 0, 1, 0, 0}),
+                               Json::array({0, 0, 0, 1, 0, 0}), Json::array({0, 0, 0, 1, 0, 0}),
+                               Json::array({0, 0, 0, 1, 0, 0})})}}),
+        HasSubstr("at most 6 planes"));
+    EXPECT_THAT(refusal({{"clip_planes", "x"}}), HasSubstr("clip_planes"));
     // A good key before a bad one changes nothing either.
     EXPECT_THAT(refusal({{"heatmap", true}, {"quality", 7}}), HasSubstr("quality"));
 }
