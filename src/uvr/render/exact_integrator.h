@@ -285,14 +285,15 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
-    bool past = tet != kNoTet && t >= tStop;  // beyond the clip region's exit
+    bool past = clipped && tet != kNoTet && t >= tStop;  // beyond the clip region's exit
     // A point field is continuous across a shared face: the value where the ray leaves one
     // tetrahedron is where it enters the next (when it continues through that face).
     bool haveEntry = false;
     float sEntry = 0.f;
     for (std::uint32_t step = 0; tet != kNoTet && !opaque && !past && step < kExactMaxSteps;
          ++step) {
-        const double tEnd = span.tOut < tStop ? span.tOut : tStop;
+        // Unclipped, the cell's exit as it is (NaN for a degenerate crossing: nothing then).
+        const double tEnd = clipped && span.tOut > tStop ? tStop : span.tOut;
         bool exitValue = false;
         if (tEnd > t) {
             ++counters.samples;  // one segment per cell crossed
@@ -308,7 +309,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
             }
             opaque = acc.w >= segment::kOpacityEnd;
-            past = tEnd >= tStop;
+            past = clipped && tEnd >= tStop;
             if (opaque || past) continue;
             t = tEnd;
             sEntry = s1;
@@ -336,7 +337,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         if (tet != kNoTet) {
             if (continuous) span = exact::clipAny<kNative>(loc.mesh, tet, ray, true, t + eps);
             if (span.tIn > t) t = span.tIn;  // empty space before it
-            past = t >= tStop;
+            past = clipped && t >= tStop;
         }
     }
     return acc;
