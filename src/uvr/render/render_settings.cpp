@@ -61,18 +61,23 @@ ClipView clipView(const RenderSettings& s, const MeshFrame& frame) {
     return v;
 }
 
-std::string clipPlaneText(const ClipPlane& p) {
+namespace {
+
+/// Two points as "x0,y0,z0,x1,y1,z1".
+std::string sixNumbersText(Vec3f a, Vec3f b) {
     std::string out;
-    for (float x : {p.origin.x, p.origin.y, p.origin.z, p.normal.x, p.normal.y, p.normal.z})
-        out += (out.empty() ? "" : ",") + formatG(x, 6);
+    for (float x : {a.x, a.y, a.z, b.x, b.y, b.z}) out += (out.empty() ? "" : ",") + formatG(x, 6);
     return out;
 }
 
+}  // namespace
+
+std::string clipPlaneText(const ClipPlane& p) {
+    return sixNumbersText(p.origin, p.normal);
+}
+
 std::string clipBoxText(const Bounds3f& b) {
-    std::string out;
-    for (float x : {b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z})
-        out += (out.empty() ? "" : ",") + formatG(x, 6);
-    return out;
+    return sixNumbersText(b.lo, b.hi);
 }
 
 void validateSettings(const RenderSettings& s) {
