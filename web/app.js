@@ -48,7 +48,12 @@ function send(message) {
 
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
-                    "opacity_unit", "opacity_law", "step", "clip_planes"];
+                    "opacity_unit", "opacity_law", "step", "clip_planes", "shade", "ambient",
+                    "diffuse", "specular", "specular_power"];
+
+// Gradient shading's coefficients: the slider's id and the setting it sets.
+const kLightSliders = [["ambient", "ambient"], ["diffuse", "diffuse"], ["specular", "specular"],
+                       ["specular-power", "specular_power"]];
 
 /// Sends a `set` changing `changes` (state keys with full values, plus `preset` or
 /// `colormap_json`), applies the state keys locally and returns its seq.
@@ -417,6 +422,15 @@ function fillSelectors(info) {
         $("quality").max = sliderFromQuality(quality.max);
     }
     if (quality.doc) $("quality").closest("label").title = quality.doc;
+    // The shading controls' ranges and docs.
+    const shade = setting("shade");
+    if (shade.doc) $("shade").closest("label").title = shade.doc;
+    for (const [id, name] of kLightSliders) {
+        const d = setting(name);
+        if (Number.isFinite(d.min)) $(id).min = d.min;
+        if (Number.isFinite(d.max)) $(id).max = d.max;
+        if (d.doc) $(id).closest("label").title = d.doc;
+    }
     const preset = $("preset");
     preset.replaceChildren(...(info.presets || []).map((p) => new Option(p, p)));
     const limits = info.limits || {};
@@ -455,6 +469,13 @@ function updateControls() {
     $("quality-value").textContent = fmt(s.quality, 4);
     if (s.opacity_law) $("opacity-law").value = s.opacity_law;
     $("heatmap").checked = !!s.heatmap;
+    $("shade").checked = !!s.shade;
+    for (const [id, name] of kLightSliders) {
+        $(id).disabled = !s.shade;  // read only with shade
+        if (!Number.isFinite(s[name])) continue;
+        if (document.activeElement !== $(id)) $(id).value = s[name];
+        $(`${id}-value`).textContent = fmt(s[name], 3);
+    }
     fillClip(s.clip_planes || []);
     fillTime(s.step || 0);
     fillSizes(s.size);
@@ -518,6 +539,30 @@ $("quality").addEventListener("change", (e) => {
     sendSet({quality: qualityFromSlider(Number(e.target.value))});
 });
 $("heatmap").addEventListener("change", (e) => sendSet({heatmap: e.target.checked}));
+
+// ---- Shading: the checkbox and the coefficients' sliders (a frame per animation frame while
+// dragged, a full one on release)
+
+$("shade").addEventListener("change", (e) => sendSet({shade: e.target.checked}));
+for (const [id, name] of kLightSliders) {
+    let pending = 0;
+    $(id).addEventListener("input", (e) => {
+        const v = Number(e.target.value);
+        $(`${id}-value`).textContent = fmt(v, 3);
+        session.state[name] = v;
+        if (!pending) {
+            pending = requestAnimationFrame(() => {
+                pending = 0;
+                sendSet({[name]: session.state[name]}, true);
+            });
+        }
+    });
+    $(id).addEventListener("change", (e) => {
+        if (pending) cancelAnimationFrame(pending);
+        pending = 0;
+        sendSet({[name]: Number(e.target.value)});
+    });
+}
 
 // ---- Clipping: one plane across an axis (the state holds up to six, from the command line too)
 

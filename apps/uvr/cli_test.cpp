@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -492,6 +493,48 @@ TEST(Cli, ClipPlanesAndBoxCutTheVolumeAndAreReported) {
          "--clip-plane 0,0,0,1,0,0 --clip-plane 0,0,0,1,0,0 --clip-plane 0,0,0,1,0,0 "
          "--clip-plane 0,0,0,1,0,0",
          "at most 6"},
+    };
+    for (const auto& [flags, says] : bad)
+        expectOneLineError(uvr(fin + "-o x.png " + flags, dir), {says}, flags);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
+}
+
+TEST(Cli, ShadeLightsTheVolumeAndIsReported) {
+    // Issue 32: --shade with ParaView's coefficients; the stats report them; a coefficient
+    // without --shade, or out of range, is refused in one line.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string fin = "-q render " + testing::sharedData("bluntfin_tets.vtk") +
+                            " --size 48x32 --method exact --azimuth 30 --elevation 20 ";
+    ASSERT_EQ(uvr(fin + "-o flat.png --stats flat.json", dir).code, 0);
+    const CliRun lit = uvr(fin +
+                               "-o lit.png --shade --ambient 0.2 --diffuse 0.7 --specular 0.1 "
+                               "--specular-power 20 --stats lit.json",
+                           dir);
+    ASSERT_EQ(lit.code, 0) << lit.err;
+    std::ifstream flatIn(dir + "/flat.json"), litIn(dir + "/lit.json");
+    const auto flat = nlohmann::json::parse(flatIn), j = nlohmann::json::parse(litIn);
+    EXPECT_EQ(flat["shade"], false);
+    EXPECT_FALSE(flat.contains("ambient"));
+    EXPECT_EQ(j["shade"], true);
+    EXPECT_FLOAT_EQ(j["ambient"].get<float>(), 0.2f);
+    EXPECT_FLOAT_EQ(j["diffuse"].get<float>(), 0.7f);
+    EXPECT_FLOAT_EQ(j["specular"].get<float>(), 0.1f);
+    EXPECT_FLOAT_EQ(j["specular_power"].get<float>(), 20.f);
+    // The light only dims or brightens the colours: the same opacity, other colours.
+    const Image a = readPng(dir + "/flat.png"), b = readPng(dir + "/lit.png");
+    double alphaDiff = 0.0, colourDiff = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        alphaDiff = std::max(alphaDiff, double(std::fabs(a.pixels[i].w - b.pixels[i].w)));
+        colourDiff += std::fabs(a.pixels[i].x - b.pixels[i].x);
+    }
+    EXPECT_LE(alphaDiff, 1.5 / 255.0);
+    EXPECT_GT(colourDiff / double(a.pixels.size()), 0.005);
+    const std::pair<const char*, const char*> bad[] = {
+        {"--ambient 0.3", "--ambient 0.3: read only with --shade on"},
+        {"--specular-power 8", "--specular-power 8: read only with --shade on"},
+        {"--shade --diffuse 1.5", "--diffuse 1.5: expected a number in [0, 1]"},
+        {"--shade --specular-power 200", "--specular-power 200: expected a number in [0, 128]"},
     };
     for (const auto& [flags, says] : bad)
         expectOneLineError(uvr(fin + "-o x.png " + flags, dir), {says}, flags);

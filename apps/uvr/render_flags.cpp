@@ -185,6 +185,10 @@ RenderSettings RenderFlags::baseSettings() const {
     if (heatmapMax && heatmapFile.empty())
         throwError(ErrorKind::Argument, "",
                    "--heatmap-max sets the heat map's scale: it needs --heatmap FILE.png");
+    std::vector<std::string> given;
+    for (const SettingDef& def : settingsVocabulary())
+        if (vocabulary.given(def.name)) given.emplace_back(def.name);
+    refuseUnreadSettings(s, given);
     if (s.jitter && s.supersample < 2)
         throwError(ErrorKind::Argument, "",
                    "--jitter moves the rays of --supersample N inside the pixel: it needs "

@@ -270,8 +270,10 @@ std::array<float, 6> sixNumbers(const char* setting, const py::handle& v, const 
 
 RenderSettings settingsOf(const py::dict& settings) {
     RenderSettings s;
+    std::vector<std::string> given;
     for (const auto& [k, v] : settings) {
         const std::string key = py::str(k).cast<std::string>();
+        given.push_back(key);
         // The clip region (not scalar settings): planes as (origin, normal), a box as (lo, hi).
         if (key == "clip_planes") {
             if (py::isinstance<py::str>(v) || !py::hasattr(v, "__iter__"))
@@ -294,6 +296,7 @@ RenderSettings settingsOf(const py::dict& settings) {
         }
         applySetting(s, key, settingValue(v));
     }
+    refuseUnreadSettings(s, given);  // e.g. ambient without shade
     checkClip(s);
     return s;
 }

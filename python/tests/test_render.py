@@ -34,6 +34,8 @@ def python_frame(renderer, **kw):
                            "--clip-box", "-8,0,0,14,8,3", "--method", "exact"],
      dict(clip_planes=[((3, 0, 0), (-1, 0, 0)), (0, 4, 0, 0, -1, 0)],
           clip_box=((-8, 0, 0), (14, 8, 3)), method="exact")),
+    ("post_tets.vtk", ["--shade", "--ambient", "0.2", "--specular", "0.3", "--specular-power", "12"],
+     dict(shade=True, ambient=0.2, specular=0.3, specular_power=12)),
 ], ids=lambda c: c[0])
 def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     name, flags, kwargs = case
@@ -235,6 +237,11 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(clip_box=((1, 0, 0), (0, 1, 1)))
     with pytest.raises(uvr.ArgumentError, match=r"^clip_box=.*: expected \(lo, hi\)"):
         r.render(clip_box=(0, 0, 0))
+    # Gradient shading (issue 32): a coefficient needs shade=True.
+    with pytest.raises(uvr.ArgumentError, match=r"^ambient=0.3: read only with shade on"):
+        r.render(ambient=0.3)
+    with pytest.raises(uvr.ArgumentError, match=r"^diffuse=2: expected a number in \[0, 1\]"):
+        r.render(shade=True, diffuse=2)
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0
 

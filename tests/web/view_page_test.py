@@ -549,6 +549,14 @@ def png_size(path):
     return struct.unpack(">II", head[16:24])
 
 
+def settled(page, frames0, what):
+    """Waits for the full frame after a change made when frameCount was frames0. Frames are
+    counted since the change, not matched by seq: the flood's seqs are above the page's own."""
+    page.wait(f"v.frameCount > {frames0}", 60, what)
+    page.quiet(0.6, 60)
+    page.wait("v.lastFrame.full && v.framesDecoded === v.frameCount", 60, what)
+
+
 def clip(page):
     step("a clip plane from the page's controls cuts the volume")
     errors0 = page.hook("errorCount")
@@ -556,11 +564,7 @@ def clip(page):
     before = page.pixels()
 
     def settled(frames0, what):
-        # Frames are counted since the change, not matched by seq: the flood's seqs are above
-        # the page's own.
-        page.wait(f"v.frameCount > {frames0}", 60, what)
-        page.quiet(0.6, 60)
-        page.wait("v.lastFrame.full && v.framesDecoded === v.frameCount", 60, what)
+        globals()["settled"](page, frames0, what)
 
     bounds = page.hook("info")["bounds"]
     frames0 = page.hook("frameCount")
@@ -588,6 +592,41 @@ def clip(page):
     check(page.hook("state")["clip_planes"][0][3:] == [-1, 0, 0], "flip kept the same side")
     check(changed_pixels(cut, page.pixels()) > 40, "the flipped clip shows the same image")
     check(page.hook("errorCount") == errors0, f"clipping gave an error: {page.hook('lastError')}")
+
+
+def shade(page):
+    step("the Shade box and its sliders light the volume")
+    errors0 = page.hook("errorCount")
+    page.quiet()
+    before = page.pixels()
+    check(page.js("return document.getElementById('diffuse').disabled"),
+          "the lighting sliders are enabled with Shade off")
+    frames0 = page.hook("frameCount")
+    page.js("const b = document.getElementById('shade'); b.checked = true;"
+            " b.dispatchEvent(new Event('change'));")
+    settled(page, frames0, "the frame of the shaded volume")
+    state = page.hook("state")
+    check(state["shade"] is True, f"the state's shade is {state['shade']}")
+    lit = page.pixels()
+    check(changed_pixels(before, lit) > 40, "the shaded image looks like the unshaded one "
+                                            f"({changed_pixels(before, lit)} of 4096 pixels "
+                                            "changed)")
+    check(not page.js("return document.getElementById('diffuse').disabled"),
+          "the lighting sliders stay disabled with Shade on")
+    # Some ambient light and less diffuse: brighter where the gradient is across the view.
+    for name, value in (("ambient", "0.3"), ("diffuse", "0.6"), ("specular", "0.2")):
+        frames0 = page.hook("frameCount")
+        page.js(f"const e = document.getElementById('{name}'); e.value = '{value}';"
+                " e.dispatchEvent(new Event('change'));")
+        settled(page, frames0, f"the frame with {name} {value}")
+    state = page.hook("state")
+    check(vec_close([state["ambient"], state["diffuse"], state["specular"]], [0.3, 0.6, 0.2],
+                    1e-6),
+          f"the state's coefficients are {state['ambient']}, {state['diffuse']}, "
+          f"{state['specular']}")
+    page.screenshot("shade")
+    check(changed_pixels(lit, page.pixels()) > 40, "the coefficients changed nothing")
+    check(page.hook("errorCount") == errors0, f"shading gave an error: {page.hook('lastError')}")
 
 
 def save_and_reproduce(page, uvr, downloads, tmp):
@@ -798,6 +837,7 @@ def main():
             bad_messages(page)
             flood(page)
             clip(page)
+            shade(page)
             save_and_reproduce(page, args.uvr, downloads, tmp)
             page.screenshot("final")
             wrong_token_page(page)

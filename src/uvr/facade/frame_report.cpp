@@ -107,6 +107,14 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     if (settings.clipBox)
         j["clip_box"] = {settings.clipBox->lo.x, settings.clipBox->lo.y, settings.clipBox->lo.z,
                          settings.clipBox->hi.x, settings.clipBox->hi.y, settings.clipBox->hi.z};
+    // Gradient shading, with its coefficients when on.
+    j["shade"] = settings.lighting.on;
+    if (settings.lighting.on) {
+        j["ambient"] = settings.lighting.ambient;
+        j["diffuse"] = settings.lighting.diffuse;
+        j["specular"] = settings.lighting.specular;
+        j["specular_power"] = settings.lighting.specularPower;
+    }
     j["rays"] = result.stats.rays();
     j["mesh"] = {{"tetrahedra", prepared.tets.tetCount()},
                  {"pyramids", prepared.tets.pyramidCount},

@@ -212,6 +212,22 @@ struct TetMeshView {
         for (int i = 0; i < n; ++i) v += w[i] * values[ids[i]];
         return v;
     }
+    /// Gradient of the interpolated field in cell c at its local coordinates (as interpolate
+    /// takes them; a tetrahedron's is constant and ignores them): a native cell's through the
+    /// inverse of its Jacobian (cellGradient). Zero for cell data (constant in each cell);
+    /// non-finite for a degenerate cell.
+    template <bool kNative = true>
+    UVR_HOST_DEVICE Vec3f gradient(std::uint64_t c, const float bary[4]) const {
+        if (cellCentered) return Vec3f(0.f);
+        Vec3f x[kMaxCellCorners];
+        float v[kMaxCellCorners];
+        if (!kNative || c < tetCount) {
+            kernelGather(c, x, v);
+            return tetGradient(x[0], x[1], x[2], x[3], v[0], v[1], v[2], v[3]);
+        }
+        gather(c, x, v);
+        return cellGradient(kind(c), x, v, Vec3f(bary[0], bary[1], bary[2]));
+    }
 };
 
 /// The rendering form of a mesh: tetrahedra (positively oriented, zero-volume ones dropped) and,

@@ -299,6 +299,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (tet == kNoTet && !emptySpace)
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
+        const LightFactors light = lightAt<kNative>(scene.base, tet, bary, ray.dir);
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
         // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
@@ -327,6 +328,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 kSample - segments.kLast > 1.f) {
                 float lo = segments.kLast, hi = kSample;  // inside end first when leaving
                 float vHi = v;  // entering: the value at hi, the first position found inside
+                LightFactors lightHi = light;  // and its light
                 std::uint32_t from = in ? tet : lastInside;
                 float probeBary[4] = {bary[0], bary[1], bary[2], bary[3]};
                 while (fabsf(hi - lo) > 1.f) {
@@ -341,29 +343,33 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                             locator.search<kNative>(scene.cells, 0, q, probeBary, counters.locate);
                     const float vMid =
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
+                    const LightFactors lightMid =
+                        lightAt<kNative>(scene.base, found, probeBary, ray.dir);
                     if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;
                         vHi = vMid;
+                        lightHi = lightMid;
                     } else {
                         // Leaving: the run goes on to the mid.
-                        if (found != kNoTet) segments.add(tf, mid, k1, true, vMid, s1, unit, acc);
+                        if (found != kNoTet)
+                            segments.add(tf, mid, k1, true, vMid, s1, unit, acc, lightMid);
                         lo = mid;
                     }
                 }
                 // Entering: the run starts at the first position found inside; leaving: it ends
                 // at the first position found outside.
                 if (in && hi < kSample)
-                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc);
+                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi);
                 else if (!in)
                     segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
             }
             if (in) lastInside = tet;
-            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc);
+            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light);
         } else if (tet != kNoTet) {
             const Vec4f c = tf.sample(v);
             const float a = correctOpacity(c.w, length, unit, tf.law);
-            if (a > 0.f) compositeFrontToBack(acc, c.xyz(), a);
+            if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
         opaque = acc.w >= stopAlpha;
         marching = !opaque;

@@ -133,10 +133,13 @@ inline constexpr int kNativeMaxPieces = 16;
 /// coordinates). n follows the deviation d of the midpoint's value from the mean of the ends:
 /// a piece's deviation falls as 1 / n^2, so n = ceil(sqrt(d / tol)) with tol a quarter of a
 /// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
-/// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc.
+/// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc; lit
+/// (gradient shading), each piece by the mean of its ends' lights (the gradient through the
+/// cell's Jacobian at the Newton iterate's coordinates).
 UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
-                                           float v0, double unit, Vec4f& acc) {
+                                           float v0, double unit, const Lighting& light,
+                                           Vec4f& acc) {
     Vec3f x[kMaxCellCorners];
     float cv[kMaxCellCorners];
     const int n = mesh.gather(t, x, cv);
@@ -161,10 +164,24 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         for (int i = 0; i < n; ++i) v += w[i] * cv[i];
         return v < cvLo ? cvLo : (v > cvHi ? cvHi : v);  // NaN stays NaN
     };
+    // The light at the parametric coordinates rst of the last point valueAt took.
+    auto lightHere = [&]() {
+        return light.on ? lightFactors(light, cellGradient(k, x, cv, rst), ray.dir)
+                        : LightFactors{};
+    };
     const float vMid = valueAt(0.5 * (t0 + t1));
     const Vec3f rstMid = rst;
-    if (!(v0 == v0)) v0 = valueAt(t0);
+    LightFactors lightA;  // at the start of the piece
+    if (!(v0 == v0)) {
+        v0 = valueAt(t0);
+        lightA = lightHere();
+    } else if (light.on) {
+        (void)valueAt(t0);  // for its coordinates only
+        lightA = lightHere();
+        rst = rstMid;  // t1's Newton starts where it would unlit
+    }
     const float vEnd = valueAt(t1);
+    const LightFactors lightEnd = lightHere();
     const double tol = 0.25 * (double(tf.hi) - tf.lo) / (tf.count > 1 ? tf.count - 1 : 1);
     const double dev = fabs(double(vMid) - 0.5 * (double(v0) + vEnd));
     int pieces = 1;
@@ -173,7 +190,9 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         pieces = want < kNativeMaxPieces ? (want > 2.0 ? int(want) : 2) : kNativeMaxPieces;
     }
     if (pieces == 1) {
+        const Vec4f before = acc;
         segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
+        lightSegment(before, lightA.mean(lightEnd), acc);
         return vEnd;
     }
     rst = rstMid;  // a good start for the pieces' points in the middle; each follows the last
@@ -181,8 +200,12 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     const double h = (t1 - t0) / pieces;
     for (int i = 1; i <= pieces && acc.w < segment::kOpacityEnd; ++i) {
         const float b = i == pieces ? vEnd : valueAt(t0 + h * i);
+        const LightFactors lightB = i == pieces ? lightEnd : lightHere();
+        const Vec4f before = acc;
         segment::integrate(tf, a, b, h, unit, acc, true);
+        lightSegment(before, lightA.mean(lightB), acc);
         a = b;
+        lightA = lightB;
     }
     return vEnd;
 }
@@ -300,13 +323,23 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             float s1;
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
                 s1 = exact::nativeSegment(loc.mesh, scene.tf, tet, ray, t, tEnd,
-                                          haveEntry ? sEntry : NAN, unit, acc);
+                                          haveEntry ? sEntry : NAN, unit, scene.params.light,
+                                          acc);
             } else {
                 const float s0 =
                     haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
                 s1 = exact::scalarAt<kNative>(loc, tet, span, ray, tEnd);
                 // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
+                const Vec4f before = acc;
                 segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
+                // Lit: a tetrahedron's gradient is constant, so is its light along the segment.
+                if (scene.params.light.on) {
+                    const float centre[4] = {0.25f, 0.25f, 0.25f, 0.25f};
+                    lightSegment(before,
+                                 lightFactors(scene.params.light,
+                                              loc.mesh.gradient<kNative>(tet, centre), ray.dir),
+                                 acc);
+                }
             }
             opaque = acc.w >= segment::kOpacityEnd;
             past = clipped && tEnd >= tStop;

@@ -213,6 +213,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.params.terminationAlpha = settings.terminationAlpha;
     f.params.preintegrated = settings.preintegrated;
     f.params.clip = clipView(settings, frame);
+    f.params.light = settings.lighting;  // directions only: the frame's scaling keeps them
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_step")
                                        : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)

@@ -49,6 +49,7 @@ struct SampleSegments {
     float kLast = 0.f;     ///< grid position of the last sample
     float kEnd = 0.f;      ///< end of the piece of the ray the last sample belongs to
     float vLast = 0.f;     ///< its value (when inside)
+    LightFactors light;    ///< its light (when inside; the identity unlit)
     float kPrev = 0.f;     ///< grid position of the sample before it in the run
     float vPrev = 0.f;     ///< its value
     bool inRun = false;    ///< the sample before the last one is in the last one's run
@@ -56,20 +57,26 @@ struct SampleSegments {
     bool started = false;  ///< a sample was taken
 
     /// Adds the sample at grid position k of a piece of the ray that ends at kPieceEnd (the
-    /// next piece continues it when it starts there); `in`: it found a cell, with value v.
+    /// next piece continues it when it starts there); `in`: it found a cell, with value v and
+    /// light f (gradient shading; the segment from the last sample is lit by the mean of their
+    /// lights, the run's last share by its last sample's).
     UVR_HOST_DEVICE void add(const TfTableView& tf, float k, float kPieceEnd, bool in, float v,
-                             float s1, double unit, Vec4f& acc) {
+                             float s1, double unit, Vec4f& acc, LightFactors f = {}) {
         const bool goesOn = started && inside && in && k <= kEnd;
-        if (goesOn)
+        if (goesOn) {
+            const Vec4f before = acc;
             segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc, true);
-        else if (started && inside)  // the run ends
+            lightSegment(before, light.mean(f), acc);
+        } else if (started && inside) {  // the run ends
             endRun(tf, (k < kEnd ? k : kEnd) - kLast, s1, unit, acc);
+        }
         inRun = goesOn;
         kPrev = kLast;
         vPrev = vLast;
         kLast = k;
         kEnd = kPieceEnd;
         vLast = v;
+        light = f;
         inside = in;
         started = true;
     }
@@ -85,9 +92,20 @@ private:
                                 Vec4f& acc) const {
         double end = vLast;
         if (inRun) end += (double(vLast) - vPrev) * (double(steps) / (double(kLast) - kPrev));
+        const Vec4f before = acc;
         segment::integrate(tf, vLast, end, double(steps) * s1, unit, acc, true);
+        lightSegment(before, light, acc);
     }
 };
+
+/// The light of a sample in cell `tet` at local coordinates bary (TetMeshView::gradient) along
+/// a ray of unit direction dir: the identity when lighting is off or no cell holds it.
+template <bool kNative = true>
+UVR_HOST_DEVICE inline LightFactors lightAt(const SceneView& scene, std::uint32_t tet,
+                                            const float bary[4], Vec3f dir) {
+    if (!scene.params.light.on || tet == kNoTet) return {};
+    return lightFactors(scene.params.light, scene.locator.mesh.gradient<kNative>(tet, bary), dir);
+}
 
 /// The reference ray marcher: samples at fixed spacing s1 on the global grid t = k * s1 between
 /// the ray's entry into and exit from the mesh bounds, locates each sample's tetrahedron
@@ -121,12 +139,13 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
+        const LightFactors light = lightAt<kNative>(scene, tet, bary, ray.dir);
         if (scene.params.preintegrated) {
-            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc);
+            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light);
         } else if (tet != kNoTet) {
             const Vec4f c = scene.tf.sample(v);
             const float a = correctOpacity(c.w, s, unit, scene.tf.law);
-            if (a > 0.f) compositeFrontToBack(acc, c.xyz(), a);
+            if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
         opaque = acc.w >= scene.params.terminationAlpha;
     }

@@ -15,6 +15,7 @@
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/clip.h"
+#include "uvr/render/lighting.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {
@@ -73,6 +74,9 @@ struct RenderSettings {
     /// the part of each ray inside all of them (the exact method cuts the cells there exactly).
     std::vector<ClipPlane> clipPlanes;
     std::optional<Bounds3f> clipBox;
+    /// Gradient shading (issue 32; lighting.h): off by default; ParaView's Ambient, Diffuse,
+    /// Specular and SpecularPower and their defaults.
+    Lighting lighting;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)

@@ -9,6 +9,7 @@
 #include "uvr/accel/point_locator.h"
 #include "uvr/core/bounds.h"
 #include "uvr/render/clip.h"
+#include "uvr/render/lighting.h"
 #include "uvr/tf/tf_table.h"
 
 namespace uvr {
@@ -23,6 +24,8 @@ struct MarchParams {
     bool preintegrated = true;
     /// The clip region: each ray integrates only its part inside (none: the whole ray).
     ClipView clip;
+    /// Gradient shading (off: the transfer function's colours as they are).
+    Lighting light;
 };
 
 /// Everything a ray needs, as plain data for CPU and GPU.

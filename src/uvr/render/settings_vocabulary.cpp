@@ -50,6 +50,14 @@ SettingDef setting(const char* name, SettingType type, const char* doc) {
     return d;
 }
 
+/// One of ParaView's lighting coefficients: a number in [0, 1], read with `shade`.
+SettingDef lightingCoefficient(const char* name, const char* doc) {
+    SettingDef d = setting(name, SettingType::Number, doc);
+    d.min = 0.0, d.max = 1.0;
+    d.needs = "shade";
+    return d;
+}
+
 std::vector<SettingDef> makeVocabulary() {
     std::vector<SettingDef> v;
     SettingDef method =
@@ -210,6 +218,45 @@ std::vector<SettingDef> makeVocabulary() {
     jitter.get = [](const RenderSettings& s) { return Json(s.jitter); };
     jitter.set = [](RenderSettings& s, const Json& x) { s.jitter = x.get<bool>(); };
     v.push_back(jitter);
+
+    SettingDef shade = setting("shade", SettingType::Flag,
+                               "Gradient shading: a headlight lights the volume, the field's "
+                               "gradient its normal (ParaView's Shade)");
+    shade.detail =
+        "colour (`ambient` + `diffuse` c) + `specular` c^`specular_power`, c the cosine between "
+        "the gradient and the view ray; exact per cell: constant in a linear tetrahedron";
+    shade.get = [](const RenderSettings& s) { return Json(s.lighting.on); };
+    shade.set = [](RenderSettings& s, const Json& x) { s.lighting.on = x.get<bool>(); };
+    v.push_back(shade);
+
+    SettingDef ambient = lightingCoefficient(
+        "ambient", "Shading: the light every point gets whatever its gradient");
+    ambient.get = [](const RenderSettings& s) { return floatJson(s.lighting.ambient); };
+    ambient.set = [](RenderSettings& s, const Json& x) { s.lighting.ambient = x.get<float>(); };
+    v.push_back(ambient);
+
+    SettingDef diffuse = lightingCoefficient(
+        "diffuse", "Shading: the light a point gets times the cosine of its gradient to the ray");
+    diffuse.get = [](const RenderSettings& s) { return floatJson(s.lighting.diffuse); };
+    diffuse.set = [](RenderSettings& s, const Json& x) { s.lighting.diffuse = x.get<float>(); };
+    v.push_back(diffuse);
+
+    SettingDef specular = lightingCoefficient(
+        "specular", "Shading: the white highlight where the gradient faces the ray");
+    specular.get = [](const RenderSettings& s) { return floatJson(s.lighting.specular); };
+    specular.set = [](RenderSettings& s, const Json& x) { s.lighting.specular = x.get<float>(); };
+    v.push_back(specular);
+
+    SettingDef shininess = setting("specular_power", SettingType::Number,
+                                "Shading: the highlight's exponent (larger: smaller highlights)");
+    shininess.detail = "with `specular`";
+    shininess.min = 0.0, shininess.max = 128.0;
+    shininess.needs = "shade";
+    shininess.get = [](const RenderSettings& s) { return floatJson(s.lighting.specularPower); };
+    shininess.set = [](RenderSettings& s, const Json& x) {
+        s.lighting.specularPower = x.get<float>();
+    };
+    v.push_back(shininess);
     return v;
 }
 
@@ -253,6 +300,12 @@ const SettingDef& settingNamed(std::string_view name) {
 
 std::string settingValueText(const Json& value) {
     if (value.is_string()) return "'" + printableShort(value.get_ref<const std::string&>()) + "'";
+    // A whole number as it is typed ("8", not JSON's "8.0").
+    if (value.is_number_float()) {
+        const double x = value.get<double>();
+        if (std::isfinite(x) && x == std::floor(x) && std::fabs(x) < 1e15)
+            return std::to_string(static_cast<long long>(x));
+    }
     return printableShort(value.dump(-1, ' ', false, Json::error_handler_t::replace));
 }
 
@@ -309,6 +362,17 @@ std::string settingExpectation(const SettingDef& d) {
     return "";
 }
 
+bool settingNeedMet(const SettingDef& d, const RenderSettings& settings) {
+    return !d.needs || settingNamed(d.needs).get(settings) == true;
+}
+
+void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std::string>& given) {
+    for (const std::string& name : given)
+        if (const SettingDef* d = findSetting(name); d && !settingNeedMet(*d, settings))
+            throw SettingError(d->name, settingValueText(d->get(settings)),
+                               std::string("read only with `") + d->needs + "` on");
+}
+
 Json settingDefault(const SettingDef& d) {
     return d.get(RenderSettings{});
 }
@@ -333,7 +397,8 @@ Json settingsVocabularyJson() {
                   {"detail", d.detail},
                   {"read_by", readBy},
                   {"default", settingDefault(d)},
-                  {"tunes_adaptive", d.tunesAdaptive}};
+                  {"tunes_adaptive", d.tunesAdaptive},
+                  {"needs", d.needs ? Json(d.needs) : Json(nullptr)}};
         if (d.type == SettingType::Choice) j["choices"] = d.choices;
         if (d.type == SettingType::Number || d.type == SettingType::Integer) {
             j["min"] = d.min;

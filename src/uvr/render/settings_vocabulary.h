@@ -45,6 +45,9 @@ struct SettingDef {
     /// The methods that read the setting (empty: every method); a front end may refuse a value
     /// given for a method that ignores it (settingReadBy).
     std::vector<RenderMethod> readBy;
+    /// A Flag setting that must be on for this one to be read (the lighting coefficients need
+    /// `shade`), or null; a front end may refuse a value given while it is off (settingNeedMet).
+    const char* needs = nullptr;
     /// The setting's value in `s` as JSON (a name, number or boolean; null for a per-mesh
     /// default).
     nlohmann::json (*get)(const RenderSettings& s) = nullptr;
@@ -53,7 +56,8 @@ struct SettingDef {
 };
 
 /// Every setting of the vocabulary: method, sampling, step_rule, quality, step, max_step, power,
-/// opacity_unit, opacity_law, skip, adaptive, supersample, jitter.
+/// opacity_unit, opacity_law, skip, adaptive, supersample, jitter, shade, ambient, diffuse,
+/// specular, specular_power.
 const std::vector<SettingDef>& settingsVocabulary();
 
 /// The setting called `name`, or null.
@@ -80,15 +84,24 @@ std::string cliFlag(const SettingDef& def);
 /// True when `method` reads the setting (RenderMethod::Auto reads what any method reads).
 bool settingReadBy(const SettingDef& def, RenderMethod method);
 
+/// True unless the setting `def.needs` is off in `settings` (then `def` is not read).
+bool settingNeedMet(const SettingDef& def, const RenderSettings& settings);
+
+/// Throws SettingError for the first of the settings named in `given` (names of the
+/// vocabulary; others are passed over) that `settings` would not read because the setting it
+/// needs is off: "ambient 0.3: read only with `shade` on".
+void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std::string>& given);
+
 /// What a value of the setting must be, in words ("a number in [0.5, 0.9999]", "'point' or
 /// 'preintegrated'", "true or false"), as checkSetting's errors say it.
 std::string settingExpectation(const SettingDef& def);
 
 /// The vocabulary as JSON for a page or a binding: per setting its name, type, doc, detail,
-/// default, the methods that read it and its choices or range.
+/// default, the methods that read it, the setting it needs and its choices or range.
 nlohmann::json settingsVocabularyJson();
 
-/// A value as a message quotes it: a string as 'text', anything else as JSON.
+/// A value as a message quotes it: a string as 'text', a whole number without a fraction (8),
+/// anything else as JSON.
 std::string settingValueText(const nlohmann::json& value);
 
 }  // namespace uvr

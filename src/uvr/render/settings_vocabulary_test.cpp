@@ -170,5 +170,43 @@ TEST(SettingsVocabulary, SaysWhichMethodsReadEachSetting) {
     EXPECT_EQ(settingExpectation(settingNamed("skip")), "true or false");
 }
 
+TEST(SettingsVocabulary, LightingCoefficientsNeedShadeOn) {
+    // Shading is off by default with ParaView's coefficients; each coefficient is read only
+    // with `shade` on, and a front end that was given one with shading off is told so.
+    EXPECT_EQ(settingDefault(settingNamed("shade")), false);
+    EXPECT_EQ(cliFlag(settingNamed("shade")), "--shade");
+    EXPECT_EQ(cliFlag(settingNamed("specular_power")), "--specular-power");
+    EXPECT_EQ(settingDefault(settingNamed("diffuse")).dump(), "1.0");
+    EXPECT_EQ(settingDefault(settingNamed("specular_power")).dump(), "100.0");
+    RenderSettings s;
+    for (const char* name : {"ambient", "diffuse", "specular", "specular_power"}) {
+        const SettingDef& d = settingNamed(name);
+        ASSERT_NE(d.needs, nullptr) << name;
+        EXPECT_STREQ(d.needs, "shade");
+        EXPECT_FALSE(settingNeedMet(d, s)) << name;
+    }
+    EXPECT_TRUE(settingNeedMet(settingNamed("quality"), s));
+    applySetting(s, "ambient", 0.25);
+    try {
+        refuseUnreadSettings(s, {"quality", "ambient"});
+        FAIL() << "ambient without shade passed";
+    } catch (const SettingError& e) {
+        EXPECT_EQ(std::string(e.what()), "ambient 0.25: read only with `shade` on");
+    }
+    applySetting(s, "shade", true);
+    EXPECT_NO_THROW(refuseUnreadSettings(s, {"quality", "ambient", "not_a_setting"}));
+    EXPECT_EQ(s.lighting.ambient, 0.25f);
+    EXPECT_TRUE(s.lighting.on);
+    // Out of range.
+    EXPECT_THAT(refusal("diffuse", 1.5).what(), HasSubstr("expected a number in [0, 1]"));
+    EXPECT_THAT(refusal("specular_power", -1).what(), HasSubstr("[0, 128]"));
+    // The JSON form says what each needs.
+    for (const Json& d : settingsVocabularyJson()) {
+        if (d["name"] == "ambient") {
+            EXPECT_EQ(d["needs"], "shade");
+        }
+    }
+}
+
 }  // namespace
 }  // namespace uvr

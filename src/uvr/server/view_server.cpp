@@ -215,14 +215,18 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     // The page's settings by their flags: the method always, the others where they are not the
     // default (the opacity unit always is: the server sets it to ParaView's), and what tunes the
     // adaptive method when it renders.
+    // A setting whose `needs` is off is not read (and the command line refuses it then).
     for (const char* name : kViewerSettings) {
         const SettingDef& def = settingNamed(name);
         const Json value = def.get(f);
         if (std::string_view(def.name) != "method" && value == settingDefault(def) &&
             !(def.tunesAdaptive && f.method == RenderMethod::Partitions))
             continue;
-        args.push_back(cliFlag(def));
-        args.push_back(value.is_string() ? value.get<std::string>() : fmtExact(value.get<float>()));
+        if (!settingNeedMet(def, f)) continue;
+        args.push_back(cliFlag(def));  // a flag's is its value ("--shade", "--no-skip")
+        if (def.type != SettingType::Flag)
+            args.push_back(value.is_string() ? value.get<std::string>()
+                                             : fmtExact(value.get<float>()));
     }
     // The page's clip planes (the command line's clip box comes with its flags).
     for (const ClipPlane& p : s.clipPlanes) {

@@ -1,0 +1,208 @@
+// SPDX-License-Identifier: MIT
+// Gradient shading (issue 32): the headlight's light in every method and on every device.
+// Oracles: a linear field (one gradient everywhere) lit in closed form, a constant field (no
+// gradient: lit as facing the light), lighting that is the identity changing no bit, and the
+// sampling methods converging to the exact integrator's lit image.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "on_each_device.h"
+#include "test_meshes.h"
+#include "uvr/mesh/field_select.h"
+#include "uvr/render/camera.h"
+#include "uvr/render/frame_setup.h"
+#include "uvr/render/lighting.h"
+
+namespace uvr {
+namespace {
+
+/// The linear field's gradient.
+const Vec3f kGradient(0.6f, 0.5f, -0.35f);
+
+/// A 6^3 grid of hexahedra over [0, 1]^3 (jittered when asked) with the field f, as native
+/// cells or split into tetrahedra.
+PreparedMesh grid(float (*f)(Vec3f), bool split, float jitter = 0.f) {
+    const Mesh m = testing::makeHexGrid(6, 0.f, 1.f, f, jitter);
+    PrepareOptions options;
+    options.kd.leafCells = 32;  // several partitions along each ray
+    options.cells.splitCells = split;
+    return prepareMesh(m, selectScalarField(m, {}), options);
+}
+
+float linearField(Vec3f p) {
+    return dot(kGradient, p);
+}
+float constantField(Vec3f) {
+    return 0.5f;
+}
+float roundField(Vec3f p) {
+    return 1.5f * length(p - Vec3f(0.45f, 0.5f, 0.55f));
+}
+
+/// A parallel view along +x through the unit cube's middle, opacity 0.6 per unit (attenuation),
+/// step 0.01: every ray crosses x from 0 to 1 inside the cube.
+RenderSettings alongX(RenderMethod method) {
+    RenderSettings s;
+    s.method = method;
+    s.width = 24, s.height = 16;
+    Camera c;
+    c.position = Vec3f(-2.f, 0.52f, 0.47f);
+    c.focalPoint = Vec3f(0.5f, 0.52f, 0.47f);
+    c.viewUp = Vec3f(0.f, 0.f, 1.f);
+    c.parallelProjection = true;
+    c.parallelScale = 0.2f;
+    s.camera = c;
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "constant:0.6");
+    s.range = {-0.5f, 1.2f};
+    s.opacityUnit = 1.f;
+    s.opacityLaw = OpacityLaw::Attenuation;
+    s.step = 0.01f;
+    return s;
+}
+
+/// A lighting with every term at work.
+Lighting someLight() {
+    Lighting l;
+    l.on = true;
+    l.ambient = 0.15f, l.diffuse = 0.6f, l.specular = 0.25f, l.specularPower = 6.f;
+    return l;
+}
+
+bool samePixels(const Image& a, const Image& b) {
+    return a.pixels.size() == b.pixels.size() &&
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec4f)) == 0;
+}
+
+constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
+                                     RenderMethod::Partitions};
+
+TEST(LightFactors, HeadlightCosineInClosedForm) {
+    const Lighting l = someLight();
+    const Vec3f dir = normalize(Vec3f(0.3f, -0.4f, 0.8f));
+    const Vec3f g(2.f, 1.f, -0.5f);
+    const float c = std::fabs(dot(g, dir)) / length(g);
+    const LightFactors f = lightFactors(l, g, dir);
+    EXPECT_NEAR(f.scale, 0.15f + 0.6f * c, 1e-6f);
+    EXPECT_NEAR(f.add, 0.25f * std::pow(c, 6.f), 1e-6f);
+    // Two-sided: the gradient's sign does not matter.
+    EXPECT_FLOAT_EQ(lightFactors(l, g * -1.f, dir).scale, f.scale);
+    // No normal (zero, huge, NaN): lit as facing the light.
+    for (const Vec3f bad : {Vec3f(0.f), Vec3f(NAN, 0.f, 1.f), Vec3f(INFINITY, 0.f, 0.f)}) {
+        const LightFactors b = lightFactors(l, bad, dir);
+        EXPECT_FLOAT_EQ(b.scale, 0.75f);
+        EXPECT_FLOAT_EQ(b.add, 0.25f);
+    }
+    // Gradients at float's ends keep their direction.
+    EXPECT_NEAR(lightFactors(l, g * 1e37f, dir).scale, f.scale, 1e-6f);
+    EXPECT_NEAR(lightFactors(l, g * 1e-40f, dir).scale, f.scale, 1e-5f);
+    // Off: the identity.
+    Lighting off = l;
+    off.on = false;
+    EXPECT_TRUE(lightFactors(off, g, dir).identity());
+}
+
+class Lit : public testing::OnEachDevice {};
+UVR_ON_EACH_DEVICE(Lit);
+
+TEST_P(Lit, ALinearFieldIsLitInClosedForm) {
+    // One gradient everywhere, rays along +x: every point gets scale = ambient + diffuse c and
+    // add = specular c^power with c = |g.x| / |g|, so the lit pixel is the unlit one's colour
+    // times scale plus its opacity times add, and the same opacity.
+    const Lighting l = someLight();
+    const float c = std::fabs(kGradient.x) / length(kGradient);
+    const float scale = l.ambient + l.diffuse * c, add = l.specular * std::pow(c, l.specularPower);
+    for (const bool split : {true, false}) {
+        const PreparedMesh pm = grid(linearField, split);
+        for (const RenderMethod m : kMethods) {
+            RenderSettings s = alongX(m);
+            const RenderResult unlit = render(pm, s);
+            s.lighting = l;
+            const RenderResult lit = render(pm, s);
+            const std::string what =
+                std::string(methodName(m)) + (split ? " tetrahedra" : " hexahedra");
+            for (std::size_t i = 0; i < lit.image.pixels.size(); ++i) {
+                const Vec4f u = unlit.image.pixels[i], p = lit.image.pixels[i];
+                ASSERT_GT(u.w, 0.4f) << what;  // the ray crosses the cube
+                EXPECT_NEAR(p.w, u.w, 1e-6f) << what << " pixel " << i;
+                EXPECT_NEAR(p.x, u.x * scale + u.w * add, 2e-5f) << what << " pixel " << i;
+                EXPECT_NEAR(p.y, u.y * scale + u.w * add, 2e-5f) << what << " pixel " << i;
+                EXPECT_NEAR(p.z, u.z * scale + u.w * add, 2e-5f) << what << " pixel " << i;
+            }
+        }
+    }
+}
+
+TEST_P(Lit, AConstantFieldIsLitAsFacingTheLight) {
+    // No gradient, no normal: every point is lit as facing the light (ambient + diffuse,
+    // specular), the same in every method.
+    const Lighting l = someLight();
+    const PreparedMesh pm = grid(constantField, true);
+    for (const RenderMethod m : kMethods) {
+        RenderSettings s = alongX(m);
+        const RenderResult unlit = render(pm, s);
+        s.lighting = l;
+        const RenderResult lit = render(pm, s);
+        const Vec4f u = unlit.image.at(12, 8), p = lit.image.at(12, 8);
+        EXPECT_NEAR(p.x, u.x * 0.75f + u.w * 0.25f, 2e-5f) << methodName(m);
+        EXPECT_NEAR(p.w, u.w, 1e-6f) << methodName(m);
+    }
+}
+
+TEST_P(Lit, IdentityLightChangesNoBit) {
+    // Lighting off whatever its coefficients, or on with ambient 1 and nothing else: the unlit
+    // pixels bit for bit.
+    const PreparedMesh pm = grid(roundField, false, 0.2f);
+    for (const RenderMethod m : kMethods) {
+        RenderSettings s = alongX(m);
+        const RenderResult unlit = render(pm, s);
+        s.lighting = someLight();
+        s.lighting.on = false;
+        EXPECT_TRUE(samePixels(render(pm, s).image, unlit.image)) << methodName(m);
+        s.lighting = Lighting{true, 1.f, 0.f, 0.f, 100.f};
+        EXPECT_TRUE(samePixels(render(pm, s).image, unlit.image)) << methodName(m);
+    }
+}
+
+TEST_P(Lit, SamplingConvergesToTheExactLight) {
+    // A curved field, so the light turns from cell to cell: with short steps the sampling
+    // methods' lit images approach the exact integrator's (each segment lit by the mean of its
+    // samples' lights, against the light of every cell crossed), tetrahedra and hexahedra.
+    const Lighting l = someLight();
+    for (const bool split : {true, false}) {
+        const PreparedMesh pm = grid(roundField, split, 0.2f);
+        RenderSettings s = alongX(RenderMethod::Exact);
+        s.lighting = l;
+        const Image exact = render(pm, s).image;
+        for (const RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
+            s.method = m;
+            s.step = 0.002f;
+            const Image sampled = render(pm, s).image;
+            float worst = 0.f;
+            for (std::size_t i = 0; i < exact.pixels.size(); ++i)
+                for (int k = 0; k < 4; ++k)
+                    worst = std::fmax(worst, std::fabs(exact.pixels[i][k] - sampled.pixels[i][k]));
+            EXPECT_LT(worst, 0.01f) << methodName(m) << (split ? " tetrahedra" : " hexahedra");
+        }
+    }
+}
+
+TEST_P(Lit, NanValuesAndDegenerateGradientsStayFinite) {
+    // A field of NaN in part of the cube: the NaN cells have no gradient (lit as facing the
+    // light) and no pixel turns NaN.
+    const PreparedMesh pm = grid(
+        [](Vec3f p) { return p.x > 0.5f && p.y > 0.4f ? NAN : roundField(p); }, true, 0.1f);
+    for (const RenderMethod m : kMethods) {
+        RenderSettings s = alongX(m);
+        s.tf.nanOpacity = 0.5f;
+        s.lighting = someLight();
+        for (const Vec4f& p : render(pm, s).image.pixels)
+            for (int k = 0; k < 4; ++k) ASSERT_TRUE(std::isfinite(p[k])) << methodName(m);
+    }
+}
+
+}  // namespace
+}  // namespace uvr
