@@ -49,7 +49,7 @@ function send(message) {
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
                     "opacity_unit", "opacity_law", "step", "clip_planes", "shade", "ambient",
-                    "diffuse", "specular", "specular_power"];
+                    "diffuse", "specular", "specular_power", "normals"];
 
 // Gradient shading's coefficients: the slider's id and the setting it sets.
 const kLightSliders = [["ambient", "ambient"], ["diffuse", "diffuse"], ["specular", "specular"],
@@ -410,7 +410,8 @@ function fillSelectors(info) {
     field.replaceChildren(...fieldList.map((e) => new Option(e.label, e.spec)));
     // The library's settings vocabulary: choices, ranges and docs of the controls.
     const setting = (name) => (info.settings || []).find((d) => d.name === name) || {};
-    for (const [id, name] of [["method", "method"], ["opacity-law", "opacity_law"]]) {
+    for (const [id, name] of [["method", "method"], ["opacity-law", "opacity_law"],
+                              ["normals", "normals"]]) {
         const d = setting(name);
         const choices = d.choices || (name === "method" ? info.methods : []) || [];
         if (choices.length) $(id).replaceChildren(...choices.map((c) => new Option(c, c)));
@@ -470,6 +471,8 @@ function updateControls() {
     if (s.opacity_law) $("opacity-law").value = s.opacity_law;
     $("heatmap").checked = !!s.heatmap;
     $("shade").checked = !!s.shade;
+    $("normals").disabled = !s.shade;
+    if (s.normals) $("normals").value = s.normals;
     for (const [id, name] of kLightSliders) {
         $(id).disabled = !s.shade;  // read only with shade
         if (!Number.isFinite(s[name])) continue;
@@ -544,6 +547,7 @@ $("heatmap").addEventListener("change", (e) => sendSet({heatmap: e.target.checke
 // dragged, a full one on release)
 
 $("shade").addEventListener("change", (e) => sendSet({shade: e.target.checked}));
+$("normals").addEventListener("change", (e) => sendSet({normals: e.target.value}));
 for (const [id, name] of kLightSliders) {
     let pending = 0;
     $(id).addEventListener("input", (e) => {

@@ -289,6 +289,7 @@ CudaScene::CudaScene(const PreparedMesh& mesh, const FractionFn& progress)
     };
     d.upload(ArrayUse::Geometry, uploaded);
     d.upload(ArrayUse::Values, uploaded);
+    d.upload(ArrayUse::Gradients, uploaded);
     d.totals.reserve(cuda::kCounters, "the frame counters");
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     d.uploadSeconds =
@@ -314,9 +315,15 @@ double CudaScene::uploadSeconds() const {
 void CudaScene::updateValues() {
     const auto start = std::chrono::steady_clock::now();
     impl_->upload(ArrayUse::Values, [] {});
+    impl_->upload(ArrayUse::Gradients, [] {});  // remade from the new values (or absent)
     UVR_CUDA_CHECK(cudaDeviceSynchronize());
     impl_->valueUploadSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void CudaScene::uploadGradients() {
+    impl_->upload(ArrayUse::Gradients, [] {});
+    UVR_CUDA_CHECK(cudaDeviceSynchronize());
 }
 
 double CudaScene::valueUploadSeconds() const {

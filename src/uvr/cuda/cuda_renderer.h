@@ -34,6 +34,9 @@ public:
     /// k-d nodes, cell lists and seed grids stay on the device untouched; buffers of unchanged
     /// size are reused. Throws Error(Resource) when the GPU lacks memory.
     void updateValues();
+    /// Uploads the prepared mesh's smooth gradients (computeSmoothGradients; gradient shading
+    /// computes them when it first needs them), or frees them when it has none.
+    void uploadGradients();
     /// Seconds the last updateValues took (0 before the first).
     double valueUploadSeconds() const;
 

@@ -48,6 +48,8 @@ RenderResult CudaScene::render(const RenderSettings&) {
 
 void CudaScene::updateValues() {}
 
+void CudaScene::uploadGradients() {}
+
 double CudaScene::valueUploadSeconds() const {
     return 0.0;
 }

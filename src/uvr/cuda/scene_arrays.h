@@ -11,8 +11,10 @@
 namespace uvr {
 
 /// Whether a scene array changes with the field's values: CudaScene::updateValues re-uploads
-/// those (a time step), the geometry stays.
-enum class ArrayUse : bool { Geometry, Values };
+/// those (a time step), the geometry stays. Gradients: the smooth gradients, made from the
+/// values when shading first asks for them (CudaScene::uploadGradients) and with the values
+/// after that.
+enum class ArrayUse : std::uint8_t { Geometry, Values, Gradients };
 
 /// The arrays of a prepared mesh that a CudaScene holds on the GPU, each declared once (issue
 /// 30): A<T> is the storage (cuda::DeviceArray<T> in the scene). forEachSceneArray binds each to
@@ -43,6 +45,8 @@ struct SceneArrays {
     A<PartitionGrid> macroGrids;
     A<MacroCell> macroCells;
     A<std::uint8_t> macroNan;  ///< absent when the field has no NaN
+    A<Vec3f> blockGradients;   ///< absent until shading asks for smooth gradients
+    A<Vec3f> pointGradients;   ///< absent then, or without native cells
 };
 
 /// Calls f(array, host, name, use) for every array of `arrays` (a SceneArrays, or a const one):
@@ -79,6 +83,10 @@ void forEachSceneArray(const PreparedMesh& m, Arrays& a, F&& f) {
     f(a.macroCells, m.macro ? &m.macro->cells : nullptr, "the macrocells", U::Values);
     f(a.macroNan, m.macro && !m.macro->nanCells.empty() ? &m.macro->nanCells : nullptr,
       "the macrocells' NaN flags", U::Values);
+    f(a.blockGradients, some(!m.tets.blockGradients.empty(), m.tets.blockGradients),
+      "the smooth gradients", U::Gradients);
+    f(a.pointGradients, some(native && !m.tets.pointGradients.empty(), m.tets.pointGradients),
+      "the native cells' smooth gradients", U::Gradients);
 }
 
 /// Points a kernel's scene view (built on the host: counts, bounds, parameters) at the arrays'
@@ -93,6 +101,8 @@ void pointAtArrays(SceneView& v, const SceneArrays<A>& a) {
     m.tetCorners = a.tetCorners.data();
     m.blockVertices = a.blockVertices.data();
     m.blockVertexBase = a.blockVertexBase.data();
+    m.blockGradients = a.blockGradients.data();  // null while absent
+    m.pointGradients = a.pointGradients.data();
     v.locator.bvh.nodes = a.bvhNodes.data();
     v.locator.bvh.primIds = a.bvhPrims.data();
     v.locator.neighbors = {a.neighborCodes.data(), a.neighborEscapes.data(),

@@ -110,6 +110,7 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     // Gradient shading, with its coefficients when on.
     j["shade"] = settings.lighting.on;
     if (settings.lighting.on) {
+        j["normals"] = settings.lighting.smooth ? "smooth" : "cell";
         j["ambient"] = settings.lighting.ambient;
         j["diffuse"] = settings.lighting.diffuse;
         j["specular"] = settings.lighting.specular;

@@ -8,6 +8,7 @@
 #include "uvr/cpu/threads.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/mesh/smooth_gradients.h"
 
 namespace uvr {
 
@@ -101,6 +102,12 @@ Renderer::Renderer(PreparedMesh prepared, Device device)
 Renderer::~Renderer() = default;
 
 RenderResult Renderer::render(const RenderSettings& settings) {
+    // Smooth shading's gradients are made when a frame first needs them (and kept, remade with
+    // new values).
+    if (settings.lighting.on && settings.lighting.smooth && !hasSmoothGradients(prepared_->tets)) {
+        computeSmoothGradients(prepared_->tets);
+        if (gpu_) gpu_->uploadGradients();
+    }
     return gpu_ ? gpu_->render(settings) : renderCpu(*prepared_, settings);
 }
 

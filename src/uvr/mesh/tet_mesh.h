@@ -106,6 +106,10 @@ struct TetMeshView {
     const TetCorners16* tetCorners = nullptr;
     const BlockVertex* blockVertices = nullptr;
     const std::uint32_t* blockVertexBase = nullptr;
+    /// Smooth gradients (computeSmoothGradients; null until computed): per block vertex for the
+    /// tetrahedra, per point for the native cells.
+    const Vec3f* blockGradients = nullptr;
+    const Vec3f* pointGradients = nullptr;
 
     /// Every cell: tetrahedra and native cells.
     UVR_HOST_DEVICE std::uint64_t cellCount() const {
@@ -213,18 +217,37 @@ struct TetMeshView {
         return v;
     }
     /// Gradient of the interpolated field in cell c at its local coordinates (as interpolate
-    /// takes them; a tetrahedron's is constant and ignores them): a native cell's through the
-    /// inverse of its Jacobian (cellGradient). Zero for cell data (constant in each cell);
-    /// non-finite for a degenerate cell.
+    /// takes them). Per cell (smooth false): a tetrahedron's constant gradient, a native cell's
+    /// through the inverse of its Jacobian (cellGradient); non-finite for a degenerate cell.
+    /// Smooth: the corners' smooth gradients (computeSmoothGradients) interpolated as the field
+    /// is (the per-cell one where they were not computed). Zero for cell data (constant in each
+    /// cell).
     template <bool kNative = true>
-    UVR_HOST_DEVICE Vec3f gradient(std::uint64_t c, const float bary[4]) const {
+    UVR_HOST_DEVICE Vec3f gradient(std::uint64_t c, const float bary[4], bool smooth) const {
         if (cellCentered) return Vec3f(0.f);
+        if (!kNative || c < tetCount) {
+            if (smooth && blockGradients) {
+                const TetCorners16 k = tetCorners[c];
+                const Vec3f* g = blockGradients + blockVertexBase[c >> kTetBlockBits];
+                return g[k.v[0]] * bary[0] + g[k.v[1]] * bary[1] + g[k.v[2]] * bary[2] +
+                       g[k.v[3]] * bary[3];
+            }
+            BlockVertex x[4];
+            tetVertices(c, x);
+            return tetGradient(x[0].p, x[1].p, x[2].p, x[3].p, x[0].value, x[1].value, x[2].value,
+                               x[3].value);
+        }
+        if (smooth && pointGradients) {
+            std::uint32_t ids[kMaxCellCorners];
+            const int n = corners(c, ids);
+            float w[kMaxCellCorners];
+            shapeFunctions(kind(c), bary[0], bary[1], bary[2], w);
+            Vec3f g(0.f);
+            for (int i = 0; i < n; ++i) g += pointGradients[ids[i]] * w[i];
+            return g;
+        }
         Vec3f x[kMaxCellCorners];
         float v[kMaxCellCorners];
-        if (!kNative || c < tetCount) {
-            kernelGather(c, x, v);
-            return tetGradient(x[0], x[1], x[2], x[3], v[0], v[1], v[2], v[3]);
-        }
         gather(c, x, v);
         return cellGradient(kind(c), x, v, Vec3f(bary[0], bary[1], bary[2]));
     }
@@ -263,6 +286,10 @@ struct TetMesh {
     std::vector<BlockVertex> blockVertices;
     std::vector<std::uint32_t> blockVertexBase;   ///< per block and one past the last
     std::vector<std::uint32_t> blockVertexPoint;  ///< point id of each block vertex
+    /// Smooth gradients for shading (computeSmoothGradients; empty until asked for): per block
+    /// vertex, and per point with native cells.
+    std::vector<Vec3f> blockGradients;
+    std::vector<Vec3f> pointGradients;
 
     /// Tetrahedra: those of `tets`, or of the kernels' blocks where `tets` is not held (a mesh
     /// read from a prepared cache).
@@ -292,6 +319,8 @@ struct TetMesh {
         v.tetCorners = tetCorners.data();
         v.blockVertices = blockVertices.data();
         v.blockVertexBase = blockVertexBase.data();
+        v.blockGradients = blockGradients.empty() ? nullptr : blockGradients.data();
+        v.pointGradients = pointGradients.empty() ? nullptr : pointGradients.data();
         return v;
     }
 };

@@ -9,6 +9,7 @@
 
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
+#include "uvr/mesh/smooth_gradients.h"
 #include "uvr/mesh/tet_math.h"
 
 namespace uvr {
@@ -222,6 +223,8 @@ void updateFieldValues(PreparedMesh& mesh, const ScalarField& field) {
                        std::to_string(expected) + " (one per " + (cellData ? "cell" : "point") +
                        " of the prepared mesh)");
     assignTetValues(mesh.tets, field);
+    // Smooth gradients follow the values once shading has asked for them.
+    if (!mesh.tets.blockGradients.empty()) computeSmoothGradients(mesh.tets);
     if (mesh.kd) {
         computePartitionValueRanges(mesh.tets, *mesh.kd);
         mesh.gradientSpread = partitionGradientSpread(mesh.tets, *mesh.kd);

@@ -125,6 +125,7 @@ struct PreparedMesh {
         v.tets = nullptr;
         if (!v.hasNative()) {
             v.points = nullptr;
+            v.pointGradients = nullptr;
             if (!v.cellCentered) v.values = nullptr;
         }
         return v;

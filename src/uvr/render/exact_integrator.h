@@ -123,6 +123,30 @@ UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t,
     return clipNative(mesh, t, ray, tMin);
 }
 
+/// Most pieces smoothLitSegment cuts a segment into, and the change of light (scale plus add)
+/// a piece may span.
+inline constexpr int kLightMaxPieces = 8;
+inline constexpr float kLightPieceChange = 0.01f;
+
+/// Pieces a lit segment needs from the lights at its start a, middle c and end b: about one per
+/// kLightPieceChange of change between the ends or of bend in the middle (four times its
+/// distance from the ends' mean), at most kLightMaxPieces.
+UVR_HOST_DEVICE inline int lightPieces(const LightFactors& a, const LightFactors& c,
+                                       const LightFactors& b) {
+    const float ends = fabsf(b.scale - a.scale) + fabsf(b.add - a.add);
+    const float bend =
+        4.f * (fabsf(c.scale - 0.5f * (a.scale + b.scale)) + fabsf(c.add - 0.5f * (a.add + b.add)));
+    const float want = ceilf((ends > bend ? ends : bend) / kLightPieceChange);
+    return want <= 1.f ? 1 : (want < kLightMaxPieces ? int(want) : kLightMaxPieces);
+}
+
+/// Simpson's weights over the lights at a segment's start, middle and end.
+UVR_HOST_DEVICE inline LightFactors simpsonLight(const LightFactors& a, const LightFactors& c,
+                                                 const LightFactors& b) {
+    return {(a.scale + 4.f * c.scale + b.scale) * (1.f / 6.f),
+            (a.add + 4.f * c.add + b.add) * (1.f / 6.f)};
+}
+
 /// Most pieces a native cell's segment is cut into (nativeSegment).
 inline constexpr int kNativeMaxPieces = 16;
 
@@ -166,8 +190,9 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     };
     // The light at the parametric coordinates rst of the last point valueAt took.
     auto lightHere = [&]() {
-        return light.on ? lightFactors(light, cellGradient(k, x, cv, rst), ray.dir)
-                        : LightFactors{};
+        if (!light.on) return LightFactors{};
+        const float at[4] = {rst.x, rst.y, rst.z, 0.f};
+        return lightFactors(light, mesh.gradient(t, at, light.smooth), ray.dir);
     };
     const float vMid = valueAt(0.5 * (t0 + t1));
     const Vec3f rstMid = rst;
@@ -189,10 +214,20 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         const double want = tol > 0.0 ? ceil(sqrt(dev / tol)) : double(kNativeMaxPieces);
         pieces = want < kNativeMaxPieces ? (want > 2.0 ? int(want) : 2) : kNativeMaxPieces;
     }
+    // Lit: also as many pieces as the light's change asks (the gradient turns in the cell).
+    LightFactors lightMid;
+    if (light.on) {
+        const Vec3f at = rst;
+        rst = rstMid;
+        lightMid = lightHere();
+        rst = at;
+        const int lit = lightPieces(lightA, lightMid, lightEnd);
+        pieces = lit > pieces ? lit : pieces;
+    }
     if (pieces == 1) {
         const Vec4f before = acc;
         segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
-        lightSegment(before, lightA.mean(lightEnd), acc);
+        lightSegment(before, simpsonLight(lightA, lightMid, lightEnd), acc);
         return vEnd;
     }
     rst = rstMid;  // a good start for the pieces' points in the middle; each follows the last
@@ -208,6 +243,60 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         lightA = lightB;
     }
     return vEnd;
+}
+
+/// The light at parameter t of the ray inside tetrahedron tet: smooth, its corners' gradients
+/// at the point's barycentrics (clamped to the cell); per cell, its constant gradient.
+template <bool kNative = true>
+UVR_HOST_DEVICE inline LightFactors lightInTet(const TetMeshView& m, std::uint32_t tet,
+                                               const Ray& ray, double t, const Lighting& light) {
+    float bary[4] = {0.25f, 0.25f, 0.25f, 0.25f};
+    if (light.smooth && m.blockGradients) {
+        BlockVertex x[4];
+        m.tetVertices(tet, x);
+        float b[4];
+        if (tetBarycentrics(ray.at(static_cast<float>(t)), x[0].p, x[1].p, x[2].p, x[3].p, b)) {
+            float sum = 0.f;
+            for (float& v : b) v = v > 0.f ? v : 0.f, sum += v;
+            if (sum > 0.f)
+                for (int i = 0; i < 4; ++i) bary[i] = b[i] / sum;
+        }
+    }
+    return lightFactors(light, m.gradient<kNative>(tet, bary, light.smooth), ray.dir);
+}
+
+/// A tetrahedron's segment [t0, t1] (scalar linear from v0 to v1) lit by smooth normals, into
+/// acc: the interpolated gradient turns along it, so the light is not constant. From the lights
+/// at its ends and middle, the segment is cut into n equal pieces (at most kLightMaxPieces) so
+/// that each spans a change of light of about kLightPieceChange; each piece is lit by the mean
+/// of its ends' lights (one piece: Simpson's weights over ends and middle).
+template <bool kNative = true>
+UVR_HOST_DEVICE inline void smoothLitSegment(const TetMeshView& m, const TfTableView& tf,
+                                             std::uint32_t tet, const Ray& ray, double t0,
+                                             double t1, float v0, float v1, double unit,
+                                             const Lighting& light, Vec4f& acc) {
+    const LightFactors a = lightInTet<kNative>(m, tet, ray, t0, light);
+    const LightFactors b = lightInTet<kNative>(m, tet, ray, t1, light);
+    const LightFactors c = lightInTet<kNative>(m, tet, ray, 0.5 * (t0 + t1), light);
+    const int n = lightPieces(a, c, b);
+    if (n == 1) {
+        const Vec4f before = acc;
+        segment::integrate(tf, v0, v1, t1 - t0, unit, acc, true);
+        lightSegment(before, simpsonLight(a, c, b), acc);
+        return;
+    }
+    LightFactors la = a;
+    float va = v0;
+    const double h = (t1 - t0) / n;
+    for (int i = 1; i <= n && acc.w < segment::kOpacityEnd; ++i) {
+        const float vb = i == n ? v1 : v0 + (v1 - v0) * (float(i) / float(n));
+        const LightFactors lb = i == n ? b : lightInTet<kNative>(m, tet, ray, t0 + h * i, light);
+        const Vec4f before = acc;
+        segment::integrate(tf, va, vb, h, unit, acc, true);
+        lightSegment(before, la.mean(lb), acc);
+        va = vb;
+        la = lb;
+    }
 }
 
 /// The tetrahedron the ray is in just after t (entered last among those it is in, or the
@@ -323,22 +412,26 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             float s1;
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
                 s1 = exact::nativeSegment(loc.mesh, scene.tf, tet, ray, t, tEnd,
-                                          haveEntry ? sEntry : NAN, unit, scene.params.light,
-                                          acc);
+                                          haveEntry ? sEntry : NAN, unit, scene.params.light, acc);
             } else {
                 const float s0 =
                     haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
                 s1 = exact::scalarAt<kNative>(loc, tet, span, ray, tEnd);
-                // Float pieces (within 1e-4 of the double closed form, deep pieces in double).
-                const Vec4f before = acc;
-                segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
-                // Lit: a tetrahedron's gradient is constant, so is its light along the segment.
-                if (scene.params.light.on) {
-                    const float centre[4] = {0.25f, 0.25f, 0.25f, 0.25f};
-                    lightSegment(before,
-                                 lightFactors(scene.params.light,
-                                              loc.mesh.gradient<kNative>(tet, centre), ray.dir),
-                                 acc);
+                const Lighting& light = scene.params.light;
+                if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
+                    exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, t, tEnd, s0, s1,
+                                                     unit, light, acc);
+                } else {
+                    // Float pieces (within 1e-4 of the double closed form, deep pieces in
+                    // double).
+                    const Vec4f before = acc;
+                    segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
+                    // Lit per cell: a tetrahedron's gradient is constant, so is its light along
+                    // the segment.
+                    if (light.on)
+                        lightSegment(before,
+                                     exact::lightInTet<kNative>(loc.mesh, tet, ray, tEnd, light),
+                                     acc);
                 }
             }
             opaque = acc.w >= segment::kOpacityEnd;

@@ -32,6 +32,9 @@ inline constexpr float kDefaultSpecularPower = 100.f;
 /// The lighting of a frame, as plain data for the integrators.
 struct Lighting {
     bool on = false;  ///< off: colours as the transfer function gives them
+    /// Normals from the smooth gradients (computeSmoothGradients), interpolated in each cell;
+    /// false: each cell's own gradient (constant in a linear tetrahedron: exact per cell).
+    bool smooth = true;
     float ambient = kDefaultAmbient;
     float diffuse = kDefaultDiffuse;
     float specular = kDefaultSpecular;

@@ -104,7 +104,8 @@ template <bool kNative = true>
 UVR_HOST_DEVICE inline LightFactors lightAt(const SceneView& scene, std::uint32_t tet,
                                             const float bary[4], Vec3f dir) {
     if (!scene.params.light.on || tet == kNoTet) return {};
-    return lightFactors(scene.params.light, scene.locator.mesh.gradient<kNative>(tet, bary), dir);
+    const Lighting& light = scene.params.light;
+    return lightFactors(light, scene.locator.mesh.gradient<kNative>(tet, bary, light.smooth), dir);
 }
 
 /// The reference ray marcher: samples at fixed spacing s1 on the global grid t = k * s1 between

@@ -56,8 +56,8 @@ struct SettingDef {
 };
 
 /// Every setting of the vocabulary: method, sampling, step_rule, quality, step, max_step, power,
-/// opacity_unit, opacity_law, skip, adaptive, supersample, jitter, shade, ambient, diffuse,
-/// specular, specular_power.
+/// opacity_unit, opacity_law, skip, adaptive, supersample, jitter, shade, normals, ambient,
+/// diffuse, specular, specular_power.
 const std::vector<SettingDef>& settingsVocabulary();
 
 /// The setting called `name`, or null.

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+#include "uvr/mesh/smooth_gradients.h"
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "uvr/core/error.h"
+
+namespace uvr {
+
+namespace {
+
+/// Adds weight w of gradient g to point p's sums (several threads add to one point).
+void addTo(std::vector<Vec3f>& sums, std::vector<float>& weights, std::uint32_t p, Vec3f g,
+           float w) {
+#pragma omp atomic
+    sums[p].x += w * g.x;
+#pragma omp atomic
+    sums[p].y += w * g.y;
+#pragma omp atomic
+    sums[p].z += w * g.z;
+#pragma omp atomic
+    weights[p] += w;
+}
+
+/// Volume of a native cell: |det J| at its parametric centre times its parametric volume.
+float nativeVolume(CellKind k, const Vec3f* x) {
+    Vec3f e[kMaxCellCorners];
+    const int n = kindCorners(k);
+    for (int i = 0; i < n; ++i) e[i] = x[i] - x[0];
+    Vec3f at, jr, js, jt;
+    cellMap(k, e, cellCentreParametric(k), at, jr, js, jt);
+    const float parametric = k == CellKind::Hex ? 1.f : (k == CellKind::Wedge ? 0.5f : 1.f / 3.f);
+    return std::fabs(dot(jr, cross(js, jt))) * parametric;
+}
+
+}  // namespace
+
+bool hasSmoothGradients(const TetMesh& mesh) {
+    if (mesh.association == Association::Cell) return true;
+    return mesh.blockGradients.size() == mesh.blockVertices.size() &&
+           (!mesh.hasNative() || mesh.pointGradients.size() == mesh.points.size());
+}
+
+void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress) {
+    mesh.blockGradients.clear();
+    mesh.pointGradients.clear();
+    ProgressCounter done(progress, 3);
+    if (mesh.association == Association::Cell) {
+        done.finish();
+        return;
+    }
+    if (mesh.blockVertexPoint.size() != mesh.blockVertices.size())
+        throwError(ErrorKind::Argument, "",
+                   "smooth shading needs the mesh's point ids, which a prepared cache does not "
+                   "hold: prepare from the mesh file, or shade with per-cell normals");
+    const std::size_t points = mesh.points.size();
+    std::vector<Vec3f> sums(points, Vec3f(0.f));
+    std::vector<float> weights(points, 0.f);
+    const TetMeshView view = mesh.view();
+    const std::int64_t tets = static_cast<std::int64_t>(mesh.tetCount());
+#pragma omp parallel for schedule(static, 4096)
+    for (std::int64_t t = 0; t < tets; ++t) {
+        BlockVertex x[4];
+        view.tetVertices(t, x);
+        const Vec3f g = tetGradient(x[0].p, x[1].p, x[2].p, x[3].p, x[0].value, x[1].value,
+                                    x[2].value, x[3].value);
+        const float w = std::fabs(signedVolume6(x[0].p, x[1].p, x[2].p, x[3].p)) / 6.f;
+        if (!isFinite(g) || !(w > 0.f)) continue;
+        const TetCorners16 c = mesh.tetCorners[t];
+        const std::uint32_t base = mesh.blockVertexBase[std::uint64_t(t) >> kTetBlockBits];
+        for (int k = 0; k < 4; ++k)
+            addTo(sums, weights, mesh.blockVertexPoint[base + c.v[k]], g, w);
+    }
+    done.add();
+    const std::int64_t cells = static_cast<std::int64_t>(mesh.cellCount());
+#pragma omp parallel for schedule(static, 1024)
+    for (std::int64_t c = tets; c < cells; ++c) {
+        Vec3f x[kMaxCellCorners];
+        float v[kMaxCellCorners];
+        std::uint32_t ids[kMaxCellCorners];
+        const int n = view.corners(c, ids);
+        view.gather(c, x, v);
+        const CellKind k = view.kind(c);
+        const float w = nativeVolume(k, x);
+        if (!(w > 0.f) || !std::isfinite(w)) continue;
+        for (int i = 0; i < n; ++i) {
+            Vec3f rst = cornerParametric(k, i);
+            if (k == CellKind::Pyramid && i == 4) rst = Vec3f(0.5f, 0.5f, 0.5f);  // the apex
+            const Vec3f g = cellGradient(k, x, v, rst);
+            if (isFinite(g)) addTo(sums, weights, ids[i], g, w);
+        }
+    }
+    done.add();
+    for (std::size_t p = 0; p < points; ++p)
+        sums[p] = weights[p] > 0.f ? sums[p] * (1.f / weights[p]) : Vec3f(0.f);
+    mesh.blockGradients.resize(mesh.blockVertices.size());
+    const std::int64_t bv = static_cast<std::int64_t>(mesh.blockVertices.size());
+#pragma omp parallel for schedule(static, 65536)
+    for (std::int64_t i = 0; i < bv; ++i) mesh.blockGradients[i] = sums[mesh.blockVertexPoint[i]];
+    if (mesh.hasNative()) mesh.pointGradients = std::move(sums);
+    done.finish();
+}
+
+}  // namespace uvr
