@@ -64,19 +64,23 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     const FrameView frame = makeFrameView(settings, result.setup, result.image.pixels.data(),
                                           result.sampleCounts.data());
     const auto start = std::chrono::steady_clock::now();
-    dispatchNative(mesh.tets.hasNative(), [&](auto kNative) {
-        const RenderMethod method = result.setup.method.method;
-        if (method == RenderMethod::Reference)
-            launchFrame(frame, result.stats, ReferenceMarch<kNative()>{result.setup.scene(mesh)},
-                        settings.progress);
-        else if (method == RenderMethod::Exact)
-            launchFrame(frame, result.stats, ExactMarch<kNative()>{result.setup.scene(mesh)},
-                        settings.progress);
-        else
-            launchFrame(frame, result.stats,
-                        PartitionMarch<kNative()>{result.setup.partitionScene(mesh, settings.skip)},
-                        settings.progress);
-    });
+    dispatchKernel(mesh.tets.hasNative(), result.setup.params.light.on,
+                   [&](auto kNative, auto kLit) {
+                       const RenderMethod method = result.setup.method.method;
+                       if (method == RenderMethod::Reference)
+                           launchFrame(frame, result.stats,
+                                       ReferenceMarch<kNative(), kLit()>{result.setup.scene(mesh)},
+                                       settings.progress);
+                       else if (method == RenderMethod::Exact)
+                           launchFrame(frame, result.stats,
+                                       ExactMarch<kNative(), kLit()>{result.setup.scene(mesh)},
+                                       settings.progress);
+                       else
+                           launchFrame(frame, result.stats,
+                                       PartitionMarch<kNative(), kLit()>{
+                                           result.setup.partitionScene(mesh, settings.skip)},
+                                       settings.progress);
+                   });
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;

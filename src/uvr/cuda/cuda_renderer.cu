@@ -413,21 +413,23 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaEventCreate(&end));
     UVR_CUDA_CHECK(cudaEventRecord(begin));
     const bool native = d.mesh.tets.hasNative();
+    const bool lit = result.setup.params.light.on;
     if (method == RenderMethod::Reference) {
-        dispatchNative(native, [&](auto kNative) {
+        dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
             cuda::launchFrame(grid, block, frame,
-                              ReferenceMarch<kNative()>{d.deviceScene(result.setup)},
+                              ReferenceMarch<kNative(), kLit()>{d.deviceScene(result.setup)},
                               d.totals.data());
         });
     } else if (method == RenderMethod::Exact) {
-        dispatchNative(native, [&](auto kNative) {
+        dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
             cuda::launchFrame(grid, block, frame,
-                              ExactMarch<kNative()>{d.deviceScene(result.setup)}, d.totals.data());
+                              ExactMarch<kNative(), kLit()>{d.deviceScene(result.setup)},
+                              d.totals.data());
         });
     } else {
         const PartitionSceneView scene = d.devicePartitionScene(result.setup, settings.skip);
-        dispatchNative(native, [&](auto kNative) {
-            cuda::launchFrame(grid, block, frame, PartitionMarch<kNative()>{scene},
+        dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
+            cuda::launchFrame(grid, block, frame, PartitionMarch<kNative(), kLit()>{scene},
                               d.totals.data());
         });
     }

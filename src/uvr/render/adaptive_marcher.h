@@ -176,7 +176,7 @@ struct PartitionSceneView {
 /// a curved boundary to the end of the piece's box), and a sample outside the mesh is followed
 /// by one s1 on (or by the first grid point past its seed-grid cell when that holds no cell), so
 /// a grazing ray's short chord is not stepped over.
-template <bool kNative = true>
+template <bool kNative = true, bool kLit = true>
 UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
                                              RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -192,7 +192,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const float stopAlpha = scene.base.params.terminationAlpha;
     const TfTableView& tf = scene.base.tf;
     const bool preintegrated = scene.base.params.preintegrated;
-    SampleSegments segments;
+    const Lighting lighting = kernelLighting<kLit>(scene.base.params);
+    SampleSegments<kLit> segments;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
@@ -299,7 +300,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (tet == kNoTet && !emptySpace)
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
-        const LightFactors light = lightAt<kNative>(scene.base, tet, bary, ray.dir);
+        const LightFactors light = lightAt<kNative>(lighting, locator.mesh, tet, bary, ray.dir);
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
         // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
@@ -344,7 +345,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     const float vMid =
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
                     const LightFactors lightMid =
-                        lightAt<kNative>(scene.base, found, probeBary, ray.dir);
+                        lightAt<kNative>(lighting, locator.mesh, found, probeBary, ray.dir);
                     if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;

@@ -67,14 +67,23 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
         Vec3d n = cross(b - a, c - a);
         double height = dot(n, p[i] - a);  // vertex i's signed distance (times |n|)
         if (height > 0.0) n = {-n.x, -n.y, -n.z}, height = -height;
-        const double num = dot(n, a - o), den = dot(n, d);
+        const double num = dot(n, a - o);
+        double den = dot(n, d);
+        // A ray parallel to the face to rounding is parallel: a ray lying in a face's plane
+        // (an axis-aligned view of a split grid) has den exactly 0 without fused multiply-adds
+        // but a few ulps of |n| with them (the GPU's), and num / den then cut the span at an
+        // arbitrary place, losing the rest of the ray (a quarter of it on the H200).
+        if (den * den <= 1e-24 * dot(n, n)) den = 0.0;
         if (den > 0.0) {
             const double t1 = num / den;
             if (t1 < s.tOut) s.tOut = t1, s.exitFace = i;
         } else if (den < 0.0) {
             const double t0 = num / den;
             if (t0 > s.tIn) s.tIn = t0;
-        } else if (num < 0.0) {  // parallel to the face and outside it
+        } else if (num < -1e-12 * sqrt(dot(n, n) * dot(a - o, a - o))) {
+            // Parallel to the face and outside it; in its plane to rounding counts as inside
+            // (both cells sharing the face hold the ray, as they do without fused
+            // multiply-adds, rather than neither).
             s.tIn = INFINITY;
             s.tOut = -INFINITY;
         }
@@ -160,6 +169,7 @@ inline constexpr int kNativeMaxPieces = 16;
 /// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc; lit
 /// (gradient shading), each piece by the mean of its ends' lights (the gradient through the
 /// cell's Jacobian at the Newton iterate's coordinates).
+template <bool kLit = true>
 UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
                                            float v0, double unit, const Lighting& light,
@@ -190,7 +200,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     };
     // The light at the parametric coordinates rst of the last point valueAt took.
     auto lightHere = [&]() {
-        if (!light.on) return LightFactors{};
+        if (!kLit || !light.on) return LightFactors{};
         const float at[4] = {rst.x, rst.y, rst.z, 0.f};
         return lightFactors(light, mesh.gradient(t, at, light.smooth), ray.dir);
     };
@@ -200,7 +210,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     if (!(v0 == v0)) {
         v0 = valueAt(t0);
         lightA = lightHere();
-    } else if (light.on) {
+    } else if (kLit && light.on) {
         (void)valueAt(t0);  // for its coordinates only
         lightA = lightHere();
         rst = rstMid;  // t1's Newton starts where it would unlit
@@ -216,7 +226,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     }
     // Lit: also as many pieces as the light's change asks (the gradient turns in the cell).
     LightFactors lightMid;
-    if (light.on) {
+    if (kLit && light.on) {
         const Vec3f at = rst;
         rst = rstMid;
         lightMid = lightHere();
@@ -227,7 +237,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     if (pieces == 1) {
         const Vec4f before = acc;
         segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
-        lightSegment(before, simpsonLight(lightA, lightMid, lightEnd), acc);
+        if constexpr (kLit) lightSegment(before, simpsonLight(lightA, lightMid, lightEnd), acc);
         return vEnd;
     }
     rst = rstMid;  // a good start for the pieces' points in the middle; each follows the last
@@ -238,7 +248,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         const LightFactors lightB = i == pieces ? lightEnd : lightHere();
         const Vec4f before = acc;
         segment::integrate(tf, a, b, h, unit, acc, true);
-        lightSegment(before, lightA.mean(lightB), acc);
+        if constexpr (kLit) lightSegment(before, lightA.mean(lightB), acc);
         a = b;
         lightA = lightB;
     }
@@ -366,7 +376,7 @@ UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, 
 }  // namespace exact
 
 /// The exact integrator for one ray (see the top of this file).
-template <bool kNative = true>
+template <bool kNative = true, bool kLit = true>
 UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -384,6 +394,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     // A gap this small between tetrahedra is rounding, not empty space.
     const double eps = 1e-6 * (double(scene.bounds.diagonal()) + double(b0));
     const double unit = scene.params.opacityUnit;
+    const Lighting lighting = kernelLighting<kLit>(scene.params);
     double t = b0;
     exact::TetSpan span;
     std::uint32_t tet =
@@ -411,27 +422,34 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             ++counters.samples;  // one segment per cell crossed
             float s1;
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
-                s1 = exact::nativeSegment(loc.mesh, scene.tf, tet, ray, t, tEnd,
-                                          haveEntry ? sEntry : NAN, unit, scene.params.light, acc);
+                s1 = exact::nativeSegment<kLit>(loc.mesh, scene.tf, tet, ray, t, tEnd,
+                                                haveEntry ? sEntry : NAN, unit, lighting, acc);
             } else {
                 const float s0 =
                     haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
                 s1 = exact::scalarAt<kNative>(loc, tet, span, ray, tEnd);
-                const Lighting& light = scene.params.light;
-                if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
-                    exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, t, tEnd, s0, s1,
-                                                     unit, light, acc);
-                } else {
+                const Lighting& light = lighting;
+                bool integrated = false;
+                if constexpr (kLit) {
+                    if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
+                        exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, t, tEnd, s0,
+                                                         s1, unit, light, acc);
+                        integrated = true;
+                    }
+                }
+                if (!integrated) {
                     // Float pieces (within 1e-4 of the double closed form, deep pieces in
                     // double).
                     const Vec4f before = acc;
                     segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
                     // Lit per cell: a tetrahedron's gradient is constant, so is its light along
                     // the segment.
-                    if (light.on)
-                        lightSegment(before,
-                                     exact::lightInTet<kNative>(loc.mesh, tet, ray, tEnd, light),
-                                     acc);
+                    if constexpr (kLit) {
+                        if (light.on)
+                            lightSegment(
+                                before, exact::lightInTet<kNative>(loc.mesh, tet, ray, tEnd, light),
+                                acc);
+                    }
                 }
             }
             opaque = acc.w >= segment::kOpacityEnd;

@@ -89,43 +89,50 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
 /// The reference marcher as a functor for shadePixel (lambdas do not cross to CUDA kernels).
 ///
 /// The integrator functors take kNative false for meshes of tetrahedra only: their kernels are
-/// compiled without the native cells' code (dispatchNative picks the instance), which costs
-/// tetrahedra 10-30% of their frame time on the GPU when present.
-template <bool kNative = true>
+/// compiled without the native cells' code (dispatchKernel picks the instance), which costs
+/// tetrahedra 10-30% of their frame time on the GPU when present; and kLit false for frames
+/// without shading (without the lighting code: up to 21% of the adaptive kernel's time).
+template <bool kNative = true, bool kLit = true>
 struct ReferenceMarch {
     SceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return marchReference<kNative>(scene, ray, counters);
+        return marchReference<kNative, kLit>(scene, ray, counters);
     }
 };
 
 /// The exact integrator as a functor for shadePixel (its "samples" are tetrahedra crossed).
-template <bool kNative = true>
+template <bool kNative = true, bool kLit = true>
 struct ExactMarch {
     SceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return integrateExact<kNative>(scene, ray, counters);
+        return integrateExact<kNative, kLit>(scene, ray, counters);
     }
 };
 
 /// The partition integrator as a functor for shadePixel.
-template <bool kNative = true>
+template <bool kNative = true, bool kLit = true>
 struct PartitionMarch {
     PartitionSceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return marchPartitions<kNative>(scene, ray, counters);
+        return marchPartitions<kNative, kLit>(scene, ray, counters);
     }
 };
 
-/// Calls f with std::true_type when the mesh has native cells, else std::false_type: the
-/// integrator functors' kNative (compiled twice; a mesh of tetrahedra runs without the native
-/// cells' code).
+/// Calls f(kNative, kLit) with std::true_type or std::false_type for each: kNative when the
+/// mesh has native cells, kLit when the frame is shaded (the integrator functors' parameters;
+/// each compiled four times, so a frame runs without the code it does not need).
 template <typename F>
-void dispatchNative(bool hasNative, F&& f) {
+void dispatchKernel(bool hasNative, bool lit, F&& f) {
+    auto withLit = [&](auto kNative) {
+        if (lit)
+            f(kNative, std::true_type{});
+        else
+            f(kNative, std::false_type{});
+    };
     if (hasNative)
-        f(std::true_type{});
+        withLit(std::true_type{});
     else
-        f(std::false_type{});
+        withLit(std::false_type{});
 }
 
 }  // namespace uvr

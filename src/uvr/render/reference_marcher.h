@@ -44,7 +44,9 @@ UVR_HOST_DEVICE inline void compositeFrontToBack(Vec4f& acc, Vec3f rgb, float a)
 /// the distance up to the next sample or the end of its piece, over which the run's last slope
 /// is extended (its value held for a run of one sample). So a run of n samples covers the same
 /// distance as n point samples, a linear field is integrated exactly, and with equal steps the
-/// partition integrator takes exactly the reference's segments.
+/// partition integrator takes exactly the reference's segments. kLit false: without the lights
+/// (an unshaded kernel holds none of their registers).
+template <bool kLit = true>
 struct SampleSegments {
     float kLast = 0.f;     ///< grid position of the last sample
     float kEnd = 0.f;      ///< end of the piece of the ray the last sample belongs to
@@ -66,7 +68,7 @@ struct SampleSegments {
         if (goesOn) {
             const Vec4f before = acc;
             segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc, true);
-            lightSegment(before, light.mean(f), acc);
+            if constexpr (kLit) lightSegment(before, light.mean(f), acc);
         } else if (started && inside) {  // the run ends
             endRun(tf, (k < kEnd ? k : kEnd) - kLast, s1, unit, acc);
         }
@@ -76,7 +78,7 @@ struct SampleSegments {
         kLast = k;
         kEnd = kPieceEnd;
         vLast = v;
-        light = f;
+        if constexpr (kLit) light = f;
         inside = in;
         started = true;
     }
@@ -94,18 +96,28 @@ private:
         if (inRun) end += (double(vLast) - vPrev) * (double(steps) / (double(kLast) - kPrev));
         const Vec4f before = acc;
         segment::integrate(tf, vLast, end, double(steps) * s1, unit, acc, true);
-        lightSegment(before, light, acc);
+        if constexpr (kLit) lightSegment(before, light, acc);
     }
 };
 
 /// The light of a sample in cell `tet` at local coordinates bary (TetMeshView::gradient) along
 /// a ray of unit direction dir: the identity when lighting is off or no cell holds it.
 template <bool kNative = true>
-UVR_HOST_DEVICE inline LightFactors lightAt(const SceneView& scene, std::uint32_t tet,
-                                            const float bary[4], Vec3f dir) {
-    if (!scene.params.light.on || tet == kNoTet) return {};
-    const Lighting& light = scene.params.light;
-    return lightFactors(light, scene.locator.mesh.gradient<kNative>(tet, bary, light.smooth), dir);
+UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, const TetMeshView& mesh,
+                                            std::uint32_t tet, const float bary[4], Vec3f dir) {
+    if (!light.on || tet == kNoTet) return {};
+    return lightFactors(light, mesh.gradient<kNative>(tet, bary, light.smooth), dir);
+}
+
+/// The lighting an integrator instance reads: the frame's, or none where it is compiled unlit
+/// (kLit false: its kernels carry no lighting code, which cost the unlit adaptive kernel up to
+/// 21% of its frame time on the H200).
+template <bool kLit>
+UVR_HOST_DEVICE inline Lighting kernelLighting(const MarchParams& params) {
+    if constexpr (kLit)
+        return params.light;
+    else
+        return Lighting{};
 }
 
 /// The reference ray marcher: samples at fixed spacing s1 on the global grid t = k * s1 between
@@ -114,7 +126,7 @@ UVR_HOST_DEVICE inline LightFactors lightAt(const SceneView& scene, std::uint32_
 /// consecutive samples (SampleSegments; or, with params.preintegrated off, classifies each sample
 /// through the transfer function and composites it with opacity correction), front to back,
 /// stopping early once opaque.
-template <bool kNative = true>
+template <bool kNative = true, bool kLit = true>
 UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -131,7 +143,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
     const float unit = scene.params.opacityUnit;
-    SampleSegments segments;
+    SampleSegments<kLit> segments;
+    const Lighting lighting = kernelLighting<kLit>(scene.params);
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
@@ -140,7 +153,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
-        const LightFactors light = lightAt<kNative>(scene, tet, bary, ray.dir);
+        const LightFactors light =
+            lightAt<kNative>(lighting, scene.locator.mesh, tet, bary, ray.dir);
         if (scene.params.preintegrated) {
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light);
         } else if (tet != kNoTet) {
