@@ -188,7 +188,11 @@ RenderSettings RenderFlags::baseSettings() const {
     std::vector<std::string> given;
     for (const SettingDef& def : settingsVocabulary())
         if (vocabulary.given(def.name)) given.emplace_back(def.name);
-    refuseUnreadSettings(s, given);
+    try {
+        refuseUnreadSettings(s, given);
+    } catch (const SettingError& e) {  // quoting the value as typed ("8", not "8.0")
+        throw SettingError(e.setting(), vocabulary.text(e.setting()), e.expected());
+    }
     if (s.jitter && s.supersample < 2)
         throwError(ErrorKind::Argument, "",
                    "--jitter moves the rays of --supersample N inside the pixel: it needs "

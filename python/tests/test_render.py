@@ -238,7 +238,7 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
     with pytest.raises(uvr.ArgumentError, match=r"^clip_box=.*: expected \(lo, hi\)"):
         r.render(clip_box=(0, 0, 0))
     # Gradient shading (issue 32): a coefficient needs shade=True.
-    with pytest.raises(uvr.ArgumentError, match=r"^ambient=0.3: read only with shade on"):
+    with pytest.raises(uvr.ArgumentError, match=r"^ambient=0.3: read only with `shade` on"):
         r.render(ambient=0.3)
     with pytest.raises(uvr.ArgumentError, match=r"^diffuse=2: expected a number in \[0, 1\]"):
         r.render(shade=True, diffuse=2)

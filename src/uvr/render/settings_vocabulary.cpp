@@ -319,12 +319,6 @@ const SettingDef& settingNamed(std::string_view name) {
 
 std::string settingValueText(const Json& value) {
     if (value.is_string()) return "'" + printableShort(value.get_ref<const std::string&>()) + "'";
-    // A whole number as it is typed ("8", not JSON's "8.0").
-    if (value.is_number_float()) {
-        const double x = value.get<double>();
-        if (std::isfinite(x) && x == std::floor(x) && std::fabs(x) < 1e15)
-            return std::to_string(static_cast<long long>(x));
-    }
     return printableShort(value.dump(-1, ' ', false, Json::error_handler_t::replace));
 }
 

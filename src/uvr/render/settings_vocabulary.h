@@ -100,8 +100,7 @@ std::string settingExpectation(const SettingDef& def);
 /// default, the methods that read it, the setting it needs and its choices or range.
 nlohmann::json settingsVocabularyJson();
 
-/// A value as a message quotes it: a string as 'text', a whole number without a fraction (8),
-/// anything else as JSON.
+/// A value as a message quotes it: a string as 'text', anything else as JSON.
 std::string settingValueText(const nlohmann::json& value);
 
 }  // namespace uvr
