@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <ostream>
 #include <string>
 
@@ -43,6 +44,12 @@ protected:
         return renderOn(GetParam(), mesh, settings);
     }
 };
+
+/// Bit for bit the same pixels.
+inline bool samePixels(const Image& a, const Image& b) {
+    return a.pixels.size() == b.pixels.size() &&
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec4f)) == 0;
+}
 
 /// How gtest prints the parameter ("cpu", "cuda") in test listings and failures.
 inline void PrintTo(TestDevice device, std::ostream* os) {

@@ -60,12 +60,6 @@ RenderSettings alongX(RenderMethod method, bool parallel, const char* opacity = 
     return s;
 }
 
-/// Bit for bit the same pixels.
-bool samePixels(const Image& a, const Image& b) {
-    return a.pixels.size() == b.pixels.size() &&
-           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec4f)) == 0;
-}
-
 constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
                                      RenderMethod::Partitions};
 
@@ -101,7 +95,7 @@ TEST_P(Clipping, PlanesThatKeepNothingOrEverything) {
         RenderSettings s = alongX(m, true);
         const RenderResult whole = render(pm, s);
         s.clipPlanes = {{Vec3f(0.f, 0.f, -5.f), Vec3f(0.f, 0.f, 1.f)}};
-        EXPECT_TRUE(samePixels(render(pm, s).image, whole.image)) << what;
+        EXPECT_TRUE(testing::samePixels(render(pm, s).image, whole.image)) << what;
         s.clipPlanes = {{Vec3f(0.f, 0.f, 5.f), Vec3f(0.f, 0.f, 1.f)}};
         for (const Vec4f& p : render(pm, s).image.pixels) ASSERT_EQ(p.w, 0.f) << what;
         // Two planes whose kept sides do not meet.
@@ -128,7 +122,7 @@ TEST_P(Clipping, ABoxAroundTheMeshChangesNothing) {
         s.clipBox = Bounds3f{Vec3f(-1.f, -1.f, -1.f), Vec3f(2.f, 2.f, 2.f)};
         const RenderResult boxed = render(pm, s);
         if (m != RenderMethod::Exact) {
-            EXPECT_TRUE(samePixels(boxed.image, whole.image)) << methodName(m);
+            EXPECT_TRUE(testing::samePixels(boxed.image, whole.image)) << methodName(m);
             continue;
         }
         for (std::size_t i = 0; i < whole.image.pixels.size(); ++i)

@@ -76,11 +76,6 @@ Lighting someLight(bool smooth = true) {
     return l;
 }
 
-bool samePixels(const Image& a, const Image& b) {
-    return a.pixels.size() == b.pixels.size() &&
-           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec4f)) == 0;
-}
-
 constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
                                      RenderMethod::Partitions};
 
@@ -169,10 +164,10 @@ TEST_P(Lit, IdentityLightChangesNoBit) {
         const RenderResult unlit = render(pm, s);
         s.lighting = someLight();
         s.lighting.on = false;
-        EXPECT_TRUE(samePixels(render(pm, s).image, unlit.image)) << methodName(m);
+        EXPECT_TRUE(testing::samePixels(render(pm, s).image, unlit.image)) << methodName(m);
         s.lighting = Lighting{};
         s.lighting.on = true, s.lighting.ambient = 1.f, s.lighting.diffuse = 0.f;
-        EXPECT_TRUE(samePixels(render(pm, s).image, unlit.image)) << methodName(m);
+        EXPECT_TRUE(testing::samePixels(render(pm, s).image, unlit.image)) << methodName(m);
     }
 }
 
