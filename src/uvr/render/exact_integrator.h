@@ -64,26 +64,22 @@ UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t,
     for (int i = 0; i < 4; ++i) {
         // Face opposite vertex i; its normal points away from vertex i.
         const Vec3d a = p[(i + 1) & 3], b = p[(i + 2) & 3], c = p[(i + 3) & 3];
-        Vec3d n = cross(b - a, c - a);
+        // Without fused multiply-adds (crossRounded, dotRounded): a ray lying in a face's plane
+        // (a parallel view down an axis of a split grid: the diagonal faces y = z hold rays)
+        // has den exactly 0 and its num the same on both cells of the face, as on the CPU.
+        // Fused, the GPU's den was a few ulps of |n|, num / den cut the span anywhere, and a
+        // quarter of such a ray was lost.
+        Vec3d n = crossRounded(b - a, c - a);
         double height = dot(n, p[i] - a);  // vertex i's signed distance (times |n|)
         if (height > 0.0) n = {-n.x, -n.y, -n.z}, height = -height;
-        const double num = dot(n, a - o);
-        double den = dot(n, d);
-        // A ray parallel to the face to rounding is parallel: a ray lying in a face's plane
-        // (an axis-aligned view of a split grid) has den exactly 0 without fused multiply-adds
-        // but a few ulps of |n| with them (the GPU's), and num / den then cut the span at an
-        // arbitrary place, losing the rest of the ray (a quarter of it on the H200).
-        if (den * den <= 1e-24 * dot(n, n)) den = 0.0;
+        const double num = dotRounded(n, a - o), den = dotRounded(n, d);
         if (den > 0.0) {
             const double t1 = num / den;
             if (t1 < s.tOut) s.tOut = t1, s.exitFace = i;
         } else if (den < 0.0) {
             const double t0 = num / den;
             if (t0 > s.tIn) s.tIn = t0;
-        } else if (num < -1e-12 * sqrt(dot(n, n) * dot(a - o, a - o))) {
-            // Parallel to the face and outside it; in its plane to rounding counts as inside
-            // (both cells sharing the face hold the ray, as they do without fused
-            // multiply-adds, rather than neither).
+        } else if (num < 0.0) {  // parallel to the face and outside it
             s.tIn = INFINITY;
             s.tOut = -INFINITY;
         }
