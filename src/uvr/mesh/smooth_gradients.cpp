@@ -93,7 +93,9 @@ void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress) {
         }
     }
     done.add();
-    for (std::size_t p = 0; p < points; ++p)
+    const std::int64_t pointCount = static_cast<std::int64_t>(points);
+#pragma omp parallel for schedule(static, 65536)
+    for (std::int64_t p = 0; p < pointCount; ++p)
         sums[p] = weights[p] > 0.f ? sums[p] * (1.f / weights[p]) : Vec3f(0.f);
     mesh.blockGradients.resize(mesh.blockVertices.size());
     const std::int64_t bv = static_cast<std::int64_t>(mesh.blockVertices.size());
