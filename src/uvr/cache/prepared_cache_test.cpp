@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/mesh/procedural.h"
+#include "uvr/mesh/smooth_gradients.h"
 #include "uvr/tf/transfer_function.h"
 
 namespace uvr {
@@ -95,6 +97,41 @@ void expectSameFramesFromCache(const Mesh& mesh, const std::string& fieldSpec) {
     }
 }
 
+/// Smooth gradients made on a mesh read from its cache (which holds no point ids: the block
+/// vertices weld by position) equal those of the fresh preparation.
+void expectSameSmoothGradientsFromCache(const Mesh& mesh, const std::string& fieldSpec) {
+    const std::string dir = testing::scratchDir();
+    const ScalarField field = selectScalarField(mesh, parseFieldSpec(fieldSpec));
+    const PrepareOptions options = bothMethods();
+    PreparedMesh fresh = prepareMesh(mesh, field, options);
+    const CacheKey key = makeCacheKey(sourceFile(dir), fieldSpec, "", options);
+    const std::string cache = dir + "/mesh.uvrprep";
+    writePreparedCache(fresh, key, SourceSummary{}, cache);
+    LoadBudget budget;
+    PreparedMesh loaded = readPreparedCache(cache, key, budget);
+    ASSERT_TRUE(loaded.tets.blockVertexPoint.empty());
+    computeSmoothGradients(fresh.tets);
+    computeSmoothGradients(loaded.tets);
+    ASSERT_TRUE(hasSmoothGradients(loaded.tets));
+    ASSERT_EQ(loaded.tets.blockGradients.size(), fresh.tets.blockGradients.size());
+    ASSERT_EQ(loaded.tets.pointGradients.size(), fresh.tets.pointGradients.size());
+    auto near = [](Vec3f a, Vec3f b) { return length(a - b) <= 1e-5f * (1.f + length(b)); };
+    for (std::size_t i = 0; i < fresh.tets.blockGradients.size(); ++i)
+        ASSERT_TRUE(near(loaded.tets.blockGradients[i], fresh.tets.blockGradients[i]))
+            << "block vertex " << i;
+    for (std::size_t i = 0; i < fresh.tets.pointGradients.size(); ++i)
+        ASSERT_TRUE(near(loaded.tets.pointGradients[i], fresh.tets.pointGradients[i]))
+            << "point " << i;
+    RenderSettings s = frameOf(mesh.bounds(), RenderMethod::Exact);
+    s.lighting.on = true;
+    const RenderResult a = renderCpu(fresh, s), b = renderCpu(loaded, s);
+    float worst = 0.f;
+    for (std::size_t i = 0; i < a.image.pixels.size(); ++i)
+        for (int k = 0; k < 4; ++k)
+            worst = std::max(worst, std::fabs(a.image.pixels[i][k] - b.image.pixels[i][k]));
+    EXPECT_LT(worst, 1e-4f);
+}
+
 TEST(PreparedCache, BoxRendersFromTheCacheAsFromAFreshPreparation) {
     ProceduralSpec spec;
     spec.targetCells = 20000;
@@ -107,6 +144,15 @@ TEST(PreparedCache, MixedCellsRenderFromTheCacheAsFromAFreshPreparation) {
 
 TEST(PreparedCache, CellDataRendersFromTheCacheAsFromAFreshPreparation) {
     expectSameFramesFromCache(generateMixedCellMesh(4), "block");
+}
+
+TEST(PreparedCache, SmoothGradientsFromTheCacheWeldTheBlockVerticesByPosition) {
+    // Tetrahedra only (the cache holds no points) and mixed cells (it holds the points, which
+    // the native cells' corners name).
+    ProceduralSpec spec;
+    spec.targetCells = 20000;
+    expectSameSmoothGradientsFromCache(generateMesh(spec), "");
+    expectSameSmoothGradientsFromCache(generateMixedCellMesh(4), "linear");
 }
 
 TEST(PreparedCache, HoldsAboutThirtyBytesPerTetrahedronForTheAdaptiveMethod) {

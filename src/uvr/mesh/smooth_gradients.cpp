@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/mesh/smooth_gradients.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
-
-#include "uvr/core/error.h"
 
 namespace uvr {
 
@@ -35,6 +35,46 @@ float nativeVolume(CellKind k, const Vec3f* x) {
     return std::fabs(dot(jr, cross(js, jt))) * parametric;
 }
 
+/// A position's bits, ordered: equal positions weld (+0 and -0 apart, which no mesh relies on).
+struct PositionKey {
+    std::uint32_t x, y, z;
+    explicit PositionKey(Vec3f p) {
+        std::memcpy(&x, &p.x, 4);
+        std::memcpy(&y, &p.y, 4);
+        std::memcpy(&z, &p.z, 4);
+    }
+    bool operator<(const PositionKey& o) const {
+        return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z);
+    }
+    bool operator==(const PositionKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+
+/// Point ids for the block vertices of a mesh that lacks them (read from a prepared cache, which
+/// does not store them): vertices at one position are one point. Ids below points.size() are
+/// the points at those positions (a native mesh's cache holds its points, which its native cells
+/// name); the others are new. Returns the number of ids.
+std::uint32_t weldBlockVertices(const TetMesh& mesh, std::vector<std::uint32_t>& ids) {
+    const std::size_t points = mesh.points.size(), vertices = mesh.blockVertices.size();
+    auto at = [&](std::uint32_t i) {
+        return PositionKey(i < points ? mesh.points[i] : mesh.blockVertices[i - points].p);
+    };
+    std::vector<std::uint32_t> order(points + vertices);
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+    // Points first among equal positions, so a group takes a point's id where it has one.
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const PositionKey ka = at(a), kb = at(b);
+        return ka < kb || (ka == kb && a < b);
+    });
+    ids.assign(vertices, 0);
+    std::uint32_t next = static_cast<std::uint32_t>(points), group = 0;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        const std::uint32_t i = order[k];
+        if (k == 0 || !(at(order[k - 1]) == at(i))) group = i < points ? i : next++;
+        if (i >= points) ids[i - points] = group;
+    }
+    return next;
+}
+
 }  // namespace
 
 bool hasSmoothGradients(const TetMesh& mesh) {
@@ -51,11 +91,11 @@ void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress) {
         done.finish();
         return;
     }
+    std::vector<std::uint32_t> welded;
+    std::size_t points = mesh.points.size();
     if (mesh.blockVertexPoint.size() != mesh.blockVertices.size())
-        throwError(ErrorKind::Argument, "",
-                   "smooth shading needs the mesh's point ids, which a prepared cache does not "
-                   "hold: prepare from the mesh file, or shade with per-cell normals");
-    const std::size_t points = mesh.points.size();
+        points = weldBlockVertices(mesh, welded);
+    const std::vector<std::uint32_t>& vertexPoint = welded.empty() ? mesh.blockVertexPoint : welded;
     std::vector<Vec3f> sums(points, Vec3f(0.f));
     std::vector<float> weights(points, 0.f);
     const TetMeshView view = mesh.view();
@@ -70,8 +110,7 @@ void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress) {
         if (!isFinite(g) || !(w > 0.f)) continue;
         const TetCorners16 c = mesh.tetCorners[t];
         const std::uint32_t base = mesh.blockVertexBase[std::uint64_t(t) >> kTetBlockBits];
-        for (int k = 0; k < 4; ++k)
-            addTo(sums, weights, mesh.blockVertexPoint[base + c.v[k]], g, w);
+        for (int k = 0; k < 4; ++k) addTo(sums, weights, vertexPoint[base + c.v[k]], g, w);
     }
     done.add();
     const std::int64_t cells = static_cast<std::int64_t>(mesh.cellCount());
@@ -100,8 +139,11 @@ void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress) {
     mesh.blockGradients.resize(mesh.blockVertices.size());
     const std::int64_t bv = static_cast<std::int64_t>(mesh.blockVertices.size());
 #pragma omp parallel for schedule(static, 65536)
-    for (std::int64_t i = 0; i < bv; ++i) mesh.blockGradients[i] = sums[mesh.blockVertexPoint[i]];
-    if (mesh.hasNative()) mesh.pointGradients = std::move(sums);
+    for (std::int64_t i = 0; i < bv; ++i) mesh.blockGradients[i] = sums[vertexPoint[i]];
+    if (mesh.hasNative()) {
+        sums.resize(mesh.points.size());  // the welded ids past the points name no native corner
+        mesh.pointGradients = std::move(sums);
+    }
     done.finish();
 }
 

@@ -17,9 +17,9 @@ namespace uvr {
 /// gradient; a native cell's at that corner through its Jacobian, a pyramid's apex at the
 /// middle of its axis). Cells of non-finite gradient (degenerate, NaN values) are left out; a
 /// point with none gets 0 (lit as facing the light). Cell data: both empty (a constant field
-/// in each cell has no gradient). Throws Error(Argument) for a mesh without its blocks' point
-/// ids (read from a prepared cache). 12 bytes per block vertex (and per point with native
-/// cells).
+/// in each cell has no gradient). A mesh without its blocks' point ids (read from a prepared
+/// cache) takes the vertices at one position as one point (a sort of them). 12 bytes per block
+/// vertex (and per point with native cells).
 void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress = {});
 
 /// True when mesh holds what TetMeshView::gradient needs for smooth gradients (or has cell
