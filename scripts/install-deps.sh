@@ -15,7 +15,7 @@
 # writes their test files; clang-format-14 checks the sources' style (tests/tools/check_format.sh).
 set -eu
 export DEBIAN_FRONTEND=noninteractive
-PACKAGES="g++ cmake make pkg-config
+PACKAGES="g++ cmake make ninja-build pkg-config
   zlib1g-dev libpng-dev libexpat1-dev libcli11-dev nlohmann-json3-dev
   liblz4-dev liblzma-dev
   libfreetype-dev libfontconfig-dev fonts-dejavu-core
