@@ -92,6 +92,16 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
                    "Clip the volume to the box x0,y0,z0,x1,y1,z1 (file coordinates): only its "
                    "inside is kept")
         ->type_name("X0,Y0,Z0,X1,Y1,Z1");
+    app.add_option("--iso", isoSurfaces,
+                   "An isosurface inside the volume where the field equals VALUE, of opacity "
+                   "OPACITY in (0, 1] (default 1: opaque) and colour #RRGGBB (default: the colour "
+                   "map's at VALUE), lit by the headlight (--ambient, --diffuse, --specular, "
+                   "--specular-power) and found exactly in every cell the ray crosses; repeat "
+                   "for up to " +
+                       std::to_string(kMaxIsoSurfaces) + " (a point field only)")
+        ->type_name("VALUE[,OPACITY[,#RRGGBB]]")
+        ->allow_extra_args(false)  // one value per occurrence: the mesh file may follow
+        ->take_all();
     // The library's settings, each once (the vocabulary): its name, doc, default and check.
     std::vector<std::string> except;
     if (!withMethod) except.push_back("method");
@@ -170,6 +180,7 @@ RenderSettings RenderFlags::baseSettings() const {
             parseFloats("--clip-box", clipBox, 6, "x0,y0,z0,x1,y1,z1: six finite numbers");
         s.clipBox = Bounds3f{Vec3f(v[0], v[1], v[2]), Vec3f(v[3], v[4], v[5])};
     }
+    for (const std::string& text : isoSurfaces) s.isoSurfaces.push_back(parseIsoSurface(text));
     // The settings of the library's vocabulary are checked there (main re-spells its errors
     // with the flags).
     vocabulary.applyTo(s);

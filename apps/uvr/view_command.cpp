@@ -31,6 +31,7 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
             add(cliFlag(def).c_str(), f.vocabulary.text(def.name));
     // The clip planes are the page's (ViewState::clipPlanes), the box the command line's.
     if (!f.clipBox.empty()) add("--clip-box", f.clipBox);
+    for (const std::string& iso : f.isoSurfaces) add("--iso", iso);
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
     if (f.splitCells) add("--split-cells", "");

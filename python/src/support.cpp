@@ -287,6 +287,56 @@ RenderSettings settingsOf(const py::dict& settings) {
             }
             continue;
         }
+        // Isosurfaces: each a value, a (value, opacity[, colour]) tuple (the colour "#RRGGBB"
+        // or (r, g, b) in [0, 1]) or the CLI's text "VALUE[,OPACITY[,#RRGGBB]]".
+        if (key == "iso") {
+            const std::string expected =
+                "expected a list of isosurfaces, each a value, (value, opacity) or (value, "
+                "opacity, colour) with colour '#RRGGBB' or (r, g, b), or the text "
+                "'VALUE[,OPACITY[,#RRGGBB]]'";
+            auto refuse = [&](const py::handle& x) {
+                throw SettingError("iso", py::str(py::repr(x)).cast<std::string>(), expected);
+            };
+            if (py::isinstance<py::str>(v) || !py::hasattr(v, "__iter__")) refuse(v);
+            for (const py::handle& item : py::iter(v)) {
+                if (py::isinstance<py::str>(item)) {
+                    s.isoSurfaces.push_back(parseIsoSurface(item.cast<std::string>()));
+                    continue;
+                }
+                IsoSurface iso;
+                try {
+                    if (!py::hasattr(item, "__iter__")) {
+                        if (py::isinstance<py::bool_>(item)) refuse(item);
+                        iso.value = item.cast<float>();
+                    } else {
+                        const py::tuple t = py::tuple(py::reinterpret_borrow<py::object>(item));
+                        if (t.size() < 1 || t.size() > 3) refuse(item);
+                        iso.value = t[0].cast<float>();
+                        if (t.size() > 1) iso.opacity = t[1].cast<float>();
+                        if (t.size() > 2) {
+                            iso.colorMapped = false;
+                            if (py::isinstance<py::str>(t[2])) {
+                                iso.color =
+                                    parseIsoSurface("0,1," + t[2].cast<std::string>()).color;
+                            } else {
+                                const py::tuple c = py::tuple(t[2]);
+                                if (c.size() != 3) refuse(item);
+                                iso.color = Vec3f(c[0].cast<float>(), c[1].cast<float>(),
+                                                  c[2].cast<float>());
+                            }
+                        }
+                    }
+                } catch (const py::error_already_set&) {
+                    refuse(item);
+                } catch (const py::cast_error&) {
+                    refuse(item);
+                } catch (const SettingError&) {
+                    refuse(item);
+                }
+                s.isoSurfaces.push_back(iso);
+            }
+            continue;
+        }
         if (key == "clip_box") {
             const auto a = sixNumbers("clip_box", v,
                                       "expected (lo, hi): six numbers, ((x0, y0, z0), (x1, y1, "
@@ -298,6 +348,7 @@ RenderSettings settingsOf(const py::dict& settings) {
     }
     refuseUnreadSettings(s, given);  // e.g. ambient without shade
     checkClip(s);
+    checkIso(s);
     return s;
 }
 

@@ -36,6 +36,9 @@ def python_frame(renderer, **kw):
           clip_box=((-8, 0, 0), (14, 8, 3)), method="exact")),
     ("post_tets.vtk", ["--shade", "--ambient", "0.2", "--specular", "0.3", "--specular-power", "12"],
      dict(shade=True, ambient=0.2, specular=0.3, specular_power=12)),
+    ("bluntfin_tets.vtk", ["--iso", "0.9", "--iso", "1.2,0.5,#ff8000", "--specular", "0.2",
+                           "--method", "adaptive"],
+     dict(iso=[0.9, (1.2, 0.5, "#ff8000")], specular=0.2, method="adaptive")),
 ], ids=lambda c: c[0])
 def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     name, flags, kwargs = case
@@ -242,6 +245,19 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(ambient=0.3)
     with pytest.raises(uvr.ArgumentError, match=r"^diffuse=2: expected a number in \[0, 1\]"):
         r.render(shade=True, diffuse=2)
+    # Isosurfaces (issue 32): values, (value, opacity[, colour]) or the CLI's text.
+    with pytest.raises(uvr.ArgumentError, match=r"^iso=0.5: expected a list of isosurfaces"):
+        r.render(iso=0.5)
+    with pytest.raises(uvr.ArgumentError, match=r"^iso=1,2: expected VALUE\[,OPACITY"):
+        r.render(iso=[(1, 2)])
+    with pytest.raises(uvr.ArgumentError, match=r"^iso=\(1, 1, 'red'\): expected a list"):
+        r.render(iso=[(1, 1, "red")])
+    with pytest.raises(uvr.ArgumentError, match=r"^iso=1,1,#ff: expected VALUE"):
+        r.render(iso=["1,1,#ff"])
+    with pytest.raises(uvr.ArgumentError, match=r"^iso=9 isosurfaces: expected at most 8"):
+        r.render(iso=list(range(9)))
+    assert r.render(size=(8, 8), iso=[(2, 0.5, (1, 0, 0)), "2.5,1,#00ff00"]).stats["iso"] == [
+        "2,0.5,#ff0000", "2.5,1,#00ff00"]
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0
 

@@ -183,7 +183,7 @@ class Renderer:
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
                size=(512, 512), method=None, quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
-               clip_planes=None, clip_box=None, **settings):
+               clip_planes=None, clip_box=None, iso=None, **settings):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
         ``.stats`` and ``.sample_counts``.
 
@@ -194,7 +194,9 @@ class Renderer:
         `field` switches to another field or new values first (set_field); `clip_planes` a list
         of up to six planes, each (origin, normal), keeping the side the normal points to, and
         `clip_box` (lo, hi) keeping its inside, in the file's coordinates (``--clip-plane``,
-        ``--clip-box``). The same settings give the CLI's pixels.
+        ``--clip-box``); `iso` a list of up to eight isosurfaces, each a value, (value, opacity)
+        or (value, opacity, colour) with colour "#RRGGBB" or (r, g, b) (``--iso``; default
+        opaque, coloured by the colour map). The same settings give the CLI's pixels.
 
         `method`, `quality` and the other keywords are the library's settings (uvr.SETTINGS,
         each named, defaulted and checked there once; None means the default), listed below.
@@ -234,7 +236,7 @@ class Renderer:
         # "auto" renders with whatever was prepared (its pick, else the other of exact and
         # adaptive; the stats say which).
         settings = _settings(method=method, quality=quality, clip_planes=clip_planes,
-                             clip_box=clip_box, **settings)
+                             clip_box=clip_box, iso=iso, **settings)
         method = settings.get("method", "auto")
         if method != "auto" and method in _uvr.METHODS and method not in self._methods:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="

@@ -64,7 +64,7 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     const FrameView frame = makeFrameView(settings, result.setup, result.image.pixels.data(),
                                           result.sampleCounts.data());
     const auto start = std::chrono::steady_clock::now();
-    dispatchKernel(mesh.tets.hasNative(), result.setup.params.light.on,
+    dispatchKernel(mesh.tets.hasNative(), litKernel(result.setup.params),
                    [&](auto kNative, auto kLit) {
                        const RenderMethod method = result.setup.method.method;
                        if (method == RenderMethod::Reference)

@@ -136,6 +136,29 @@ struct NanShade {
     }
 };
 
+/// Transfer-function update, isosurfaces (one element per partition): those an isosurface
+/// crosses are visible and stepped at s1 (shadeIso).
+struct PartitionIsoShade {
+    const KdPartition* partitions;
+    IsoView iso;
+    float s1;
+    PartitionShading* shading;
+    __device__ void operator()(std::uint64_t p) const {
+        shadeIso(shading[p], partitions[p].valueMin, partitions[p].valueMax, iso, s1);
+    }
+};
+
+/// The same per macrocell.
+struct MacroIsoShade {
+    const MacroCell* cells;
+    IsoView iso;
+    float s1;
+    PartitionShading* shading;
+    __device__ void operator()(std::uint64_t c) const {
+        shadeIso(shading[c], cells[c].valueMin, cells[c].valueMax, iso, s1);
+    }
+};
+
 /// Transfer-function update, last pass (one element per partition): whether each partition
 /// marches by its macrocells.
 struct MacroChoice {
@@ -361,6 +384,10 @@ void CudaScene::updateShading(RenderResult& result) {
         cuda::forEachElement(
             "partition NaN shading", n,
             cuda::NanShade{d.a.partitionNan.data(), f.tfNan.w, f.stepRule.s1, d.shading.data()});
+    if (f.params.iso.active())
+        cuda::forEachElement("partition isosurface shading", n,
+                             cuda::PartitionIsoShade{d.a.partitions.data(), f.params.iso,
+                                                     f.stepRule.s1, d.shading.data()});
     // The macrocells' shading stays on the GPU.
     d.macroActive = false;
     if (usesMacroCells(d.mesh, f.stepRule)) {
@@ -373,6 +400,10 @@ void CudaScene::updateShading(RenderResult& result) {
             cuda::forEachElement("macrocell NaN shading", m,
                                  cuda::NanShade{d.a.macroNan.data(), f.tfNan.w, f.stepRule.s1,
                                                 d.macroShading.data()});
+        if (f.params.iso.active())
+            cuda::forEachElement("macrocell isosurface shading", m,
+                                 cuda::MacroIsoShade{d.a.macroCells.data(), f.params.iso,
+                                                     f.stepRule.s1, d.macroShading.data()});
         cuda::forEachElement(
             "macrocell choice", n,
             cuda::MacroChoice{d.a.macroGrids.data(), d.macroShading.data(), d.shading.data()});
@@ -413,7 +444,7 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaEventCreate(&end));
     UVR_CUDA_CHECK(cudaEventRecord(begin));
     const bool native = d.mesh.tets.hasNative();
-    const bool lit = result.setup.params.light.on;
+    const bool lit = litKernel(result.setup.params);
     if (method == RenderMethod::Reference) {
         dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
             cuda::launchFrame(grid, block, frame,

@@ -107,9 +107,15 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     if (settings.clipBox)
         j["clip_box"] = {settings.clipBox->lo.x, settings.clipBox->lo.y, settings.clipBox->lo.z,
                          settings.clipBox->hi.x, settings.clipBox->hi.y, settings.clipBox->hi.z};
-    // Gradient shading, with its coefficients when on.
+    // Isosurfaces, as the CLI's --iso writes them.
+    if (!settings.isoSurfaces.empty()) {
+        nlohmann::json iso = nlohmann::json::array();
+        for (const IsoSurface& s : settings.isoSurfaces) iso.push_back(isoText(s));
+        j["iso"] = std::move(iso);
+    }
+    // Gradient shading, with its coefficients when on (they light isosurfaces too).
     j["shade"] = settings.lighting.on;
-    if (settings.lighting.on) {
+    if (settings.lighting.on || !settings.isoSurfaces.empty()) {
         j["normals"] = settings.lighting.smooth ? "smooth" : "cell";
         j["ambient"] = settings.lighting.ambient;
         j["diffuse"] = settings.lighting.diffuse;

@@ -102,9 +102,10 @@ Renderer::Renderer(PreparedMesh prepared, Device device)
 Renderer::~Renderer() = default;
 
 RenderResult Renderer::render(const RenderSettings& settings) {
-    // Smooth shading's gradients are made when a frame first needs them (and kept, remade with
-    // new values).
-    if (settings.lighting.on && settings.lighting.smooth && !hasSmoothGradients(prepared_->tets)) {
+    // Smooth shading's gradients are made when a frame first needs them (shaded, or the
+    // isosurfaces' normals) and kept, remade with new values.
+    const bool lit = settings.lighting.on || !settings.isoSurfaces.empty();
+    if (lit && settings.lighting.smooth && !hasSmoothGradients(prepared_->tets)) {
         computeSmoothGradients(prepared_->tets);
         if (gpu_) gpu_->uploadGradients();
     }

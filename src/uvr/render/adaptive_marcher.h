@@ -103,6 +103,19 @@ UVR_HOST_DEVICE inline void shadeNan(PartitionShading& s, float nanAlpha, float 
     if (s.maxOpacity > 0.f) s.step = s1;
 }
 
+/// Shading of a partition or macrocell whose value range [lo, hi] holds an iso value: visible
+/// (never skipped) and stepped at s1, so the crossing between two samples is where the
+/// reference's samples put it (the surface is a jump in colour and opacity that the range's
+/// statistics do not show).
+UVR_HOST_DEVICE inline void shadeIso(PartitionShading& s, float lo, float hi, const IsoView& iso,
+                                     float s1) {
+    if (!iso.within(lo, hi)) return;
+    for (int i = 0; i < iso.count; ++i)
+        s.maxOpacity =
+            iso.surfaces[i].opacity > s.maxOpacity ? iso.surfaces[i].opacity : s.maxOpacity;
+    s.step = s1;
+}
+
 /// The macrocells' layout and their shading for the current transfer function.
 struct MacroShadingView {
     const PartitionGrid* grids = nullptr;       ///< per partition; null: no macrocells
@@ -194,6 +207,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const bool preintegrated = scene.base.params.preintegrated;
     const Lighting lighting = kernelLighting<kLit>(scene.base.params);
     SampleSegments<kLit> segments;
+    segments.setIsos(scene.base.params.iso, lighting, ray.dir);
+    PointIsos<kLit> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
@@ -300,7 +315,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (tet == kNoTet && !emptySpace)
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
-        const LightFactors light = lightAt<kNative>(lighting, locator.mesh, tet, bary, ray.dir);
+        const Vec3f grad =
+            sampleGradient<kNative, kLit>(scene.base.params, locator.mesh, tet, bary);
+        const LightFactors light = lightAt(lighting, tet, grad, ray.dir);
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
         // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
@@ -329,7 +346,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 kSample - segments.kLast > 1.f) {
                 float lo = segments.kLast, hi = kSample;  // inside end first when leaving
                 float vHi = v;  // entering: the value at hi, the first position found inside
-                LightFactors lightHi = light;  // and its light
+                LightFactors lightHi = light;  // and its light and gradient
+                Vec3f gradHi = grad;
                 std::uint32_t from = in ? tet : lastInside;
                 float probeBary[4] = {bary[0], bary[1], bary[2], bary[3]};
                 while (fabsf(hi - lo) > 1.f) {
@@ -344,30 +362,35 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                             locator.search<kNative>(scene.cells, 0, q, probeBary, counters.locate);
                     const float vMid =
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
-                    const LightFactors lightMid =
-                        lightAt<kNative>(lighting, locator.mesh, found, probeBary, ray.dir);
+                    const Vec3f gradMid = sampleGradient<kNative, kLit>(
+                        scene.base.params, locator.mesh, found, probeBary);
+                    const LightFactors lightMid = lightAt(lighting, found, gradMid, ray.dir);
                     if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;
                         vHi = vMid;
                         lightHi = lightMid;
+                        gradHi = gradMid;
                     } else {
                         // Leaving: the run goes on to the mid.
                         if (found != kNoTet)
-                            segments.add(tf, mid, k1, true, vMid, s1, unit, acc, lightMid);
+                            segments.add(tf, mid, k1, true, vMid, s1, unit, acc, lightMid, gradMid);
                         lo = mid;
                     }
                 }
                 // Entering: the run starts at the first position found inside; leaving: it ends
                 // at the first position found outside.
                 if (in && hi < kSample)
-                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi);
+                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi, gradHi);
                 else if (!in)
                     segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
             }
             if (in) lastInside = tet;
-            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light);
-        } else if (tet != kNoTet) {
+            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light, grad);
+        } else {
+            pointIsos.add(scene.base.params, tf, ray.dir, tet != kNoTet, v, grad, acc);
+        }
+        if (!preintegrated && tet != kNoTet) {
             const Vec4f c = tf.sample(v);
             const float a = correctOpacity(c.w, length, unit, tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);

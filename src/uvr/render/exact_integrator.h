@@ -154,6 +154,8 @@ UVR_HOST_DEVICE inline LightFactors simpsonLight(const LightFactors& a, const Li
 
 /// Most pieces a native cell's segment is cut into (nativeSegment).
 inline constexpr int kNativeMaxPieces = 16;
+/// Evaluations of a native cell's field that place an isosurface's crossing (nativeSegment).
+inline constexpr int kIsoRefinements = 4;
 
 /// The point field along the ray through native cell t from t0 to t1 (issue 14): the inverse
 /// isoparametric map is not closed-form along a ray (a trilinear field is a cubic in t only in a
@@ -164,12 +166,14 @@ inline constexpr int kNativeMaxPieces = 16;
 /// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
 /// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc; lit
 /// (gradient shading), each piece by the mean of its ends' lights (the gradient through the
-/// cell's Jacobian at the Newton iterate's coordinates).
+/// cell's Jacobian at the Newton iterate's coordinates). With isosurfaces (iso, kLit), a piece
+/// crossing one is cut where the cell's own field meets its value (regula falsi from the
+/// piece's linear reading, kIsoRefinements evaluations) and the surface composited there.
 template <bool kLit = true>
 UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
-                                           float v0, double unit, const Lighting& light,
-                                           Vec4f& acc) {
+                                           float v0, double unit, const Lighting& light, Vec4f& acc,
+                                           const IsoView* iso = nullptr) {
     Vec3f x[kMaxCellCorners];
     float cv[kMaxCellCorners];
     const int n = mesh.gather(t, x, cv);
@@ -195,11 +199,12 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         return v < cvLo ? cvLo : (v > cvHi ? cvHi : v);  // NaN stays NaN
     };
     // The light at the parametric coordinates rst of the last point valueAt took.
-    auto lightHere = [&]() {
-        if (!kLit || !light.on) return LightFactors{};
+    auto lightWith = [&](const Lighting& l) {
+        if (!kLit || !l.on) return LightFactors{};
         const float at[4] = {rst.x, rst.y, rst.z, 0.f};
-        return lightFactors(light, mesh.gradient(t, at, light.smooth), ray.dir);
+        return lightFactors(l, mesh.gradient(t, at, l.smooth), ray.dir);
     };
+    auto lightHere = [&]() { return lightWith(light); };
     const float vMid = valueAt(0.5 * (t0 + t1));
     const Vec3f rstMid = rst;
     LightFactors lightA;  // at the start of the piece
@@ -230,7 +235,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         const int lit = lightPieces(lightA, lightMid, lightEnd);
         pieces = lit > pieces ? lit : pieces;
     }
-    if (pieces == 1) {
+    if (pieces == 1 && !(kLit && iso)) {
         const Vec4f before = acc;
         segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
         if constexpr (kLit) lightSegment(before, simpsonLight(lightA, lightMid, lightEnd), acc);
@@ -242,9 +247,40 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     for (int i = 1; i <= pieces && acc.w < segment::kOpacityEnd; ++i) {
         const float b = i == pieces ? vEnd : valueAt(t0 + h * i);
         const LightFactors lightB = i == pieces ? lightEnd : lightHere();
-        const Vec4f before = acc;
-        segment::integrate(tf, a, b, h, unit, acc, true);
-        if constexpr (kLit) lightSegment(before, lightA.mean(lightB), acc);
+        const LightFactors vol = lightA.mean(lightB);
+        double ta = t0 + h * (i - 1), len = h;  // the rest of the piece: from ta, len long
+        float va = a;
+        if constexpr (kLit) {
+            if (iso) {
+                const double tb = i == pieces ? t1 : t0 + h * i;
+                const Lighting surface = surfaceLighting(light);
+                iso->crossings(a, b, [&](int j, float f) {
+                    if (acc.w >= segment::kOpacityEnd) return;
+                    const float c = iso->surfaces[j].value;
+                    // Regula falsi on the cell's field over [lo, hi], from the linear guess.
+                    double lo = ta, hi = tb, tc = ta + (tb - ta) * f;
+                    float flo = va - c, fhi = b - c;
+                    for (int r = 0; r < kIsoRefinements && flo != fhi; ++r) {
+                        tc = lo + (hi - lo) * (double(flo) / (double(flo) - fhi));
+                        const float fc = valueAt(tc) - c;
+                        if (fc == 0.f || !(fc == fc)) break;
+                        ((fc < 0.f) == (flo < 0.f) ? lo : hi) = tc;
+                        ((fc < 0.f) == (flo < 0.f) ? flo : fhi) = fc;
+                    }
+                    const Vec4f before = acc;
+                    segment::integrate(tf, va, c, tc - ta, unit, acc, true);
+                    lightSegment(before, vol, acc);
+                    (void)valueAt(tc);  // the surface's coordinates, for its normal
+                    compositeIso(iso->surfaces[j], tf.sample(c).xyz(), lightWith(surface), acc);
+                    ta = tc, va = c, len = tb - tc;
+                });
+            }
+        }
+        if (acc.w < segment::kOpacityEnd) {
+            const Vec4f before = acc;
+            segment::integrate(tf, va, b, len, unit, acc, true);
+            if constexpr (kLit) lightSegment(before, vol, acc);
+        }
         a = b;
         lightA = lightB;
     }
@@ -391,6 +427,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     const double eps = 1e-6 * (double(scene.bounds.diagonal()) + double(b0));
     const double unit = scene.params.opacityUnit;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
+    const IsoView* isos = kLit && scene.params.iso.active() ? &scene.params.iso : nullptr;
     double t = b0;
     exact::TetSpan span;
     std::uint32_t tet =
@@ -418,35 +455,54 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             ++counters.samples;  // one segment per cell crossed
             float s1;
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
-                s1 = exact::nativeSegment<kLit>(loc.mesh, scene.tf, tet, ray, t, tEnd,
-                                                haveEntry ? sEntry : NAN, unit, lighting, acc);
+                s1 =
+                    exact::nativeSegment<kLit>(loc.mesh, scene.tf, tet, ray, t, tEnd,
+                                               haveEntry ? sEntry : NAN, unit, lighting, acc, isos);
             } else {
                 const float s0 =
                     haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
                 s1 = exact::scalarAt<kNative>(loc, tet, span, ray, tEnd);
                 const Lighting& light = lighting;
-                bool integrated = false;
-                if constexpr (kLit) {
-                    if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
-                        exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, t, tEnd, s0,
-                                                         s1, unit, light, acc);
-                        integrated = true;
+                // The piece [ta, tb] of the segment, the scalar linear from va to vb.
+                auto piece = [&](double ta, double tb, float va, float vb) {
+                    if constexpr (kLit) {
+                        if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
+                            exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, ta, tb,
+                                                             va, vb, unit, light, acc);
+                            return;
+                        }
                     }
-                }
-                if (!integrated) {
                     // Float pieces (within 1e-4 of the double closed form, deep pieces in
                     // double).
                     const Vec4f before = acc;
-                    segment::integrate(scene.tf, s0, s1, tEnd - t, unit, acc, true);
+                    segment::integrate(scene.tf, va, vb, tb - ta, unit, acc, true);
                     // Lit per cell: a tetrahedron's gradient is constant, so is its light along
                     // the segment.
                     if constexpr (kLit) {
                         if (light.on)
-                            lightSegment(
-                                before, exact::lightInTet<kNative>(loc.mesh, tet, ray, tEnd, light),
-                                acc);
+                            lightSegment(before,
+                                         exact::lightInTet<kNative>(loc.mesh, tet, ray, tb, light),
+                                         acc);
+                    }
+                };
+                double ta = t;
+                float va = s0;
+                if constexpr (kLit) {
+                    // Isosurfaces: the segment is cut where its linear scalar meets them.
+                    if (isos && continuous) {
+                        isos->crossings(s0, s1, [&](int i, float f) {
+                            if (acc.w >= segment::kOpacityEnd) return;
+                            const IsoSurface& iso = isos->surfaces[i];
+                            const double tc = t + (tEnd - t) * double(f);
+                            piece(ta, tc, va, iso.value);
+                            const LightFactors lit = exact::lightInTet<kNative>(
+                                loc.mesh, tet, ray, tc, surfaceLighting(light));
+                            compositeIso(iso, scene.tf.sample(iso.value).xyz(), lit, acc);
+                            ta = tc, va = iso.value;
+                        });
                     }
                 }
+                if (acc.w < segment::kOpacityEnd) piece(ta, tEnd, va, s1);
             }
             opaque = acc.w >= segment::kOpacityEnd;
             past = clipped && tEnd >= tStop;

@@ -214,6 +214,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.params.preintegrated = settings.preintegrated;
     f.params.clip = clipView(settings, frame);
     f.params.light = settings.lighting;  // directions only: the frame's scaling keeps them
+    f.params.iso = isoView(settings);
+    if (f.params.iso.active() && mesh.tets.association == Association::Cell)
+        throw SettingError("iso", isoText(f.params.iso.surfaces[0]),
+                           "isosurfaces need a point field, and '" + mesh.tets.fieldName +
+                               "' is cell data (constant in each cell: it has no surfaces "
+                               "inside a cell)");
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_step")
                                        : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
@@ -313,10 +319,20 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         // Partitions and macrocells holding NaN values (their value ranges leave NaN out).
         for (std::size_t p = 0; p < mesh.partitionNan.size(); ++p)
             if (mesh.partitionNan[p]) shadeNan(f.shading[p], f.tfNan.w, f.stepRule.s1);
+        // Partitions and macrocells an isosurface crosses: visible, at s1.
+        const IsoView& iso = f.params.iso;
+        if (iso.active())
+            for (std::size_t p = 0; p < f.shading.size(); ++p)
+                shadeIso(f.shading[p], mesh.kd->partitions[p].valueMin,
+                         mesh.kd->partitions[p].valueMax, iso, f.stepRule.s1);
         if (usesMacroCells(mesh, f.stepRule)) {
             f.macroShading = computeMacroShading(*mesh.macro, ranges.view(table), f.stepRule);
             for (std::size_t c = 0; c < mesh.macro->nanCells.size(); ++c)
                 if (mesh.macro->nanCells[c]) shadeNan(f.macroShading[c], f.tfNan.w, f.stepRule.s1);
+            if (iso.active())
+                for (std::size_t c = 0; c < f.macroShading.size(); ++c)
+                    shadeIso(f.macroShading[c], mesh.macro->cells[c].valueMin,
+                             mesh.macro->cells[c].valueMax, iso, f.stepRule.s1);
             for (std::size_t p = 0; p < f.shading.size(); ++p)
                 f.shading[p].byMacroCells =
                     macroCellsPay(mesh.macro->grids[p], f.macroShading.data(), f.shading[p]);

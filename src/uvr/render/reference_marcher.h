@@ -45,30 +45,57 @@ UVR_HOST_DEVICE inline void compositeFrontToBack(Vec4f& acc, Vec3f rgb, float a)
 /// is extended (its value held for a run of one sample). So a run of n samples covers the same
 /// distance as n point samples, a linear field is integrated exactly, and with equal steps the
 /// partition integrator takes exactly the reference's segments. kLit false: without the lights
-/// (an unshaded kernel holds none of their registers).
+/// and isosurfaces (an unshaded kernel holds none of their registers). With isosurfaces
+/// (setIsos), a segment crossing one is integrated up to the crossing (where the linear value
+/// meets it), the surface composited there, lit by the gradient interpolated between the two
+/// samples', and the rest integrated after it.
 template <bool kLit = true>
 struct SampleSegments {
-    float kLast = 0.f;     ///< grid position of the last sample
-    float kEnd = 0.f;      ///< end of the piece of the ray the last sample belongs to
-    float vLast = 0.f;     ///< its value (when inside)
-    LightFactors light;    ///< its light (when inside; the identity unlit)
-    float kPrev = 0.f;     ///< grid position of the sample before it in the run
-    float vPrev = 0.f;     ///< its value
-    bool inRun = false;    ///< the sample before the last one is in the last one's run
-    bool inside = false;   ///< the last sample found a cell
-    bool started = false;  ///< a sample was taken
+    float kLast = 0.f;              ///< grid position of the last sample
+    float kEnd = 0.f;               ///< end of the piece of the ray the last sample belongs to
+    float vLast = 0.f;              ///< its value (when inside)
+    LightFactors light;             ///< its light (when inside; the identity unlit)
+    Vec3f gradLast{0.f, 0.f, 0.f};  ///< its gradient (with isosurfaces)
+    const IsoView* iso = nullptr;   ///< the isosurfaces (null: none)
+    Lighting surface;               ///< their lighting (surfaceLighting)
+    Vec3f dir{0.f, 0.f, 1.f};       ///< the ray's direction
+    float kPrev = 0.f;              ///< grid position of the sample before it in the run
+    float vPrev = 0.f;              ///< its value
+    bool inRun = false;             ///< the sample before the last one is in the last one's run
+    bool inside = false;            ///< the last sample found a cell
+    bool started = false;           ///< a sample was taken
+
+    /// Isosurfaces to composite between samples (kLit only), lit by `l` along a ray of
+    /// direction d.
+    UVR_HOST_DEVICE void setIsos(const IsoView& isos, const Lighting& l, Vec3f d) {
+        if constexpr (kLit) {
+            iso = isos.active() ? &isos : nullptr;
+            surface = surfaceLighting(l);
+            dir = d;
+        }
+    }
 
     /// Adds the sample at grid position k of a piece of the ray that ends at kPieceEnd (the
-    /// next piece continues it when it starts there); `in`: it found a cell, with value v and
+    /// next piece continues it when it starts there); `in`: it found a cell, with value v,
     /// light f (gradient shading; the segment from the last sample is lit by the mean of their
-    /// lights, the run's last share by its last sample's).
+    /// lights, the run's last share by its last sample's) and gradient g (isosurfaces).
     UVR_HOST_DEVICE void add(const TfTableView& tf, float k, float kPieceEnd, bool in, float v,
-                             float s1, double unit, Vec4f& acc, LightFactors f = {}) {
+                             float s1, double unit, Vec4f& acc, LightFactors f = {},
+                             Vec3f g = Vec3f(0.f)) {
         const bool goesOn = started && inside && in && k <= kEnd;
         if (goesOn) {
-            const Vec4f before = acc;
-            segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc, true);
-            if constexpr (kLit) lightSegment(before, light.mean(f), acc);
+            bool done = false;
+            if constexpr (kLit) {
+                if (iso) {
+                    withIsos(tf, v, double(k - kLast) * s1, unit, light.mean(f), g, acc);
+                    done = true;
+                }
+            }
+            if (!done) {
+                const Vec4f before = acc;
+                segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc, true);
+                if constexpr (kLit) lightSegment(before, light.mean(f), acc);
+            }
         } else if (started && inside) {  // the run ends
             endRun(tf, (k < kEnd ? k : kEnd) - kLast, s1, unit, acc);
         }
@@ -78,7 +105,7 @@ struct SampleSegments {
         kLast = k;
         kEnd = kPieceEnd;
         vLast = v;
-        if constexpr (kLit) light = f;
+        if constexpr (kLit) light = f, gradLast = g;
         inside = in;
         started = true;
     }
@@ -88,6 +115,27 @@ struct SampleSegments {
     }
 
 private:
+    /// The segment from the last sample to one of value v and gradient g over len, split at
+    /// the isosurfaces it crosses (volume lit by vol).
+    UVR_HOST_DEVICE void withIsos(const TfTableView& tf, float v, double len, double unit,
+                                  const LightFactors& vol, Vec3f g, Vec4f& acc) const {
+        float f0 = 0.f, va = vLast;
+        iso->crossings(vLast, v, [&](int i, float f) {
+            if (acc.w >= segment::kOpacityEnd) return;
+            const IsoSurface& s = iso->surfaces[i];
+            const Vec4f before = acc;
+            segment::integrate(tf, va, s.value, double(f - f0) * len, unit, acc, true);
+            lightSegment(before, vol, acc);
+            const Vec3f gi = gradLast + (g - gradLast) * f;
+            compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
+            f0 = f, va = s.value;
+        });
+        if (acc.w >= segment::kOpacityEnd) return;
+        const Vec4f before = acc;
+        segment::integrate(tf, va, v, double(1.f - f0) * len, unit, acc, true);
+        lightSegment(before, vol, acc);
+    }
+
     /// The last sample's share: `steps` grid steps along the run's last slope (in double: the
     /// difference of two values may overflow float).
     UVR_HOST_DEVICE void endRun(const TfTableView& tf, float steps, float s1, double unit,
@@ -100,14 +148,52 @@ private:
     }
 };
 
-/// The light of a sample in cell `tet` at local coordinates bary (TetMeshView::gradient) along
-/// a ray of unit direction dir: the identity when lighting is off or no cell holds it.
-template <bool kNative = true>
-UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, const TetMeshView& mesh,
-                                            std::uint32_t tet, const float bary[4], Vec3f dir) {
-    if (!light.on || tet == kNoTet) return {};
-    return lightFactors(light, mesh.gradient<kNative>(tet, bary, light.smooth), dir);
+/// The gradient at a sample in cell `tet` at local coordinates bary (TetMeshView::gradient,
+/// smooth as the lighting asks) where a lit instance needs it (shaded, or with isosurfaces);
+/// else, or outside the mesh, 0.
+template <bool kNative = true, bool kLit = true>
+UVR_HOST_DEVICE inline Vec3f sampleGradient(const MarchParams& params, const TetMeshView& mesh,
+                                            std::uint32_t tet, const float bary[4]) {
+    if constexpr (kLit) {
+        if (tet != kNoTet && (params.light.on || params.iso.active()))
+            return mesh.gradient<kNative>(tet, bary, params.light.smooth);
+    }
+    return Vec3f(0.f);
 }
+
+/// The light of a sample of gradient g along a ray of unit direction dir: the identity when
+/// lighting is off or no cell holds the sample.
+UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, std::uint32_t tet, Vec3f g,
+                                            Vec3f dir) {
+    if (!light.on || tet == kNoTet) return {};
+    return lightFactors(light, g, dir);
+}
+
+/// Point sampling with isosurfaces (kLit): the surfaces crossed between consecutive samples
+/// inside the mesh, where the value read linearly between them meets theirs, composited before
+/// the later sample.
+template <bool kLit = true>
+struct PointIsos {
+    float vLast = 0.f;
+    Vec3f gradLast{0.f, 0.f, 0.f};
+    bool inside = false;
+
+    UVR_HOST_DEVICE void add(const MarchParams& params, const TfTableView& tf, Vec3f dir, bool in,
+                             float v, Vec3f g, Vec4f& acc) {
+        if constexpr (kLit) {
+            const IsoView& iso = params.iso;
+            if (in && inside && iso.active()) {
+                const Lighting surface = surfaceLighting(params.light);
+                iso.crossings(vLast, v, [&](int i, float f) {
+                    const IsoSurface& s = iso.surfaces[i];
+                    const Vec3f gi = gradLast + (g - gradLast) * f;
+                    compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
+                });
+            }
+            inside = in, vLast = v, gradLast = g;
+        }
+    }
+};
 
 /// The lighting an integrator instance reads: the frame's, or none where it is compiled unlit
 /// (kLit false: its kernels carry no lighting code, which cost the unlit adaptive kernel up to
@@ -145,6 +231,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float unit = scene.params.opacityUnit;
     SampleSegments<kLit> segments;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
+    segments.setIsos(scene.params.iso, lighting, ray.dir);
+    PointIsos<kLit> pointIsos;
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
@@ -153,11 +241,14 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
-        const LightFactors light =
-            lightAt<kNative>(lighting, scene.locator.mesh, tet, bary, ray.dir);
+        const Vec3f g = sampleGradient<kNative, kLit>(scene.params, scene.locator.mesh, tet, bary);
+        const LightFactors light = lightAt(lighting, tet, g, ray.dir);
         if (scene.params.preintegrated) {
-            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light);
-        } else if (tet != kNoTet) {
+            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light, g);
+        } else {
+            pointIsos.add(scene.params, scene.tf, ray.dir, tet != kNoTet, v, g, acc);
+        }
+        if (!scene.params.preintegrated && tet != kNoTet) {
             const Vec4f c = scene.tf.sample(v);
             const float a = correctOpacity(c.w, s, unit, scene.tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/render/render_settings.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "uvr/core/error.h"
@@ -80,6 +84,96 @@ std::string clipBoxText(const Bounds3f& b) {
     return sixNumbersText(b.lo, b.hi);
 }
 
+IsoView isoView(const RenderSettings& s) {
+    IsoView v;
+    for (const IsoSurface& iso : s.isoSurfaces) {
+        if (v.count == kMaxIsoSurfaces) break;  // validateSettings refuses more
+        v.surfaces[v.count++] = iso;
+    }
+    std::stable_sort(v.surfaces, v.surfaces + v.count,
+                     [](const IsoSurface& a, const IsoSurface& b) { return a.value < b.value; });
+    return v;
+}
+
+namespace {
+
+constexpr const char* kIsoForm =
+    "expected VALUE[,OPACITY[,#RRGGBB]]: a finite value, an opacity in (0, 1] (default 1: "
+    "opaque) and a "
+    "colour (default: the colour map's at the value)";
+
+/// A colour channel in [0, 1] as two hex digits (out of range or NaN: clamped, for messages).
+std::string hexByte(float c) {
+    const float v = c >= 0.f ? (c <= 1.f ? c : 1.f) : 0.f;
+    char buf[4];
+    std::snprintf(buf, sizeof buf, "%02x", int(std::lround(v * 255.f)));
+    return buf;
+}
+
+/// The shortest decimal that reads back as the same float ("0.1", not "0.100000001").
+std::string shortest(float v) {
+    char buf[32];
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    return ec == std::errc() ? std::string(buf, end) : formatG(v, 9);
+}
+
+}  // namespace
+
+std::string isoText(const IsoSurface& iso) {
+    std::string out = shortest(iso.value);
+    if (iso.opacity != 1.f || !iso.colorMapped) out += "," + shortest(iso.opacity);
+    if (!iso.colorMapped)
+        out += ",#" + hexByte(iso.color.x) + hexByte(iso.color.y) + hexByte(iso.color.z);
+    return out;
+}
+
+IsoSurface parseIsoSurface(const std::string& text) {
+    auto bad = [&]() { throw SettingError("iso", text, kIsoForm); };
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t comma = text.find(',', start);
+        parts.push_back(text.substr(start, comma - start));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (parts.size() > 3) bad();
+    auto number = [&](const std::string& t) {
+        char* end = nullptr;
+        const float v = std::strtof(t.c_str(), &end);
+        if (t.empty() || *end != '\0' || !std::isfinite(v) || std::isspace((unsigned char)t[0]))
+            bad();
+        return v;
+    };
+    IsoSurface iso;
+    iso.value = number(parts[0]);
+    if (parts.size() > 1) iso.opacity = number(parts[1]);
+    if (!(iso.opacity > 0.f && iso.opacity <= 1.f)) bad();
+    if (parts.size() > 2) {
+        const std::string& c = parts[2];
+        if (c.size() != 7 || c[0] != '#' ||
+            c.find_first_not_of("0123456789abcdefABCDEF", 1) != std::string::npos)
+            bad();
+        const long rgb = std::strtol(c.c_str() + 1, nullptr, 16);
+        iso.colorMapped = false;
+        iso.color = Vec3f(float((rgb >> 16) & 255) / 255.f, float((rgb >> 8) & 255) / 255.f,
+                          float(rgb & 255) / 255.f);
+    }
+    return iso;
+}
+
+void checkIso(const RenderSettings& s) {
+    if (s.isoSurfaces.size() > std::size_t(kMaxIsoSurfaces))
+        throw SettingError("iso", std::to_string(s.isoSurfaces.size()) + " isosurfaces",
+                           "expected at most " + std::to_string(kMaxIsoSurfaces));
+    for (const IsoSurface& iso : s.isoSurfaces) {
+        const Vec3f& c = iso.color;
+        if (!std::isfinite(iso.value) || !(iso.opacity > 0.f && iso.opacity <= 1.f) ||
+            !(c.x >= 0.f && c.x <= 1.f && c.y >= 0.f && c.y <= 1.f && c.z >= 0.f && c.z <= 1.f))
+            throw SettingError("iso", isoText(iso), kIsoForm);
+    }
+}
+
 void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;
@@ -100,6 +194,7 @@ void validateSettings(const RenderSettings& s) {
         bad("transfer function needs at least one colour and one opacity point");
     if (s.camera) validateCamera(*s.camera);
     checkClip(s);
+    checkIso(s);
 }
 
 void checkClip(const RenderSettings& s) {

@@ -15,6 +15,7 @@
 #include "uvr/render/adaptive_marcher.h"
 #include "uvr/render/camera.h"
 #include "uvr/render/clip.h"
+#include "uvr/render/isosurface.h"
 #include "uvr/render/lighting.h"
 #include "uvr/tf/transfer_function.h"
 
@@ -77,6 +78,10 @@ struct RenderSettings {
     /// Gradient shading (issue 32; lighting.h): off by default; ParaView's Ambient, Diffuse,
     /// Specular and SpecularPower and their defaults.
     Lighting lighting;
+    /// Isosurfaces inside the volume (issue 32; isosurface.h), at most kMaxIsoSurfaces, in any
+    /// order: each lit by `lighting`'s coefficients whether or not the volume is shaded. A point
+    /// field only.
+    std::vector<IsoSurface> isoSurfaces;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)
@@ -101,6 +106,21 @@ void checkClip(const RenderSettings& settings);
 /// "x0,y0,z0,x1,y1,z1".
 std::string clipPlaneText(const ClipPlane& plane);
 std::string clipBoxText(const Bounds3f& box);
+
+/// The settings' isosurfaces for the integrators, sorted by value.
+IsoView isoView(const RenderSettings& settings);
+
+/// Throws SettingError (iso) for more than kMaxIsoSurfaces isosurfaces, or one whose value is
+/// not finite, opacity not in (0, 1] or colour not in [0, 1]. (validateSettings calls it.)
+void checkIso(const RenderSettings& settings);
+
+/// An isosurface as every front end writes it: "VALUE[,OPACITY[,#RRGGBB]]" (the opacity when
+/// not 1, the colour when not mapped; shortest decimals).
+std::string isoText(const IsoSurface& iso);
+
+/// Reads isoText's form (an opacity in (0, 1], a colour as #RRGGBB); throws SettingError (iso)
+/// naming the text and the form otherwise.
+IsoSurface parseIsoSurface(const std::string& text);
 
 /// Largest RenderSettings::supersample: 8 x 8 = 64 rays per pixel.
 inline constexpr int kMaxSupersample = 8;

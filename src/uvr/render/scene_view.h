@@ -9,6 +9,7 @@
 #include "uvr/accel/point_locator.h"
 #include "uvr/core/bounds.h"
 #include "uvr/render/clip.h"
+#include "uvr/render/isosurface.h"
 #include "uvr/render/lighting.h"
 #include "uvr/tf/tf_table.h"
 
@@ -26,7 +27,15 @@ struct MarchParams {
     ClipView clip;
     /// Gradient shading (off: the transfer function's colours as they are).
     Lighting light;
+    /// Isosurfaces inside the volume (none: the volume alone).
+    IsoView iso;
 };
+
+/// Whether a frame runs the integrators' lit instances (kLit): shaded, or with isosurfaces
+/// (which are always lit and need the gradients).
+UVR_HOST_DEVICE inline bool litKernel(const MarchParams& p) {
+    return p.light.on || p.iso.active();
+}
 
 /// Everything a ray needs, as plain data for CPU and GPU.
 struct SceneView {

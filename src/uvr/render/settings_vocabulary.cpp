@@ -376,14 +376,19 @@ std::string settingExpectation(const SettingDef& d) {
 }
 
 bool settingNeedMet(const SettingDef& d, const RenderSettings& settings) {
-    return !d.needs || settingNamed(d.needs).get(settings) == true;
+    if (!d.needs) return true;
+    // The lighting settings light isosurfaces too, shaded or not.
+    if (std::string_view(d.needs) == "shade" && !settings.isoSurfaces.empty()) return true;
+    return settingNamed(d.needs).get(settings) == true;
 }
 
 void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std::string>& given) {
     for (const std::string& name : given)
         if (const SettingDef* d = findSetting(name); d && !settingNeedMet(*d, settings))
-            throw SettingError(d->name, settingValueText(d->get(settings)),
-                               std::string("read only with `") + d->needs + "` on");
+            throw SettingError(
+                d->name, settingValueText(d->get(settings)),
+                std::string("read only with `") + d->needs + "` on" +
+                    (std::string_view(d->needs) == "shade" ? " or an `iso` surface" : ""));
 }
 
 Json settingDefault(const SettingDef& d) {
