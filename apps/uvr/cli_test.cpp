@@ -24,6 +24,7 @@
 #include "uvr/core/text.h"
 #include "uvr/cuda/cuda_renderer.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/render/depth_image.h"
 #include "uvr/render/image.h"
 #include "uvr/render/image_metrics.h"
 
@@ -577,6 +578,46 @@ TEST(Cli, IsoDrawsSurfacesInsideTheVolumeAndIsReported) {
                                  " --field pressure:cell --size 16x16 --iso 0.5 -o x.png",
                              dir);
     expectOneLineError(cells, {"isosurfaces need a point field"}, "cell data");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
+}
+
+TEST(Cli, DepthIsWrittenAndReadAsNpy) {
+    // Issue 32: --depth writes where an opaque isosurface (or the opacity asked for) is, as a
+    // .npy; --depth-in ends the rays there, so nothing behind the surface is added.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string fin = "-q render " + testing::sharedData("bluntfin_tets.vtk") +
+                            " --size 48x32 --method exact --azimuth 30 --elevation 20 ";
+    const CliRun out = uvr(fin + "-o iso.png --iso 0.9 --depth d.npy --stats d.json", dir);
+    ASSERT_EQ(out.code, 0) << out.err;
+    const std::vector<float> depth = readDepthNpy(dir + "/d.npy", 48, 32);
+    int hits = 0;
+    for (float z : depth) hits += std::isfinite(z);
+    EXPECT_GT(hits, 100);
+    std::ifstream in(dir + "/d.json");
+    EXPECT_FLOAT_EQ(nlohmann::json::parse(in)["depth_alpha"].get<float>(), 0.5f);
+    ASSERT_EQ(uvr(fin + "-o whole.png", dir).code, 0);
+    const CliRun cut = uvr(fin + "-o cut.png --depth-in d.npy", dir);
+    ASSERT_EQ(cut.code, 0) << cut.err;
+    const Image whole = readPng(dir + "/whole.png"), front = readPng(dir + "/cut.png");
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        if (!std::isfinite(depth[i])) {
+            EXPECT_EQ(front.pixels[i].w, whole.pixels[i].w) << i;
+        } else {
+            EXPECT_LE(front.pixels[i].w, whole.pixels[i].w + 1.f / 255.f) << i;
+        }
+    }
+    const std::pair<const char*, const char*> bad[] = {
+        {"--depth d.png", "--depth writes a NumPy array: name it *.npy"},
+        {"--depth-opacity 0.3", "--depth-opacity sets what --depth writes: it needs --depth"},
+        {"--depth-in iso.png", "not a depth image"},
+    };
+    for (const auto& [flags, says] : bad)
+        expectOneLineError(uvr(fin + "-o x.png " + flags, dir), {says}, flags);
+    expectOneLineError(uvr("-q render " + testing::sharedData("bluntfin_tets.vtk") +
+                               " --size 8x8 --depth-in d.npy -o x.png",
+                           dir),
+                       {"shape (32, 48), but the frame is 8x8"}, "another size");
     EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
 }
 

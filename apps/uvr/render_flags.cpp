@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "uvr/core/setting_error.h"
+#include "uvr/render/depth_image.h"
 
 namespace uvr::cli {
 
@@ -137,6 +138,22 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
                          std::to_string(kLegendMinWidth) + "x" + std::to_string(kLegendMinHeight) +
                          ")");
     if (oneFrame) app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
+    if (oneFrame) {
+        app.add_option("--depth", depthFile,
+                       "Also write the depth image: per pixel the distance along the view "
+                       "direction (file units) at which the accumulated opacity first reaches "
+                       "--depth-opacity (an opaque --iso surface: the surface), inf where it "
+                       "never does; a float32 NumPy .npy of shape (height, width), row 0 at the "
+                       "top");
+        app.add_option("--depth-opacity", depthOpacity,
+                       "With --depth: the accumulated opacity whose depth is written (default 0.5)")
+            ->check(CLI::Range(0.0001f, 1.f));
+        app.add_option("--depth-in", depthInFile,
+                       "Composite over opaque geometry rendered elsewhere: a .npy of shape "
+                       "(height, width), float32 or float64, of its distances along the view "
+                       "direction (file units, as --depth writes them; inf or NaN: none); every "
+                       "ray of a pixel ends there");
+    }
     app.add_option("--device", device,
                    "Where to render: cpu, cuda, or auto (CUDA when a device is present)")
         ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
@@ -181,6 +198,8 @@ RenderSettings RenderFlags::baseSettings() const {
         s.clipBox = Bounds3f{Vec3f(v[0], v[1], v[2]), Vec3f(v[3], v[4], v[5])};
     }
     for (const std::string& text : isoSurfaces) s.isoSurfaces.push_back(parseIsoSurface(text));
+    if (!depthFile.empty()) s.depthAlpha = depthOpacity.value_or(0.5f);
+    if (!depthInFile.empty()) s.depthIn = readDepthNpy(depthInFile, s.width, s.height);
     // The settings of the library's vocabulary are checked there (main re-spells its errors
     // with the flags).
     vocabulary.applyTo(s);
@@ -193,6 +212,9 @@ RenderSettings RenderFlags::baseSettings() const {
     if (s.stepRule == StepRule::ErrorBound && vocabulary.given("power"))
         throwError(ErrorKind::Argument, "",
                    "--power shapes the variance rule's step: it needs --step-rule variance");
+    if (depthOpacity && depthFile.empty())
+        throwError(ErrorKind::Argument, "",
+                   "--depth-opacity sets what --depth writes: it needs --depth FILE.npy");
     if (heatmapMax && heatmapFile.empty())
         throwError(ErrorKind::Argument, "",
                    "--heatmap-max sets the heat map's scale: it needs --heatmap FILE.png");
@@ -365,6 +387,7 @@ RenderOutputs RenderFlags::renderOutputs() const {
     out.heatmap = heatmapFile;
     out.heatmapMax = heatmapMax;
     out.stats = statsFile;
+    out.depth = depthFile;
     out.background = backgroundColor();
     out.legend = legendFont();
     return out;
@@ -375,6 +398,7 @@ std::vector<NamedFile> RenderFlags::outputs() const {
     if (!output.empty()) out.push_back({"-o", output});
     if (!heatmapFile.empty()) out.push_back({"--heatmap", heatmapFile});
     if (!statsFile.empty()) out.push_back({"--stats", statsFile});
+    if (!depthFile.empty()) out.push_back({"--depth", depthFile});
     return out;
 }
 
@@ -382,6 +406,7 @@ std::vector<NamedFile> RenderFlags::inputs() const {
     const auto tfFile = splitColorMapFile(tf);  // FILE.json[:NAME]: the file
     std::vector<NamedFile> in{{"--tf", tfFile ? tfFile->first : tf}};
     if (!cameraFile.empty()) in.push_back({"--camera", cameraFile});
+    if (!depthInFile.empty()) in.push_back({"--depth-in", depthInFile});
     return in;
 }
 
@@ -412,6 +437,7 @@ void RenderFlags::checkFiles(const std::string& meshFile) const {
     checkExtension("-o", output, ".png", "a PNG image");
     checkExtension("--heatmap", heatmapFile, ".png", "a PNG image");
     checkExtension("--stats", statsFile, ".json", "JSON");
+    checkExtension("--depth", depthFile, ".npy", "a NumPy array");
     for (const NamedFile& out : outputs()) resolveOutput(out.path);
 }
 

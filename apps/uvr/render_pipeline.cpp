@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "progress.h"
+#include "uvr/render/depth_image.h"
 
 namespace uvr::cli {
 
@@ -128,6 +129,11 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
                  sampleHeatmap(result.sampleCounts, settings.width, settings.height, heatmapTop));
         ctx.step("heat map: the bar runs from 0 samples per pixel (black, bottom) to " +
                  std::to_string(heatmapTop) + " (top)");
+    }
+    if (!out.depth.empty()) {
+        ctx.setActivity(out.depth, "writing the depth image");
+        outputs.push_back(std::make_unique<OutputFile>(out.depth));
+        writeDepthNpy(*outputs.back(), settings.width, settings.height, result.depth);
     }
     if (!out.stats.empty()) {
         // The library's frame report, and what only the CLI knows: the file, its counts and

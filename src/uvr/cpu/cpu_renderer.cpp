@@ -61,8 +61,11 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     result.setup = makeFrameSetup(mesh, settings);
     result.image = Image(settings.width, settings.height);
     result.sampleCounts.assign(result.image.pixels.size(), 0);
-    const FrameView frame = makeFrameView(settings, result.setup, result.image.pixels.data(),
-                                          result.sampleCounts.data());
+    if (settings.depthAlpha > 0.f) result.depth.assign(result.image.pixels.size(), INFINITY);
+    const FrameView frame = makeFrameView(
+        settings, result.setup, result.image.pixels.data(), result.sampleCounts.data(),
+        result.depth.empty() ? nullptr : result.depth.data(),
+        settings.depthIn.empty() ? nullptr : settings.depthIn.data());
     const auto start = std::chrono::steady_clock::now();
     dispatchKernel(mesh.tets.hasNative(), litKernel(result.setup.params),
                    [&](auto kNative, auto kLit) {

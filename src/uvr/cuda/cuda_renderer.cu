@@ -252,6 +252,8 @@ struct CudaScene::Impl {
     bool macroActive = false;  ///< macroShading holds this frame's shading (usesMacroCells)
     cuda::DeviceArray<Vec4f> pixels;
     cuda::DeviceArray<std::uint32_t> sampleCounts;
+    cuda::DeviceArray<float> depth;    ///< depth out (RenderSettings::depthAlpha)
+    cuda::DeviceArray<float> depthIn;  ///< depth in (RenderSettings::depthIn)
     cuda::DeviceArray<unsigned long long> totals;
     double uploadSeconds = 0.0;
     double valueUploadSeconds = 0.0;
@@ -426,9 +428,13 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     const std::size_t pixelCount = static_cast<std::size_t>(settings.width) * settings.height;
     d.pixels.reserve(pixelCount, "the image");
     d.sampleCounts.reserve(pixelCount, "the sample counts");
+    const bool depthOut = settings.depthAlpha > 0.f;
+    if (depthOut) d.depth.reserve(pixelCount, "the depth image");
+    if (!settings.depthIn.empty()) d.depthIn.upload(settings.depthIn, "the depth image given");
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
-    const FrameView frame =
-        makeFrameView(settings, result.setup, d.pixels.data(), d.sampleCounts.data());
+    const FrameView frame = makeFrameView(settings, result.setup, d.pixels.data(),
+                                          d.sampleCounts.data(), depthOut ? d.depth.data() : nullptr,
+                                          settings.depthIn.empty() ? nullptr : d.depthIn.data());
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);
@@ -477,6 +483,11 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
                               pixelCount * sizeof(Vec4f), cudaMemcpyDeviceToHost));
     UVR_CUDA_CHECK(cudaMemcpy(result.sampleCounts.data(), d.sampleCounts.data(),
                               pixelCount * sizeof(std::uint32_t), cudaMemcpyDeviceToHost));
+    if (depthOut) {
+        result.depth.resize(pixelCount);
+        UVR_CUDA_CHECK(cudaMemcpy(result.depth.data(), d.depth.data(), pixelCount * sizeof(float),
+                                  cudaMemcpyDeviceToHost));
+    }
     unsigned long long totals[cuda::kCounters];
     UVR_CUDA_CHECK(cudaMemcpy(totals, d.totals.data(), sizeof totals, cudaMemcpyDeviceToHost));
     result.stats.seconds = ms * 1e-3;

@@ -107,6 +107,9 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     if (settings.clipBox)
         j["clip_box"] = {settings.clipBox->lo.x, settings.clipBox->lo.y, settings.clipBox->lo.z,
                          settings.clipBox->hi.x, settings.clipBox->hi.y, settings.clipBox->hi.z};
+    // Depth out and in.
+    if (settings.depthAlpha > 0.f) j["depth_alpha"] = settings.depthAlpha;
+    if (!settings.depthIn.empty()) j["depth_in"] = true;
     // Isosurfaces, as the CLI's --iso writes them.
     if (!settings.isoSurfaces.empty()) {
         nlohmann::json iso = nlohmann::json::array();

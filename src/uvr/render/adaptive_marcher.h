@@ -199,6 +199,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         return acc;
     const ClipView& clip = scene.base.params.clip;
     if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, tEnter, tExit)) return acc;
+    if (ray.tMax < tExit) tExit = ray.tMax;  // depth in: opaque geometry there
+    if (!(tEnter <= tExit)) return acc;
     const TetLocator& locator = scene.base.locator;
     const float s1 = scene.base.params.step;
     const float unit = scene.base.params.opacityUnit;
@@ -223,6 +225,17 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
     float kLocated = -INFINITY;  // grid position of the last sample located
     bool marching = true, opaque = false, macro = false;
+    // Depth out: the opacity and the end of the stretch of the ray noted last, noted wherever
+    // the run composites (after each sample, and where a transparent macrocell ends a run).
+    [[maybe_unused]] float aNoted = 0.f, tNoted = tEnter;
+    [[maybe_unused]] const float depthAlpha = scene.base.params.depthAlpha;
+    auto note = [&](float tNow) {
+        if constexpr (kLit) {
+            tNow = fmaxf(tNoted, tNow);
+            noteDepth(depthAlpha, aNoted, acc.w, tNoted, tNow, counters);
+            aNoted = acc.w, tNoted = tNow;
+        }
+    };
     while (marching) {
         if (!(k < kStop)) {
             float t0, t1;
@@ -287,8 +300,10 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 const bool longGap = preintegrated && segments.started && segments.inside &&
                                      kSample - segments.kLast > 1.f;
                 if (!longGap) {
-                    if (preintegrated)
+                    if (preintegrated) {
                         segments.add(tf, kSample, kSample, false, 0.f, s1, unit, acc);
+                        note(kSample * s1);
+                    }
                     k = kPast;
                     continue;
                 }
@@ -395,10 +410,14 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             const float a = correctOpacity(c.w, length, unit, tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
+        note(kSample * s1);
         opaque = acc.w >= stopAlpha;
         marching = !opaque;
     }
-    if (preintegrated && !opaque) segments.finish(tf, s1, unit, acc);
+    if (preintegrated && !opaque) {
+        segments.finish(tf, s1, unit, acc);
+        note(tExit);
+    }
     return acc;
 }
 

@@ -419,8 +419,11 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     // Clipped: the ray starts at the region's entry (inside a cell, which is cut there) and
     // stops at its exit.
     const ClipView& clip = scene.params.clip;
-    const bool clipped = clip.active();
-    if (clipped && !clip.restrict(ray.org, ray.dir, inv, b0, b1)) return acc;
+    if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, b0, b1)) return acc;
+    // Depth in: the ray ends at opaque geometry (cut there as at a clip plane).
+    if (ray.tMax < b1) b1 = ray.tMax;
+    if (!(b0 <= b1)) return acc;
+    const bool clipped = clip.active() || ray.tMax < INFINITY;
     const double tStop = clipped ? double(b1) : INFINITY;
     const TetLocator& loc = scene.locator;
     // A gap this small between tetrahedra is rounding, not empty space.
@@ -454,10 +457,13 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         if (tEnd > t) {
             ++counters.samples;  // one segment per cell crossed
             float s1;
+            [[maybe_unused]] const float depthAlpha = scene.params.depthAlpha;
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
-                s1 =
-                    exact::nativeSegment<kLit>(loc.mesh, scene.tf, tet, ray, t, tEnd,
-                                               haveEntry ? sEntry : NAN, unit, lighting, acc, isos);
+                [[maybe_unused]] const float a0 = acc.w;
+                s1 = exact::nativeSegment<kLit>(loc.mesh, scene.tf, tet, ray, t, tEnd,
+                                                haveEntry ? sEntry : NAN, unit, lighting, acc,
+                                                isos);
+                if constexpr (kLit) noteDepth(depthAlpha, a0, acc.w, t, tEnd, counters);
             } else {
                 const float s0 =
                     haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
@@ -466,9 +472,11 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 // The piece [ta, tb] of the segment, the scalar linear from va to vb.
                 auto piece = [&](double ta, double tb, float va, float vb) {
                     if constexpr (kLit) {
+                        const float a0 = acc.w;
                         if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
                             exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, ta, tb,
                                                              va, vb, unit, light, acc);
+                            noteDepth(depthAlpha, a0, acc.w, ta, tb, counters);
                             return;
                         }
                     }
@@ -483,6 +491,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                             lightSegment(before,
                                          exact::lightInTet<kNative>(loc.mesh, tet, ray, tb, light),
                                          acc);
+                        noteDepth(depthAlpha, before.w, acc.w, ta, tb, counters);
                     }
                 };
                 double ta = t;
@@ -497,7 +506,9 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                             piece(ta, tc, va, iso.value);
                             const LightFactors lit = exact::lightInTet<kNative>(
                                 loc.mesh, tet, ray, tc, surfaceLighting(light));
+                            const float a0 = acc.w;
                             compositeIso(iso, scene.tf.sample(iso.value).xyz(), lit, acc);
+                            noteDepth(depthAlpha, a0, acc.w, tc, tc, counters);
                             ta = tc, va = iso.value;
                         });
                     }

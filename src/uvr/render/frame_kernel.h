@@ -21,6 +21,27 @@ struct FrameView {
     CameraRays rays;
     int supersample = 1;  ///< N: N x N rays per pixel, in [1, kMaxSupersample]
     bool jitter = false;  ///< each ray at a hashed position in its sub-pixel cell, not its centre
+    /// Depth out (null: none): per pixel the view depth where the ray's opacity first reached
+    /// MarchParams::depthAlpha (RayCounters::depth), the nearest over the pixel's rays.
+    float* depth = nullptr;
+    /// Depth in (null: none): per pixel the view depth of opaque geometry: the rays end there.
+    const float* depthIn = nullptr;
+    /// View depths (file units) from ray parameters (rendering units): z = (rayStartDepth + t
+    /// dot(dir, viewDirection)) / depthScale.
+    Vec3f viewDirection{0.f, 0.f, -1.f};
+    float rayStartDepth = 0.f;
+    float depthScale = 1.f;
+
+    /// The view depth of parameter t of ray r (infinity for an infinite t).
+    UVR_HOST_DEVICE float viewDepth(const Ray& r, float t) const {
+        return t < INFINITY ? (rayStartDepth + t * dot(r.dir, viewDirection)) / depthScale
+                            : INFINITY;
+    }
+    /// The parameter of ray r at view depth z (infinity for none: an infinite or NaN z).
+    UVR_HOST_DEVICE float rayParameter(const Ray& r, float z) const {
+        const float c = dot(r.dir, viewDirection);
+        return z < INFINITY && c > 0.f ? (z * depthScale - rayStartDepth) / c : INFINITY;
+    }
 };
 
 /// A 32-bit integer hash (lowbias32, Wellons 2018: a bijection with low bias).
@@ -54,35 +75,44 @@ UVR_HOST_DEVICE inline void jitterOffsets(int x, int y, int s, float& ox, float&
 /// the integrator, the GPU kernels keep their registers (the loop cost the partition kernel 7%).
 template <bool Supersampled = true, class March>
 UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int y, March&& march) {
+    const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
     if constexpr (!Supersampled) {
-        const Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        if (frame.depthIn) ray.tMax = frame.rayParameter(ray, frame.depthIn[i]);
         RayCounters counters;
         const Vec4f c = march(ray, counters);
-        const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
         frame.pixels[i] = c;
         frame.sampleCounts[i] = counters.samples;
+        if (frame.depth) frame.depth[i] = frame.viewDepth(ray, counters.depth);
         return counters;
     }
     const int n = frame.supersample;
     const float cell = 1.f / static_cast<float>(n);
     Vec4f sum(0.f, 0.f, 0.f, 0.f);
     RayCounters total;
+    float nearest = INFINITY;
     for (int s = 0; s < n * n; ++s) {
         float ox = 0.5f, oy = 0.5f;
         if (frame.jitter) jitterOffsets(x, y, s, ox, oy);
         const float px = static_cast<float>(x) + (static_cast<float>(s % n) + ox) * cell;
         const float py = static_cast<float>(y) + (static_cast<float>(s / n) + oy) * cell;
         RayCounters counters;
-        sum = sum + march(frame.rays.ray(px, py), counters);
+        Ray ray = frame.rays.ray(px, py);
+        if (frame.depthIn) ray.tMax = frame.rayParameter(ray, frame.depthIn[i]);
+        sum = sum + march(ray, counters);
+        if (frame.depth) {
+            const float z = frame.viewDepth(ray, counters.depth);
+            nearest = z < nearest ? z : nearest;
+        }
         total.samples += counters.samples;
         total.partitionsVisited += counters.partitionsVisited;
         total.partitionsSkipped += counters.partitionsSkipped;
         total.locate.walkSteps += counters.locate.walkSteps;
         total.locate.bvhQueries += counters.locate.bvhQueries;
     }
-    const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
     frame.pixels[i] = sum * (cell * cell);
     frame.sampleCounts[i] = total.samples;
+    if (frame.depth) frame.depth[i] = nearest;
     return total;
 }
 

@@ -215,6 +215,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.params.clip = clipView(settings, frame);
     f.params.light = settings.lighting;  // directions only: the frame's scaling keeps them
     f.params.iso = isoView(settings);
+    f.params.depthAlpha = settings.depthAlpha;
     if (f.params.iso.active() && mesh.tets.association == Association::Cell)
         throw SettingError("iso", isoText(f.params.iso.surfaces[0]),
                            "isosurfaces need a point field, and '" + mesh.tets.fieldName +
@@ -296,6 +297,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     }
     validateCamera(f.camera);
     f.rays = makeCameraRays(f.camera, settings.width, settings.height, nearDistance);
+    f.viewDirection = normalize(f.camera.focalPoint - f.camera.position);
+    f.rayStartDepth = parallel ? static_cast<float>(nearDistance) : 0.f;
     if (method == RenderMethod::Partitions && !mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
     if (method != RenderMethod::Partitions && mesh.bvh.nodes.empty() && mesh.tets.cellCount() != 0)

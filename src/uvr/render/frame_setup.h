@@ -99,6 +99,10 @@ struct FrameSetup {
     MeshFrame frame;
     Camera camera;
     CameraRays rays;
+    /// Depth in and out: the unit view direction and the depth along it at which the rays
+    /// start (a parallel projection's rays start in front of the camera), in rendering units.
+    Vec3f viewDirection{0.f, 0.f, -1.f};
+    float rayStartDepth = 0.f;
     MarchParams params;
     /// The value range the table spans: the settings' or the field's; with a log-scale transfer
     /// function one from 0 or below starts at min(hi / 10^4, 1) (ParaView's AdjustRangeForLog).
@@ -120,16 +124,25 @@ struct FrameSetup {
 };
 
 /// The frame's output buffers and rays for the shared pixel kernel (both backends): pixels and
-/// counts hold width * height entries on the device that renders.
+/// counts hold width * height entries on the device that renders, as do depth (depth out, or
+/// null) and depthIn (depth in, or null).
 inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup& setup,
-                               Vec4f* pixels, std::uint32_t* sampleCounts) {
-    return FrameView{pixels,
-                     sampleCounts,
-                     settings.width,
-                     settings.height,
-                     setup.rays,
-                     settings.supersample,
-                     settings.jitter && settings.supersample > 1};
+                               Vec4f* pixels, std::uint32_t* sampleCounts, float* depth = nullptr,
+                               const float* depthIn = nullptr) {
+    FrameView v;
+    v.pixels = pixels;
+    v.sampleCounts = sampleCounts;
+    v.width = settings.width;
+    v.height = settings.height;
+    v.rays = setup.rays;
+    v.supersample = settings.supersample;
+    v.jitter = settings.jitter && settings.supersample > 1;
+    v.depth = depth;
+    v.depthIn = depthIn;
+    v.viewDirection = setup.viewDirection;
+    v.rayStartDepth = setup.rayStartDepth;
+    v.depthScale = static_cast<float>(setup.frame.scale);
+    return v;
 }
 
 /// Resolves defaults (the method for the GPU when gpu, else the CPU: resolveMethod) and
@@ -186,6 +199,9 @@ struct RenderStats {
 struct RenderResult {
     Image image;
     std::vector<std::uint32_t> sampleCounts;  ///< per pixel, row-major
+    /// Depth out (RenderSettings::depthAlpha > 0): per pixel, row-major, the distance along the
+    /// view direction in the file's units (the nearest over the pixel's rays); else empty.
+    std::vector<float> depth;
     RenderStats stats;
     FrameSetup setup;
 };

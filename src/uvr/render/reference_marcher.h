@@ -222,6 +222,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     if (scene.bounds.empty() || !intersectBox(scene.bounds, ray.org, inv, t0, t1)) return acc;
     if (scene.params.clip.active() && !scene.params.clip.restrict(ray.org, ray.dir, inv, t0, t1))
         return acc;
+    if (ray.tMax < t1) t1 = ray.tMax;  // depth in: opaque geometry there
+    if (!(t0 <= t1)) return acc;
     const float s = scene.params.step;
     // Global sample grid k * s, so every integrator that samples a span takes the same samples.
     float k = ceilf(t0 / s);
@@ -236,7 +238,9 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
+    [[maybe_unused]] float tNoted = t0;  // depth out: the end of the stretch of the ray noted last
     for (; k <= kEnd && !opaque; k += 1.f) {
+        [[maybe_unused]] const float a0 = acc.w;
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
@@ -253,9 +257,17 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             const float a = correctOpacity(c.w, s, unit, scene.tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
+        if constexpr (kLit) {
+            noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, k * s, counters);
+            tNoted = k * s;
+        }
         opaque = acc.w >= scene.params.terminationAlpha;
     }
-    if (scene.params.preintegrated && !opaque) segments.finish(scene.tf, s, unit, acc);
+    if (scene.params.preintegrated && !opaque) {
+        [[maybe_unused]] const float a0 = acc.w;
+        segments.finish(scene.tf, s, unit, acc);
+        if constexpr (kLit) noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, t1, counters);
+    }
     return acc;
 }
 

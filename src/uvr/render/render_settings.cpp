@@ -195,6 +195,17 @@ void validateSettings(const RenderSettings& s) {
     if (s.camera) validateCamera(*s.camera);
     checkClip(s);
     checkIso(s);
+    checkDepth(s);
+}
+
+void checkDepth(const RenderSettings& s) {
+    if (!(s.depthAlpha >= 0.f && s.depthAlpha <= 1.f))
+        throw SettingError("depth_alpha", formatG(s.depthAlpha, 6), "expected a number in [0, 1]");
+    if (!s.depthIn.empty() &&
+        s.depthIn.size() != std::size_t(s.width) * std::size_t(std::max(s.height, 0)))
+        throw SettingError("depth_in", std::to_string(s.depthIn.size()) + " depths",
+                           "expected one per pixel: " + std::to_string(s.width) + " x " +
+                               std::to_string(s.height));
 }
 
 void checkClip(const RenderSettings& s) {

@@ -82,6 +82,16 @@ struct RenderSettings {
     /// order: each lit by `lighting`'s coefficients whether or not the volume is shaded. A point
     /// field only.
     std::vector<IsoSurface> isoSurfaces;
+    /// Depth out (issue 32): above 0, a frame also gives per pixel the distance along the view
+    /// direction, in the file's units, at which the accumulated opacity first reaches this
+    /// (RenderResult::depth; infinity where it never does). An opaque isosurface reaches any
+    /// such opacity at the surface. In [0, 1]; 0: no depth.
+    float depthAlpha = 0.f;
+    /// Depth in: width x height distances along the view direction, in the file's units, row 0
+    /// at the top, of opaque geometry rendered elsewhere: every ray of a pixel ends at its
+    /// distance, so the frame composites over that geometry (infinity or NaN: none at that
+    /// pixel). Empty: none.
+    std::vector<float> depthIn;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)
@@ -121,6 +131,10 @@ std::string isoText(const IsoSurface& iso);
 /// Reads isoText's form (an opacity in (0, 1], a colour as #RRGGBB); throws SettingError (iso)
 /// naming the text and the form otherwise.
 IsoSurface parseIsoSurface(const std::string& text);
+
+/// Throws SettingError (depth_alpha, depth_in) for an opacity outside [0, 1] or a depth image
+/// that is not width x height. (validateSettings calls it.)
+void checkDepth(const RenderSettings& settings);
 
 /// Largest RenderSettings::supersample: 8 x 8 = 64 rays per pixel.
 inline constexpr int kMaxSupersample = 8;

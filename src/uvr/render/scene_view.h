@@ -4,6 +4,7 @@
 // The plain-data types every integrator shares, on the CPU and the GPU: the compositing
 // parameters, the scene a ray reads and the counters it keeps.
 
+#include <cmath>
 #include <cstdint>
 
 #include "uvr/accel/point_locator.h"
@@ -29,12 +30,15 @@ struct MarchParams {
     Lighting light;
     /// Isosurfaces inside the volume (none: the volume alone).
     IsoView iso;
+    /// Depth out: each ray reports where its accumulated opacity first reaches this (0: no
+    /// depth asked for; RayCounters::depth).
+    float depthAlpha = 0.f;
 };
 
-/// Whether a frame runs the integrators' lit instances (kLit): shaded, or with isosurfaces
-/// (which are always lit and need the gradients).
+/// Whether a frame runs the integrators' lit instances (kLit, the instances with the per-ray
+/// extras): shaded, with isosurfaces (always lit, they need the gradients) or writing depth.
 UVR_HOST_DEVICE inline bool litKernel(const MarchParams& p) {
-    return p.light.on || p.iso.active();
+    return p.light.on || p.iso.active() || p.depthAlpha > 0.f;
 }
 
 /// Everything a ray needs, as plain data for CPU and GPU.
@@ -45,12 +49,31 @@ struct SceneView {
     MarchParams params;
 };
 
-/// Per-ray counters.
+/// Per-ray counters, and the ray's depth.
 struct RayCounters {
     std::uint32_t samples = 0;            ///< samples taken (point locations)
     std::uint32_t partitionsVisited = 0;  ///< k-d partitions the ray entered
     std::uint32_t partitionsSkipped = 0;  ///< of those, skipped as fully transparent
     LocateCounters locate;
+    /// Depth out (MarchParams::depthAlpha): the ray parameter where the accumulated opacity
+    /// first reached it; infinity where it never did.
+    float depth = INFINITY;
 };
+
+/// Depth out: a stretch [t0, t1] of the ray took the accumulated opacity from a0 to a1; where
+/// that first reaches `alpha` (> 0) the ray's depth is noted, read within the stretch as if its
+/// extinction were constant (the optical depth -ln(1 - a) linear in t: exact for a constant
+/// extinction; an opaque surface, t0 = t1, is where it is).
+UVR_HOST_DEVICE inline void noteDepth(float alpha, float a0, float a1, float t0, float t1,
+                                      RayCounters& c) {
+    if (!(alpha > 0.f) || c.depth < INFINITY || !(a1 >= alpha)) return;
+    float f = 0.f;
+    if (a1 < 1.f && a1 > a0) {
+        const float tau0 = -log1pf(-a0), tau1 = -log1pf(-a1), tau = -log1pf(-alpha);
+        f = (tau - tau0) / (tau1 - tau0);
+    }
+    f = f > 0.f ? (f < 1.f ? f : 1.f) : 0.f;  // also NaN
+    c.depth = t0 + (t1 - t0) * f;
+}
 
 }  // namespace uvr
