@@ -8,7 +8,9 @@
 #if defined(__CUDACC__)
 #define UVR_HOST_DEVICE __host__ __device__
 #define UVR_INLINE __forceinline__
+#define UVR_NOINLINE __noinline__
 #else
 #define UVR_HOST_DEVICE
 #define UVR_INLINE inline __attribute__((always_inline))
+#define UVR_NOINLINE __attribute__((noinline))
 #endif

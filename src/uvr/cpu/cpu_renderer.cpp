@@ -67,23 +67,24 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
         result.depth.empty() ? nullptr : result.depth.data(),
         settings.depthIn.empty() ? nullptr : settings.depthIn.data());
     const auto start = std::chrono::steady_clock::now();
-    dispatchKernel(mesh.tets.hasNative(), litKernel(result.setup.params),
-                   [&](auto kNative, auto kLit) {
-                       const RenderMethod method = result.setup.method.method;
-                       if (method == RenderMethod::Reference)
-                           launchFrame(frame, result.stats,
-                                       ReferenceMarch<kNative(), kLit()>{result.setup.scene(mesh)},
-                                       settings.progress);
-                       else if (method == RenderMethod::Exact)
-                           launchFrame(frame, result.stats,
-                                       ExactMarch<kNative(), kLit()>{result.setup.scene(mesh)},
-                                       settings.progress);
-                       else
-                           launchFrame(frame, result.stats,
-                                       PartitionMarch<kNative(), kLit()>{
-                                           result.setup.partitionScene(mesh, settings.skip)},
-                                       settings.progress);
-                   });
+    dispatchKernel(
+        mesh.tets.hasNative(), litKernel(result.setup.params), surfacesKernel(result.setup.params),
+        [&](auto kNative, auto kLit, auto kSurf) {
+            const RenderMethod method = result.setup.method.method;
+            if (method == RenderMethod::Reference)
+                launchFrame(frame, result.stats,
+                            ReferenceMarch<kNative(), kLit(), kSurf()>{result.setup.scene(mesh)},
+                            settings.progress);
+            else if (method == RenderMethod::Exact)
+                launchFrame(frame, result.stats,
+                            ExactMarch<kNative(), kLit(), kSurf()>{result.setup.scene(mesh)},
+                            settings.progress);
+            else
+                launchFrame(frame, result.stats,
+                            PartitionMarch<kNative(), kLit(), kSurf()>{
+                                result.setup.partitionScene(mesh, settings.skip)},
+                            settings.progress);
+        });
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.stats.width = settings.width;

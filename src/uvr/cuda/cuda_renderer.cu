@@ -432,9 +432,9 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     if (depthOut) d.depth.reserve(pixelCount, "the depth image");
     if (!settings.depthIn.empty()) d.depthIn.upload(settings.depthIn, "the depth image given");
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
-    const FrameView frame = makeFrameView(settings, result.setup, d.pixels.data(),
-                                          d.sampleCounts.data(), depthOut ? d.depth.data() : nullptr,
-                                          settings.depthIn.empty() ? nullptr : d.depthIn.data());
+    const FrameView frame = makeFrameView(
+        settings, result.setup, d.pixels.data(), d.sampleCounts.data(),
+        depthOut ? d.depth.data() : nullptr, settings.depthIn.empty() ? nullptr : d.depthIn.data());
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);
@@ -451,22 +451,24 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     UVR_CUDA_CHECK(cudaEventRecord(begin));
     const bool native = d.mesh.tets.hasNative();
     const bool lit = litKernel(result.setup.params);
+    const bool surfaces = surfacesKernel(result.setup.params);
     if (method == RenderMethod::Reference) {
-        dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
-            cuda::launchFrame(grid, block, frame,
-                              ReferenceMarch<kNative(), kLit()>{d.deviceScene(result.setup)},
-                              d.totals.data());
+        dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
+            cuda::launchFrame(
+                grid, block, frame,
+                ReferenceMarch<kNative(), kLit(), kSurf()>{d.deviceScene(result.setup)},
+                d.totals.data());
         });
     } else if (method == RenderMethod::Exact) {
-        dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
+        dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
             cuda::launchFrame(grid, block, frame,
-                              ExactMarch<kNative(), kLit()>{d.deviceScene(result.setup)},
+                              ExactMarch<kNative(), kLit(), kSurf()>{d.deviceScene(result.setup)},
                               d.totals.data());
         });
     } else {
         const PartitionSceneView scene = d.devicePartitionScene(result.setup, settings.skip);
-        dispatchKernel(native, lit, [&](auto kNative, auto kLit) {
-            cuda::launchFrame(grid, block, frame, PartitionMarch<kNative(), kLit()>{scene},
+        dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
+            cuda::launchFrame(grid, block, frame, PartitionMarch<kNative(), kLit(), kSurf()>{scene},
                               d.totals.data());
         });
     }

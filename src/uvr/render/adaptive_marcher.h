@@ -103,17 +103,22 @@ UVR_HOST_DEVICE inline void shadeNan(PartitionShading& s, float nanAlpha, float 
     if (s.maxOpacity > 0.f) s.step = s1;
 }
 
+/// Longest step, in s1, in a partition or macrocell an isosurface crosses (shadeIso).
+inline constexpr float kIsoMaxStep = 4.f;
+
 /// Shading of a partition or macrocell whose value range [lo, hi] holds an iso value: visible
-/// (never skipped) and stepped at s1, so the crossing between two samples is where the
-/// reference's samples put it (the surface is a jump in colour and opacity that the range's
-/// statistics do not show).
+/// (never skipped) and stepped at most kIsoMaxStep s1. A step that crosses a surface is bisected
+/// to within s1 (bisectIso), so the surface lies where the reference's samples put it; what a
+/// step can still miss is a fold of the surface thinner than the step (a ray grazing it: a
+/// silhouette moves in by about step^2 / (8 r) for a surface of curvature radius r).
 UVR_HOST_DEVICE inline void shadeIso(PartitionShading& s, float lo, float hi, const IsoView& iso,
                                      float s1) {
     if (!iso.within(lo, hi)) return;
     for (int i = 0; i < iso.count; ++i)
         s.maxOpacity =
             iso.surfaces[i].opacity > s.maxOpacity ? iso.surfaces[i].opacity : s.maxOpacity;
-    s.step = s1;
+    const float longest = kIsoMaxStep * s1;
+    s.step = s.step < longest ? s.step : longest;
 }
 
 /// The macrocells' layout and their shading for the current transfer function.
@@ -165,6 +170,54 @@ struct PartitionSceneView {
     float longStep = kLongStep;   ///< steps above this many s1 do not walk from the previous sample
 };
 
+/// A long step from the run's last sample to the sample at kSample (in tetrahedron tet) crosses
+/// an isosurface (an odd number of them): probes by bisection, each located by a walk from the
+/// last one found, narrow the crossing to within s1, and the probes before it join the run as
+/// samples (the one just past it too), so the surface lies where the reference's samples put
+/// it, to within s1, whatever the step. Not inlined: only frames with isosurfaces call it, at
+/// the steps that cross one.
+template <bool kNative>
+UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, const Ray& ray,
+                                            float kSample, float k1, std::uint32_t tet,
+                                            SampleSegments<true, true>& segments,
+                                            RayCounters& counters, Vec4f& acc) {
+    const TetLocator& locator = scene.base.locator;
+    const MarchParams& params = scene.base.params;
+    const float s1 = params.step;
+    const IsoView& iso = params.iso;
+    auto odd = [&](float a, float b) { return iso.crossings(a, b, [](int, float) {}) % 2 == 1; };
+    float lo = segments.kLast, hi = kSample, vLo = segments.vLast;
+    bool haveHi = false;  // a probe found at hi (else hi is the sample itself)
+    float vHi = 0.f;
+    Vec3f gradHi(0.f);
+    std::uint32_t tetHi = tet;
+    float bary[4];
+    std::uint32_t from = tet;
+    while (hi - lo > 1.f) {
+        const float mid = floorf(0.5f * (lo + hi) + 0.5f);
+        if (mid <= lo || mid >= hi) break;
+        ++counters.samples;
+        const Vec3f q = ray.at(mid * s1);
+        std::uint32_t found = locator.walk<kNative>(q, from, bary, counters.locate);
+        if (found == kNoTet)
+            found = locator.search<kNative>(scene.cells, 0, q, bary, counters.locate);
+        if (found == kNoTet) break;  // a hole in the mesh: the step's linear reading stands
+        from = found;
+        const float vMid = locator.mesh.interpolate<kNative>(found, bary);
+        const Vec3f gradMid = sampleGradient<kNative, true>(params, locator.mesh, found, bary);
+        if (odd(vLo, vMid)) {  // the crossing lies before mid
+            hi = mid, vHi = vMid, gradHi = gradMid, tetHi = found, haveHi = true;
+        } else {  // after it: the run goes on to mid
+            segments.add(scene.base.tf, mid, k1, true, vMid, s1, params.opacityUnit, acc,
+                         lightAt(params.light, found, gradMid, ray.dir), gradMid);
+            lo = mid, vLo = vMid;
+        }
+    }
+    if (haveHi)
+        segments.add(scene.base.tf, hi, k1, true, vHi, s1, params.opacityUnit, acc,
+                     lightAt(params.light, tetHi, gradHi, ray.dir), gradHi);
+}
+
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
 /// back in exact order; skips unoccupied space (outside the shrunk boxes) and, when asked,
 /// partitions with zero maximum opacity; marches each visited partition with its own step s,
@@ -189,7 +242,7 @@ struct PartitionSceneView {
 /// a curved boundary to the end of the piece's box), and a sample outside the mesh is followed
 /// by one s1 on (or by the first grid point past its seed-grid cell when that holds no cell), so
 /// a grazing ray's short chord is not stepped over.
-template <bool kNative = true, bool kLit = true>
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
                                              RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -208,9 +261,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const TfTableView& tf = scene.base.tf;
     const bool preintegrated = scene.base.params.preintegrated;
     const Lighting lighting = kernelLighting<kLit>(scene.base.params);
-    SampleSegments<kLit> segments;
-    segments.setIsos(scene.base.params.iso, lighting, ray.dir);
-    PointIsos<kLit> pointIsos;
+    SampleSegments<kLit, kSurf> segments;
+    segments.setIsos(scene.base.params.iso, lighting, ray.dir, scene.base.params.depthAlpha);
+    PointIsos<kSurf> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
@@ -230,7 +283,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     [[maybe_unused]] float aNoted = 0.f, tNoted = tEnter;
     [[maybe_unused]] const float depthAlpha = scene.base.params.depthAlpha;
     auto note = [&](float tNow) {
-        if constexpr (kLit) {
+        if constexpr (kSurf) {
+            if (segments.kDepth < INFINITY && !(counters.depth < INFINITY))
+                counters.depth = segments.kDepth * s1;
             tNow = fmaxf(tNoted, tNow);
             noteDepth(depthAlpha, aNoted, acc.w, tNoted, tNow, counters);
             aNoted = acc.w, tNoted = tNow;
@@ -331,7 +386,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
         const Vec3f grad =
-            sampleGradient<kNative, kLit>(scene.base.params, locator.mesh, tet, bary);
+            sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
         const LightFactors light = lightAt(lighting, tet, grad, ray.dir);
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
@@ -377,7 +432,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                             locator.search<kNative>(scene.cells, 0, q, probeBary, counters.locate);
                     const float vMid =
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
-                    const Vec3f gradMid = sampleGradient<kNative, kLit>(
+                    const Vec3f gradMid = sampleGradient<kNative, kLit, kSurf>(
                         scene.base.params, locator.mesh, found, probeBary);
                     const LightFactors lightMid = lightAt(lighting, found, gradMid, ray.dir);
                     if (found != kNoTet) from = found;
@@ -399,6 +454,14 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi, gradHi);
                 else if (!in)
                     segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
+            }
+            // A step longer than s1 inside the mesh across an isosurface: the crossing is
+            // bisected for to within s1 (isosurface.h).
+            if constexpr (kSurf) {
+                if (in && segments.iso && segments.started && segments.inside &&
+                    kSample <= segments.kEnd && kSample - segments.kLast > 1.f &&
+                    segments.iso->crossings(segments.vLast, v, [](int, float) {}) % 2 == 1)
+                    bisectIso<kNative>(scene, ray, kSample, k1, tet, segments, counters, acc);
             }
             if (in) lastInside = tet;
             segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light, grad);

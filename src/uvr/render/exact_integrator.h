@@ -166,10 +166,10 @@ inline constexpr int kIsoRefinements = 4;
 /// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
 /// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc; lit
 /// (gradient shading), each piece by the mean of its ends' lights (the gradient through the
-/// cell's Jacobian at the Newton iterate's coordinates). With isosurfaces (iso, kLit), a piece
+/// cell's Jacobian at the Newton iterate's coordinates). With isosurfaces (iso, kSurf), a piece
 /// crossing one is cut where the cell's own field meets its value (regula falsi from the
 /// piece's linear reading, kIsoRefinements evaluations) and the surface composited there.
-template <bool kLit = true>
+template <bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
                                            float v0, double unit, const Lighting& light, Vec4f& acc,
@@ -235,7 +235,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         const int lit = lightPieces(lightA, lightMid, lightEnd);
         pieces = lit > pieces ? lit : pieces;
     }
-    if (pieces == 1 && !(kLit && iso)) {
+    if (pieces == 1 && !(kSurf && iso)) {
         const Vec4f before = acc;
         segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
         if constexpr (kLit) lightSegment(before, simpsonLight(lightA, lightMid, lightEnd), acc);
@@ -250,7 +250,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         const LightFactors vol = lightA.mean(lightB);
         double ta = t0 + h * (i - 1), len = h;  // the rest of the piece: from ta, len long
         float va = a;
-        if constexpr (kLit) {
+        if constexpr (kSurf) {
             if (iso) {
                 const double tb = i == pieces ? t1 : t0 + h * i;
                 const Lighting surface = surfaceLighting(light);
@@ -405,10 +405,69 @@ UVR_HOST_DEVICE inline float scalarAt(const TetLocator& loc, std::uint32_t tet, 
     return m.interpolate<kNative>(tet, bary);
 }
 
+/// The piece [ta, tb] of tetrahedron tet's segment, the scalar linear from va to vb, into acc:
+/// float pieces (within 1e-4 of the double closed form, deep pieces in double), lit (kLit) per
+/// cell (a tetrahedron's gradient is constant, so is its light along the segment) or by smooth
+/// normals (smoothLitSegment), and the ray's depth noted (kSurf).
+template <bool kNative, bool kLit, bool kSurf>
+UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t tet, const Ray& ray,
+                                         double ta, double tb, float va, float vb,
+                                         const Lighting& light, bool continuous,
+                                         RayCounters& counters, Vec4f& acc) {
+    const TetMeshView& mesh = scene.locator.mesh;
+    const double unit = scene.params.opacityUnit;
+    if constexpr (kLit) {
+        if (light.on && light.smooth && mesh.blockGradients && continuous) {
+            const float a0 = acc.w;
+            smoothLitSegment<kNative>(mesh, scene.tf, tet, ray, ta, tb, va, vb, unit, light, acc);
+            if constexpr (kSurf)
+                noteDepth(scene.params.depthAlpha, a0, acc.w, float(ta), float(tb), counters);
+            return;
+        }
+    }
+    const Vec4f before = acc;
+    segment::integrate(scene.tf, va, vb, tb - ta, unit, acc, true);
+    if constexpr (kLit) {
+        if (light.on) lightSegment(before, lightInTet<kNative>(mesh, tet, ray, tb, light), acc);
+        if constexpr (kSurf)
+            noteDepth(scene.params.depthAlpha, before.w, acc.w, float(ta), float(tb), counters);
+    }
+}
+
+/// A tetrahedron's segment [t, tEnd] (scalar linear from s0 to s1) with the frame's
+/// isosurfaces: integrated up to each crossing (exact: the scalar is linear), the surface
+/// composited there, lit by its normal at that point, and the rest after it. Not inlined: only
+/// frames with isosurfaces call it.
+template <bool kNative>
+UVR_HOST_DEVICE UVR_NOINLINE void isoTetSegment(const SceneView& scene, std::uint32_t tet,
+                                                const Ray& ray, double t, double tEnd, float s0,
+                                                float s1, const Lighting& light,
+                                                RayCounters& counters, Vec4f& acc) {
+    const IsoView& isos = scene.params.iso;
+    double ta = t;
+    float va = s0;
+    isos.crossings(s0, s1, [&](int i, float f) {
+        if (acc.w >= segment::kOpacityEnd) return;
+        const IsoSurface& iso = isos.surfaces[i];
+        const double tc = t + (tEnd - t) * double(f);
+        tetPiece<kNative, true, true>(scene, tet, ray, ta, tc, va, iso.value, light, true, counters,
+                                      acc);
+        const LightFactors lit =
+            lightInTet<kNative>(scene.locator.mesh, tet, ray, tc, surfaceLighting(light));
+        const float a0 = acc.w;
+        compositeIso(iso, scene.tf.sample(iso.value).xyz(), lit, acc);
+        noteDepth(scene.params.depthAlpha, a0, acc.w, float(tc), float(tc), counters);
+        ta = tc, va = iso.value;
+    });
+    if (acc.w < segment::kOpacityEnd)
+        tetPiece<kNative, true, true>(scene, tet, ray, ta, tEnd, va, s1, light, true, counters,
+                                      acc);
+}
+
 }  // namespace exact
 
 /// The exact integrator for one ray (see the top of this file).
-template <bool kNative = true, bool kLit = true>
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -430,7 +489,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     const double eps = 1e-6 * (double(scene.bounds.diagonal()) + double(b0));
     const double unit = scene.params.opacityUnit;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
-    const IsoView* isos = kLit && scene.params.iso.active() ? &scene.params.iso : nullptr;
+    const IsoView* isos = kSurf && scene.params.iso.active() ? &scene.params.iso : nullptr;
     double t = b0;
     exact::TetSpan span;
     std::uint32_t tet =
@@ -460,60 +519,27 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             [[maybe_unused]] const float depthAlpha = scene.params.depthAlpha;
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
                 [[maybe_unused]] const float a0 = acc.w;
-                s1 = exact::nativeSegment<kLit>(loc.mesh, scene.tf, tet, ray, t, tEnd,
-                                                haveEntry ? sEntry : NAN, unit, lighting, acc,
-                                                isos);
-                if constexpr (kLit) noteDepth(depthAlpha, a0, acc.w, t, tEnd, counters);
+                s1 = exact::nativeSegment<kLit, kSurf>(loc.mesh, scene.tf, tet, ray, t, tEnd,
+                                                       haveEntry ? sEntry : NAN, unit, lighting,
+                                                       acc, isos);
+                if constexpr (kSurf) noteDepth(depthAlpha, a0, acc.w, t, tEnd, counters);
             } else {
                 const float s0 =
                     haveEntry ? sEntry : exact::scalarAt<kNative>(loc, tet, span, ray, t);
                 s1 = exact::scalarAt<kNative>(loc, tet, span, ray, tEnd);
-                const Lighting& light = lighting;
-                // The piece [ta, tb] of the segment, the scalar linear from va to vb.
-                auto piece = [&](double ta, double tb, float va, float vb) {
-                    if constexpr (kLit) {
-                        const float a0 = acc.w;
-                        if (light.on && light.smooth && loc.mesh.blockGradients && continuous) {
-                            exact::smoothLitSegment<kNative>(loc.mesh, scene.tf, tet, ray, ta, tb,
-                                                             va, vb, unit, light, acc);
-                            noteDepth(depthAlpha, a0, acc.w, ta, tb, counters);
-                            return;
-                        }
-                    }
-                    // Float pieces (within 1e-4 of the double closed form, deep pieces in
-                    // double).
-                    const Vec4f before = acc;
-                    segment::integrate(scene.tf, va, vb, tb - ta, unit, acc, true);
-                    // Lit per cell: a tetrahedron's gradient is constant, so is its light along
-                    // the segment.
-                    if constexpr (kLit) {
-                        if (light.on)
-                            lightSegment(before,
-                                         exact::lightInTet<kNative>(loc.mesh, tet, ray, tb, light),
-                                         acc);
-                        noteDepth(depthAlpha, before.w, acc.w, ta, tb, counters);
-                    }
-                };
-                double ta = t;
-                float va = s0;
-                if constexpr (kLit) {
-                    // Isosurfaces: the segment is cut where its linear scalar meets them.
+                // Isosurfaces: the segment is cut where its linear scalar meets them (a call
+                // of its own: frames without them keep the inlined piece alone).
+                bool done = false;
+                if constexpr (kSurf) {
                     if (isos && continuous) {
-                        isos->crossings(s0, s1, [&](int i, float f) {
-                            if (acc.w >= segment::kOpacityEnd) return;
-                            const IsoSurface& iso = isos->surfaces[i];
-                            const double tc = t + (tEnd - t) * double(f);
-                            piece(ta, tc, va, iso.value);
-                            const LightFactors lit = exact::lightInTet<kNative>(
-                                loc.mesh, tet, ray, tc, surfaceLighting(light));
-                            const float a0 = acc.w;
-                            compositeIso(iso, scene.tf.sample(iso.value).xyz(), lit, acc);
-                            noteDepth(depthAlpha, a0, acc.w, tc, tc, counters);
-                            ta = tc, va = iso.value;
-                        });
+                        exact::isoTetSegment<kNative>(scene, tet, ray, t, tEnd, s0, s1, lighting,
+                                                      counters, acc);
+                        done = true;
                     }
                 }
-                if (acc.w < segment::kOpacityEnd) piece(ta, tEnd, va, s1);
+                if (!done)
+                    exact::tetPiece<kNative, kLit, kSurf>(scene, tet, ray, t, tEnd, s0, s1,
+                                                          lighting, continuous, counters, acc);
             }
             opaque = acc.w >= segment::kOpacityEnd;
             past = clipped && tEnd >= tStop;

@@ -120,49 +120,54 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
 ///
 /// The integrator functors take kNative false for meshes of tetrahedra only: their kernels are
 /// compiled without the native cells' code (dispatchKernel picks the instance), which costs
-/// tetrahedra 10-30% of their frame time on the GPU when present; and kLit false for frames
-/// without shading (without the lighting code: up to 21% of the adaptive kernel's time).
-template <bool kNative = true, bool kLit = true>
+/// tetrahedra 10-30% of their frame time on the GPU when present; kLit false for frames
+/// without shading (without the lighting code: up to 21% of the adaptive kernel's time); kSurf
+/// false for frames without isosurfaces or depth.
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct ReferenceMarch {
     SceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return marchReference<kNative, kLit>(scene, ray, counters);
+        return marchReference<kNative, kLit, kSurf>(scene, ray, counters);
     }
 };
 
 /// The exact integrator as a functor for shadePixel (its "samples" are tetrahedra crossed).
-template <bool kNative = true, bool kLit = true>
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct ExactMarch {
     SceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return integrateExact<kNative, kLit>(scene, ray, counters);
+        return integrateExact<kNative, kLit, kSurf>(scene, ray, counters);
     }
 };
 
 /// The partition integrator as a functor for shadePixel.
-template <bool kNative = true, bool kLit = true>
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct PartitionMarch {
     PartitionSceneView scene;
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return marchPartitions<kNative, kLit>(scene, ray, counters);
+        return marchPartitions<kNative, kLit, kSurf>(scene, ray, counters);
     }
 };
 
-/// Calls f(kNative, kLit) with std::true_type or std::false_type for each: kNative when the
-/// mesh has native cells, kLit when the frame is shaded (the integrator functors' parameters;
-/// each compiled four times, so a frame runs without the code it does not need).
+/// Calls f(kNative, kLit, kSurf) with std::true_type or std::false_type for each: kNative when
+/// the mesh has native cells; kLit when the frame is shaded or kSurf; kSurf when it has
+/// isosurfaces or writes depth (the integrator functors' parameters: each compiled six times,
+/// so a frame runs without the code it does not need; the isosurfaces' and depth's code in the
+/// shaded kernels cost them 40-90% on the H200).
 template <typename F>
-void dispatchKernel(bool hasNative, bool lit, F&& f) {
-    auto withLit = [&](auto kNative) {
-        if (lit)
-            f(kNative, std::true_type{});
+void dispatchKernel(bool hasNative, bool lit, bool surfaces, F&& f) {
+    auto withExtras = [&](auto kNative) {
+        if (surfaces)
+            f(kNative, std::true_type{}, std::true_type{});
+        else if (lit)
+            f(kNative, std::true_type{}, std::false_type{});
         else
-            f(kNative, std::false_type{});
+            f(kNative, std::false_type{}, std::false_type{});
     };
     if (hasNative)
-        withLit(std::true_type{});
+        withExtras(std::true_type{});
     else
-        withLit(std::false_type{});
+        withExtras(std::false_type{});
 }
 
 }  // namespace uvr

@@ -45,11 +45,11 @@ UVR_HOST_DEVICE inline void compositeFrontToBack(Vec4f& acc, Vec3f rgb, float a)
 /// is extended (its value held for a run of one sample). So a run of n samples covers the same
 /// distance as n point samples, a linear field is integrated exactly, and with equal steps the
 /// partition integrator takes exactly the reference's segments. kLit false: without the lights
-/// and isosurfaces (an unshaded kernel holds none of their registers). With isosurfaces
-/// (setIsos), a segment crossing one is integrated up to the crossing (where the linear value
-/// meets it), the surface composited there, lit by the gradient interpolated between the two
-/// samples', and the rest integrated after it.
-template <bool kLit = true>
+/// (an unshaded kernel holds none of their registers); kSurf false: without isosurfaces and
+/// depth. With isosurfaces (setIsos), a segment crossing one is integrated up to the crossing
+/// (where the linear value meets it), the surface composited there, lit by the gradient
+/// interpolated between the two samples', and the rest integrated after it.
+template <bool kLit = true, bool kSurf = kLit>
 struct SampleSegments {
     float kLast = 0.f;              ///< grid position of the last sample
     float kEnd = 0.f;               ///< end of the piece of the ray the last sample belongs to
@@ -59,16 +59,21 @@ struct SampleSegments {
     const IsoView* iso = nullptr;   ///< the isosurfaces (null: none)
     Lighting surface;               ///< their lighting (surfaceLighting)
     Vec3f dir{0.f, 0.f, 1.f};       ///< the ray's direction
-    float kPrev = 0.f;              ///< grid position of the sample before it in the run
-    float vPrev = 0.f;              ///< its value
-    bool inRun = false;             ///< the sample before the last one is in the last one's run
-    bool inside = false;            ///< the last sample found a cell
-    bool started = false;           ///< a sample was taken
+    float depthAlpha = 0.f;         ///< depth out (MarchParams::depthAlpha)
+    /// Depth out: the grid position where an isosurface took the opacity to depthAlpha
+    /// (infinity: none did); the marchers prefer it to their coarser stretches.
+    float kDepth = INFINITY;
+    float kPrev = 0.f;     ///< grid position of the sample before it in the run
+    float vPrev = 0.f;     ///< its value
+    bool inRun = false;    ///< the sample before the last one is in the last one's run
+    bool inside = false;   ///< the last sample found a cell
+    bool started = false;  ///< a sample was taken
 
-    /// Isosurfaces to composite between samples (kLit only), lit by `l` along a ray of
-    /// direction d.
-    UVR_HOST_DEVICE void setIsos(const IsoView& isos, const Lighting& l, Vec3f d) {
-        if constexpr (kLit) {
+    /// Isosurfaces to composite between samples (kSurf only), lit by `l` along a ray of
+    /// direction d, and the opacity whose depth is asked for.
+    UVR_HOST_DEVICE void setIsos(const IsoView& isos, const Lighting& l, Vec3f d, float alpha) {
+        if constexpr (kSurf) {
+            depthAlpha = alpha;
             iso = isos.active() ? &isos : nullptr;
             surface = surfaceLighting(l);
             dir = d;
@@ -79,15 +84,15 @@ struct SampleSegments {
     /// next piece continues it when it starts there); `in`: it found a cell, with value v,
     /// light f (gradient shading; the segment from the last sample is lit by the mean of their
     /// lights, the run's last share by its last sample's) and gradient g (isosurfaces).
-    UVR_HOST_DEVICE void add(const TfTableView& tf, float k, float kPieceEnd, bool in, float v,
-                             float s1, double unit, Vec4f& acc, LightFactors f = {},
-                             Vec3f g = Vec3f(0.f)) {
+    UVR_HOST_DEVICE UVR_INLINE void add(const TfTableView& tf, float k, float kPieceEnd, bool in,
+                                        float v, float s1, double unit, Vec4f& acc,
+                                        LightFactors f = {}, Vec3f g = Vec3f(0.f)) {
         const bool goesOn = started && inside && in && k <= kEnd;
         if (goesOn) {
             bool done = false;
-            if constexpr (kLit) {
+            if constexpr (kSurf) {
                 if (iso) {
-                    withIsos(tf, v, double(k - kLast) * s1, unit, light.mean(f), g, acc);
+                    withIsos(tf, v, k, s1, unit, light.mean(f), g, acc);
                     done = true;
                 }
             }
@@ -105,7 +110,8 @@ struct SampleSegments {
         kLast = k;
         kEnd = kPieceEnd;
         vLast = v;
-        if constexpr (kLit) light = f, gradLast = g;
+        if constexpr (kLit) light = f;
+        if constexpr (kSurf) gradLast = g;
         inside = in;
         started = true;
     }
@@ -116,9 +122,12 @@ struct SampleSegments {
 
 private:
     /// The segment from the last sample to one of value v and gradient g over len, split at
-    /// the isosurfaces it crosses (volume lit by vol).
-    UVR_HOST_DEVICE void withIsos(const TfTableView& tf, float v, double len, double unit,
-                                  const LightFactors& vol, Vec3f g, Vec4f& acc) const {
+    /// the isosurfaces it crosses (volume lit by vol). Not inlined: only frames with
+    /// isosurfaces call it, and inlined it cost the shaded kernel its inlined add().
+    UVR_HOST_DEVICE UVR_NOINLINE void withIsos(const TfTableView& tf, float v, float k, float s1,
+                                               double unit, const LightFactors& vol, Vec3f g,
+                                               Vec4f& acc) {
+        const double len = double(k - kLast) * s1;
         float f0 = 0.f, va = vLast;
         iso->crossings(vLast, v, [&](int i, float f) {
             if (acc.w >= segment::kOpacityEnd) return;
@@ -127,7 +136,10 @@ private:
             segment::integrate(tf, va, s.value, double(f - f0) * len, unit, acc, true);
             lightSegment(before, vol, acc);
             const Vec3f gi = gradLast + (g - gradLast) * f;
+            const float a0 = acc.w;
             compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
+            if (depthAlpha > 0.f && !(kDepth < INFINITY) && a0 < depthAlpha && acc.w >= depthAlpha)
+                kDepth = kLast + (k - kLast) * f;
             f0 = f, va = s.value;
         });
         if (acc.w >= segment::kOpacityEnd) return;
@@ -149,13 +161,13 @@ private:
 };
 
 /// The gradient at a sample in cell `tet` at local coordinates bary (TetMeshView::gradient,
-/// smooth as the lighting asks) where a lit instance needs it (shaded, or with isosurfaces);
-/// else, or outside the mesh, 0.
-template <bool kNative = true, bool kLit = true>
+/// smooth as the lighting asks) where an instance needs it (kLit: shaded; kSurf: also with
+/// isosurfaces); else, or outside the mesh, 0.
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec3f sampleGradient(const MarchParams& params, const TetMeshView& mesh,
                                             std::uint32_t tet, const float bary[4]) {
     if constexpr (kLit) {
-        if (tet != kNoTet && (params.light.on || params.iso.active()))
+        if (tet != kNoTet && (params.light.on || (kSurf && params.iso.active())))
             return mesh.gradient<kNative>(tet, bary, params.light.smooth);
     }
     return Vec3f(0.f);
@@ -169,10 +181,10 @@ UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, std::uint32_t
     return lightFactors(light, g, dir);
 }
 
-/// Point sampling with isosurfaces (kLit): the surfaces crossed between consecutive samples
+/// Point sampling with isosurfaces (kSurf): the surfaces crossed between consecutive samples
 /// inside the mesh, where the value read linearly between them meets theirs, composited before
 /// the later sample.
-template <bool kLit = true>
+template <bool kSurf = true>
 struct PointIsos {
     float vLast = 0.f;
     Vec3f gradLast{0.f, 0.f, 0.f};
@@ -180,7 +192,7 @@ struct PointIsos {
 
     UVR_HOST_DEVICE void add(const MarchParams& params, const TfTableView& tf, Vec3f dir, bool in,
                              float v, Vec3f g, Vec4f& acc) {
-        if constexpr (kLit) {
+        if constexpr (kSurf) {
             const IsoView& iso = params.iso;
             if (in && inside && iso.active()) {
                 const Lighting surface = surfaceLighting(params.light);
@@ -212,7 +224,7 @@ UVR_HOST_DEVICE inline Lighting kernelLighting(const MarchParams& params) {
 /// consecutive samples (SampleSegments; or, with params.preintegrated off, classifies each sample
 /// through the transfer function and composites it with opacity correction), front to back,
 /// stopping early once opaque.
-template <bool kNative = true, bool kLit = true>
+template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& ray,
                                             RayCounters& counters) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
@@ -231,10 +243,10 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
     const float unit = scene.params.opacityUnit;
-    SampleSegments<kLit> segments;
+    SampleSegments<kLit, kSurf> segments;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
-    segments.setIsos(scene.params.iso, lighting, ray.dir);
-    PointIsos<kLit> pointIsos;
+    segments.setIsos(scene.params.iso, lighting, ray.dir, scene.params.depthAlpha);
+    PointIsos<kSurf> pointIsos;
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
@@ -245,7 +257,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
-        const Vec3f g = sampleGradient<kNative, kLit>(scene.params, scene.locator.mesh, tet, bary);
+        const Vec3f g =
+            sampleGradient<kNative, kLit, kSurf>(scene.params, scene.locator.mesh, tet, bary);
         const LightFactors light = lightAt(lighting, tet, g, ray.dir);
         if (scene.params.preintegrated) {
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light, g);
@@ -257,7 +270,9 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             const float a = correctOpacity(c.w, s, unit, scene.tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
-        if constexpr (kLit) {
+        if constexpr (kSurf) {
+            if (segments.kDepth < INFINITY && !(counters.depth < INFINITY))
+                counters.depth = segments.kDepth * s;
             noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, k * s, counters);
             tNoted = k * s;
         }
@@ -266,7 +281,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     if (scene.params.preintegrated && !opaque) {
         [[maybe_unused]] const float a0 = acc.w;
         segments.finish(scene.tf, s, unit, acc);
-        if constexpr (kLit) noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, t1, counters);
+        if constexpr (kSurf) noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, t1, counters);
     }
     return acc;
 }

@@ -35,10 +35,15 @@ struct MarchParams {
     float depthAlpha = 0.f;
 };
 
-/// Whether a frame runs the integrators' lit instances (kLit, the instances with the per-ray
-/// extras): shaded, with isosurfaces (always lit, they need the gradients) or writing depth.
+/// Whether a frame runs the integrators' instances with isosurfaces and depth (kSurf).
+UVR_HOST_DEVICE inline bool surfacesKernel(const MarchParams& p) {
+    return p.iso.active() || p.depthAlpha > 0.f;
+}
+
+/// Whether a frame runs the integrators' lit instances (kLit): shaded, or with the surfaces'
+/// instances (isosurfaces are lit and need the gradients).
 UVR_HOST_DEVICE inline bool litKernel(const MarchParams& p) {
-    return p.light.on || p.iso.active() || p.depthAlpha > 0.f;
+    return p.light.on || surfacesKernel(p);
 }
 
 /// Everything a ray needs, as plain data for CPU and GPU.
