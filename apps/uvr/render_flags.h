@@ -20,7 +20,7 @@ struct RenderOutputs {
     std::string stats;                ///< --stats: the frame report as JSON ("" for none)
     std::optional<Vec3f> background;  ///< --background: composited over it (none: RGBA)
     std::optional<Font> legend;       ///< --legend: the font it is drawn in (none: no legend)
-    std::string depth;  ///< --depth: the depth image as a .npy ("" for none)
+    std::string depth;                ///< --depth: the depth image as a .npy ("" for none)
 };
 
 /// Render options shared by `render` and `demo`, registered on a subcommand.
@@ -53,10 +53,10 @@ struct RenderFlags {
     std::string background;
     bool legend = false;  ///< draw a colour legend (title, bar, ticks) at the right edge
     std::string statsFile;
-    std::string depthFile;     ///< --depth FILE.npy: depth out
+    std::string depthFile;  ///< --depth FILE.npy: depth out
     /// --depth-opacity: the opacity whose depth --depth writes (unset: kDefaultDepthOpacity).
     std::optional<float> depthOpacity;
-    std::string depthInFile;   ///< --depth-in FILE.npy: depth in
+    std::string depthInFile;  ///< --depth-in FILE.npy: depth in
     int threads = 0;
 
     /// Adds the flags to a subcommand; oneFrame adds those of a single render (output, heat map,

@@ -268,7 +268,8 @@ std::array<float, 6> sixNumbers(const char* setting, const py::handle& v, const 
 
 }  // namespace
 
-RenderSettings settingsOf(const py::dict& settings) {
+RenderSettings settingsOf(const py::dict& settings,
+                          std::pair<py::ssize_t, py::ssize_t>* depthShape) {
     RenderSettings s;
     std::vector<std::string> given;
     for (const auto& [k, v] : settings) {
@@ -337,6 +338,36 @@ RenderSettings settingsOf(const py::dict& settings) {
             }
             continue;
         }
+        // Depth out: the opacity whose depth the frame reports (Image.depth); depth in: a 2-D
+        // array of view depths of geometry rendered elsewhere (inf or NaN: none).
+        if (key == "depth") {
+            const std::string text = py::str(py::repr(v)).cast<std::string>();
+            if (py::isinstance<py::bool_>(v) ||
+                !(py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v)))
+                throw SettingError(
+                    "depth", text,
+                    "expected the opacity whose depth is written, a number in (0, 1]");
+            s.depthAlpha = v.cast<float>();
+            if (!(s.depthAlpha > 0.f && s.depthAlpha <= 1.f))
+                throw SettingError(
+                    "depth", text,
+                    "expected the opacity whose depth is written, a number in (0, 1]");
+            continue;
+        }
+        if (key == "depth_in") {
+            py::array_t<float, py::array::c_style | py::array::forcecast> a;
+            try {
+                a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(v);
+            } catch (const py::error_already_set&) {
+            }
+            if (!a || a.ndim() != 2)
+                throw SettingError("depth_in",
+                                   "a " + std::string(py::str(py::type::of(v).attr("__name__"))),
+                                   "expected a 2-D array of view depths, shape (height, width)");
+            s.depthIn.assign(a.data(), a.data() + a.size());
+            if (depthShape) *depthShape = {a.shape(0), a.shape(1)};
+            continue;
+        }
         if (key == "clip_box") {
             const auto a = sixNumbers("clip_box", v,
                                       "expected (lo, hi): six numbers, ((x0, y0, z0), (x1, y1, "
@@ -355,7 +386,14 @@ RenderSettings settingsOf(const py::dict& settings) {
 py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
                       int width, int height, const py::dict& settings) {
-    RenderSettings s = settingsOf(settings);
+    std::pair<py::ssize_t, py::ssize_t> depthShape{0, 0};
+    RenderSettings s = settingsOf(settings, &depthShape);
+    if (!s.depthIn.empty() && (depthShape.first != height || depthShape.second != width))
+        throw SettingError("depth_in",
+                           "shape (" + std::to_string(depthShape.first) + ", " +
+                               std::to_string(depthShape.second) + ")",
+                           "expected the frame's (height, width): (" + std::to_string(height) +
+                               ", " + std::to_string(width) + ")");
     s.width = width, s.height = height;
     s.tf = tf;
     s.range = range;
@@ -370,7 +408,9 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
     const auto h = static_cast<py::ssize_t>(height), w = static_cast<py::ssize_t>(width);
     py::array pixels = vectorArray<float>(std::move(r.image.pixels), {h, w, 4});
     py::array counts = vectorArray<std::uint32_t>(std::move(r.sampleCounts), {h, w});
-    return py::make_tuple(pixels, counts, stats);
+    py::object depth = py::none();
+    if (!r.depth.empty()) depth = vectorArray<float>(std::move(r.depth), {h, w});
+    return py::make_tuple(pixels, counts, stats, depth);
 }
 
 py::tuple fileBounds(const PreparedMesh& p) {

@@ -184,7 +184,10 @@ py::object fromJson(const nlohmann::json& j);
 
 /// RenderSettings from a dict of the settings vocabulary (settings_vocabulary.h): each key a
 /// setting's name, each value checked there; the library's SettingError says what is wrong.
-RenderSettings settingsOf(const py::dict& settings);
+/// depthShape, when given, receives depth_in's (rows, columns) (renderFrame checks them against
+/// the frame's size).
+RenderSettings settingsOf(const py::dict& settings,
+                          std::pair<py::ssize_t, py::ssize_t>* depthShape = nullptr);
 
 /// The renderer object of the library with the GIL released around its long calls.
 struct PyRenderer {

@@ -262,6 +262,32 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
     assert r.render(size=(8, 8)).stats["samples"] > 0
 
 
+def test_depth_out_and_in(data_dir):
+    # Issue 32: depth= gives the view depths of an opaque isosurface; depth_in= ends the rays
+    # there, so nothing behind it is added; a depth image of another shape is refused.
+    r = uvr.Renderer(data_dir / "bluntfin_tets.vtk", device="cpu")
+    kw = dict(size=(48, 32), method="exact", azimuth=30, elevation=20)
+    img = r.render(iso=[0.9], depth=0.5, **kw)
+    assert img.depth.shape == (32, 48) and img.depth.dtype == np.float32
+    hit = np.isfinite(img.depth)
+    assert hit.sum() > 100 and (img.depth[hit] > 0).all()
+    assert img.stats["depth_alpha"] == 0.5
+    assert r.render(**kw).depth is None
+    whole = r.render(**kw)
+    front = r.render(depth_in=img.depth, **kw)
+    assert front.stats["depth_in"] is True
+    assert (np.asarray(front)[..., 3] <= np.asarray(whole)[..., 3] + 1e-5).all()
+    assert np.array_equal(np.asarray(front)[~hit], np.asarray(whole)[~hit])
+    with pytest.raises(uvr.ArgumentError, match=r"^depth_in=shape \(48, 32\): expected the frame's"):
+        r.render(depth_in=img.depth.T, **kw)
+    with pytest.raises(uvr.ArgumentError, match=r"^depth=2: expected the opacity"):
+        r.render(depth=2, **kw)
+    with pytest.raises(uvr.ArgumentError, match=r"^depth=True: expected the opacity"):
+        r.render(depth=True, **kw)
+    with pytest.raises(uvr.ArgumentError, match=r"^depth_in=a str: expected a 2-D array"):
+        r.render(depth_in="x", **kw)
+
+
 def test_the_settings_vocabulary_is_the_librarys(data_dir):
     names = [d["name"] for d in uvr.SETTINGS]
     assert names[:3] == ["method", "sampling", "step_rule"] and len(set(names)) == len(names)

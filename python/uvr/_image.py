@@ -26,16 +26,18 @@ class Image(np.ndarray):
     premultiplied by alpha (as the renderer composites it; row 0 at the top).
 
     ``stats`` holds the frame's statistics (time, samples, ...), ``sample_counts`` the samples of
-    each pixel (uint32 (h, w)). ``to_uint8()`` gives the 8-bit pixels of the PNG (straight RGBA,
+    each pixel (uint32 (h, w)), ``depth`` the view depths asked for with ``depth=`` (float32
+    (h, w), else None). ``to_uint8()`` gives the 8-bit pixels of the PNG (straight RGBA,
     or RGB over a background), ``save(path)`` writes the PNG ``uvr render`` writes, and in
     Jupyter the image displays itself (``_repr_png_``) over ``background`` (transparent when
     None).
     """
 
-    def __new__(cls, pixels, stats=None, sample_counts=None, background=None):
+    def __new__(cls, pixels, stats=None, sample_counts=None, background=None, depth=None):
         obj = np.asarray(pixels, dtype=np.float32).view(cls)
         obj.stats = dict(stats or {})
         obj.sample_counts = sample_counts
+        obj.depth = depth
         obj.background = _background(background)
         return obj
 
@@ -44,6 +46,7 @@ class Image(np.ndarray):
             return
         self.stats = getattr(obj, "stats", {})
         self.sample_counts = getattr(obj, "sample_counts", None)
+        self.depth = getattr(obj, "depth", None)
         self.background = getattr(obj, "background", None)
 
     def _check(self):

@@ -183,7 +183,7 @@ class Renderer:
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
                size=(512, 512), method=None, quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
-               clip_planes=None, clip_box=None, iso=None, **settings):
+               clip_planes=None, clip_box=None, iso=None, depth=None, depth_in=None, **settings):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
         ``.stats`` and ``.sample_counts``.
 
@@ -196,7 +196,12 @@ class Renderer:
         `clip_box` (lo, hi) keeping its inside, in the file's coordinates (``--clip-plane``,
         ``--clip-box``); `iso` a list of up to eight isosurfaces, each a value, (value, opacity)
         or (value, opacity, colour) with colour "#RRGGBB" or (r, g, b) (``--iso``; default
-        opaque, coloured by the colour map). The same settings give the CLI's pixels.
+        opaque, coloured by the colour map); `depth` an opacity in (0, 1]: the image's ``.depth``
+        then holds per pixel the distance along the view direction (file units) where the
+        opacity first reaches it, inf where it never does (``--depth``, ``--depth-opacity``);
+        `depth_in` a (height, width) array of such distances of opaque geometry rendered
+        elsewhere: every ray ends there (``--depth-in``). The same settings give the CLI's
+        pixels.
 
         `method`, `quality` and the other keywords are the library's settings (uvr.SETTINGS,
         each named, defaulted and checked there once; None means the default), listed below.
@@ -236,14 +241,15 @@ class Renderer:
         # "auto" renders with whatever was prepared (its pick, else the other of exact and
         # adaptive; the stats say which).
         settings = _settings(method=method, quality=quality, clip_planes=clip_planes,
-                             clip_box=clip_box, iso=iso, **settings)
+                             clip_box=clip_box, iso=iso, depth=depth, depth_in=depth_in,
+                             **settings)
         method = settings.get("method", "auto")
         if method != "auto" and method in _uvr.METHODS and method not in self._methods:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
                                      f"{self._methods!r} when the Renderer was made)")
-        pixels, counts, stats = self._core.render(t, range, camera, w, h, settings)
+        pixels, counts, stats, depth = self._core.render(t, range, camera, w, h, settings)
         return Image(pixels, stats=stats, sample_counts=counts,
-                     background=_background(background))
+                     background=_background(background), depth=depth)
 
     def __repr__(self):
         i = self.info

@@ -98,8 +98,8 @@ TEST_P(Depth, AnOpaqueIsosurfaceIsWhereThePlaneIs) {
         for (int y = 0; y < s.height; ++y)
             for (int x = 0; x < s.width; ++x) {
                 const Ray ray = r.setup.rays.ray(float(x) + 0.5f, float(y) + 0.5f);
-                const float hit = (c - kGradient.y * ray.org.y - kGradient.z * ray.org.z) /
-                                  kGradient.x;
+                const float hit =
+                    (c - kGradient.y * ray.org.y - kGradient.z * ray.org.z) / kGradient.x;
                 const float tol = m == RenderMethod::Exact ? 1e-4f : 0.011f;
                 const float z = r.depth[std::size_t(y) * s.width + x];
                 if (hit > 0.02f && hit < 0.98f) {
