@@ -185,7 +185,6 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
     const MarchParams& params = scene.base.params;
     const float s1 = params.step;
     const IsoView& iso = params.iso;
-    auto odd = [&](float a, float b) { return iso.crossings(a, b, [](int, float) {}) % 2 == 1; };
     float lo = segments.kLast, hi = kSample, vLo = segments.vLast;
     bool haveHi = false;  // a probe found at hi (else hi is the sample itself)
     float vHi = 0.f;
@@ -205,7 +204,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
         from = found;
         const float vMid = locator.mesh.interpolate<kNative>(found, bary);
         const Vec3f gradMid = sampleGradient<kNative, true>(params, locator.mesh, found, bary);
-        if (odd(vLo, vMid)) {  // the crossing lies before mid
+        if (iso.crossesOdd(vLo, vMid)) {  // the crossing lies before mid
             hi = mid, vHi = vMid, gradHi = gradMid, tetHi = found, haveHi = true;
         } else {  // after it: the run goes on to mid
             segments.add(scene.base.tf, mid, k1, true, vMid, s1, params.opacityUnit, acc,
@@ -460,7 +459,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if constexpr (kSurf) {
                 if (in && segments.iso && segments.started && segments.inside &&
                     kSample <= segments.kEnd && kSample - segments.kLast > 1.f &&
-                    segments.iso->crossings(segments.vLast, v, [](int, float) {}) % 2 == 1)
+                    segments.iso->crossesOdd(segments.vLast, v))
                     bisectIso<kNative>(scene, ray, kSample, k1, tet, segments, counters, acc);
             }
             if (in) lastInside = tet;

@@ -11,9 +11,9 @@
 // own field), the sampling methods between consecutive samples. A piece crosses a value c where
 // its ends lie on either side, at the fraction (c - v0) / (v1 - v0): exact in a linear
 // tetrahedron, within the sampling's linear reading between samples otherwise (the adaptive
-// method samples partitions and macrocells whose value range holds an iso value at the
-// reference's step s1: shadeIso). The piece is integrated up to the crossing, the surface
-// composited, the rest integrated after it.
+// method steps partitions and macrocells whose value range holds an iso value at most 4 s1 and
+// bisects a long step across a surface to within s1: shadeIso, bisectIso). The piece is
+// integrated up to the crossing, the surface composited, the rest integrated after it.
 
 #include <cstdint>
 
@@ -68,6 +68,12 @@ struct IsoView {
             ++n;
         }
         return n;
+    }
+
+    /// True when a field running linearly from v0 to v1 crosses an odd number of surfaces (a
+    /// step whose ends lie on either side of one: bisectIso narrows it).
+    UVR_HOST_DEVICE bool crossesOdd(float v0, float v1) const {
+        return crossings(v0, v1, [](int, float) {}) % 2 == 1;
     }
 };
 
