@@ -5,7 +5,7 @@
 // edit is sent as a `set` with the full value of each key it changes.
 
 import * as cam from "./camera.js";
-import {TfEditor} from "./tf_editor.js";
+import {TfEditor, isoText, parseIso} from "./tf_editor.js";
 
 const $ = (id) => document.getElementById(id);
 
@@ -49,7 +49,7 @@ function send(message) {
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
                     "opacity_unit", "opacity_law", "step", "clip_planes", "shade", "ambient",
-                    "diffuse", "specular", "specular_power", "normals"];
+                    "diffuse", "specular", "specular_power", "normals", "iso"];
 
 // Gradient shading's coefficients: the slider's id and the setting it sets.
 const kLightSliders = [["ambient", "ambient"], ["diffuse", "diffuse"], ["specular", "specular"],
@@ -281,7 +281,9 @@ function finalCamera() {
 view.addEventListener("pointerdown", (e) => {
     if (!session.state || drag) return;
     let mode = null;
-    if (e.button === 0) mode = e.shiftKey ? "pan" : e.ctrlKey ? "zoom" : "rotate";
+    const clipDrag = e.altKey || (e.ctrlKey && e.shiftKey);
+    if (e.button === 0 && clipDrag) mode = clipAxis() >= 0 ? "clip" : null;
+    else if (e.button === 0) mode = e.shiftKey ? "pan" : e.ctrlKey ? "zoom" : "rotate";
     else if (e.button === 1) mode = "pan";
     else if (e.button === 2) mode = "zoom";
     if (!mode) return;
@@ -300,6 +302,10 @@ view.addEventListener("pointermove", (e) => {
     drag.y = e.clientY;
     drag.moved = true;
     const w = view.clientWidth, h = view.clientHeight;
+    if (drag.mode === "clip") {
+        moveClipPlane(dx, dy, h);
+        return;
+    }
     let c = session.state.camera;
     if (drag.mode === "rotate") {
         const r = cam.dragRotation(dx, dy, w, h);
@@ -317,9 +323,10 @@ function endDrag(e) {
     if (!drag || e.pointerId !== drag.pointerId) return;
     if (view.hasPointerCapture(e.pointerId)) view.releasePointerCapture(e.pointerId);
     view.classList.remove("dragging");
-    const moved = drag.moved;
+    const {moved, mode} = drag;
     drag = null;
-    if (moved) finalCamera();
+    if (moved && mode === "clip") sendSet({clip_planes: session.state.clip_planes});
+    else if (moved) finalCamera();
 }
 view.addEventListener("pointerup", endDrag);
 view.addEventListener("pointercancel", endDrag);
@@ -351,7 +358,7 @@ $("reset-camera").addEventListener("click", () => send({type: "reset_camera"}));
 
 const tfEditor = new TfEditor($("tf-canvas"), (opacity, interactive) => {
     sendSet({tf: {...session.state.tf, opacity}}, interactive);
-});
+}, (iso, interactive) => sendSet({iso}, interactive));
 
 /// A field spec split into its parts: name, association (point/cell) and component
 /// (magnitude/x/y/z/N), as `--field` reads NAME[:point|:cell][:magnitude|:x|:y|:z|:N].
@@ -480,6 +487,7 @@ function updateControls() {
         $(`${id}-value`).textContent = fmt(s[name], 3);
     }
     fillClip(s.clip_planes || []);
+    fillIso(s.iso || []);
     fillTime(s.step || 0);
     fillSizes(s.size);
     // Transfer function.
@@ -498,7 +506,7 @@ function updateControls() {
         input.dataset.shown = fmt(s.range[i]);
         if (document.activeElement !== input) input.value = input.dataset.shown;
     });
-    tfEditor.update({tf: s.tf, range: s.range});
+    tfEditor.update({tf: s.tf, range: s.range, isos: s.iso || []});
 }
 
 function fillSizes(size) {
@@ -613,6 +621,37 @@ function fillClip(planes) {
     $("clip-pos").disabled = $("clip-flip").disabled = value === "" || value === "custom";
 }
 
+/// The axis (0, 1, 2) of the state's one clip plane across an axis, or -1.
+function clipAxis() {
+    const planes = (session.state && session.state.clip_planes) || [];
+    if (planes.length !== 1) return -1;
+    const n = planes[0].slice(3);
+    return [0, 1, 2].find((a) => n[a] !== 0 && n[(a + 1) % 3] === 0 && n[(a + 2) % 3] === 0) ?? -1;
+}
+
+let clipFrame = 0;
+
+/// Moves the clip plane along its axis by a pointer motion of (dx, dy) pixels in the view (kept
+/// within the mesh's bounds); one interactive frame per animation frame.
+function moveClipPlane(dx, dy, height) {
+    const a = clipAxis();
+    if (a < 0) return;
+    const plane = [...session.state.clip_planes[0]];
+    const axis = [0, 0, 0];
+    axis[a] = 1;
+    const [lo, hi] = meshBounds();
+    const t = cam.dragAlong(session.state.camera, axis, dx, dy, height);
+    plane[a] = Math.min(hi[a], Math.max(lo[a], plane[a] + t));
+    session.state.clip_planes = [plane];
+    fillClip(session.state.clip_planes);
+    if (!clipFrame) {
+        clipFrame = requestAnimationFrame(() => {
+            clipFrame = 0;
+            if (drag && drag.mode === "clip") sendSet({clip_planes: session.state.clip_planes}, true);
+        });
+    }
+}
+
 $("clip-axis").addEventListener("change", () => {
     if ($("clip-axis").value !== "custom") sendSet({clip_planes: clipPlanesFromControls()});
 });
@@ -620,6 +659,80 @@ $("clip-pos").addEventListener("input", () =>
     sendSet({clip_planes: clipPlanesFromControls()}, true));
 $("clip-pos").addEventListener("change", () => sendSet({clip_planes: clipPlanesFromControls()}));
 $("clip-flip").addEventListener("change", () => sendSet({clip_planes: clipPlanesFromControls()}));
+
+// ---- Isosurfaces: a row each (value, opacity, colour by the map or its own, remove); the
+// transfer-function editor shows them as markers
+
+/// Sends the state's isosurfaces with entry i changed by `change` ({value, opacity, color}).
+function setIso(i, change, interactive = false) {
+    const list = [...(session.state.iso || [])];
+    list[i] = isoText({...parseIso(list[i]), ...change});
+    sendSet({iso: list}, interactive);
+}
+
+function isoRow(text, i) {
+    const iso = parseIso(text);
+    const row = document.createElement("div");
+    row.className = "iso-row";
+    row.dataset.index = String(i);
+    const value = Object.assign(document.createElement("input"),
+                                {type: "number", step: "any", title: "Value"});
+    value.className = "iso-value";
+    value.value = fmt(iso.value, 7);
+    value.addEventListener("change", () => {
+        const v = Number(value.value);
+        if (value.value.trim() === "" || !Number.isFinite(v)) {
+            showError("isosurface value: a finite number");
+            updateControls();
+            return;
+        }
+        setIso(i, {value: v});
+    });
+    const opacity = Object.assign(document.createElement("input"),
+                                  {type: "range", min: "0.05", max: "1", step: "0.05",
+                                   title: "Opacity (1: opaque)"});
+    opacity.className = "iso-opacity";
+    opacity.value = String(iso.opacity);
+    opacity.addEventListener("input", () => setIso(i, {opacity: Number(opacity.value)}, true));
+    opacity.addEventListener("change", () => setIso(i, {opacity: Number(opacity.value)}));
+    const mapped = Object.assign(document.createElement("input"),
+                                 {type: "checkbox", title: "Colour by the colour map"});
+    mapped.className = "iso-mapped";
+    mapped.checked = !iso.color;
+    const color = Object.assign(document.createElement("input"),
+                                {type: "color", title: "The surface's own colour"});
+    color.className = "iso-color";
+    color.value = iso.color || "#ffffff";
+    color.disabled = !iso.color;
+    mapped.addEventListener("change", () =>
+        setIso(i, {color: mapped.checked ? null : color.value}));
+    color.addEventListener("change", () => setIso(i, {color: color.value}));
+    const remove = Object.assign(document.createElement("button"),
+                                 {type: "button", textContent: "×", title: "Remove"});
+    remove.className = "iso-remove";
+    remove.addEventListener("click", () =>
+        sendSet({iso: (session.state.iso || []).filter((_, j) => j !== i)}));
+    row.append(value, opacity, mapped, color, remove);
+    return row;
+}
+
+/// Shows the state's isosurfaces (rows are rebuilt unless one of them has the focus, which keeps
+/// what the user is typing or dragging).
+function fillIso(list) {
+    const box = $("iso-list");
+    const max = (session.info && session.info.limits && session.info.limits.max_iso) || 8;
+    $("iso-add").disabled = list.length >= max;
+    tfEditor.maxIsos = max;
+    if (box.dataset.shown === JSON.stringify(list) || box.contains(document.activeElement)) return;
+    box.dataset.shown = JSON.stringify(list);
+    box.replaceChildren(...list.map(isoRow));
+}
+
+$("iso-add").addEventListener("click", () => {
+    const [lo, hi] = session.state.range;
+    const list = session.state.iso || [];
+    sendSet({iso: [...list, isoText({value: 0.5 * (lo + hi), opacity: 1, color: null})]});
+});
 
 // ---- Time steps ------------------------------------------------------------------------------
 
@@ -986,6 +1099,7 @@ window.uvrView = Object.freeze({
         return true;
     },
     opacityPointClient(i) { return tfEditor.pointClient(i); },
+    isoHandleClient(i) { return tfEditor.isoClient(i); },
 });
 
 connect();

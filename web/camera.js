@@ -90,6 +90,19 @@ export function pan(cam, dx, dy, displayHeight) {
     return out;
 }
 
+/// The distance along unit vector `axis` that a cursor motion of (dx, dy) display pixels (dy
+/// down) stands for, on a view `displayHeight` pixels high, at the focal distance: the motion's
+/// part along the axis's image on the screen. An axis nearly along the view direction (its image
+/// shorter than a fifth) moves with the vertical motion, up moving it away from the camera.
+export function dragAlong(cam, axis, dx, dy, displayHeight) {
+    const f = frame(cam);
+    const s = worldPerPixel(cam, displayHeight);
+    const px = dot(axis, f.right), py = -dot(axis, f.up);
+    const pp = px * px + py * py;
+    if (pp < 0.04) return -dy * s * Math.sign(dot(axis, f.dir) || 1);
+    return (s * (dx * px + dy * py)) / pp;
+}
+
 /// VTK's Dolly: factor > 1 moves the camera towards the focal point (the distance divided by
 /// factor), < 1 away from it; in parallel projection the parallel scale is divided instead.
 export function dolly(cam, factor) {

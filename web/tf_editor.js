@@ -2,7 +2,9 @@
 // The transfer-function editor's canvas: the field's histogram (log-scaled counts) over the
 // transfer function's value range, the opacity curve over it with its control points (drag to
 // move, double-click empty space to add, double-click or right-click a point to remove; at least
-// two stay), the colour map beneath the curve and as a bar at the bottom.
+// two stay), the colour map beneath the curve and as a bar at the bottom. Isosurfaces show as
+// vertical markers: Shift+click adds one at the value under the pointer, dragging a marker's
+// handle (the triangle at the top) moves it, right-click on the handle removes it.
 
 import {colorAt, css, opacityAt} from "./colormap.js";
 
@@ -23,16 +25,47 @@ export function valueAt(t, lo, hi, log) {
     return Math.pow(10, Math.log10(l0) + t * (Math.log10(hi) - Math.log10(l0)));
 }
 
+/// Normalised transfer-function position of `value` over [lo, hi] (valueAt's inverse).
+export function positionOf(value, lo, hi, log) {
+    if (log) {
+        const l0 = lo > 0 ? lo : Math.min(hi / 1e4, 1);
+        if (hi > l0 && value > 0)
+            return (Math.log10(value) - Math.log10(l0)) / (Math.log10(hi) - Math.log10(l0));
+        if (hi > l0) return -Infinity;
+    }
+    return hi > lo ? (value - lo) / (hi - lo) : 0.5;
+}
+
+/// An isosurface as the state writes it ("VALUE[,OPACITY[,#RRGGBB]]", as `--iso` takes it)
+/// split into {value, opacity, color} (color: "#rrggbb", or null for the colour map's).
+export function parseIso(text) {
+    const [v, o, c] = String(text).split(",");
+    return {value: Number(v), opacity: o === undefined ? 1 : Number(o), color: c || null};
+}
+
+/// The state's text of an isosurface {value, opacity, color}.
+export function isoText({value, opacity, color}) {
+    const num = (x) => String(Number(Number(x).toPrecision(7)));
+    let out = num(value);
+    if (opacity !== 1 || color) out += `,${num(opacity)}`;
+    if (color) out += `,${color}`;
+    return out;
+}
+
 export class TfEditor {
     /// `onOpacity(points, interactive)` is called with a new copy of the opacity points on every
-    /// edit: interactive true while a point is dragged, false for a final value.
-    constructor(canvas, onOpacity) {
+    /// edit: interactive true while a point is dragged, false for a final value. `onIso(texts,
+    /// interactive)` likewise with the isosurfaces' new list when one is added, moved or removed.
+    constructor(canvas, onOpacity, onIso = () => {}) {
         this.canvas = canvas;
         this.onOpacity = onOpacity;
+        this.onIso = onIso;
         this.tf = null;
         this.range = [0, 1];
         this.histogram = null;
-        this.drag = null;       // {index, points, moved}
+        this.isos = [];         // the state's isosurfaces, as texts
+        this.maxIsos = 8;       // info.limits.max_iso once it comes
+        this.drag = null;       // {index, points, moved} or {iso, isos, moved}
         this.hover = -1;
         this.pendingFrame = 0;  // requestAnimationFrame id of a pending interactive send
         canvas.addEventListener("pointerdown", (e) => this.pointerDown(e));
@@ -44,17 +77,57 @@ export class TfEditor {
         new ResizeObserver(() => this.draw()).observe(canvas);
     }
 
-    /// Shows a new transfer function, value range and histogram (any may be undefined: kept).
-    update({tf, range, histogram} = {}) {
+    /// Shows a new transfer function, value range, histogram and isosurfaces (any may be
+    /// undefined: kept).
+    update({tf, range, histogram, isos} = {}) {
         if (tf !== undefined) this.tf = tf;
         if (range !== undefined) this.range = range;
         if (histogram !== undefined) this.histogram = histogram;
+        if (isos !== undefined && !(this.drag && this.drag.isos)) this.isos = isos;
         // A point being dragged keeps following the pointer, whatever the server said last.
         this.draw();
     }
 
     points() {
-        return this.drag ? this.drag.points : (this.tf ? this.tf.opacity : []);
+        return this.drag && this.drag.points ? this.drag.points : (this.tf ? this.tf.opacity : []);
+    }
+
+    isoList() {
+        return this.drag && this.drag.isos ? this.drag.isos : this.isos;
+    }
+
+    /// Client x (CSS pixels in the canvas) of isosurface value v, or null off the axis.
+    isoX(v) {
+        const t = positionOf(v, this.range[0], this.range[1], this.tf && this.tf.log);
+        if (!(t >= 0 && t <= 1)) return null;
+        const p = this.plot();
+        return p.x0 + t * (p.x1 - p.x0);
+    }
+
+    /// Index of the isosurface whose handle (a triangle at the plot's top) is under the event.
+    hitIso(e) {
+        const {cx, cy} = this.fromEvent(e);
+        const p = this.plot();
+        if (cy > p.y0 + 2 * kHitRadius) return -1;
+        let best = -1, bestD = kHitRadius;
+        this.isoList().forEach((text, i) => {
+            const x = this.isoX(parseIso(text).value);
+            if (x !== null && Math.abs(x - cx) <= bestD) {
+                best = i;
+                bestD = Math.abs(x - cx);
+            }
+        });
+        return best;
+    }
+
+    /// Client (viewport) coordinates of isosurface i's handle: for tests that drag it.
+    isoClient(i) {
+        const list = this.isoList();
+        if (i < 0 || i >= list.length) return null;
+        const x = this.isoX(parseIso(list[i]).value);
+        if (x === null) return null;
+        const r = this.canvas.getBoundingClientRect();
+        return {x: r.left + x, y: r.top + this.plot().y0 + 4};
     }
 
     // The plot's rectangle in CSS pixels.
@@ -103,6 +176,26 @@ export class TfEditor {
 
     pointerDown(e) {
         if (e.button !== 0 || !this.tf) return;
+        if (e.shiftKey) {
+            // A new isosurface at the value under the pointer.
+            e.preventDefault();
+            const {x} = this.fromEvent(e);
+            const [lo, hi] = this.range;
+            const value = valueAt(x, lo, hi, this.tf.log);
+            if (this.isos.length >= this.maxIsos || !Number.isFinite(value)) return;
+            this.isos = [...this.isos, isoText({value, opacity: 1, color: null})];
+            this.onIso([...this.isos], false);
+            this.draw();
+            return;
+        }
+        const k = this.hitIso(e);
+        if (k >= 0 && this.hit(e) < 0) {
+            e.preventDefault();
+            this.canvas.setPointerCapture(e.pointerId);
+            this.drag = {iso: k, isos: [...this.isos], moved: false};
+            this.draw();
+            return;
+        }
         const i = this.hit(e);
         if (i < 0) return;
         e.preventDefault();
@@ -114,10 +207,26 @@ export class TfEditor {
     pointerMove(e) {
         if (!this.drag) {
             const h = this.tf ? this.hit(e) : -1;
+            const onIso = this.tf && h < 0 && this.hitIso(e) >= 0;
+            this.canvas.style.cursor = h >= 0 ? "grab" : onIso ? "ew-resize" : "crosshair";
             if (h !== this.hover) {
                 this.hover = h;
-                this.canvas.style.cursor = h >= 0 ? "grab" : "crosshair";
                 this.draw();
+            }
+            return;
+        }
+        if (this.drag.isos) {
+            const {x} = this.fromEvent(e);
+            const iso = parseIso(this.drag.isos[this.drag.iso]);
+            iso.value = valueAt(x, this.range[0], this.range[1], this.tf.log);
+            this.drag.isos[this.drag.iso] = isoText(iso);
+            this.drag.moved = true;
+            this.draw();
+            if (!this.pendingFrame) {
+                this.pendingFrame = requestAnimationFrame(() => {
+                    this.pendingFrame = 0;
+                    if (this.drag && this.drag.isos) this.onIso([...this.drag.isos], true);
+                });
             }
             return;
         }
@@ -145,9 +254,14 @@ export class TfEditor {
         }
         if (this.pendingFrame) cancelAnimationFrame(this.pendingFrame);
         this.pendingFrame = 0;
-        const {points, moved} = this.drag;
+        const {points, isos, moved} = this.drag;
         this.drag = null;
-        if (moved) {
+        if (isos) {
+            if (moved) {
+                this.isos = isos;
+                this.onIso([...isos], false);
+            }
+        } else if (moved) {
             this.tf = {...this.tf, opacity: points};
             this.onOpacity(points.map((p) => [...p]), false);
         }
@@ -186,7 +300,16 @@ export class TfEditor {
         e.preventDefault();
         if (!this.tf) return;
         const i = this.hit(e);
-        if (i >= 0) this.removePoint(i);
+        if (i >= 0) {
+            this.removePoint(i);
+            return;
+        }
+        const k = this.hitIso(e);
+        if (k >= 0) {
+            this.isos = this.isos.filter((_, j) => j !== k);
+            this.onIso([...this.isos], false);
+            this.draw();
+        }
     }
 
     /// Histogram count at normalised position t of the transfer function's axis (the histogram's
@@ -270,6 +393,35 @@ export class TfEditor {
             g.strokeStyle = active ? "#ffd166" : "#ffffff";
             g.stroke();
         });
+
+        // Isosurfaces: a line across the plot in the surface's colour, a handle at the top.
+        for (const text of this.isoList()) {
+            const iso = parseIso(text);
+            const x = this.isoX(iso.value);
+            if (x === null) continue;
+            const t = (x - p.x0) / pw;
+            const color = iso.color || css(colorAt(this.tf.colors, this.tf.color_space, t));
+            g.strokeStyle = color;
+            g.globalAlpha = 0.35 + 0.65 * iso.opacity;
+            g.lineWidth = 2;
+            g.setLineDash([4, 3]);
+            g.beginPath();
+            g.moveTo(x, p.y0);
+            g.lineTo(x, p.y1);
+            g.stroke();
+            g.setLineDash([]);
+            g.globalAlpha = 1;
+            g.beginPath();
+            g.moveTo(x - 6, p.y0);
+            g.lineTo(x + 6, p.y0);
+            g.lineTo(x, p.y0 + 9);
+            g.closePath();
+            g.fillStyle = color;
+            g.fill();
+            g.lineWidth = 1;
+            g.strokeStyle = "#ffffff";
+            g.stroke();
+        }
 
         // Colour bar.
         const by = h - kBarHeight - 2;

@@ -29,9 +29,8 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
     for (const SettingDef& def : settingsVocabulary())
         if (f.vocabulary.given(def.name) && !server::isViewerSetting(def.name))
             add(cliFlag(def).c_str(), f.vocabulary.text(def.name));
-    // The clip planes are the page's (ViewState::clipPlanes), the box the command line's.
+    // The clip planes and isosurfaces are the page's (ViewState), the box the command line's.
     if (!f.clipBox.empty()) add("--clip-box", f.clipBox);
-    for (const std::string& iso : f.isoSurfaces) add("--iso", iso);
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
     if (f.splitCells) add("--split-cells", "");
@@ -126,6 +125,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         s.tf = settings.tf;
         s.range = settings.range.value_or(finiteRange(field.values));
         s.clipPlanes = settings.clipPlanes;
+        s.isoSurfaces = settings.isoSurfaces;
         s.field = flags->field;
         // The page's settings start as the command line set them (or their defaults).
         for (const char* name : server::kViewerSettings)

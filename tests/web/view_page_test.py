@@ -17,6 +17,9 @@
 - a flood of 2000 camera `set`s from the page's socket is limited (an `error` for the excess,
   far fewer frames than messages, the connection open), and a final camera afterwards shows the
   same image as before the flood (no queue of stale frames after it);
+- a clip plane from the Clip row cuts the volume, flip and Alt+drag in the view move it; the
+  Shade box and its sliders light it; an isosurface added by Shift+click on the histogram, its
+  marker dragged, a second from the list made translucent and green, then removed;
 - Save PNG downloads a PNG of the state's size; Export TF and Export camera download the files
   the exported `uvr render` command names; that command, run here, gives an image with SSIM >=
   0.99 against the saved PNG (`uvr compare --min-ssim 0.99`);
@@ -591,7 +594,92 @@ def clip(page):
     settled(frames0, "the frame of the flipped clip")
     check(page.hook("state")["clip_planes"][0][3:] == [-1, 0, 0], "flip kept the same side")
     check(changed_pixels(cut, page.pixels()) > 40, "the flipped clip shows the same image")
+    # Alt+drag in the view moves the plane along its axis.
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    # Looking along +y, x across the view: the plane shows edge-on and follows the pointer.
+    frames0 = page.hook("frameCount")
+    page.d.find_element(By.ID, "view-py").click()
+    settled(frames0, "the frame of the +Y view")
+    x0 = page.hook("state")["clip_planes"][0][0]
+    camera0 = page.hook("state")["camera"]
+    flipped = page.pixels()
+    frames0 = page.hook("frameCount")
+    chain = ActionChains(page.d, duration=30)
+    chain.key_down(Keys.ALT).move_to_element_with_offset(
+        page.d.find_element(By.ID, "view"), 0, 0).click_and_hold()
+    for _ in range(6):
+        chain.move_by_offset(-10, 0).pause(0.03)
+    chain.release().key_up(Keys.ALT).perform()
+    settled(frames0, "the frame of the dragged clip plane")
+    plane = page.hook("state")["clip_planes"][0]
+    check(page.hook("state")["camera"] == camera0, "Alt+drag moved the camera")
+    check(plane[3:] == [-1, 0, 0] and plane[0] < x0 - 0.05 * (bounds[1][0] - bounds[0][0]),
+          f"Alt+drag did not move the plane along x: {x0} -> {plane}")
+    check(bounds[0][0] <= plane[0] <= bounds[1][0], f"the dragged plane left the mesh: {plane}")
+    moved = changed_pixels(flipped, page.pixels())
+    check(moved > 20, f"moving the plane {x0} -> {plane[0]} changed {moved} pixels")
     check(page.hook("errorCount") == errors0, f"clipping gave an error: {page.hook('lastError')}")
+
+
+def isosurfaces(page):
+    step("isosurfaces: Shift+click on the histogram, drag the marker, the list's controls")
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    errors0 = page.hook("errorCount")
+    page.quiet()
+    before = page.pixels()
+    tf_canvas = page.d.find_element(By.ID, "tf-canvas")
+    page.d.execute_script("arguments[0].scrollIntoView({block: 'center'});", tf_canvas)
+    lo, hi = page.hook("state")["range"]
+    frames0 = page.hook("frameCount")
+    ActionChains(page.d).key_down(Keys.SHIFT).move_to_element_with_offset(
+        tf_canvas, -20, 0).click().key_up(Keys.SHIFT).perform()
+    page.wait("v.state.iso.length === 1", 10, "the state with the new isosurface")
+    settled(page, frames0, "the frame with an isosurface")
+    value = float(page.hook("state")["iso"][0])
+    check(lo < value < 0.5 * (lo + hi), f"Shift+click left of the middle put the isosurface at "
+                                        f"{value}, not in ({lo}, {0.5 * (lo + hi)})")
+    with_iso = page.pixels()
+    page.screenshot("iso")
+    check(changed_pixels(before, with_iso) > 40, "the isosurface changed nothing in the image")
+    check(page.js("return document.querySelectorAll('#iso-list .iso-row').length") == 1,
+          "the isosurface list does not show one row")
+    # Drag its handle to the right: a higher value.
+    at = page.js("return window.uvrView.isoHandleClient(0);")
+    rect = page.js("const r = arguments[0].getBoundingClientRect(); "
+                   "return {x: r.left + r.width / 2, y: r.top + r.height / 2};", tf_canvas)
+    frames0 = page.hook("frameCount")
+    drag(page.d, tf_canvas, (round(at["x"] - rect["x"]), round(at["y"] - rect["y"])),
+         [(6, 0)] * 5)
+    page.wait(f"Number(v.state.iso[0]) > {value}", 10, "the dragged isosurface's value")
+    settled(page, frames0, "the frame of the dragged isosurface")
+    moved = float(page.hook("state")["iso"][0])
+    check(moved > value + 0.02 * (hi - lo), f"dragging the marker right moved it {value} -> {moved}")
+    check(changed_pixels(with_iso, page.pixels()) > 20, "moving the isosurface changed nothing")
+    # A second from the Add button, made translucent with a colour of its own, then removed.
+    page.d.find_element(By.ID, "iso-add").click()
+    page.wait("v.state.iso.length === 2", 10, "the state with a second isosurface")
+    page.js("const r = document.querySelectorAll('#iso-list .iso-row')[1];"
+            " const o = r.querySelector('.iso-opacity'); o.value = '0.5';"
+            " o.dispatchEvent(new Event('change'));")
+    page.wait("v.state.iso[1].split(',')[1] === '0.5'", 10, "the second's opacity")
+    frames0 = page.hook("frameCount")
+    page.js("const r = document.querySelectorAll('#iso-list .iso-row')[1];"
+            " const c = r.querySelector('.iso-color'); c.value = '#00ff00';"
+            " const m = r.querySelector('.iso-mapped'); m.checked = false;"
+            " m.dispatchEvent(new Event('change'));")
+    page.wait("v.state.iso[1].endsWith(',#00ff00')", 10, "the second's own colour")
+    settled(page, frames0, "the frame with two isosurfaces")
+    green = page.pixels()
+    page.screenshot("iso-two")
+    check(changed_pixels(with_iso, green) > 20, "the second, green isosurface changed nothing")
+    page.js("document.querySelectorAll('#iso-list .iso-remove')[1].click();")
+    page.wait("v.state.iso.length === 1", 10, "the state after removing the second")
+    check(page.hook("errorCount") == errors0,
+          f"isosurfaces gave an error: {page.hook('lastError')}")
 
 
 def shade(page):
@@ -663,6 +751,7 @@ def save_and_reproduce(page, uvr, downloads, tmp):
     check("--opacity-law" in args and args[args.index("--opacity-law") + 1] == "transmittance",
           f"the command does not carry the opacity law: {command}")
     check("--clip-plane" in args, f"the command does not carry the page's clip plane: {command}")
+    check("--iso" in args, f"the command does not carry the page's isosurface: {command}")
     # Run it here: our uvr, the output in tmp, on the CPU like the server.
     args[0] = uvr
     out = os.path.join(tmp, "reproduced.png")
@@ -838,6 +927,7 @@ def main():
             flood(page)
             clip(page)
             shade(page)
+            isosurfaces(page)
             save_and_reproduce(page, args.uvr, downloads, tmp)
             page.screenshot("final")
             wrong_token_page(page)

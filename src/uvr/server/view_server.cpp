@@ -236,6 +236,7 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
             plane += (plane.empty() ? "" : ",") + fmtExact(x);
         args.insert(args.end(), {"--clip-plane", plane});
     }
+    for (const IsoSurface& iso : s.isoSurfaces) args.insert(args.end(), {"--iso", isoText(iso)});
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
     args.insert(args.end(), {"-o", "uvr-view.png"});
     std::string command;
@@ -607,7 +608,9 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                     {"max_messages_per_second", d.opt.maxMessagesPerSecond},
                     {"min_size", kMinViewSize},
                     {"max_size", kMaxViewSize},
-                    {"max_tf_points", kMaxTfPoints}}}};
+                    {"max_tf_points", kMaxTfPoints},
+                    {"max_clip_planes", kMaxClipPlanes},
+                    {"max_iso", kMaxIsoSurfaces}}}};
 }
 
 ViewServer::~ViewServer() {

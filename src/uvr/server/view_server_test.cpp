@@ -399,6 +399,12 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
                 HasSubstr("--clip-plane 0.25,0,0,1,0,0 --step 0.01"));
     c.send({{"type", "set"}, {"clip_planes", Json::array()}});
+    // So do its isosurfaces.
+    c.send({{"type", "set"}, {"iso", {"0.5", "1,0.5,#00ff00"}}});
+    c.send({{"type", "export"}});
+    EXPECT_THAT(c.until("export")["command"].get<std::string>(),
+                HasSubstr("--iso 0.5 --iso '1,0.5,#00ff00' --step 0.01"));
+    c.send({{"type", "set"}, {"iso", Json::array()}});
     c.send({{"type", "set"}, {"method", "adaptive"}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),

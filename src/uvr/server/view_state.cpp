@@ -145,6 +145,36 @@ Json clipPlanesJson(const std::vector<ClipPlane>& planes) {
     return out;
 }
 
+/// Isosurfaces ["VALUE[,OPACITY[,#RRGGBB]]" or a bare number, ...], checked as the library
+/// checks them.
+std::vector<IsoSurface> isoSurfaces(const std::string& key, const Json& v) {
+    const std::string shape = "at most " + std::to_string(kMaxIsoSurfaces) +
+                              " isosurfaces, each \"VALUE[,OPACITY[,#RRGGBB]]\" or a number";
+    if (!v.is_array() || v.size() > std::size_t(kMaxIsoSurfaces)) bad(key, shape, v);
+    RenderSettings s;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string where = key + "[" + std::to_string(i) + "]";
+        try {
+            if (v[i].is_number())
+                s.isoSurfaces.push_back({finiteFloat(where, v[i])});
+            else if (v[i].is_string() && v[i].get_ref<const std::string&>().size() <= 64)
+                s.isoSurfaces.push_back(parseIsoSurface(v[i].get<std::string>()));
+            else
+                bad(where, "\"VALUE[,OPACITY[,#RRGGBB]]\" or a number", v[i]);
+            checkIso(s);
+        } catch (const SettingError& e) {
+            throwError(ErrorKind::Argument, "", e.spelledAs("\"" + where + "\":", " "));
+        }
+    }
+    return s.isoSurfaces;
+}
+
+Json isoSurfacesJson(const std::vector<IsoSurface>& surfaces) {
+    Json out = Json::array();
+    for (const IsoSurface& s : surfaces) out.push_back(isoText(s));
+    return out;
+}
+
 void applyCamera(Camera& cam, const Json& v) {
     for (const auto& [k, x] : object("camera", v).items()) {
         const std::string key = "camera." + k;
@@ -232,6 +262,7 @@ Json toJson(const ViewState& s) {
               {"field", s.field},
               {"heatmap", s.heatmap},
               {"clip_planes", clipPlanesJson(s.clipPlanes)},
+              {"iso", isoSurfacesJson(s.isoSurfaces)},
               {"size", {s.width, s.height}},
               {"step", s.step}};
     // The viewer's settings of the vocabulary as set (`uvr view` starts every tab with all of
@@ -326,6 +357,8 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.heatmap = boolean(k, v);
         } else if (k == "clip_planes") {
             next.clipPlanes = clipPlanes(k, v);
+        } else if (k == "iso") {
+            next.isoSurfaces = isoSurfaces(k, v);
         } else if (k == "size") {
             if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() ||
                 !v[1].is_number_integer())
@@ -349,7 +382,7 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.step = v.get<std::size_t>();
         } else {
             std::string keys =
-                "camera, tf, range, field, heatmap, clip_planes, size, step, preset, "
+                "camera, tf, range, field, heatmap, clip_planes, iso, size, step, preset, "
                 "colormap_json";
             for (const char* name : kViewerSettings) keys += std::string(", ") + name;
             bad("set", "state keys (" + keys + "), not \"" + printableShort(k, 40) + "\"", message);
@@ -373,6 +406,7 @@ RenderSettings frameSettings(const ViewState& state, const RenderSettings& base,
     s.tf = state.tf;
     s.range = state.range;
     s.clipPlanes = state.clipPlanes;
+    s.isoSurfaces = state.isoSurfaces;
     for (const auto& [name, value] : state.settings.items()) applySetting(s, name, value);
     scale = std::max(scale, 1);
     s.width = std::max(1, state.width / scale);

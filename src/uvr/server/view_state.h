@@ -45,6 +45,9 @@ struct ViewState {
     bool heatmap = false;  ///< show samples per pixel instead of the volume
     /// Clip planes (file coordinates; RenderSettings::clipPlanes), up to kMaxClipPlanes.
     std::vector<ClipPlane> clipPlanes;
+    /// Isosurfaces (RenderSettings::isoSurfaces), up to kMaxIsoSurfaces; the protocol writes
+    /// each as `--iso` does: "VALUE[,OPACITY[,#RRGGBB]]".
+    std::vector<IsoSurface> isoSurfaces;
     int width = 1024, height = 1024;
     std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
 };
@@ -62,7 +65,7 @@ struct SetResult {
 };
 
 /// Applies the state keys of a `set` message (camera, tf, range, field, method, quality,
-/// heatmap, clip_planes, size, opacity_unit, opacity_law, step (below stepCount), preset,
+/// heatmap, clip_planes, iso, size, opacity_unit, opacity_law, step (below stepCount), preset,
 /// colormap_json and colormap_name) to `state`, all or
 /// nothing: on any bad value it throws Error(Argument) (Error(Parse) for a malformed uploaded
 /// colour map) naming the key and what was expected, and leaves `state` unchanged. Unknown keys

@@ -106,6 +106,35 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     EXPECT_EQ(toJson(s)["clip_planes"], Json::array());
 }
 
+TEST(ViewState, IsosurfacesAreSetInTheirCommandLineFormAndReachTheFrame) {
+    ViewState s = startState();
+    EXPECT_EQ(toJson(s)["iso"], Json::array());
+    applySet(s, {{"iso", {0.5, "1.5,0.25", "2,1,#ff8000"}}});
+    ASSERT_EQ(s.isoSurfaces.size(), 3u);
+    EXPECT_EQ(s.isoSurfaces[0].value, 0.5f);
+    EXPECT_EQ(s.isoSurfaces[1].opacity, 0.25f);
+    EXPECT_FALSE(s.isoSurfaces[2].colorMapped);
+    EXPECT_EQ(s.isoSurfaces[2].color, Vec3f(1.f, 128.f / 255.f, 0.f));
+    // The state writes each as --iso does, and reads that back.
+    EXPECT_EQ(toJson(s)["iso"], Json({"0.5", "1.5,0.25", "2,1,#ff8000"}));
+    ViewState again = startState();
+    applySet(again, {{"iso", toJson(s)["iso"]}});
+    EXPECT_EQ(toJson(again)["iso"], toJson(s)["iso"]);
+    const RenderSettings f = frameSettings(s, RenderSettings{});
+    ASSERT_EQ(f.isoSurfaces.size(), 3u);
+    EXPECT_EQ(f.isoSurfaces[1].value, 1.5f);
+    applySet(s, {{"iso", Json::array()}});
+    EXPECT_TRUE(frameSettings(s, RenderSettings{}).isoSurfaces.empty());
+    // Bad ones are refused naming the entry, with the library's expected form.
+    EXPECT_THAT(refusal({{"iso", {0.5, "1,2"}}}),
+                HasSubstr("\"iso[1]\": 1,2: expected VALUE[,OPACITY[,#RRGGBB]]"));
+    EXPECT_THAT(refusal({{"iso", {"1,0.5,#ff80"}}}), HasSubstr("iso[0]"));
+    EXPECT_THAT(refusal({{"iso", {true}}}), HasSubstr("iso[0]"));
+    EXPECT_THAT(refusal({{"iso", 0.5}}), HasSubstr("at most 8 isosurfaces"));
+    EXPECT_THAT(refusal({{"iso", Json::array({1, 2, 3, 4, 5, 6, 7, 8, 9})}}),
+                HasSubstr("at most 8 isosurfaces"));
+}
+
 TEST(ViewState, PresetsAndUploadedColourMapsReplaceColoursAndAskForTheStateBack) {
     ViewState s = startState();
     applySet(s, {{"tf", {{"opacity", {{0, 0}, {1, 0.3}}}}}});
