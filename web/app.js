@@ -716,14 +716,16 @@ function isoRow(text, i) {
     return row;
 }
 
-/// Shows the state's isosurfaces (rows are rebuilt unless one of them has the focus, which keeps
-/// what the user is typing or dragging).
+/// Shows the state's isosurfaces (the rows are rebuilt unless a value being typed or an opacity
+/// being dragged has the focus).
 function fillIso(list) {
     const box = $("iso-list");
     const max = (session.info && session.info.limits && session.info.limits.max_iso) || 8;
     $("iso-add").disabled = list.length >= max;
     tfEditor.maxIsos = max;
-    if (box.dataset.shown === JSON.stringify(list) || box.contains(document.activeElement)) return;
+    const a = document.activeElement;
+    const editing = box.contains(a) && (a.type === "number" || a.type === "range");
+    if (box.dataset.shown === JSON.stringify(list) || editing) return;
     box.dataset.shown = JSON.stringify(list);
     box.replaceChildren(...list.map(isoRow));
 }

@@ -676,8 +676,12 @@ def isosurfaces(page):
     green = page.pixels()
     page.screenshot("iso-two")
     check(changed_pixels(with_iso, green) > 20, "the second, green isosurface changed nothing")
-    page.js("document.querySelectorAll('#iso-list .iso-remove')[1].click();")
+    check(not page.js("return document.querySelectorAll('#iso-list .iso-color')[1].disabled"),
+          "the second's colour stays disabled with its own colour chosen")
+    page.d.find_elements(By.CSS_SELECTOR, "#iso-list .iso-remove")[1].click()  # focuses it
     page.wait("v.state.iso.length === 1", 10, "the state after removing the second")
+    check(page.js("return document.querySelectorAll('#iso-list .iso-row').length") == 1,
+          "the list still shows the removed isosurface")
     check(page.hook("errorCount") == errors0,
           f"isosurfaces gave an error: {page.hook('lastError')}")
 
