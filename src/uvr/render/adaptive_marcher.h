@@ -264,6 +264,16 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     segments.setIsos(scene.base.params.iso, lighting, ray.dir, scene.base.params.depthAlpha);
     PointIsos<kSurf> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
+    // Isosurfaces: where a run may start at the mesh's boundary (sampleAtBoundary): after the
+    // grid position kRunFrom, outside the mesh when runFromOutside (else the span's start), while
+    // runFromValid (no sample inside and nothing skipped since).
+    [[maybe_unused]] float kRunFrom = tEnter / s1;
+    [[maybe_unused]] bool runFromOutside = false, runFromValid = true;
+    [[maybe_unused]] const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b) {
+        std::uint32_t found = locator.walk<kNative>(q, from, b, counters.locate);
+        if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, counters.locate);
+        return found;
+    };
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
     // One loop whose every iteration takes a sample, skips a transparent macrocell or moves to
@@ -303,6 +313,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if (part.cellCount == 0) continue;
             if (scene.skipTransparent && !(shade.maxOpacity > 0.f)) {
                 ++counters.partitionsSkipped;
+                if constexpr (kSurf) runFromValid = false;
                 continue;
             }
             // Only the part of [t0, t1) inside the shrunk box can hold cells.
@@ -353,6 +364,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // transparent): the sample is then located as usual, which finds the boundary.
                 const bool longGap = preintegrated && segments.started && segments.inside &&
                                      kSample - segments.kLast > 1.f;
+                if constexpr (kSurf) runFromValid = false;
                 if (!longGap) {
                     if (preintegrated) {
                         segments.add(tf, kSample, kSample, false, 0.f, s1, unit, acc);
@@ -449,6 +461,15 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 }
                 // Entering: the run starts at the first position found inside; leaving: it ends
                 // at the first position found outside.
+                if constexpr (kSurf) {
+                    // With isosurfaces the run starts or ends at the boundary itself.
+                    if (segments.iso && (!in || runFromValid))
+                        sampleAtBoundary<kNative, kLit, kSurf>(
+                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, in ? lo : hi,
+                            true, in ? hi : segments.kLast, from, in ? vHi : segments.vLast, k1,
+                            segments, counters, acc);
+                    if (in) runFromValid = false;
+                }
                 if (in && hi < kSample)
                     segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi, gradHi);
                 else if (!in)
@@ -463,6 +484,25 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     bisectIso<kNative>(scene, ray, kSample, k1, tet, segments, counters, acc);
             }
             if (in) lastInside = tet;
+            if constexpr (kSurf) {
+                // With isosurfaces a run starts (not after a long step: bisected above) at the
+                // mesh's boundary or the span's start, and ends at the boundary.
+                if (in && segments.iso && runFromValid && !segments.inside)
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kRunFrom,
+                        runFromOutside, kSample, tet, v, k1, segments, counters, acc);
+                if (!in && segments.iso && segments.started && segments.inside &&
+                    kSample <= segments.kEnd && !endsRun)
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kSample,
+                        true, segments.kLast, lastInside, segments.vLast, k1, segments, counters,
+                        acc);
+                if (in) {
+                    runFromValid = false;
+                } else {
+                    kRunFrom = kSample, runFromOutside = true, runFromValid = true;
+                }
+            }
             segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light, grad);
         } else {
             pointIsos.add(scene.base.params, tf, ray.dir, tet != kNoTet, v, grad, acc);
@@ -477,6 +517,15 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         marching = !opaque;
     }
     if (preintegrated && !opaque) {
+        if constexpr (kSurf) {
+            // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
+            // the run's last sample at the end.
+            if (segments.iso && segments.inside)
+                sampleAtBoundary<kNative, kLit, kSurf>(
+                    locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, tExit / s1,
+                    true, segments.kLast, lastInside, segments.vLast, segments.kEnd, segments,
+                    counters, acc);
+        }
         segments.finish(tf, s1, unit, acc);
         note(tExit);
     }

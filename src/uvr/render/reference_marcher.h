@@ -207,6 +207,63 @@ struct PointIsos {
     }
 };
 
+/// Bisection probes sampleAtBoundary takes for the mesh's boundary: to within s1 / 2^10.
+inline constexpr int kBoundaryBisections = 10;
+
+/// Isosurfaces (pre-integrated, kSurf): a run of samples starts or ends at the mesh's boundary
+/// (or the end of the ray's span) between the sample at grid position kIn (inside, in cell
+/// tetIn) and a position kOut outside the mesh or past the span's end (outKnown; before kIn
+/// where a run starts, after it where one ends), or the start of the span (!outKnown, before
+/// the first sample: the span may start inside the mesh, at a clip plane or the camera). Probes
+/// by bisection, each located by `locate(q, from, bary)` from the last one found, narrow the
+/// boundary to within s1 / 2^kBoundaryBisections, and where a surface lies between the boundary
+/// and the sample (vIn its value) the run gets a sample at the boundary. So a surface
+/// between the boundary and the nearest grid sample (a thin layer at the mesh's skin, which no
+/// pair of grid samples brackets: rings where the grid happened to) is crossed where the exact
+/// integrator crosses it. Not inlined: only frames with isosurfaces call it, at a run's ends.
+template <bool kNative, bool kLit, bool kSurf, class Locate>
+UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(
+    const Locate& locate, const MarchParams& params, const TetMeshView& mesh,
+    const TfTableView& tf, const Ray& ray, const Lighting& lighting, float kOut, bool outKnown,
+    float kIn, std::uint32_t tetIn, float vIn, float kPieceEnd,
+    SampleSegments<kLit, kSurf>& segments,
+    RayCounters& counters, Vec4f& acc) {
+    const float s1 = params.step;
+    float lo = kOut, hi = kIn;
+    std::uint32_t from = tetIn, tetHi = kNoTet;
+    float bary[4], baryHi[4] = {0.f, 0.f, 0.f, 0.f};
+    if (!outKnown) {
+        ++counters.samples;
+        const std::uint32_t t = locate(ray.at(lo * s1), from, bary);
+        if (t != kNoTet) {
+            hi = lo, tetHi = t;
+            for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+        }
+    }
+    for (int n = 0; n < kBoundaryBisections && hi != lo; ++n) {
+        const float mid = 0.5f * (lo + hi);
+        if (mid == lo || mid == hi) break;
+        ++counters.samples;
+        const std::uint32_t t = locate(ray.at(mid * s1), from, bary);
+        if (t == kNoTet) {
+            lo = mid;
+        } else {
+            hi = mid, from = tetHi = t;
+            for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+        }
+    }
+    if (tetHi == kNoTet || hi == kIn) return;
+    const float v = mesh.interpolate<kNative>(tetHi, baryHi);
+    // Only where a surface lies between the boundary and the sample (else the run, and every
+    // pixel without a surface there, stays as it was).
+    const bool entering = hi < kIn;
+    if (segments.iso->crossings(entering ? v : vIn, entering ? vIn : v, [](int, float) {}) == 0)
+        return;
+    const Vec3f g = sampleGradient<kNative, kLit, kSurf>(params, mesh, tetHi, baryHi);
+    segments.add(tf, hi, kPieceEnd, true, v, s1, params.opacityUnit, acc,
+                 lightAt(lighting, tetHi, g, ray.dir), g);
+}
+
 /// The lighting an integrator instance reads: the frame's, or none where it is compiled unlit
 /// (kLit false: its kernels carry no lighting code, which cost the unlit adaptive kernel up to
 /// 21% of its frame time on the H200).
@@ -247,6 +304,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const Lighting lighting = kernelLighting<kLit>(scene.params);
     segments.setIsos(scene.params.iso, lighting, ray.dir, scene.params.depthAlpha);
     PointIsos<kSurf> pointIsos;
+    [[maybe_unused]] std::uint32_t lastInside = kNoTet;  // the cell of the last sample inside
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
@@ -261,6 +319,20 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             sampleGradient<kNative, kLit, kSurf>(scene.params, scene.locator.mesh, tet, bary);
         const LightFactors light = lightAt(lighting, tet, g, ray.dir);
         if (scene.params.preintegrated) {
+            if constexpr (kSurf) {
+                if (segments.iso && (tet != kNoTet) != segments.inside) {
+                    const auto locate = [&](Vec3f q, std::uint32_t from, float* b) {
+                        return scene.locator.locate<kNative>(q, from, b, counters.locate);
+                    };
+                    const bool first = !segments.started, in = tet != kNoTet;
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locate, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
+                        in ? (first ? t0 / s : k - 1.f) : k, !first, in ? k : segments.kLast,
+                        in ? tet : lastInside, in ? v : segments.vLast, kEnd + 1.f, segments,
+                        counters, acc);
+                }
+                if (tet != kNoTet) lastInside = tet;
+            }
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light, g);
         } else {
             pointIsos.add(scene.params, scene.tf, ray.dir, tet != kNoTet, v, g, acc);
@@ -280,6 +352,19 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     }
     if (scene.params.preintegrated && !opaque) {
         [[maybe_unused]] const float a0 = acc.w;
+        if constexpr (kSurf) {
+            // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
+            // the run's last sample at the end.
+            if (segments.iso && segments.inside) {
+                const auto locate = [&](Vec3f q, std::uint32_t from, float* b) {
+                    return scene.locator.locate<kNative>(q, from, b, counters.locate);
+                };
+                sampleAtBoundary<kNative, kLit, kSurf>(
+                    locate, scene.params, scene.locator.mesh, scene.tf, ray, lighting, t1 / s,
+                    true, segments.kLast, lastInside, segments.vLast, kEnd + 1.f, segments,
+                    counters, acc);
+            }
+        }
         segments.finish(scene.tf, s, unit, acc);
         if constexpr (kSurf) noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, t1, counters);
     }
