@@ -49,7 +49,7 @@ function send(message) {
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
                     "opacity_unit", "opacity_law", "step", "clip_planes", "shade", "ambient",
-                    "diffuse", "specular", "specular_power", "normals", "iso"];
+                    "diffuse", "specular", "specular_power", "normals", "iso", "clip_surface"];
 
 // Gradient shading's coefficients: the slider's id and the setting it sets.
 const kLightSliders = [["ambient", "ambient"], ["diffuse", "diffuse"], ["specular", "specular"],
@@ -478,10 +478,14 @@ function updateControls() {
     if (s.opacity_law) $("opacity-law").value = s.opacity_law;
     $("heatmap").checked = !!s.heatmap;
     $("shade").checked = !!s.shade;
-    $("normals").disabled = !s.shade;
+    // The coefficients light the volume when shaded, and isosurfaces and the cut face always.
+    const lit = !!s.shade || (s.iso || []).length > 0 ||
+                (!!s.clip_surface && (s.clip_planes || []).length > 0);
+    $("normals").disabled = !lit;
     if (s.normals) $("normals").value = s.normals;
+    $("clip-surface").checked = !!s.clip_surface;
     for (const [id, name] of kLightSliders) {
-        $(id).disabled = !s.shade;  // read only with shade
+        $(id).disabled = !lit;  // read only then
         if (!Number.isFinite(s[name])) continue;
         if (document.activeElement !== $(id)) $(id).value = s[name];
         $(`${id}-value`).textContent = fmt(s[name], 3);
@@ -619,6 +623,7 @@ function fillClip(planes) {
     }
     axis.value = value;
     $("clip-pos").disabled = $("clip-flip").disabled = value === "" || value === "custom";
+    $("clip-surface").disabled = planes.length === 0;
 }
 
 /// The axis (0, 1, 2) of the state's one clip plane across an axis, or -1.
@@ -659,6 +664,7 @@ $("clip-pos").addEventListener("input", () =>
     sendSet({clip_planes: clipPlanesFromControls()}, true));
 $("clip-pos").addEventListener("change", () => sendSet({clip_planes: clipPlanesFromControls()}));
 $("clip-flip").addEventListener("change", () => sendSet({clip_planes: clipPlanesFromControls()}));
+$("clip-surface").addEventListener("change", (e) => sendSet({clip_surface: e.target.checked}));
 
 // ---- Isosurfaces: a row each (value, opacity, colour by the map or its own, remove); the
 // transfer-function editor shows them as markers

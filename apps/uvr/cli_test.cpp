@@ -469,6 +469,20 @@ TEST(Cli, ClipPlanesAndBoxCutTheVolumeAndAreReported) {
     ASSERT_EQ(j["clip_planes"].size(), 2u);
     EXPECT_EQ(j["clip_planes"][1], nlohmann::json::parse("[0,4,0,0,-1,0]"));
     EXPECT_FALSE(j.contains("clip_box"));
+    EXPECT_FALSE(j.contains("clip_surface"));
+    // --clip-surface: the cut face drawn and reported, with the coefficients that light it.
+    const CliRun face = uvr(fin +
+                                "-o face.png --clip-plane 3,0,0,1,0,0 --clip-plane 0,4,0,0,-1,0 "
+                                "--clip-surface --ambient 0.3 --stats f.json",
+                            dir);
+    ASSERT_EQ(face.code, 0) << face.err;
+    std::ifstream fin2(dir + "/f.json");
+    const auto f = nlohmann::json::parse(fin2);
+    EXPECT_EQ(f.value("clip_surface", false), true);
+    EXPECT_FLOAT_EQ(f.value("ambient", 0.f), 0.3f);
+    EXPECT_LT(
+        compareImages(toRgb8(readPng(dir + "/cut.png")), toRgb8(readPng(dir + "/face.png"))).ssim,
+        0.99);
     const Image whole = readPng(dir + "/whole.png"), part = readPng(dir + "/cut.png");
     double sumWhole = 0.0, sumPart = 0.0;
     for (std::size_t i = 0; i < whole.pixels.size(); ++i)

@@ -594,6 +594,15 @@ def clip(page):
     settled(frames0, "the frame of the flipped clip")
     check(page.hook("state")["clip_planes"][0][3:] == [-1, 0, 0], "flip kept the same side")
     check(changed_pixels(cut, page.pixels()) > 40, "the flipped clip shows the same image")
+    # The "face" box: the cut face, seen through the volume in front of it, as a surface.
+    flipped = page.pixels()
+    frames0 = page.hook("frameCount")
+    page.js("const f = document.getElementById('clip-surface'); f.checked = true;"
+            " f.dispatchEvent(new Event('change'));")
+    settled(frames0, "the frame with the cut face")
+    check(page.hook("state")["clip_surface"] is True, "the face box did not set clip_surface")
+    page.screenshot("clip-face")
+    check(changed_pixels(flipped, page.pixels()) > 40, "the cut face changed nothing")
     # Alt+drag in the view moves the plane along its axis.
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
@@ -691,8 +700,11 @@ def shade(page):
     errors0 = page.hook("errorCount")
     page.quiet()
     before = page.pixels()
-    check(page.js("return document.getElementById('diffuse').disabled"),
-          "the lighting sliders are enabled with Shade off")
+    # With Shade off the coefficients light only the cut face (on since the clip test) and
+    # isosurfaces: the sliders follow.
+    face = bool(page.hook("state").get("clip_surface"))
+    check(page.js("return document.getElementById('diffuse').disabled") != face,
+          f"the lighting sliders' state with Shade off and the cut face {face}")
     frames0 = page.hook("frameCount")
     page.js("const b = document.getElementById('shade'); b.checked = true;"
             " b.dispatchEvent(new Event('change'));")
@@ -756,6 +768,7 @@ def save_and_reproduce(page, uvr, downloads, tmp):
           f"the command does not carry the opacity law: {command}")
     check("--clip-plane" in args, f"the command does not carry the page's clip plane: {command}")
     check("--iso" in args, f"the command does not carry the page's isosurface: {command}")
+    check("--clip-surface" in args, f"the command does not carry the cut face: {command}")
     # Run it here: our uvr, the output in tmp, on the CPU like the server.
     args[0] = uvr
     out = os.path.join(tmp, "reproduced.png")

@@ -107,6 +107,8 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     if (settings.clipBox)
         j["clip_box"] = {settings.clipBox->lo.x, settings.clipBox->lo.y, settings.clipBox->lo.z,
                          settings.clipBox->hi.x, settings.clipBox->hi.y, settings.clipBox->hi.z};
+    if (settings.clipSurface && (!settings.clipPlanes.empty() || settings.clipBox))
+        j["clip_surface"] = true;
     // Depth out and in.
     if (settings.depthAlpha > 0.f) j["depth_alpha"] = settings.depthAlpha;
     if (!settings.depthIn.empty()) j["depth_in"] = true;
@@ -116,9 +118,10 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
         for (const IsoSurface& s : settings.isoSurfaces) iso.push_back(isoText(s));
         j["iso"] = std::move(iso);
     }
-    // Gradient shading, with its coefficients when on (they light isosurfaces too).
+    // Gradient shading, with its coefficients when on (they light isosurfaces and the cut face
+    // too).
     j["shade"] = settings.lighting.on;
-    if (settings.lighting.on || !settings.isoSurfaces.empty()) {
+    if (settings.lighting.on || !settings.isoSurfaces.empty() || j.contains("clip_surface")) {
         j["normals"] = settings.lighting.smooth ? "smooth" : "cell";
         j["ambient"] = settings.lighting.ambient;
         j["diffuse"] = settings.lighting.diffuse;

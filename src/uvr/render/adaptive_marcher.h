@@ -250,8 +250,15 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     if (scene.kd.partitionCount == 0 || !intersectBox(scene.kd.bounds, ray.org, inv, tEnter, tExit))
         return acc;
     const ClipView& clip = scene.base.params.clip;
-    if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, tEnter, tExit)) return acc;
-    if (ray.tMax < tExit) tExit = ray.tMax;  // depth in: opaque geometry there
+    [[maybe_unused]] bool cut0 = false, cut1 = false;  // the span's ends on the clip's faces
+    [[maybe_unused]] Vec3f n0, n1;
+    if (kSurf && clip.surface) {
+        if (!clip.restrictFaces(ray.org, ray.dir, inv, tEnter, tExit, cut0, n0, cut1, n1))
+            return acc;
+    } else if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, tEnter, tExit)) {
+        return acc;
+    }
+    if (ray.tMax < tExit) tExit = ray.tMax, cut1 = false;  // depth in: opaque geometry there
     if (!(tEnter <= tExit)) return acc;
     const TetLocator& locator = scene.base.locator;
     const float s1 = scene.base.params.step;
@@ -274,6 +281,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, counters.locate);
         return found;
     };
+    if constexpr (kSurf) {  // the cut face in front: nothing else shows
+        if (cut0 && cutFace<kNative>(locateFrom, scene.base.params, locator.mesh, tf, ray, tEnter,
+                                     n0, kNoTet, counters, acc))
+            return acc;
+    }
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
     // One loop whose every iteration takes a sample, skips a transparent macrocell or moves to
@@ -465,9 +477,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     // With isosurfaces the run starts or ends at the boundary itself.
                     if (segments.iso && (!in || runFromValid))
                         sampleAtBoundary<kNative, kLit, kSurf>(
-                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, in ? lo : hi,
-                            true, in ? hi : segments.kLast, from, in ? vHi : segments.vLast, k1,
-                            segments, counters, acc);
+                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
+                            in ? lo : hi, true, in ? hi : segments.kLast, from,
+                            in ? vHi : segments.vLast, k1, segments, counters, acc);
                     if (in) runFromValid = false;
                 }
                 if (in && hi < kSample)
@@ -521,13 +533,18 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
             // the run's last sample at the end.
             if (segments.iso && segments.inside)
-                sampleAtBoundary<kNative, kLit, kSurf>(
-                    locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, tExit / s1,
-                    true, segments.kLast, lastInside, segments.vLast, segments.kEnd, segments,
-                    counters, acc);
+                sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator.mesh,
+                                                       tf, ray, lighting, tExit / s1, true,
+                                                       segments.kLast, lastInside, segments.vLast,
+                                                       segments.kEnd, segments, counters, acc);
         }
         segments.finish(tf, s1, unit, acc);
         note(tExit);
+    }
+    if constexpr (kSurf) {  // the cut face behind the volume
+        if (cut1 && !opaque)
+            cutFace<kNative>(locateFrom, scene.base.params, locator.mesh, tf, ray, tExit, n1,
+                             lastInside, counters, acc);
     }
     return acc;
 }

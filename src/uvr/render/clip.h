@@ -29,6 +29,10 @@ struct ClipView {
     int planeCount = 0;
     bool hasBox = false;
     Bounds3f box;  ///< kept inside, with hasBox
+    /// The cut face as an opaque surface (RenderSettings::clipSurface): where a ray's part
+    /// inside the region starts or ends on a plane or the box inside the mesh, the surface there
+    /// is coloured by the transfer function at the field's value and lit with the face's normal.
+    bool surface = false;
 
     UVR_HOST_DEVICE bool active() const { return planeCount > 0 || hasBox; }
 
@@ -49,6 +53,39 @@ struct ClipView {
                 t1 = t < t1 ? t : t1;
             } else if (a < 0.f) {
                 return false;  // parallel to the plane, on the clipped side
+            }
+        }
+        return t0 <= t1;
+    }
+
+    /// restrict, and which ends of [t0, t1] the region moved onto one of its faces: cut0 (cut1)
+    /// with that face's normal n0 (n1); an end the region left where it was keeps false.
+    UVR_HOST_DEVICE bool restrictFaces(Vec3f org, Vec3f dir, Vec3f invDir, float& t0, float& t1,
+                                       bool& cut0, Vec3f& n0, bool& cut1, Vec3f& n1) const {
+        cut0 = cut1 = false;
+        if (hasBox) {
+            for (int a = 0; a < 3; ++a) {
+                const float ta = (box.lo[a] - org[a]) * invDir[a];
+                const float tb = (box.hi[a] - org[a]) * invDir[a];
+                const float tNear = ta < tb ? ta : tb, tFar = ta < tb ? tb : ta;
+                Vec3f axis(0.f, 0.f, 0.f);
+                axis[a] = 1.f;
+                if (tNear > t0) t0 = tNear, cut0 = true, n0 = axis;
+                if (tFar < t1) t1 = tFar, cut1 = true, n1 = axis;
+            }
+        }
+        for (int i = 0; i < planeCount; ++i) {
+            const ClipPlane& p = planes[i];
+            const float a = dot(p.normal, org - p.origin);
+            const float b = dot(p.normal, dir);
+            if (b > 0.f) {
+                const float t = -a / b;
+                if (t > t0) t0 = t, cut0 = true, n0 = p.normal;
+            } else if (b < 0.f) {
+                const float t = -a / b;
+                if (t < t1) t1 = t, cut1 = true, n1 = p.normal;
+            } else if (a < 0.f) {
+                return false;
             }
         }
         return t0 <= t1;

@@ -155,6 +155,62 @@ TEST_P(Clipping, TheTwoHalvesOfACutCompositeToTheWhole) {
     EXPECT_GT(whole.image.at(12, 8).w, farHalf.image.at(12, 8).w + 0.01f);
 }
 
+TEST_P(Clipping, TheCutFaceShowsTheFieldWhereThePlaneCutsIt) {
+    // A linear field (which trilinear hexahedra and tetrahedra reproduce exactly), cut at
+    // x = 0.43. Keeping x >= 0.43, every ray of the parallel view along +x meets the cut face
+    // first: with clip_surface the pixel is the transfer function's colour at the field's value
+    // there, lit head-on (ambient 0 + diffuse 1: the colour itself), opaque. Keeping x <= 0.43,
+    // the face ends the rays: the volume in front composites over it.
+    const auto field = [](Vec3f p) { return p.x + 0.5f * p.y + 0.25f * p.z; };
+    for (const bool split : {false, true}) {
+        PrepareOptions options;
+        options.kd.leafCells = 32;
+        options.cells.splitCells = split;
+        const Mesh m = testing::makeHexGrid(6, 0.f, 1.f, field);
+        const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), options);
+        for (const RenderMethod method : kMethods) {
+            const std::string what =
+                std::string(methodName(method)) + (split ? " tetrahedra" : " hexahedra");
+            RenderSettings s = alongX(method, true, "constant:1");
+            s.clipSurface = true;
+            s.clipPlanes = {{Vec3f(0.43f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f)}};
+            const RenderResult front = render(pm, s);
+            // The colour at pixel (x, y): the view's right is -y, its up +z, 0.025 a pixel.
+            auto faceColour = [&](int x, int y) {
+                const Vec3f p(0.43f, 0.52f - (float(x) + 0.5f - 12.f) * 0.025f,
+                              0.47f + (8.f - (float(y) + 0.5f)) * 0.025f);
+                return s.tf.colorAt((field(p) - s.range->first) /
+                                    (s.range->second - s.range->first));
+            };
+            float worst = 0.f;
+            for (int y = 0; y < s.height; ++y)
+                for (int x = 0; x < s.width; ++x) {
+                    const Vec4f c = front.image.at(x, y);
+                    const Vec3f want = faceColour(x, y);
+                    EXPECT_EQ(c.w, 1.f) << what;
+                    for (int k = 0; k < 3; ++k) worst = std::max(worst, std::fabs(c[k] - want[k]));
+                }
+            EXPECT_LT(worst, 3.f / 255.f) << what;
+            // The other side: the volume x in [0, 0.43] over the face.
+            s.clipPlanes = {{Vec3f(0.43f, 0.f, 0.f), Vec3f(-1.f, 0.f, 0.f)}};
+            const RenderResult behind = render(pm, s);
+            s.clipSurface = false;
+            const RenderResult volume = render(pm, s);
+            worst = 0.f;
+            for (int y = 0; y < s.height; ++y)
+                for (int x = 0; x < s.width; ++x) {
+                    const Vec4f v = volume.image.at(x, y), c = behind.image.at(x, y);
+                    const Vec3f want = faceColour(x, y);
+                    EXPECT_LT(v.w, 0.9f) << what;  // the face shows through
+                    EXPECT_EQ(c.w, 1.f) << what;
+                    for (int k = 0; k < 3; ++k)
+                        worst = std::max(worst, std::fabs(c[k] - (v[k] + (1.f - v.w) * want[k])));
+                }
+            EXPECT_LT(worst, 3.f / 255.f) << what;
+        }
+    }
+}
+
 TEST(ClipSettings, BadPlanesAndBoxesAreRefusedNamingThem) {
     RenderSettings s;
     s.tf = transferFunctionPreset("viridis");

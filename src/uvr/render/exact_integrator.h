@@ -478,10 +478,24 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     // Clipped: the ray starts at the region's entry (inside a cell, which is cut there) and
     // stops at its exit.
     const ClipView& clip = scene.params.clip;
-    if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, b0, b1)) return acc;
+    [[maybe_unused]] bool cut0 = false, cut1 = false;  // the span's ends on the clip's faces
+    [[maybe_unused]] Vec3f n0, n1;
+    if (kSurf && clip.surface) {
+        if (!clip.restrictFaces(ray.org, ray.dir, inv, b0, b1, cut0, n0, cut1, n1)) return acc;
+    } else if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, b0, b1)) {
+        return acc;
+    }
     // Depth in: the ray ends at opaque geometry (cut there as at a clip plane).
-    if (ray.tMax < b1) b1 = ray.tMax;
+    if (ray.tMax < b1) b1 = ray.tMax, cut1 = false;
     if (!(b0 <= b1)) return acc;
+    [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b) {
+        return scene.locator.locate<kNative>(q, from, b, counters.locate);
+    };
+    if constexpr (kSurf) {  // the cut face in front: nothing else shows
+        if (cut0 && cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, b0,
+                                     n0, kNoTet, counters, acc))
+            return acc;
+    }
     const bool clipped = clip.active() || ray.tMax < INFINITY;
     const double tStop = clipped ? double(b1) : INFINITY;
     const TetLocator& loc = scene.locator;
@@ -572,6 +586,11 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
             if (span.tIn > t) t = span.tIn;  // empty space before it
             past = clipped && t >= tStop;
         }
+    }
+    if constexpr (kSurf) {  // the cut face behind the volume
+        if (cut1 && !opaque)
+            cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, b1, n1,
+                             kNoTet, counters, acc);
     }
     return acc;
 }

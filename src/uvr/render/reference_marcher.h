@@ -222,12 +222,13 @@ inline constexpr int kBoundaryBisections = 10;
 /// pair of grid samples brackets: rings where the grid happened to) is crossed where the exact
 /// integrator crosses it. Not inlined: only frames with isosurfaces call it, at a run's ends.
 template <bool kNative, bool kLit, bool kSurf, class Locate>
-UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(
-    const Locate& locate, const MarchParams& params, const TetMeshView& mesh,
-    const TfTableView& tf, const Ray& ray, const Lighting& lighting, float kOut, bool outKnown,
-    float kIn, std::uint32_t tetIn, float vIn, float kPieceEnd,
-    SampleSegments<kLit, kSurf>& segments,
-    RayCounters& counters, Vec4f& acc) {
+UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const MarchParams& params,
+                                                   const TetMeshView& mesh, const TfTableView& tf,
+                                                   const Ray& ray, const Lighting& lighting,
+                                                   float kOut, bool outKnown, float kIn,
+                                                   std::uint32_t tetIn, float vIn, float kPieceEnd,
+                                                   SampleSegments<kLit, kSurf>& segments,
+                                                   RayCounters& counters, Vec4f& acc) {
     const float s1 = params.step;
     float lo = kOut, hi = kIn;
     std::uint32_t from = tetIn, tetHi = kNoTet;
@@ -264,6 +265,32 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(
                  lightAt(lighting, tetHi, g, ray.dir), g);
 }
 
+/// The clip region's cut face (ClipView::surface; kSurf instances): the point at parameter t of
+/// the ray, on a face of normal n, located by `locate(q, hint, bary)`; inside the mesh, an opaque
+/// surface coloured by the transfer function at the field's value there, lit by the headlight
+/// with normal n (`surface`: the frame's coefficients, always on), composited under what acc
+/// holds and ending the ray. Returns whether the point lay inside the mesh. The depth asked for
+/// (params.depthAlpha) is reached there if not before.
+template <bool kNative, class Locate>
+UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParams& params,
+                                          const TetMeshView& mesh, const TfTableView& tf,
+                                          const Ray& ray, float t, Vec3f n, std::uint32_t hint,
+                                          RayCounters& counters, Vec4f& acc) {
+    float bary[4];
+    ++counters.samples;
+    const std::uint32_t c = locate(ray.at(t), hint, bary);
+    if (c == kNoTet) return false;
+    const Vec3f rgb = lightFactors(surfaceLighting(params.light), n, ray.dir)
+                          .apply(tf.sample(mesh.interpolate<kNative>(c, bary)).xyz());
+    const float w = 1.f - acc.w;
+    acc.x += w * rgb.x;
+    acc.y += w * rgb.y;
+    acc.z += w * rgb.z;
+    acc.w = 1.f;
+    if (params.depthAlpha > 0.f && !(counters.depth < INFINITY)) counters.depth = t;
+    return true;
+}
+
 /// The lighting an integrator instance reads: the frame's, or none where it is compiled unlit
 /// (kLit false: its kernels carry no lighting code, which cost the unlit adaptive kernel up to
 /// 21% of its frame time on the H200).
@@ -289,10 +316,24 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     float t0 = 0.f, t1 = INFINITY;
     // An empty mesh has inverted bounds, which every ray would "cross" from -FLT_MAX to FLT_MAX.
     if (scene.bounds.empty() || !intersectBox(scene.bounds, ray.org, inv, t0, t1)) return acc;
-    if (scene.params.clip.active() && !scene.params.clip.restrict(ray.org, ray.dir, inv, t0, t1))
+    [[maybe_unused]] bool cut0 = false, cut1 = false;  // the span's ends on the clip's faces
+    [[maybe_unused]] Vec3f n0, n1;
+    const ClipView& clip = scene.params.clip;
+    if (kSurf && clip.surface) {
+        if (!clip.restrictFaces(ray.org, ray.dir, inv, t0, t1, cut0, n0, cut1, n1)) return acc;
+    } else if (clip.active() && !clip.restrict(ray.org, ray.dir, inv, t0, t1)) {
         return acc;
-    if (ray.tMax < t1) t1 = ray.tMax;  // depth in: opaque geometry there
+    }
+    if (ray.tMax < t1) t1 = ray.tMax, cut1 = false;  // depth in: opaque geometry there
     if (!(t0 <= t1)) return acc;
+    [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b) {
+        return scene.locator.locate<kNative>(q, from, b, counters.locate);
+    };
+    if constexpr (kSurf) {  // the cut face in front: nothing else shows
+        if (cut0 && cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, t0,
+                                     n0, kNoTet, counters, acc))
+            return acc;
+    }
     const float s = scene.params.step;
     // Global sample grid k * s, so every integrator that samples a span takes the same samples.
     float k = ceilf(t0 / s);
@@ -359,14 +400,19 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
                 const auto locate = [&](Vec3f q, std::uint32_t from, float* b) {
                     return scene.locator.locate<kNative>(q, from, b, counters.locate);
                 };
-                sampleAtBoundary<kNative, kLit, kSurf>(
-                    locate, scene.params, scene.locator.mesh, scene.tf, ray, lighting, t1 / s,
-                    true, segments.kLast, lastInside, segments.vLast, kEnd + 1.f, segments,
-                    counters, acc);
+                sampleAtBoundary<kNative, kLit, kSurf>(locate, scene.params, scene.locator.mesh,
+                                                       scene.tf, ray, lighting, t1 / s, true,
+                                                       segments.kLast, lastInside, segments.vLast,
+                                                       kEnd + 1.f, segments, counters, acc);
             }
         }
         segments.finish(scene.tf, s, unit, acc);
         if constexpr (kSurf) noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, t1, counters);
+    }
+    if constexpr (kSurf) {  // the cut face behind the volume
+        if (cut1 && !opaque)
+            cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, t1, n1,
+                             tet, counters, acc);
     }
     return acc;
 }

@@ -62,6 +62,7 @@ ClipView clipView(const RenderSettings& s, const MeshFrame& frame) {
         v.box.lo = Vec3f(float(lo[0]), float(lo[1]), float(lo[2]));
         v.box.hi = Vec3f(float(hi[0]), float(hi[1]), float(hi[2]));
     }
+    v.surface = s.clipSurface && v.active();
     return v;
 }
 

@@ -75,6 +75,9 @@ struct RenderSettings {
     /// the part of each ray inside all of them (the exact method cuts the cells there exactly).
     std::vector<ClipPlane> clipPlanes;
     std::optional<Bounds3f> clipBox;
+    /// The cut face as an opaque surface coloured by the field (ClipView::surface), lit with
+    /// the face's normal by the lighting coefficients.
+    bool clipSurface = false;
     /// Gradient shading (issue 32; lighting.h): off by default; ParaView's Ambient, Diffuse,
     /// Specular and SpecularPower and their defaults.
     Lighting lighting;

@@ -35,9 +35,10 @@ struct MarchParams {
     float depthAlpha = 0.f;
 };
 
-/// Whether a frame runs the integrators' instances with isosurfaces and depth (kSurf).
+/// Whether a frame runs the integrators' instances with isosurfaces, depth and the clip's cut
+/// face (kSurf).
 UVR_HOST_DEVICE inline bool surfacesKernel(const MarchParams& p) {
-    return p.iso.active() || p.depthAlpha > 0.f;
+    return p.iso.active() || p.depthAlpha > 0.f || (p.clip.surface && p.clip.active());
 }
 
 /// Whether a frame runs the integrators' lit instances (kLit): shaded, or with the surfaces'

@@ -229,6 +229,17 @@ std::vector<SettingDef> makeVocabulary() {
     shade.set = [](RenderSettings& s, const Json& x) { s.lighting.on = x.get<bool>(); };
     v.push_back(shade);
 
+    SettingDef clipSurface =
+        setting("clip_surface", SettingType::Flag,
+                "Clipping: the cut face as an opaque surface coloured by the field, lit with the "
+                "face's normal");
+    clipSurface.detail =
+        "where the clip planes or box cut the mesh; read with `--clip-plane` or `--clip-box`; "
+        "lit by `ambient`, `diffuse`, `specular` and `specular_power`, shaded or not";
+    clipSurface.get = [](const RenderSettings& s) { return Json(s.clipSurface); };
+    clipSurface.set = [](RenderSettings& s, const Json& x) { s.clipSurface = x.get<bool>(); };
+    v.push_back(clipSurface);
+
     SettingDef normals =
         setting("normals", SettingType::Choice,
                 "Shading: smooth (the points' gradients interpolated in each cell) or cell "
@@ -377,18 +388,21 @@ std::string settingExpectation(const SettingDef& d) {
 
 bool settingNeedMet(const SettingDef& d, const RenderSettings& settings) {
     if (!d.needs) return true;
-    // The lighting settings light isosurfaces too, shaded or not.
-    if (std::string_view(d.needs) == "shade" && !settings.isoSurfaces.empty()) return true;
+    // The lighting settings light isosurfaces and the cut face too, shaded or not.
+    if (std::string_view(d.needs) == "shade" &&
+        (!settings.isoSurfaces.empty() || settings.clipSurface))
+        return true;
     return settingNamed(d.needs).get(settings) == true;
 }
 
 void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std::string>& given) {
     for (const std::string& name : given)
         if (const SettingDef* d = findSetting(name); d && !settingNeedMet(*d, settings))
-            throw SettingError(
-                d->name, settingValueText(d->get(settings)),
-                std::string("read only with `") + d->needs + "` on" +
-                    (std::string_view(d->needs) == "shade" ? " or an `iso` surface" : ""));
+            throw SettingError(d->name, settingValueText(d->get(settings)),
+                               std::string("read only with `") + d->needs + "` on" +
+                                   (std::string_view(d->needs) == "shade"
+                                        ? " or an `iso` surface or `clip_surface`"
+                                        : ""));
 }
 
 Json settingDefault(const SettingDef& d) {

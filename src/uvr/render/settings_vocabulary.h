@@ -89,7 +89,8 @@ bool settingNeedMet(const SettingDef& def, const RenderSettings& settings);
 
 /// Throws SettingError for the first of the settings named in `given` (names of the
 /// vocabulary; others are passed over) that `settings` would not read because the setting it
-/// needs is off: "ambient 0.3: read only with `shade` on or an `iso` surface".
+/// needs is off: "ambient 0.3: read only with `shade` on or an `iso` surface or
+/// `clip_surface`".
 void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std::string>& given);
 
 /// What a value of the setting must be, in words ("a number in [0.5, 0.9999]", "'point' or

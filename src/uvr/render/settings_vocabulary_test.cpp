@@ -192,7 +192,8 @@ TEST(SettingsVocabulary, LightingCoefficientsNeedShadeOn) {
         FAIL() << "ambient without shade passed";
     } catch (const SettingError& e) {
         EXPECT_EQ(std::string(e.what()),
-                  "ambient 0.25: read only with `shade` on or an `iso` surface");
+                  "ambient 0.25: read only with `shade` on or an `iso` surface or "
+                  "`clip_surface`");
     }
     applySetting(s, "shade", true);
     EXPECT_NO_THROW(refuseUnreadSettings(s, {"quality", "ambient", "not_a_setting"}));

@@ -24,9 +24,9 @@ inline constexpr std::size_t kMaxTfPoints = 4096;
 /// The settings of the library's vocabulary (settings_vocabulary.h) that the page sets, by name:
 /// a setting joins the viewer with its name here and a control on the page (which reads its
 /// choices, range and doc from the `info` message). The others are the command line's.
-inline constexpr std::array<const char*, 10> kViewerSettings{
-    "method",  "quality", "opacity_unit", "opacity_law", "shade",
-    "normals", "ambient", "diffuse",      "specular",    "specular_power"};
+inline constexpr std::array<const char*, 11> kViewerSettings{
+    "method",  "quality", "opacity_unit", "opacity_law",    "shade",       "normals",
+    "ambient", "diffuse", "specular",     "specular_power", "clip_surface"};
 
 /// True for a name of kViewerSettings.
 bool isViewerSetting(std::string_view name);
