@@ -502,6 +502,7 @@ TEST(Cli, ClipPlanesAndBoxCutTheVolumeAndAreReported) {
     const std::pair<const char*, const char*> bad[] = {
         {"--clip-plane 1,2,3", "--clip-plane '1,2,3': expected ox,oy,oz,nx,ny,nz"},
         {"--clip-plane 0,0,0,0,0,0", "normal other than 0,0,0"},
+        {"--clip-surface", "read only with clip planes or a clip box"},
         {"--clip-box 1,1,1,0,0,0", "x0 <= x1"},
         {"--clip-box 0,0,0,1,1,nan", "--clip-box"},
         {"--clip-plane 0,0,0,1,0,0 --clip-plane 0,0,0,1,0,0 --clip-plane 0,0,0,1,0,0 "

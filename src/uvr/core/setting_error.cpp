@@ -7,13 +7,14 @@ namespace uvr {
 
 SettingError::SettingError(std::string setting, std::string value, std::string expected,
                            ErrorKind kind)
-    : Error(kind, setting + " " + value + ": " + expected),
+    : Error(kind, (value.empty() ? setting : setting + " " + value) + ": " + expected),
       setting_(std::move(setting)),
       value_(std::move(value)),
       expected_(std::move(expected)) {}
 
 std::string SettingError::spelledAs(const std::string& name, const std::string& separator) const {
-    return name + separator + value_ + ": " + expected_;
+    // A flag given bare ("--clip-surface") has no value to quote.
+    return value_.empty() ? name + ": " + expected_ : name + separator + value_ + ": " + expected_;
 }
 
 std::string respellMentions(std::string_view message,

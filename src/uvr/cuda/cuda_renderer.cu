@@ -11,6 +11,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/setting_error.h"
 #include "uvr/cuda/cuda_check.h"
+#include "uvr/cuda/frame_launch.cuh"
 #include "uvr/cuda/launch.cuh"
 #include "uvr/render/frame_kernel.h"
 
@@ -42,45 +43,6 @@ namespace {
 
 /// Walk length on the GPU before the BVH takes over.
 constexpr int kGpuMaxWalkSteps = 64;
-
-/// Counters summed over a frame: samples, walk steps, BVH queries, partitions visited, skipped.
-constexpr int kCounters = 5;
-
-/// Threads per frame block (16 x 8 pixels) and the blocks per multiprocessor the frame kernels
-/// are compiled for: 4 caps them at 128 registers (the partition kernel needed 134, which let
-/// only 3 blocks run per multiprocessor).
-constexpr int kFrameBlock = 128;
-constexpr int kFrameBlocksPerSm = 4;
-
-/// Kernel: one thread per pixel runs the shared pixel body, then the warp sums its counters.
-template <bool Supersampled, class March>
-__global__ void __launch_bounds__(kFrameBlock, kFrameBlocksPerSm)
-    frameKernel(FrameView frame, March march, unsigned long long* totals) {
-    const int x = blockIdx.x * blockDim.x + threadIdx.x;
-    const int y = blockIdx.y * blockDim.y + threadIdx.y;
-    RayCounters c;
-    if (x < frame.width && y < frame.height) c = shadePixel<Supersampled>(frame, x, y, march);
-    unsigned long long v[kCounters] = {c.samples, c.locate.walkSteps, c.locate.bvhQueries,
-                                       c.partitionsVisited, c.partitionsSkipped};
-    const unsigned lane = (threadIdx.y * blockDim.x + threadIdx.x) % 32u;
-    for (int k = 0; k < kCounters; ++k) {
-        for (int offset = 16; offset > 0; offset /= 2)
-            v[k] += __shfl_down_sync(0xffffffffu, v[k], offset);
-        if (lane == 0 && v[k]) atomicAdd(&totals[k], v[k]);
-    }
-}
-
-/// Launches the frame kernel for the frame's rays per pixel: the one-ray body when it has one.
-template <class March>
-void launchFrame(dim3 grid, dim3 block, const FrameView& frame, const March& march,
-                 unsigned long long* totals) {
-    const auto start = std::chrono::steady_clock::now();
-    if (frame.supersample == 1)
-        frameKernel<false><<<grid, block>>>(frame, march, totals);
-    else
-        frameKernel<true><<<grid, block>>>(frame, march, totals);
-    finishLaunch("frame", std::uint64_t(frame.width) * std::uint64_t(frame.height), start);
-}
 
 /// Transfer-function update, pass 1 (one element per partition): range statistics, and the
 /// minimum and maximum variance over the visible partitions (as ordered bit patterns: variances
@@ -452,26 +414,17 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     const bool native = d.mesh.tets.hasNative();
     const bool lit = litKernel(result.setup.params);
     const bool surfaces = surfacesKernel(result.setup.params);
-    if (method == RenderMethod::Reference) {
-        dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
-            cuda::launchFrame(
-                grid, block, frame,
-                ReferenceMarch<kNative(), kLit(), kSurf()>{d.deviceScene(result.setup)},
-                d.totals.data());
-        });
-    } else if (method == RenderMethod::Exact) {
-        dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
-            cuda::launchFrame(grid, block, frame,
-                              ExactMarch<kNative(), kLit(), kSurf()>{d.deviceScene(result.setup)},
-                              d.totals.data());
-        });
-    } else {
-        const PartitionSceneView scene = d.devicePartitionScene(result.setup, settings.skip);
-        dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
-            cuda::launchFrame(grid, block, frame, PartitionMarch<kNative(), kLit(), kSurf()>{scene},
-                              d.totals.data());
-        });
-    }
+    // One translation unit per method (frame_launch.cuh): their kernels compile in parallel.
+    if (method == RenderMethod::Reference)
+        cuda::launchReference(grid, block, frame, d.deviceScene(result.setup), native, lit,
+                              surfaces, d.totals.data());
+    else if (method == RenderMethod::Exact)
+        cuda::launchExact(grid, block, frame, d.deviceScene(result.setup), native, lit, surfaces,
+                          d.totals.data());
+    else
+        cuda::launchPartitions(grid, block, frame,
+                               d.devicePartitionScene(result.setup, settings.skip), native, lit,
+                               surfaces, d.totals.data());
     UVR_CUDA_CHECK(cudaEventRecord(end));
     UVR_CUDA_CHECK(cudaEventSynchronize(end));
     float ms = 0.f;

@@ -397,6 +397,11 @@ bool settingNeedMet(const SettingDef& d, const RenderSettings& settings) {
 
 void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std::string>& given) {
     for (const std::string& name : given)
+        if (name == "clip_surface" && settings.clipSurface && settings.clipPlanes.empty() &&
+            !settings.clipBox)
+            throw SettingError("clip_surface", "true",
+                               "read only with clip planes or a clip box: there is no cut face");
+    for (const std::string& name : given)
         if (const SettingDef* d = findSetting(name); d && !settingNeedMet(*d, settings))
             throw SettingError(d->name, settingValueText(d->get(settings)),
                                std::string("read only with `") + d->needs + "` on" +

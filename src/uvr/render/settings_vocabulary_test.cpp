@@ -195,6 +195,20 @@ TEST(SettingsVocabulary, LightingCoefficientsNeedShadeOn) {
                   "ambient 0.25: read only with `shade` on or an `iso` surface or "
                   "`clip_surface`");
     }
+    // The cut face lights with them too, and needs something cut.
+    applySetting(s, "clip_surface", true);
+    try {
+        refuseUnreadSettings(s, {"clip_surface", "ambient"});
+        FAIL() << "clip_surface without a clip passed";
+    } catch (const SettingError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "clip_surface true: read only with clip planes or a clip box: there is no cut "
+                  "face");
+    }
+    s.clipPlanes = {{Vec3f(0.f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f)}};
+    EXPECT_NO_THROW(refuseUnreadSettings(s, {"clip_surface", "ambient"}));
+    s.clipPlanes.clear();
+    applySetting(s, "clip_surface", false);
     applySetting(s, "shade", true);
     EXPECT_NO_THROW(refuseUnreadSettings(s, {"quality", "ambient", "not_a_setting"}));
     EXPECT_EQ(s.lighting.ambient, 0.25f);

@@ -1,0 +1,14 @@
+// SPDX-License-Identifier: MIT
+// The exact method's frame kernels (frame_launch.cuh): six instances, compiled on their own.
+#include "uvr/cuda/frame_launch.cuh"
+
+namespace uvr::cuda {
+
+void launchExact(dim3 grid, dim3 block, const FrameView& frame, const SceneView& scene, bool native,
+                 bool lit, bool surfaces, unsigned long long* totals) {
+    dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
+        launchFrame(grid, block, frame, ExactMarch<kNative(), kLit(), kSurf()>{scene}, totals);
+    });
+}
+
+}  // namespace uvr::cuda

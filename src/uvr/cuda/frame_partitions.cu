@@ -1,0 +1,15 @@
+// SPDX-License-Identifier: MIT
+// The partitions method's frame kernels (frame_launch.cuh): six instances, compiled on their own.
+#include "uvr/cuda/frame_launch.cuh"
+
+namespace uvr::cuda {
+
+void launchPartitions(dim3 grid, dim3 block, const FrameView& frame,
+                      const PartitionSceneView& scene, bool native, bool lit, bool surfaces,
+                      unsigned long long* totals) {
+    dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
+        launchFrame(grid, block, frame, PartitionMarch<kNative(), kLit(), kSurf()>{scene}, totals);
+    });
+}
+
+}  // namespace uvr::cuda
