@@ -296,6 +296,16 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // active threads per instruction, 12x the reference marcher's time at the same samples).
     KdLeafIterator leaves(tEnter, tExit);
     std::uint32_t p = 0;
+    // Isosurfaces: the partition of the last sample inside the mesh; a run's end at the boundary
+    // is bisected for only where this one's or the current one's value range holds an iso value
+    // (the surface between the sample and the boundary lies in their cells).
+    [[maybe_unused]] std::uint32_t pInside = 0;
+    [[maybe_unused]] const auto isoNear = [&]() {
+        const KdPartition& a = scene.kd.partitions[p];
+        const KdPartition& b = scene.kd.partitions[pInside];
+        return segments.iso->within(a.valueMin, a.valueMax) ||
+               segments.iso->within(b.valueMin, b.valueMax);
+    };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
     float kLocated = -INFINITY;  // grid position of the last sample located
     bool marching = true, opaque = false, macro = false;
@@ -475,7 +485,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // at the first position found outside.
                 if constexpr (kSurf) {
                     // With isosurfaces the run starts or ends at the boundary itself.
-                    if (segments.iso && (!in || runFromValid))
+                    if (segments.iso && (!in || runFromValid) && isoNear())
                         sampleAtBoundary<kNative, kLit, kSurf>(
                             locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
                             in ? lo : hi, true, in ? hi : segments.kLast, from,
@@ -497,14 +507,15 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             }
             if (in) lastInside = tet;
             if constexpr (kSurf) {
+                if (in) pInside = p;
                 // With isosurfaces a run starts (not after a long step: bisected above) at the
                 // mesh's boundary or the span's start, and ends at the boundary.
-                if (in && segments.iso && runFromValid && !segments.inside)
+                if (in && segments.iso && runFromValid && !segments.inside && isoNear())
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kRunFrom,
                         runFromOutside, kSample, tet, v, k1, segments, counters, acc);
                 if (!in && segments.iso && segments.started && segments.inside &&
-                    kSample <= segments.kEnd && !endsRun)
+                    kSample <= segments.kEnd && !endsRun && isoNear())
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kSample,
                         true, segments.kLast, lastInside, segments.vLast, k1, segments, counters,
@@ -532,7 +543,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if constexpr (kSurf) {
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
             // the run's last sample at the end.
-            if (segments.iso && segments.inside)
+            if (segments.iso && segments.inside && isoNear())
                 sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator.mesh,
                                                        tf, ray, lighting, tExit / s1, true,
                                                        segments.kLast, lastInside, segments.vLast,

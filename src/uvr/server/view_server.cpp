@@ -223,6 +223,9 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
             !(def.tunesAdaptive && f.method == RenderMethod::Partitions))
             continue;
         if (!settingNeedMet(def, f)) continue;
+        // The face box kept on with the clip off draws nothing, and the command line refuses it.
+        if (std::string_view(def.name) == "clip_surface" && f.clipPlanes.empty() && !f.clipBox)
+            continue;
         args.push_back(cliFlag(def));  // a flag's is its value ("--shade", "--no-skip")
         if (def.type != SettingType::Flag)
             args.push_back(value.is_string() ? value.get<std::string>()

@@ -38,6 +38,7 @@ namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Json = nlohmann::json;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using namespace std::chrono_literals;
 
 /// A mesh with a point field "f" and a cell field "g" of other ranges.
@@ -405,6 +406,14 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
                 HasSubstr("--iso 0.5 --iso '1,0.5,#00ff00' --step 0.01"));
     c.send({{"type", "set"}, {"iso", Json::array()}});
+    // The cut face exports with a clip plane, and not without one (the CLI refuses it then).
+    c.send({{"type", "set"}, {"clip_surface", true}, {"clip_planes", {{0.25, 0, 0, 1, 0, 0}}}});
+    c.send({{"type", "export"}});
+    EXPECT_THAT(c.until("export")["command"].get<std::string>(), HasSubstr("--clip-surface"));
+    c.send({{"type", "set"}, {"clip_planes", Json::array()}});
+    c.send({{"type", "export"}});
+    EXPECT_THAT(c.until("export")["command"].get<std::string>(), Not(HasSubstr("--clip-surface")));
+    c.send({{"type", "set"}, {"clip_surface", false}});
     c.send({{"type", "set"}, {"method", "adaptive"}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
