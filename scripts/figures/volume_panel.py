@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 """The README's lighting, clipping and isosurface figure (issue 32): the NASA Blunt Fin's
 density rendered by the default method unshaded, shaded (`--shade`), clipped by a plane
-(`--clip-plane`) and with two isosurfaces inside the volume (`--iso`), each captioned with the
+(`--clip-plane`), with two isosurfaces inside the volume (`--iso`) and clipped with the cut face
+drawn (`--clip-surface`), each captioned with the
 flags and its worst pixels against the exact integrator at the same settings (99.9th percentile
 and maximum of the per-pixel difference, 8-bit levels, `uvr compare`).
 
@@ -35,6 +36,9 @@ panels = [
      ["--shade", "--specular", "0.3", "--specular-power", "20", "--clip-plane", "3,0,0,-1,0,0"]),
     ("--iso 1.3,0.6,#ff6020 --iso 2.5", ["--iso", "1.3,0.6,#ff6020", "--iso", "2.5",
                                          "--specular", "0.3", "--specular-power", "20"]),
+    ("--clip-plane 0,0,1.5,0,0,-1 --clip-surface",
+     ["--clip-plane", "0,0,1.5,0,0,-1", "--clip-surface", "--ambient", "0.2", "--diffuse",
+      "0.8"]),
 ]
 with tempfile.TemporaryDirectory() as tmp:
     images, labels = [], []
@@ -51,11 +55,11 @@ with tempfile.TemporaryDirectory() as tmp:
         labels.append(f"{name}\nvs exact: p99.9 {c['p999_difference']:.0f}, "
                       f"max {c['max_abs_difference']:.0f}")
         images.append(mpimg.imread(png))
-    fig, axes = plt.subplots(1, len(images), figsize=(4 * len(images), 3.6))
+    fig, axes = plt.subplots(1, len(images), figsize=(4 * len(images), 3.8))
     for ax, img, label in zip(axes, images, labels):
         ax.imshow(img)
         ax.set_title(label, fontsize=9)
         ax.axis("off")
-    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.86, wspace=0.03)
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.84, wspace=0.03)
     fig.savefig(out, dpi=96)
 print("wrote", out)
