@@ -110,6 +110,24 @@ TEST_P(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
     }
 }
 
+TEST_P(PartitionIntegrator, ShadedFramesStepAtMostThreeS1UnlessTold) {
+    // The error-bound rule does not see the normals turn: shaded frames default to s2 = 3 s1
+    // (kShadedMaxStepFactor), unshaded ones to 16 s1; a max_step given stands either way.
+    const PreparedMesh pm = jitteredGrid();
+    RenderSettings s = baseSettings();
+    s.method = RenderMethod::Partitions;
+    const RenderResult plain = render(pm, s);
+    const float s1 = plain.setup.params.step;
+    EXPECT_FLOAT_EQ(plain.setup.maxStep, kDefaultMaxStepFactor * s1);
+    s.lighting.on = true;
+    s.lighting.smooth = false;  // per-cell normals: no smooth gradients needed
+    const RenderResult lit = render(pm, s);
+    EXPECT_FLOAT_EQ(lit.setup.maxStep, kShadedMaxStepFactor * s1);
+    for (const PartitionShading& sh : lit.setup.shading) EXPECT_LE(sh.step, 3.f * s1 * 1.001f);
+    s.maxStep = 8.f * s1;
+    EXPECT_FLOAT_EQ(render(pm, s).setup.maxStep, 8.f * s1);
+}
+
 // The correctness bar of the method: with s1 == s2 the partition integrator reproduces the
 // reference (any loss comes from the adaptive step only), on every real mesh.
 TEST_P(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {

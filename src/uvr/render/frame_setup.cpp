@@ -221,8 +221,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                            "isosurfaces need a point field, and '" + mesh.tets.fieldName +
                                "' is cell data (constant in each cell: it has no surfaces "
                                "inside a cell)");
+    // Shaded with a light that depends on the normal: long steps would miss it turning.
+    const Lighting& light = settings.lighting;
+    const bool turns = light.on && (light.diffuse > 0.f || light.specular > 0.f);
+    const float defaultFactor = turns ? kShadedMaxStepFactor : kDefaultMaxStepFactor;
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_step")
-                                       : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
+                                       : std::fmin(defaultFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
         throw SettingError(
             "max_step", formatG(f.maxStep / frame.scale, 3),

@@ -135,7 +135,7 @@ std::vector<SettingDef> makeVocabulary() {
 
     SettingDef maxStep =
         setting("max_step", SettingType::Number,
-                "Adaptive: the largest step s2 in the file's units (default: 16 s1)");
+                "Adaptive: the largest step s2 in the file's units (default: 16 s1; 3 s1 shaded)");
     maxStep.min = 0.0, maxStep.max = kInf, maxStep.minOpen = true, maxStep.nullDefault = true;
     maxStep.tunesAdaptive = true;
     maxStep.readBy = {RenderMethod::Partitions};
