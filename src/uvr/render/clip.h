@@ -39,7 +39,39 @@ struct ClipView {
     /// Narrows [t0, t1] of the ray org + t dir to its part inside the region; false when none
     /// is left. invDir is 1 / dir per component (as intersectBox takes it).
     UVR_HOST_DEVICE bool restrict(Vec3f org, Vec3f dir, Vec3f invDir, float& t0, float& t1) const {
-        if (hasBox && !intersectBox(box, org, invDir, t0, t1)) return false;
+        bool cut0, cut1;
+        Vec3f n0, n1;
+        return narrow<false>(org, dir, invDir, t0, t1, cut0, n0, cut1, n1);
+    }
+
+    /// restrict, and which ends of [t0, t1] the region moved onto one of its faces: cut0 (cut1)
+    /// with that face's normal n0 (n1); an end the region left where it was keeps false.
+    UVR_HOST_DEVICE bool restrictFaces(Vec3f org, Vec3f dir, Vec3f invDir, float& t0, float& t1,
+                                       bool& cut0, Vec3f& n0, bool& cut1, Vec3f& n1) const {
+        return narrow<true>(org, dir, invDir, t0, t1, cut0, n0, cut1, n1);
+    }
+
+private:
+    /// restrict (kFaces false: the faces are not tracked) or restrictFaces.
+    template <bool kFaces>
+    UVR_HOST_DEVICE bool narrow(Vec3f org, Vec3f dir, Vec3f invDir, float& t0, float& t1,
+                                bool& cut0, Vec3f& n0, bool& cut1, Vec3f& n1) const {
+        cut0 = cut1 = false;
+        if (hasBox) {
+            if constexpr (kFaces) {
+                for (int a = 0; a < 3; ++a) {
+                    const float ta = (box.lo[a] - org[a]) * invDir[a];
+                    const float tb = (box.hi[a] - org[a]) * invDir[a];
+                    const float tNear = ta < tb ? ta : tb, tFar = ta < tb ? tb : ta;
+                    Vec3f axis(0.f, 0.f, 0.f);
+                    axis[a] = 1.f;
+                    if (tNear > t0) t0 = tNear, cut0 = true, n0 = axis;
+                    if (tFar < t1) t1 = tFar, cut1 = true, n1 = axis;
+                }
+            } else if (!intersectBox(box, org, invDir, t0, t1)) {
+                return false;
+            }
+        }
         for (int i = 0; i < planeCount; ++i) {
             const ClipPlane& p = planes[i];
             // dot(n, org + t dir - o) = a + t b >= 0.
@@ -47,45 +79,18 @@ struct ClipView {
             const float b = dot(p.normal, dir);
             if (b > 0.f) {
                 const float t = -a / b;
-                t0 = t > t0 ? t : t0;
+                if (t > t0) {
+                    t0 = t;
+                    if constexpr (kFaces) cut0 = true, n0 = p.normal;
+                }
             } else if (b < 0.f) {
                 const float t = -a / b;
-                t1 = t < t1 ? t : t1;
+                if (t < t1) {
+                    t1 = t;
+                    if constexpr (kFaces) cut1 = true, n1 = p.normal;
+                }
             } else if (a < 0.f) {
                 return false;  // parallel to the plane, on the clipped side
-            }
-        }
-        return t0 <= t1;
-    }
-
-    /// restrict, and which ends of [t0, t1] the region moved onto one of its faces: cut0 (cut1)
-    /// with that face's normal n0 (n1); an end the region left where it was keeps false.
-    UVR_HOST_DEVICE bool restrictFaces(Vec3f org, Vec3f dir, Vec3f invDir, float& t0, float& t1,
-                                       bool& cut0, Vec3f& n0, bool& cut1, Vec3f& n1) const {
-        cut0 = cut1 = false;
-        if (hasBox) {
-            for (int a = 0; a < 3; ++a) {
-                const float ta = (box.lo[a] - org[a]) * invDir[a];
-                const float tb = (box.hi[a] - org[a]) * invDir[a];
-                const float tNear = ta < tb ? ta : tb, tFar = ta < tb ? tb : ta;
-                Vec3f axis(0.f, 0.f, 0.f);
-                axis[a] = 1.f;
-                if (tNear > t0) t0 = tNear, cut0 = true, n0 = axis;
-                if (tFar < t1) t1 = tFar, cut1 = true, n1 = axis;
-            }
-        }
-        for (int i = 0; i < planeCount; ++i) {
-            const ClipPlane& p = planes[i];
-            const float a = dot(p.normal, org - p.origin);
-            const float b = dot(p.normal, dir);
-            if (b > 0.f) {
-                const float t = -a / b;
-                if (t > t0) t0 = t, cut0 = true, n0 = p.normal;
-            } else if (b < 0.f) {
-                const float t = -a / b;
-                if (t < t1) t1 = t, cut1 = true, n1 = p.normal;
-            } else if (a < 0.f) {
-                return false;
             }
         }
         return t0 <= t1;
