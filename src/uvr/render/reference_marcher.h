@@ -280,13 +280,10 @@ UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParam
     ++counters.samples;
     const std::uint32_t c = locate(ray.at(t), hint, bary);
     if (c == kNoTet) return false;
-    const Vec3f rgb = lightFactors(surfaceLighting(params.light), n, ray.dir)
-                          .apply(tf.sample(mesh.interpolate<kNative>(c, bary)).xyz());
-    const float w = 1.f - acc.w;
-    acc.x += w * rgb.x;
-    acc.y += w * rgb.y;
-    acc.z += w * rgb.z;
-    acc.w = 1.f;
+    // An opaque surface coloured by the map (IsoSurface's defaults), composited as isosurfaces
+    // are.
+    compositeIso(IsoSurface{}, tf.sample(mesh.interpolate<kNative>(c, bary)).xyz(),
+                 lightFactors(surfaceLighting(params.light), n, ray.dir), acc);
     if (params.depthAlpha > 0.f && !(counters.depth < INFINITY)) counters.depth = t;
     return true;
 }
@@ -362,12 +359,9 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         if (scene.params.preintegrated) {
             if constexpr (kSurf) {
                 if (segments.iso && (tet != kNoTet) != segments.inside) {
-                    const auto locate = [&](Vec3f q, std::uint32_t from, float* b) {
-                        return scene.locator.locate<kNative>(q, from, b, counters.locate);
-                    };
                     const bool first = !segments.started, in = tet != kNoTet;
                     sampleAtBoundary<kNative, kLit, kSurf>(
-                        locate, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
+                        locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
                         in ? (first ? t0 / s : k - 1.f) : k, !first, in ? k : segments.kLast,
                         in ? tet : lastInside, in ? v : segments.vLast, kEnd + 1.f, segments,
                         counters, acc);
@@ -397,10 +391,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
             // the run's last sample at the end.
             if (segments.iso && segments.inside) {
-                const auto locate = [&](Vec3f q, std::uint32_t from, float* b) {
-                    return scene.locator.locate<kNative>(q, from, b, counters.locate);
-                };
-                sampleAtBoundary<kNative, kLit, kSurf>(locate, scene.params, scene.locator.mesh,
+                sampleAtBoundary<kNative, kLit, kSurf>(locateAny, scene.params, scene.locator.mesh,
                                                        scene.tf, ray, lighting, t1 / s, true,
                                                        segments.kLast, lastInside, segments.vLast,
                                                        kEnd + 1.f, segments, counters, acc);
