@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
 """Reads a VTKHDF file with VTK's own vtkHDFReader (python3-vtk9) and prints what it holds as
-JSON: points, cell types, offsets (cells + 1), connectivity, and the point and cell arrays
-(components and values), for src/uvr/mesh/io/vtkhdf_test.cpp to compare with uvr's reader and
+JSON: points, cell types, offsets (cells + 1), connectivity, the point and cell arrays
+(components and values) and what VTK warned or complained of while reading ("messages"), for src/uvr/mesh/io/vtkhdf_test.cpp to compare with uvr's reader and
 writer. Exit status 77 when vtk or its HDF reader is missing.
 Usage: vtkhdf_oracle.py FILE
 """
@@ -10,6 +10,7 @@ import json
 import sys
 
 try:
+    from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
     from vtkmodules.vtkIOHDF import vtkHDFReader
     from vtkmodules.util.numpy_support import vtk_to_numpy
 except ImportError:
@@ -30,6 +31,8 @@ def arrays(data):
 
 
 def main():
+    log = vtkStringOutputWindow()
+    vtkOutputWindow.SetInstance(log)
     reader = vtkHDFReader()
     reader.SetFileName(sys.argv[1])
     reader.Update()
@@ -43,6 +46,7 @@ def main():
         "connectivity": vtk_to_numpy(cells.GetConnectivityArray()).astype(int).tolist(),
         "point_data": arrays(grid.GetPointData()),
         "cell_data": arrays(grid.GetCellData()),
+        "messages": log.GetOutput(),
     }
     json.dump(result, sys.stdout)
 

@@ -11,10 +11,16 @@ Writes, each as VTU (ascii, binary, appended) and legacy VTK (5.1 and 4.2, ASCII
                 wedges and six pyramids around a centre point (conforming: split diagonals go
                 through each square's smallest point index), plus an octahedron polyhedron with
                 a tetrahedron on one face.
-Point field 'f' = x + 2y - z, cell field 'id' = the cell's index. For mixed, also
-mixed_volumes.txt: VTK's volume of each cell (vtkCellSizeFilter), and
+  prisms.*      a regular pentagonal prism (VTK type 15) and, beside it, a regular hexagonal
+                prism (type 16) with a hexahedron on one of its square faces;
+  ghosts.*      cubes_hex with VTK's ghost arrays (vtkGhostType): cell 0 HIDDENCELL (32), cell 1
+                DUPLICATECELL (1), cell 2 EXTERIORCELL (16, shown by ParaView), point (N, N, N)
+                HIDDENPOINT (2, hides cell 26) and point 0 DUPLICATEPOINT (1, hides nothing).
+Point field 'f' = x + 2y - z, cell field 'id' = the cell's index. For mixed and prisms, also
+NAME_volumes.txt: VTK's volume of each cell (vtkCellSizeFilter), and
 mixed_pieces.vtu: three <Piece>s. Needs python3-vtk9.
 """
+import math
 import os
 import sys
 
@@ -118,6 +124,68 @@ def write_all(ug, out, name):
             assert w.Write() == 1
 
 
+def write_volumes(ug, path):
+    sizes = vtk.vtkCellSizeFilter()
+    sizes.SetInputData(ug)
+    sizes.ComputeVolumeOn()
+    sizes.Update()
+    vol = sizes.GetOutput().GetCellData().GetArray("Volume")
+    with open(path, "w") as fh:
+        for c in range(vol.GetNumberOfTuples()):
+            fh.write(f"{vol.GetValue(c):.17g}\n")
+
+
+def prisms_mesh():
+    """Regular pentagonal and hexagonal prisms (bases in z = 0 and z = 1, VTK's numbering: the
+    bottom base counter-clockwise seen from above, the top above it), a hexahedron on one of the
+    hexagonal prism's square faces."""
+    pts = vtk.vtkPoints()
+    ug = vtk.vtkUnstructuredGrid()
+    ug.SetPoints(pts)
+
+    def prism(cx, n, ctype):
+        ids = []
+        for z in (0.0, 1.0):
+            for i in range(n):
+                a = 2 * math.pi * i / n
+                ids.append(pts.InsertNextPoint(cx + math.cos(a), math.sin(a), z))
+        idl = vtk.vtkIdList()
+        for v in ids:
+            idl.InsertNextId(v)
+        ug.InsertNextCell(ctype, idl)
+        return ids
+
+    prism(0.0, 5, vtk.VTK_PENTAGONAL_PRISM)
+    h = prism(3.0, 6, vtk.VTK_HEXAGONAL_PRISM)
+    # The hexahedron on the square face (0, 1, 7, 6) of the hexagonal prism, outward along the
+    # face's normal: VTK hexahedron order, bottom (on the face) then top.
+    b = [h[0], h[1], h[7], h[6]]
+    p0 = [pts.GetPoint(i) for i in b]
+    mid = [sum(q[a] for q in p0) / 4 for a in range(3)]
+    nx, ny = mid[0] - 3.0, mid[1]
+    norm = math.hypot(nx, ny)
+    top = [pts.InsertNextPoint(q[0] + nx / norm, q[1] + ny / norm, q[2]) for q in p0]
+    idl = vtk.vtkIdList()
+    for v in b + top:
+        idl.InsertNextId(v)
+    ug.InsertNextCell(vtk.VTK_HEXAHEDRON, idl)
+    return ug
+
+
+def ghost_arrays(ug):
+    cells = vtk.vtkUnsignedCharArray()
+    cells.SetName("vtkGhostType")
+    for c in range(ug.GetNumberOfCells()):
+        cells.InsertNextValue({0: 32, 1: 1, 2: 16}.get(c, 0))
+    ug.GetCellData().AddArray(cells)
+    points = vtk.vtkUnsignedCharArray()
+    points.SetName("vtkGhostType")
+    last = ug.GetNumberOfPoints() - 1  # (N, N, N): numbered x fastest
+    for i in range(ug.GetNumberOfPoints()):
+        points.InsertNextValue(2 if i == last else 1 if i == 0 else 0)
+    ug.GetPointData().AddArray(points)
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -145,14 +213,17 @@ def main():
     w.SetNumberOfPieces(3)
     w.SetDataModeToBinary()
     assert w.Write() == 1
-    sizes = vtk.vtkCellSizeFilter()
-    sizes.SetInputData(ug)
-    sizes.ComputeVolumeOn()
-    sizes.Update()
-    vol = sizes.GetOutput().GetCellData().GetArray("Volume")
-    with open(os.path.join(out, "mixed_volumes.txt"), "w") as fh:
-        for c in range(vol.GetNumberOfTuples()):
-            fh.write(f"{vol.GetValue(c):.17g}\n")
+    write_volumes(ug, os.path.join(out, "mixed_volumes.txt"))
+
+    ug = prisms_mesh()
+    add_fields(ug)
+    write_all(ug, out, "prisms")
+    write_volumes(ug, os.path.join(out, "prisms_volumes.txt"))
+
+    ug = grid_mesh(lambda i, j, k: "hex")[0]
+    add_fields(ug)
+    ghost_arrays(ug)
+    write_all(ug, out, "ghosts")
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ moved by dx and 'cellid' = base + c.
 
 Files: mixed.vtkhdf (1.0, one partition, float64 points), parts.vtkhdf (1.0, two partitions:
 dx 0 and 10, cellid bases 0 and 100), parts_flat.vtkhdf (a partition of one triangle at z = 5,
-then the mixed one), temporal_shared.vtkhdf (2.0, three steps sharing one
+then the mixed one), typeless_1_0.vtkhdf (mixed.vtkhdf without the Type attribute), temporal_shared.vtkhdf (2.0, three steps sharing one
 geometry; temp + 10 s and cellid + 100 s per step), temporal_changing.vtkhdf (2.0, steps 0 and 1
 share the mixed partition, step 2 holds two partitions at dx 10 and 20), and bad_*.vtkhdf /
 bad_*.hdf: one defect each (the test names the message it expects).
@@ -169,6 +169,15 @@ def main():
     write_static(p("mixed.vtkhdf"), [mixed])
     write_static(p("parts.vtkhdf"), [mixed, shifted], points_dtype=np.float32)
     write_static(p("parts_flat.vtkhdf"), [flat(), mixed])
+    # Version 1.0 without Type, as VTK 9.1-era writers left it (VTK's can_0.hdf): VTK 9.1 reads
+    # it as an UnstructuredGrid; with a WholeExtent it would be ImageData.
+    write_static(p("typeless_1_0.vtkhdf"), [mixed], edit=lambda root: root.attrs.__delitem__("Type"))
+
+    def typeless_image(root):
+        root.attrs.__delitem__("Type")
+        root.attrs.create("WholeExtent", np.array([0, 2, 0, 2, 0, 2], dtype=np.int64))
+
+    write_static(p("bad_typeless_image.vtkhdf"), [mixed], edit=typeless_image)
 
     # Three steps on one geometry: temp + 10 s, cellid + 100 s.
     def fields(s, row, steps, geo):

@@ -19,17 +19,49 @@ constexpr int kPolyhedronType = 42;
 /// (longest edge)^3 comes from a degenerate face triangle and is left out (tetrahedralize's rule).
 constexpr double kZeroVolumeRelative = 1e-7;
 
-std::string cellLabel(std::uint64_t c) {
-    return "cell " + std::to_string(c) + " (polyhedron)";
+constexpr int kPentagonalPrismType = 15, kHexagonalPrismType = 16;
+
+/// Sides of the bases of a VTK pentagonal (15) or hexagonal (16) prism; 0 for other types.
+int prismSides(std::int32_t type) {
+    return type == kPentagonalPrismType ? 5 : type == kHexagonalPrismType ? 6 : 0;
 }
+
+std::string cellLabel(std::uint64_t c, std::int32_t type = kPolyhedronType) {
+    const char* name = type == kPentagonalPrismType  ? "pentagonal prism"
+                       : type == kHexagonalPrismType ? "hexagonal prism"
+                                                     : "polyhedron";
+    return "cell " + std::to_string(c) + " (" + name + ")";
+}
+
+/// The face stream of a prism whose bases have n sides, numbered as VTK's vtkPentagonalPrism and
+/// vtkHexagonalPrism number them (the bottom base 0..n-1, the top n..2n-1 above it): the bottom
+/// wound n-1, ..., 0, the top n, ..., 2n-1, the sides (i, i+1, n+i+1, n+i): one winding
+/// throughout, as decomposePolyhedron needs.
+void prismFaceStream(const std::int64_t* ids, int n, std::vector<std::int64_t>& out) {
+    out.assign({n + 2, n});
+    for (int i = n - 1; i >= 0; --i) out.push_back(ids[i]);
+    out.push_back(n);
+    for (int i = 0; i < n; ++i) out.push_back(ids[n + i]);
+    for (int i = 0; i < n; ++i) {
+        const int j = (i + 1) % n;
+        out.insert(out.end(), {4, ids[i], ids[j], ids[n + j], ids[n + i]});
+    }
+}
+
+/// VTK's ghost flags (vtkDataSetAttributes): cells flagged DUPLICATECELL (owned by another
+/// piece) or HIDDENCELL (blanked), and cells using a point flagged HIDDENPOINT, are not part of
+/// what ParaView shows.
+constexpr unsigned kDuplicateCell = 1u, kHiddenCell = 32u, kHiddenPoint = 2u;
+constexpr const char* kGhostArray = "vtkGhostType";
 
 /// Checks one polyhedron's face stream [nFaces, n0, ids..., n1, ids...] and returns its number
 /// of face triangles (sum of n_i - 2); throws Error(Parse) for a malformed stream and
 /// Error(Validation) for a point index outside [0, pointCount).
 std::uint64_t checkFaceStream(std::span<const std::int64_t> s, std::uint64_t c,
-                              std::uint64_t pointCount, const std::string& file) {
+                              std::uint64_t pointCount, const std::string& file,
+                              std::int32_t type = kPolyhedronType) {
     auto fail = [&](ErrorKind kind, const std::string& what) {
-        throwError(kind, file, cellLabel(c) + ": " + what);
+        throwError(kind, file, cellLabel(c, type) + ": " + what);
     };
     if (s.empty()) fail(ErrorKind::Parse, "empty face stream, expected a face count first");
     const std::int64_t faces = s[0];
@@ -170,8 +202,8 @@ void decomposePolyhedron(std::span<const std::int64_t> s, std::uint64_t c, Mesh&
 
 }  // namespace
 
-void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& file,
-                    LoadBudget* budget) {
+std::vector<std::uint64_t> appendVtkCells(const VtkCellArrays& cells, Mesh& mesh,
+                                          const std::string& file, LoadBudget* budget) {
     const std::uint64_t n = cells.types.size();
     if (cells.offsets.size() != n + 1)
         throwError(ErrorKind::Parse, file,
@@ -185,8 +217,18 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
                        " entries, expected " + std::to_string(n + 1) + " for " + std::to_string(n) +
                        " cells");
     const std::uint64_t pointCount = mesh.pointCount();
-    // The face stream of polyhedron c (its node list in legacy files).
+    // The face stream of polyhedron or prism c (a polyhedron's node list in legacy files).
+    std::vector<std::int64_t> prismStream;
     auto faceStream = [&](std::uint64_t c) -> std::span<const std::int64_t> {
+        if (const int sides = prismSides(cells.types[c])) {
+            const std::int64_t begin = cells.offsets[c], nodes = cells.offsets[c + 1] - begin;
+            if (nodes < 2 * sides)
+                throwError(ErrorKind::Parse, file,
+                           cellLabel(c, cells.types[c]) + " lists " + std::to_string(nodes) +
+                               " nodes, expected " + std::to_string(2 * sides));
+            prismFaceStream(cells.connectivity.data() + begin, sides, prismStream);
+            return prismStream;
+        }
         if (!separateFaces)
             return {cells.connectivity.data() + cells.offsets[c],
                     cells.connectivity.data() + cells.offsets[c + 1]};
@@ -209,6 +251,11 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
                        "cell " + std::to_string(c) + ": node range [" + std::to_string(begin) +
                            ", " + std::to_string(end) + ") outside the connectivity array of " +
                            std::to_string(cells.connectivity.size()) + " entries");
+        if (prismSides(cells.types[c])) {
+            polyTriangles += checkFaceStream(faceStream(c), c, pointCount, file, cells.types[c]);
+            ++polyhedra;
+            continue;
+        }
         if (cells.types[c] != kPolyhedronType) continue;
         if (cells.polyhedronFaces == PolyhedronFaces::None)
             throwError(ErrorKind::Unsupported, file,
@@ -242,8 +289,48 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
     PolyhedraStats poly;
     std::uint32_t ids[8];
     const std::uint64_t firstNewCell = mesh.cellCount();
+    // VTK's ghost flags: this batch's cell flags and the points' (values checked by the reader
+    // to be one per cell and point; flags are small integers, exact in float).
+    const Field* cellGhosts = nullptr;
+    const Field* pointGhosts = nullptr;
+    for (const Field& f : mesh.fields) {
+        if (f.name != kGhostArray || f.components != 1) continue;
+        if (f.association == Association::Cell && f.values.size() == firstNewCell + n)
+            cellGhosts = &f;
+        if (f.association == Association::Point && f.values.size() == pointCount) pointGhosts = &f;
+    }
+    const auto flags = [](float v) { return v >= 0.f && v < 256.f ? unsigned(v) : 0u; };
+    std::uint64_t duplicates = 0, hidden = 0, prisms = 0;
     for (std::uint64_t c = 0; c < n; ++c) {
         const std::int64_t begin = cells.offsets[c], end = cells.offsets[c + 1];
+        if (cellGhosts) {
+            const unsigned g = flags(cellGhosts->values[firstNewCell + c]);
+            if (g & kDuplicateCell) {
+                ++duplicates;
+                continue;
+            }
+            if (g & kHiddenCell) {
+                ++hidden;
+                continue;
+            }
+        }
+        if (pointGhosts) {
+            bool hiddenPoint = false;
+            for (std::int64_t k = begin; k < end && !hiddenPoint; ++k) {
+                const std::int64_t id = cells.connectivity[k];
+                hiddenPoint = id >= 0 && static_cast<std::uint64_t>(id) < pointCount &&
+                              (flags(pointGhosts->values[id]) & kHiddenPoint);
+            }
+            if (hiddenPoint && cells.types[c] != kPolyhedronType) {
+                ++hidden;
+                continue;
+            }
+        }
+        if (prismSides(cells.types[c])) {
+            decomposePolyhedron(faceStream(c), c, mesh, source, poly);
+            ++prisms;
+            continue;
+        }
         const VtkCellTypeInfo info = vtkCellTypeInfo(cells.types[c]);
         if (!info.known)
             throwError(ErrorKind::Parse, file,
@@ -294,6 +381,14 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
     for (const auto& [name, count] : dropped)
         mesh.notes.push_back("dropped " + std::to_string(count) + " non-volumetric " + name +
                              " cell(s)");
+    if (duplicates)
+        mesh.notes.push_back("left out " + std::to_string(duplicates) +
+                             " ghost cell(s) that vtkGhostType marks as duplicates of another "
+                             "piece's (DUPLICATECELL), as ParaView does");
+    if (hidden)
+        mesh.notes.push_back("left out " + std::to_string(hidden) +
+                             " cell(s) that vtkGhostType marks hidden (HIDDENCELL, or a "
+                             "HIDDENPOINT corner), as ParaView does");
     if (voxels)
         mesh.notes.push_back("read " + std::to_string(voxels) +
                              " voxel cell(s) as hexahedra (the same cells, corners reordered)");
@@ -303,12 +398,14 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
             " cell(s) to their corner nodes: their mid-edge and higher-order nodes are used by "
             "no cell, and fields are interpolated between the corners");
     if (poly.polyhedra) {
-        std::string note = std::to_string(poly.polyhedra) + " polyhedra decomposed into " +
-                           std::to_string(poly.tets) +
-                           " tetrahedra around their vertex centroids (" +
-                           std::to_string(poly.polyhedra) +
-                           " points added; point fields there are the mean of the vertex "
-                           "values; docs/METHOD.md, Polyhedra)";
+        std::string note =
+            std::to_string(poly.polyhedra) + " polyhedra" +
+            (prisms ? " (" + std::to_string(prisms) + " of them pentagonal or hexagonal prisms)"
+                    : std::string()) +
+            " decomposed into " + std::to_string(poly.tets) +
+            " tetrahedra around their vertex centroids (" + std::to_string(poly.polyhedra) +
+            " points added; point fields there are the mean of the vertex "
+            "values; docs/METHOD.md, Polyhedra)";
         if (poly.degenerate)
             note +=
                 "; " + std::to_string(poly.degenerate) + " degenerate face triangle(s) left out";
@@ -354,6 +451,7 @@ void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& f
             f.values = std::move(values);
         }
     }
+    return source;
 }
 
 }  // namespace uvr

@@ -31,15 +31,19 @@ struct VtkCellArrays {
 };
 
 /// Converts VTK cells into mesh cells: quadratic and Lagrange 3D cells keep their corner nodes,
-/// voxels become hexahedra, 0D-2D cells are dropped (with a note in mesh.notes), polyhedra are
-/// decomposed into tetrahedra around a new point at their vertex centroid (decomposePolyhedron's
-/// rule; point fields get the mean of the polyhedron's vertex values there, a note says how many),
-/// and unknown types, malformed face streams, short cells and point indices outside
-/// [0, mesh.pointCount()) throw Error(Parse/Validation/Unsupported) naming the file and cell
-/// index. Cell fields in mesh.fields (one tuple per source cell) are filtered to the kept cells
-/// and repeated for a polyhedron's tetrahedra. mesh.points must already be set; the growth from
-/// polyhedra is charged to budget when one is given.
-void appendVtkCells(const VtkCellArrays& cells, Mesh& mesh, const std::string& file,
-                    LoadBudget* budget = nullptr);
+/// voxels become hexahedra, 0D-2D cells are dropped (with a note in mesh.notes), polyhedra and
+/// pentagonal and hexagonal prisms (types 15, 16) are decomposed into tetrahedra around a new
+/// point at their vertex centroid (decomposePolyhedron's rule; point fields get the mean of the
+/// cell's vertex values there, a note says how many), cells VTK's ghost array (`vtkGhostType`,
+/// cell and point data in mesh.fields) marks as another piece's duplicates or hidden are left
+/// out as ParaView leaves them out (a note says how many), and unknown types, malformed face
+/// streams, short cells and point indices outside [0, mesh.pointCount()) throw
+/// Error(Parse/Validation/Unsupported) naming the file and cell index. Cell fields in
+/// mesh.fields (one tuple per source cell) are filtered to the kept cells and repeated for a
+/// decomposed cell's tetrahedra. mesh.points must already be set; the growth from polyhedra is
+/// charged to budget when one is given. Returns, per cell added, the index of its cell in
+/// `cells`.
+std::vector<std::uint64_t> appendVtkCells(const VtkCellArrays& cells, Mesh& mesh,
+                                          const std::string& file, LoadBudget* budget = nullptr);
 
 }  // namespace uvr

@@ -134,6 +134,83 @@ TEST(VtkPolyhedra, MixedMeshMatchesVtkVolumesFieldsAndNeighbours) {
     }
 }
 
+TEST(VtkPolyhedra, PentagonalAndHexagonalPrismsMatchVtkVolumes) {
+    // VTK types 15 and 16, as VTK and ParaView read them (issue 35): decomposed as polyhedra.
+    REQUIRE_POLY_DIR();
+    std::vector<double> vtkVolumes;
+    {
+        std::ifstream in(polyDir() + "/prisms_volumes.txt");
+        for (double v; in >> v;) vtkVolumes.push_back(v);
+    }
+    ASSERT_EQ(vtkVolumes.size(), 3u);  // the two prisms and the hexahedron on one
+    for (const std::string& variant : kVariants) {
+        SCOPED_TRACE(variant);
+        const std::string path = polyDir() + "/prisms_" + variant;
+        const Mesh m = readMesh(path);
+        // The pentagonal prism: 2 x 3 + 5 x 2 face triangles, the hexagonal 2 x 4 + 6 x 2.
+        ASSERT_EQ(m.cellCount(), 16u + 20u + 1u);
+        ASSERT_EQ(m.pointCount(), 10u + 12u + 4u + 2u);
+        EXPECT_THAT(m.notes, ::testing::Contains(
+                                 HasSubstr("2 polyhedra (2 of them pentagonal or hexagonal prisms) "
+                                           "decomposed into 36 tetrahedra")));
+        const ValidationReport report = validateMesh(m, path);
+        EXPECT_TRUE(report.findings().empty()) << ::testing::PrintToString(report.findings());
+        const Field* id = m.findField("id", Association::Cell);
+        ASSERT_NE(id, nullptr);
+        ASSERT_EQ(id->values.size(), m.cellCount());
+        std::vector<double> volume(vtkVolumes.size(), 0.0);
+        for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+            const std::size_t source = static_cast<std::size_t>(id->values[c]);
+            ASSERT_LT(source, volume.size());
+            if (m.cellTypes[c] == CellType::Tetra) {
+                const double v = tetVolume(m, c);
+                EXPECT_GT(v, 0.0) << "cell " << c;
+                volume[source] += v;
+            } else {
+                volume[source] += vtkVolumes[source];
+            }
+        }
+        // (ASCII files hold 6 digits.)
+        for (std::size_t c = 0; c < volume.size(); ++c)
+            EXPECT_NEAR(volume[c], vtkVolumes[c], 1e-5) << "source cell " << c;
+        const Field* f = m.findField("f", Association::Point);
+        ASSERT_NE(f, nullptr);
+        for (std::uint64_t p = 0; p < m.pointCount(); ++p) {
+            const Vec3f q = m.points[p];
+            EXPECT_NEAR(f->values[p], q.x + 2.f * q.y - q.z, 1e-4f) << "point " << p;
+        }
+        // Conforming where the hexahedron meets the hexagonal prism: only the shared square is
+        // inside (16 + 20 face triangles of the prisms, 12 of the hexahedron, 2 + 2 shared).
+        EXPECT_EQ(boundaryFaces(m), 16u + 20u + 12u - 4u);
+    }
+}
+
+TEST(VtkGhosts, HiddenAndDuplicateCellsAreLeftOutAsParaViewDoes) {
+    // vtkGhostType (issue 35): ParaView leaves out cells marked DUPLICATECELL (another piece's)
+    // or HIDDENCELL, and cells with a HIDDENPOINT corner; EXTERIORCELL and DUPLICATEPOINT hide
+    // nothing.
+    REQUIRE_POLY_DIR();
+    for (const std::string& variant : kVariants) {
+        SCOPED_TRACE(variant);
+        const Mesh m = readMesh(polyDir() + "/ghosts_" + variant);
+        ASSERT_EQ(m.cellCount(), 24u);
+        const Field* id = m.findField("id", Association::Cell);
+        ASSERT_NE(id, nullptr);
+        ASSERT_EQ(id->values.size(), 24u);
+        for (std::uint64_t c = 0; c < 24; ++c) EXPECT_EQ(id->values[c], float(c + 2)) << c;
+        EXPECT_THAT(m.notes,
+                    ::testing::Contains(HasSubstr(
+                        "left out 1 ghost cell(s) that vtkGhostType marks as duplicates")));
+        EXPECT_THAT(m.notes, ::testing::Contains(
+                                 HasSubstr("left out 2 cell(s) that vtkGhostType marks hidden")));
+        // The corners only the left-out cells used: (0, 0, 0), (1, 0, 0) and (3, 3, 3).
+        EXPECT_THAT(validateMesh(m, variant).findings(),
+                    ::testing::ElementsAre(HasSubstr("3 point(s) used by no cell")));
+    }
+    // The same cells without the ghost arrays: all 27.
+    EXPECT_EQ(readMesh(polyDir() + "/cubes_hex_ascii.vtu").cellCount(), 27u);
+}
+
 TEST(VtkPolyhedra, PiecesOffsetTheFaceStreamsPointIndices) {
     REQUIRE_POLY_DIR();
     // Each Piece holds the whole mixed mesh: its face streams must index its own points (the
@@ -318,6 +395,26 @@ TEST(VtkPolyhedra, MalformedLegacyFaceStreamsAreRefused) {
         const Error e = testing::catchError([&] { readMesh(path); });
         EXPECT_THAT(e.what(), HasSubstr(c.message)) << c.cells;
         EXPECT_THAT(e.what(), HasSubstr("bad" + std::to_string(k) + ".vtk")) << c.cells;
+    }
+}
+
+TEST(VtkPolyhedra, ShortOrOutOfRangePrismsAreRefused) {
+    const std::string dir = testing::scratchDir();
+    struct Case {
+        std::string ids, type, message;
+    };
+    const std::vector<Case> cases = {
+        {"0 1 2 3 4 5 6 7", "15", "cell 0 (pentagonal prism) lists 8 nodes, expected 10"},
+        {"0 1 2 3 4 5 6 7 0 1", "16", "cell 0 (hexagonal prism) lists 10 nodes, expected 12"},
+        {"0 1 2 3 4 5 6 7 0 9", "15", "cell 0 (pentagonal prism): face 1 of 7: point index 9"},
+    };
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+        const Case& c = cases[k];
+        const std::string path = testing::writeFile(dir + "/prism" + std::to_string(k) + ".vtk",
+                                                    legacyCube(cellsRecord(c.ids), 1, c.type));
+        const Error e = testing::catchError([&] { readMesh(path); });
+        EXPECT_THAT(e.what(), HasSubstr(c.message)) << k;
+        EXPECT_THAT(e.what(), HasSubstr("prism" + std::to_string(k) + ".vtk")) << k;
     }
 }
 

@@ -172,7 +172,12 @@ public:
                        "/VTKHDF: Version " + std::to_string(version[0]) + "." +
                            std::to_string(version[1]) +
                            " is not supported: expected major version 1 or 2");
-        const std::string type = stringAttribute(root_.get(), "/VTKHDF", "Type");
+        // Version 1.0 files of VTK 9.1's era may lack Type: VTK 9.1 reads one with a
+        // WholeExtent as ImageData and any other as an UnstructuredGrid, and so does uvr.
+        const bool typeless = version[0] == 1 && H5Aexists(root_.get(), "Type") <= 0;
+        const std::string type = !typeless ? stringAttribute(root_.get(), "/VTKHDF", "Type")
+                                 : H5Aexists(root_.get(), "WholeExtent") > 0 ? "ImageData"
+                                                                             : "UnstructuredGrid";
         if (type != "UnstructuredGrid")
             throwError(ErrorKind::Unsupported, path,
                        "/VTKHDF: Type '" + type +
@@ -603,17 +608,20 @@ private:
         return fields;
     }
 
-    /// Keeps the tuples of the listed cells, in order.
+    /// Keeps the tuples of the listed cells, in order (a cell listed twice, once per
+    /// tetrahedron of a decomposed one, twice).
     static void keepCells(Field& f, const std::vector<std::uint64_t>& kept) {
         const std::size_t comps = static_cast<std::size_t>(f.components);
+        std::vector<float> values(kept.size() * comps);
         for (std::size_t k = 0; k < kept.size(); ++k)
             for (std::size_t c = 0; c < comps; ++c)
-                f.values[k * comps + c] = f.values[kept[k] * comps + c];
-        f.values.resize(kept.size() * comps);
+                values[k * comps + c] = f.values[kept[k] * comps + c];
+        f.values = std::move(values);
     }
 
-    /// Partition p of step i as a mesh; kept receives the indices of the cells kept when some
-    /// (0D-2D cells) are dropped, else stays empty.
+    /// Partition p of step i as a mesh; kept receives the file's cell of each mesh cell when
+    /// they differ (0D-2D cells dropped, ghost cells left out, polyhedra decomposed), else stays
+    /// empty.
     Mesh readPartition(std::size_t i, std::size_t p, const Partition& part, LoadBudget& budget,
                        KeptCells& kept) const {
         const std::string what = label(i, p);
@@ -685,12 +693,10 @@ private:
         }
         // As in .vtu: corners of quadratic cells, voxels reordered, 0D-2D cells dropped (and
         // their cell-field tuples with them).
-        appendVtkCells(cells, piece, path() + ": " + what);
-        if (piece.cellCount() != cells.types.size()) {
-            kept.emplace();
-            for (std::uint64_t c = 0; c < cells.types.size(); ++c)
-                if (vtkCellTypeInfo(cells.types[c]).volumetric) kept->push_back(c);
-        }
+        std::vector<std::uint64_t> source = appendVtkCells(cells, piece, path() + ": " + what);
+        bool same = source.size() == cells.types.size();
+        for (std::size_t c = 0; same && c < source.size(); ++c) same = source[c] == c;
+        if (!same) kept = std::move(source);
         return piece;
     }
 

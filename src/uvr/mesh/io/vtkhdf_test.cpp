@@ -235,6 +235,15 @@ TEST(VtkHdf, TemporalStepWithNewGeometryIsReadWhole) {
     expectPartition(readMesh(caseFile("temporal_changing.vtkhdf")), 0, 0.f, 0.f, 0.f);
 }
 
+TEST(VtkHdf, Version1WithoutTypeIsAnUnstructuredGridAsVtk91ReadsIt) {
+    REQUIRE_CASES();
+    const Mesh typeless = readMesh(caseFile("typeless_1_0.vtkhdf"));
+    const Mesh typed = readMesh(caseFile("mixed.vtkhdf"));
+    EXPECT_EQ(typeless.cellCount(), typed.cellCount());
+    EXPECT_TRUE(testing::sameBytes(typeless.points, typed.points));
+    EXPECT_TRUE(testing::sameBytes(typeless.cellIndices, typed.cellIndices));
+}
+
 TEST(VtkHdf, RecognisesHdf5ByItsVtkhdfGroup) {
     REQUIRE_CASES();
     const std::string dir = testing::scratchDir();
@@ -261,6 +270,7 @@ TEST(VtkHdf, BadInputsGetClearErrors) {
         {"bad_no_vtkhdf.hdf", ErrorKind::Parse, {"without a /VTKHDF group"}},
         {"bad_type.vtkhdf", ErrorKind::Unsupported, {"Type 'PolyData'", "UnstructuredGrid"}},
         {"bad_version.vtkhdf", ErrorKind::Unsupported, {"Version 3.0", "major version 1 or 2"}},
+        {"bad_typeless_image.vtkhdf", ErrorKind::Unsupported, {"Type 'ImageData'"}},
         {"bad_missing_connectivity.vtkhdf",
          ErrorKind::Parse,
          {"/VTKHDF/Connectivity", "missing dataset"}},
@@ -416,6 +426,8 @@ TEST(VtkHdf, WrittenFilesReadByVtkHdfReader) {
     const nlohmann::json vtk = vtkRead(out, dir);
     if (vtk.is_null()) GTEST_SKIP() << "no vtk module in /usr/bin/python3";
     EXPECT_EQ(vtk["types"].size(), mesh.cellCount());  // only volumetric cells were written
+    // Version 1.0, which VTK 9.1 reads without a warning (2.2 made it warn; issue 35).
+    EXPECT_EQ(vtk["messages"].get<std::string>(), "");
     expectSameAsVtk(mesh, vtk);
     expectSameMesh(readVtkHdf(out), mesh);
 }

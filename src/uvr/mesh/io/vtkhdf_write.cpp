@@ -127,12 +127,14 @@ void writeVtkHdfFile(const Mesh& mesh, const std::string& path,
         if (progress) progress(0.5 * double(done) / double(std::max<std::uint64_t>(total, 1)));
     };
 
-    // The file, in memory: /VTKHDF with Version 2.2 and Type, one partition.
+    // The file, in memory: /VTKHDF with Version and Type, one partition. The oldest version
+    // that holds the data, so that older readers take it without a warning (VTK 9.1 reads 1.0):
+    // 1.0 for one step, 2.0 (Steps) for a series.
     std::optional<FormatLibraryLock> lock(std::in_place);
     Hdf5Writer w(path, total + (1u << 16));
     H5Handle root = w.group(w.file(), "VTKHDF");
     {
-        const std::int64_t version[2] = {2, 2};
+        const std::int64_t version[2] = {times ? 2 : 1, 0};
         const hsize_t two = 2;
         H5Handle space(H5Screate_simple(1, &two, nullptr), H5Sclose);
         H5Handle attr(
