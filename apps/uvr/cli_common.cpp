@@ -63,7 +63,8 @@ std::vector<float> parseFloats(const std::string& flag, const std::string& text,
 
 namespace {
 
-/// The long option `name` ("--max-step") of `app` or of one of its subcommands, or nullptr.
+/// The long option `name` ("--max-sample-distance") of `app` or of one of its subcommands, or
+/// nullptr.
 const CLI::Option* findFlag(const CLI::App& app, const std::string& name) {
     if (const CLI::Option* o = app.get_option_no_throw(name)) return o;
     for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))

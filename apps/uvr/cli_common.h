@@ -31,8 +31,9 @@ public:
     void setActivity(const std::string& file, const std::string& what) const;
     /// The one-line message for running out of memory during the current activity.
     std::string outOfMemoryMessage() const;
-    /// `message` in the CLI's spelling: each setting the library mentions ("`max_step`") as its
-    /// flag ("--max-step", or "--no-seed-grid" where only that exists), looked up in `app`.
+    /// `message` in the CLI's spelling: each setting the library mentions ("`max_sample_distance`")
+    /// as its flag ("--max-sample-distance", or "--no-seed-grid" where only that exists), looked up
+    /// in `app`.
     std::string spell(const std::string& message) const;
     /// An error's message in the CLI's spelling (a SettingError: "--quality 1.5: ...").
     std::string spell(const Error& error) const;

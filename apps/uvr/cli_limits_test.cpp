@@ -102,12 +102,14 @@ TEST(CliLimits, AbsurdStepIsRefusedWithTheEstimateAndAStepThatWorks) {
     const std::string dir = testing::scratchDir();
     const std::string cube = writeCube(dir + "/cube.vtk");
     expectOneLineError(
-        uvr("-q render " + cube + " -o out.png --size 64x64 --step 3e-6", dir),
-        {"--step 3e-06 would take up to 2.36e+09 samples (64x64 pixels x 5.77e+05 per "
+        uvr("-q render " + cube + " -o out.png --size 64x64 --sample-distance 3e-6", dir),
+        {"--sample-distance 3e-06 would take up to 2.36e+09 samples (64x64 pixels x 5.77e+05 per "
          "ray across the bounds' diagonal 1.73), more than the 100,000 samples per ray "
-         "allowed: use --step 1.8e-05 or larger (the default here is "});
+         "allowed: use --sample-distance 1.8e-05 or larger (the default here is "});
     EXPECT_FALSE(std::filesystem::exists(dir + "/out.png"));
-    EXPECT_EQ(uvr("-q render " + cube + " -o out.png --size 64x64 --step 1.8e-5", dir).code, 0);
+    EXPECT_EQ(
+        uvr("-q render " + cube + " -o out.png --size 64x64 --sample-distance 1.8e-5", dir).code,
+        0);
 }
 
 TEST(CliLimits, MaxMemoryBoundsTheWholeLoad) {

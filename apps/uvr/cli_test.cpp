@@ -58,8 +58,8 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
     for (const std::string& args : std::vector<std::string>{
              "render " + spx + " -o " + out + " --size 0x10",
              "render " + spx + " -o " + out + " --size 100000x100000",
-             "render " + spx + " -o " + out + " --step -1",
-             "render " + spx + " -o " + out + " --step nan",
+             "render " + spx + " -o " + out + " --sample-distance -1",
+             "render " + spx + " -o " + out + " --sample-distance nan",
              "render " + spx + " -o " + out + " --range 5,1",
              "render " + spx + " -o " + out + " --camera-position nan,0,0",
              "render " + spx + " -o " + out + " --field nosuch",
@@ -258,17 +258,18 @@ TEST(Cli, ExactMethodAgreesWithTheReferenceAtASixteenthOfItsStep) {
         " --size 96x96 --azimuth -30 --elevation 25 --opacity 0:0,0.3:0.6,0.35:0,0.7:0.8,1:0.2 ";
     const CliRun e = uvr("-q render " + post + " --method exact -o e.png" + view, dir);
     ASSERT_EQ(e.code, 0) << e.err;
-    const CliRun f =
-        uvr("-q render " + post + " --method reference --step 0.00587 -o f.png" + view, dir);
+    const CliRun f = uvr(
+        "-q render " + post + " --method reference --sample-distance 0.00587 -o f.png" + view, dir);
     ASSERT_EQ(f.code, 0) << f.err;
     const ImageComparison m =
         compareImages(toRgb8(readPng(dir + "/e.png")), toRgb8(readPng(dir + "/f.png")));
     EXPECT_GE(m.ssim, 0.999);
-    expectOneLineError(uvr("-q render " + post + " --method exact --max-step 1 -o x.png", dir),
-                       {"--max-step is not read by --method exact: it needs --method adaptive"},
-                       "exact with --max-step");
+    expectOneLineError(
+        uvr("-q render " + post + " --method exact --max-sample-distance 1 -o x.png", dir),
+        {"--max-sample-distance is not read by --method exact: it needs --method adaptive"},
+        "exact with --max-sample-distance");
     // 0 means nothing: refused, not taken as the default.
-    for (const char* flag : {"--step", "--opacity-unit", "--max-step"})
+    for (const char* flag : {"--sample-distance", "--opacity-unit", "--max-sample-distance"})
         expectOneLineError(uvr("-q render " + post + " " + flag + " 0 -o x.png", dir), {flag},
                            std::string(flag) + " 0");
 }
@@ -439,7 +440,8 @@ TEST(Cli, AdaptiveRenderWithHeatmapAndStats) {
     EXPECT_THAT(d.value("method_reason", ""),
                 HasSubstr("auto: exact (about 13.2 cells per ray, at most 32 on the CPU)"));
     EXPECT_FALSE(d.contains("partitions"));  // only what exact needs was prepared
-    for (const char* tuning : {"--quality 0.995", "--step 0.05", "--sampling point", "--no-skip"}) {
+    for (const char* tuning :
+         {"--quality 0.995", "--sample-distance 0.05", "--sampling point", "--no-skip"}) {
         const auto t = statsOf("spx.vtk", tuning);
         EXPECT_EQ(t.value("method", ""), "adaptive") << tuning;
         EXPECT_TRUE(t.contains("partitions")) << tuning;
@@ -650,8 +652,9 @@ TEST(Cli, FlagsThatWouldBeIgnoredOrMeanNothingAreRefused) {
                        "magnitude of a scalar");
     expectOneLineError(uvr(render + "--background 1,2", dir),
                        {"--background '1,2'", "three finite numbers r,g,b"}, "--background");
-    expectOneLineError(uvr(render + "--step 0", dir),
-                       {"--step 0: expected a positive finite number"}, "--step 0");
+    expectOneLineError(uvr(render + "--sample-distance 0", dir),
+                       {"--sample-distance 0: expected a positive finite number"},
+                       "--sample-distance 0");
     expectOneLineError(uvr(render + "--opacity-unit 0", dir),
                        {"--opacity-unit 0: expected a positive finite number"}, "--opacity-unit 0");
     // Flags the method ignores, named together with the method that reads them.

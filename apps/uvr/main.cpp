@@ -64,7 +64,8 @@ int main(int argc, char** argv) {
                      printable(cli::describeParseError(app, args, e)).c_str());
         return 2;
     } catch (const Error& e) {
-        // The library names settings in neutral words: here, by their flags (--max-step -2:
+        // The library names settings in neutral words: here, by their flags (--max-sample-distance
+        // -2:
         // ...). Messages quote names from files: escaped, they stay one line.
         std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.spell(e)).c_str());
         return e.kind() == ErrorKind::Internal ? 70 : 2;

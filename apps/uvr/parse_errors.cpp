@@ -38,7 +38,12 @@ const std::map<std::string, std::string>& aliases() {
         {"--resolution", "--size"},
         {"--image-size", "--size"},
         {"--camera-file", "--camera"},
-        {"--sample-distance", "--step"},
+        // The sample spacing was --step until issue 35: a time step is --step-index.
+        {"--step",
+         "--sample-distance for the sample spacing, or --step-index or --time for a "
+         "time step"},
+        {"--max-step", "--max-sample-distance"},
+        {"--sampledistance", "--sample-distance"},
         {"--unit-distance", "--opacity-unit"},
         {"--log-scale", "--log"},
         {"--use-log-scale", "--log"},

@@ -16,8 +16,8 @@ namespace uvr::cli {
 
 namespace {
 
-/// A finite number above 0, with a plain message ("--step: must be a positive number, not 0")
-/// instead of CLI11's range of all doubles.
+/// A finite number above 0, with a plain message ("--sample-distance: must be a positive number,
+/// not 0") instead of CLI11's range of all doubles.
 CLI::Validator positiveNumber() {
     return CLI::Validator(
         [](std::string& text) -> std::string {

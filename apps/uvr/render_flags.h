@@ -38,7 +38,7 @@ struct RenderFlags {
     bool parallel = false;               ///< --parallel: parallel projection
     std::optional<float> parallelScale;  ///< unset: the camera file's, else the reset camera's
     float azimuth = 0.f, elevation = 0.f;
-    /// The settings of the library's vocabulary (--method, --quality, --step, ...).
+    /// The settings of the library's vocabulary (--method, --quality, --sample-distance, ...).
     SettingFlags vocabulary;
     std::vector<std::string> clipPlanes;   ///< --clip-plane ox,oy,oz,nx,ny,nz (repeatable)
     std::string clipBox;                   ///< --clip-box x0,y0,z0,x1,y1,z1
@@ -95,8 +95,8 @@ struct RenderFlags {
     /// (the mesh file, when not empty, or a file the flags read) or another output.
     void checkFiles(const std::string& meshFile) const;
     /// The method the flags ask for: --method's, except that auto with settings that tune
-    /// sampling (tunesAdaptive: --quality 0.995, --step, --sampling point, --no-skip, ...) or a
-    /// partition flag (--leaf-cells, --no-seed-grid) is the adaptive method they tune.
+    /// sampling (tunesAdaptive: --quality 0.995, --sample-distance, --sampling point, --no-skip,
+    /// ...) or a partition flag (--leaf-cells, --no-seed-grid) is the adaptive method they tune.
     RenderMethod requestedMethod() const;
     /// Refuses (Error(Argument), one line) flags that --method's integrator would ignore: a
     /// setting it does not read (settingReadBy: --quality with --method reference, --sampling

@@ -14,9 +14,9 @@
 namespace uvr::cli {
 
 /// The library's settings vocabulary (settingsVocabulary) as flags: one option per setting,
-/// spelled as cliFlag ("--max-step", "--no-skip"), its help the setting's doc, its value parsed
-/// by the setting's type and checked by the library (applySetting), so that a setting added to
-/// the vocabulary is a flag of every command that registers these.
+/// spelled as cliFlag ("--max-sample-distance", "--no-skip"), its help the setting's doc, its value
+/// parsed by the setting's type and checked by the library (applySetting), so that a setting added
+/// to the vocabulary is a flag of every command that registers these.
 class SettingFlags {
 public:
     SettingFlags() = default;
@@ -37,7 +37,7 @@ public:
     /// Sets a value as if given (a command's own choice, e.g. bench's method).
     void set(std::string_view name, nlohmann::json value);
     /// Stores every given value into `settings`; a value the setting refuses throws SettingError
-    /// quoting it as given ("--step 0: expected a positive finite number").
+    /// quoting it as given ("--sample-distance 0: expected a positive finite number").
     void applyTo(RenderSettings& settings) const;
     /// The settings given whose values `method` does not read (settingReadBy).
     std::vector<const SettingDef*> ignoredBy(RenderMethod method) const;

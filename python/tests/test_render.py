@@ -131,7 +131,7 @@ def test_the_gil_is_released_while_rendering(data_dir):
     ticks = 0
 
     def work():
-        r.render(size=(256, 256), method="reference", step=0.02)
+        r.render(size=(256, 256), method="reference", sample_distance=0.02)
         done.set()
 
     thread = threading.Thread(target=work)
@@ -200,8 +200,8 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(quality=2.0)
     with pytest.raises(uvr.ArgumentError, match=r"^supersample=9: expected an integer in \[1, 8\]$"):
         r.render(supersample=9)
-    with pytest.raises(uvr.ArgumentError, match=r"^step=-1\.0: expected a positive finite number$"):
-        r.render(step=-1.0)
+    with pytest.raises(uvr.ArgumentError, match=r"^sample_distance=-1\.0: expected a positive finite number$"):
+        r.render(sample_distance=-1.0)
     with pytest.raises(uvr.ArgumentError, match=r"^skip='no': expected true or false$"):
         r.render(skip="no")
     with pytest.raises(uvr.ArgumentError, match="'qualty': not a setting; the settings are 'method'"):
@@ -304,7 +304,7 @@ def test_the_settings_vocabulary_is_the_librarys(data_dir):
     # numpy scalars are numbers; a value of another type is refused by name.
     r = uvr.Renderer(data_dir / "tetraMesh.vtk", device="cpu", methods=("adaptive",))
     img = r.render(size=(16, 16), method="adaptive", quality=np.float32(0.995),
-                   supersample=np.int64(2), step=None)
+                   supersample=np.int64(2), sample_distance=None)
     assert img.stats["quality"] == pytest.approx(0.995) and img.stats["supersample"] == 2
     with pytest.raises(uvr.ArgumentError, match=r"^power='\[2\]': expected a number in \[1, 64\]$"):
         r.render(power=[2])

@@ -56,7 +56,7 @@ def test_a_clip_plane_equals_the_mesh_cut_by_vtk(bluntfin, method):
     assert 0 < whole.GetNumberOfCells() < cut.GetNumberOfCells() < grid.GetNumberOfCells()
     # The same camera, range, opacity unit and step for all (the defaults follow the bounds).
     view = dict(size=SIZE, camera=full.camera(SIZE, 60, 20).zoom(2.5), method=method,
-                range=(0.19, 4.98), opacity="0:0,1:0.6", opacity_unit=0.5, step=0.05)
+                range=(0.19, 4.98), opacity="0:0,1:0.6", opacity_unit=0.5, sample_distance=0.05)
     clipped = full.render(clip_planes=[(origin, normal)], **view)
     by_vtk = uvr.Renderer(uvr.from_vtk(cut), field="density", device="cpu").render(**view)
     cells = uvr.Renderer(uvr.from_vtk(whole), field="density", device="cpu").render(**view)

@@ -14,10 +14,10 @@ namespace uvr {
 /// knows (respellMentions: the CLI's `--range`, Python's `log_scale` for `log`).
 
 /// An error about one setting's value (an Argument error unless said otherwise), in neutral words:
-/// the setting's name (as the settings vocabulary spells it: `quality`, `max_step`), the value as
-/// given and what was expected. what() reads "quality 1.5: expected a number in [0.5, 0.9999]"; a
-/// front end says it in its own spelling (spelledAs: the CLI's `--quality 1.5: ...`, Python's
-/// `quality=1.5: ...`).
+/// the setting's name (as the settings vocabulary spells it: `quality`, `max_sample_distance`), the
+/// value as given and what was expected. what() reads "quality 1.5: expected a number in [0.5,
+/// 0.9999]"; a front end says it in its own spelling (spelledAs: the CLI's `--quality 1.5: ...`,
+/// Python's `quality=1.5: ...`).
 class SettingError : public Error {
 public:
     SettingError(std::string setting, std::string value, std::string expected,

@@ -79,7 +79,7 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
                                {"bytes", prepared.seeds->bytes()},
                                {"build_seconds", prepared.seeds->buildSeconds}};
         j["tf_update_seconds"] = setup.tfUpdateSeconds;
-        j["max_step"] = reportNumber(setup.maxStep / frame.scale);
+        j["max_sample_distance"] = reportNumber(setup.maxStep / frame.scale);
         j["step_rule"] = stepRuleName(settings.stepRule);
         if (settings.stepRule == StepRule::ErrorBound) {
             j["quality"] = settings.quality;
@@ -150,7 +150,7 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     j["walk_steps"] = result.stats.walkSteps;
     j["bvh_queries"] = result.stats.bvhQueries;
     // Lengths and positions in the file's units (the mesh may render scaled and moved).
-    j["step"] = reportNumber(setup.params.step / frame.scale);
+    j["sample_distance"] = reportNumber(setup.params.step / frame.scale);
     j["opacity_unit"] = reportNumber(setup.params.opacityUnit / frame.scale);
     j["opacity_law"] = opacityLawName(settings.opacityLaw);
     j["range"] = {setup.rangeLo, setup.rangeHi};

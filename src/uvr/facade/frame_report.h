@@ -14,10 +14,10 @@ namespace uvr {
 ///
 /// Keys: field, field_association, device, threads, gpu (on the GPU), method (auto resolved),
 /// method_asked and method_reason (auto), sampling (not exact), partitions, seed_grids,
-/// tf_update_seconds, max_step, step_rule, quality and tolerance (error rule) or power (variance
-/// rule), skip, adaptive, partitions_visited and partitions_skipped (meshes with partitions),
-/// image, supersample, jitter (supersampled), rays, mesh, prepare_seconds, render_seconds,
-/// samples, mean_samples_per_pixel, mean_samples_per_ray, max_samples_per_pixel,
+/// tf_update_seconds, max_sample_distance, step_rule, quality and tolerance (error rule) or power
+/// (variance rule), skip, adaptive, partitions_visited and partitions_skipped (meshes with
+/// partitions), image, supersample, jitter (supersampled), rays, mesh, prepare_seconds,
+/// render_seconds, samples, mean_samples_per_pixel, mean_samples_per_ray, max_samples_per_pixel,
 /// samples_per_second, walk_steps, bvh_queries, step, opacity_unit, opacity_law, range,
 /// log_scale, tf_table_entries, camera, notes, empty_frame.
 nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& settings,

@@ -97,7 +97,7 @@ TEST(FrameReport, LengthsAndPositionsAreInTheFilesUnits) {
     const RenderResult ra = a.render(sa), rb = b.render(sb);
     EXPECT_EQ(ra.stats.samples, rb.stats.samples);
     const nlohmann::json ja = frameReport(a, sa, ra), jb = frameReport(b, sb, rb);
-    for (const char* key : {"step", "max_step", "opacity_unit"})
+    for (const char* key : {"sample_distance", "max_sample_distance", "opacity_unit"})
         EXPECT_FLOAT_EQ(jb[key].get<float>(), ja[key].get<float>() * k) << key;
     for (int i = 0; i < 3; ++i)
         EXPECT_NEAR(jb["camera"]["position"][i].get<double>(),

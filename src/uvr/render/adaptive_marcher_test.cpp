@@ -112,7 +112,8 @@ TEST_P(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
 
 TEST_P(PartitionIntegrator, ShadedFramesStepAtMostThreeS1UnlessTold) {
     // The error-bound rule does not see the normals turn: shaded frames default to s2 = 3 s1
-    // (kShadedMaxStepFactor), unshaded ones to 16 s1; a max_step given stands either way.
+    // (kShadedMaxStepFactor), unshaded ones to 16 s1; a max_sample_distance given stands either
+    // way.
     const PreparedMesh pm = jitteredGrid();
     RenderSettings s = baseSettings();
     s.method = RenderMethod::Partitions;

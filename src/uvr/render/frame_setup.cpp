@@ -126,7 +126,7 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
         std::max(diagonal / kMaxSamplesPerRay, diagonal * pixels / kMaxFrameSamples);
     const double scale = std::pow(10.0, std::floor(std::log10(least)) - 1.0);
     const double suggest = std::ceil(least / scale * 1.0001) * scale;
-    const std::string what = settings.step > 0.f ? "`step` " + formatG(step * unit, 3)
+    const std::string what = settings.step > 0.f ? "`sample_distance` " + formatG(step * unit, 3)
                                                  : "the default step " + formatG(step * unit, 3) +
                                                        " (from the mean cell size)";
     throwError(ErrorKind::Argument, "",
@@ -140,7 +140,7 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
                    formatG(diagonal, 3) + "), more than the " +
                    (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
                                                         : "10^12 samples per frame") +
-                   " allowed: use `step` " + formatG(suggest, 3) + " or larger" +
+                   " allowed: use `sample_distance` " + formatG(suggest, 3) + " or larger" +
                    (settings.step > 0.f
                         ? " (the default here is " + formatG(defaultStep(mesh.tets) * unit, 3) + ")"
                         : std::string()));
@@ -206,7 +206,17 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                                    formatG(bounds.diagonal() / frame.scale, 3) + " across)");
         return static_cast<float>(v);
     };
-    f.params.step = settings.step > 0.f ? toLocal(settings.step, "step") : defaultStep(mesh.tets);
+    f.params.step =
+        settings.step > 0.f ? toLocal(settings.step, "sample_distance") : defaultStep(mesh.tets);
+    if (settings.step > 0.f && !empty) {
+        const double across = bounds.diagonal() / f.params.step;
+        if (across < kFewSamplesAcross)
+            f.notes.push_back("`sample_distance` " + formatG(settings.step, 3) + " takes " +
+                              formatG(across, 2) + " samples across the mesh (its diagonal is " +
+                              formatG(bounds.diagonal() / frame.scale, 3) +
+                              "): the image is coarse; the default here is " +
+                              formatG(defaultStep(mesh.tets) / frame.scale, 3));
+    }
     f.params.opacityUnit = settings.opacityUnit > 0.f
                                ? toLocal(settings.opacityUnit, "opacity_unit")
                                : defaultOpacityUnit(bounds, mesh.sourceCells);
@@ -225,12 +235,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     const Lighting& light = settings.lighting;
     const bool turns = light.on && (light.diffuse > 0.f || light.specular > 0.f);
     const float defaultFactor = turns ? kShadedMaxStepFactor : kDefaultMaxStepFactor;
-    f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_step")
+    f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_sample_distance")
                                        : std::fmin(defaultFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
-        throw SettingError(
-            "max_step", formatG(f.maxStep / frame.scale, 3),
-            "below `step` " + formatG(f.params.step / frame.scale, 3) + " (s2 must be >= s1)");
+        throw SettingError("max_sample_distance", formatG(f.maxStep / frame.scale, 3),
+                           "below `sample_distance` " + formatG(f.params.step / frame.scale, 3) +
+                               " (s2 must be >= s1)");
     // The camera in rendering units (the reset camera is in them already), in double until it
     // is known to fit float.
     const Camera given = settings.camera ? *settings.camera : resetCamera(bounds, aspect);
@@ -246,7 +256,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     double nearDistance = 0.0;
     // The integrators count sample grid points k = t / s1 from the ray origin in float: at 2^24
     // and beyond, k + 1 == k and a ray would never end. Refuse a camera that many steps from the
-    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny --step).
+    // mesh's farthest corner (a camera far out with a narrow view angle, or a tiny sample
+    // distance).
     if (!empty) {
         // One pass over the bounds' corners: their depths along the view direction (parallel)
         // and their distances from the camera (perspective).
@@ -276,12 +287,12 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                        parallel ? "the mesh is " + formatG(steps, 3) + " steps of " +
                                       formatG(f.params.step / frame.scale, 3) +
                                       " deep along the view direction (at most 16 million): use "
-                                      "a larger `step`"
+                                      "a larger `sample_distance`"
                                 : "the camera is " + formatG(steps, 3) + " steps of " +
                                       formatG(f.params.step / frame.scale, 3) +
                                       " from the far side of the mesh (at most 16 million): move "
                                       "the camera closer (and widen `view_angle`) or use a "
-                                      "larger `step`");
+                                      "larger `sample_distance`");
     }
     f.camera = given;
     f.camera.position = Vec3f(float(position[0]), float(position[1]), float(position[2]));

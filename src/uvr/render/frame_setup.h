@@ -34,6 +34,10 @@ ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& set
 /// step takes 2 to 3 samples per cell, so this is a step 40 times finer than the default on a
 /// mesh of a billion cells; finer steps are far smaller than any cell and change nothing seen.
 inline constexpr double kMaxSamplesPerRay = 1e5;
+/// A sample distance that leaves fewer samples than this along the bounds' diagonal gets a note
+/// (the default leaves at least kMinSamplesPerDiagonal): the image is coarse (and users who
+/// wrote `--step 3` when this was --step meant time step 3).
+inline constexpr double kFewSamplesAcross = 16;
 /// Most samples a frame may take (pixels x samples per ray): about an hour for 16 CPU cores
 /// (2e7 samples per second each), minutes on a GPU.
 inline constexpr double kMaxFrameSamples = 1e12;

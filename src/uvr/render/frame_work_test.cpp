@@ -38,10 +38,11 @@ TEST(FrameWork, AbsurdStepsAreRefusedNamingAStepThatIsAccepted) {
     s.step = 1e-5f;  // 173,205 samples per ray
     Error e = testing::catchError([&] { (void)makeFrameSetup(mesh, s); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
-    EXPECT_NE(std::string(e.what()).find("`step` 1e-05 would take up to 4.43e+07 samples (16x16 "
-                                         "pixels x 1.73e+05 per ray across the bounds' diagonal "
-                                         "1.73), more than the 100,000 samples per ray allowed: "
-                                         "use `step` 1.8e-05 or larger (the default here is "),
+    EXPECT_NE(std::string(e.what()).find(
+                  "`sample_distance` 1e-05 would take up to 4.43e+07 samples (16x16 "
+                  "pixels x 1.73e+05 per ray across the bounds' diagonal "
+                  "1.73), more than the 100,000 samples per ray allowed: "
+                  "use `sample_distance` 1.8e-05 or larger (the default here is "),
               std::string::npos)
         << e.what();
     s.step = 1.8e-5f;
@@ -51,7 +52,7 @@ TEST(FrameWork, AbsurdStepsAreRefusedNamingAStepThatIsAccepted) {
     s.step = 4e-4f;
     e = testing::catchError([&] { (void)makeFrameSetup(mesh, s); });
     EXPECT_NE(std::string(e.what()).find("more than the 10^12 samples per frame allowed: use "
-                                         "`step` 0.00047 or larger"),
+                                         "`sample_distance` 0.00047 or larger"),
               std::string::npos)
         << e.what();
 }

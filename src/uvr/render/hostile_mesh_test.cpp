@@ -319,7 +319,8 @@ TEST_P(HostileMesh, CellsFromMicrometreToMegametreRenderTheExactImage) {
     // many steps away for a float grid count): a clear error, not an endless render.
     const Error e = testing::catchError([&] { (void)render(pm, s); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
-    EXPECT_NE(std::string(e.what()).find("a larger `step`"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a larger `sample_distance`"), std::string::npos)
+        << e.what();
 }
 
 TEST_P(HostileMesh, CameraInsideTheVolumeSeesItsPathToTheBoundary) {

@@ -469,8 +469,8 @@ TEST(ImageMetrics, SeamDetectorSeesAKnownPartitionSeamOnTheCylinder) {
     // showed it too until long steps ended at the mesh's boundary, issue 29.)
     const Rgb8Image exact = renderCylinder(dir, "exact", "--method exact");
     const Rgb8Image reference = renderCylinder(dir, "reference", "--method reference");
-    const Rgb8Image seam =
-        renderCylinder(dir, "variance", "--sampling point --step-rule variance --max-step 1");
+    const Rgb8Image seam = renderCylinder(
+        dir, "variance", "--sampling point --step-rule variance --max-sample-distance 1");
     const ImageComparison withSeam = compareImages(exact, seam);
     EXPECT_GE(withSeam.seamCount, 1);
     EXPECT_GE(withSeam.longestSeam, kSeamMinLength);

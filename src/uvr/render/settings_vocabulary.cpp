@@ -124,9 +124,9 @@ std::vector<SettingDef> makeVocabulary() {
     v.push_back(quality);
 
     SettingDef step =
-        setting("step", SettingType::Number,
-                "Sample spacing s1 in the file's units (default: half the cube root of the "
-                "mean tetrahedron volume)");
+        setting("sample_distance", SettingType::Number,
+                "Sample spacing s1 in the file's units, ParaView's Sample Distance (default: "
+                "half the cube root of the mean tetrahedron volume)");
     step.min = 0.0, step.max = kInf, step.minOpen = true, step.nullDefault = true;
     step.tunesAdaptive = true;
     step.get = [](const RenderSettings& s) { return lengthOrNull(s.step); };
@@ -134,7 +134,7 @@ std::vector<SettingDef> makeVocabulary() {
     v.push_back(step);
 
     SettingDef maxStep =
-        setting("max_step", SettingType::Number,
+        setting("max_sample_distance", SettingType::Number,
                 "Adaptive: the largest step s2 in the file's units (default: 16 s1; 3 s1 shaded)");
     maxStep.min = 0.0, maxStep.max = kInf, maxStep.minOpen = true, maxStep.nullDefault = true;
     maxStep.tunesAdaptive = true;

@@ -55,7 +55,8 @@ struct SettingDef {
     void (*set)(RenderSettings& s, const nlohmann::json& value) = nullptr;
 };
 
-/// Every setting of the vocabulary: method, sampling, step_rule, quality, step, max_step, power,
+/// Every setting of the vocabulary: method, sampling, step_rule, quality, sample_distance,
+/// max_sample_distance, power,
 /// opacity_unit, opacity_law, skip, adaptive, supersample, jitter, shade, normals, ambient,
 /// diffuse, specular, specular_power.
 const std::vector<SettingDef>& settingsVocabulary();
@@ -77,8 +78,8 @@ void applySetting(RenderSettings& settings, std::string_view name, const nlohman
 /// The default value of `def` (RenderSettings' own).
 nlohmann::json settingDefault(const SettingDef& def);
 
-/// The CLI's flag of a setting: "--" and the name with '-' for '_' ("--max-step"); a flag that
-/// is on by default is turned off by "--no-" and its name ("--no-skip").
+/// The CLI's flag of a setting: "--" and the name with '-' for '_' ("--max-sample-distance"); a
+/// flag that is on by default is turned off by "--no-" and its name ("--no-skip").
 std::string cliFlag(const SettingDef& def);
 
 /// True when `method` reads the setting (RenderMethod::Auto reads what any method reads).

@@ -56,8 +56,8 @@ TEST(SettingsVocabulary, EachSettingOnceWithItsDefaultFirstAndAccepted) {
     // The library's defaults, as every front end now shows them.
     EXPECT_EQ(settingDefault(settingNamed("method")), "auto");
     EXPECT_FLOAT_EQ(settingDefault(settingNamed("quality")).get<float>(), kDefaultQuality);
-    EXPECT_TRUE(settingDefault(settingNamed("step")).is_null());  // worked out per mesh
-    EXPECT_EQ(cliFlag(settingNamed("max_step")), "--max-step");
+    EXPECT_TRUE(settingDefault(settingNamed("sample_distance")).is_null());  // worked out per mesh
+    EXPECT_EQ(cliFlag(settingNamed("max_sample_distance")), "--max-sample-distance");
     EXPECT_EQ(cliFlag(settingNamed("skip")), "--no-skip");
     EXPECT_EQ(cliFlag(settingNamed("jitter")), "--jitter");
 }
@@ -74,8 +74,8 @@ TEST(SettingsVocabulary, AValueStoredIsTheValueReadBack) {
         EXPECT_NE(d.get(s), settingDefault(d)) << d.name;
     }
     RenderSettings s;
-    applySetting(s, "step", 0.5);
-    applySetting(s, "step", nullptr);  // back to the per-mesh default
+    applySetting(s, "sample_distance", 0.5);
+    applySetting(s, "sample_distance", nullptr);  // back to the per-mesh default
     EXPECT_EQ(s.step, 0.f);
 }
 
@@ -95,8 +95,10 @@ TEST(SettingsVocabulary, BadValuesNameTheSettingTheValueAndWhatWasExpected) {
     EXPECT_STREQ(refusal("quality", 1.5).what(), "quality 1.5: expected a number in [0.5, 0.9999]");
     EXPECT_STREQ(refusal("method", "fast").what(),
                  "method 'fast': expected 'auto', 'adaptive', 'reference' or 'exact'");
-    EXPECT_STREQ(refusal("step", 0).what(), "step 0: expected a positive finite number");
-    EXPECT_STREQ(refusal("step", -1).what(), "step -1: expected a positive finite number");
+    EXPECT_STREQ(refusal("sample_distance", 0).what(),
+                 "sample_distance 0: expected a positive finite number");
+    EXPECT_STREQ(refusal("sample_distance", -1).what(),
+                 "sample_distance -1: expected a positive finite number");
     EXPECT_STREQ(refusal("supersample", 9).what(), "supersample 9: expected an integer in [1, 8]");
     EXPECT_STREQ(refusal("supersample", 2.5).what(),
                  "supersample 2.5: expected an integer in [1, 8]");
@@ -104,16 +106,18 @@ TEST(SettingsVocabulary, BadValuesNameTheSettingTheValueAndWhatWasExpected) {
     EXPECT_STREQ(refusal("power", nullptr).what(), "power null: expected a number in [1, 64]");
     EXPECT_THAT(refusal("opacity_law", 3).what(),
                 HasSubstr("expected 'attenuation' or 'transmittance'"));
-    EXPECT_THAT(refusal("max_step", 1e39).what(), HasSubstr("expected a positive finite number"));
+    EXPECT_THAT(refusal("max_sample_distance", 1e39).what(),
+                HasSubstr("expected a positive finite number"));
     const SettingError unknown = refusal("qualty", 0.9);
     EXPECT_EQ(unknown.setting(), "setting");
     EXPECT_THAT(unknown.what(), HasSubstr("'qualty': not a setting; the settings are 'method'"));
     EXPECT_EQ(unknown.kind(), ErrorKind::Argument);
     // Each front end in its own spelling.
-    const SettingError e = refusal("max_step", -2);
+    const SettingError e = refusal("max_sample_distance", -2);
     EXPECT_EQ(e.spelledAs(cliFlag(settingNamed(e.setting())), " "),
-              "--max-step -2: expected a positive finite number");
-    EXPECT_EQ(e.spelledAs(e.setting(), "="), "max_step=-2: expected a positive finite number");
+              "--max-sample-distance -2: expected a positive finite number");
+    EXPECT_EQ(e.spelledAs(e.setting(), "="),
+              "max_sample_distance=-2: expected a positive finite number");
 }
 
 TEST(SettingsVocabulary, ValidateSettingsChecksEverySettingOfTheTable) {

@@ -69,8 +69,8 @@ struct ViewScene {
     std::vector<std::string> notes;   ///< validation findings and notes the page shows
     double loadSeconds = 0.0;         ///< reading the file
     std::optional<Vec3f> background;  ///< --background: snapshots composite over it
-    /// Flags of the command line that shape the image beyond the state (--step, --sampling, ...)
-    /// for the exported `uvr render` command, each a separate argument.
+    /// Flags of the command line that shape the image beyond the state (--sample-distance,
+    /// --sampling, ...) for the exported `uvr render` command, each a separate argument.
     std::vector<std::string> commandFlags;
 };
 

@@ -67,7 +67,7 @@ std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
     s.width = 64;
     s.height = 48;
     s.settings["opacity_unit"] = 0.5;
-    scene.commandFlags = {"--step", "0.01"};
+    scene.commandFlags = {"--sample-distance", "0.01"};
     o.port = 0;
     auto server = std::make_unique<ViewServer>(std::move(scene), o, std::move(log));
     server->start();
@@ -391,20 +391,20 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     const std::string cmd = ex["command"];
     EXPECT_THAT(cmd, HasSubstr("uvr render grid.vtk --tf uvr-tf.json --camera uvr-camera.pvcc "
                                "--range -2.5,2.5 --size 64x48 --method auto --opacity-unit 0.5 "
-                               "--step 0.01 -o uvr-view.png"));
+                               "--sample-distance 0.01 -o uvr-view.png"));
     // The adaptive method exports its quality; so does auto with a quality of its own (which
     // makes its frames adaptive).
     // The page's clip planes export as flags.
     c.send({{"type", "set"}, {"clip_planes", {{0.25, 0, 0, 1, 0, 0}}}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
-                HasSubstr("--clip-plane 0.25,0,0,1,0,0 --step 0.01"));
+                HasSubstr("--clip-plane 0.25,0,0,1,0,0 --sample-distance 0.01"));
     c.send({{"type", "set"}, {"clip_planes", Json::array()}});
     // So do its isosurfaces.
     c.send({{"type", "set"}, {"iso", {"0.5", "1,0.5,#00ff00"}}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
-                HasSubstr("--iso 0.5 --iso '1,0.5,#00ff00' --step 0.01"));
+                HasSubstr("--iso 0.5 --iso '1,0.5,#00ff00' --sample-distance 0.01"));
     c.send({{"type", "set"}, {"iso", Json::array()}});
     // The cut face exports with a clip plane, and not without one (the CLI refuses it then).
     c.send({{"type", "set"}, {"clip_surface", true}, {"clip_planes", {{0.25, 0, 0, 1, 0, 0}}}});
