@@ -160,6 +160,50 @@ TEST(CliAnimate, GenerateWritesATimeSeriesOfOneGeometry) {
     EXPECT_LT(std::filesystem::file_size(dir + "/t.vtkhdf"), 2 * oneStep);  // not 3 geometries
 }
 
+TEST(CliAnimate, ConvertWritesEveryTimeStepOrThePickedOne) {
+    // Issue 35: `convert run.pvd run.vtkhdf` wrote step 0 alone and exited 0.
+    const std::string dir = testing::scratchDir();
+    ASSERT_EQ(
+        uvr("-q generate box --cells 2000 --fields jet --steps 3 --dt 0.1 -o t.uvrm", dir).code, 0);
+    // The .pvd's times as written: the shortest text that reads back exactly.
+    EXPECT_NE(testing::readFile(dir + "/t.pvd").find("timestep=\"0.1\""), std::string::npos);
+    // Every step as a file a step and a .pvd.
+    const CliRun all = uvr("convert t.pvd c.vtu", dir);
+    ASSERT_EQ(all.code, 0) << all.err;
+    EXPECT_NE(all.err.find("3 time steps: converting them all"), std::string::npos) << all.err;
+    auto converted = openMeshSeries(dir + "/c.pvd");
+    ASSERT_EQ(converted->times(), (std::vector<double>{0.0, 0.1, 0.2}));
+    for (std::size_t k = 0; k < 3; ++k) {
+        char name[32];
+        std::snprintf(name, sizeof name, "/t_%04zu.uvrm", k);
+        EXPECT_EQ(converted->readStep(k).fields[0].values, readMesh(dir + name).fields[0].values)
+            << k;
+    }
+    // One step when asked.
+    ASSERT_EQ(uvr("-q convert t.pvd two.vtu --step-index 2", dir).code, 0);
+    EXPECT_EQ(readMesh(dir + "/two.vtu").fields[0].values,
+              readMesh(dir + "/t_0002.uvrm").fields[0].values);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/two.pvd"));
+    if (!vtkHdfSupported()) GTEST_SKIP() << "built without HDF5";
+    // One temporal .vtkhdf of the one geometry.
+    ASSERT_EQ(uvr("-q convert t.pvd t.vtkhdf", dir).code, 0);
+    auto hdf = openMeshSeries(dir + "/t.vtkhdf");
+    ASSERT_EQ(hdf->times(), (std::vector<double>{0.0, 0.1, 0.2}));
+    EXPECT_EQ(hdf->readStep(2).fields[0].values, readMesh(dir + "/t_0002.uvrm").fields[0].values);
+    // Steps of other geometries do not fit one .vtkhdf: refused, nothing written.
+    ASSERT_EQ(uvr("-q generate box --cells 900 --fields jet -o small.vtu", dir).code, 0);
+    testing::writeFile(dir + "/mixed.pvd",
+                       "<VTKFile type=\"Collection\"><Collection>\n"
+                       "<DataSet timestep=\"0\" file=\"t_0000.uvrm\"/>\n"
+                       "<DataSet timestep=\"1\" file=\"small.vtu\"/>\n"
+                       "</Collection></VTKFile>\n");
+    expectOneLineError(uvr("-q convert mixed.pvd m.vtkhdf", dir),
+                       {"time step 1 has other points or cells than step 0", ".pvd"});
+    EXPECT_FALSE(std::filesystem::exists(dir + "/m.vtkhdf"));
+    ASSERT_EQ(uvr("-q convert mixed.pvd m.uvrm", dir).code, 0);  // a file a step: fine
+    EXPECT_EQ(readMesh(dir + "/m_0001.uvrm").cellCount(), readMesh(dir + "/small.vtu").cellCount());
+}
+
 TEST(CliAnimate, BadStepsAndOutputsAreRefusedBeforeRendering) {
     const std::string dir = testing::scratchDir();
     writeSeries(dir);

@@ -135,6 +135,34 @@ void writeMeshWithProgress(const Mesh& mesh, const std::string& out, const Conte
 
 }  // namespace
 
+/// Writes a time series as one file a step, OUT's name with _0000, _0001, ... before its
+/// extension, and the ParaView .pvd beside them listing them (relative to its folder) at `times`;
+/// stepMesh(k) gives step k's mesh, valid until the next call.
+void writePvdSeries(const std::string& out, const std::vector<double>& times,
+                    const std::function<const Mesh&(std::size_t)>& stepMesh, const Context& ctx) {
+    namespace fs = std::filesystem;
+    const fs::path path(out);
+    const std::string stem = path.stem().string(), ext = path.extension().string();
+    std::string pvd =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+        "version=\"0.1\">\n  <Collection>\n";
+    for (std::size_t k = 0; k < times.size(); ++k) {
+        char name[32];
+        std::snprintf(name, sizeof name, "_%04zu", k);
+        const std::string file = stem + name + ext;
+        writeMeshWithProgress(stepMesh(k), (path.parent_path() / file).string(), ctx);
+        pvd += "    <DataSet timestep=\"" + formatExact(times[k]) + "\" part=\"0\" file=\"" + file +
+               "\"/>\n";
+    }
+    pvd += "  </Collection>\n</VTKFile>\n";
+    const std::string pvdPath = (path.parent_path() / (stem + ".pvd")).string();
+    OutputFile index(pvdPath);
+    index.write(pvd);
+    index.finish();
+    index.commit();
+    ctx.step("wrote " + pvdPath + " (" + std::to_string(times.size()) + " time steps)");
+}
+
 void addInfoCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "info",
@@ -319,7 +347,8 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "convert",
         "Convert a mesh between formats (any readable format to .uvrm, .vtu, legacy .vtk or "
-        ".vtkhdf)");
+        ".vtkhdf); of a file or series with time steps, every step (one temporal .vtkhdf, or "
+        "OUT_0000... and OUT.pvd) unless --time or --step-index picks one");
     auto in = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     auto compress = std::make_shared<std::string>();
@@ -330,7 +359,9 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
                     "Compression of a .vtu output: none, zlib (the default), lz4 (faster, larger) "
                     "or lzma (smaller, slower)")
         ->check(CLI::IsMember({"none", "zlib", "lz4", "lzma"}));
-    cmd->callback([in, out, compress, &ctx] {
+    auto steps = std::make_shared<StepFlags>();
+    steps->registerOn(*cmd);
+    cmd->callback([in, out, compress, steps, &ctx] {
         checkOutputsDistinct({{"the input mesh", *in}}, {{"OUT", *out}});
         resolveOutput(*out);
         MeshWriteOptions options;
@@ -339,8 +370,45 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
         if (*compress == "lz4") options.compressor = VtuCompressor::Lz4;
         if (*compress == "lzma") options.compressor = VtuCompressor::Lzma;
         checkMeshWritable(*out, options);  // before reading (minutes at 100M cells)
-        const Mesh mesh = loadMesh(*in, ctx);
-        writeMeshWithProgress(mesh, *out, ctx, options);
+        const std::unique_ptr<MeshSeries> series = openSeries(*in, ctx);
+        if (series->stepCount() == 1 || steps->time || steps->index) {
+            const Mesh mesh = loadMesh(*in, ctx, *steps);
+            return writeMeshWithProgress(mesh, *out, ctx, options);
+        }
+        // Every time step: one temporal .vtkhdf (one geometry), or a file a step and a .pvd.
+        const std::vector<double>& times = series->times();
+        ctx.step(*in + " has " + std::to_string(times.size()) +
+                 " time steps: converting them all (--step-index or --time picks one)");
+        Mesh mesh = loadMesh(*in, ctx, StepFlags{std::nullopt, 0});
+        if (fileExtension(*out) == ".vtkhdf") {
+            ctx.setActivity(*out, "writing the time series");
+            Progress write(ctx, "writing " + *out);
+            writeVtkHdfSeries(
+                mesh, times,
+                [&](std::size_t k) {
+                    if (k == 0) return mesh.fields;
+                    std::optional<std::vector<Field>> fields =
+                        series->readFieldsIfSameGeometry(k, mesh);
+                    if (!fields)
+                        throwError(ErrorKind::Argument, *in,
+                                   "time step " + std::to_string(k) +
+                                       " has other points or cells than step 0, and a .vtkhdf "
+                                       "series holds one geometry: give a .vtu, .vtk or .uvrm "
+                                       "OUT (a file a step and a .pvd), or pick a step with "
+                                       "--step-index or --time");
+                    return std::move(*fields);
+                },
+                *out, write.callback());
+            write.done("wrote " + *out + " (" + std::to_string(times.size()) + " time steps)");
+            return;
+        }
+        writePvdSeries(
+            *out, times,
+            [&](std::size_t k) -> const Mesh& {
+                if (k > 0) mesh = loadMesh(*in, ctx, StepFlags{std::nullopt, k});
+                return mesh;
+            },
+            ctx);
     });
 }
 
@@ -467,33 +535,18 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
                        " time steps of one geometry)");
             return;
         }
-        // A time series: one file a step and the .pvd naming them (relative to its folder).
-        namespace fs = std::filesystem;
-        const fs::path path(*out);
-        const std::string stem = path.stem().string(), ext = path.extension().string();
-        std::string pvd =
-            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
-            "version=\"0.1\">\n  <Collection>\n";
-        for (int k = 0; k < *steps; ++k) {
-            char name[32];
-            std::snprintf(name, sizeof name, "_%04d", k);
-            const std::string file = stem + name + ext;
-            ProceduralSpec at = *spec;
-            at.time = *dt * k;
-            if (k > 0) setProceduralFields(mesh, at);
-            writeMeshWithProgress(mesh, (path.parent_path() / file).string(), ctx);
-            char entry[64];
-            std::snprintf(entry, sizeof entry, "%.17g", at.time);
-            pvd += "    <DataSet timestep=\"" + std::string(entry) + "\" part=\"0\" file=\"" +
-                   file + "\"/>\n";
-        }
-        pvd += "  </Collection>\n</VTKFile>\n";
-        const std::string pvdPath = (path.parent_path() / (stem + ".pvd")).string();
-        OutputFile index(pvdPath);
-        index.write(pvd);
-        index.finish();
-        index.commit();
-        ctx.step("wrote " + pvdPath + " (" + std::to_string(*steps) + " time steps)");
+        // A time series: one file a step and the .pvd naming them.
+        std::vector<double> times;
+        for (int k = 0; k < *steps; ++k) times.push_back(*dt * k);
+        writePvdSeries(
+            *out, times,
+            [&](std::size_t k) -> const Mesh& {
+                ProceduralSpec at = *spec;
+                at.time = times[k];
+                if (k > 0) setProceduralFields(mesh, at);
+                return mesh;
+            },
+            ctx);
     });
 }
 

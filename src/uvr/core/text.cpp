@@ -2,6 +2,7 @@
 #include "uvr/core/text.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdint>
 #include <cstdio>
 
@@ -214,6 +215,12 @@ std::string formatG(double value, int significant) {
     char buf[40];
     std::snprintf(buf, sizeof buf, "%.*g", significant, value);
     return buf;
+}
+
+std::string formatExact(double value) {
+    char buf[40];
+    const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, value);
+    return std::string(buf, r.ptr);
 }
 
 }  // namespace uvr

@@ -33,6 +33,10 @@ bool isValidUtf8(std::string_view text);
 /// A number for a message: printf's "%.Ng" with `significant` digits ("0.0173", "1.72e+12").
 std::string formatG(double value, int significant);
 
+/// The shortest text that reads back as exactly `value` ("0.1", not "0.10000000000000001"): for
+/// numbers written to files (a .pvd's times) and reports.
+std::string formatExact(double value);
+
 /// "UTF-32" or "UTF-16" when the start of a text file is in one of those encodings (a byte-order
 /// mark, or NUL bytes among the first four, which UTF-8 text never has), else nullptr. Readers of
 /// UTF-8 formats use it to refuse such files with a clear message.
