@@ -180,10 +180,10 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                     series->readFieldsIfSameGeometry(i, player.mesh());
                 std::vector<float> values;
                 if (fields) {
-                    values = fieldValues(player.mesh(), *fields, spec);
+                    values = fieldValues(player.mesh(), *fields, player.spec());
                 } else {
                     const Mesh other = series->readStep(i);
-                    values = fieldValues(other, other.fields, spec);
+                    values = fieldValues(other, other.fields, player.spec());
                 }
                 for (float v : values)  // finite values only (finiteRange gives 0, 0 for none)
                     if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);

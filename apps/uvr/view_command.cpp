@@ -127,6 +127,16 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         s.clipPlanes = settings.clipPlanes;
         s.isoSurfaces = settings.isoSurfaces;
         s.field = flags->field;
+        // A series shows one field at every step: the default its first step chose (pinField).
+        if (scene.series && flags->field.empty()) {
+            const FieldSpec pinned = pinField(*mesh, parseFieldSpec(""));
+            bool twoOfName = false;
+            for (const Field& f : mesh->fields)
+                twoOfName =
+                    twoOfName || (f.name == pinned.name && f.association != *pinned.association);
+            s.field = pinned.name +
+                      (twoOfName && *pinned.association == Association::Cell ? ":cell" : "");
+        }
         // The page's settings start as the command line set them (or their defaults).
         for (const char* name : server::kViewerSettings)
             s.settings[name] = settingNamed(name).get(settings);

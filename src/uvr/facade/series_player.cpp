@@ -37,7 +37,10 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
     : series_(std::move(series)), spec_(std::move(spec)), options_(options), progress_(progress) {
     UVR_CHECK(series_ != nullptr, "a player needs a series");
     mesh_ = series_->readStep(first);
-    field_ = selectScalarField(mesh_, spec_);
+    field_ = selectScalarField(mesh_, spec_);  // the choice as the first step explains it
+    const std::string choice = field_.choice;
+    spec_ = pinField(mesh_, spec_);  // every step the field this one chose
+    field_.choice = choice;
     renderer_ = std::make_unique<Renderer>(mesh_, field_, options_, progress_);
     step_ = first;
 }

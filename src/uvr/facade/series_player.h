@@ -52,6 +52,9 @@ public:
     const Mesh& mesh() const { return mesh_; }
     /// The rendered field's values at the current step.
     const ScalarField& field() const { return field_; }
+    /// The field spec every step renders: the one given, its default resolved at the first step
+    /// (pinField).
+    const FieldSpec& spec() const { return spec_; }
     /// The series.
     const MeshSeries& series() const { return *series_; }
     /// The step shown.

@@ -105,5 +105,29 @@ TEST(SeriesPlayer, StepsOfOneGeometryRefreshValuesAndFramesEqualAFreshPreparatio
     EXPECT_EQ(player.step(), 3u);
 }
 
+TEST(SeriesPlayer, TheDefaultFieldOfTheFirstStepStaysAtEveryStep) {
+    // Field "a" is constant at step 0 and varies at step 1: the default passes over it at step
+    // 0 (pinField) and the player keeps "f" at step 1 rather than switching fields.
+    const std::string dir = testing::scratchDir();
+    for (int k = 0; k < 2; ++k) {
+        Mesh m = stepMesh(float(k));
+        Field a{"a", Association::Point, 1, std::vector<float>(m.pointCount(), 1.f)};
+        if (k == 1)
+            for (std::size_t i = 0; i < a.values.size(); ++i) a.values[i] = float(i);
+        m.fields.insert(m.fields.begin(), a);
+        writeMesh(m, dir + "/s_" + std::to_string(k) + ".vtu");
+    }
+    RendererOptions o;
+    o.device = Device::Cpu;
+    SeriesPlayer player(openMeshSeries(dir + "/s_*.vtu"), parseFieldSpec(""), o);
+    EXPECT_EQ(player.field().name, "f");
+    EXPECT_THAT(player.field().choice, HasSubstr("a holds one value here"));
+    EXPECT_EQ(player.spec().name, "f");
+    player.show(1);
+    EXPECT_EQ(player.field().name, "f");
+    const RenderSettings s = frameOf(player.mesh().bounds());
+    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(1.f), s, o), "step 1");
+}
+
 }  // namespace
 }  // namespace uvr

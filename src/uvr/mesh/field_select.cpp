@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/mesh/field_select.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string_view>
@@ -59,22 +60,46 @@ bool isIdFieldName(const std::string& name) {
 
 std::optional<std::size_t> defaultFieldIndex(const std::vector<FieldInfo>& fields) {
     for (const bool ids : {false, true})
-        for (const bool vectors : {false, true})
-            for (const Association a : {Association::Point, Association::Cell})
-                for (std::size_t i = 0; i < fields.size(); ++i) {
-                    const FieldInfo& f = fields[i];
-                    if (f.association == a && (f.components > 1) == vectors &&
-                        isIdFieldName(f.name) == ids)
-                        return i;
-                }
+        for (const bool constant : {false, true})
+            for (const bool vectors : {false, true})
+                for (const Association a : {Association::Point, Association::Cell})
+                    for (std::size_t i = 0; i < fields.size(); ++i) {
+                        const FieldInfo& f = fields[i];
+                        if (f.association == a && (f.components > 1) == vectors &&
+                            isIdFieldName(f.name) == ids && f.constant == constant)
+                            return i;
+                    }
     return std::nullopt;
 }
 
-std::optional<std::size_t> defaultFieldIndex(const Mesh& mesh) {
+std::vector<FieldInfo> fieldInfos(const Mesh& mesh) {
     std::vector<FieldInfo> infos;
     infos.reserve(mesh.fields.size());
-    for (const Field& f : mesh.fields) infos.push_back({f.name, f.association, f.components});
-    return defaultFieldIndex(infos);
+    for (const Field& f : mesh.fields) {
+        // Constant: every component holds one value over the tuples (NaN left out); a scan
+        // that stops at the first pair of differing values, at once for most fields.
+        bool constant = true;
+        const std::size_t nc = static_cast<std::size_t>(std::max(f.components, 1));
+        for (std::size_t c = 0; c < nc && constant; ++c) {
+            float first = NAN;
+            for (std::size_t i = c; i < f.values.size(); i += nc) {
+                const float v = f.values[i];
+                if (v != v) continue;
+                if (first != first) {
+                    first = v;
+                } else if (v != first) {
+                    constant = false;
+                    break;
+                }
+            }
+        }
+        infos.push_back({f.name, f.association, f.components, constant});
+    }
+    return infos;
+}
+
+std::optional<std::size_t> defaultFieldIndex(const Mesh& mesh) {
+    return defaultFieldIndex(fieldInfos(mesh));
 }
 
 std::string ScalarField::describe() const {
@@ -107,11 +132,19 @@ FieldChoice resolveField(const std::vector<FieldInfo>& fields, const FieldSpec& 
         }
         if (!index) throwError(ErrorKind::Argument, "", "no field to render: " + describe());
         const FieldInfo& f = fields[*index];
+        // A constant field the choice passed over, to say so.
+        std::string skipped;
+        for (const FieldInfo& g : fields)
+            if (g.constant && !f.constant && !isIdFieldName(g.name) && skipped.empty())
+                skipped = g.name;
         choice = isIdFieldName(f.name)
                      ? "the default: the file holds only id arrays"
                      : std::string("the default: the first ") + associationName(f.association) +
                            (f.components == 1 ? "-data scalar field"
-                                              : "-data field (no scalar field exists)");
+                                              : "-data field (no scalar field exists)") +
+                           (skipped.empty()
+                                ? ""
+                                : " that is not constant (" + skipped + " holds one value here)");
     } else {
         int matches = 0, pointMatches = 0;
         for (std::size_t i = 0; i < fields.size(); ++i) {
@@ -162,11 +195,21 @@ FieldChoice resolveField(const std::vector<FieldInfo>& fields, const FieldSpec& 
     return {*index, std::move(choice)};
 }
 
+FieldSpec pinField(const Mesh& mesh, const FieldSpec& spec) {
+    if (!spec.name.empty()) return spec;
+    const FieldChoice choice = resolveField(fieldInfos(mesh), spec);
+    FieldSpec pinned = spec;
+    pinned.name = mesh.fields[choice.index].name;
+    pinned.association = mesh.fields[choice.index].association;
+    return pinned;
+}
+
 ScalarField selectScalarField(const Mesh& mesh, const FieldSpec& spec) {
-    std::vector<FieldInfo> infos;
-    infos.reserve(mesh.fields.size());
-    for (const Field& f : mesh.fields) infos.push_back({f.name, f.association, f.components});
-    FieldChoice choice = resolveField(infos, spec);
+    FieldChoice choice = resolveField(spec.name.empty() ? fieldInfos(mesh) : [&] {
+        std::vector<FieldInfo> infos;  // a named field: no need to scan the values
+        for (const Field& f : mesh.fields) infos.push_back({f.name, f.association, f.components});
+        return infos;
+    }(), spec);
     ScalarField out = scalarFieldOf(mesh, mesh.fields[choice.index], spec.component);
     out.choice = std::move(choice.choice);
     return out;

@@ -42,6 +42,9 @@ struct FieldInfo {
     std::string name;
     Association association = Association::Point;
     int components = 1;
+    /// Known to hold one value (NaN left out) or none: it would render as nothing or one colour,
+    /// so it is the default only when every other field is too (false when values are unknown).
+    bool constant = false;
 };
 
 /// True for the names of id and bookkeeping arrays that writers add beside physical fields
@@ -53,10 +56,14 @@ bool isIdFieldName(const std::string& name);
 /// The field rendered when --field is not given, the same whatever the file format lists first
 /// (ParaView's preference): the first point-data scalar field, else the first cell-data scalar
 /// field, else the first point-data vector (its magnitude), else the first cell-data vector; id
-/// arrays (isIdFieldName) only when no other field exists. Empty for no fields.
+/// arrays (isIdFieldName) only when no other field exists, constant fields (FieldInfo::constant)
+/// only when no other physical field exists. Empty for no fields.
 std::optional<std::size_t> defaultFieldIndex(const std::vector<FieldInfo>& fields);
-/// The same for a mesh's fields.
+/// The same for a mesh's fields (their values tell which are constant: fieldInfos).
 std::optional<std::size_t> defaultFieldIndex(const Mesh& mesh);
+
+/// What choosing a field needs to know of a mesh's fields, constancy included.
+std::vector<FieldInfo> fieldInfos(const Mesh& mesh);
 
 /// The field a spec names among `fields` (its index) and, when the spec left something to
 /// choose, how it was chosen (ScalarField::choice).
@@ -68,6 +75,12 @@ struct FieldChoice {
 /// Resolves a spec against a list of fields (a mesh's, or a .uvrm header's before its values are
 /// read); throws Error(Argument) as selectScalarField does.
 FieldChoice resolveField(const std::vector<FieldInfo>& fields, const FieldSpec& spec);
+
+/// The spec with the field it resolves to on `mesh` named (name and association), component as
+/// given: what a time series renders at every step, so that the default chosen at its first step
+/// (which passes over fields constant there) stays the field of every step. Throws as
+/// resolveField does.
+FieldSpec pinField(const Mesh& mesh, const FieldSpec& spec);
 
 /// Resolves a spec against the mesh and extracts the scalar values; throws Error(Argument) naming
 /// the available fields when the name, association or component does not exist, or when a name

@@ -94,6 +94,32 @@ TEST(FieldSelect, DefaultSaysWhyAndKeepsAnAssociation) {
     EXPECT_EQ(selectScalarField(m, parseFieldSpec("GlobalNodeId")).values.size(), 4u);
 }
 
+TEST(FieldSelect, DefaultPassesOverConstantFieldsAndSaysSo) {
+    // Issue 35: VTK's mug.e, whose first field holds one value at step 0, rendered empty.
+    Mesh m = meshWithFields();
+    m.fields.insert(m.fields.begin(), Field{"zero", Association::Point, 1, {0, 0, NAN, 0}});
+    m.fields.insert(m.fields.begin(), Field{"NodeId", Association::Point, 1, {0, 1, 2, 3}});
+    const ScalarField d = selectScalarField(m, parseFieldSpec(""));
+    EXPECT_EQ(d.describe(), "p (point data)");
+    EXPECT_NE(d.choice.find("that is not constant (zero holds one value here)"), std::string::npos)
+        << d.choice;
+    const std::vector<FieldInfo> infos = fieldInfos(m);
+    EXPECT_TRUE(infos[1].constant);   // zero: NaN left out
+    EXPECT_FALSE(infos[2].constant);  // v: its components vary
+    EXPECT_EQ(pinField(m, parseFieldSpec("")).name, "p");
+    EXPECT_EQ(pinField(m, parseFieldSpec("zero")).name, "zero");  // named: as given
+    // Every physical field constant: the first of them, before the id array.
+    Mesh flat;
+    flat.points = m.points;
+    flat.addCell(CellType::Tetra, std::vector<std::uint32_t>{0, 1, 2, 3});
+    flat.fields = {{"NodeId", Association::Point, 1, {0, 1, 2, 3}},
+                   {"a", Association::Point, 1, {2, 2, 2, 2}},
+                   {"b", Association::Point, 1, {5, 5, 5, 5}}};
+    const ScalarField f = selectScalarField(flat, parseFieldSpec(""));
+    EXPECT_EQ(f.name, "a");
+    EXPECT_EQ(f.choice.find("not constant"), std::string::npos) << f.choice;
+}
+
 TEST(FieldSelect, TwoPointFieldsOfTheSameNameAreNotCalledPointAndCell) {
     Mesh m = meshWithFields();
     m.fields.push_back({"p", Association::Point, 1, {5, 6, 7, 8}});
