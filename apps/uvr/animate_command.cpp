@@ -251,8 +251,11 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             else
                 line +=
                     std::string(u.rebuilt ? "new geometry prepared in " : "values refreshed in ") +
-                    secondsText(u.updateSeconds) + ", read " + secondsText(u.readSeconds) +
-                    (u.prefetched ? " (waiting for the background read)" : "");
+                    secondsText(u.updateSeconds) +
+                    (!u.prefetched             ? ", read " + secondsText(u.readSeconds)
+                     : u.readSeconds >= 0.0005 ? ", read in the background (waited " +
+                                                     secondsText(u.readSeconds) + " for it)"
+                                               : ", read in the background");
             line += ", frame " + secondsText(result.stats.seconds) + " -> " + path;
             ctx.step(line);
             progress.set(double(k + 1) / double(chosen.size()));

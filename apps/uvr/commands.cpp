@@ -455,6 +455,13 @@ void addGenerateCommand(CLI::App& app, Context& ctx) {
         ->capture_default_str()
         ->check(CLI::Range(-1e6, 1e6));
     cmd->callback([cmd, shape, out, spec, fields, steps, dt, &ctx] {
+        const std::vector<std::string> shapes = {"box", "shell", "graded", "mixed", "hex"};
+        if (std::find(shapes.begin(), shapes.end(), *shape) == shapes.end()) {
+            const std::vector<std::string> close = closeMatches(*shape, shapes, 1);
+            throwError(ErrorKind::Argument, "",
+                       "unknown shape '" + *shape + "': expected box, shell, graded, mixed or hex" +
+                           (close.empty() ? "" : " (did you mean " + close[0] + "?)"));
+        }
         resolveOutput(*out);
         checkMeshWritable(*out);  // before generating
         if (*shape == "mixed" || *shape == "hex") {

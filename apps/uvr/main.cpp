@@ -7,6 +7,7 @@
 #include "cli_common.h"
 #include "parse_errors.h"
 #include "uvr/core/text.h"
+#include "uvr/core/version.h"
 
 int main(int argc, char** argv) {
     using namespace uvr;
@@ -14,11 +15,12 @@ int main(int argc, char** argv) {
     installOutputSignalHandlers();
     CLI::App app{
         "uvr: GPU-ready renderer for unstructured volume meshes (VTK .vtk/.vtu/.pvtu/.vtkhdf, "
-        "native .uvrm)",
+        "Exodus II .e/.exo/.ex2, ParaView .pvd series, numbered series 'run_*.vtu', native "
+        ".uvrm)",
         "uvr"};
     app.require_subcommand(1);
     app.fallthrough();  // -q works after the subcommand too
-    app.set_version_flag("--version", "uvr 0.1.0");
+    app.set_version_flag("--version", std::string("uvr ") + kVersion);
     cli::Context ctx;
     ctx.app = &app;
     app.add_flag("-q,--quiet", ctx.quiet, "No progress messages on stderr");

@@ -9,6 +9,8 @@ void bindSettings(py::module_& m) {
     m.attr("METHODS") = methodNames();
     // The settings vocabulary (settings_vocabulary.h): name, type, doc, default, choices or range.
     m.attr("SETTINGS") = fromJson(settingsVocabularyJson());
+    // The image size a frame has unless told (RenderSettings', the CLI's --size default).
+    m.attr("DEFAULT_SIZE") = py::make_tuple(RenderSettings{}.width, RenderSettings{}.height);
     m.def(
         "check_settings", [](const py::dict& settings) { settingsOf(settings); },
         py::arg("settings"),

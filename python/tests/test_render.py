@@ -311,3 +311,8 @@ def test_the_settings_vocabulary_is_the_librarys(data_dir):
     assert r.render(size=(8, 8), method="adaptive", skip=np.bool_(False)).stats["skip"] is False
     assert uvr._uvr.tunes_adaptive({"quality": 0.995})
     assert not uvr._uvr.tunes_adaptive({"quality": 0.99, "supersample": 4})
+
+
+def test_the_version_is_the_clis(cli):
+    assert uvr.__version__
+    assert cli("--version").stdout.strip() == f"uvr {uvr.__version__}"

@@ -13,6 +13,7 @@ from . import _uvr
 from ._image import Image, compare, compare_report, contact_sheet, read_png
 from ._mesh import Mesh, Series, as_mesh, from_meshio, from_vtk, read
 from ._render import Renderer, render, transfer_function
+from ._uvr import __version__
 from ._uvr import (SETTINGS, ArgumentError, Camera, Error, FileError, InternalError, ParseError,
                    ResourceError, TransferFunction, UnsupportedError, ValidationError)
 

@@ -172,16 +172,17 @@ class Renderer:
         """The preparation: tetrahedra, partitions, times, value updates, the field."""
         return self._core.info
 
-    def camera(self, size=(512, 512), azimuth=0.0, elevation=0.0, zoom=1.0):
-        """ParaView's reset camera for the mesh and the image size, orbited and zoomed."""
-        w, h = size
+    def camera(self, size=None, azimuth=0.0, elevation=0.0, zoom=1.0):
+        """ParaView's reset camera for the mesh and the image size (default: the CLI's,
+        uvr._uvr.DEFAULT_SIZE), orbited and zoomed."""
+        w, h = _uvr.DEFAULT_SIZE if size is None else size
         cam = _uvr.Camera.reset(self.bounds, float(w) / float(h))
         if azimuth or elevation:
             cam = cam.orbit(azimuth, elevation)
         return cam.zoom(zoom) if zoom != 1.0 else cam
 
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
-               size=(512, 512), method=None, quality=None, *, azimuth=0.0,
+               size=None, method=None, quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
                clip_planes=None, clip_box=None, iso=None, depth=None, depth_in=None, **settings):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
@@ -190,7 +191,8 @@ class Renderer:
         The arguments are ``uvr render``'s flags: `tf` a preset, ParaView JSON or
         TransferFunction; `opacity` an opacity spec or (x, alpha) pairs; `range` (lo, hi) the
         values the transfer function spans (default: the field's); `camera` a uvr.Camera
-        (default: ParaView's reset camera), then `azimuth`/`elevation`/`zoom`; `size` (w, h);
+        (default: ParaView's reset camera), then `azimuth`/`elevation`/`zoom`; `size` (w, h)
+        (default: the CLI's, uvr._uvr.DEFAULT_SIZE);
         `field` switches to another field or new values first (set_field); `clip_planes` a list
         of up to six planes, each (origin, normal), keeping the side the normal points to, and
         `clip_box` (lo, hi) keeping its inside, in the file's coordinates (``--clip-plane``,
@@ -219,6 +221,8 @@ class Renderer:
                 raise _uvr.ArgumentError("nan_color: expected (r, g, b) or (r, g, b, a)")
             t.nan_color = c[:3]
             t.nan_opacity = c[3] if len(c) == 4 else 1.0
+        if size is None:
+            size = _uvr.DEFAULT_SIZE
         try:
             w, h = (int(size[0]), int(size[1]))
         except (TypeError, ValueError, IndexError):

@@ -661,14 +661,25 @@ std::vector<std::string> transferFunctionPresetNames() {
 
 TransferFunction transferFunctionPreset(const std::string& name) {
     if (const PresetSpec* p = findPreset(name)) return makePreset(*p);
+    // Each preset by its whole name and by the name before a parenthesis ("Viridis" of
+    // "Viridis (matplotlib)"), so that a slip in the short name finds it too.
     std::vector<std::string> keys;
-    for (const PresetSpec& p : kPresets) keys.push_back(canonicalName(p.name));
-    std::string suggest;
-    for (const std::string& key : closeMatches(canonicalName(name), keys)) {
-        for (const PresetSpec& p : kPresets)
-            if (canonicalName(p.name) == key)
-                suggest += std::string(suggest.empty() ? "" : ", ") + "\"" + p.name + "\"";
+    std::vector<const char*> names;
+    for (const PresetSpec& p : kPresets) {
+        const std::string full = p.name, brief = full.substr(0, full.find(" ("));
+        for (const std::string& k : {canonicalName(full), canonicalName(brief)}) {
+            keys.push_back(k);
+            names.push_back(p.name);
+        }
     }
+    std::vector<const char*> close;
+    for (const std::string& key : closeMatches(canonicalName(name), keys))
+        for (std::size_t i = 0; i < keys.size(); ++i)
+            if (keys[i] == key && std::find(close.begin(), close.end(), names[i]) == close.end())
+                close.push_back(names[i]);
+    std::string suggest;
+    for (const char* n : close)
+        suggest += std::string(suggest.empty() ? "" : ", ") + "\"" + n + "\"";
     throwError(ErrorKind::Argument, "",
                "unknown transfer function preset \"" + printableShort(name, 60) + "\"" +
                    (suggest.empty() ? "" : "; did you mean " + suggest + "?") +

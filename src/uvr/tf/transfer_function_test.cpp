@@ -305,6 +305,9 @@ TEST(TransferFunction, PresetsResolveAliasesAndSuffixes) {
     Error e = catchError([] { transferFunctionPreset("jett"); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
     EXPECT_THAT(e.what(), HasSubstr("\"jett\"; did you mean \"Jet\"?"));
+    // A slip in the name before a parenthesis (issue 35).
+    EXPECT_THAT(catchError([] { transferFunctionPreset("viridiss"); }).what(),
+                HasSubstr("did you mean \"Viridis (matplotlib)\"?"));
     EXPECT_THAT(e.what(), HasSubstr("`uvr presets` lists"));
     e = catchError([] { transferFunctionPreset("rainbow"); });
     EXPECT_THAT(e.what(), HasSubstr("\"Rainbow Uniform\""));

@@ -53,7 +53,8 @@ struct ArrayDesc {
     std::uint64_t textByte = 0;
     bool haveText = false;
     Section section = Section::None;
-    std::string label;  // "Piece 0: DataArray 'offsets'"
+    std::string label;               // "Piece 0: DataArray 'offsets'"
+    std::uint64_t encodedBytes = 0;  // its share of the file (progress; setEncodedBytes)
 };
 
 struct PieceDesc {
@@ -360,6 +361,24 @@ XmlDoc parseXml(const std::string& path, const std::vector<char>& bytes) {
                             "expected </AppendedData> after the appended data (file truncated?)");
         doc.appendedEnd = end;
     }
+    // Each array's share of the file (progress): its inline text, or the appended bytes up to
+    // the next array's offset.
+    std::vector<std::uint64_t> offsets;
+    for (const PieceDesc& piece : doc.pieces)
+        for (const ArrayDesc& a : piece.arrays)
+            if (a.encoding == Encoding::Appended) offsets.push_back(a.offset);
+    std::sort(offsets.begin(), offsets.end());
+    const std::uint64_t appended = doc.appendedEnd - doc.appendedStart;
+    for (PieceDesc& piece : doc.pieces)
+        for (ArrayDesc& a : piece.arrays) {
+            if (a.encoding != Encoding::Appended) {
+                a.encodedBytes = a.text.size();
+                continue;
+            }
+            const auto next = std::upper_bound(offsets.begin(), offsets.end(), a.offset);
+            const std::uint64_t end = next == offsets.end() ? appended : *next;
+            a.encodedBytes = end > a.offset ? end - a.offset : 0;
+        }
     return doc;
 }
 
@@ -667,9 +686,23 @@ std::vector<T> convertValues(const PayloadBytes& raw, bool swap, const XmlDoc& d
     return out;
 }
 
+/// Within this file a reader's options.progress hears the encoded bytes of each array decoded
+/// (ArrayDesc::encodedBytes), not a fraction: readVtuFile's wrapper turns them into one.
+template <class T>
+std::vector<T> decodeArray(const std::vector<char>& bytes, const XmlDoc& doc, const ArrayDesc& a,
+                           std::uint64_t expected, const ReadOptions& options);
+
 template <class T>
 std::vector<T> readArray(const std::vector<char>& bytes, const XmlDoc& doc, const ArrayDesc& a,
                          std::uint64_t expected, const ReadOptions& options) {
+    std::vector<T> out = decodeArray<T>(bytes, doc, a, expected, options);
+    if (options.progress) options.progress(double(a.encodedBytes));
+    return out;
+}
+
+template <class T>
+std::vector<T> decodeArray(const std::vector<char>& bytes, const XmlDoc& doc, const ArrayDesc& a,
+                           std::uint64_t expected, const ReadOptions& options) {
     if (a.encoding == Encoding::Ascii) return parseAscii<T>(doc, a, expected, options);
     PayloadBytes raw;
     if (a.encoding == Encoding::Binary) {
@@ -1040,7 +1073,12 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
                            (format == MeshFormat::Pvd ? "a ParaView collection (.pvd)"
                                                       : "a PUnstructuredGrid (.pvtu)") +
                            "; a .pvtu piece must be an UnstructuredGrid .vtu file");
-        Mesh piece = readVtuFile(piecePath, options, false);
+        ReadOptions pieceOptions = options;  // progress: piece k's fraction of the whole
+        if (options.progress)
+            pieceOptions.progress = [k, n = doc.pieces.size(), outer = options.progress](double f) {
+                outer((double(k) + f) / double(n));
+            };
+        Mesh piece = readVtuFile(piecePath, pieceOptions, false);
         budget.charge(path, label, meshBytes(piece), 1);  // its copy in the merged mesh
 
         appendMeshPiece(mesh, piece, k == 0, path, atLine(p.line), label);
@@ -1071,8 +1109,21 @@ Mesh readVtuFile(const std::string& path, const ReadOptions& options, bool allow
         throwParseError(path, atByte(0),
                         "expected at least one <Piece NumberOfPoints=... NumberOfCells=...>");
     checkDeclaredMesh(doc, budget);
+    // Progress: the fraction of the arrays' encoded bytes decoded (decoding, zlib's above all,
+    // is most of a large file's read).
+    ReadOptions local = options;
+    if (options.progress) {
+        std::uint64_t total = 0;
+        for (const PieceDesc& p : doc.pieces)
+            for (const ArrayDesc& a : p.arrays) total += a.encodedBytes;
+        auto done = std::make_shared<double>(0.0);
+        local.progress = [done, total, outer = options.progress](double arrayBytes) {
+            *done += arrayBytes;
+            outer(total > 0 ? std::min(1.0, *done / double(total)) : 1.0);
+        };
+    }
     RawGrid grid;
-    for (std::size_t k = 0; k < doc.pieces.size(); ++k) readPiece(bytes, doc, k, options, grid);
+    for (std::size_t k = 0; k < doc.pieces.size(); ++k) readPiece(bytes, doc, k, local, grid);
     Mesh mesh;
     mesh.points = std::move(grid.points);
     mesh.fields = std::move(grid.fields);

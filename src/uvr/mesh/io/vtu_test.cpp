@@ -193,6 +193,21 @@ TEST(VtuSharedData, FireUgRefusesAnArrayAboveTheMemoryLimit) {
                 {path + ": the file needs 631781 bytes", "memory limit of 100000"});
 }
 
+TEST(VtuSharedData, ProgressRisesToOneAsTheArraysAreDecoded) {
+    // Issue 35: a large .vtu showed only elapsed seconds; now the fraction of its arrays' bytes.
+    if (!uvr::testing::haveSharedData()) GTEST_SKIP() << "no shared data";
+    ReadOptions options;
+    std::vector<double> heard;
+    options.progress = [&](double f) { heard.push_back(f); };
+    const Mesh mesh = readVtu(uvr::testing::sharedData("fire_ug.vtu"), options);
+    EXPECT_EQ(mesh.cellCount(), 10462u);
+    ASSERT_GE(heard.size(), 4u);  // points, connectivity, offsets, types, fields
+    for (std::size_t i = 1; i < heard.size(); ++i) EXPECT_GE(heard[i], heard[i - 1]);
+    EXPECT_GT(heard.front(), 0.0);
+    EXPECT_LT(heard.front(), 1.0);
+    EXPECT_DOUBLE_EQ(heard.back(), 1.0);
+}
+
 // ---- files written by VTK and meshio ----
 
 void checkManifest(const std::string& kind, std::size_t expectedFiles) {
@@ -231,6 +246,14 @@ TEST(PvtuVariants, ThreePiecesMatchVtk) {
 TEST(PvtuVariants, ReadVtuForwardsAPvtu) {
     REQUIRE_VARIANTS();
     expectMatches(readVtu(variant("three.pvtu")), loadJson(variant("three.pvtu.json")));
+    // Progress over the pieces: each piece's fraction of the whole, rising to 1.
+    ReadOptions options;
+    std::vector<double> heard;
+    options.progress = [&](double f) { heard.push_back(f); };
+    (void)readVtu(variant("three.pvtu"), options);
+    ASSERT_FALSE(heard.empty());
+    for (std::size_t i = 1; i < heard.size(); ++i) EXPECT_GE(heard[i], heard[i - 1]);
+    EXPECT_DOUBLE_EQ(heard.back(), 1.0);
 }
 
 TEST(VtuVariants, SeveralPiecesInOneFileAreMerged) {
