@@ -38,7 +38,7 @@ inline std::string sharedData(const std::string& name) {
 }
 
 /// ParaView's tutorial data disk_out_ref.ex2 (7,472 hexahedra, Exodus II), as Debian's mayavi2
-/// package ships it (scripts/install-deps.sh installs it; tests skip it when absent).
+/// package ships it (scripts/install-deps.sh --tests installs it; tests skip it when absent).
 inline constexpr const char* kDiskOutRef =
     "/usr/lib/python3/dist-packages/mayavi/tests/data/disk_out_ref.ex2";
 
