@@ -5,6 +5,7 @@
 // edit is sent as a `set` with the full value of each key it changes.
 
 import * as cam from "./camera.js";
+import {colorAt, css} from "./colormap.js";
 import {TfEditor, isoText, parseIso} from "./tf_editor.js";
 
 const $ = (id) => document.getElementById(id);
@@ -49,7 +50,8 @@ function send(message) {
 // The session-state keys the page keeps a local copy of.
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
                     "opacity_unit", "opacity_law", "step", "clip_planes", "shade", "ambient",
-                    "diffuse", "specular", "specular_power", "normals", "iso", "clip_surface"];
+                    "diffuse", "specular", "specular_power", "normals", "iso", "clip_surface",
+                    "background"];
 
 // Gradient shading's coefficients: the slider's id and the setting it sets.
 const kLightSliders = [["ambient", "ambient"], ["diffuse", "diffuse"], ["specular", "specular"],
@@ -226,11 +228,101 @@ async function drawFrame(header, buffer) {
 /// full size (the canvas holds the state's full-resolution pixels).
 function paint() {
     viewContext.clearRect(0, 0, view.width, view.height);
+    drawAnnotations();
     if (!shownBitmap) return;
     viewContext.imageSmoothingEnabled = true;
     viewContext.imageSmoothingQuality = "high";
     viewContext.drawImage(shownBitmap, 0, 0, view.width, view.height);
 }
+
+// ---- Annotations: scalar bar, orientation axes, outline (drawn over the image on a canvas of
+// their own; the saved PNG is the volume over the background, as `uvr render` writes it) -----
+
+const overlay = $("overlay");
+const overlayContext = overlay.getContext("2d");
+// ParaView's orientation axes colours: x red, y yellow, z green.
+const kAxisColors = ["#e8413c", "#f2d64b", "#4fc35a"];
+
+/// Redraws the annotations the View section turns on, for the local state's camera and map.
+function drawAnnotations() {
+    const g = overlayContext, w = overlay.width, h = overlay.height;
+    g.clearRect(0, 0, w, h);
+    const s = session.state;
+    if (!s || !s.camera) return;
+    const unit = window.devicePixelRatio || 1;  // one CSS pixel
+    if ($("show-outline").checked) drawOutline(g, s.camera, w, h, unit);
+    if ($("show-axes").checked) drawAxes(g, s.camera, h, unit);
+    if ($("show-scalar-bar").checked && s.tf && s.range) drawScalarBar(g, s, w, h, unit);
+}
+
+function drawOutline(g, camera, w, h, unit) {
+    const [lo, hi] = meshBounds();
+    const corner = (i) => [i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]];
+    g.strokeStyle = "rgba(255, 255, 255, 0.7)";
+    g.lineWidth = unit;
+    g.beginPath();
+    for (let i = 0; i < 8; i++)
+        for (const bit of [1, 2, 4]) {
+            if (i & bit) continue;
+            const a = cam.project(camera, corner(i), w, h);
+            const b = cam.project(camera, corner(i | bit), w, h);
+            if (!a || !b) continue;  // an edge reaching behind the camera
+            g.moveTo(a[0], a[1]);
+            g.lineTo(b[0], b[1]);
+        }
+    g.stroke();
+}
+
+function drawAxes(g, camera, h, unit) {
+    const f = cam.frame(camera);
+    const length = 28 * unit, cx = 44 * unit, cy = h - 44 * unit;
+    // Farthest first, so the nearer axes are drawn over it.
+    const axes = [0, 1, 2].map((a) => {
+        const e = [0, 1, 2].map((i) => (i === a ? 1 : 0));
+        return {a, x: cam.dot(e, f.right), y: cam.dot(e, f.up), z: cam.dot(e, f.dir)};
+    }).sort((p, q) => q.z - p.z);
+    g.font = `bold ${Math.round(11 * unit)}px sans-serif`;
+    g.textAlign = "center";
+    g.textBaseline = "middle";
+    g.lineWidth = 2 * unit;
+    for (const {a, x, y} of axes) {
+        const ex = cx + x * length, ey = cy - y * length;
+        g.strokeStyle = g.fillStyle = kAxisColors[a];
+        g.beginPath();
+        g.moveTo(cx, cy);
+        g.lineTo(ex, ey);
+        g.stroke();
+        g.fillText("XYZ"[a], cx + x * (length + 9 * unit), cy - y * (length + 9 * unit));
+    }
+}
+
+function drawScalarBar(g, s, w, h, unit) {
+    const barW = 14 * unit, barH = Math.min(0.5 * h, 240 * unit);
+    const x = w - barW - 56 * unit, y = 0.5 * (h - barH);
+    const rows = Math.max(2, Math.round(barH));
+    for (let i = 0; i < rows; i++) {
+        const t = 1 - i / (rows - 1);  // the range's top at the bar's top
+        g.fillStyle = css(colorAt(s.tf.colors, s.tf.color_space, t));
+        g.fillRect(x, y + (i / rows) * barH, barW, barH / rows + 1);
+    }
+    g.strokeStyle = "rgba(255, 255, 255, 0.8)";
+    g.lineWidth = unit;
+    g.strokeRect(x, y, barW, barH);
+    g.fillStyle = "#fff";
+    g.font = `${Math.round(11 * unit)}px sans-serif`;
+    g.textAlign = "left";
+    g.textBaseline = "middle";
+    g.fillText(fmt(s.range[1], 4), x + barW + 4 * unit, y);
+    g.fillText(fmt(s.range[0], 4), x + barW + 4 * unit, y + barH);
+    g.textAlign = "center";
+    g.textBaseline = "bottom";
+    const fields = (session.info && session.info.fields) || [];
+    const field = s.field || (fields.find((f) => f.default) || {}).name || "";
+    if (field) g.fillText(field, x + 0.5 * barW, y - 6 * unit);
+}
+
+for (const id of ["show-scalar-bar", "show-axes", "show-outline"])
+    $(id).addEventListener("change", drawAnnotations);
 
 /// The full-resolution size of a frame: a reduced frame's size times its reduction factor (a
 /// whole number, found from the heights). Not simply the state's size: a heat map may carry a
@@ -255,6 +347,20 @@ function resizeCanvas(size) {
     const s = Math.max(0, Math.min(availW / view.width, availH / view.height));
     view.style.width = `${Math.floor(view.width * s)}px`;
     view.style.height = `${Math.floor(view.height * s)}px`;
+    // The annotations' canvas exactly over the image, at the screen's pixels (their text and
+    // lines keep their size whatever the image's resolution).
+    const dpr = window.devicePixelRatio || 1;
+    const ow = Math.max(1, Math.round(view.width * s * dpr));
+    const oh = Math.max(1, Math.round(view.height * s * dpr));
+    overlay.style.left = `${view.offsetLeft}px`;
+    overlay.style.top = `${view.offsetTop}px`;
+    overlay.style.width = view.style.width;
+    overlay.style.height = view.style.height;
+    if (overlay.width !== ow || overlay.height !== oh) {
+        overlay.width = ow;
+        overlay.height = oh;
+        drawAnnotations();
+    }
 }
 new ResizeObserver(() => resizeCanvas()).observe($("view-wrap"));
 
@@ -511,7 +617,40 @@ function updateControls() {
         if (document.activeElement !== input) input.value = input.dataset.shown;
     });
     tfEditor.update({tf: s.tf, range: s.range, isos: s.iso || []});
+    // View.
+    if (Array.isArray(s.background) && document.activeElement !== $("background"))
+        $("background").value = hexColor(s.background);
+    if (s.camera) $("parallel").checked = !!s.camera.parallel;
+    drawAnnotations();
 }
+
+const hexColor = (rgb) => "#" + rgb.map((c) => Math.round(Math.min(1, Math.max(0, c)) * 255)
+                                                .toString(16).padStart(2, "0")).join("");
+const rgbColor = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16) / 255);
+
+$("background").addEventListener("input", (e) => sendSet({background: rgbColor(e.target.value)}, true));
+$("background").addEventListener("change", (e) => sendSet({background: rgbColor(e.target.value)}));
+$("parallel").addEventListener("change", (e) => {
+    if (!session.state) return;
+    sendSet({camera: cam.withProjection(session.state.camera, e.target.checked)});
+});
+
+/// Opacity curves over the range (the opacity points' [t, alpha], t from 0 to 1), as ParaView's
+/// editor makes them.
+const kOpacityPresets = {
+    "ramp": [[0, 0], [1, 1]],
+    "ramp-down": [[0, 1], [1, 0]],
+    "constant": [[0, 0.2], [1, 0.2]],
+    "step": [[0, 0], [0.499, 0], [0.5, 1], [1, 1]],
+    "band": [[0, 0], [0.4, 0], [0.5, 1], [0.6, 0], [1, 0]],
+    "edges": [[0, 1], [0.2, 0], [0.8, 0], [1, 1]],
+};
+$("opacity-preset").addEventListener("change", (e) => {
+    const points = kOpacityPresets[e.target.value];
+    e.target.value = "";
+    if (!points || !session.state || !session.state.tf) return;
+    sendSet({tf: {...session.state.tf, opacity: points.map((p) => [...p])}});
+});
 
 function fillSizes(size) {
     const select = $("size");

@@ -103,6 +103,35 @@ export function dragAlong(cam, axis, dx, dy, displayHeight) {
     return (s * (dx * px + dy * py)) / pp;
 }
 
+/// Where world point p appears on a view `width` x `height` pixels: [x, y] in pixels from the
+/// top left, as the renderer projects (VTK's vertical view angle, or parallel_scale half the
+/// height); null for a point at or behind the camera's plane in perspective.
+export function project(cam, p, width, height) {
+    const f = frame(cam);
+    const v = sub(p, cam.position);
+    const z = dot(v, f.dir);
+    let half;  // half the view's height in world units at p's depth
+    if (cam.parallel) {
+        half = cam.parallel_scale;
+    } else {
+        if (!(z > 1e-9 * Math.max(1, f.distance))) return null;
+        half = z * Math.tan(0.5 * cam.view_angle * kDeg);
+    }
+    const aspect = width / Math.max(1, height);
+    const x = dot(v, f.right) / (half * aspect), y = dot(v, f.up) / half;
+    return [(0.5 + 0.5 * x) * width, (0.5 - 0.5 * y) * height];
+}
+
+/// The camera switched to parallel projection (on) or perspective (off), keeping what is seen at
+/// the focal point: parallel_scale is half the height the perspective view spans there.
+export function withProjection(cam, parallel) {
+    const out = copy(cam);
+    out.parallel = !!parallel;
+    if (parallel && !cam.parallel)
+        out.parallel_scale = frame(cam).distance * Math.tan(0.5 * cam.view_angle * kDeg);
+    return out;
+}
+
 /// VTK's Dolly: factor > 1 moves the camera towards the focal point (the distance divided by
 /// factor), < 1 away from it; in parallel projection the parallel scale is divided instead.
 export function dolly(cam, factor) {

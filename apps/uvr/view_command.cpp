@@ -29,12 +29,12 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
     for (const SettingDef& def : settingsVocabulary())
         if (f.vocabulary.given(def.name) && !server::isViewerSetting(def.name))
             add(cliFlag(def).c_str(), f.vocabulary.text(def.name));
-    // The clip planes and isosurfaces are the page's (ViewState), the box the command line's.
+    // The clip planes, isosurfaces and background are the page's (ViewState), the box the
+    // command line's.
     if (!f.clipBox.empty()) add("--clip-box", f.clipBox);
     if (f.leafCells) add("--leaf-cells", std::to_string(f.leafCells));
     if (f.noSeedGrid) add("--no-seed-grid", "");
     if (f.splitCells) add("--split-cells", "");
-    if (!f.background.empty()) add("--background", f.background);
     return out;
 }
 #endif
@@ -127,6 +127,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         s.clipPlanes = settings.clipPlanes;
         s.isoSurfaces = settings.isoSurfaces;
         s.field = flags->field;
+        s.background = flags->backgroundColor().value_or(Vec3f(0.f, 0.f, 0.f));
         // A series shows one field at every step: the default its first step chose (pinField).
         if (scene.series && flags->field.empty()) {
             const FieldSpec pinned = pinField(*mesh, parseFieldSpec(""));
@@ -154,7 +155,6 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         if (resolvesToCuda(scene.rendererOptions.device))
             ctx.step("GPU: " + cudaDeviceDescription());
         scene.base = settings;
-        scene.background = flags->backgroundColor();
         scene.commandFlags = imageFlags(*flags);
         // Step 3: serve until Ctrl-C.
         server::ViewServer server(std::move(scene), so, [&ctx](const std::string& line) {

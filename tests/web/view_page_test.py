@@ -733,6 +733,91 @@ def shade(page):
     check(page.hook("errorCount") == errors0, f"shading gave an error: {page.hook('lastError')}")
 
 
+def overlay_painted(page):
+    """Pixels the annotations' canvas paints (alpha above 0), in all and in its right quarter."""
+    return page.js("""
+        const c = document.getElementById('overlay');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let all = 0, right = 0;
+        for (let i = 3; i < d.length; i += 4) {
+            if (d[i] === 0) continue;
+            all++;
+            if (((i - 3) / 4) % c.width >= 0.75 * c.width) right++;
+        }
+        return {all, right};""")
+
+
+def view_section(page):
+    step("the View section: background, annotations, projection, opacity presets")
+    errors0 = page.hook("errorCount")
+    page.quiet()
+
+    def set_input(element_id, value, event="change"):
+        page.js(f"const e = document.getElementById('{element_id}'); e.value = '{value}';"
+                f" e.dispatchEvent(new Event('{event}'));")
+
+    def toggle(element_id, on):
+        page.js(f"const e = document.getElementById('{element_id}'); e.checked = {str(on).lower()};"
+                " e.dispatchEvent(new Event('change'));")
+
+    # The annotations: drawn over the image on a canvas of their own, each turned off by its box.
+    shown = overlay_painted(page)
+    check(shown["all"] > 500, f"the scalar bar and axes paint only {shown['all']} pixels")
+    check(shown["right"] > 200, f"no scalar bar at the right of the view ({shown})")
+    for box in ("show-scalar-bar", "show-axes"):
+        toggle(box, False)
+    blank = overlay_painted(page)
+    check(blank["all"] == 0, f"annotations remain with the scalar bar and axes off ({blank})")
+    toggle("show-outline", True)
+    outline = overlay_painted(page)
+    check(outline["all"] > 200, f"the outline draws only {outline['all']} pixels")
+    page.screenshot("outline")
+    toggle("show-outline", False)
+    for box in ("show-scalar-bar", "show-axes"):
+        toggle(box, True)
+
+    # The background: the frames, and the saved PNG, composite over it.
+    frames0 = page.hook("frameCount")
+    set_input("background", "#ff0000")
+    settled(page, frames0, "the frame over a red background")
+    state = page.hook("state")
+    check(vec_close(state["background"], [1, 0, 0], 1e-6),
+          f"the state's background is {state['background']}")
+    px = page.pixels()
+    check(px[0] > 200 and px[1] < 40 and px[2] < 40, f"the corner pixel is {px[:3]}, not red")
+    frames0 = page.hook("frameCount")
+    set_input("background", "#000000")
+    settled(page, frames0, "the frame over black again")
+
+    # Parallel projection: the camera's, keeping the size seen at the focal point.
+    camera0 = page.hook("state")["camera"]
+    frames0 = page.hook("frameCount")
+    toggle("parallel", True)
+    settled(page, frames0, "the frame in parallel projection")
+    camera1 = page.hook("state")["camera"]
+    check(camera1["parallel"] is True, "the camera is not parallel")
+    check(camera1["parallel_scale"] > 0, f"parallel scale {camera1['parallel_scale']}")
+    frames0 = page.hook("frameCount")
+    toggle("parallel", False)
+    settled(page, frames0, "the frame in perspective again")
+    check(page.hook("state")["camera"]["parallel"] is False, "the camera stays parallel")
+    check(vec_close(page.hook("state")["camera"]["position"], camera0["position"], 1e-9),
+          "the projection toggle moved the camera")
+
+    # An opacity preset replaces the curve.
+    tf0 = page.hook("state")["tf"]
+    frames0 = page.hook("frameCount")
+    set_input("opacity-preset", "constant")
+    settled(page, frames0, "the frame of the constant opacity")
+    opacity = page.hook("state")["tf"]["opacity"]
+    check(opacity == [[0, 0.2], [1, 0.2]], f"the opacity preset gave {opacity}")
+    frames0 = page.hook("frameCount")
+    page.hook(f"set({{tf: {json.dumps(tf0)}}})")
+    settled(page, frames0, "the frame of the earlier opacity")
+    check(page.hook("errorCount") == errors0, f"the View section gave an error: "
+                                              f"{page.hook('lastError')}")
+
+
 def save_and_reproduce(page, uvr, downloads, tmp):
     step("Save PNG, Export TF and camera, and the exported command")
     from selenium.webdriver.common.by import By
@@ -945,6 +1030,7 @@ def main():
             clip(page)
             shade(page)
             isosurfaces(page)
+            view_section(page)
             save_and_reproduce(page, args.uvr, downloads, tmp)
             page.screenshot("final")
             wrong_token_page(page)

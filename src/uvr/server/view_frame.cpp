@@ -32,10 +32,11 @@ ViewFrame renderViewFrame(Renderer& renderer, const ViewState& state, const Rend
                             ? sampleHeatmap(result.sampleCounts, settings.width, settings.height, 0)
                             : result.image;
     ViewFrame out;
-    const Vec3f bg = encoding.background.value_or(Vec3f(0.f, 0.f, 0.f));
+    // Frames and snapshots over the state's background: the saved PNG is what the page showed.
+    const Vec3f bg = state.background;
     const char* format = "png";
     if (snapshot)
-        out.bytes = encodePng(image, encoding.background);
+        out.bytes = encodePng(image, bg);
     else if (kind == FrameKind::Reduced)
         out.bytes = encodeJpeg(image, bg, encoding.jpegQuality), format = "jpeg";
     else

@@ -24,9 +24,6 @@ struct ViewFrame {
 
 /// How frames are encoded (ServerOptions' and the scene's values).
 struct FrameEncoding {
-    /// Snapshots composite over it when given (else they keep their alpha); frames always do,
-    /// over black when none is given.
-    std::optional<Vec3f> background;
     int jpegQuality = 80;  ///< of reduced frames
 };
 

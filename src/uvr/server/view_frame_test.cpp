@@ -88,11 +88,15 @@ TEST_F(ViewFrameTest, AFullFrameIsAnOpaquePngAndASnapshotKeepsItsAlpha) {
     const PngHeader sh = pngHeader(snap.bytes);
     EXPECT_EQ(sh.width, 64);
     EXPECT_EQ(sh.height, 48);
-    EXPECT_EQ(sh.colorType, 6);  // RGBA
-    // Over a given background a snapshot is opaque too.
-    const ViewFrame over = renderViewFrame(renderer_, state_, RenderSettings{}, FrameKind::Snapshot,
-                                           1, 3, {Vec3f(1.f, 1.f, 1.f), 80});
+    // Over the state's background, as the frames the page showed (issue 35: the saved PNG was
+    // transparent while the page showed black).
+    EXPECT_EQ(sh.colorType, 2);  // RGB
+    ViewState white = state_;
+    white.background = Vec3f(1.f, 1.f, 1.f);
+    const ViewFrame over =
+        renderViewFrame(renderer_, white, RenderSettings{}, FrameKind::Snapshot, 1, 3, {});
     EXPECT_EQ(pngHeader(over.bytes).colorType, 2);
+    EXPECT_NE(over.bytes, snap.bytes);  // the corners are white now
 }
 
 TEST_F(ViewFrameTest, AHeatMapStateShowsSamplesButNotInSnapshots) {

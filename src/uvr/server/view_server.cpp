@@ -241,6 +241,10 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
     }
     for (const IsoSurface& iso : s.isoSurfaces) args.insert(args.end(), {"--iso", isoText(iso)});
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
+    // The background the page shows (uvr render's default is a transparent PNG).
+    args.insert(args.end(),
+                {"--background", fmtExact(s.background.x) + "," + fmtExact(s.background.y) + "," +
+                                     fmtExact(s.background.z)});
     args.insert(args.end(), {"-o", "uvr-view.png"});
     std::string command;
     for (const std::string& a : args) command += (command.empty() ? "" : " ") + shellQuote(a);
@@ -297,7 +301,7 @@ void ViewServer::Impl::renderLoop() {
     prepareAtStart();
     const ScheduleOptions schedule{std::chrono::milliseconds(opt.refineDelayMs), opt.targetFrameMs,
                                    opt.maxScale};
-    const FrameEncoding encoding{scene.background, opt.jpegQuality};
+    const FrameEncoding encoding{opt.jpegQuality};
     std::unique_lock lk(m);
     while (!stopping) {
         // Step 1: the next tab with work (frame_scheduler.h), or wait for one.
@@ -541,10 +545,11 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     const Mesh& mesh = *d.scene.mesh;
     // The fields as the page lists them, with their ranges.
     Json fields = Json::array();
-    const std::optional<std::size_t> def = defaultFieldIndex(mesh);
+    // With their values' constancy, so that the default resolves as selectScalarField does.
+    d.fieldInfos = uvr::fieldInfos(mesh);
+    const std::optional<std::size_t> def = defaultFieldIndex(d.fieldInfos);
     for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
         const Field& f = mesh.fields[i];
-        d.fieldInfos.push_back({f.name, f.association, f.components});
         const auto range = finiteRange(scalarFieldOf(mesh, f).values);
         fields.push_back({{"name", f.name},
                           {"association", associationName(f.association)},

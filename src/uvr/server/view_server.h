@@ -66,9 +66,8 @@ struct ViewScene {
     /// Prepared for initial.field (the command line's preparation, with its progress); null:
     /// prepared before the first frame.
     std::unique_ptr<Renderer> renderer;
-    std::vector<std::string> notes;   ///< validation findings and notes the page shows
-    double loadSeconds = 0.0;         ///< reading the file
-    std::optional<Vec3f> background;  ///< --background: snapshots composite over it
+    std::vector<std::string> notes;  ///< validation findings and notes the page shows
+    double loadSeconds = 0.0;        ///< reading the file
     /// Flags of the command line that shape the image beyond the state (--sample-distance,
     /// --sampling, ...) for the exported `uvr render` command, each a separate argument.
     std::vector<std::string> commandFlags;

@@ -379,6 +379,9 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_EQ(snap["height"], 48);
     EXPECT_TRUE(c.next().contains("binary"));
     EXPECT_TRUE(isPng(c.lastBinary()));
+    // Composited over the page's background, as the frames are (IHDR colour type 2: RGB).
+    ASSERT_GT(c.lastBinary().size(), 25u);
+    EXPECT_EQ(static_cast<unsigned char>(c.lastBinary()[25]), 2u);
     c.send({{"type", "export"}});
     const Json ex = c.until("export");
     ASSERT_FALSE(ex.is_null());
@@ -391,7 +394,7 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     const std::string cmd = ex["command"];
     EXPECT_THAT(cmd, HasSubstr("uvr render grid.vtk --tf uvr-tf.json --camera uvr-camera.pvcc "
                                "--range -2.5,2.5 --size 64x48 --method auto --opacity-unit 0.5 "
-                               "--sample-distance 0.01 -o uvr-view.png"));
+                               "--sample-distance 0.01 --background 0,0,0 -o uvr-view.png"));
     // The adaptive method exports its quality; so does auto with a quality of its own (which
     // makes its frames adaptive).
     // The page's clip planes export as flags.

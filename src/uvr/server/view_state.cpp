@@ -264,7 +264,8 @@ Json toJson(const ViewState& s) {
               {"clip_planes", clipPlanesJson(s.clipPlanes)},
               {"iso", isoSurfacesJson(s.isoSurfaces)},
               {"size", {s.width, s.height}},
-              {"step", s.step}};
+              {"step", s.step},
+              {"background", vec(s.background)}};
     // The viewer's settings of the vocabulary as set (`uvr view` starts every tab with all of
     // them from its command line; the library's default for one a state does not hold).
     for (const char* name : kViewerSettings) {
@@ -371,6 +372,13 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
                     v);
             next.width = static_cast<int>(w);
             next.height = static_cast<int>(h);
+        } else if (k == "background") {
+            if (!v.is_array() || v.size() != 3) bad(k, "[r, g, b], each in [0, 1]", v);
+            for (int c = 0; c < 3; ++c) {
+                const double x = v[c].is_number() ? v[c].get<double>() : NAN;
+                if (!(x >= 0.0 && x <= 1.0)) bad(k, "[r, g, b], each in [0, 1]", v);
+                next.background[c] = static_cast<float>(x);
+            }
         } else if (k == "step") {
             const bool index =
                 v.is_number_unsigned() || (v.is_number_integer() && v.get<std::int64_t>() >= 0);
@@ -382,7 +390,8 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.step = v.get<std::size_t>();
         } else {
             std::string keys =
-                "camera, tf, range, field, heatmap, clip_planes, iso, size, step, preset, "
+                "camera, tf, range, field, heatmap, clip_planes, iso, size, step, background, "
+                "preset, "
                 "colormap_json";
             for (const char* name : kViewerSettings) keys += std::string(", ") + name;
             bad("set", "state keys (" + keys + "), not \"" + printableShort(k, 40) + "\"", message);

@@ -50,6 +50,9 @@ struct ViewState {
     std::vector<IsoSurface> isoSurfaces;
     int width = 1024, height = 1024;
     std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
+    /// What frames and snapshots composite over (r, g, b in [0, 1]; `--background`, black by
+    /// default): the saved PNG is what the page showed.
+    Vec3f background{0.f, 0.f, 0.f};
 };
 
 /// The state as the protocol's JSON object.
@@ -65,7 +68,8 @@ struct SetResult {
 };
 
 /// Applies the state keys of a `set` message (camera, tf, range, field, method, quality,
-/// heatmap, clip_planes, iso, size, opacity_unit, opacity_law, step (below stepCount), preset,
+/// heatmap, clip_planes, iso, size, background, opacity_unit, opacity_law, step (below
+/// stepCount), preset,
 /// colormap_json and colormap_name) to `state`, all or
 /// nothing: on any bad value it throws Error(Argument) (Error(Parse) for a malformed uploaded
 /// colour map) naming the key and what was expected, and leaves `state` unchanged. Unknown keys

@@ -213,6 +213,27 @@ TEST(ViewState, AFieldChangeIsReported) {
     EXPECT_EQ(s.field, "velocity:x");
 }
 
+TEST(ViewState, TheBackgroundIsAColourInTheUnitCube) {
+    // Issue 35: what the page shows is what it saves; the background is the state's.
+    ViewState s = startState();
+    EXPECT_EQ(toJson(s)["background"], Json::array({0.f, 0.f, 0.f}));
+    applySet(s, {{"background", {0.25, 0.5, 1}}});
+    EXPECT_EQ(s.background.x, 0.25f);
+    EXPECT_EQ(s.background.z, 1.f);
+    EXPECT_EQ(toJson(s)["background"], Json::array({0.25f, 0.5f, 1.f}));
+    for (const Json& bad : {Json(1), Json::array({0, 0}), Json::array({0, 0, 2}),
+                            Json::array({0, "x", 0}), Json::array({0, -0.1, 0})}) {
+        SCOPED_TRACE(bad.dump());
+        try {
+            applySet(s, {{"background", bad}});
+            ADD_FAILURE() << "accepted";
+        } catch (const Error& e) {
+            EXPECT_THAT(e.what(), ::testing::HasSubstr("\"background\": expected [r, g, b]"));
+        }
+        EXPECT_EQ(s.background.y, 0.5f);
+    }
+}
+
 TEST(ViewState, TheStepIsOneOfTheFilesTimeSteps) {
     ViewState s = startState();
     applySet(s, {{"step", 2}}, 3);
