@@ -156,6 +156,7 @@ function fnv1a(buffer) {
 
 function onInfo(m) {
     session.info = m;
+    fitView = !!m.fit_size;
     session.state = structuredClone(m.state);
     session.histogram = m.histogram || null;
     tfEditor.update({histogram: session.histogram});
@@ -166,6 +167,7 @@ function onInfo(m) {
     resizeCanvas(session.state.size);
     updateControls();
     scheduleExportRefresh();
+    fitSize();
 }
 
 function onState(state) {
@@ -656,14 +658,19 @@ function fillSizes(size) {
     const select = $("size");
     const key = `${size[0]}x${size[1]}`;
     const sizes = kSizes.map(([w, h]) => `${w}x${h}`);
-    if (!sizes.includes(key)) sizes.unshift(key);
-    const wanted = [...sizes, "custom"];
+    // The command line's size and the current one stay offered.
+    const start = session.info && session.info.state && session.info.state.size;
+    for (const k of [start ? `${start[0]}x${start[1]}` : null, key])
+        if (k && !sizes.includes(k)) sizes.unshift(k);
+    const wanted = ["fit", ...sizes, "custom"];
     const have = [...select.options].map((o) => o.value);
     if (wanted.join() !== have.join()) {
         select.replaceChildren(...wanted.map((v) => new Option(
-            v === "custom" ? "custom…" : v.replace("x", " × "), v)));
+            v === "custom" ? "custom…" : v === "fit" ? "fit the view" : v.replace("x", " × "),
+            v)));
     }
-    if (select.value !== "custom" || $("size-custom").hidden) select.value = key;
+    if (fitView) select.value = "fit";
+    else if (select.value !== "custom" || $("size-custom").hidden) select.value = key;
     $("size-w").placeholder = size[0];
     $("size-h").placeholder = size[1];
 }
@@ -919,6 +926,12 @@ $("time-play").addEventListener("click", () => {
 });
 
 $("size").addEventListener("change", (e) => {
+    fitView = e.target.value === "fit";
+    if (fitView) {
+        $("size-custom").hidden = true;
+        fitSize();
+        return;
+    }
     if (e.target.value === "custom") {
         $("size-custom").hidden = false;
         $("size-w").value = session.state.size[0];
@@ -937,6 +950,33 @@ for (const id of ["size-w", "size-h"]) {
         if (e.key === "Enter") $("size-apply").click();
     });
 }
+
+// Fit the view: the image is rendered at the size its area has on the screen (device pixels),
+// re-sent when the area changes; the default unless `uvr view --size` was given (info's
+// fit_size). On a CPU the pixels are most of a frame's time.
+let fitView = false;
+let fitTimer = 0;
+const kFitSettleMs = 250;
+
+function fitSize() {
+    if (!fitView || !session.state) return;
+    const wrap = $("view-wrap");
+    const style = getComputedStyle(wrap);
+    const px = (v) => parseFloat(v) || 0;
+    const dpr = window.devicePixelRatio || 1;
+    const limits = (session.info && session.info.limits) || {};
+    const lo = limits.min_size || 16, hi = limits.max_size || 4096;
+    const side = (v) => Math.max(lo, Math.min(hi, Math.floor(v * dpr)));
+    const w = side(wrap.clientWidth - px(style.paddingLeft) - px(style.paddingRight));
+    const h = side(wrap.clientHeight - px(style.paddingTop) - px(style.paddingBottom));
+    const [sw, sh] = session.state.size;
+    if (Math.abs(w - sw) > 2 || Math.abs(h - sh) > 2) sendSet({size: [w, h]});
+}
+
+new ResizeObserver(() => {
+    clearTimeout(fitTimer);
+    fitTimer = setTimeout(fitSize, kFitSettleMs);
+}).observe($("view-wrap"));
 
 function applySize([w, h]) {
     const limits = (session.info && session.info.limits) || {};

@@ -156,6 +156,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
             ctx.step("GPU: " + cudaDeviceDescription());
         scene.base = settings;
         scene.commandFlags = imageFlags(*flags);
+        scene.sizeGiven = cmd->count("--size") > 0;
         // Step 3: serve until Ctrl-C.
         server::ViewServer server(std::move(scene), so, [&ctx](const std::string& line) {
             ctx.step(line.rfind("view: ", 0) == 0 ? line.substr(6) : line);

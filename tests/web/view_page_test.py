@@ -804,6 +804,25 @@ def view_section(page):
     check(vec_close(page.hook("state")["camera"]["position"], camera0["position"], 1e-9),
           "the projection toggle moved the camera")
 
+    # Fit the view: the image takes the size of its area on the screen (device pixels).
+    size0 = page.hook("state")["size"]
+    check(page.hook("info")["fit_size"] is False, "info's fit_size with --size given")
+    frames0 = page.hook("frameCount")
+    set_input("size", "fit")
+    settled(page, frames0, "the frame at the view's size")
+    want = page.js("""
+        const w = document.getElementById('view-wrap'), s = getComputedStyle(w);
+        const d = window.devicePixelRatio || 1, p = (v) => parseFloat(v) || 0;
+        return [Math.floor((w.clientWidth - p(s.paddingLeft) - p(s.paddingRight)) * d),
+                Math.floor((w.clientHeight - p(s.paddingTop) - p(s.paddingBottom)) * d)];""")
+    size = page.hook("state")["size"]
+    check(all(abs(a - b) <= 2 for a, b in zip(size, want)),
+          f"the fitted size is {size}, the view's area {want}")
+    frames0 = page.hook("frameCount")
+    set_input("size", f"{size0[0]}x{size0[1]}")
+    settled(page, frames0, "the frame at the earlier size")
+    check(page.hook("state")["size"] == size0, "the size did not come back")
+
     # An opacity preset replaces the curve.
     tf0 = page.hook("state")["tf"]
     frames0 = page.hook("frameCount")

@@ -610,6 +610,7 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
                   {"load_seconds", d.scene.loadSeconds},
                   {"prepare_seconds", prepareSeconds},
                   {"notes", d.scene.notes},
+                  {"fit_size", !d.scene.sizeGiven},
                   {"times", d.scene.series ? d.scene.series->times() : std::vector<double>{0.0}},
                   {"limits",
                    {{"max_message_bytes", d.opt.maxMessageBytes},

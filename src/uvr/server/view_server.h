@@ -71,6 +71,9 @@ struct ViewScene {
     /// Flags of the command line that shape the image beyond the state (--sample-distance,
     /// --sampling, ...) for the exported `uvr render` command, each a separate argument.
     std::vector<std::string> commandFlags;
+    /// The image size was given (--size): the page keeps it; otherwise it renders at the size
+    /// of its view on the screen (info's `fit_size`), which on a CPU is most of the speed.
+    bool sizeGiven = false;
 };
 
 /// Log lines of the server (connections, preparations, failures), one line each.
