@@ -37,6 +37,8 @@ const session = {
     exportFresh: false,    // lastExport describes the current state
     exportWaiters: [],     // {then, quiet} for the next `export` replies, in order
     lastPong: null,
+    sentSteps: [],         // [seq, step] of the sets that changed the time step, oldest first
+    shownStep: null,       // the time step of the frame on the canvas (null: the state's)
 };
 
 const token = new URLSearchParams(location.search).get("token") || "";
@@ -63,6 +65,10 @@ function sendSet(changes, interactive = false) {
     const seq = ++session.seq;
     const message = {type: "set", seq, interactive, ...changes};
     if (!send(message)) return seq;
+    if ("step" in changes) {
+        session.sentSteps.push([seq, changes.step]);
+        if (session.sentSteps.length > 64) session.sentSteps.shift();
+    }
     for (const k of kStateKeys) {
         if (k in changes && session.state) session.state[k] = structuredClone(changes[k]);
     }
@@ -222,6 +228,13 @@ async function drawFrame(header, buffer) {
     drawnDecode = id;
     if (shownBitmap) shownBitmap.close();
     shownBitmap = bitmap;
+    // The time label follows the frames shown, not the steps asked for.
+    let shown = null;
+    for (const [seq, step] of session.sentSteps) if (seq <= (header.seq ?? 0)) shown = step;
+    if (shown !== null && shown !== session.shownStep) {
+        session.shownStep = shown;
+        fillTime((session.state && session.state.step) || 0);
+    }
     resizeCanvas(fullSize(header));
     paint();
 }
@@ -254,7 +267,41 @@ function drawAnnotations() {
     const unit = window.devicePixelRatio || 1;  // one CSS pixel
     if ($("show-outline").checked) drawOutline(g, s.camera, w, h, unit);
     if ($("show-axes").checked) drawAxes(g, s.camera, h, unit);
-    if ($("show-scalar-bar").checked && s.tf && s.range) drawScalarBar(g, s, w, h, unit);
+    if (s.heatmap) drawHeatmapScale(g, w, h, unit);
+    else if ($("show-scalar-bar").checked && s.tf && s.range) drawScalarBar(g, s, w, h, unit);
+}
+
+// The heat map's colour bar (render/heatmap.cpp: kHeatmapLegendWidth pixels at the image's right,
+// the bar from kBarGap, kBarMarginY from the top and bottom) carries no numbers: the page writes
+// its scale, 0 to the frame's largest samples per pixel, beside it.
+const kHeatmapLegend = {width: 40, gap: 8, marginY: 8};
+
+function drawHeatmapScale(g, w, h, unit) {
+    const frame = session.lastFrame;
+    const top = frame && frame.stats && frame.stats.max_samples_per_pixel;
+    if (!Number.isFinite(top) || view.width <= kHeatmapLegend.width) return;
+    const sx = w / view.width, sy = h / view.height;
+    const margin = view.height >= 3 * kHeatmapLegend.marginY ? kHeatmapLegend.marginY : 0;
+    const x = (view.width - kHeatmapLegend.width + kHeatmapLegend.gap) * sx - 4 * unit;
+    const yTop = margin * sy, yBottom = (view.height - 1 - margin) * sy;
+    g.font = `${Math.round(11 * unit)}px sans-serif`;
+    g.textAlign = "right";
+    g.textBaseline = "middle";
+    const mid = Math.floor(top / 2);
+    const ticks = [[top, yTop], [0, yBottom]];
+    if (mid > 0 && mid < top) ticks.push([mid, yBottom - (mid / top) * (yBottom - yTop)]);
+    for (const [v, y] of ticks) {
+        const text = String(v);
+        const tw = g.measureText(text).width;
+        g.fillStyle = "rgba(0, 0, 0, 0.6)";
+        g.fillRect(x - tw - 3 * unit, y - 7 * unit, tw + 6 * unit, 14 * unit);
+        g.fillStyle = "#fff";
+        g.fillText(text, x, y);
+    }
+    g.textAlign = "right";
+    g.textBaseline = "bottom";
+    g.fillStyle = "#fff";
+    g.fillText("samples / pixel", x, Math.max(12 * unit, yTop - 2 * unit));
 }
 
 function drawOutline(g, camera, w, h, unit) {
@@ -897,8 +944,9 @@ function fillTime(step) {
     const slider = $("time");
     slider.max = String(times.length - 1);
     if (document.activeElement !== slider) slider.value = String(step);
-    $("time-value").textContent =
-        `${fmt(times[Math.min(step, times.length - 1)], 6)} (${step + 1}/${times.length})`;
+    // The label: the step of the frame shown (the slider: the one asked for).
+    const shown = Math.min(session.shownStep ?? step, times.length - 1);
+    $("time-value").textContent = `${fmt(times[shown], 6)} (${shown + 1}/${times.length})`;
 }
 
 let playTimer = null;  // while playing: the interval that steps on
@@ -907,6 +955,7 @@ function stopPlaying() {
     if (playTimer !== null) clearInterval(playTimer);
     playTimer = null;
     $("time-play").textContent = "▶";
+    $("time-play").title = "Play the time steps";
 }
 
 $("time").addEventListener("input", (e) => {
@@ -916,7 +965,9 @@ $("time").addEventListener("input", (e) => {
 $("time").addEventListener("change", (e) => sendSet({step: Number(e.target.value)}));
 $("time-play").addEventListener("click", () => {
     if (playTimer !== null) return stopPlaying();
-    $("time-play").textContent = "⏸";
+    // Two bars (not U+23F8, which Debian's Chromium fonts lack: it showed as an empty box).
+    $("time-play").textContent = "❚❚";
+    $("time-play").title = "Pause";
     // One step every 250 ms, the newest wins: a slow frame drops steps rather than queueing.
     playTimer = setInterval(() => {
         const count = ((session.info && session.info.times) || [0]).length;

@@ -776,6 +776,18 @@ def view_section(page):
     for box in ("show-scalar-bar", "show-axes"):
         toggle(box, True)
 
+    # The heat map's scale gets its numbers from the page (the image's bar has none).
+    frames0 = page.hook("frameCount")
+    page.hook("set({heatmap: true})")
+    settled(page, frames0, "the heat map")
+    top = page.hook("lastFrame")["stats"]["max_samples_per_pixel"]
+    labels = overlay_painted(page)
+    check(labels["right"] > 100, f"no numbers beside the heat map's scale ({labels}, top {top})")
+    page.screenshot("heatmap-scale")
+    frames0 = page.hook("frameCount")
+    page.hook("set({heatmap: false})")
+    settled(page, frames0, "the volume again")
+
     # The background: the frames, and the saved PNG, composite over it.
     frames0 = page.hook("frameCount")
     set_input("background", "#ff0000")
@@ -980,6 +992,8 @@ def time_series(uvr, driver, shots, work, tmp):
                   f"the exported command naming --step-index 2 (it reads {command!r})")
         # Play steps on from 2 and wraps to 0; pause stops it.
         page.d.find_element(By.ID, "time-play").click()
+        glyph = page.js("return document.getElementById('time-play').textContent")
+        check(glyph == "\u275a\u275a", f"the pause button reads {glyph!r}")
         page.wait("v.state && v.state.step === 0", 10, "play to wrap to step 0")
         page.d.find_element(By.ID, "time-play").click()
         shown = page.hook("state")["step"]
