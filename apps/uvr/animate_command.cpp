@@ -227,7 +227,9 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                 LegendStyle style;
                 style.background = background;
                 drawLegend(image, *legendFont, settings.tf, result.setup.rangeLo,
-                           result.setup.rangeHi, player.field().name, settings.tf.logScale, style);
+                           result.setup.rangeHi,
+                           legendTitle(player.field().name, player.field().association),
+                           settings.tf.logScale, style);
             }
             char name[64];
             std::snprintf(name, sizeof name, "%0*zu.png", digits, i);

@@ -108,7 +108,8 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
         LegendStyle style;
         style.background = background;
         drawLegend(result.image, *legendFont, settings.tf, result.setup.rangeLo,
-                   result.setup.rangeHi, field.name, settings.tf.logScale, style);
+                   result.setup.rangeHi, legendTitle(field.name, field.association),
+                   settings.tf.logScale, style);
         ctx.step("drew the legend in " + legendFont->familyName() + " (" + legendFont->path() +
                  ")");
     }

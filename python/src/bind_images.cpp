@@ -42,6 +42,24 @@ void bindImages(py::module_& m) {
         },
         py::arg("path"), py::arg("pixels"), py::arg("background") = py::none());
     m.def(
+        "draw_legend",
+        [](const py::handle& pixels, const TransferFunction& tf, double lo, double hi,
+           const std::string& title, bool logScale,
+           std::optional<std::array<float, 3>> background) {
+            Image image = imageOf(pixels);
+            LegendStyle style;
+            if (background) style.background = vec3(*background);
+            {
+                py::gil_scoped_release release;
+                const Font font(findFontFile());
+                drawLegend(image, font, tf, lo, hi, title, logScale, style);
+            }
+            return vectorArray<float>(std::move(image.pixels), {image.height, image.width, 4});
+        },
+        py::arg("pixels"), py::arg("tf"), py::arg("lo"), py::arg("hi"), py::arg("title"),
+        py::arg("log_scale"), py::arg("background") = py::none(),
+        "The image with `uvr render --legend`'s colour legend drawn on it (a new array).");
+    m.def(
         "read_png",
         [](const std::string& path) {
             Image image = readPng(path);

@@ -316,3 +316,16 @@ def test_the_settings_vocabulary_is_the_librarys(data_dir):
 def test_the_version_is_the_clis(cli):
     assert uvr.__version__
     assert cli("--version").stdout.strip() == f"uvr {uvr.__version__}"
+
+
+def test_a_legend_is_the_clis(data_dir, cli, tmp_path):
+    # Issue 35: --legend in Python too; the title says point or cell data, the ends are labelled.
+    out = tmp_path / "cli.png"
+    cli("render", data_dir / "bluntfin_tets.vtk", "-o", out, "--size", "256x192", "--legend",
+        "--background", "0,0,0", "--device", "cpu", "-q")
+    img = uvr.render(data_dir / "bluntfin_tets.vtk", size=(256, 192), legend=True,
+                     background=(0, 0, 0), device="cpu")
+    assert img.png_bytes() == out.read_bytes()
+    plain = uvr.render(data_dir / "bluntfin_tets.vtk", size=(256, 192), background=(0, 0, 0),
+                       device="cpu")
+    assert not np.array_equal(img, plain)

@@ -184,7 +184,8 @@ class Renderer:
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
                size=None, method=None, quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
-               clip_planes=None, clip_box=None, iso=None, depth=None, depth_in=None, **settings):
+               clip_planes=None, clip_box=None, iso=None, depth=None, depth_in=None,
+               legend=False, **settings):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
         ``.stats`` and ``.sample_counts``.
 
@@ -202,7 +203,8 @@ class Renderer:
         then holds per pixel the distance along the view direction (file units) where the
         opacity first reaches it, inf where it never does (``--depth``, ``--depth-opacity``);
         `depth_in` a (height, width) array of such distances of opaque geometry rendered
-        elsewhere: every ray ends there (``--depth-in``). The same settings give the CLI's
+        elsewhere: every ray ends there (``--depth-in``); `legend` True draws ``--legend``'s
+        colour legend (the field, point or cell, the range's ends) onto the image. The same settings give the CLI's
         pixels.
 
         `method`, `quality` and the other keywords are the library's settings (uvr.SETTINGS,
@@ -252,6 +254,11 @@ class Renderer:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
                                      f"{self._methods!r} when the Renderer was made)")
         pixels, counts, stats, depth = self._core.render(t, range, camera, w, h, settings)
+        if legend:
+            lo, hi = stats["range"]
+            title = f"{stats['field']} ({stats['field_association']})"
+            pixels = _uvr.draw_legend(pixels, t, lo, hi, title, bool(t.log_scale),
+                                      _background(background))
         return Image(pixels, stats=stats, sample_counts=counts,
                      background=_background(background), depth=depth)
 

@@ -218,6 +218,32 @@ double legendPosition(double v, double lo, double hi, bool logScale) {
     return std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0);
 }
 
+void addRangeEnds(LegendTicks& ticks, double lo, double hi, bool logScale, double gap) {
+    if (!(hi > lo)) return;
+    const auto at = [&](double v) { return legendPosition(v, lo, hi, logScale); };
+    const auto same = [&](double a, double b) {
+        return std::fabs(a - b) <= 1e-9 * std::max(std::fabs(a), std::fabs(b));
+    };
+    const auto label = [](double v) {
+        char buf[40];
+        std::snprintf(buf, sizeof buf, "%.4g", v);
+        return tidy(buf, false);
+    };
+    LegendTicks out;
+    const bool loTick = !ticks.values.empty() && same(ticks.values.front(), lo);
+    const bool hiTick = !ticks.values.empty() && same(ticks.values.back(), hi);
+    if (!loTick) out.values.push_back(lo), out.labels.push_back(label(lo));
+    for (std::size_t i = 0; i < ticks.values.size(); ++i) {
+        const double t = at(ticks.values[i]);
+        const bool end = (i == 0 && loTick) || (i + 1 == ticks.values.size() && hiTick);
+        if (!end && ((!loTick && t < gap) || (!hiTick && t > 1.0 - gap))) continue;
+        out.values.push_back(ticks.values[i]);
+        out.labels.push_back(ticks.labels[i]);
+    }
+    if (!hiTick) out.values.push_back(hi), out.labels.push_back(label(hi));
+    ticks = std::move(out);
+}
+
 LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
                         double hi, const std::string& title, bool logScale,
                         const LegendStyle& style) {
@@ -249,6 +275,7 @@ LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& 
     // Labels at least 1.8 digit heights apart.
     const int maxTicks = std::clamp(barHeight / (digitHeight * 9 / 5) + 1, 2, 8);
     L.ticks = legendTicks(lo, hi, logScale, std::min(5, maxTicks), maxTicks);
+    addRangeEnds(L.ticks, lo, hi, logScale, (digitHeight * 9.0 / 5.0) / barHeight);
     int labelWidth = 0;
     for (const std::string& s : L.ticks.labels)
         labelWidth = std::max(labelWidth, font.advance(s, u));

@@ -7,6 +7,7 @@
 
 #include "uvr/annotate/font.h"
 #include "uvr/core/vec.h"
+#include "uvr/mesh/mesh.h"
 #include "uvr/render/image.h"
 #include "uvr/tf/transfer_function.h"
 
@@ -34,6 +35,11 @@ LegendTicks legendTicks(double lo, double hi, bool logScale, int target = 5, int
 /// shortest form: fixed point when all values lie in [1e-3, 1e5), else 10 with a superscript
 /// exponent ("10⁶", "2×10⁻⁷").
 std::vector<std::string> formatTickLabels(const std::vector<double>& values, bool logScale = false);
+
+/// ParaView's range labels: the ends lo and hi join `ticks` (4 significant digits) unless a tick
+/// already marks them, and the ticks closer to an end than `gap` (a fraction of the bar) leave,
+/// so that no two labels overlap.
+void addRangeEnds(LegendTicks& ticks, double lo, double hi, bool logScale, double gap);
 
 /// Position in [0, 1] of value v along a legend of [lo, hi] (log: of log10 v), clamped; 0.5 when
 /// lo == hi. The transfer function's colour at that position is the colour of v.
@@ -66,6 +72,11 @@ struct LegendLayout {
     std::vector<int> tickRows;  ///< the row of each tick mark
 };
 
+/// A legend's title: the field's name and whether it is point or cell data ("density (point)").
+inline std::string legendTitle(const std::string& field, Association association) {
+    return field + " (" + associationName(association) + ")";
+}
+
 /// The smallest image a legend is drawn on (its text would not be readable on less).
 inline constexpr int kLegendMinWidth = 128;
 inline constexpr int kLegendMinHeight = 128;
@@ -73,7 +84,8 @@ inline constexpr int kLegendMinHeight = 128;
 /// Draws a colour legend in the style of ParaView's scalar bar onto a premultiplied image: a
 /// vertical bar with the transfer function's colours over its normalised domain (colour only, as
 /// ParaView and matplotlib show it: opacity per unit length is not what the image shows), the
-/// title above it and ticks from legendTicks(lo, hi, logScale) beside it, all on an opaque-text,
+/// title above it and ticks from legendTicks(lo, hi, logScale) and the range's ends
+/// (addRangeEnds) beside it, all on an opaque-text,
 /// semi-transparent box so it reads over the rendering and on a transparent PNG. Its size scales
 /// with the image (labels 1/40 of the height or 1/24 of the width, the smaller, at least 10 px).
 /// The title is any bytes (invalid UTF-8 drawn as U+FFFD), shortened with an ellipsis beyond 45%

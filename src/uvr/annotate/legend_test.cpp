@@ -195,7 +195,25 @@ TEST(LegendDraw, DrawsOnlyInItsBoxAtTheRightEdge) {
         }
     EXPECT_EQ(outside, 0);
     EXPECT_GT(ink, 200);  // title, labels, ticks and frame
-    EXPECT_EQ(L.ticks.labels, (Labels{kMinus + "4", kMinus + "2", "0", "2", "4"}));
+    // ParaView's range labels: the ends beside the nice ticks (issue 35).
+    EXPECT_EQ(L.ticks.labels,
+              (Labels{kMinus + "5", kMinus + "4", kMinus + "2", "0", "2", "4", "5"}));
+}
+
+TEST(LegendTicks, TheRangeEndsJoinTheTicksAndCrowdedTicksLeave) {
+    LegendTicks t = legendTicks(0.1926, 4.9775, false);
+    ASSERT_EQ(t.labels, (Labels{"1", "2", "3", "4"}));
+    addRangeEnds(t, 0.1926, 4.9775, false, 0.05);
+    EXPECT_EQ(t.labels, (Labels{"0.1926", "1", "2", "3", "4", "4.978"}));
+    // A tick within the gap of an end leaves; an end that is a tick is not doubled.
+    t = legendTicks(0.0, 2.254, false);
+    addRangeEnds(t, 0.0, 2.254, false, 0.15);
+    EXPECT_EQ(t.values.front(), 0.0);
+    EXPECT_EQ(t.labels.back(), "2.254");
+    for (std::size_t i = 1; i < t.values.size(); ++i) EXPECT_GT(t.values[i], t.values[i - 1]);
+    EXPECT_TRUE(std::none_of(t.values.begin(), t.values.end() - 1,
+                             [](double v) { return v > 2.254 * 0.85 && v < 2.254; }));
+    EXPECT_EQ(legendTitle("density", Association::Point), "density (point)");
 }
 
 TEST(LegendDraw, TextContrastsWithTheBackground) {
