@@ -10,6 +10,7 @@
 #include "cli_common.h"
 #include "progress.h"
 #include "render_pipeline.h"
+#include "uvr/core/text.h"
 
 namespace uvr::cli {
 
@@ -94,6 +95,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
     auto steps = std::make_shared<std::string>();
     auto prefix = std::make_shared<std::string>("frame_");
     auto perStep = std::make_shared<bool>(false);
+    auto timeLabel = std::make_shared<bool>(false);
     cmd->add_option("FILE", *file,
                     "Mesh file or series: .pvd, a quoted numbered series ('run_*.vtu'), a file "
                     "with time steps, or any mesh file (one frame)")
@@ -104,6 +106,9 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
     cmd->add_flag("--legend", flags->legend,
                   "Draw a colour legend at the right edge of every frame (the field's name, the "
                   "colour map, ticks over the value range)");
+    cmd->add_flag("--time-label", *timeLabel,
+                  "Write the step's time at the top-left of every frame (\"Time: 0.5\", as "
+                  "ParaView's Annotate Time)");
     cmd->add_option("--steps", *steps,
                     "Steps to render, FIRST:LAST[:STRIDE] by index, inclusive (default: all)");
     cmd->add_option("--prefix", *prefix, "File name of the frames before the step's number")
@@ -165,6 +170,21 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         validateSettings(settings);
         const std::optional<Vec3f> background = flags->backgroundColor();
         const std::optional<Font> legendFont = flags->legendFont();
+        std::optional<Font> labelFont;
+        if (*timeLabel) {
+            const auto [w, h] = parseSize("--size", flags->size);
+            if (w < kLegendMinWidth || h < kLegendMinHeight)
+                throwError(ErrorKind::Argument, "",
+                           "--time-label needs frames of at least " +
+                               std::to_string(kLegendMinWidth) + "x" +
+                               std::to_string(kLegendMinHeight) + " pixels, not --size " +
+                               flags->size);
+            try {
+                labelFont.emplace(findFontFile());
+            } catch (const Error& e) {
+                throwError(e.kind(), "", std::string("--time-label: ") + e.what());
+            }
+        }
 
         // Step 2: one value range for every frame (the union over the rendered steps).
         if (!settings.range && !*perStep) {
@@ -230,6 +250,12 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                            result.setup.rangeHi,
                            legendTitle(player.field().name, player.field().association),
                            settings.tf.logScale, style);
+            }
+            if (labelFont) {
+                LegendStyle style;
+                style.background = background;
+                drawCornerText(image, *labelFont,
+                               "Time: " + formatExact(player.series().times()[i]), style);
             }
             char name[64];
             std::snprintf(name, sizeof name, "%0*zu.png", digits, i);

@@ -12,9 +12,11 @@
 
 #include "cli_test_support.h"
 #include "test_support.h"
+#include "uvr/annotate/font.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/io/vtkhdf.h"
+#include "uvr/render/image.h"
 
 namespace uvr {
 namespace {
@@ -202,6 +204,35 @@ TEST(CliAnimate, ConvertWritesEveryTimeStepOrThePickedOne) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/m.vtkhdf"));
     ASSERT_EQ(uvr("-q convert mixed.pvd m.uvrm", dir).code, 0);  // a file a step: fine
     EXPECT_EQ(readMesh(dir + "/m_0001.uvrm").cellCount(), readMesh(dir + "/small.vtu").cellCount());
+}
+
+TEST(CliAnimate, TheTimeLabelIsWrittenAtTheTopLeft) {
+    // Issue 35: ParaView's Annotate Time.
+    if (!textEngineAvailable()) GTEST_SKIP() << "built without text (UVR_ENABLE_TEXT=OFF)";
+    const std::string dir = testing::scratchDir();
+    writeSeries(dir);
+    const std::string look =
+        " --field blob --size 160x128 --device cpu --opacity 0:0,1:0.8 --range 0,1 -q";
+    ASSERT_EQ(uvr("animate run.pvd -o plain" + look, dir).code, 0);
+    const CliRun r = uvr("animate run.pvd -o labelled --time-label" + look, dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char* frame : {"frame_0000.png", "frame_0002.png"}) {
+        const Image a = readPng(dir + "/plain/" + frame), b = readPng(dir + "/labelled/" + frame);
+        int topLeft = 0, rest = 0;
+        for (int y = 0; y < a.height; ++y)
+            for (int x = 0; x < a.width; ++x) {
+                const Vec4f p = a.at(x, y), q = b.at(x, y);
+                const bool differs = p.x != q.x || p.y != q.y || p.z != q.z || p.w != q.w;
+                (x < a.width * 3 / 4 && y < a.height * 3 / 8 ? topLeft : rest) += differs;
+            }
+        EXPECT_GT(topLeft, 100) << frame;
+        EXPECT_EQ(rest, 0) << frame;
+    }
+    // Different times write different labels.
+    EXPECT_NE(testing::readFile(dir + "/labelled/frame_0000.png"),
+              testing::readFile(dir + "/labelled/frame_0002.png"));
+    expectOneLineError(uvr("-q animate run.pvd -o tiny --time-label --size 64x48", dir),
+                       {"--time-label needs frames of at least 128x128"});
 }
 
 TEST(CliAnimate, BadStepsAndOutputsAreRefusedBeforeRendering) {

@@ -244,6 +244,31 @@ void addRangeEnds(LegendTicks& ticks, double lo, double hi, bool logScale, doubl
     ticks = std::move(out);
 }
 
+PixelRect drawCornerText(Image& image, const Font& font, const std::string& text,
+                         const LegendStyle& style) {
+    const int W = image.width, H = image.height;
+    if (W < kLegendMinWidth || H < kLegendMinHeight)
+        throwError(ErrorKind::Argument, "",
+                   "a label needs an image of at least " + std::to_string(kLegendMinWidth) + "x" +
+                       std::to_string(kLegendMinHeight) + " pixels, not " + std::to_string(W) +
+                       "x" + std::to_string(H));
+    const float u = std::max(10.f, std::round(std::min(H / 40.f, W / 24.f)));
+    const int margin = std::max(1, static_cast<int>(std::lround(0.8f * u)));
+    const int pad = std::max(1, static_cast<int>(std::lround(0.6f * u)));
+    const std::string shown = fitTitle(font, text, u, static_cast<int>(0.9f * W) - 2 * pad);
+    const FontMetrics m = font.metrics(u);
+    const int ascent = static_cast<int>(std::ceil(m.ascender));
+    const int height = static_cast<int>(std::ceil(m.ascender + m.descender));
+    PixelRect box{margin, margin, margin + font.advance(shown, u) + 2 * pad,
+                  margin + height + 2 * pad};
+    const Vec3f boxColor = style.background.value_or(Vec3f{1.f, 1.f, 1.f});
+    const float luminance = 0.2126f * boxColor.x + 0.7152f * boxColor.y + 0.0722f * boxColor.z;
+    const Vec3f ink = luminance > 0.45f ? Vec3f{0.08f, 0.08f, 0.08f} : Vec3f{0.95f, 0.95f, 0.95f};
+    fillRect(image, box, boxColor, 0.8f);
+    font.draw(image, shown, u, box.x0 + pad, box.y0 + pad + ascent, ink);
+    return box;
+}
+
 LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
                         double hi, const std::string& title, bool logScale,
                         const LegendStyle& style) {

@@ -95,4 +95,11 @@ LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& 
                         double hi, const std::string& title, bool logScale,
                         const LegendStyle& style = {});
 
+/// Draws one line of text at the image's top-left corner on a box as drawLegend's (the
+/// background's colour, 80%; ink contrasting), sized as the legend's labels: ParaView's
+/// Annotate Time ("Time: 0.5") on an animation's frames. Returns the box. Throws as drawLegend
+/// for an image below kLegendMinWidth x kLegendMinHeight.
+PixelRect drawCornerText(Image& image, const Font& font, const std::string& text,
+                         const LegendStyle& style = {});
+
 }  // namespace uvr
