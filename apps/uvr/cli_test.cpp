@@ -1224,5 +1224,22 @@ TEST(Cli, LinksPlantedInASharedFolderByAnotherUserAreNotFollowed) {
     EXPECT_EQ(testing::readFile(victim).substr(1, 3), "PNG");
 }
 
+TEST(Cli, TheLogSaysWhenThePngIsTransparent) {
+    // Issue 35: the default PNG is transparent (washed out on white); the log says so.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string base = "render " + testing::sharedData("spx.vtk") +
+                             " --size 32x32 --device cpu --stats s.json -o a.png";
+    const CliRun clear = uvr(base, dir);
+    ASSERT_EQ(clear.code, 0) << clear.err;
+    EXPECT_NE(clear.err.find("a.png (a transparent RGBA PNG: --background R,G,B"),
+              std::string::npos)
+        << clear.err;
+    EXPECT_EQ(clear.err.find("s.json (a transparent"), std::string::npos) << clear.err;
+    const CliRun black = uvr(base + " --background 0,0,0", dir);
+    ASSERT_EQ(black.code, 0) << black.err;
+    EXPECT_EQ(black.err.find("transparent"), std::string::npos) << black.err;
+}
+
 }  // namespace
 }  // namespace uvr

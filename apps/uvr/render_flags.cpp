@@ -129,7 +129,8 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
                        "maximum)");
     }
     app.add_option("--background", background,
-                   "Composite over this colour r,g,b in [0,1] (default: transparent RGBA PNG)")
+                   "Composite over this colour r,g,b in [0,1], e.g. 0,0,0 for black (default: a "
+                   "transparent RGBA PNG, which image viewers show over white)")
         ->capture_default_str();
     if (oneFrame)
         app.add_flag("--legend", legend,

@@ -156,7 +156,13 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
     for (const auto& file : outputs) file->finish();  // buffered bytes reach the disk (or fail)
     for (const auto& file : outputs) {
         file->commit();
-        ctx.step("wrote " + file->path());
+        // The image's background said (issue 35: a transparent PNG looks washed out on white).
+        const bool image = file->path() == outputs.front()->path();
+        ctx.step("wrote " + file->path() +
+                 (!image       ? ""
+                  : background ? ""
+                               : " (a transparent RGBA PNG: --background R,G,B composites it "
+                                 "over a colour, as the viewer shows it over black)"));
     }
     return result;
 }
