@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <set>
 
 #include "cli_common.h"
@@ -96,6 +97,8 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
     auto prefix = std::make_shared<std::string>("frame_");
     auto perStep = std::make_shared<bool>(false);
     auto timeLabel = std::make_shared<bool>(false);
+    auto movie = std::make_shared<std::string>();
+    auto fps = std::make_shared<double>(10.0);
     cmd->add_option("FILE", *file,
                     "Mesh file or series: .pvd, a quoted numbered series ('run_*.vtu'), a file "
                     "with time steps, or any mesh file (one frame)")
@@ -109,6 +112,12 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
     cmd->add_flag("--time-label", *timeLabel,
                   "Write the step's time at the top-left of every frame (\"Time: 0.5\", as "
                   "ParaView's Annotate Time)");
+    cmd->add_option("--movie", *movie,
+                    "Also write the frames as one animated PNG (APNG: browsers, ffmpeg and "
+                    "Pillow play it; other viewers show its first frame), looping");
+    cmd->add_option("--fps", *fps, "Frames per second of --movie")
+        ->capture_default_str()
+        ->check(CLI::Range(0.01, 1000.0));
     cmd->add_option("--steps", *steps,
                     "Steps to render, FIRST:LAST[:STRIDE] by index, inclusive (default: all)");
     cmd->add_option("--prefix", *prefix, "File name of the frames before the step's number")
@@ -125,6 +134,13 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             throwError(ErrorKind::Argument, "",
                        "--range-per-step and --range contradict: a given range is every "
                        "frame's");
+        if (!movie->empty()) {
+            if (fileExtension(*movie) != ".png")
+                throwError(ErrorKind::Argument, "",
+                           "--movie '" + *movie +
+                               "': the movie is an animated PNG, so its name ends in .png");
+            resolveOutput(*movie);
+        }
         if (prefix->empty() || prefix->find('/') != std::string::npos)
             throwError(ErrorKind::Argument, "",
                        "--prefix '" + *prefix + "': expected a file name part without '/'");
@@ -223,6 +239,13 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         const int digits = std::max<int>(4, int(std::to_string(series->stepCount() - 1).size()));
         std::set<std::string> warned;
         std::vector<double> reads, updates, frames;
+        // The movie: written frame by frame beside the PNGs, committed after the last.
+        std::optional<OutputFile> movieFile;
+        std::optional<ApngWriter> movieWriter;
+        if (!movie->empty()) {
+            movieFile.emplace(*movie);
+            movieWriter.emplace(*movieFile, static_cast<int>(chosen.size()), *fps);
+        }
         Progress progress(ctx, "rendering " + std::to_string(chosen.size()) + " time steps",
                           double(chosen.size()), "steps");
         for (std::size_t k = 0; k < chosen.size(); ++k) {
@@ -266,6 +289,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                 out.finish();
                 out.commit();
             }
+            if (movieWriter) movieWriter->add(image, background);
             for (const std::string& note : result.setup.notes)
                 if (warned.insert(note).second) ctx.warn(*file + ": " + note);
             const std::string empty =
@@ -300,6 +324,15 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                       chosen.size(), folder->c_str(), median(reads), median(updates),
                       median(frames));
         progress.done(summary);
+        if (movieWriter) {
+            movieWriter->finish();
+            movieFile->finish();
+            movieFile->commit();
+            char line[160];
+            std::snprintf(line, sizeof line, "wrote %s (%zu frames at %g per second)",
+                          movie->c_str(), chosen.size(), *fps);
+            ctx.step(line);
+        }
     });
 }
 

@@ -96,3 +96,30 @@ def test_set_step_is_refused_clearly(series_dir):
     with pytest.raises(uvr.ArgumentError, match="step 7"):
         r.set_step(7)
     assert r.step == 0
+
+
+def test_animate_writes_a_movie_pillow_plays(cli, tmp_path):
+    # Issue 35: uvr animate --movie, an animated PNG beside the frames, checked by Pillow.
+    from PIL import Image as PilImage
+
+    cli("-q", "generate", "box", "--cells", "2000", "--fields", "jet", "--steps", "3",
+        "-o", tmp_path / "t.uvrm")
+    movie = tmp_path / "m.png"
+    cli("-q", "animate", tmp_path / "t.pvd", "-o", tmp_path / "frames", "--movie", movie,
+        "--fps", "4", "--size", "64x48", "--device", "cpu", "--background", "0,0,0")
+    with PilImage.open(movie) as m:
+        assert m.format == "PNG" and m.is_animated and m.n_frames == 3
+        frames = []
+        for k in range(3):
+            m.seek(k)
+            assert m.info.get("duration") == 250  # ms at 4 frames per second
+            frames.append(np.asarray(m.convert("RGB")))
+    # Each movie frame is the frame PNG of its step.
+    for k in range(3):
+        with PilImage.open(tmp_path / "frames" / f"frame_{k:04d}.png") as f:
+            assert np.array_equal(frames[k], np.asarray(f.convert("RGB")))
+    assert not np.array_equal(frames[0], frames[2])
+    # A movie not named .png is refused before rendering.
+    r = cli("animate", tmp_path / "t.pvd", "-o", tmp_path / "f2", "--movie", tmp_path / "m.gif",
+            check=False)
+    assert r.returncode == 2 and "animated PNG" in r.stderr

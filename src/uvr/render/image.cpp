@@ -4,6 +4,7 @@
 #include <png.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csetjmp>
@@ -245,6 +246,121 @@ std::vector<std::uint8_t> encodePng(const Image& image, const std::optional<Vec3
     sink.level = level;
     encodeImage(sink, "PNG in memory", image, background);
     return bytes;
+}
+
+namespace {
+
+void putU32(std::vector<std::uint8_t>& v, std::uint32_t x) {
+    for (int s = 24; s >= 0; s -= 8) v.push_back(static_cast<std::uint8_t>(x >> s));
+}
+
+void putU16(std::vector<std::uint8_t>& v, std::uint16_t x) {
+    v.push_back(static_cast<std::uint8_t>(x >> 8));
+    v.push_back(static_cast<std::uint8_t>(x));
+}
+
+std::uint32_t getU32(const std::uint8_t* p) {
+    return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) |
+           std::uint32_t(p[3]);
+}
+
+}  // namespace
+
+ApngWriter::ApngWriter(OutputFile& out, int frameCount, double fps)
+    : out_(out), frameCount_(frameCount) {
+    if (frameCount < 1)
+        throwError(ErrorKind::Argument, out.path(),
+                   "an animation needs at least one frame, not " + std::to_string(frameCount));
+    if (!(fps > 0.0 && fps <= 1000.0))
+        throwError(ErrorKind::Argument, out.path(),
+                   "frames per second must lie in (0, 1000], not " + std::to_string(fps));
+    // The delay as a fraction num / den seconds: 1 / fps for whole fps, else in milliseconds.
+    if (std::fabs(fps - std::round(fps)) < 1e-9 && fps <= 65535.0) {
+        delayNum_ = 1, delayDen_ = static_cast<std::uint16_t>(std::round(fps));
+    } else {
+        delayNum_ = static_cast<std::uint16_t>(std::clamp(std::round(1000.0 / fps), 1.0, 65535.0));
+        delayDen_ = 1000;
+    }
+}
+
+void ApngWriter::chunk(const char* type, const std::uint8_t* data, std::size_t size) {
+    std::uint8_t head[8];
+    for (int k = 0; k < 4; ++k) head[k] = static_cast<std::uint8_t>(size >> (24 - 8 * k));
+    std::memcpy(head + 4, type, 4);
+    uLong crc = crc32(0L, head + 4, 4);
+    if (size > 0) crc = crc32(crc, data, static_cast<uInt>(size));
+    out_.write(head, sizeof head);
+    if (size > 0) out_.write(data, size);
+    std::uint8_t tail[4];
+    for (int k = 0; k < 4; ++k) tail[k] = static_cast<std::uint8_t>(crc >> (24 - 8 * k));
+    out_.write(tail, sizeof tail);
+}
+
+void ApngWriter::add(const Image& image, const std::optional<Vec3f>& background) {
+    if (added_ >= frameCount_)
+        throwError(ErrorKind::Argument, out_.path(),
+                   "more frames than the " + std::to_string(frameCount_) + " announced");
+    if (added_ > 0 && (image.width != width_ || image.height != height_))
+        throwError(ErrorKind::Argument, out_.path(),
+                   "frame " + std::to_string(added_) + " is " + std::to_string(image.width) + "x" +
+                       std::to_string(image.height) + ", the first " + std::to_string(width_) +
+                       "x" + std::to_string(height_));
+    const std::vector<std::uint8_t> png = encodePng(image, background);
+    // The PNG's chunks after its signature: IHDR first, then IDATs (libpng writes no others
+    // between them that a frame needs).
+    std::size_t at = 8;
+    bool first = added_ == 0;
+    if (first) {
+        static const std::uint8_t kSignature[8] = {137, 80, 78, 71, 13, 10, 26, 10};
+        out_.write(kSignature, sizeof kSignature);
+        width_ = image.width, height_ = image.height;
+    }
+    std::vector<std::uint8_t> control;  // fcTL
+    putU32(control, sequence_++);
+    putU32(control, static_cast<std::uint32_t>(image.width));
+    putU32(control, static_cast<std::uint32_t>(image.height));
+    putU32(control, 0);
+    putU32(control, 0);
+    putU16(control, delayNum_);
+    putU16(control, delayDen_);
+    control.push_back(0);  // dispose: none
+    control.push_back(0);  // blend: source (each frame replaces the last)
+    bool controlWritten = false;
+    while (at + 12 <= png.size()) {
+        const std::uint32_t length = getU32(&png[at]);
+        const char* type = reinterpret_cast<const char*>(&png[at + 4]);
+        const std::uint8_t* data = &png[at + 8];
+        if (at + 12 + length > png.size()) break;
+        const std::string name(type, 4);
+        if (name == "IHDR" && first) {
+            chunk("IHDR", data, length);
+            std::vector<std::uint8_t> actl;
+            putU32(actl, static_cast<std::uint32_t>(frameCount_));
+            putU32(actl, 0);  // loop for ever
+            chunk("acTL", actl.data(), actl.size());
+        } else if (name == "IDAT") {
+            if (!controlWritten) chunk("fcTL", control.data(), control.size());
+            controlWritten = true;
+            if (first) {
+                chunk("IDAT", data, length);
+            } else {
+                std::vector<std::uint8_t> fdat;
+                putU32(fdat, sequence_++);
+                fdat.insert(fdat.end(), data, data + length);
+                chunk("fdAT", fdat.data(), fdat.size());
+            }
+        }
+        at += 12 + length;
+    }
+    ++added_;
+}
+
+void ApngWriter::finish() {
+    if (added_ != frameCount_)
+        throwError(ErrorKind::Argument, out_.path(),
+                   std::to_string(added_) + " frames added of the " + std::to_string(frameCount_) +
+                       " announced");
+    chunk("IEND", nullptr, 0);
 }
 
 Image readPng(const std::string& path) {

@@ -54,6 +54,29 @@ std::vector<std::uint8_t> encodePng(const Image& image,
                                     const std::optional<Vec3f>& background = std::nullopt,
                                     int level = -1);
 
+/// An animated PNG (APNG: the PNG extension every current browser, ffmpeg and Pillow read; a
+/// plain PNG reader shows its first frame) written frame by frame to `out`: each frame is the
+/// PNG encodePng makes of it (libpng, zlib), its image data carried as one frame of the
+/// animation, shown for 1/fps seconds, looping. Every frame must have the first's size and the
+/// same background (so the same colour type). finish() writes the end; the caller commits `out`.
+class ApngWriter {
+public:
+    /// Starts an animation of frameCount frames (>= 1) at fps (> 0) frames per second.
+    ApngWriter(OutputFile& out, int frameCount, double fps);
+    /// Appends the next frame; Error(Argument) past frameCount or for another size.
+    void add(const Image& image, const std::optional<Vec3f>& background = std::nullopt);
+    /// Writes the end; Error(Argument) when fewer than frameCount frames were added.
+    void finish();
+
+private:
+    void chunk(const char* type, const std::uint8_t* data, std::size_t size);
+    OutputFile& out_;
+    int frameCount_ = 0, added_ = 0;
+    std::uint16_t delayNum_ = 1, delayDen_ = 10;
+    std::uint32_t sequence_ = 0;
+    int width_ = 0, height_ = 0;
+};
+
 /// Reads an 8-bit or 16-bit PNG (grey, grey+alpha, RGB, RGBA, palette) into a premultiplied
 /// Image; throws Error(Io/Parse) naming the file.
 Image readPng(const std::string& path);

@@ -13,6 +13,7 @@
 #include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/core/file_util.h"
+#include "uvr/core/output_file.h"
 
 namespace uvr {
 namespace {
@@ -258,6 +259,41 @@ TEST(Png, WritingIntoMissingFolderThrowsAndLeavesNoFile) {
     EXPECT_EQ(catchError([&] { writePng(dir + "/zero.png", Image(0, 3)); }).kind(),
               ErrorKind::Argument);
     EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+TEST(Apng, FramesAreCountedAndSizedAndTheFirstIsAPlainPng) {
+    const std::string dir = testing::scratchDir();
+    Image a(8, 6), b(8, 6);
+    for (Vec4f& p : a.pixels) p = Vec4f(1.f, 0.f, 0.f, 1.f);
+    for (Vec4f& p : b.pixels) p = Vec4f(0.f, 0.f, 1.f, 1.f);
+    {
+        OutputFile out(dir + "/m.png");
+        ApngWriter movie(out, 2, 5.0);
+        movie.add(a);
+        EXPECT_THROW(movie.finish(), Error);          // one frame short
+        EXPECT_THROW(movie.add(Image(4, 4)), Error);  // another size
+        movie.add(b);
+        EXPECT_THROW(movie.add(a), Error);  // past the count
+        movie.finish();
+        out.finish();
+        out.commit();
+    }
+    // A plain PNG reader sees the first frame; the animation's chunks are there, in order.
+    const Image first = readPng(dir + "/m.png");
+    EXPECT_EQ(first.width, 8);
+    EXPECT_EQ(first.at(3, 3).x, 1.f);
+    const std::string bytes = testing::readFile(dir + "/m.png");
+    const std::size_t actl = bytes.find("acTL"), idat = bytes.find("IDAT"),
+                      fdat = bytes.find("fdAT");
+    ASSERT_NE(actl, std::string::npos);
+    ASSERT_NE(fdat, std::string::npos);
+    EXPECT_LT(actl, idat);
+    EXPECT_LT(idat, fdat);
+    EXPECT_EQ(static_cast<unsigned char>(bytes[actl + 7]), 2u);  // num_frames 2
+    EXPECT_EQ(bytes.substr(bytes.size() - 8, 4), "IEND");
+    OutputFile other(dir + "/n.png");
+    EXPECT_THROW(ApngWriter(other, 0, 5.0), Error);
+    EXPECT_THROW(ApngWriter(other, 1, 0.0), Error);
 }
 
 }  // namespace
