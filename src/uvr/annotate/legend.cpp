@@ -244,14 +244,32 @@ void addRangeEnds(LegendTicks& ticks, double lo, double hi, bool logScale, doubl
     ticks = std::move(out);
 }
 
+namespace {
+
+/// Error(Argument) unless the image is at least kLegendMinWidth x kLegendMinHeight.
+void requireAnnotatable(const Image& image, const char* what) {
+    if (image.width < kLegendMinWidth || image.height < kLegendMinHeight)
+        throwError(ErrorKind::Argument, "",
+                   std::string(what) + " needs an image of at least " +
+                       std::to_string(kLegendMinWidth) + "x" + std::to_string(kLegendMinHeight) +
+                       " pixels, not " + std::to_string(image.width) + "x" +
+                       std::to_string(image.height));
+}
+
+/// An annotation's backing box colour (the background, white on a transparent image) and the
+/// one of near-black and near-white ink that contrasts with it.
+std::pair<Vec3f, Vec3f> boxAndInk(const LegendStyle& style) {
+    const Vec3f box = style.background.value_or(Vec3f{1.f, 1.f, 1.f});
+    const float luminance = 0.2126f * box.x + 0.7152f * box.y + 0.0722f * box.z;
+    return {box, luminance > 0.45f ? Vec3f{0.08f, 0.08f, 0.08f} : Vec3f{0.95f, 0.95f, 0.95f}};
+}
+
+}  // namespace
+
 PixelRect drawCornerText(Image& image, const Font& font, const std::string& text,
                          const LegendStyle& style) {
+    requireAnnotatable(image, "a label");
     const int W = image.width, H = image.height;
-    if (W < kLegendMinWidth || H < kLegendMinHeight)
-        throwError(ErrorKind::Argument, "",
-                   "a label needs an image of at least " + std::to_string(kLegendMinWidth) + "x" +
-                       std::to_string(kLegendMinHeight) + " pixels, not " + std::to_string(W) +
-                       "x" + std::to_string(H));
     const float u = std::max(10.f, std::round(std::min(H / 40.f, W / 24.f)));
     const int margin = std::max(1, static_cast<int>(std::lround(0.8f * u)));
     const int pad = std::max(1, static_cast<int>(std::lround(0.6f * u)));
@@ -261,9 +279,7 @@ PixelRect drawCornerText(Image& image, const Font& font, const std::string& text
     const int height = static_cast<int>(std::ceil(m.ascender + m.descender));
     PixelRect box{margin, margin, margin + font.advance(shown, u) + 2 * pad,
                   margin + height + 2 * pad};
-    const Vec3f boxColor = style.background.value_or(Vec3f{1.f, 1.f, 1.f});
-    const float luminance = 0.2126f * boxColor.x + 0.7152f * boxColor.y + 0.0722f * boxColor.z;
-    const Vec3f ink = luminance > 0.45f ? Vec3f{0.08f, 0.08f, 0.08f} : Vec3f{0.95f, 0.95f, 0.95f};
+    const auto [boxColor, ink] = boxAndInk(style);
     fillRect(image, box, boxColor, 0.8f);
     font.draw(image, shown, u, box.x0 + pad, box.y0 + pad + ascent, ink);
     return box;
@@ -272,12 +288,8 @@ PixelRect drawCornerText(Image& image, const Font& font, const std::string& text
 LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
                         double hi, const std::string& title, bool logScale,
                         const LegendStyle& style) {
+    requireAnnotatable(image, "a legend");
     const int W = image.width, H = image.height;
-    if (W < kLegendMinWidth || H < kLegendMinHeight)
-        throwError(ErrorKind::Argument, "",
-                   "a legend needs an image of at least " + std::to_string(kLegendMinWidth) + "x" +
-                       std::to_string(kLegendMinHeight) + " pixels, not " + std::to_string(W) +
-                       "x" + std::to_string(H));
     legendTicks(lo, hi, logScale);  // a bad range fails before anything is drawn
 
     // Sizes: everything in units of the label size u, about 1/40 of the height.
@@ -327,9 +339,7 @@ LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& 
     L.bar.y1 = L.bar.y0 + barHeight;
 
     // Colours: the box as the background (white on a transparent image), text contrasting.
-    const Vec3f boxColor = style.background.value_or(Vec3f{1.f, 1.f, 1.f});
-    const float luminance = 0.2126f * boxColor.x + 0.7152f * boxColor.y + 0.0722f * boxColor.z;
-    const Vec3f ink = luminance > 0.45f ? Vec3f{0.08f, 0.08f, 0.08f} : Vec3f{0.95f, 0.95f, 0.95f};
+    const auto [boxColor, ink] = boxAndInk(style);
 
     // Drawing: box, title, bar with its frame, tick marks and labels.
     fillRect(image, L.box, boxColor, 0.8f);

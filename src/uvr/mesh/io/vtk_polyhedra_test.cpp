@@ -75,6 +75,29 @@ std::uint64_t boundaryFaces(const Mesh& m) {
     return n;
 }
 
+/// Volume per source cell (the cell field 'id' each tetrahedron inherits) against VTK's, the
+/// tetrahedra all positive; cells VTK's own (not decomposed) count as VTK's volume.
+void expectVolumesPerSourceCell(const Mesh& m, const std::vector<double>& vtkVolumes,
+                                double tolerance) {
+    const Field* id = m.findField("id", Association::Cell);
+    ASSERT_NE(id, nullptr);
+    ASSERT_EQ(id->values.size(), m.cellCount());
+    std::vector<double> volume(vtkVolumes.size(), 0.0);
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
+        const std::size_t source = static_cast<std::size_t>(id->values[c]);
+        ASSERT_LT(source, volume.size());
+        if (m.cellTypes[c] == CellType::Tetra) {
+            const double v = tetVolume(m, c);
+            EXPECT_GT(v, 0.0) << "cell " << c;
+            volume[source] += v;
+        } else {
+            volume[source] += vtkVolumes[source];
+        }
+    }
+    for (std::size_t c = 0; c < volume.size(); ++c)
+        EXPECT_NEAR(volume[c], vtkVolumes[c], tolerance) << "source cell " << c;
+}
+
 #define REQUIRE_POLY_DIR() \
     if (polyDir().empty()) GTEST_SKIP() << "no python3-vtk9 in the system python"
 
@@ -99,24 +122,7 @@ TEST(VtkPolyhedra, MixedMeshMatchesVtkVolumesFieldsAndNeighbours) {
         const ValidationReport report = validateMesh(m, path);
         EXPECT_TRUE(report.findings().empty()) << ::testing::PrintToString(report.findings());
 
-        // Volume per source cell (the cell field 'id' each tetrahedron inherits) against VTK's.
-        const Field* id = m.findField("id", Association::Cell);
-        ASSERT_NE(id, nullptr);
-        ASSERT_EQ(id->values.size(), m.cellCount());
-        std::vector<double> volume(vtkVolumes.size(), 0.0);
-        for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
-            const std::size_t source = static_cast<std::size_t>(id->values[c]);
-            ASSERT_LT(source, volume.size());
-            if (m.cellTypes[c] == CellType::Tetra) {
-                const double v = tetVolume(m, c);
-                EXPECT_GT(v, 0.0) << "cell " << c;
-                volume[source] += v;
-            } else {
-                volume[source] += vtkVolumes[source];  // VTK's own cells: counted as VTK's
-            }
-        }
-        for (std::size_t c = 0; c < volume.size(); ++c)
-            EXPECT_NEAR(volume[c], vtkVolumes[c], 1e-6) << "source cell " << c;
+        expectVolumesPerSourceCell(m, vtkVolumes, 1e-6);
 
         // The point field at the original points as written, and x + 2y - z at every point:
         // the centroids' means of a linear field are the field at the centroid.
@@ -155,24 +161,7 @@ TEST(VtkPolyhedra, PentagonalAndHexagonalPrismsMatchVtkVolumes) {
                                            "decomposed into 36 tetrahedra")));
         const ValidationReport report = validateMesh(m, path);
         EXPECT_TRUE(report.findings().empty()) << ::testing::PrintToString(report.findings());
-        const Field* id = m.findField("id", Association::Cell);
-        ASSERT_NE(id, nullptr);
-        ASSERT_EQ(id->values.size(), m.cellCount());
-        std::vector<double> volume(vtkVolumes.size(), 0.0);
-        for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
-            const std::size_t source = static_cast<std::size_t>(id->values[c]);
-            ASSERT_LT(source, volume.size());
-            if (m.cellTypes[c] == CellType::Tetra) {
-                const double v = tetVolume(m, c);
-                EXPECT_GT(v, 0.0) << "cell " << c;
-                volume[source] += v;
-            } else {
-                volume[source] += vtkVolumes[source];
-            }
-        }
-        // (ASCII files hold 6 digits.)
-        for (std::size_t c = 0; c < volume.size(); ++c)
-            EXPECT_NEAR(volume[c], vtkVolumes[c], 1e-5) << "source cell " << c;
+        expectVolumesPerSourceCell(m, vtkVolumes, 1e-5);  // ASCII files hold 6 digits
         const Field* f = m.findField("f", Association::Point);
         ASSERT_NE(f, nullptr);
         for (std::uint64_t p = 0; p < m.pointCount(); ++p) {
