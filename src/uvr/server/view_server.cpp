@@ -148,10 +148,13 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
                            std::to_string(meshStep) +
                            ": the viewer shows the time steps of one geometry (uvr animate renders "
                            "any)");
-        std::vector<FieldInfo> infos;
+        // The two lists compared as listed (names, associations, components): whether a field
+        // holds one value is the step's values, not its list.
+        std::vector<FieldInfo> infos, listed = fieldInfos;
         for (const Field& f : *stepFields) infos.push_back({f.name, f.association, f.components});
+        for (FieldInfo& f : listed) f.constant = false;
         if (resolveField(infos, parseFieldSpec(spec)).index !=
-            resolveField(fieldInfos, parseFieldSpec(spec)).index)
+            resolveField(listed, parseFieldSpec(spec)).index)
             throwError(ErrorKind::Unsupported, scene.series->stepSource(step),
                        "time step " + std::to_string(step) +
                            " lists its fields otherwise than "
