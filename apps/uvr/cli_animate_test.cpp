@@ -181,6 +181,10 @@ TEST(CliAnimate, ConvertWritesEveryTimeStepOrThePickedOne) {
         EXPECT_EQ(converted->readStep(k).fields[0].values, readMesh(dir + name).fields[0].values)
             << k;
     }
+    // --compress reaches every step's file.
+    ASSERT_EQ(uvr("-q convert t.pvd raw.vtu --compress none", dir).code, 0);
+    EXPECT_EQ(testing::readFile(dir + "/raw_0001.vtu").find("compressor="), std::string::npos);
+    EXPECT_NE(testing::readFile(dir + "/c_0001.vtu").find("compressor="), std::string::npos);
     // One step when asked.
     ASSERT_EQ(uvr("-q convert t.pvd two.vtu --step-index 2", dir).code, 0);
     EXPECT_EQ(readMesh(dir + "/two.vtu").fields[0].values,

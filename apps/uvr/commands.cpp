@@ -139,7 +139,8 @@ void writeMeshWithProgress(const Mesh& mesh, const std::string& out, const Conte
 /// extension, and the ParaView .pvd beside them listing them (relative to its folder) at `times`;
 /// stepMesh(k) gives step k's mesh, valid until the next call.
 void writePvdSeries(const std::string& out, const std::vector<double>& times,
-                    const std::function<const Mesh&(std::size_t)>& stepMesh, const Context& ctx) {
+                    const std::function<const Mesh&(std::size_t)>& stepMesh, const Context& ctx,
+                    const MeshWriteOptions& options = {}) {
     namespace fs = std::filesystem;
     const fs::path path(out);
     const std::string stem = path.stem().string(), ext = path.extension().string();
@@ -150,7 +151,7 @@ void writePvdSeries(const std::string& out, const std::vector<double>& times,
         char name[32];
         std::snprintf(name, sizeof name, "_%04zu", k);
         const std::string file = stem + name + ext;
-        writeMeshWithProgress(stepMesh(k), (path.parent_path() / file).string(), ctx);
+        writeMeshWithProgress(stepMesh(k), (path.parent_path() / file).string(), ctx, options);
         pvd += "    <DataSet timestep=\"" + formatExact(times[k]) + "\" part=\"0\" file=\"" + file +
                "\"/>\n";
     }
@@ -408,7 +409,7 @@ void addConvertCommand(CLI::App& app, Context& ctx) {
                 if (k > 0) mesh = loadMesh(*in, ctx, StepFlags{std::nullopt, k});
                 return mesh;
             },
-            ctx);
+            ctx, options);
     });
 }
 
