@@ -187,20 +187,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         const std::optional<Vec3f> background = flags->backgroundColor();
         const std::optional<Font> legendFont = flags->legendFont();
         std::optional<Font> labelFont;
-        if (*timeLabel) {
-            const auto [w, h] = parseSize("--size", flags->size);
-            if (w < kLegendMinWidth || h < kLegendMinHeight)
-                throwError(ErrorKind::Argument, "",
-                           "--time-label needs frames of at least " +
-                               std::to_string(kLegendMinWidth) + "x" +
-                               std::to_string(kLegendMinHeight) + " pixels, not --size " +
-                               flags->size);
-            try {
-                labelFont.emplace(findFontFile());
-            } catch (const Error& e) {
-                throwError(e.kind(), "", std::string("--time-label: ") + e.what());
-            }
-        }
+        if (*timeLabel) labelFont.emplace(flags->annotationFont("--time-label", "frames"));
 
         // Step 2: one value range for every frame (the union over the rendered steps).
         if (!settings.range && !*perStep) {

@@ -359,16 +359,20 @@ RenderSettings RenderFlags::settings(const Bounds3f& bounds, const std::string& 
 
 std::optional<Font> RenderFlags::legendFont() const {
     if (!legend) return std::nullopt;
+    return annotationFont("--legend", "an image");
+}
+
+Font RenderFlags::annotationFont(const std::string& flag, const std::string& image) const {
     const auto [width, height] = parseSize("--size", size);
     if (width < kLegendMinWidth || height < kLegendMinHeight)
         throwError(ErrorKind::Argument, "",
-                   "--legend needs an image of at least " + std::to_string(kLegendMinWidth) + "x" +
-                       std::to_string(kLegendMinHeight) + " pixels to be readable, not --size " +
-                       size);
+                   flag + " needs " + image + " of at least " + std::to_string(kLegendMinWidth) +
+                       "x" + std::to_string(kLegendMinHeight) +
+                       " pixels to be readable, not --size " + size);
     try {
         return Font(findFontFile());
     } catch (const Error& e) {
-        throwError(e.kind(), "", std::string("--legend: ") + e.what());
+        throwError(e.kind(), "", flag + ": " + e.what());
     }
 }
 

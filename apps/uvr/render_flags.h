@@ -72,6 +72,10 @@ struct RenderFlags {
     /// --size leaves room for it; throws Error naming --legend and what is missing. Without
     /// --legend, none.
     std::optional<Font> legendFont() const;
+    /// The font of an annotation `flag` asks for (--legend, --time-label), after checking that
+    /// --size gives `image` ("an image", "frames") large enough to read it; Error(Argument) or
+    /// the font lookup's error, prefixed by the flag.
+    Font annotationFont(const std::string& flag, const std::string& image) const;
     /// Checks every flag that does not need the mesh (and, for a .uvrm meshFile, that --field
     /// names one of the fields its header lists; with --legend, that a font is found), so that a
     /// bad flag fails before minutes of reading; throws Error(Argument) as settings() would.

@@ -157,12 +157,11 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
     for (const auto& file : outputs) {
         file->commit();
         // The image's background said (issue 35: a transparent PNG looks washed out on white).
-        const bool image = file->path() == outputs.front()->path();
+        const bool transparentImage = file == outputs.front() && !background;
         ctx.step("wrote " + file->path() +
-                 (!image       ? ""
-                  : background ? ""
-                               : " (a transparent RGBA PNG: --background R,G,B composites it "
-                                 "over a colour, as the viewer shows it over black)"));
+                 (transparentImage ? " (a transparent RGBA PNG: --background R,G,B composites it "
+                                     "over a colour, as the viewer shows it over black)"
+                                   : ""));
     }
     return result;
 }

@@ -44,9 +44,11 @@ void bindImages(py::module_& m) {
     m.def(
         "draw_legend",
         [](const py::handle& pixels, const TransferFunction& tf, double lo, double hi,
-           const std::string& title, bool logScale,
+           const std::string& field, const std::string& association, bool logScale,
            std::optional<std::array<float, 3>> background) {
             Image image = imageOf(pixels);
+            const std::string title =
+                legendTitle(field, parseAssociation(association, "association"));
             LegendStyle style;
             if (background) style.background = vec3(*background);
             {
@@ -56,8 +58,8 @@ void bindImages(py::module_& m) {
             }
             return vectorArray<float>(std::move(image.pixels), {image.height, image.width, 4});
         },
-        py::arg("pixels"), py::arg("tf"), py::arg("lo"), py::arg("hi"), py::arg("title"),
-        py::arg("log_scale"), py::arg("background") = py::none(),
+        py::arg("pixels"), py::arg("tf"), py::arg("lo"), py::arg("hi"), py::arg("field"),
+        py::arg("association"), py::arg("log_scale"), py::arg("background") = py::none(),
         "The image with `uvr render --legend`'s colour legend drawn on it (a new array).");
     m.def(
         "read_png",

@@ -256,8 +256,8 @@ class Renderer:
         pixels, counts, stats, depth = self._core.render(t, range, camera, w, h, settings)
         if legend:
             lo, hi = stats["range"]
-            title = f"{stats['field']} ({stats['field_association']})"
-            pixels = _uvr.draw_legend(pixels, t, lo, hi, title, bool(t.log_scale),
+            pixels = _uvr.draw_legend(pixels, t, lo, hi, stats["field"],
+                                      stats["field_association"], bool(t.log_scale),
                                       _background(background))
         return Image(pixels, stats=stats, sample_counts=counts,
                      background=_background(background), depth=depth)
