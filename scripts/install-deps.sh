@@ -4,13 +4,15 @@
 # building and running uvr needs: the compiler and CMake, the image, XML, compression and HDF5
 # libraries, FreeType, fontconfig and the DejaVu fonts for the colour legend (`--legend`), Boost
 # (Beast, headers only) and libturbojpeg for the browser viewer (`uvr view`), netCDF for Exodus II,
+# Open MPI (libopenmpi-dev, and openmpi-bin's mpirun) for rendering over several ranks,
 # python3-dev, pybind11-dev and numpy for the Python module (python/). With --tests, also what
 # the test suite needs (about 1.3 GB more): GoogleTest and Google Benchmark; clang with libFuzzer
 # (libclang-rt-14-dev) and its OpenMP (libomp-dev) for the sanitizer build and the fuzz targets;
 # clang-format-14 for the style check; xvfb for VTK's oracle tests; chromium, chromium-driver and
 # python3-selenium for the viewer page's browser test; pytest, meshio, python3-vtk9, scikit-image
 # and matplotlib for the Python tests and benchmark figures; python3-h5py for the VTKHDF test
-# files; mayavi2 for ParaView's disk_out_ref.ex2 the Exodus tests read.
+# files; mayavi2 for ParaView's disk_out_ref.ex2 the Exodus tests read; python3-mpi4py for the
+# Python module under mpirun.
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make ninja-build pkg-config
@@ -19,13 +21,14 @@ PACKAGES="g++ cmake make ninja-build pkg-config
   libfreetype-dev libfontconfig-dev fonts-dejavu-core
   libboost-dev libturbojpeg0-dev
   libnetcdf-dev libhdf5-dev
+  libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-dev pybind11-dev"
 TEST_PACKAGES="libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev libomp-dev clang-format-14
   python3-vtk9 python3-meshio python3-skimage python3-pytest python3-matplotlib
   xvfb xauth
   chromium chromium-driver python3-selenium
-  python3-h5py mayavi2"
+  python3-h5py mayavi2 python3-mpi4py"
 case "${1:-}" in
   --tests) PACKAGES="$PACKAGES $TEST_PACKAGES" ;;
   "") ;;

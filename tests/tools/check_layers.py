@@ -24,6 +24,7 @@ LADDER = [
     ["prepare"],
     ["render"],
     ["cpu", "cuda", "annotate", "cache"],
+    ["dist"],
     ["facade"],
     ["uvr.h"],  # the public header: the facade and what its users need beside it
     ["server"],
