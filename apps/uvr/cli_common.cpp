@@ -93,15 +93,15 @@ std::string Context::spell(const Error& error) const {
 }
 
 void Context::step(const std::string& message) const {
-    if (!quiet) printStderrLine("uvr: " + printable(spell(message)));
+    if (!quiet && root()) printStderrLine("uvr: " + printable(spell(message)));
 }
 
 void Context::warn(const std::string& message) const {
-    printStderrLine("uvr: warning: " + printable(spell(message)));
+    if (root()) printStderrLine("uvr: warning: " + printable(spell(message)));
 }
 
 void Context::done(const std::string& message, Clock::time_point start) const {
-    if (quiet) return;
+    if (quiet || !root()) return;
     char seconds[32];
     std::snprintf(seconds, sizeof seconds, " (%.2f s)",
                   std::chrono::duration<double>(Clock::now() - start).count());

@@ -39,6 +39,13 @@ public:
     std::string spell(const Error& error) const;
     /// The command line, for spell (set once by main).
     const CLI::App* app = nullptr;
+    /// The ranks of a data-parallel run (`mpirun -n N uvr render`; set by main), else null.
+    Communicator* comm = nullptr;
+    /// True where messages and outputs are written: rank 0 of a data-parallel run, any other
+    /// run.
+    bool root() const { return !comm || comm->rank() == 0; }
+    /// True in a data-parallel run of more than one rank.
+    bool dataParallel() const { return comm && comm->size() > 1; }
 
 private:
     mutable std::string activityFile_, activity_;

@@ -33,6 +33,14 @@ int main(int argc, char** argv) {
                        "buffers), and the estimated image buffers of --size and meshes of "
                        "--cells; larger needs are refused before allocating");
     app.parse_complete_callback([&] {
+        // mpirun: one rank per process, data-parallel; only `render` divides its work yet.
+        if (ctx.dataParallel())
+            for (const CLI::App* sub : app.get_subcommands())
+                if (sub->get_name() != "render")
+                    throwError(ErrorKind::Unsupported, "",
+                               "uvr " + sub->get_name() +
+                                   " does not run data-parallel yet: run it without mpirun "
+                                   "(`mpirun -n N uvr render` does)");
         cli::capEnvironmentThreads();
         ctx.maxMemoryBytes =
             maxMemory.empty() ? memoryDefault.bytes : cli::parseBytes("--max-memory", maxMemory);
@@ -50,6 +58,18 @@ int main(int argc, char** argv) {
     cli::addPresetsCommand(app, ctx);
     cli::addViewCommand(app, ctx);
     cli::addAnimateCommand(app, ctx);
+    // Started by mpirun (or srun): the ranks render data-parallel, and only rank 0 writes
+    // messages and files; every rank agrees on failures, so all exit with rank 0's message.
+    try {
+        if (launchedUnderMpi()) {
+            pinGpuToLocalRank();  // one GPU per rank of a node, before CUDA starts
+            ctx.comm = &mpiWorld();
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "uvr: error: %s\n", printable(e.what()).c_str());
+        return 2;
+    }
+    const bool root = ctx.root();
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -62,14 +82,15 @@ int main(int argc, char** argv) {
         return e.get_exit_code();  // a completed command's own exit status (compare --min-ssim)
     } catch (const CLI::ParseError& e) {
         const std::vector<std::string> args(argv + 1, argv + argc);
-        std::fprintf(stderr, "uvr: error: %s\n",
-                     printable(cli::describeParseError(app, args, e)).c_str());
+        if (root)
+            std::fprintf(stderr, "uvr: error: %s\n",
+                         printable(cli::describeParseError(app, args, e)).c_str());
         return 2;
     } catch (const Error& e) {
         // The library names settings in neutral words: here, by their flags (--max-sample-distance
         // -2:
         // ...). Messages quote names from files: escaped, they stay one line.
-        std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.spell(e)).c_str());
+        if (root) std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.spell(e)).c_str());
         return e.kind() == ErrorKind::Internal ? 70 : 2;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "uvr: error: %s\n", printable(ctx.outOfMemoryMessage()).c_str());

@@ -82,7 +82,7 @@ Progress::Progress(const Context& ctx, std::string what, double total, std::stri
       what_(std::move(what)),
       unit_(std::move(unit)),
       total_(total),
-      style_(styleFor(ctx.quiet)),
+      style_(styleFor(ctx.quiet || !ctx.root())),
       start_(Clock::now()) {
     if (style_ != ProgressStyle::Off) ticker_ = std::thread([this] { run(); });
 }

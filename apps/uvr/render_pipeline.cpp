@@ -82,13 +82,16 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
         result = renderer.render(settings);
         settings.progress = {};
     }
+    if (!renderer.isRoot()) return result;  // rank 0 writes the frame (data-parallel)
     ctx.setActivity(out.image, "writing the image");
     char line[200];
+    const std::string where = result.ranks.empty() ? std::string(renderer.deviceName())
+                                                   : std::to_string(result.ranks.size()) +
+                                                         " ranks (" + renderer.deviceName() + ")";
     std::snprintf(
         line, sizeof line, "rendered on %s in %.3f s: %llu samples, %.1f per pixel, step %g",
-        renderer.deviceName(), result.stats.seconds,
-        static_cast<unsigned long long>(result.stats.samples), result.stats.meanSamplesPerPixel(),
-        result.setup.params.step / result.setup.frame.scale);
+        where.c_str(), result.stats.seconds, static_cast<unsigned long long>(result.stats.samples),
+        result.stats.meanSamplesPerPixel(), result.setup.params.step / result.setup.frame.scale);
     ctx.step(line);
     if (!result.setup.method.reason.empty()) ctx.step(result.setup.method.reason);
     if (result.setup.method.method == RenderMethod::Partitions) {
@@ -180,6 +183,7 @@ RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const Render
     const RenderSettings settings = checkedSettings(flags, src, ctx);
     ctx.setActivity(source, "preparing the mesh for rendering");
     RendererOptions options = flags.rendererOptions();
+    options.communicator = ctx.comm;
     // The mesh as read is not needed once split: freed then (a billion cells' arrays).
     options.afterSplit = [&mesh] { mesh = Mesh(); };
     const std::unique_ptr<Renderer> renderer = makeRenderer(mesh, field, options, ctx);

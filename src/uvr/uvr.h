@@ -9,6 +9,8 @@
 #include "uvr/core/file_util.h"
 #include "uvr/core/output_file.h"
 #include "uvr/cuda/cuda_device.h"
+#include "uvr/dist/communicator.h"
+#include "uvr/dist/mpi_communicator.h"
 #include "uvr/facade/frame_report.h"
 #include "uvr/facade/renderer.h"
 #include "uvr/facade/series_player.h"

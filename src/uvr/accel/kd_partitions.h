@@ -184,6 +184,9 @@ struct KdTree {
     std::vector<Bounds3f> leafShrunk;
     std::vector<std::uint64_t> leafBegin{0};
     std::vector<std::uint32_t> leafCells;
+    /// When not empty: each partition's box as it is (a subtree of a whole mesh's tree keeps the
+    /// whole tree's boxes, padded by the whole mesh's size); else the shrunk regions padded.
+    std::vector<Bounds3f> leafBoxes;
 };
 
 struct KdBuildOptions;
@@ -237,5 +240,20 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
 /// finite). The only value-dependent part of the partitions: buildKdPartitions ends with it, and
 /// new values of the same mesh (a time step) need only this, not a rebuild.
 void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd);
+
+/// The subtree of `kd` below `node` as a tree of its own (a rank's share of a mesh rendered
+/// data-parallel, dist/): its nodes renumbered, each leaf's partition box kept (leafBoxes and
+/// leafShrunk), no cells (replayKdTree gives it a mesh's).
+KdTree kdSubtree(const KdPartitions& kd, std::uint32_t node);
+
+/// The region of every node of a k-d tree whose root region is `bounds` (inner nodes split it
+/// at their planes), indexed as kd.nodes.
+std::vector<Bounds3f> kdNodeRegions(const std::vector<KdNode>& nodes, const Bounds3f& bounds);
+
+/// `shape` (a kdSubtree, whose root region is `region`) with the cells of `mesh` in its leaves:
+/// the cells whose boxes reach the closed region, handed down each inner node by the build's own
+/// rules (kdsplit::goesBelow, goesAbove), so a leaf gets exactly the cells the whole tree's
+/// leaf has when the mesh holds every cell reaching the region (in its own ids and order).
+KdTree replayKdTree(const TetMesh& mesh, const KdTree& shape, const Bounds3f& region);
 
 }  // namespace uvr

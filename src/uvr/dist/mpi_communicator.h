@@ -19,6 +19,15 @@ bool builtWithMpi();
 /// (OMPI_COMM_WORLD_SIZE, PMIX_RANK, PMI_RANK, PMI_SIZE, ...); a plain start is never one.
 bool launchedUnderMpi();
 
+/// This process's rank among the ranks of its node, as the launcher says (Open MPI's
+/// OMPI_COMM_WORLD_LOCAL_RANK, Slurm's SLURM_LOCALID, ...); -1 when none says.
+int localRankFromEnvironment();
+
+/// One GPU per rank of a node: unless CUDA_VISIBLE_DEVICES is set, sets it to the local rank
+/// modulo the node's GPUs (counted from the driver's /dev/nvidiaN nodes) when there are two or
+/// more, before CUDA starts. Returns the device chosen, or "" when it left the setting alone.
+/// Call before anything touches CUDA.
+std::string pinGpuToLocalRank();
 
 /// The communicator over every process of MPI_COMM_WORLD (a duplicate of it). The first call
 /// initialises MPI (MPI_THREAD_FUNNELED: only the thread that made it calls MPI) unless someone

@@ -149,6 +149,22 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
         result.stats.seconds > 0 ? double(result.stats.samples) / result.stats.seconds : 0.0;
     j["walk_steps"] = result.stats.walkSteps;
     j["bvh_queries"] = result.stats.bvhQueries;
+    if (!result.ranks.empty()) {
+        // A data-parallel frame: each rank's share and how even they were.
+        nlohmann::json ranks = nlohmann::json::array();
+        double slowest = 0.0, total = 0.0;
+        for (const RankFrameStats& r : result.ranks) {
+            ranks.push_back({{"frame_seconds", r.frameSeconds},
+                             {"composite_seconds", r.compositeSeconds},
+                             {"composite_bytes_sent", r.bytesSent},
+                             {"samples", r.samples},
+                             {"cells", r.cells}});
+            slowest = std::max(slowest, r.frameSeconds);
+            total += r.frameSeconds;
+        }
+        j["ranks"] = std::move(ranks);
+        j["imbalance"] = total > 0.0 ? slowest * double(result.ranks.size()) / total : 1.0;
+    }
     // Lengths and positions in the file's units (the mesh may render scaled and moved).
     j["sample_distance"] = reportNumber(setup.params.step / frame.scale);
     j["opacity_unit"] = reportNumber(setup.params.opacityUnit / frame.scale);

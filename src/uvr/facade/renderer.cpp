@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/facade/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "uvr/core/error.h"
@@ -8,9 +9,20 @@
 #include "uvr/cpu/threads.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/dist/communicator.h"
+#include "uvr/dist/composite.h"
+#include "uvr/dist/decompose.h"
 #include "uvr/mesh/smooth_gradients.h"
 
 namespace uvr {
+
+namespace {
+
+/// A data-parallel piece's ghost cells reach this many of the whole mesh's default steps past
+/// its box: the sample ending a piece's last segment lies at most one step beyond it.
+constexpr float kGhostSteps = 2.f;
+
+}  // namespace
 
 Device parseDevice(const std::string& text, const std::string& what) {
     if (text == "auto") return Device::Auto;
@@ -78,15 +90,35 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
                    const ProgressFn& progress) {
     checkDeviceUsable(options.device);
     const auto start = std::chrono::steady_clock::now();
-    prepared_ = std::make_unique<PreparedMesh>(
-        prepareMesh(mesh, field, options.prepareOptions(), progress));
+    if (options.communicator && options.communicator->size() > 1) {
+        // Data-parallel: the whole mesh's k-d tree cut into the ranks' boxes, and this rank's
+        // piece prepared as one process would prepare that box (dist/decompose.h).
+        comm_ = options.communicator;
+        PrepareOptions prepare = options.prepareOptions();
+        RankPiece piece = agreeOn(*comm_, [&] {
+            const WholeMesh whole = describeWholeMesh(mesh, field, prepare, progress);
+            auto d = std::make_shared<Decomposition>(
+                decompose(whole.kd, partitionCosts(whole.kd), comm_->size()));
+            decomposition_ = d;
+            return extractPiece(mesh, field, whole, *d, comm_->rank(),
+                                kGhostSteps * whole.defaultStep);
+        });
+        prepare.piece = piece.piece;
+        prepared_ = std::make_unique<PreparedMesh>(agreeOn(
+            *comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));
+    } else {
+        prepared_ = std::make_unique<PreparedMesh>(
+            prepareMesh(mesh, field, options.prepareOptions(), progress));
+    }
     prepareSeconds_ =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress && resolvesToCuda(options.device))
         progress("uploading " +
                  std::to_string((cudaSceneBytes(*prepared_) + (1u << 20) - 1) >> 20) +
                  " MiB to the GPU");
-    gpu_ = uploadIf(options.device, *prepared_, progress.fraction);
+    gpu_ = comm_ ? agreeOn(*comm_,
+                           [&] { return uploadIf(options.device, *prepared_, progress.fraction); })
+                 : uploadIf(options.device, *prepared_, progress.fraction);
 }
 
 Renderer::Renderer(PreparedMesh prepared, Device device)
@@ -101,7 +133,50 @@ Renderer::Renderer(PreparedMesh prepared, Device device)
 
 Renderer::~Renderer() = default;
 
+bool Renderer::isRoot() const {
+    return !comm_ || comm_->rank() == 0;
+}
+
 RenderResult Renderer::render(const RenderSettings& settings) {
+    if (!comm_) return renderLocal(settings);
+    RenderResult result = agreeOn(*comm_, [&] {
+        if (settings.depthAlpha > 0.f || !settings.depthIn.empty())
+            throwError(ErrorKind::Unsupported, "",
+                       "depth images (`depth_alpha`, `depth_in`) are not rendered data-parallel "
+                       "yet: render them in one process");
+        return renderLocal(settings);
+    });
+    // Every rank's piece composited onto rank 0, front to back in the boxes' order.
+    const Camera& camera = result.setup.camera;
+    const std::vector<int> order = visibilityOrder(*decomposition_, camera.parallelProjection,
+                                                   camera.position, result.setup.viewDirection);
+    const double frameSeconds = result.stats.seconds;
+    const std::uint64_t samples = result.stats.samples;
+    const CompositeStats composited = compositeFrame(*comm_, result.image, result.sampleCounts,
+                                                     order, 0, settings.terminationAlpha);
+    // The ranks' counters summed, and each rank's share.
+    std::uint64_t counters[5] = {result.stats.samples, result.stats.walkSteps,
+                                 result.stats.bvhQueries, result.stats.partitionsVisited,
+                                 result.stats.partitionsSkipped};
+    comm_->allReduce(counters, ReduceOp::Sum);
+    result.stats.samples = counters[0], result.stats.walkSteps = counters[1];
+    result.stats.bvhQueries = counters[2], result.stats.partitionsVisited = counters[3];
+    result.stats.partitionsSkipped = counters[4];
+    RankFrameStats mine;
+    mine.frameSeconds = frameSeconds;
+    mine.compositeSeconds = composited.seconds;
+    mine.bytesSent = composited.bytesSent;
+    mine.samples = samples;
+    mine.cells = prepared_->tets.cellCount();
+    result.ranks = comm_->allGatherValues(mine);
+    double slowest = 0.0;
+    for (const RankFrameStats& r : result.ranks)
+        slowest = std::max(slowest, r.frameSeconds + r.compositeSeconds);
+    result.stats.seconds = slowest;
+    return result;
+}
+
+RenderResult Renderer::renderLocal(const RenderSettings& settings) {
     // Smooth shading's gradients are made when a frame first needs them (shaded, or the
     // isosurfaces' normals) and kept, remade with new values.
     const bool lit = settings.lighting.on || !settings.isoSurfaces.empty();
@@ -113,6 +188,10 @@ RenderResult Renderer::render(const RenderSettings& settings) {
 }
 
 void Renderer::setFieldValues(const ScalarField& field) {
+    if (comm_)
+        throwError(ErrorKind::Unsupported, "",
+                   "new field values (time steps) are not given to a data-parallel renderer yet: "
+                   "prepare each step anew");
     updateFieldValues(*prepared_, field);
     if (gpu_) gpu_->updateValues();
 }

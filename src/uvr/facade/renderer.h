@@ -14,6 +14,8 @@
 namespace uvr {
 
 class CudaScene;
+class Communicator;
+struct Decomposition;
 
 /// Where frames render, or where acceleration structures build.
 enum class Device {
@@ -47,6 +49,11 @@ struct RendererOptions {
     /// PrepareOptions::afterSplit: called once the source mesh is no longer read (it may be
     /// freed then).
     std::function<void()> afterSplit;
+    /// Data-parallel over this communicator's ranks when it has more than one (issue 31): every
+    /// rank constructs its Renderer together with the whole mesh, holds and renders the piece of
+    /// it that the whole mesh's k-d tree gives it (dist/), and every frame is composited onto
+    /// rank 0, whose RenderResult is the whole picture. Null: one process. Not owned.
+    Communicator* communicator = nullptr;
 
     /// The preparation these options ask for (the builders of the GPU when buildDevice resolves
     /// to it, the device's default leaf size).
@@ -82,7 +89,8 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     /// Renders one frame; throws Error(Argument) for settings validateSettings refuses and for a
-    /// method whose structures were not prepared.
+    /// method whose structures were not prepared. Data-parallel: a collective call on every
+    /// rank with the same settings; a failure on any rank throws on every rank.
     RenderResult render(const RenderSettings& settings);
 
     /// Gives the prepared mesh new values of a field of the same mesh (a time step, or another
@@ -104,11 +112,20 @@ public:
     std::optional<GpuResidency> gpuResidency() const;
     /// Seconds the preparation took (0 for a mesh prepared elsewhere).
     double prepareSeconds() const { return prepareSeconds_; }
+    /// The communicator of a data-parallel renderer (RendererOptions::communicator), else null.
+    Communicator* communicator() const { return comm_; }
+    /// True on the rank whose frames are the whole picture (rank 0; any one-process renderer).
+    bool isRoot() const;
 
 private:
+    /// This rank's frame: its piece's on a data-parallel renderer.
+    RenderResult renderLocal(const RenderSettings& settings);
+
     std::unique_ptr<PreparedMesh> prepared_;
     std::unique_ptr<CudaScene> gpu_;
     double prepareSeconds_ = 0.0;
+    Communicator* comm_ = nullptr;
+    std::shared_ptr<const Decomposition> decomposition_;
 };
 
 }  // namespace uvr

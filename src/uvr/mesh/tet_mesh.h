@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -345,6 +346,9 @@ struct TetrahedralizeOptions {
     bool spatialOrder = true;
     /// When set, the Morton order's sort runs there (the same order).
     CellOrderSorter sorter = nullptr;
+    /// When set, the rendering frame instead of frameForBounds of the kept cells' bounds (a
+    /// rank's piece of a mesh rendered data-parallel takes the whole mesh's).
+    std::optional<MeshFrame> frame = std::nullopt;
 };
 
 /// Number of tetrahedra (at most 6) a cell splits into and their corners, as indices into the

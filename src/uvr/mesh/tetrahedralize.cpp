@@ -278,7 +278,7 @@ TetMesh tetrahedralize(const MeshView& mesh, const ScalarField& field,
         sortCellsSpatially(out, subRange(progress, kGatherEnd, kSortEnd), options.sorter);
     assignTetValues(out, field);
     if (progress) progress(kValuesEnd);
-    out.frame = frameForBounds(out.bounds);
+    out.frame = options.frame ? *options.frame : frameForBounds(out.bounds);
     if (!out.frame.identity()) {
         const MeshFrame& f = out.frame;
         const std::int64_t n = static_cast<std::int64_t>(out.points.size());

@@ -40,6 +40,16 @@ constexpr std::uint64_t kSmallCellTreeCells = std::uint64_t(1) << 24;
 
 }  // namespace
 
+KdBuildOptions kdBuildOptions(const TetMesh& tets, const PrepareOptions& options) {
+    KdBuildOptions kd = options.kd;
+    // The leaf size counts tetrahedra of the split: native cells fill a leaf as the tetrahedra
+    // they stand for would (partitions of the same size in space).
+    if (tets.hasNative())
+        kd.leafCells = static_cast<std::uint32_t>(
+            std::max(1.0, std::round(kd.leafCells / tets.meanSplitTets())));
+    return kd;
+}
+
 PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                          const PrepareOptions& options, const ProgressFn& progress) {
     PreparedMesh out;
@@ -50,6 +60,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      ? "splitting " + std::to_string(mesh.cellCount()) + " cells into tetrahedra"
                      : "preparing " + std::to_string(mesh.cellCount()) + " cells");
     TetrahedralizeOptions cells = options.cells;
+    if (options.piece) cells.frame = options.piece->frame;
     // The builders (the GPU's) only where the mesh is large enough to pay.
     const bool large = mesh.cellCount() >= options.builderMinTets;
     if (!large) cells.sorter = nullptr;
@@ -62,7 +73,10 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     std::vector<std::uint32_t> welded;
     if (welding.valid()) welded = std::move(welding.get().first);  // before the points are freed
     if (options.afterSplit) options.afterSplit();
-    out.autoChoice = autoMethod(out.tets, options.autoOnGpu);
+    out.piece = options.piece;
+    out.autoChoice = !options.piece      ? autoMethod(out.tets, options.autoOnGpu)
+                     : options.autoOnGpu ? options.piece->autoGpu
+                                         : options.piece->autoCpu;
     out.splitSeconds = secondsSince(start);
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
     // What RenderMethod::Auto renders with, besides what was asked for.
@@ -138,15 +152,17 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
             progress("building k-d partitions (up to " + std::to_string(options.kd.leafCells) +
                      " cells each" + (splitter ? ", on " + options.builderDevice : std::string()) +
                      ")");
-        KdBuildOptions kd = options.kd;
-        // The leaf size counts tetrahedra of the split: native cells fill a leaf as the
-        // tetrahedra they stand for would (partitions of the same size in space).
-        if (out.tets.hasNative())
-            kd.leafCells = static_cast<std::uint32_t>(
-                std::max(1.0, std::round(kd.leafCells / out.tets.meanSplitTets())));
+        KdBuildOptions kd = kdBuildOptions(out.tets, options);
         if (splitter) kd.splitter = splitter;
+        if (const std::shared_ptr<const MeshPiece> piece = options.piece)
+            kd.splitter = [piece](const TetMesh& tets, const KdBuildOptions&, const FractionFn&) {
+                return replayKdTree(tets, piece->tree, piece->region);
+            };
         start = std::chrono::steady_clock::now();
         out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
+        // A piece's traversal starts at the whole mesh's bounds and narrows to its box (the
+        // marchers' PieceView), as one process's does.
+        if (options.piece) out.kd->bounds = options.piece->bounds;
         out.phaseSeconds.emplace_back("partitions", secondsSince(start));
         if (cellTree.valid()) {
             auto [tree, seconds] = cellTree.get();
@@ -289,6 +305,10 @@ std::vector<float> partitionGradientSpread(const TetMesh& tets, const KdPartitio
 PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field) {
     const PrepareOptions defaults;
     return prepareMesh(mesh, field, defaults);
+}
+
+float PreparedMesh::wholeDefaultStep() const {
+    return piece ? piece->defaultStep : defaultStep(tets);
 }
 
 float defaultStep(const TetMesh& mesh) {

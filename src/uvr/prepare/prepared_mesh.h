@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -26,6 +27,24 @@
 #include "uvr/prepare/render_method.h"
 
 namespace uvr {
+
+/// One rank's piece of a mesh rendered data-parallel (issue 31, dist/): the box of the whole
+/// mesh's k-d tree that it renders, that box's subtree, and what the whole mesh decides for every
+/// rank's frames alike, so that each rank's frame setup (camera, step, range, method) is the one
+/// a single process makes and its partitions are that process's partitions in the box.
+struct MeshPiece {
+    int rank = 0, ranks = 1;  ///< this rank, of how many
+    Bounds3f region;          ///< the rank's box (rendering units)
+    KdTree tree;              ///< kdSubtree of the whole tree at the rank's node (no cells)
+    MeshFrame frame;          ///< the whole mesh's rendering frame
+    Bounds3f bounds;          ///< the whole mesh's bounds (rendering units)
+    float valueMin = 0.f;     ///< the whole field's finite range
+    float valueMax = 0.f;
+    float defaultStep = 0.f;        ///< defaultStep of the whole mesh
+    std::uint64_t sourceCells = 0;  ///< cells of the whole mesh
+    /// autoMethod of the whole mesh for the CPU and the GPU.
+    AutoMethodChoice autoCpu{RenderMethod::Partitions}, autoGpu{RenderMethod::Partitions};
+};
 
 /// What prepareMesh builds besides the cells, BVH and neighbours.
 struct PrepareOptions {
@@ -68,6 +87,10 @@ struct PrepareOptions {
     /// the source mesh: a caller holding the only copy may free it then, so a one-shot render of
     /// a billion cells does not hold the mesh as read beside the prepared one.
     std::function<void()> afterSplit;
+    /// When set, the mesh is this rank's piece of a whole mesh (its cells reaching the piece's
+    /// box): it takes the whole mesh's frame and method choice, and its k-d partitions are the
+    /// piece's subtree (replayKdTree) instead of a tree of its own.
+    std::shared_ptr<const MeshPiece> piece = nullptr;
     std::string builderDevice = "cpu";  ///< where the builders above build (progress messages)
     std::uint64_t builderMinTets = 0;   ///< use them only from this many cells
 };
@@ -115,6 +138,8 @@ struct PreparedMesh {
     /// The prepared cache it was read from (readPreparedCache), holding only what rendering
     /// reads; empty when prepared from a mesh. updateFieldValues refuses such a mesh.
     std::string cacheFile;
+    /// A data-parallel rank's piece (PrepareOptions::piece), or null for a whole mesh.
+    std::shared_ptr<const MeshPiece> piece = nullptr;
     std::uint64_t valueUpdates = 0;   ///< times updateFieldValues gave it new values
     double valueUpdateSeconds = 0.0;  ///< time the last updateFieldValues took
 
@@ -130,6 +155,15 @@ struct PreparedMesh {
         }
         return v;
     }
+    /// The whole mesh's bounds (rendering units): a piece's whole mesh's, else the cells'.
+    const Bounds3f& wholeBounds() const { return piece ? piece->bounds : tets.bounds; }
+    /// The whole mesh's finite field range.
+    float wholeValueMin() const { return piece ? piece->valueMin : tets.valueMin; }
+    float wholeValueMax() const { return piece ? piece->valueMax : tets.valueMax; }
+    /// Cells of the whole source mesh.
+    std::uint64_t wholeSourceCells() const { return piece ? piece->sourceCells : sourceCells; }
+    /// The whole mesh's default step s1 (defaultStep).
+    float wholeDefaultStep() const;
     /// Point locator over this mesh, as kernels use it.
     TetLocator locator() const { return {kernelMesh(), bvh.view(), neighborCodes.view()}; }
 };
@@ -161,6 +195,10 @@ struct ProgressFn {
     /// Whether anything is reported.
     explicit operator bool() const { return step || fraction; }
 };
+
+/// The k-d build options prepareMesh builds the partitions of `tets` with: options.kd, its leaf
+/// size counted in tetrahedra of the split (a mesh of native cells gets fewer cells a leaf).
+KdBuildOptions kdBuildOptions(const TetMesh& tets, const PrepareOptions& options);
 
 /// Splits cells (or keeps them native), builds the BVH over them and the face-neighbour table,
 /// and what options ask for besides. `progress` hears each phase of PreparedMesh::phaseSeconds

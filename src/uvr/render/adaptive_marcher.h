@@ -259,6 +259,13 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         return acc;
     }
     if (ray.tMax < tExit) tExit = ray.tMax, cut1 = false;  // depth in: opaque geometry there
+    // A data-parallel frame: this rank's piece of the span (its k-d tree is the whole tree's
+    // subtree there, so the partitions' pieces are one process's).
+    bool pieceStart = false, pieceEnd = false;
+    if (!scene.base.params.piece.narrow(ray.org, inv, tEnter, tExit, pieceStart, pieceEnd))
+        return acc;
+    if (pieceStart) cut0 = false;
+    if (pieceEnd) cut1 = false;
     if (!(tEnter <= tExit)) return acc;
     const TetLocator& locator = scene.base.locator;
     const float s1 = scene.base.params.step;
@@ -275,7 +282,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // grid position kRunFrom, outside the mesh when runFromOutside (else the span's start), while
     // runFromValid (no sample inside and nothing skipped since).
     [[maybe_unused]] float kRunFrom = tEnter / s1;
-    [[maybe_unused]] bool runFromOutside = false, runFromValid = true;
+    [[maybe_unused]] bool runFromOutside = false, runFromValid = !pieceStart;
     [[maybe_unused]] const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b) {
         std::uint32_t found = locator.walk<kNative>(q, from, b, counters.locate);
         if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, counters.locate);
@@ -344,7 +351,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             // Reference grid points owned: [K0, K1); the ray's end point belongs to the last
             // piece.
             k = ceilf(c0 / s1);
-            k1 = (c1 < t1 || t1 >= tExit) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
+            k1 = (c1 < t1 || (t1 >= tExit && !pieceEnd)) ? floorf(c1 / s1) + 1.f : ceilf(t1 / s1);
             mPiece = shade.step / s1;  // step in grid units (1 for s1)
             macro = scene.macro.grids && shade.byMacroCells;
             kStop = k1;
@@ -539,7 +546,23 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         opaque = acc.w >= stopAlpha;
         marching = !opaque;
     }
-    if (preintegrated && !opaque) {
+    if (preintegrated && !opaque && pieceEnd) {
+        // The span goes on in the next rank's piece, whose first grid point is kClose: a run
+        // reaching it ends its last segment at the sample there, as one process's run does
+        // when the next partition is marched (its share is the next piece's).
+        const float kClose = ceilf(tExit / s1);
+        if (segments.started && segments.inside && segments.kEnd >= kClose) {
+            ++counters.samples;
+            const Vec3f q = ray.at(kClose * s1);
+            tet = locateFrom(q, lastInside, bary);
+            const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
+            const Vec3f grad =
+                sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
+            segments.add(tf, kClose, kClose, tet != kNoTet, v, s1, unit, acc,
+                         lightAt(lighting, tet, grad, ray.dir), grad);
+        }
+        note(tExit);
+    } else if (preintegrated && !opaque) {
         if constexpr (kSurf) {
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
             // the run's last sample at the end.

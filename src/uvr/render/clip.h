@@ -97,4 +97,30 @@ private:
     }
 };
 
+/// A data-parallel frame's piece (issue 31, dist/): the box of the whole mesh's k-d tree that
+/// this rank renders. A ray integrates only its part inside the box, so the ranks' parts of a
+/// ray meet end to end and composite, front to back, into the whole ray. Where the box cuts a
+/// ray's end inside the mesh the span goes on in the next rank's piece: the sampling
+/// integrators leave the sample on the grid point there to that rank and take it only to end
+/// their last segment (ReferenceMarch: the segment's far value, as one process takes it).
+struct PieceView {
+    bool active = false;
+    Bounds3f box;  ///< the rank's box (rendering units), with active
+
+    /// Narrows [t0, t1] of the ray org + t dir to the box (nothing without one); startCut
+    /// (endCut): the box moved that end, so the ray's span goes on in another piece there. False
+    /// when nothing is left. Computed as intersectBox, so the ends are the k-d traversal's
+    /// split-plane crossings bit for bit.
+    UVR_HOST_DEVICE bool narrow(Vec3f org, Vec3f invDir, float& t0, float& t1, bool& startCut,
+                                bool& endCut) const {
+        startCut = endCut = false;
+        if (!active) return t0 <= t1;
+        float a = t0, b = t1;
+        if (!intersectBox(box, org, invDir, a, b)) return false;
+        startCut = a > t0, endCut = b < t1;
+        t0 = a, t1 = b;
+        return t0 <= t1;
+    }
+};
+
 }  // namespace uvr

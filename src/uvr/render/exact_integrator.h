@@ -487,6 +487,12 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     }
     // Depth in: the ray ends at opaque geometry (cut there as at a clip plane).
     if (ray.tMax < b1) b1 = ray.tMax, cut1 = false;
+    // A data-parallel frame: this rank's piece of the span, its cells cut at the piece's box as
+    // at a clip plane (the cut faces at its ends are the other ranks' where it moved them).
+    bool pieceStart = false, pieceEnd = false;
+    if (!scene.params.piece.narrow(ray.org, inv, b0, b1, pieceStart, pieceEnd)) return acc;
+    if (pieceStart) cut0 = false;
+    if (pieceEnd) cut1 = false;
     if (!(b0 <= b1)) return acc;
     [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b) {
         return scene.locator.locate<kNative>(q, from, b, counters.locate);
@@ -496,7 +502,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                                      n0, kNoTet, counters, acc))
             return acc;
     }
-    const bool clipped = clip.active() || ray.tMax < INFINITY;
+    const bool clipped = clip.active() || ray.tMax < INFINITY || scene.params.piece.active;
     const double tStop = clipped ? double(b1) : INFINITY;
     const TetLocator& loc = scene.locator;
     // A gap this small between tetrahedra is rounding, not empty space.

@@ -25,7 +25,9 @@ ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& set
         return {RenderMethod::Partitions, "auto: adaptive (the settings tune its sampling)"};
     const AutoMethodChoice choice = mesh.autoChoice && mesh.autoChoice->gpu == gpu
                                         ? *mesh.autoChoice
-                                        : autoMethod(mesh.tets, gpu);
+                                    : !mesh.piece ? autoMethod(mesh.tets, gpu)
+                                    : gpu         ? mesh.piece->autoGpu
+                                                  : mesh.piece->autoCpu;
     const bool bvh = !mesh.bvh.nodes.empty(), kd = mesh.kd.has_value();
     if (choice.method == RenderMethod::Exact && !bvh && kd)
         return {RenderMethod::Partitions,
@@ -112,7 +114,7 @@ constexpr double kMaxGridSteps = 16e6;
 /// Refuses a frame whose estimated work (every ray across the bounds' diagonal) exceeds
 /// kMaxSamplesPerRay or kMaxFrameSamples, naming the step that would be accepted.
 void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, float step) {
-    const Bounds3f& bounds = mesh.tets.bounds;
+    const Bounds3f& bounds = mesh.wholeBounds();
     const int raysPerPixel = settings.supersample * settings.supersample;
     const FrameWork w =
         estimateFrameWork(bounds, step, settings.width, settings.height, raysPerPixel);
@@ -129,21 +131,21 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
     const std::string what = settings.step > 0.f ? "`sample_distance` " + formatG(step * unit, 3)
                                                  : "the default step " + formatG(step * unit, 3) +
                                                        " (from the mean cell size)";
-    throwError(ErrorKind::Argument, "",
-               what + " would take up to " + formatG(w.samples, 3) + " samples (" +
-                   std::to_string(settings.width) + "x" + std::to_string(settings.height) +
-                   " pixels x " +
-                   (raysPerPixel > 1 ? std::to_string(raysPerPixel) + " rays (`supersample` " +
-                                           std::to_string(settings.supersample) + ") x "
-                                     : std::string()) +
-                   formatG(w.samplesPerRay, 3) + " per ray across the bounds' diagonal " +
-                   formatG(diagonal, 3) + "), more than the " +
-                   (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
-                                                        : "10^12 samples per frame") +
-                   " allowed: use `sample_distance` " + formatG(suggest, 3) + " or larger" +
-                   (settings.step > 0.f
-                        ? " (the default here is " + formatG(defaultStep(mesh.tets) * unit, 3) + ")"
-                        : std::string()));
+    throwError(
+        ErrorKind::Argument, "",
+        what + " would take up to " + formatG(w.samples, 3) + " samples (" +
+            std::to_string(settings.width) + "x" + std::to_string(settings.height) + " pixels x " +
+            (raysPerPixel > 1 ? std::to_string(raysPerPixel) + " rays (`supersample` " +
+                                    std::to_string(settings.supersample) + ") x "
+                              : std::string()) +
+            formatG(w.samplesPerRay, 3) + " per ray across the bounds' diagonal " +
+            formatG(diagonal, 3) + "), more than the " +
+            (w.samplesPerRay > kMaxSamplesPerRay ? "100,000 samples per ray"
+                                                 : "10^12 samples per frame") +
+            " allowed: use `sample_distance` " + formatG(suggest, 3) + " or larger" +
+            (settings.step > 0.f
+                 ? " (the default here is " + formatG(mesh.wholeDefaultStep() * unit, 3) + ")"
+                 : std::string()));
 }
 
 }  // namespace
@@ -153,8 +155,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     FrameSetup f;
     f.method = resolveMethod(mesh, settings, gpu);
     const RenderMethod method = f.method.method;
-    f.rangeLo = settings.range ? settings.range->first : mesh.tets.valueMin;
-    f.rangeHi = settings.range ? settings.range->second : mesh.tets.valueMax;
+    f.rangeLo = settings.range ? settings.range->first : mesh.wholeValueMin();
+    f.rangeHi = settings.range ? settings.range->second : mesh.wholeValueMax();
     // The baked table: linear in the value over [rangeLo, rangeHi]; a log-scale function is
     // evaluated at each entry's log position, on a table fine enough where log changes fastest.
     int tableSize = settings.tfTableSize;
@@ -191,8 +193,8 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     // the identity unless the mesh is very large, very small or far from the origin).
     const MeshFrame& frame = mesh.tets.frame;
     f.frame = frame;
-    const Bounds3f& bounds = mesh.tets.bounds;
-    const bool empty = mesh.tets.cellCount() == 0;
+    const Bounds3f& bounds = mesh.wholeBounds();
+    const bool empty = mesh.tets.cellCount() == 0 && !mesh.piece;
     if (empty && !settings.camera)
         throwError(ErrorKind::Argument, "",
                    "the mesh has no cell of non-zero volume (every cell is flat or uses NaN/Inf "
@@ -207,7 +209,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
         return static_cast<float>(v);
     };
     f.params.step =
-        settings.step > 0.f ? toLocal(settings.step, "sample_distance") : defaultStep(mesh.tets);
+        settings.step > 0.f ? toLocal(settings.step, "sample_distance") : mesh.wholeDefaultStep();
     if (settings.step > 0.f && !empty) {
         const double across = bounds.diagonal() / f.params.step;
         if (across < kFewSamplesAcross)
@@ -215,14 +217,15 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                               formatG(across, 2) + " samples across the mesh (its diagonal is " +
                               formatG(bounds.diagonal() / frame.scale, 3) +
                               "): the image is coarse; the default here is " +
-                              formatG(defaultStep(mesh.tets) / frame.scale, 3));
+                              formatG(mesh.wholeDefaultStep() / frame.scale, 3));
     }
     f.params.opacityUnit = settings.opacityUnit > 0.f
                                ? toLocal(settings.opacityUnit, "opacity_unit")
-                               : defaultOpacityUnit(bounds, mesh.sourceCells);
+                               : defaultOpacityUnit(bounds, mesh.wholeSourceCells());
     f.params.terminationAlpha = settings.terminationAlpha;
     f.params.preintegrated = settings.preintegrated;
     f.params.clip = clipView(settings, frame);
+    if (mesh.piece) f.params.piece = {true, mesh.piece->region};
     f.params.light = settings.lighting;  // directions only: the frame's scaling keeps them
     f.params.iso = isoView(settings);
     f.params.depthAlpha = settings.depthAlpha;

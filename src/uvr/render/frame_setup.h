@@ -199,6 +199,15 @@ struct RenderStats {
     }
 };
 
+/// One rank's share of a data-parallel frame (RenderResult::ranks).
+struct RankFrameStats {
+    double frameSeconds = 0.0;      ///< its piece's frame
+    double compositeSeconds = 0.0;  ///< its part of the compositing
+    std::uint64_t bytesSent = 0;    ///< bytes it sent compositing
+    std::uint64_t samples = 0;      ///< samples its rays took
+    std::uint64_t cells = 0;        ///< cells it holds (its piece's, with the ghosts)
+};
+
 /// A rendered frame: image, per-pixel sample counts, statistics.
 struct RenderResult {
     Image image;
@@ -208,6 +217,9 @@ struct RenderResult {
     std::vector<float> depth;
     RenderStats stats;
     FrameSetup setup;
+    /// A data-parallel frame: per rank (every rank's, in rank order), on every rank; stats then
+    /// sum the ranks' counters. Empty for one process.
+    std::vector<RankFrameStats> ranks;
 };
 
 }  // namespace uvr

@@ -322,6 +322,12 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         return acc;
     }
     if (ray.tMax < t1) t1 = ray.tMax, cut1 = false;  // depth in: opaque geometry there
+    // A data-parallel frame: this rank's piece of the span (the cut faces at its ends are the
+    // other ranks' where the piece moved them).
+    bool pieceStart = false, pieceEnd = false;
+    if (!scene.params.piece.narrow(ray.org, inv, t0, t1, pieceStart, pieceEnd)) return acc;
+    if (pieceStart) cut0 = false;
+    if (pieceEnd) cut1 = false;
     if (!(t0 <= t1)) return acc;
     [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b) {
         return scene.locator.locate<kNative>(q, from, b, counters.locate);
@@ -334,7 +340,10 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float s = scene.params.step;
     // Global sample grid k * s, so every integrator that samples a span takes the same samples.
     float k = ceilf(t0 / s);
-    const float kEnd = floorf(t1 / s);
+    // The piece's last grid point lies before its end (the next piece takes the one on it);
+    // past it the loop takes one more sample, kClose, which only ends the last segment.
+    const float kEnd = pieceEnd ? ceilf(t1 / s) - 1.f : floorf(t1 / s);
+    const float kClose = pieceEnd ? kEnd + 1.f : kEnd;
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
     const float unit = scene.params.opacityUnit;
@@ -347,7 +356,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     // (adaptive_marcher.h says why).
     bool opaque = false;
     [[maybe_unused]] float tNoted = t0;  // depth out: the end of the stretch of the ray noted last
-    for (; k <= kEnd && !opaque; k += 1.f) {
+    for (; k <= kClose && !opaque; k += 1.f) {
+        const bool own = k <= kEnd;  // else the closing sample: its share is the next piece's
         [[maybe_unused]] const float a0 = acc.w;
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
@@ -358,7 +368,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         const LightFactors light = lightAt(lighting, tet, g, ray.dir);
         if (scene.params.preintegrated) {
             if constexpr (kSurf) {
-                if (segments.iso && (tet != kNoTet) != segments.inside) {
+                if (segments.iso && (tet != kNoTet) != segments.inside &&
+                    !(pieceStart && !segments.started)) {
                     const bool first = !segments.started, in = tet != kNoTet;
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
@@ -372,7 +383,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         } else {
             pointIsos.add(scene.params, scene.tf, ray.dir, tet != kNoTet, v, g, acc);
         }
-        if (!scene.params.preintegrated && tet != kNoTet) {
+        if (!scene.params.preintegrated && tet != kNoTet && own) {
             const Vec4f c = scene.tf.sample(v);
             const float a = correctOpacity(c.w, s, unit, scene.tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
@@ -385,7 +396,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         }
         opaque = acc.w >= scene.params.terminationAlpha;
     }
-    if (scene.params.preintegrated && !opaque) {
+    if (scene.params.preintegrated && !opaque && !pieceEnd) {
         [[maybe_unused]] const float a0 = acc.w;
         if constexpr (kSurf) {
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):

@@ -26,6 +26,8 @@ struct MarchParams {
     bool preintegrated = true;
     /// The clip region: each ray integrates only its part inside (none: the whole ray).
     ClipView clip;
+    /// A data-parallel frame's piece of the ray (none: the whole ray).
+    PieceView piece;
     /// Gradient shading (off: the transfer function's colours as they are).
     Lighting light;
     /// Isosurfaces inside the volume (none: the volume alone).

@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// Sort-last compositing of a data-parallel frame (issue 31): every rank's premultiplied image of
+// its box, composited per pixel front to back in the boxes' visibility order.
+
+#include <cstdint>
+#include <vector>
+
+#include "uvr/dist/communicator.h"
+#include "uvr/render/image.h"
+
+namespace uvr {
+
+/// What compositing one frame cost this rank.
+struct CompositeStats {
+    double seconds = 0.0;         ///< wall time of the exchange and the blending
+    std::uint64_t bytesSent = 0;  ///< bytes this rank sent
+};
+
+/// The rows [first, end) of an image of `height` rows that rank `rank` of `ranks` composites
+/// (direct send: one band of rows each, as even as the rows allow).
+std::pair<int, int> compositeBand(int height, int rank, int ranks);
+
+/// Composites one frame over the ranks (collective): each pixel is every rank's premultiplied
+/// RGBA blended front to back in `order` (visibilityOrder: every rank's, each once), in float,
+/// and the per-pixel sample counts are summed. A pixel takes no more ranks once its opacity
+/// reaches stopAlpha (the integrators' early termination: one process's ray stops there too).
+/// Direct send: rank r blends band r of every rank's image (compositeBand), then `root` gathers the
+/// bands. On root, `image` and `counts` become the whole frame's; elsewhere they are left as they
+/// were. Every rank's image must have the same size, and counts width * height entries (or none on
+/// every rank).
+CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std::uint32_t>& counts,
+                              const std::vector<int>& order, int root = 0, float stopAlpha = 1.f);
+
+}  // namespace uvr

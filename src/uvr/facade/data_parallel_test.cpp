@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+// Data-parallel frames (issue 31) against one process's: the ranks are threads of this process
+// (InProcessGroup), each holding its piece of the whole mesh and composited onto rank 0.
+#include <gmock/gmock.h>
+
+#include <mutex>
+
+#include "test_meshes.h"
+#include "test_support.h"
+#include "uvr/dist/communicator.h"
+#include "uvr/dist/decompose.h"
+#include "uvr/dist/in_process_communicator.h"
+#include "uvr/facade/renderer.h"
+#include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/render/image_metrics.h"
+
+namespace uvr {
+namespace {
+
+using ::testing::HasSubstr;
+using uvr::testing::catchError;
+
+/// The same picture: SSIM and the largest channel difference against one process.
+constexpr double kMinSsim = 0.999;
+constexpr double kMaxLevels = 2.0;
+
+RenderSettings frameOf(const Bounds3f& bounds, RenderMethod method, float azimuth,
+                       float elevation) {
+    RenderSettings s;
+    s.width = 160;
+    s.height = 120;
+    s.method = method;
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "0:0,0.3:0.1,0.6:0.6,1:0.2");
+    s.camera = orbitCamera(resetCamera(bounds, 160.f / 120.f), azimuth, elevation);
+    return s;
+}
+
+/// Rank 0's frames of `ranks` in-process ranks, one per settings.
+std::vector<RenderResult> dataParallelFrames(const Mesh& mesh, const ScalarField& field, int ranks,
+                                             const RendererOptions& options,
+                                             const std::vector<RenderSettings>& frames) {
+    std::vector<RenderResult> out;
+    InProcessGroup::run(ranks, [&](Communicator& comm) {
+        RendererOptions o = options;
+        o.communicator = &comm;
+        Renderer r(mesh, field, o);
+        for (const RenderSettings& s : frames) {
+            RenderResult result = r.render(s);
+            if (comm.rank() == 0) out.push_back(std::move(result));
+        }
+    });
+    return out;
+}
+
+struct Case {
+    const char* file;
+    const char* field;
+};
+
+TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
+    const std::vector<Case> cases = {
+        {"bluntfin_tets.vtk", ""}, {"post.vtk", ""}, {"spx.vtk", ""}, {"hexa.vtk", ""}};
+    for (const Case& c : cases) {
+        const std::string path = testing::sharedData(c.file);
+        if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+        const Mesh mesh = readMesh(path);
+        const ScalarField field = selectScalarField(mesh, parseFieldSpec(c.field));
+        RendererOptions options;
+        options.device = Device::Cpu;
+        Renderer one(mesh, field, options);
+        const Bounds3f bounds = mesh.bounds();
+        std::vector<RenderSettings> frames;
+        for (RenderMethod m :
+             {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact})
+            for (auto [az, el] : {std::pair{30.f, 20.f}, std::pair{-120.f, -35.f}})
+                frames.push_back(frameOf(bounds, m, az, el));
+        std::vector<RenderResult> single;
+        for (const RenderSettings& s : frames) {
+            single.push_back(one.render(s));
+            // A picture to compare: a good part of the frame is covered.
+            std::size_t covered = 0;
+            for (const Vec4f& p : single.back().image.pixels) covered += p.w > 0.1f;
+            ASSERT_GT(covered, single.back().image.pixels.size() / 20) << c.file;
+        }
+        for (int ranks : {2, 3, 5, 8}) {
+            const std::vector<RenderResult> many =
+                dataParallelFrames(mesh, field, ranks, options, frames);
+            ASSERT_EQ(many.size(), frames.size());
+            for (std::size_t i = 0; i < frames.size(); ++i) {
+                const ImageComparison cmp =
+                    compareImages(toRgb8(single[i].image), toRgb8(many[i].image));
+                SCOPED_TRACE(std::string(c.file) + " " + methodName(frames[i].method) + " view " +
+                             std::to_string(i % 2) + ", " + std::to_string(ranks) + " ranks");
+                EXPECT_GE(cmp.ssim, kMinSsim);
+                EXPECT_LE(cmp.maxAbsDifference, kMaxLevels) << differenceSummary(cmp);
+                ASSERT_EQ(many[i].ranks.size(), std::size_t(ranks));
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace uvr

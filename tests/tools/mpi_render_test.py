@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Data-parallel rendering under mpirun (issue 31): `mpirun -n N uvr render` on real meshes with
+the CPU renderer, every method, against the one-process image of the same command: SSIM >= 0.999
+and no channel more than 2/255 apart (`uvr compare --min-ssim --max-diff`). Also what a user
+gets wrong: a bad flag, a missing file and a flag that is not data-parallel each end every rank
+with exit status 2 and one error line, and no output file.
+
+Usage: mpi_render_test.py --uvr UVR --data DATA_DIR --out DIR [--ranks 2,4]
+Exit status 77 (skipped) without mpirun or the shared data.
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+MESHES = [("bluntfin_tets.vtk", ["--azimuth", "35", "--elevation", "25"]),
+          ("hexa.vtk", ["--azimuth", "-60", "--elevation", "30"])]
+METHODS = ["reference", "adaptive", "exact"]
+SIZE = "192x144"
+
+
+def mpirun(ranks):
+    return ["mpirun", "-n", str(ranks), "--oversubscribe", "--allow-run-as-root",
+            "--mca", "btl", "self,vader"]
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=300, **kw)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--uvr", required=True)
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--ranks", default="2,4")
+    args = ap.parse_args()
+    if not shutil.which("mpirun"):
+        print("skipped: no mpirun (openmpi-bin)")
+        return 77
+    if not os.path.isdir(args.data):
+        print(f"skipped: no shared data in {args.data}")
+        return 77
+    os.makedirs(args.out, exist_ok=True)
+    failures = []
+    ranks_list = [int(r) for r in args.ranks.split(",")]
+
+    def check(ok, what):
+        print(("ok   " if ok else "FAIL ") + what, flush=True)
+        if not ok:
+            failures.append(what)
+
+    # The same picture as one process.
+    for mesh, view in MESHES:
+        path = os.path.join(args.data, mesh)
+        for method in METHODS:
+            base = [args.uvr, "render", path, "--device", "cpu", "--size", SIZE, "--no-cache",
+                    "--method", method, "--tf", "viridis", "--opacity", "0:0,0.5:0.3,1:0.8",
+                    "-q"] + view
+            one = os.path.join(args.out, f"{mesh}_{method}_1.png")
+            r = run(base + ["-o", one])
+            check(r.returncode == 0, f"{mesh} {method}: one process ({r.stderr.strip()})")
+            for n in ranks_list:
+                many = os.path.join(args.out, f"{mesh}_{method}_{n}.png")
+                stats = os.path.join(args.out, f"{mesh}_{method}_{n}.json")
+                r = run(mpirun(n) + base + ["-o", many, "--stats", stats])
+                check(r.returncode == 0 and os.path.exists(many),
+                      f"{mesh} {method}: {n} ranks render ({r.stderr.strip()[-400:]})")
+                if r.returncode != 0:
+                    continue
+                with open(stats) as f:
+                    report = json.load(f)
+                check(len(report.get("ranks", [])) == n and report.get("imbalance", 0) >= 1,
+                      f"{mesh} {method}: --stats has {n} ranks and the imbalance")
+                c = run([args.uvr, "compare", one, many, "--json", "--min-ssim", "0.999",
+                         "--max-diff", "2"])
+                detail = c.stdout.strip().replace("\n", " ")[:300]
+                check(c.returncode == 0, f"{mesh} {method}: {n} ranks = one process ({detail})")
+
+    # Bad input: every rank ends, exit status 2, one error line, nothing written.
+    blunt = os.path.join(args.data, "bluntfin_tets.vtk")
+    out = os.path.join(args.out, "bad.png")
+    cases = [
+        ("a bad flag value", ["render", blunt, "--quality", "7", "-o", out], "--quality"),
+        ("a missing file", ["render", os.path.join(args.out, "none.vtk"), "-o", out], "none.vtk"),
+        ("a command that is not data-parallel", ["info", blunt], "data-parallel"),
+        ("a prepared cache", ["render", blunt, "--cache", os.path.join(args.out, "x.uvrprep"),
+                              "-o", out], "--cache"),
+    ]
+    for what, argv, needle in cases:
+        if os.path.exists(out):
+            os.remove(out)
+        r = run(mpirun(2) + [args.uvr] + argv)
+        errors = [line for line in r.stderr.splitlines() if line.startswith("uvr: error")]
+        check(r.returncode != 0 and len(errors) == 1 and needle in errors[0]
+              and not os.path.exists(out),
+              f"mpirun -n 2: {what}: exit {r.returncode}, error lines {errors}")
+    if failures:
+        print(f"{len(failures)} failed")
+        return 1
+    print("all passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
