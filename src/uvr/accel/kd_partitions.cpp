@@ -260,7 +260,19 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
             std::ceil(std::log2(std::max(1.0, double(n) / double(kSubtreeCells)))));
         ProgressCounter topDone(progress, std::int64_t(n) * std::max(topLevels, 1), kBoxesEnd,
                                 kTopEnd);
-        {
+        if (const std::optional<KdSubtreeRoot>& root = options.root) {
+            // A larger tree's node: the cells it hands that node, in id order.
+            std::vector<std::uint32_t> reaching;
+            for (std::int64_t t = 0; t < tetCount; ++t) {
+                const Bounds3f& b = data.boxes[t];
+                bool reaches = true;
+                for (int a = 0; a < 3; ++a)
+                    reaches =
+                        reaches && b.lo[a] <= root->region.hi[a] && b.hi[a] >= root->region.lo[a];
+                if (reaches) reaching.push_back(static_cast<std::uint32_t>(t));
+            }
+            stack.push_back({0, root->region, std::move(reaching), root->depth});
+        } else {
             std::vector<std::uint32_t> all(n);
 #pragma omp parallel for schedule(static)
             for (std::int64_t t = 0; t < tetCount; ++t) all[t] = static_cast<std::uint32_t>(t);
@@ -333,12 +345,13 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
     }
     // Step 6: each partition's padded shrunk box and its cell list, in partition order.
-    const Vec3f pad = Vec3f(kBoxPadding * mesh.bounds.diagonal());
+    const Vec3f pad =
+        Vec3f(kBoxPadding * (options.root && !options.splitter ? options.root->paddingDiagonal
+                                                               : mesh.bounds.diagonal()));
     if (!tree) kd.cells.resize(cells);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t p = 0; p < leafCount; ++p) {
         describePartition(shrunkOf(p), cellsOf(p), pad, kd.partitions[p]);
-        if (tree && !tree->leafBoxes.empty()) kd.partitions[p].box = tree->leafBoxes[p];
         if (tree) continue;
         std::copy(leaves[p].cells.begin(), leaves[p].cells.end(),
                   kd.cells.begin() + kd.partitions[p].firstCell);
@@ -377,98 +390,6 @@ void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd) {
         part.valueMin = lo <= hi ? lo : 0.f;
         part.valueMax = lo <= hi ? hi : 0.f;
     }
-}
-
-KdTree kdSubtree(const KdPartitions& kd, std::uint32_t node) {
-    UVR_CHECK(node < kd.nodes.size(), "k-d node " << node << " of " << kd.nodes.size());
-    KdTree out;
-    out.nodes.emplace_back();
-    // Depth first, each inner node's children appended side by side (the build's layout).
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{node, 0u}};  // whole, ours
-    while (!stack.empty()) {
-        const auto [from, to] = stack.back();
-        stack.pop_back();
-        const KdNode n = kd.nodes[from];
-        if (n.isLeaf()) {
-            const std::uint32_t leaf = static_cast<std::uint32_t>(out.leafBoxes.size());
-            out.nodes[to].bits = (leaf << 2) | 3u;
-            out.leafBoxes.push_back(kd.partitions[n.child()].box);
-            out.leafShrunk.push_back(kd.partitions[n.child()].box);
-            continue;
-        }
-        const std::uint32_t child = static_cast<std::uint32_t>(out.nodes.size());
-        out.nodes[to].split = n.split;
-        out.nodes[to].bits = (child << 2) | static_cast<std::uint32_t>(n.axis());
-        out.nodes.emplace_back();
-        out.nodes.emplace_back();
-        stack.push_back({n.child() + 1, child + 1});
-        stack.push_back({n.child(), child});
-    }
-    out.leafBegin.assign(out.leafBoxes.size() + 1, 0);
-    return out;
-}
-
-std::vector<Bounds3f> kdNodeRegions(const std::vector<KdNode>& nodes, const Bounds3f& bounds) {
-    std::vector<Bounds3f> regions(nodes.size());
-    if (nodes.empty()) return regions;
-    regions[0] = bounds;
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-        const KdNode n = nodes[i];
-        if (n.isLeaf()) continue;
-        Bounds3f below = regions[i], above = regions[i];
-        below.hi[n.axis()] = n.split;
-        above.lo[n.axis()] = n.split;
-        regions[n.child()] = below;
-        regions[n.child() + 1] = above;
-    }
-    return regions;
-}
-
-KdTree replayKdTree(const TetMesh& mesh, const KdTree& shape, const Bounds3f& region) {
-    KdTree out;
-    out.nodes = shape.nodes;
-    out.leafShrunk = shape.leafShrunk;
-    out.leafBoxes = shape.leafBoxes;
-    const std::size_t leaves = shape.leafShrunk.size();
-    const TetMeshView view = mesh.view();
-    const std::int64_t n = static_cast<std::int64_t>(mesh.cellCount());
-    // Each chunk of cells lists (leaf, cell) for every leaf a cell reaches; the chunks' lists,
-    // in order, then sorted stably by leaf, give each leaf its cells in id order.
-    constexpr std::int64_t kReplayChunk = 1 << 16;
-    const std::int64_t chunks = (n + kReplayChunk - 1) / kReplayChunk;
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found(chunks);
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < chunks; ++c) {
-        std::uint32_t stack[kKdMaxDepth + 2];
-        for (std::int64_t t = c * kReplayChunk; t < std::min(n, (c + 1) * kReplayChunk); ++t) {
-            const Bounds3f box = view.cellBounds(std::uint64_t(t));
-            bool reaches = true;
-            for (int a = 0; a < 3; ++a)
-                reaches = reaches && box.lo[a] <= region.hi[a] && box.hi[a] >= region.lo[a];
-            if (!reaches || out.nodes.empty()) continue;
-            int top = 0;
-            stack[top++] = 0;
-            while (top > 0) {
-                const KdNode node = out.nodes[stack[--top]];
-                if (node.isLeaf()) {
-                    found[c].emplace_back(node.child(), static_cast<std::uint32_t>(t));
-                    continue;
-                }
-                if (kdsplit::goesAbove(box, node.axis(), node.split))
-                    stack[top++] = node.child() + 1;
-                if (kdsplit::goesBelow(box, node.axis(), node.split)) stack[top++] = node.child();
-            }
-        }
-    }
-    out.leafBegin.assign(leaves + 1, 0);
-    for (const auto& list : found)
-        for (const auto& [leaf, cell] : list) ++out.leafBegin[leaf + 1];
-    for (std::size_t l = 0; l < leaves; ++l) out.leafBegin[l + 1] += out.leafBegin[l];
-    out.leafCells.resize(out.leafBegin[leaves]);
-    std::vector<std::uint64_t> next(out.leafBegin.begin(), out.leafBegin.end() - 1);
-    for (const auto& list : found)
-        for (const auto& [leaf, cell] : list) out.leafCells[next[leaf]++] = cell;
-    return out;
 }
 
 }  // namespace uvr

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "uvr/accel/bvh.h"
@@ -184,9 +185,15 @@ struct KdTree {
     std::vector<Bounds3f> leafShrunk;
     std::vector<std::uint64_t> leafBegin{0};
     std::vector<std::uint32_t> leafCells;
-    /// When not empty: each partition's box as it is (a subtree of a whole mesh's tree keeps the
-    /// whole tree's boxes, padded by the whole mesh's size); else the shrunk regions padded.
-    std::vector<Bounds3f> leafBoxes;
+};
+
+/// A node of a larger mesh's k-d tree to build a subtree below (a data-parallel rank's piece,
+/// dist/): the node's region and depth in that tree, and that mesh's bounds diagonal (the
+/// partitions' boxes are padded by a fraction of it).
+struct KdSubtreeRoot {
+    Bounds3f region;
+    int depth = 0;
+    float paddingDiagonal = 0.f;
 };
 
 struct KdBuildOptions;
@@ -202,6 +209,11 @@ struct KdBuildOptions {
     /// When set, the k-d tree (splits, leaves and their cells) comes from this splitter
     /// (buildKdTreeCuda: on the GPU; the same partitions as the CPU's); else the CPU threads.
     KdSplitter splitter;
+    /// When set (and no splitter), the tree is the subtree below this node of a larger mesh's
+    /// tree: built from the mesh's cells whose boxes reach the node's closed region (the cells
+    /// the larger tree hands that node) by the same rules, so its partitions are that tree's
+    /// there when the mesh holds every cell reaching the region. kd.bounds stays the mesh's.
+    std::optional<KdSubtreeRoot> root = std::nullopt;
 };
 
 /// Spatial k-d partitions of a tetrahedral mesh: convex, disjoint leaf regions, each with its
@@ -240,20 +252,5 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
 /// finite). The only value-dependent part of the partitions: buildKdPartitions ends with it, and
 /// new values of the same mesh (a time step) need only this, not a rebuild.
 void computePartitionValueRanges(const TetMesh& mesh, KdPartitions& kd);
-
-/// The subtree of `kd` below `node` as a tree of its own (a rank's share of a mesh rendered
-/// data-parallel, dist/): its nodes renumbered, each leaf's partition box kept (leafBoxes and
-/// leafShrunk), no cells (replayKdTree gives it a mesh's).
-KdTree kdSubtree(const KdPartitions& kd, std::uint32_t node);
-
-/// The region of every node of a k-d tree whose root region is `bounds` (inner nodes split it
-/// at their planes), indexed as kd.nodes.
-std::vector<Bounds3f> kdNodeRegions(const std::vector<KdNode>& nodes, const Bounds3f& bounds);
-
-/// `shape` (a kdSubtree, whose root region is `region`) with the cells of `mesh` in its leaves:
-/// the cells whose boxes reach the closed region, handed down each inner node by the build's own
-/// rules (kdsplit::goesBelow, goesAbove), so a leaf gets exactly the cells the whole tree's
-/// leaf has when the mesh holds every cell reaching the region (in its own ids and order).
-KdTree replayKdTree(const TetMesh& mesh, const KdTree& shape, const Bounds3f& region);
 
 }  // namespace uvr

@@ -2,92 +2,46 @@
 #include "uvr/dist/decompose.h"
 
 #include <algorithm>
-#include <numeric>
+#include <cmath>
+#include <cstring>
 #include <string>
 
 #include "uvr/core/error.h"
 #include "uvr/mesh/tet_mesh.h"
+#include "uvr/prepare/render_method.h"
 
 namespace uvr {
 
-std::vector<double> partitionCosts(const KdPartitions& kd) {
-    const std::size_t n = kd.partitions.size();
-    std::vector<double> cost(n, 0.0);
-    double cells = 0.0, volume = 0.0;
-    const auto volumeOf = [](const Bounds3f& b) {
-        if (b.empty()) return 0.0;
-        const Vec3f e = b.extent();
-        return double(e.x) * e.y * e.z;
-    };
-    for (const KdPartition& p : kd.partitions) cells += p.cellCount, volume += volumeOf(p.box);
-    for (std::size_t p = 0; p < n; ++p) {
-        const double c = cells > 0.0 ? kd.partitions[p].cellCount / cells : 0.0;
-        const double v = volume > 0.0 ? volumeOf(kd.partitions[p].box) / volume : 0.0;
-        cost[p] = 0.5 * c + 0.5 * v;
-    }
-    return cost;
-}
-
-Decomposition decompose(const KdPartitions& kd, const std::vector<double>& partitionCost,
-                        int ranks) {
-    UVR_CHECK(ranks >= 1, "rank count " << ranks);
-    UVR_CHECK(partitionCost.size() == kd.partitions.size(), "partition costs missing");
-    if (kd.nodes.empty() || kd.partitions.size() < std::size_t(ranks))
-        throwError(ErrorKind::Argument, "",
-                   "the mesh has " + std::to_string(kd.partitions.size()) +
-                       " k-d partitions, fewer than the " + std::to_string(ranks) +
-                       " ranks: run on at most " + std::to_string(kd.partitions.size()) + " ranks");
-    // Each node's cost: its partitions' (children follow their parents in the layout).
-    const std::size_t nodeCount = kd.nodes.size();
-    std::vector<double> nodeCost(nodeCount, 0.0);
-    for (std::size_t i = nodeCount; i-- > 0;) {
-        const KdNode n = kd.nodes[i];
-        nodeCost[i] =
-            n.isLeaf() ? partitionCost[n.child()] : nodeCost[n.child()] + nodeCost[n.child() + 1];
-    }
-    // The cut: the costliest inner node replaced by its children, `ranks` - 1 times.
-    std::vector<std::uint32_t> cut{0};
-    while (cut.size() < std::size_t(ranks)) {
-        std::size_t best = cut.size();
-        for (std::size_t i = 0; i < cut.size(); ++i)
-            if (!kd.nodes[cut[i]].isLeaf() &&
-                (best == cut.size() || nodeCost[cut[i]] > nodeCost[cut[best]]))
-                best = i;
-        UVR_CHECK(best < cut.size(), "no inner node left to cut");
-        const std::uint32_t child = kd.nodes[cut[best]].child();
-        cut[best] = child;
-        cut.insert(cut.begin() + std::ptrdiff_t(best) + 1, child + 1);
-    }
-    // The tree above the cut, depth first from the root (the same left-to-right order as the
-    // cut, which names the ranks); regions from the whole tree's.
-    const std::vector<Bounds3f> regions = kdNodeRegions(kd.nodes, kd.bounds);
-    Decomposition d;
-    d.rankTree.emplace_back();
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};  // whole, ours
-    while (!stack.empty()) {
-        const auto [from, to] = stack.back();
-        stack.pop_back();
-        const auto inCut = std::find(cut.begin(), cut.end(), from);
-        if (inCut != cut.end()) {
-            const std::uint32_t rank = static_cast<std::uint32_t>(inCut - cut.begin());
-            d.rankTree[to].bits = (rank << 2) | 3u;
-            continue;
+MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks) {
+    UVR_CHECK(ranks >= 1 && rank >= 0 && rank < ranks, "share " << rank << " of " << ranks);
+    const std::uint64_t n = mesh.cellCount();
+    const std::uint64_t first = n * std::uint64_t(rank) / std::uint64_t(ranks);
+    const std::uint64_t end = n * std::uint64_t(rank + 1) / std::uint64_t(ranks);
+    const bool pointData = field.association == Association::Point;
+    MeshShare s;
+    std::vector<std::uint8_t> used(mesh.pointCount(), 0);
+    for (std::uint64_t c = first; c < end; ++c)
+        for (std::uint32_t id : mesh.cell(c)) used[id] = 1;
+    std::vector<std::uint32_t> local(mesh.pointCount(), 0);
+    for (std::uint64_t i = 0; i < mesh.pointCount(); ++i)
+        if (used[i]) {
+            local[i] = static_cast<std::uint32_t>(s.pointIds.size());
+            s.pointIds.push_back(i);
+            s.mesh.points.push_back(mesh.points[i]);
+            if (pointData) s.field.values.push_back(field.values[i]);
         }
-        const KdNode n = kd.nodes[from];
-        const std::uint32_t child = static_cast<std::uint32_t>(d.rankTree.size());
-        d.rankTree[to].split = n.split;
-        d.rankTree[to].bits = (child << 2) | static_cast<std::uint32_t>(n.axis());
-        d.rankTree.emplace_back();
-        d.rankTree.emplace_back();
-        stack.push_back({n.child() + 1, child + 1});
-        stack.push_back({n.child(), child});
+    std::vector<std::uint32_t> ids;
+    for (std::uint64_t c = first; c < end; ++c) {
+        ids.clear();
+        for (std::uint32_t id : mesh.cell(c)) ids.push_back(local[id]);
+        s.mesh.addCell(mesh.cellTypes[c], ids);
+        s.cellIds.push_back(c);
+        if (!pointData) s.field.values.push_back(field.values[c]);
     }
-    for (std::uint32_t node : cut) {
-        d.node.push_back(node);
-        d.regions.push_back(regions[node]);
-        d.cost.push_back(nodeCost[node]);
-    }
-    return d;
+    s.field.name = field.name;
+    s.field.association = field.association;
+    s.field.choice = field.choice;
+    return s;
 }
 
 std::vector<int> visibilityOrder(const Decomposition& d, bool parallel, Vec3f eye, Vec3f dir) {
@@ -109,103 +63,359 @@ std::vector<int> visibilityOrder(const Decomposition& d, bool parallel, Vec3f ey
     return order;
 }
 
-WholeMesh describeWholeMesh(const MeshView& mesh, const ScalarField& field,
-                            const PrepareOptions& options, const ProgressFn& progress) {
-    WholeMesh w;
+namespace {
+
+/// Smallest and largest of a box over the ranks (an empty box contributes nothing).
+Bounds3f reduceBounds(Communicator& comm, const Bounds3f& b) {
+    double v[6];
+    for (int a = 0; a < 3; ++a) v[a] = b.lo[a], v[3 + a] = -double(b.hi[a]);
+    comm.allReduce(v, ReduceOp::Min);
+    Bounds3f out;
+    for (int a = 0; a < 3; ++a)
+        out.lo[a] = static_cast<float>(v[a]), out.hi[a] = static_cast<float>(-v[3 + a]);
+    return out;
+}
+
+/// The volume of a box (0 when empty).
+double volumeOf(const Bounds3f& b) {
+    if (b.empty()) return 0.0;
+    const Vec3f e = b.extent();
+    return double(e.x) * e.y * e.z;
+}
+
+/// A node of the top of the whole tree as the ranks build it: its region and depth, this rank's
+/// cells of it, and the whole node's count and occupied region.
+struct TopNode {
+    Bounds3f region;
+    int depth = 0;
+    std::vector<std::uint32_t> cells;  ///< this rank's share cells (TetMesh ids) in the node
+    std::uint64_t count = 0;           ///< the node's cells over every rank
+    Bounds3f shrunk;                   ///< its region shrunk to its cells' bounds
+    double cost = 0.0;
+    bool leaf = false;  ///< a partition of the whole tree (the build splits it no further)
+    int below = -1, above = -1;
+    int axis = 0;
+    float split = 0.f;
+};
+
+/// The node's count and occupied region over every rank.
+void describeNode(Communicator& comm, TopNode& node, const std::vector<Bounds3f>& boxes) {
+    std::uint64_t count = node.cells.size();
+    comm.allReduce(std::span<std::uint64_t>(&count, 1), ReduceOp::Sum);
+    Bounds3f cellBounds;
+    for (std::uint32_t c : node.cells) cellBounds.extend(boxes[c]);
+    node.count = count;
+    node.shrunk = kdsplit::shrunkRegion(node.region, reduceBounds(comm, cellBounds));
+}
+
+/// The k-th smallest key over every rank's keys (0-based): radix selection, one 8-bit digit a
+/// pass from the most significant, each pass's histogram summed over the ranks.
+std::uint32_t kthKey(Communicator& comm, const std::vector<std::uint32_t>& keys, std::uint64_t k) {
+    std::uint32_t prefix = 0, mask = 0;
+    for (int shift = 24; shift >= 0; shift -= 8) {
+        std::vector<std::uint64_t> hist(256, 0);
+        for (std::uint32_t key : keys)
+            if ((key & mask) == prefix) ++hist[(key >> shift) & 0xffu];
+        comm.allReduce(hist, ReduceOp::Sum);
+        std::uint32_t digit = 0;
+        while (digit < 255 && k >= hist[digit]) k -= hist[digit++];
+        prefix |= digit << shift;
+        mask |= 0xffu << shift;
+    }
+    return prefix;
+}
+
+/// Splits `node` as the single-process build would (kd_partitions.cpp: splitLarge,
+/// buildSubtree): false when the build makes it a partition.
+bool splitNode(Communicator& comm, std::vector<TopNode>& nodes, int index,
+               const std::vector<Bounds3f>& boxes, const std::vector<Vec3f>& centres,
+               const KdBuildOptions& kd) {
+    TopNode& node = nodes[index];
+    if (!kdsplit::wantsSplit(node.count, node.depth, node.shrunk, kd.leafCells, kd.maxDepth))
+        return false;
+    const int axis = node.shrunk.longestAxis();
+    std::vector<std::uint32_t> keys(node.cells.size());
+    for (std::size_t i = 0; i < node.cells.size(); ++i)
+        keys[i] = kdsplit::floatKey(centres[node.cells[i]][axis]);
+    const float plane = kdsplit::keyFloat(kthKey(comm, keys, node.count / 2));
+    std::vector<std::uint32_t> left, right;
+    for (std::uint32_t c : node.cells) {
+        if (kdsplit::goesBelow(boxes[c], axis, plane)) left.push_back(c);
+        if (kdsplit::goesAbove(boxes[c], axis, plane)) right.push_back(c);
+    }
+    std::uint64_t sides[2] = {left.size(), right.size()};
+    comm.allReduce(sides, ReduceOp::Sum);
+    if (!kdsplit::keepsSplit(node.region, axis, plane, sides[0], sides[1], node.count))
+        return false;
+    TopNode below, above;
+    below.region = above.region = node.region;
+    below.region.hi[axis] = plane;
+    above.region.lo[axis] = plane;
+    below.depth = above.depth = node.depth + 1;
+    below.cells = std::move(left);
+    above.cells = std::move(right);
+    node.cells = {};
+    node.axis = axis;
+    node.split = plane;
+    node.below = static_cast<int>(nodes.size());
+    node.above = node.below + 1;
+    nodes.push_back(std::move(below));  // `node` is not used past here
+    nodes.push_back(std::move(above));
+    describeNode(comm, nodes[nodes.size() - 2], boxes);
+    describeNode(comm, nodes.back(), boxes);
+    return true;
+}
+
+/// Appends a trivially copyable value's bytes.
+template <class T>
+void put(std::vector<std::byte>& out, const T& v) {
+    const std::size_t at = out.size();
+    out.resize(at + sizeof(T));
+    std::memcpy(out.data() + at, &v, sizeof(T));
+}
+
+/// Reads a trivially copyable value at `at`, moving past it.
+template <class T>
+T take(const std::vector<std::byte>& in, std::size_t& at) {
+    UVR_CHECK(at + sizeof(T) <= in.size(), "cell message ends early");
+    T v;
+    std::memcpy(&v, in.data() + at, sizeof(T));
+    at += sizeof(T);
+    return v;
+}
+
+/// A point as the cells carry it: its id in the whole mesh, position and value.
+struct CarriedPoint {
+    std::uint64_t id;
+    Vec3f p;
+    float value;
+};
+
+}  // namespace
+
+RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptions& options,
+                         float ghostSteps, const ProgressFn& progress) {
+    const int ranks = comm.size(), me = comm.rank();
+    const bool pointData = share.field.association == Association::Point;
+    RankPiece out;
+    out.field.name = share.field.name;
+    out.field.association = share.field.association;
+    out.field.choice = share.field.choice;
+    out.shareCells = share.mesh.cellCount();
+    // Step 1: the share split as one process splits it, in the whole mesh's frame (found from
+    // every share's kept cells, as tetrahedralize finds it from the whole mesh's).
     if (progress)
-        progress("splitting the whole mesh's " + std::to_string(mesh.cellCount()) +
-                 " cells for its k-d tree");
+        progress("splitting this rank's share of " + std::to_string(out.shareCells) +
+                 " cells for the ranks' k-d tree");
     TetrahedralizeOptions cells = options.cells;
     cells.spatialOrder = false;  // the tree does not depend on the cells' order
     cells.sorter = nullptr;
-    const TetMesh tets = tetrahedralize(mesh, field, cells, progress.fraction);
-    if (progress) progress("building the whole mesh's k-d tree");
-    KdBuildOptions kd = kdBuildOptions(tets, options);
-    kd.splitter = nullptr;
-    w.kd = buildKdPartitions(tets, kd, progress.fraction);
-    w.frame = tets.frame;
-    w.bounds = tets.bounds;
-    w.valueMin = tets.valueMin, w.valueMax = tets.valueMax;
-    w.defaultStep = defaultStep(tets);
-    w.sourceCells = mesh.cellCount();
-    w.autoCpu = autoMethod(tets, false);
-    w.autoGpu = autoMethod(tets, true);
-    return w;
-}
-
-RankPiece extractPiece(const MeshView& mesh, const ScalarField& field, const WholeMesh& whole,
-                       const Decomposition& d, int rank, float ghostWidth) {
-    UVR_CHECK(rank >= 0 && std::size_t(rank) < d.regions.size(), "rank " << rank);
-    const Bounds3f region = d.regions[rank];
-    Bounds3f reach = region;
-    reach.lo = reach.lo - Vec3f(ghostWidth), reach.hi = reach.hi + Vec3f(ghostWidth);
-    // The cells whose bounds (in rendering units) reach the widened box.
-    const std::uint64_t cellCount = mesh.cellCount();
-    std::vector<std::uint8_t> keep(cellCount, 0);
-    std::vector<std::uint8_t> used(mesh.pointCount(), 0);
-    const std::int64_t n = static_cast<std::int64_t>(cellCount);
-#pragma omp parallel for schedule(static)
-    for (std::int64_t c = 0; c < n; ++c) {
+    cells.frame = MeshFrame{};
+    TetMesh tets = agreeOn(comm, [&] { return tetrahedralize(share.mesh, share.field, cells); });
+    const Bounds3f fileBounds = reduceBounds(comm, tets.bounds);
+    const MeshFrame frame = frameForBounds(fileBounds);
+    if (!frame.identity()) {
+        cells.frame = frame;
+        tets = agreeOn(comm, [&] { return tetrahedralize(share.mesh, share.field, cells); });
+    }
+    // Step 2: what the whole mesh decides, reduced over the shares.
+    auto piece = std::make_shared<MeshPiece>();
+    piece->rank = me;
+    piece->ranks = ranks;
+    piece->frame = frame;
+    piece->bounds = reduceBounds(comm, tets.bounds);
+    {
+        const bool any = tets.cellCount() > 0 && tets.valueMin <= tets.valueMax;
+        double range[2] = {any ? double(tets.valueMin) : INFINITY,
+                           any ? -double(tets.valueMax) : INFINITY};
+        comm.allReduce(range, ReduceOp::Min);
+        piece->valueMin = std::isfinite(range[0]) ? static_cast<float>(range[0]) : 0.f;
+        piece->valueMax = std::isfinite(range[1]) ? static_cast<float>(-range[1]) : 0.f;
+        double sums[4] = {tets.cellCount() ? tets.totalVolume : 0.0, double(tets.splitTetCount()),
+                          cellSurfaceEstimate(tets, kAutoCpuLimits.nativeCellCost),
+                          cellSurfaceEstimate(tets, kAutoGpuLimits.nativeCellCost)};
+        comm.allReduce(sums, ReduceOp::Sum);
+        std::uint64_t counts[2] = {tets.cellCount(), out.shareCells};
+        comm.allReduce(counts, ReduceOp::Sum);
+        piece->defaultStep = defaultStep(piece->bounds, sums[0], sums[1]);
+        piece->sourceCells = counts[1];
+        piece->meanSplitTets = counts[0] ? sums[1] / double(counts[0]) : 1.0;
+        piece->autoCpu = autoMethodFor(sums[2], piece->bounds, false);
+        piece->autoGpu = autoMethodFor(sums[3], piece->bounds, true);
+    }
+    // Step 3: the top of the whole tree, the costliest node split until there is one per rank.
+    if (progress)
+        progress("splitting the whole mesh's k-d tree among " + std::to_string(ranks) + " ranks");
+    KdBuildOptions kd = options.kd;
+    if (piece->meanSplitTets > 1.0)  // as kdBuildOptions sizes the whole mesh's leaves
+        kd.leafCells = static_cast<std::uint32_t>(
+            std::max(1.0, std::round(kd.leafCells / piece->meanSplitTets)));
+    const std::size_t n = tets.cellCount();
+    std::vector<Bounds3f> boxes(n);
+    std::vector<Vec3f> centres(n);
+    {
+        const TetMeshView view = tets.view();
+        for (std::size_t t = 0; t < n; ++t)
+            boxes[t] = view.cellBounds(t), centres[t] = boxes[t].center();
+    }
+    tets = TetMesh();
+    std::vector<TopNode> nodes(1);
+    nodes[0].region = piece->bounds;
+    nodes[0].cells.resize(n);
+    for (std::size_t t = 0; t < n; ++t) nodes[0].cells[t] = static_cast<std::uint32_t>(t);
+    describeNode(comm, nodes[0], boxes);
+    const double totalCells = std::max<double>(1.0, double(nodes[0].count));
+    const double totalVolume = volumeOf(nodes[0].shrunk);
+    const auto costOf = [&](const TopNode& node) {
+        return 0.5 * double(node.count) / totalCells +
+               (totalVolume > 0.0 ? 0.5 * volumeOf(node.shrunk) / totalVolume : 0.0);
+    };
+    nodes[0].cost = costOf(nodes[0]);
+    std::vector<int> frontier{0};  // left to right
+    while (int(frontier.size()) < ranks) {
+        int best = -1;
+        for (int i = 0; i < int(frontier.size()); ++i) {
+            const TopNode& f = nodes[frontier[i]];
+            if (!f.leaf && (best < 0 || f.cost > nodes[frontier[best]].cost)) best = i;
+        }
+        if (best < 0) {
+            std::size_t partitions = frontier.size();
+            throwError(ErrorKind::Argument, "",
+                       "the mesh has " + std::to_string(partitions) +
+                           " k-d partitions, fewer than the " + std::to_string(ranks) +
+                           " ranks: run on at most " + std::to_string(partitions) + " ranks");
+        }
+        const int index = frontier[best];
+        if (!splitNode(comm, nodes, index, boxes, centres, kd)) {
+            nodes[index].leaf = true;
+            continue;
+        }
+        nodes[nodes[index].below].cost = costOf(nodes[nodes[index].below]);
+        nodes[nodes[index].above].cost = costOf(nodes[nodes[index].above]);
+        frontier[best] = nodes[index].below;
+        frontier.insert(frontier.begin() + best + 1, nodes[index].above);
+    }
+    // The ranks' tree (the nodes above the frontier; a leaf names its rank).
+    Decomposition& d = out.decomposition;
+    for (int f : frontier) {
+        d.regions.push_back(nodes[f].region);
+        d.depths.push_back(nodes[f].depth);
+        d.cost.push_back(nodes[f].cost);
+    }
+    {
+        d.rankTree.emplace_back();
+        std::vector<std::pair<int, std::uint32_t>> stack{{0, 0u}};  // top node, ours
+        while (!stack.empty()) {
+            const auto [from, to] = stack.back();
+            stack.pop_back();
+            const auto rank = std::find(frontier.begin(), frontier.end(), from);
+            if (rank != frontier.end()) {
+                d.rankTree[to].bits =
+                    (static_cast<std::uint32_t>(rank - frontier.begin()) << 2) | 3u;
+                continue;
+            }
+            const TopNode& t = nodes[from];
+            const std::uint32_t child = static_cast<std::uint32_t>(d.rankTree.size());
+            d.rankTree[to].split = t.split;
+            d.rankTree[to].bits = (child << 2) | static_cast<std::uint32_t>(t.axis);
+            d.rankTree.emplace_back();
+            d.rankTree.emplace_back();
+            stack.push_back({t.above, child + 1});
+            stack.push_back({t.below, child});
+        }
+    }
+    nodes = {};
+    boxes = {};
+    centres = {};
+    piece->region = d.regions[me];
+    piece->depth = d.depths[me];
+    // Step 4: each source cell to every rank whose box, widened by the ghosts, it reaches.
+    if (progress) progress("moving cells to the ranks that render them");
+    const float ghost = ghostSteps * piece->defaultStep;
+    std::vector<std::vector<std::byte>> toEach(ranks);
+    for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
+        const std::span<const std::uint32_t> corners = share.mesh.cell(c);
         Bounds3f box;
-        for (std::uint32_t id : mesh.cell(std::uint64_t(c))) {
+        for (std::uint32_t id : corners) {
             double p[3];
-            whole.frame.toLocal(mesh.points[id], p);
+            frame.toLocal(share.mesh.points[id], p);
             box.extend(Vec3f(float(p[0]), float(p[1]), float(p[2])));
         }
-        bool reaches = !box.empty();
-        for (int a = 0; a < 3; ++a)
-            reaches = reaches && box.lo[a] <= reach.hi[a] && box.hi[a] >= reach.lo[a];
-        keep[c] = reaches ? 1 : 0;
-    }
-    for (std::uint64_t c = 0; c < cellCount; ++c)
-        if (keep[c])
-            for (std::uint32_t id : mesh.cell(c)) used[id] = 1;
-    // The points in the whole mesh's order (so cells split as one process splits them).
-    RankPiece out;
-    std::vector<std::uint32_t> newId(mesh.pointCount(), 0);
-    for (std::uint64_t i = 0; i < mesh.pointCount(); ++i)
-        if (used[i]) {
-            newId[i] = static_cast<std::uint32_t>(out.mesh.points.size());
-            out.mesh.points.push_back(mesh.points[i]);
+        for (int r = 0; r < ranks; ++r) {
+            bool reaches = !box.empty();
+            for (int a = 0; a < 3; ++a)
+                reaches = reaches && box.lo[a] <= d.regions[r].hi[a] + ghost &&
+                          box.hi[a] >= d.regions[r].lo[a] - ghost;
+            if (!reaches) continue;
+            std::vector<std::byte>& m = toEach[r];
+            put(m, share.cellIds[c]);
+            put(m, static_cast<std::uint8_t>(share.mesh.cellTypes[c]));
+            put(m, static_cast<std::uint8_t>(corners.size()));
+            for (std::uint32_t id : corners) {
+                put(m, share.pointIds[id]);
+                put(m, share.mesh.points[id]);
+                put(m, pointData ? share.field.values[id] : 0.f);
+            }
+            if (!pointData) put(m, share.field.values[c]);
         }
-    out.field.name = field.name;
-    out.field.association = field.association;
-    out.field.choice = field.choice;
-    const bool pointData = field.association == Association::Point;
-    if (pointData)
-        for (std::uint64_t i = 0; i < mesh.pointCount(); ++i)
-            if (used[i]) out.field.values.push_back(field.values[i]);
+    }
+    share = MeshShare();
+    std::vector<std::vector<std::byte>> received = comm.allToAll(toEach);
+    toEach = {};
+    // Step 5: the piece: its points in the whole mesh's order, its cells in the whole mesh's.
+    struct CarriedCell {
+        std::uint64_t id;
+        CellType type;
+        std::vector<std::uint64_t> corners;
+        float value;
+    };
+    std::vector<CarriedCell> carried;
+    std::vector<CarriedPoint> points;
+    for (const std::vector<std::byte>& m : received) {
+        std::size_t at = 0;
+        while (at < m.size()) {
+            CarriedCell cell;
+            cell.id = take<std::uint64_t>(m, at);
+            cell.type = static_cast<CellType>(take<std::uint8_t>(m, at));
+            const int count = take<std::uint8_t>(m, at);
+            for (int k = 0; k < count; ++k) {
+                CarriedPoint p;
+                p.id = take<std::uint64_t>(m, at);
+                p.p = take<Vec3f>(m, at);
+                p.value = take<float>(m, at);
+                cell.corners.push_back(p.id);
+                points.push_back(p);
+            }
+            cell.value = pointData ? 0.f : take<float>(m, at);
+            carried.push_back(std::move(cell));
+        }
+    }
+    received = {};
+    std::sort(points.begin(), points.end(),
+              [](const CarriedPoint& a, const CarriedPoint& b) { return a.id < b.id; });
+    points.erase(
+        std::unique(points.begin(), points.end(),
+                    [](const CarriedPoint& a, const CarriedPoint& b) { return a.id == b.id; }),
+        points.end());
+    std::sort(carried.begin(), carried.end(),
+              [](const CarriedCell& a, const CarriedCell& b) { return a.id < b.id; });
+    for (const CarriedPoint& p : points) {
+        out.mesh.points.push_back(p.p);
+        if (pointData) out.field.values.push_back(p.value);
+    }
     std::vector<std::uint32_t> ids;
-    for (std::uint64_t c = 0; c < cellCount; ++c) {
-        if (!keep[c]) continue;
+    for (const CarriedCell& cell : carried) {
         ids.clear();
-        for (std::uint32_t id : mesh.cell(c)) ids.push_back(newId[id]);
-        out.mesh.addCell(mesh.cellTypes[c], ids);
-        if (!pointData) out.field.values.push_back(field.values[c]);
+        for (std::uint64_t id : cell.corners) {
+            const auto it =
+                std::lower_bound(points.begin(), points.end(), id,
+                                 [](const CarriedPoint& p, std::uint64_t v) { return p.id < v; });
+            ids.push_back(static_cast<std::uint32_t>(it - points.begin()));
+        }
+        out.mesh.addCell(cell.type, ids);
+        if (!pointData) out.field.values.push_back(cell.value);
     }
-    // What the rank's preparation takes from the whole mesh.
-    auto piece = std::make_shared<MeshPiece>();
-    piece->rank = rank;
-    piece->ranks = static_cast<int>(d.regions.size());
-    piece->region = region;
-    piece->tree = kdSubtree(whole.kd, d.node[rank]);
-    piece->frame = whole.frame;
-    piece->bounds = whole.bounds;
-    piece->valueMin = whole.valueMin, piece->valueMax = whole.valueMax;
-    piece->defaultStep = whole.defaultStep;
-    piece->sourceCells = whole.sourceCells;
-    piece->autoCpu = whole.autoCpu, piece->autoGpu = whole.autoGpu;
     out.piece = std::move(piece);
-    // The cells of the whole tree's leaves below the rank's node (with their duplicates).
-    std::vector<std::uint32_t> stack{d.node[rank]};
-    while (!stack.empty()) {
-        const KdNode node = whole.kd.nodes[stack.back()];
-        stack.pop_back();
-        if (node.isLeaf())
-            out.ownedCells += whole.kd.partitions[node.child()].cellCount;
-        else
-            stack.push_back(node.child()), stack.push_back(node.child() + 1);
-    }
     return out;
 }
 

@@ -4,9 +4,11 @@
 #include <gmock/gmock.h>
 
 #include <mutex>
+#include <tuple>
 
 #include "test_meshes.h"
 #include "test_support.h"
+#include "uvr/cuda/cuda_device.h"
 #include "uvr/dist/communicator.h"
 #include "uvr/dist/decompose.h"
 #include "uvr/dist/in_process_communicator.h"
@@ -98,6 +100,89 @@ TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
             }
         }
     }
+}
+
+TEST(DataParallel, TheRanksPartitionsAreOneProcessPartitions) {
+    for (const char* file : {"bluntfin_tets.vtk", "hexa.vtk"}) {
+        const std::string path = testing::sharedData(file);
+        if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+        const Mesh mesh = readMesh(path);
+        const ScalarField field = selectScalarField(mesh, {});
+        RendererOptions options;
+        options.device = Device::Cpu;
+        options.leafCells = 256;  // many partitions: deep ranks' subtrees
+        const Renderer one(mesh, field, options);
+        const auto key = [](const KdPartition& p) {
+            return std::tuple(p.box.lo.x, p.box.lo.y, p.box.lo.z, p.box.hi.x, p.box.hi.y,
+                              p.box.hi.z, p.cellCount, p.valueMin, p.valueMax);
+        };
+        std::vector<decltype(key(KdPartition{}))> whole;
+        for (const KdPartition& p : one.prepared().kd->partitions) whole.push_back(key(p));
+        std::sort(whole.begin(), whole.end());
+        for (int ranks : {2, 3, 5, 8}) {
+            std::vector<decltype(key(KdPartition{}))> pieces;
+            std::vector<std::uint64_t> cells;
+            std::mutex m;
+            InProcessGroup::run(ranks, [&](Communicator& comm) {
+                RendererOptions o = options;
+                o.communicator = &comm;
+                const Renderer r(mesh, field, o);
+                const std::lock_guard<std::mutex> lock(m);
+                for (const KdPartition& p : r.prepared().kd->partitions) pieces.push_back(key(p));
+                cells.push_back(r.prepared().tets.cellCount());
+            });
+            std::sort(pieces.begin(), pieces.end());
+            SCOPED_TRACE(std::string(file) + ", " + std::to_string(ranks) + " ranks");
+            EXPECT_EQ(pieces.size(), whole.size());
+            EXPECT_TRUE(pieces == whole);
+            // No rank holds the whole mesh (the ghosts aside, about a rank's share of it).
+            for (std::uint64_t c : cells) EXPECT_LT(c, one.prepared().tets.cellCount());
+        }
+    }
+}
+
+TEST(DataParallel, OnTheGpuEveryMethodGivesOneProcessPicture) {
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
+    const std::string path = testing::sharedData("bluntfin_tets.vtk");
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+    const Mesh mesh = readMesh(path);
+    const ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options;
+    options.device = Device::Cuda;
+    Renderer one(mesh, field, options);
+    std::vector<RenderSettings> frames;
+    for (RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact})
+        frames.push_back(frameOf(mesh.bounds(), m, 30.f, 20.f));
+    for (int ranks : {2, 3}) {
+        const std::vector<RenderResult> many =
+            dataParallelFrames(mesh, field, ranks, options, frames);
+        ASSERT_EQ(many.size(), frames.size());
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            const ImageComparison cmp =
+                compareImages(toRgb8(one.render(frames[i]).image), toRgb8(many[i].image));
+            SCOPED_TRACE(std::string(methodName(frames[i].method)) + ", " + std::to_string(ranks) +
+                         " ranks on the GPU");
+            EXPECT_GE(cmp.ssim, kMinSsim);
+            EXPECT_LE(cmp.maxAbsDifference, kMaxLevels) << differenceSummary(cmp);
+        }
+    }
+}
+
+TEST(DataParallel, TooManyRanksForThePartitionsAreRefusedOnEveryRank) {
+    const Mesh mesh = testing::makeHexGrid(
+        3, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);
+    const ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options;
+    options.device = Device::Cpu;
+    const Error e = catchError([&] {
+        InProcessGroup::run(3, [&](Communicator& comm) {
+            RendererOptions o = options;
+            o.communicator = &comm;
+            Renderer r(mesh, field, o);
+        });
+    });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(), HasSubstr("fewer than the 3 ranks"));
 }
 
 }  // namespace

@@ -95,14 +95,11 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
         // piece prepared as one process would prepare that box (dist/decompose.h).
         comm_ = options.communicator;
         PrepareOptions prepare = options.prepareOptions();
-        RankPiece piece = agreeOn(*comm_, [&] {
-            const WholeMesh whole = describeWholeMesh(mesh, field, prepare, progress);
-            auto d = std::make_shared<Decomposition>(
-                decompose(whole.kd, partitionCosts(whole.kd), comm_->size()));
-            decomposition_ = d;
-            return extractPiece(mesh, field, whole, *d, comm_->rank(),
-                                kGhostSteps * whole.defaultStep);
-        });
+        // For now every rank holds the whole mesh and starts from its share of the cells.
+        RankPiece piece =
+            distributeMesh(*comm_, shareOfMesh(mesh, field, comm_->rank(), comm_->size()), prepare,
+                           kGhostSteps, progress);
+        decomposition_ = std::make_shared<Decomposition>(std::move(piece.decomposition));
         prepare.piece = piece.piece;
         prepared_ = std::make_unique<PreparedMesh>(agreeOn(
             *comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));

@@ -309,8 +309,13 @@ struct TetMesh {
     /// splitTetCount per cell (1 for tetrahedra only): grids sized by tetrahedra per grid cell
     /// scale a partition's cell count by it, so a native mesh gets its split's grids.
     double meanSplitTets() const {
+        if (wholeMeanSplitTets > 0.0) return wholeMeanSplitTets;
         return cellCount() ? double(splitTetCount()) / double(cellCount()) : 1.0;
     }
+    /// When > 0 (a data-parallel rank's piece of a mesh): the whole mesh's meanSplitTets, which
+    /// meanSplitTets gives instead of the piece's own, so grids and leaves are sized as the whole
+    /// mesh's.
+    double wholeMeanSplitTets = 0.0;
     /// View for kernels; the TetMesh must outlive it.
     TetMeshView view() const {
         TetMeshView v{points.data(), tets.empty() ? nullptr : tets.data(), values.data(),

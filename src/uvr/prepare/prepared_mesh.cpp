@@ -44,7 +44,7 @@ KdBuildOptions kdBuildOptions(const TetMesh& tets, const PrepareOptions& options
     KdBuildOptions kd = options.kd;
     // The leaf size counts tetrahedra of the split: native cells fill a leaf as the tetrahedra
     // they stand for would (partitions of the same size in space).
-    if (tets.hasNative())
+    if (tets.meanSplitTets() > 1.0)
         kd.leafCells = static_cast<std::uint32_t>(
             std::max(1.0, std::round(kd.leafCells / tets.meanSplitTets())));
     return kd;
@@ -70,6 +70,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     if (large && options.faceMatcher)
         welding = beside([points = mesh.points] { return coincidentPointIds(points); });
     out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
+    if (options.piece) out.tets.wholeMeanSplitTets = options.piece->meanSplitTets;
     std::vector<std::uint32_t> welded;
     if (welding.valid()) welded = std::move(welding.get().first);  // before the points are freed
     if (options.afterSplit) options.afterSplit();
@@ -154,10 +155,10 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      ")");
         KdBuildOptions kd = kdBuildOptions(out.tets, options);
         if (splitter) kd.splitter = splitter;
-        if (const std::shared_ptr<const MeshPiece> piece = options.piece)
-            kd.splitter = [piece](const TetMesh& tets, const KdBuildOptions&, const FractionFn&) {
-                return replayKdTree(tets, piece->tree, piece->region);
-            };
+        if (const MeshPiece* piece = options.piece.get()) {
+            kd.splitter = nullptr;
+            kd.root = KdSubtreeRoot{piece->region, piece->depth, piece->bounds.diagonal()};
+        }
         start = std::chrono::steady_clock::now();
         out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
         // A piece's traversal starts at the whole mesh's bounds and narrows to its box (the
@@ -312,10 +313,15 @@ float PreparedMesh::wholeDefaultStep() const {
 }
 
 float defaultStep(const TetMesh& mesh) {
-    const double diagonal = mesh.bounds.diagonal();
-    if (mesh.cellCount() == 0 || !(mesh.totalVolume > 0.0))
+    return defaultStep(mesh.bounds, mesh.cellCount() ? mesh.totalVolume : 0.0,
+                       double(mesh.splitTetCount()));
+}
+
+float defaultStep(const Bounds3f& bounds, double totalVolume, double splitTets) {
+    const double diagonal = bounds.diagonal();
+    if (!(splitTets > 0.0) || !(totalVolume > 0.0))
         return diagonal > 0.0 ? static_cast<float>(0.01 * diagonal) : 1.f;
-    const double mean = 0.5 * std::cbrt(mesh.totalVolume / double(mesh.splitTetCount()));
+    const double mean = 0.5 * std::cbrt(totalVolume / splitTets);
     const double step = std::min(mean, diagonal / kMinSamplesPerDiagonal);
     return static_cast<float>(std::max(step, kMinDefaultStepFraction * diagonal));
 }

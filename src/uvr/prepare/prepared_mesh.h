@@ -34,14 +34,15 @@ namespace uvr {
 /// a single process makes and its partitions are that process's partitions in the box.
 struct MeshPiece {
     int rank = 0, ranks = 1;  ///< this rank, of how many
-    Bounds3f region;          ///< the rank's box (rendering units)
-    KdTree tree;              ///< kdSubtree of the whole tree at the rank's node (no cells)
+    Bounds3f region;          ///< the rank's box (rendering units): a node of the whole tree
+    int depth = 0;            ///< that node's depth in the whole tree
     MeshFrame frame;          ///< the whole mesh's rendering frame
     Bounds3f bounds;          ///< the whole mesh's bounds (rendering units)
     float valueMin = 0.f;     ///< the whole field's finite range
     float valueMax = 0.f;
     float defaultStep = 0.f;        ///< defaultStep of the whole mesh
     std::uint64_t sourceCells = 0;  ///< cells of the whole mesh
+    double meanSplitTets = 1.0;     ///< the whole mesh's TetMesh::meanSplitTets
     /// autoMethod of the whole mesh for the CPU and the GPU.
     AutoMethodChoice autoCpu{RenderMethod::Partitions}, autoGpu{RenderMethod::Partitions};
 };
@@ -88,8 +89,8 @@ struct PrepareOptions {
     /// a billion cells does not hold the mesh as read beside the prepared one.
     std::function<void()> afterSplit;
     /// When set, the mesh is this rank's piece of a whole mesh (its cells reaching the piece's
-    /// box): it takes the whole mesh's frame and method choice, and its k-d partitions are the
-    /// piece's subtree (replayKdTree) instead of a tree of its own.
+    /// box, and more): it takes the whole mesh's frame and method choice, and its k-d partitions
+    /// are the whole tree's below the piece's node (KdBuildOptions::root, on the CPU threads).
     std::shared_ptr<const MeshPiece> piece = nullptr;
     std::string builderDevice = "cpu";  ///< where the builders above build (progress messages)
     std::uint64_t builderMinTets = 0;   ///< use them only from this many cells
@@ -243,6 +244,9 @@ std::vector<std::uint8_t> partitionNanFlags(const TetMesh& tets, const KdPartiti
 /// step); at least kMinDefaultStepFraction of the diagonal (a mesh of slivers has a tiny mean
 /// volume).
 float defaultStep(const TetMesh& mesh);
+/// defaultStep of a mesh of these bounds, summed tetrahedron volume and tetrahedra of the split
+/// (TetMesh::splitTetCount), e.g. summed over the ranks' shares of a mesh.
+float defaultStep(const Bounds3f& bounds, double totalVolume, double splitTets);
 
 /// Fewest samples the default step takes across the bounds' diagonal (it decides the step of
 /// meshes below about 400,000 tetrahedra).

@@ -46,12 +46,10 @@ double cellSurface(CellKind k, const Vec3f* x) {
 
 }  // namespace
 
-double exactCellsPerRay(const TetMesh& mesh, double nativeCellCost) {
+double cellSurfaceEstimate(const TetMesh& mesh, double nativeCellCost) {
     const TetMeshView view = mesh.view();
     const std::uint64_t cells = view.cellCount();
     if (cells == 0) return 0.0;
-    const Vec3f e = mesh.bounds.hi - mesh.bounds.lo;
-    const double box = 2.0 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
     const std::uint64_t stride = std::max<std::uint64_t>(1, cells / kAutoSampleCells);
     double sum = 0.0;
     std::uint64_t measured = 0;
@@ -62,19 +60,40 @@ double exactCellsPerRay(const TetMesh& mesh, double nativeCellCost) {
         const double s = cellSurface(k, x);
         if (std::isfinite(s)) sum += k == CellKind::Tet ? s : nativeCellCost * s;
     }
-    const double total = sum * (double(cells) / double(measured));
-    // A flat box (all cells in a plane) has no volume to cross: one cell per ray at most.
-    return box > 0.0 ? total / box : 1.0;
+    return sum * (double(cells) / double(measured));
 }
 
-AutoMethodChoice autoMethod(const TetMesh& mesh, bool gpu) {
+namespace {
+
+/// Mean cells a ray through the bounds crosses for cells of summed surface `surface`.
+double cellsPerRayOf(double surface, const Bounds3f& bounds) {
+    const Vec3f e = bounds.hi - bounds.lo;
+    const double box = 2.0 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
+    // A flat box (all cells in a plane) has no volume to cross: one cell per ray at most.
+    return box > 0.0 ? surface / box : 1.0;
+}
+
+}  // namespace
+
+double exactCellsPerRay(const TetMesh& mesh, double nativeCellCost) {
+    if (mesh.cellCount() == 0) return 0.0;
+    return cellsPerRayOf(cellSurfaceEstimate(mesh, nativeCellCost), mesh.bounds);
+}
+
+AutoMethodChoice autoMethodFor(double surface, const Bounds3f& bounds, bool gpu) {
     const AutoMethodLimits& limits = gpu ? kAutoGpuLimits : kAutoCpuLimits;
     AutoMethodChoice c;
     c.gpu = gpu;
     c.limit = limits.maxExactCellsPerRay;
-    c.cellsPerRay = exactCellsPerRay(mesh, limits.nativeCellCost);
+    c.cellsPerRay = surface > 0.0 ? cellsPerRayOf(surface, bounds) : 0.0;
     c.method = c.cellsPerRay <= c.limit ? RenderMethod::Exact : RenderMethod::Partitions;
     return c;
+}
+
+AutoMethodChoice autoMethod(const TetMesh& mesh, bool gpu) {
+    const AutoMethodLimits& limits = gpu ? kAutoGpuLimits : kAutoCpuLimits;
+    return autoMethodFor(mesh.cellCount() ? cellSurfaceEstimate(mesh, limits.nativeCellCost) : 0.0,
+                         mesh.bounds, gpu);
 }
 
 std::string AutoMethodChoice::reason() const {

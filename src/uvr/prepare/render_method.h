@@ -93,4 +93,13 @@ struct AutoMethodChoice {
 };
 AutoMethodChoice autoMethod(const TetMesh& mesh, bool gpu);
 
+/// The estimate behind exactCellsPerRay before it is divided by the bounds' surface: the summed
+/// surface of the mesh's cells (from at most kAutoSampleCells, scaled), each native cell counted
+/// nativeCellCost times. Shares of a mesh add up to the whole mesh's.
+double cellSurfaceEstimate(const TetMesh& mesh, double nativeCellCost);
+
+/// autoMethod for a mesh whose cells' summed surface (cellSurfaceEstimate with the device's
+/// native-cell cost) is `surface`, within `bounds`.
+AutoMethodChoice autoMethodFor(double surface, const Bounds3f& bounds, bool gpu);
+
 }  // namespace uvr
