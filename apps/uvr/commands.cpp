@@ -294,15 +294,14 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         checkFrameMemory(*flags, ctx);
         const CudaWarmUp cuda(flags->device);  // CUDA starts while the mesh is read
         if (ctx.dataParallel()) {
-            // Every rank reads the file (the whole mesh, for now) and prepares its piece; a
-            // prepared cache holds one process's preparation.
+            // Every rank reads its part of the file and prepares its piece; a prepared cache
+            // holds one process's preparation.
             if (!cache->file.empty())
                 throwError(ErrorKind::Unsupported, "",
                            "--cache: a prepared cache is one process's preparation; a "
                            "data-parallel render (mpirun) prepares each rank's piece from the "
                            "mesh");
-            Mesh mesh = agreeOn(*ctx.comm, [&] { return loadMesh(*file, ctx, *steps); });
-            renderAndWrite(std::move(mesh), *file, *flags, ctx);
+            renderDataParallel(*file, *flags, *steps, ctx);
             return;
         }
         if (renderFromCache(*file, *flags, *steps, *cache, ctx)) return;

@@ -191,6 +191,75 @@ RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const Render
     return renderPreparedAndWrite(*renderer, src, settings, out, ctx);
 }
 
+RenderResult renderDataParallel(const std::string& file, const RenderFlags& flags,
+                                const StepFlags& steps, const Context& ctx) {
+    Communicator& comm = *ctx.comm;
+    const RenderOutputs out = flags.renderOutputs();  // checked before the expensive work
+    const int rank = comm.rank(), ranks = comm.size();
+    const auto start = Clock::now();
+    const auto cellsOf = [&](std::uint64_t n, int r) { return n * std::uint64_t(r) / ranks; };
+    // This rank's part of the file.
+    MeshPart part = agreeOn(comm, [&] {
+        if (sniffMeshFormat(file) == MeshFormat::Native && !steps.time && !steps.index) {
+            const std::uint64_t n = readNativeSummary(file, false).cellCount;
+            ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
+                     " ranks reads about " + std::to_string(n / ranks) + " of its " +
+                     std::to_string(n) + " cells");
+            ReadOptions read;
+            read.maxMemoryBytes = ctx.maxMemoryBytes;
+            return readNativePart(file, cellsOf(n, rank), cellsOf(n, rank + 1), read);
+        }
+        const Mesh whole = loadMesh(file, ctx, steps);
+        const std::uint64_t n = whole.cellCount();
+        return meshPart(whole, cellsOf(n, rank), cellsOf(n, rank + 1));
+    });
+    const std::uint64_t pointIdEnd = part.pointIds.empty() ? 0 : part.pointIds.back() + 1;
+    MeshShare share = shareOfPart(comm, std::move(part), parseFieldSpec(flags.field));
+    // The checks, over every rank's share.
+    RenderSource src;
+    src.path = file;
+    const ValidationReport report = agreeOn(comm, [&] { return validateMesh(share.mesh, file); });
+    std::uint64_t counts[2] = {share.mesh.cellCount(), pointIdEnd};
+    comm.allReduce(std::span<std::uint64_t>(counts, 1), ReduceOp::Sum);
+    comm.allReduce(std::span<std::uint64_t>(counts + 1, 1), ReduceOp::Max);
+    src.summary.cells = counts[0];
+    src.summary.points = counts[1];
+    src.summary.bounds = reduceBounds(comm, report.bounds);
+    src.summary.fieldName = share.field.name;
+    src.summary.association = share.field.association;
+    src.summary.fieldChoice = share.field.choice;
+    src.summary.notes = share.mesh.notes;
+    std::string mine;
+    for (const std::string& f : report.findings()) mine += f + "\n";
+    const std::vector<std::vector<std::byte>> findings =
+        comm.allGather(std::as_bytes(std::span<const char>(mine)));
+    for (int r = 0; r < ranks; ++r) {
+        const std::string text(reinterpret_cast<const char*>(findings[r].data()),
+                               findings[r].size());
+        for (std::size_t at = 0, end; (end = text.find('\n', at)) != std::string::npos;
+             at = end + 1)
+            src.summary.findings.push_back(text.substr(at, end - at) + " (rank " +
+                                           std::to_string(r) + "'s share)");
+    }
+    for (const std::string& f : src.summary.findings) ctx.step("validation: " + f);
+    if (src.summary.bounds.empty())
+        throwError(ErrorKind::Validation, file,
+                   "no cell has volume: all " + std::to_string(src.summary.cells) +
+                       " cell(s) are flat or use NaN/Inf points; nothing to render");
+    const RenderSettings settings = checkedSettings(flags, src, ctx);
+    ctx.setActivity(file, "preparing this rank's piece for rendering");
+    RendererOptions options = flags.rendererOptions();
+    options.communicator = ctx.comm;
+    PhaseProgress phases(ctx);
+    Renderer renderer(std::move(share), options, phases.callbacks());
+    phases.finish();
+    reportUpload(renderer, ctx);
+    ctx.done("prepared " + std::to_string(ranks) +
+                 " pieces; rank 0's: " + describeCells(renderer.prepared().tets),
+             start);
+    return renderPreparedAndWrite(renderer, src, settings, out, ctx);
+}
+
 void CacheFlags::registerOn(CLI::App& app) {
     auto* c = app.add_option("--cache", file,
                              "Render from this prepared cache (`uvr prepare`) without reading the "

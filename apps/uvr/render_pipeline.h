@@ -50,4 +50,11 @@ bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, cons
 /// where it renders as the other makeRenderer does.
 std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx);
 
+/// `mpirun -n N uvr render FILE`: each rank reads its part of the file (a .uvrm only where the
+/// part lies; any other file whole, keeping its part), the ranks agree on the field, the bounds
+/// and the checks, render their pieces data-parallel (Renderer from a MeshShare), and rank 0
+/// writes the outputs. ctx.comm must be set.
+RenderResult renderDataParallel(const std::string& file, const RenderFlags& flags,
+                                const StepFlags& steps, const Context& ctx);
+
 }  // namespace uvr::cli

@@ -10,6 +10,7 @@
 #include "uvr/core/output_file.h"
 #include "uvr/cuda/cuda_device.h"
 #include "uvr/dist/communicator.h"
+#include "uvr/dist/decompose.h"
 #include "uvr/dist/mpi_communicator.h"
 #include "uvr/facade/frame_report.h"
 #include "uvr/facade/renderer.h"

@@ -44,6 +44,33 @@ MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, 
     return s;
 }
 
+MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec) {
+    // Which fields hold one value over the whole mesh (NaN left out): their finite ranges
+    // reduced over the ranks.
+    std::vector<FieldInfo> infos = fieldInfos(part.mesh);
+    std::vector<double> range(2 * infos.size(), INFINITY);
+    for (std::size_t f = 0; f < infos.size(); ++f)
+        for (float v : part.mesh.fields[f].values)
+            if (std::isfinite(v))
+                range[2 * f] = std::min(range[2 * f], double(v)),
+                          range[2 * f + 1] = std::min(range[2 * f + 1], -double(v));
+    comm.allReduce(range, ReduceOp::Min);
+    for (std::size_t f = 0; f < infos.size(); ++f)
+        infos[f].constant = !(range[2 * f] < -range[2 * f + 1]);
+    FieldChoice choice = resolveField(infos, spec);
+    FieldSpec pinned = spec;
+    pinned.name = part.mesh.fields[choice.index].name;
+    pinned.association = part.mesh.fields[choice.index].association;
+    MeshShare share;
+    share.field = selectScalarField(part.mesh, pinned);
+    share.field.choice = std::move(choice.choice);
+    share.mesh = std::move(part.mesh);
+    share.mesh.fields.clear();
+    share.pointIds = std::move(part.pointIds);
+    share.cellIds = std::move(part.cellIds);
+    return share;
+}
+
 std::vector<int> visibilityOrder(const Decomposition& d, bool parallel, Vec3f eye, Vec3f dir) {
     std::vector<int> order;
     std::vector<std::uint32_t> stack{0};
@@ -63,9 +90,6 @@ std::vector<int> visibilityOrder(const Decomposition& d, bool parallel, Vec3f ey
     return order;
 }
 
-namespace {
-
-/// Smallest and largest of a box over the ranks (an empty box contributes nothing).
 Bounds3f reduceBounds(Communicator& comm, const Bounds3f& b) {
     double v[6];
     for (int a = 0; a < 3; ++a) v[a] = b.lo[a], v[3 + a] = -double(b.hi[a]);
@@ -75,6 +99,8 @@ Bounds3f reduceBounds(Communicator& comm, const Bounds3f& b) {
         out.lo[a] = static_cast<float>(v[a]), out.hi[a] = static_cast<float>(-v[3 + a]);
     return out;
 }
+
+namespace {
 
 /// The volume of a box (0 when empty).
 double volumeOf(const Bounds3f& b) {

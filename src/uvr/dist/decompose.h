@@ -17,6 +17,7 @@
 #include "uvr/core/vec.h"
 #include "uvr/dist/communicator.h"
 #include "uvr/mesh/field_select.h"
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/prepare/prepared_mesh.h"
 
@@ -34,6 +35,14 @@ struct MeshShare {
 
 /// Share `rank` of `ranks` of a mesh held whole: the cells [rank n / ranks, (rank + 1) n / ranks).
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks);
+
+/// The smallest box holding every rank's box (collective; an empty box adds nothing).
+Bounds3f reduceBounds(Communicator& comm, const Bounds3f& box);
+
+/// A rank's share from the part of a file it read (readNativePart, meshPart) and the field
+/// `spec` names (collective: the default field passes over fields constant over the whole mesh,
+/// as one process's choice does, so every rank renders the same field).
+MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec);
 
 /// How the ranks split the whole mesh: the top of its k-d tree down to one node per rank.
 struct Decomposition {

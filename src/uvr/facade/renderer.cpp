@@ -91,22 +91,39 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
     checkDeviceUsable(options.device);
     const auto start = std::chrono::steady_clock::now();
     if (options.communicator && options.communicator->size() > 1) {
-        // Data-parallel: the whole mesh's k-d tree cut into the ranks' boxes, and this rank's
-        // piece prepared as one process would prepare that box (dist/decompose.h).
-        comm_ = options.communicator;
-        PrepareOptions prepare = options.prepareOptions();
-        // For now every rank holds the whole mesh and starts from its share of the cells.
-        RankPiece piece =
-            distributeMesh(*comm_, shareOfMesh(mesh, field, comm_->rank(), comm_->size()), prepare,
-                           kGhostSteps, progress);
-        decomposition_ = std::make_shared<Decomposition>(std::move(piece.decomposition));
-        prepare.piece = piece.piece;
-        prepared_ = std::make_unique<PreparedMesh>(agreeOn(
-            *comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));
+        // Data-parallel from a whole mesh every rank holds: each starts from its share.
+        const Communicator& comm = *options.communicator;
+        prepareShare(shareOfMesh(mesh, field, comm.rank(), comm.size()), options, progress);
     } else {
         prepared_ = std::make_unique<PreparedMesh>(
             prepareMesh(mesh, field, options.prepareOptions(), progress));
     }
+    finishPreparation(options, progress, start);
+}
+
+Renderer::Renderer(MeshShare share, const RendererOptions& options, const ProgressFn& progress) {
+    checkDeviceUsable(options.device);
+    UVR_CHECK(options.communicator, "a renderer from a share needs a communicator");
+    const auto start = std::chrono::steady_clock::now();
+    prepareShare(std::move(share), options, progress);
+    finishPreparation(options, progress, start);
+}
+
+void Renderer::prepareShare(MeshShare share, const RendererOptions& options,
+                            const ProgressFn& progress) {
+    // The whole mesh's k-d tree cut into the ranks' boxes, and this rank's piece prepared as one
+    // process would prepare that box (dist/decompose.h).
+    comm_ = options.communicator;
+    PrepareOptions prepare = options.prepareOptions();
+    RankPiece piece = distributeMesh(*comm_, std::move(share), prepare, kGhostSteps, progress);
+    decomposition_ = std::make_shared<Decomposition>(std::move(piece.decomposition));
+    prepare.piece = piece.piece;
+    prepared_ = std::make_unique<PreparedMesh>(
+        agreeOn(*comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));
+}
+
+void Renderer::finishPreparation(const RendererOptions& options, const ProgressFn& progress,
+                                 std::chrono::steady_clock::time_point start) {
     prepareSeconds_ =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress && resolvesToCuda(options.device))

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -16,6 +17,7 @@ namespace uvr {
 class CudaScene;
 class Communicator;
 struct Decomposition;
+struct MeshShare;
 
 /// Where frames render, or where acceleration structures build.
 enum class Device {
@@ -82,6 +84,10 @@ public:
     /// the GPU lacks memory.
     Renderer(const MeshView& mesh, const ScalarField& field, const RendererOptions& options = {},
              const ProgressFn& progress = {});
+    /// A data-parallel renderer from this rank's share of a mesh (dist/decompose.h: read by the
+    /// rank, e.g. readNativePart, shareOfPart): collective over options.communicator, which must
+    /// be set; no rank holds the whole mesh. Throws as the constructor above.
+    Renderer(MeshShare share, const RendererOptions& options, const ProgressFn& progress = {});
     /// Renders an already prepared mesh, taking it over, on `device`.
     Renderer(PreparedMesh prepared, Device device);
     ~Renderer();
@@ -120,6 +126,11 @@ public:
 private:
     /// This rank's frame: its piece's on a data-parallel renderer.
     RenderResult renderLocal(const RenderSettings& settings);
+    /// Data-parallel: distributes this rank's share and prepares its piece (comm_ set).
+    void prepareShare(MeshShare share, const RendererOptions& options, const ProgressFn& progress);
+    /// The upload to the GPU (when rendering there) after the preparation that began at start.
+    void finishPreparation(const RendererOptions& options, const ProgressFn& progress,
+                           std::chrono::steady_clock::time_point start);
 
     std::unique_ptr<PreparedMesh> prepared_;
     std::unique_ptr<CudaScene> gpu_;

@@ -411,6 +411,134 @@ Mesh readNative(const std::string& path, const ReadOptions& options) {
     return mesh;
 }
 
+MeshPart readNativePart(const std::string& path, std::uint64_t firstCell, std::uint64_t endCell,
+                        const ReadOptions& options) {
+    const std::uint64_t size = fileSize(path);
+    Reader in(path, size);
+    const NativeLayout layout = readLayout(in, path, size);
+    const std::vector<ArraySpan>& arrays = layout.arrays;
+    if (firstCell > endCell || endCell > layout.cellCount)
+        throwError(ErrorKind::Argument, path,
+                   "cells [" + std::to_string(firstCell) + ", " + std::to_string(endCell) +
+                       ") asked for, but the file has " + std::to_string(layout.cellCount));
+    const std::uint64_t n = endCell - firstCell;
+    const BudgetedOptions budgeted(options);
+    budgeted.budget().charge(path, "the part's cell types and offsets", n, 9);
+    MeshPart part;
+    Mesh& mesh = part.mesh;
+    // The cells: their types and offsets, then their corner indices.
+    mesh.cellTypes.resize(n);
+    in.readAt(mesh.cellTypes.data(), arrays[1].start + firstCell, n, arrays[1].what);
+    std::vector<std::uint64_t> offsets(n + 1);
+    in.readAt(offsets.data(), arrays[2].start + 8 * firstCell, 8 * (n + 1), arrays[2].what);
+    swapWordsIfBigEndian(offsets.data(), n + 1, 8);
+    for (std::uint64_t c = 0; c < n; ++c)
+        if (offsets[c + 1] < offsets[c] || offsets[c + 1] > layout.indexCount)
+            throwParseError(path, atByte(arrays[2].start + 8 * (firstCell + c + 1)),
+                            "cell offsets: offset " + std::to_string(offsets[c + 1]) + " of cell " +
+                                std::to_string(firstCell + c + 1) +
+                                " is below the one before or past the " +
+                                std::to_string(layout.indexCount) + " indices");
+    const std::uint64_t i0 = offsets[0], i1 = offsets[n];
+    budgeted.budget().charge(path, "the part's cell indices", i1 - i0, 8);
+    std::vector<std::uint32_t> indices(i1 - i0);
+    in.readAt(indices.data(), arrays[3].start + 4 * i0, 4 * (i1 - i0), arrays[3].what);
+    swapWordsIfBigEndian(indices.data(), indices.size(), 4);
+    for (std::uint64_t k = 0; k < indices.size(); ++k)
+        if (indices[k] >= layout.pointCount)
+            throwParseError(path, atByte(arrays[3].start + 4 * (i0 + k)),
+                            "cell indices: index " + std::to_string(indices[k]) + " of " +
+                                std::to_string(layout.pointCount) + " points");
+    // The points they use, in the file's order, read in runs of nearby ids.
+    std::vector<std::uint32_t> ids(indices);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    budgeted.budget().charge(path, "the part's points", ids.size(), 20);
+    part.pointIds.assign(ids.begin(), ids.end());
+    constexpr std::uint64_t kRunGap = 4096;  // ids this close are read in one run
+    const auto readRuns = [&](const ArraySpan& array, std::uint64_t wordBytes, unsigned char* out) {
+        std::vector<unsigned char> run;
+        for (std::size_t a = 0; a < ids.size();) {
+            std::size_t b = a + 1;
+            while (b < ids.size() && ids[b] - ids[b - 1] <= kRunGap) ++b;
+            const std::uint64_t lo = ids[a], hi = ids[b - 1];
+            run.resize((hi - lo + 1) * wordBytes);
+            in.readAt(run.data(), array.start + lo * wordBytes, run.size(), array.what);
+            for (std::size_t k = a; k < b; ++k)
+                std::memcpy(out + k * wordBytes, run.data() + (ids[k] - lo) * wordBytes, wordBytes);
+            a = b;
+        }
+    };
+    mesh.points.resize(ids.size());
+    readRuns(arrays[0], 12, reinterpret_cast<unsigned char*>(mesh.points.data()));
+    swapWordsIfBigEndian(mesh.points.data(), 3 * ids.size(), 4);
+    mesh.cellOffsets.resize(n + 1);
+    for (std::uint64_t c = 0; c <= n; ++c) mesh.cellOffsets[c] = offsets[c] - i0;
+    mesh.cellIndices.resize(indices.size());
+    for (std::size_t k = 0; k < indices.size(); ++k)
+        mesh.cellIndices[k] = static_cast<std::uint32_t>(
+            std::lower_bound(ids.begin(), ids.end(), indices[k]) - ids.begin());
+    part.cellIds.resize(n);
+    for (std::uint64_t c = 0; c < n; ++c) part.cellIds[c] = firstCell + c;
+    // Every field on them.
+    for (std::size_t f = 0; f < layout.descriptors.size(); ++f) {
+        const FieldDescriptor& d = layout.descriptors[f];
+        const ArraySpan& array = arrays[4 + f];
+        Field field;
+        field.name = d.name;
+        field.association = d.association == 0 ? Association::Point : Association::Cell;
+        field.components = static_cast<int>(d.components);
+        const std::uint64_t word = 4ull * d.components;
+        if (field.association == Association::Point) {
+            field.values.resize(ids.size() * d.components);
+            readRuns(array, word, reinterpret_cast<unsigned char*>(field.values.data()));
+        } else {
+            field.values.resize(n * d.components);
+            in.readAt(field.values.data(), array.start + firstCell * word, n * word, array.what);
+        }
+        swapWordsIfBigEndian(field.values.data(), field.values.size(), 4);
+        mesh.fields.push_back(std::move(field));
+    }
+    validateStructure(mesh, path);
+    return part;
+}
+
+MeshPart meshPart(const Mesh& whole, std::uint64_t firstCell, std::uint64_t endCell) {
+    UVR_CHECK(firstCell <= endCell && endCell <= whole.cellCount(), "cells of a part");
+    MeshPart part;
+    std::vector<std::uint8_t> used(whole.pointCount(), 0);
+    for (std::uint64_t c = firstCell; c < endCell; ++c)
+        for (std::uint32_t id : whole.cell(c)) used[id] = 1;
+    std::vector<std::uint32_t> local(whole.pointCount(), 0);
+    for (std::uint64_t i = 0; i < whole.pointCount(); ++i)
+        if (used[i]) {
+            local[i] = static_cast<std::uint32_t>(part.pointIds.size());
+            part.pointIds.push_back(i);
+            part.mesh.points.push_back(whole.points[i]);
+        }
+    std::vector<std::uint32_t> corners;
+    for (std::uint64_t c = firstCell; c < endCell; ++c) {
+        corners.clear();
+        for (std::uint32_t id : whole.cell(c)) corners.push_back(local[id]);
+        part.mesh.addCell(whole.cellTypes[c], corners);
+        part.cellIds.push_back(c);
+    }
+    for (const Field& f : whole.fields) {
+        Field field{f.name, f.association, f.components, {}};
+        const std::size_t k = static_cast<std::size_t>(f.components);
+        if (f.association == Association::Point) {
+            for (std::uint64_t i : part.pointIds)
+                field.values.insert(field.values.end(), f.values.begin() + i * k,
+                                    f.values.begin() + (i + 1) * k);
+        } else {
+            field.values.assign(f.values.begin() + firstCell * k, f.values.begin() + endCell * k);
+        }
+        part.mesh.fields.push_back(std::move(field));
+    }
+    part.mesh.notes = whole.notes;
+    return part;
+}
+
 MeshSummary readNativeSummary(const std::string& path, bool cellTypes) {
     const std::uint64_t size = fileSize(path);
     Reader in(path, size);

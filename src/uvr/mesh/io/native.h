@@ -28,6 +28,24 @@ struct MeshSummary {
 /// against the file size before anything is allocated.
 Mesh readNative(const std::string& path, const ReadOptions& options = {});
 
+/// A part of a mesh file: some of its cells, the points they use (in the file's order) and every
+/// field on them, with the ids of both in the whole file (a data-parallel rank's share).
+struct MeshPart {
+    Mesh mesh;
+    std::vector<std::uint64_t> pointIds;  ///< per point: its index in the file (increasing)
+    std::vector<std::uint64_t> cellIds;   ///< per cell: its index in the file (increasing)
+};
+
+/// Reads the cells [firstCell, endCell) of a native mesh and what they use (each array read only
+/// where the part lies in it: the points and point values in runs of the ids the cells name),
+/// checked as readNative checks a whole file. Throws Error(Argument) for a range beyond the file's
+/// cells.
+MeshPart readNativePart(const std::string& path, std::uint64_t firstCell, std::uint64_t endCell,
+                        const ReadOptions& options = {});
+
+/// The part of a mesh held whole that holds the cells [firstCell, endCell).
+MeshPart meshPart(const Mesh& mesh, std::uint64_t firstCell, std::uint64_t endCell);
+
 /// What `uvr info` prints of a .uvrm without reading its arrays: the header's counts and fields
 /// and, with cellTypes, the cell types (one byte per cell, read in chunks); checked as
 /// readNative checks them.

@@ -126,6 +126,34 @@ TEST(Native, MixedMeshRoundTripsExactly) {
     EXPECT_TRUE(std::signbit(back.fields[0].values[4]));
 }
 
+TEST(Native, APartIsTheWholeMeshsCellsWithTheirPointsAndFields) {
+    const std::string path = testing::scratchDir() + "/part.uvrm";
+    ProceduralSpec spec;
+    spec.targetCells = 3000;
+    Mesh m = generateMesh(spec);
+    Field cellField{"c", Association::Cell, 2, {}};
+    for (std::uint64_t c = 0; c < m.cellCount(); ++c)
+        cellField.values.insert(cellField.values.end(), {float(c), -float(c)});
+    m.fields.push_back(cellField);
+    writeNative(m, path);
+    const std::uint64_t n = m.cellCount();
+    for (auto [a, b] : {std::pair<std::uint64_t, std::uint64_t>{0, n / 3}, {n / 3, n}, {n, n}}) {
+        const MeshPart part = readNativePart(path, a, b);
+        const MeshPart expected = meshPart(m, a, b);
+        EXPECT_EQ(part.pointIds, expected.pointIds);
+        EXPECT_EQ(part.cellIds, expected.cellIds);
+        expectSameMesh(expected.mesh, part.mesh);
+        ASSERT_EQ(part.mesh.cellCount(), b - a);
+        // Each corner is the whole mesh's point.
+        for (std::uint64_t c = 0; c < part.mesh.cellCount(); ++c)
+            for (std::size_t k = 0; k < part.mesh.cell(c).size(); ++k)
+                EXPECT_EQ(part.mesh.points[part.mesh.cell(c)[k]], m.points[m.cell(a + c)[k]]);
+    }
+    expectError([&] { readNativePart(path, 10, n + 1); }, ErrorKind::Argument,
+                {"part.uvrm", "cells [10, " + std::to_string(n + 1) + ")"});
+    expectError([&] { readNativePart(path, 10, 5); }, ErrorKind::Argument, {"cells [10, 5)"});
+}
+
 TEST(Native, HeaderAndArraysFollowTheDocumentedLayout) {
     const std::string dir = testing::scratchDir();
     const std::string path = dir + "/mixed.uvrm";
