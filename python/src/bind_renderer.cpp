@@ -11,7 +11,7 @@ void bindRenderer(py::module_& m) {
                          const std::string& association, const py::handle& values,
                          const std::string& device, const std::string& buildDevice,
                          std::uint32_t leafCells, bool meshBvh, bool seedGrids, bool splitCells,
-                         bool partitions, bool forAuto) {
+                         bool partitions, bool forAuto, int ranks) {
                  ScalarField field = scalarField(name, association, values);
                  RendererOptions o;
                  o.device = parseDevice(device, "device");
@@ -22,6 +22,15 @@ void bindRenderer(py::module_& m) {
                  o.forAuto = forAuto;
                  o.seedGrids = seedGrids;
                  o.splitCells = splitCells;
+                 if (ranks > 1) {
+                     // Data-parallel over MPI's world (mpi4py's COMM_WORLD, checked in Python).
+                     Communicator& world = mpiWorld();
+                     if (world.size() != ranks)
+                         raise(ErrorKind::Argument,
+                               "comm: " + std::to_string(ranks) + " ranks, but MPI's world has " +
+                                   std::to_string(world.size()));
+                     o.communicator = &world;
+                 }
                  // The mesh's points and cells as they are now (a borrowed mesh's copied and
                  // checked again), freed as soon as they are split.
                  std::shared_ptr<const Mesh> cells = cellsNow(mesh);
@@ -43,7 +52,7 @@ void bindRenderer(py::module_& m) {
              py::arg("device") = "auto", py::arg("build_device") = "auto",
              py::arg("leaf_cells") = 0, py::arg("mesh_bvh") = true, py::arg("seed_grids") = true,
              py::arg("split_cells") = false, py::arg("partitions") = true,
-             py::arg("for_auto") = false)
+             py::arg("for_auto") = false, py::arg("ranks") = 1)
         .def(
             "set_field_values",
             [](PyRenderer& self, const std::string& name, const std::string& association,
@@ -72,7 +81,7 @@ void bindRenderer(py::module_& m) {
             d["points"] = p.tets.points.size();
             d["field"] = p.tets.fieldName;
             d["field_association"] = associationName(p.tets.association);
-            d["value_range"] = py::make_tuple(p.tets.valueMin, p.tets.valueMax);
+            d["value_range"] = py::make_tuple(p.wholeValueMin(), p.wholeValueMax());
             d["partitions"] = p.kd ? p.kd->partitions.size() : 0;
             d["partition_build_seconds"] = p.kd ? p.kd->buildSeconds : 0.0;
             d["mesh_bvh_nodes"] = p.bvh.nodes.size();

@@ -415,8 +415,8 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
 
 py::tuple fileBounds(const PreparedMesh& p) {
     double lo[3], hi[3];
-    p.tets.frame.toFile(p.tets.bounds.lo, lo);
-    p.tets.frame.toFile(p.tets.bounds.hi, hi);
+    p.tets.frame.toFile(p.wholeBounds().lo, lo);
+    p.tets.frame.toFile(p.wholeBounds().hi, hi);
     return py::make_tuple(py::make_tuple(lo[0], lo[1], lo[2]), py::make_tuple(hi[0], hi[1], hi[2]));
 }
 

@@ -48,13 +48,19 @@ class Renderer:
     geometric either. Made from a ``uvr.Series``, it shows the first step and ``set_time`` /
     ``set_step`` show others (values only while the points and cells stay). The GIL is released
     while preparing and rendering.
+
+    ``comm``: under ``mpirun``, mpi4py's ``MPI.COMM_WORLD`` renders data-parallel as
+    ``mpirun -n N uvr render`` does: every rank makes the Renderer and calls ``render`` with the
+    same arguments, each rank holds and renders its piece of the mesh, and rank 0's ``render``
+    returns the whole picture (the other ranks' return None).
     """
 
     def __init__(self, mesh, field=None, device="auto", *, build_device="auto", leaf_cells=0,
                  methods=tuple(_uvr.METHODS), seed_grids=True, split_cells=False,
-                 association=None):
+                 association=None, comm=None):
         self.series = mesh if isinstance(mesh, Series) else None
         self._step = 0
+        self._ranks, self._rank = _ranks_of(comm)
         self._options = dict(device=device, build_device=build_device, leaf_cells=leaf_cells,
                              methods=methods, seed_grids=seed_grids, split_cells=split_cells)
         self._prepare(as_mesh(mesh), field, association)
@@ -78,7 +84,7 @@ class Renderer:
                                        seed_grids=bool(seed_grids),
                                        split_cells=bool(self._options["split_cells"]),
                                        partitions="adaptive" in methods,
-                                       for_auto="auto" in methods)
+                                       for_auto="auto" in methods, ranks=self._ranks)
         except BaseException:
             self.mesh = previous  # a failed new step leaves the renderer as it was
             raise
@@ -108,7 +114,10 @@ class Renderer:
             raise _uvr.ArgumentError("set_step/set_time: the field was given as values; name "
                                      "it (field='pressure') to follow it through the steps")
         same = self.series._same_geometry(step, self.mesh)
-        if same is not None:
+        if same is not None and self._ranks > 1:
+            self._prepare(same, self._field_key)  # data-parallel: the pieces prepared anew
+            same = None
+        elif same is not None:
             name, assoc, values = _uvr.select_field(same._data, same.fields,
                                                     self._field_key or "")[:3]
             self._core.set_field_values(name, assoc, values)
@@ -153,6 +162,9 @@ class Renderer:
         """New values of the same mesh (a time step; one per point or cell), or another field
         by its spec: the values, value ranges and macrocells are refreshed, nothing geometric is
         rebuilt (on the GPU only the value arrays are uploaded)."""
+        if self._ranks > 1:  # data-parallel: the pieces are prepared anew
+            self._prepare(self.mesh, field, association)
+            return
         name, assoc, values = self._field(field, association)
         self._core.set_field_values(name, assoc, values)
         self._field_key = field if isinstance(field, str) else None
@@ -254,6 +266,8 @@ class Renderer:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
                                      f"{self._methods!r} when the Renderer was made)")
         pixels, counts, stats, depth = self._core.render(t, range, camera, w, h, settings)
+        if self._rank != 0:
+            return None  # data-parallel: rank 0 holds the picture
         if legend:
             lo, hi = stats["range"]
             pixels = _uvr.draw_legend(pixels, t, lo, hi, stats["field"],
@@ -266,6 +280,20 @@ class Renderer:
         i = self.info
         return (f"uvr.Renderer({i['tetrahedra']} tetrahedra, {i['partitions']} partitions, "
                 f"field {i['field']} ({i['field_association']}), on {self.device})")
+
+
+def _ranks_of(comm):
+    """(ranks, rank) of a Renderer's `comm`: (1, 0) for None or one rank; else mpi4py's
+    COMM_WORLD (or a communicator congruent with it), the only one uvr renders over."""
+    if comm is None:
+        return 1, 0
+    if not all(hasattr(comm, a) for a in ("Get_size", "Get_rank", "Compare")):
+        raise TypeError(f"comm: expected mpi4py's MPI.COMM_WORLD, got {type(comm).__name__}")
+    from mpi4py import MPI  # the caller's communicator is mpi4py's: it is imported
+    if MPI.Comm.Compare(comm, MPI.COMM_WORLD) not in (MPI.IDENT, MPI.CONGRUENT):
+        raise _uvr.ArgumentError("comm: uvr renders over MPI.COMM_WORLD (or a duplicate of it), "
+                                 "not a part of it")
+    return comm.Get_size(), comm.Get_rank()
 
 
 def _settings(**kwargs):
