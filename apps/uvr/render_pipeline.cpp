@@ -200,13 +200,26 @@ RenderResult renderDataParallel(const std::string& file, const RenderFlags& flag
     const auto cellsOf = [&](std::uint64_t n, int r) { return n * std::uint64_t(r) / ranks; };
     // This rank's part of the file.
     MeshPart part = agreeOn(comm, [&] {
-        if (sniffMeshFormat(file) == MeshFormat::Native && !steps.time && !steps.index) {
+        const MeshFormat format = sniffMeshFormat(file);
+        ReadOptions read;
+        read.maxMemoryBytes = ctx.maxMemoryBytes;
+        if (format == MeshFormat::Pvtu) {
+            // A rank reads its run of the pieces when there are as many as ranks.
+            const std::size_t pieces = pvtuPieceCount(file);
+            if (pieces >= std::size_t(ranks)) {
+                ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
+                         " ranks reads about " + std::to_string(pieces / ranks) + " of its " +
+                         std::to_string(pieces) + " pieces");
+                return readPvtuPart(file, cellsOf(pieces, rank), cellsOf(pieces, rank + 1), read);
+            }
+            ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(pieces) +
+                     " pieces for " + std::to_string(ranks) + " ranks");
+        }
+        if (format == MeshFormat::Native && !steps.time && !steps.index) {
             const std::uint64_t n = readNativeSummary(file, false).cellCount;
             ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
                      " ranks reads about " + std::to_string(n / ranks) + " of its " +
                      std::to_string(n) + " cells");
-            ReadOptions read;
-            read.maxMemoryBytes = ctx.maxMemoryBytes;
             return readNativePart(file, cellsOf(n, rank), cellsOf(n, rank + 1), read);
         }
         const Mesh whole = loadMesh(file, ctx, steps);

@@ -1025,8 +1025,13 @@ void checkDeclaredMesh(const XmlDoc& doc, const LoadBudget& budget) {
                  bytes, 1);
 }
 
-Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions& options) {
+/// Reads a .pvtu's pieces [first, end) (all: the defaults) into one mesh; every listed piece is
+/// checked first. counts, when given, receives each piece read's points and cells.
+Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions& options,
+                  std::size_t firstPiece = 0, std::size_t endPiece = SIZE_MAX,
+                  std::vector<std::pair<std::uint64_t, std::uint64_t>>* counts = nullptr) {
     if (doc.pieces.empty()) throwParseError(path, atByte(0), "expected <Piece Source=...> entries");
+    const std::size_t end = std::min(endPiece, doc.pieces.size());
     namespace fs = std::filesystem;
     const fs::path folder = fs::path(path).parent_path();
     // Every piece's file, checked before reading any: not the .pvtu itself, and each file once
@@ -1060,7 +1065,7 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
     LoadBudget& budget = *options.budget;
     const std::uint64_t heldBefore = budget.used();
     Mesh mesh;
-    for (std::size_t k = 0; k < doc.pieces.size(); ++k) {
+    for (std::size_t k = firstPiece; k < end; ++k) {
         const PieceDesc& p = doc.pieces[k];
         const std::string& piecePath = piecePaths[k];
         const std::string label = "Piece " + std::to_string(k) + " ('" + p.source + "')";
@@ -1075,13 +1080,14 @@ Mesh readPvtuFile(const std::string& path, const XmlDoc& doc, const ReadOptions&
                            "; a .pvtu piece must be an UnstructuredGrid .vtu file");
         ReadOptions pieceOptions = options;  // progress: piece k's fraction of the whole
         if (options.progress)
-            pieceOptions.progress = [k, n = doc.pieces.size(), outer = options.progress](double f) {
+            pieceOptions.progress = [k = k - firstPiece, n = end - firstPiece,
+                                     outer = options.progress](double f) {
                 outer((double(k) + f) / double(n));
             };
         Mesh piece = readVtuFile(piecePath, pieceOptions, false);
         budget.charge(path, label, meshBytes(piece), 1);  // its copy in the merged mesh
-
-        appendMeshPiece(mesh, piece, k == 0, path, atLine(p.line), label);
+        if (counts) counts->emplace_back(piece.pointCount(), piece.cellCount());
+        appendMeshPiece(mesh, piece, k == firstPiece, path, atLine(p.line), label);
         budget.resetTo(heldBefore + meshBytes(mesh));  // the piece is freed next
     }
     return mesh;
@@ -1159,6 +1165,41 @@ Mesh readPvtu(const std::string& path, const ReadOptions& options) {
     Mesh mesh = readPvtuFile(path, doc, budgeted.options());
     budget.resetTo(heldBefore + meshBytes(mesh));
     return mesh;
+}
+
+std::size_t pvtuPieceCount(const std::string& path) {
+    LoadBudget budget(0);
+    const std::vector<char> bytes = readFileCharged(path, budget);
+    const XmlDoc doc = parseXml(path, bytes);
+    if (doc.type != "PUnstructuredGrid")
+        throwError(ErrorKind::Unsupported, path,
+                   "VTKFile type '" + doc.type + "' is not a PUnstructuredGrid (.pvtu)");
+    return doc.pieces.size();
+}
+
+MeshPart readPvtuPart(const std::string& path, std::size_t firstPiece, std::size_t endPiece,
+                      const ReadOptions& options) {
+    const BudgetedOptions budgeted(options);
+    const std::vector<char> bytes = readFileCharged(path, budgeted.budget());
+    const XmlDoc doc = parseXml(path, bytes);
+    if (doc.type != "PUnstructuredGrid")
+        throwError(ErrorKind::Unsupported, path,
+                   "VTKFile type '" + doc.type + "' is not a PUnstructuredGrid (.pvtu)");
+    if (firstPiece >= endPiece || endPiece > doc.pieces.size())
+        throwError(ErrorKind::Argument, path,
+                   "pieces [" + std::to_string(firstPiece) + ", " + std::to_string(endPiece) +
+                       ") asked for, but the file lists " + std::to_string(doc.pieces.size()));
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> counts;
+    MeshPart part;
+    part.mesh = readPvtuFile(path, doc, budgeted.options(), firstPiece, endPiece, &counts);
+    // Ids in the whole file's order (its pieces concatenated, as readPvtu merges them): the
+    // piece's index above kPieceIdShift bits, the point's or cell's in the piece below.
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        const std::uint64_t base = std::uint64_t(firstPiece + k) << kPieceIdShift;
+        for (std::uint64_t i = 0; i < counts[k].first; ++i) part.pointIds.push_back(base | i);
+        for (std::uint64_t c = 0; c < counts[k].second; ++c) part.cellIds.push_back(base | c);
+    }
+    return part;
 }
 
 }  // namespace uvr

@@ -243,6 +243,34 @@ TEST(PvtuVariants, ThreePiecesMatchVtk) {
     checkManifest("pvtu", 1);
 }
 
+TEST(PvtuVariants, PartsArePiecesOfTheWholeReadWithIdsInItsOrder) {
+    REQUIRE_VARIANTS();
+    const std::string path = variant("three.pvtu");
+    ASSERT_EQ(pvtuPieceCount(path), 3u);
+    const Mesh whole = readPvtu(path);
+    std::uint64_t points = 0, cells = 0;  // before the part, in the whole mesh
+    for (auto [a, b] : {std::pair<std::size_t, std::size_t>{0, 1}, {1, 3}}) {
+        const MeshPart part = readPvtuPart(path, a, b);
+        ASSERT_EQ(part.pointIds.size(), part.mesh.pointCount());
+        ASSERT_EQ(part.cellIds.size(), part.mesh.cellCount());
+        EXPECT_TRUE(std::is_sorted(part.pointIds.begin(), part.pointIds.end()));
+        // The part's points, cells and fields are the whole mesh's, from `points`/`cells` on.
+        for (std::uint64_t i = 0; i < part.mesh.pointCount(); ++i)
+            EXPECT_EQ(part.mesh.points[i], whole.points[points + i]);
+        for (std::uint64_t c = 0; c < part.mesh.cellCount(); ++c) {
+            EXPECT_EQ(part.mesh.cellTypes[c], whole.cellTypes[cells + c]);
+            for (std::size_t k = 0; k < part.mesh.cell(c).size(); ++k)
+                EXPECT_EQ(part.mesh.cell(c)[k] + points, whole.cell(cells + c)[k]);
+        }
+        ASSERT_EQ(part.mesh.fields.size(), whole.fields.size());
+        points += part.mesh.pointCount(), cells += part.mesh.cellCount();
+    }
+    EXPECT_EQ(points, whole.pointCount());
+    EXPECT_EQ(cells, whole.cellCount());
+    EXPECT_EQ(testing::catchError([&] { readPvtuPart(path, 2, 4); }).kind(), ErrorKind::Argument);
+    EXPECT_EQ(testing::catchError([&] { readPvtuPart(path, 1, 1); }).kind(), ErrorKind::Argument);
+}
+
 TEST(PvtuVariants, ReadVtuForwardsAPvtu) {
     REQUIRE_VARIANTS();
     expectMatches(readVtu(variant("three.pvtu")), loadJson(variant("three.pvtu.json")));
