@@ -26,9 +26,9 @@ void bindRenderer(py::module_& m) {
                      // Data-parallel over MPI's world (mpi4py's COMM_WORLD, checked in Python).
                      Communicator& world = mpiWorld();
                      if (world.size() != ranks)
-                         raise(ErrorKind::Argument,
-                               "comm: " + std::to_string(ranks) + " ranks, but MPI's world has " +
-                                   std::to_string(world.size()));
+                         raise(ErrorKind::Argument, "comm: " + std::to_string(ranks) +
+                                                        " ranks, but MPI's world has " +
+                                                        std::to_string(world.size()));
                      o.communicator = &world;
                  }
                  // The mesh's points and cells as they are now (a borrowed mesh's copied and
