@@ -7,9 +7,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cli_common.h"
+#include "progress.h"
 #include "render_pipeline.h"
 #include "uvr/core/text.h"
 #include "uvr/cpu/threads.h"
@@ -114,17 +116,38 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         // Partitions are needed; the variants pick their integrators.
         flags->vocabulary.set("method", methodName(RenderMethod::Partitions));
         flags->checkBeforeLoading(*file);
-        const Mesh mesh = loadMesh(*file, ctx);
-        const ScalarField field = selectScalarField(mesh, parseFieldSpec(flags->field));
+        // One process reads the mesh; data-parallel ranks read their shares (readDistributed)
+        // and time the composited frames, and rank 0 prints and writes.
+        const bool root = ctx.root();
+        std::optional<Mesh> mesh;
+        std::optional<DistributedSource> share;
+        if (ctx.dataParallel())
+            share = readDistributed(*file, flags->field, StepFlags{}, ctx);
+        else
+            mesh = loadMesh(*file, ctx);
+        const ScalarField field = share ? ScalarField{share->share.field.name,
+                                                      share->share.field.association,
+                                                      {},
+                                                      share->share.field.choice}
+                                        : selectScalarField(*mesh, parseFieldSpec(flags->field));
         ctx.step("field " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice));
         std::vector<std::string> notes;
-        const RenderSettings base = flags->settings(mesh.bounds(), *file, &notes);
+        const RenderSettings base =
+            flags->settings(share ? share->source.summary.bounds : mesh->bounds(), *file, &notes);
         for (const std::string& note : notes) ctx.step("note: " + note);
         ctx.setActivity(*file, "preparing the mesh and rendering it");
         const std::optional<Vec3f> background = flags->backgroundColor();
         const Vec3f bg = background ? *background : Vec3f(0.f, 0.f, 0.f);
-        const std::unique_ptr<Renderer> rendererOwner =
-            makeRenderer(mesh, field, flags->rendererOptions(/*withReference=*/true), ctx);
+        RendererOptions options = flags->rendererOptions(/*withReference=*/true);
+        std::unique_ptr<Renderer> rendererOwner;
+        if (share) {
+            options.communicator = ctx.comm;
+            PhaseProgress phases(ctx);
+            rendererOwner =
+                std::make_unique<Renderer>(std::move(share->share), options, phases.callbacks());
+        } else {
+            rendererOwner = makeRenderer(*mesh, field, options, ctx);
+        }
         Renderer& renderer = *rendererOwner;
         const PreparedMesh& prepared = renderer.prepared();
         const FrameSetup setup = makeFrameSetup(prepared, base);
@@ -180,8 +203,9 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
         exact.samples = exact.last.stats.samples;  // tetrahedra crossed
         exact.cmp.ssim = 1.0;
         exact.cmp.psnr = INFINITY;
-        const Rgb8Image yardstick = toRgb8(exact.last.image, bg);
-        if (!images->empty()) writePng(*images + "/exact.png", exact.last.image, background);
+        const Rgb8Image yardstick = root ? toRgb8(exact.last.image, bg) : Rgb8Image{};
+        if (root && !images->empty())
+            writePng(*images + "/exact.png", exact.last.image, background);
         // Render: one warm-up frame, then `repeat` timed frames per variant.
         bool first = true;
         std::uint32_t heatmapMax = 0;  // the reference's largest count: one scale for all
@@ -200,6 +224,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
             if (first)
                 for (std::uint32_t c : v.last.sampleCounts) heatmapMax = std::max(heatmapMax, c);
             first = false;
+            if (!root) continue;  // rank 0 holds the frames
             v.cmp = compareImages(yardstick, toRgb8(v.last.image, bg));
             if (!images->empty()) {
                 const std::string stem = *images + "/" + v.file;
@@ -208,6 +233,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                                                               v.settings.height, heatmapMax));
             }
         }
+        if (!root) return;
         // Table.
         const int threads = cpu::threadCount();
         char ruleBuf[64];
@@ -310,6 +336,7 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                 j["threads"] = threads;
                 j["device"] = where;
                 j["repeat"] = *repeat;
+                j["ranks"] = ctx.comm ? ctx.comm->size() : 1;
                 j["tf_update_seconds"] = variants.back().last.setup.tfUpdateSeconds;
                 j["ssim_against"] = "exact";
                 j["exact"] = {{"seconds_per_frame", exact.medianSeconds},
@@ -327,6 +354,12 @@ void addBenchCommand(CLI::App& app, Context& ctx) {
                                                 : nlohmann::json(f.value);
                     }
                     if (!images->empty()) row["image"] = v.file;  // <file>.png, <file>_samples.png
+                    // Data-parallel: each rank's share of the last frame.
+                    for (const RankFrameStats& r : v.last.ranks)
+                        row["ranks"].push_back({{"frame_seconds", r.frameSeconds},
+                                                {"composite_seconds", r.compositeSeconds},
+                                                {"composite_bytes_sent", r.bytesSent},
+                                                {"cells", r.cells}});
                     j["rows"].push_back(row);
                 }
                 // The heat maps' common scale and colours, for bench/plot_bench.py's legend.

@@ -191,12 +191,10 @@ RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const Render
     return renderPreparedAndWrite(*renderer, src, settings, out, ctx);
 }
 
-RenderResult renderDataParallel(const std::string& file, const RenderFlags& flags,
-                                const StepFlags& steps, const Context& ctx) {
+DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
+                                  const StepFlags& steps, const Context& ctx) {
     Communicator& comm = *ctx.comm;
-    const RenderOutputs out = flags.renderOutputs();  // checked before the expensive work
     const int rank = comm.rank(), ranks = comm.size();
-    const auto start = Clock::now();
     const auto cellsOf = [&](std::uint64_t n, int r) { return n * std::uint64_t(r) / ranks; };
     // This rank's part of the file.
     MeshPart part = agreeOn(comm, [&] {
@@ -227,9 +225,11 @@ RenderResult renderDataParallel(const std::string& file, const RenderFlags& flag
         return meshPart(whole, cellsOf(n, rank), cellsOf(n, rank + 1));
     });
     const std::uint64_t pointIdEnd = part.pointIds.empty() ? 0 : part.pointIds.back() + 1;
-    MeshShare share = shareOfPart(comm, std::move(part), parseFieldSpec(flags.field));
+    DistributedSource out;
+    MeshShare& share = out.share;
+    share = shareOfPart(comm, std::move(part), parseFieldSpec(fieldSpec));
     // The checks, over every rank's share.
-    RenderSource src;
+    RenderSource& src = out.source;
     src.path = file;
     const ValidationReport report = agreeOn(comm, [&] { return validateMesh(share.mesh, file); });
     std::uint64_t counts[2] = {share.mesh.cellCount(), pointIdEnd};
@@ -259,12 +259,22 @@ RenderResult renderDataParallel(const std::string& file, const RenderFlags& flag
         throwError(ErrorKind::Validation, file,
                    "no cell has volume: all " + std::to_string(src.summary.cells) +
                        " cell(s) are flat or use NaN/Inf points; nothing to render");
+    return out;
+}
+
+RenderResult renderDataParallel(const std::string& file, const RenderFlags& flags,
+                                const StepFlags& steps, const Context& ctx) {
+    const RenderOutputs out = flags.renderOutputs();  // checked before the expensive work
+    const auto start = Clock::now();
+    DistributedSource read = readDistributed(file, flags.field, steps, ctx);
+    const RenderSource& src = read.source;
+    const int ranks = ctx.comm->size();
     const RenderSettings settings = checkedSettings(flags, src, ctx);
     ctx.setActivity(file, "preparing this rank's piece for rendering");
     RendererOptions options = flags.rendererOptions();
     options.communicator = ctx.comm;
     PhaseProgress phases(ctx);
-    Renderer renderer(std::move(share), options, phases.callbacks());
+    Renderer renderer(std::move(read.share), options, phases.callbacks());
     phases.finish();
     reportUpload(renderer, ctx);
     ctx.done("prepared " + std::to_string(ranks) +

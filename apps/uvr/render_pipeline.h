@@ -50,6 +50,19 @@ bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, cons
 /// where it renders as the other makeRenderer does.
 std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, const Context& ctx);
 
+/// A data-parallel rank's share of a file and what the ranks agreed on about the whole mesh.
+struct DistributedSource {
+    MeshShare share;      ///< this rank's cells, with the field the ranks agreed on
+    RenderSource source;  ///< the whole mesh's counts, bounds and checks
+};
+
+/// Reads this rank's part of a file (a .uvrm only where the part lies, a .pvtu by runs of its
+/// pieces when it has as many as ranks, any other file whole, keeping the part), agrees with
+/// every rank on the field `fieldSpec` names, and reduces the counts, bounds and checks over the
+/// ranks (collective; ctx.comm must be set). Throws on every rank when any rank fails.
+DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
+                                  const StepFlags& steps, const Context& ctx);
+
 /// `mpirun -n N uvr render FILE`: each rank reads its part of the file (a .uvrm only where the
 /// part lies; any other file whole, keeping its part), the ranks agree on the field, the bounds
 /// and the checks, render their pieces data-parallel (Renderer from a MeshShare), and rank 0

@@ -140,6 +140,18 @@ with open({pvtu!r}, "w") as f:
             check(c.returncode == 0,
                   f"fin.pvtu: {n} ranks = one process ({c.stdout.strip()[-200:]})")
 
+    # uvr bench under mpirun: every variant timed on the composited frames, rank 0 writes.
+    bench = os.path.join(args.out, "bench.json")
+    r = run(mpirun(2) + [args.uvr, "bench", box, "--device", "cpu", "--size", "96x96",
+                         "--repeat", "1", "--sweep", "4", "--json", bench, "-q"])
+    ok = r.returncode == 0 and os.path.exists(bench)
+    if ok:
+        with open(bench) as f:
+            report = json.load(f)
+        ok = report.get("ranks") == 2 and all(len(row.get("ranks", [])) == 2
+                                               for row in report["rows"])
+    check(ok, f"mpirun -n 2 uvr bench: rows with both ranks ({r.stderr[-300:]})")
+
     # Bad input: every rank ends, exit status 2, one error line, nothing written.
     blunt = os.path.join(args.data, "bluntfin_tets.vtk")
     out = os.path.join(args.out, "bad.png")
