@@ -15,32 +15,19 @@ namespace uvr {
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks) {
     UVR_CHECK(ranks >= 1 && rank >= 0 && rank < ranks, "share " << rank << " of " << ranks);
     const std::uint64_t n = mesh.cellCount();
-    const std::uint64_t first = n * std::uint64_t(rank) / std::uint64_t(ranks);
-    const std::uint64_t end = n * std::uint64_t(rank + 1) / std::uint64_t(ranks);
-    const bool pointData = field.association == Association::Point;
+    MeshPart part = meshPart(mesh, n * std::uint64_t(rank) / std::uint64_t(ranks),
+                             n * std::uint64_t(rank + 1) / std::uint64_t(ranks));
     MeshShare s;
-    std::vector<std::uint8_t> used(mesh.pointCount(), 0);
-    for (std::uint64_t c = first; c < end; ++c)
-        for (std::uint32_t id : mesh.cell(c)) used[id] = 1;
-    std::vector<std::uint32_t> local(mesh.pointCount(), 0);
-    for (std::uint64_t i = 0; i < mesh.pointCount(); ++i)
-        if (used[i]) {
-            local[i] = static_cast<std::uint32_t>(s.pointIds.size());
-            s.pointIds.push_back(i);
-            s.mesh.points.push_back(mesh.points[i]);
-            if (pointData) s.field.values.push_back(field.values[i]);
-        }
-    std::vector<std::uint32_t> ids;
-    for (std::uint64_t c = first; c < end; ++c) {
-        ids.clear();
-        for (std::uint32_t id : mesh.cell(c)) ids.push_back(local[id]);
-        s.mesh.addCell(mesh.cellTypes[c], ids);
-        s.cellIds.push_back(c);
-        if (!pointData) s.field.values.push_back(field.values[c]);
-    }
     s.field.name = field.name;
     s.field.association = field.association;
     s.field.choice = field.choice;
+    const std::vector<std::uint64_t>& ids =
+        field.association == Association::Point ? part.pointIds : part.cellIds;
+    s.field.values.reserve(ids.size());
+    for (std::uint64_t i : ids) s.field.values.push_back(field.values[i]);
+    s.mesh = std::move(part.mesh);
+    s.pointIds = std::move(part.pointIds);
+    s.cellIds = std::move(part.cellIds);
     return s;
 }
 

@@ -52,9 +52,10 @@ struct RendererOptions {
     /// freed then).
     std::function<void()> afterSplit;
     /// Data-parallel over this communicator's ranks when it has more than one (issue 31): every
-    /// rank constructs its Renderer together with the whole mesh, holds and renders the piece of
-    /// it that the whole mesh's k-d tree gives it (dist/), and every frame is composited onto
-    /// rank 0, whose RenderResult is the whole picture. Null: one process. Not owned.
+    /// rank constructs its Renderer together (with the whole mesh, or with its share of it), holds
+    /// and renders the piece of it that the whole mesh's k-d tree gives it (dist/), and every
+    /// frame is composited onto rank 0, whose RenderResult is the whole picture. Null: one
+    /// process. Not owned.
     Communicator* communicator = nullptr;
 
     /// The preparation these options ask for (the builders of the GPU when buildDevice resolves

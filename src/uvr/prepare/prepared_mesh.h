@@ -28,10 +28,10 @@
 
 namespace uvr {
 
-/// One rank's piece of a mesh rendered data-parallel (issue 31, dist/): the box of the whole
-/// mesh's k-d tree that it renders, that box's subtree, and what the whole mesh decides for every
-/// rank's frames alike, so that each rank's frame setup (camera, step, range, method) is the one
-/// a single process makes and its partitions are that process's partitions in the box.
+/// One rank's piece of a mesh rendered data-parallel (issue 31, dist/): the node of the whole
+/// mesh's k-d tree whose box it renders, and what the whole mesh decides for every rank's frames
+/// alike, so that each rank's frame setup (camera, step, range, method) is the one a single
+/// process makes and its partitions (the tree below that node) are that process's in the box.
 struct MeshPiece {
     int rank = 0, ranks = 1;  ///< this rank, of how many
     Bounds3f region;          ///< the rank's box (rendering units): a node of the whole tree

@@ -503,7 +503,7 @@ MeshPart readNativePart(const std::string& path, std::uint64_t firstCell, std::u
     return part;
 }
 
-MeshPart meshPart(const Mesh& whole, std::uint64_t firstCell, std::uint64_t endCell) {
+MeshPart meshPart(const MeshView& whole, std::uint64_t firstCell, std::uint64_t endCell) {
     UVR_CHECK(firstCell <= endCell && endCell <= whole.cellCount(), "cells of a part");
     MeshPart part;
     std::vector<std::uint8_t> used(whole.pointCount(), 0);
@@ -523,6 +523,11 @@ MeshPart meshPart(const Mesh& whole, std::uint64_t firstCell, std::uint64_t endC
         part.mesh.addCell(whole.cellTypes[c], corners);
         part.cellIds.push_back(c);
     }
+    return part;
+}
+
+MeshPart meshPart(const Mesh& whole, std::uint64_t firstCell, std::uint64_t endCell) {
+    MeshPart part = meshPart(MeshView(whole), firstCell, endCell);
     for (const Field& f : whole.fields) {
         Field field{f.name, f.association, f.components, {}};
         const std::size_t k = static_cast<std::size_t>(f.components);

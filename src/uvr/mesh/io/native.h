@@ -43,7 +43,9 @@ struct MeshPart {
 MeshPart readNativePart(const std::string& path, std::uint64_t firstCell, std::uint64_t endCell,
                         const ReadOptions& options = {});
 
-/// The part of a mesh held whole that holds the cells [firstCell, endCell).
+/// The part of a mesh held whole that holds the cells [firstCell, endCell), without fields.
+MeshPart meshPart(const MeshView& mesh, std::uint64_t firstCell, std::uint64_t endCell);
+/// The same with every field of the mesh on the part's points and cells, and its notes.
 MeshPart meshPart(const Mesh& mesh, std::uint64_t firstCell, std::uint64_t endCell);
 
 /// What `uvr info` prints of a .uvrm without reading its arrays: the header's counts and fields
