@@ -168,6 +168,37 @@ TEST(DataParallel, OnTheGpuEveryMethodGivesOneProcessPicture) {
     }
 }
 
+TEST(DataParallel, ExactGoesOnBehindANearlyOpaqueFrontRankAsOneProcessDoes) {
+    // Two ranks split the cube at the median cell centre, x = 0.125; seen from -x, the front
+    // rank's opacity is 0.9905, above the sampling methods' termination (0.99) but below
+    // exact's: one process's exact ray goes on into the back (about 2.3/255 of its colour), so
+    // the composite must take the back rank too.
+    const Mesh mesh = testing::makeHexGrid(
+        8, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);
+    const ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options;
+    options.device = Device::Cpu;
+    options.leafCells = 64;
+    RenderSettings s;
+    s.width = s.height = 48;
+    s.method = RenderMethod::Exact;
+    s.tf = transferFunctionPreset("viridis");
+    applyOpacitySpec(s.tf, "constant:0.5");
+    s.opacityUnit = 0.1208f;  // 1 - exp(-0.5 * 1.125 / 0.1208) = 0.9905 in front
+    Camera c;
+    c.position = Vec3f(-6.f, 0.f, 0.f);
+    c.focalPoint = Vec3f(0.f, 0.f, 0.f);
+    c.viewUp = Vec3f(0.f, 0.f, 1.f);
+    s.camera = c;
+    const Image one = Renderer(mesh, field, options).render(s).image;
+    const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 2, options, {s});
+    ASSERT_EQ(many.size(), 1u);
+    const Vec4f centre = one.at(24, 24);
+    EXPECT_GT(centre.w, 0.9995f);  // the back was reached
+    const ImageComparison cmp = compareImages(toRgb8(one), toRgb8(many[0].image));
+    EXPECT_LE(cmp.maxAbsDifference, 1.0) << differenceSummary(cmp);
+}
+
 TEST(DataParallel, TooManyRanksForThePartitionsAreRefusedOnEveryRank) {
     const Mesh mesh = testing::makeHexGrid(
         3, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);

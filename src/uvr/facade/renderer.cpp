@@ -13,6 +13,7 @@
 #include "uvr/dist/composite.h"
 #include "uvr/dist/decompose.h"
 #include "uvr/mesh/smooth_gradients.h"
+#include "uvr/render/segment_integral.h"
 
 namespace uvr {
 
@@ -166,8 +167,13 @@ RenderResult Renderer::render(const RenderSettings& settings) {
                                                    camera.position, result.setup.viewDirection);
     const double frameSeconds = result.stats.seconds;
     const std::uint64_t samples = result.stats.samples;
-    const CompositeStats composited = compositeFrame(*comm_, result.image, result.sampleCounts,
-                                                     order, 0, settings.terminationAlpha);
+    // A pixel stops taking ranks where one process's ray stops (exact integrates on to
+    // kOpacityEnd, the sampling methods to the termination opacity).
+    const float stopAlpha = result.setup.method.method == RenderMethod::Exact
+                                ? segment::kOpacityEnd
+                                : settings.terminationAlpha;
+    const CompositeStats composited =
+        compositeFrame(*comm_, result.image, result.sampleCounts, order, 0, stopAlpha);
     // The ranks' counters summed, and each rank's share.
     std::uint64_t counters[5] = {result.stats.samples, result.stats.walkSteps,
                                  result.stats.bvhQueries, result.stats.partitionsVisited,
