@@ -55,14 +55,19 @@ std::vector<RenderResult> dataParallelFrames(const Mesh& mesh, const ScalarField
     return out;
 }
 
+/// A mesh and the rank counts it is rendered on (Blunt Fin, the largest, on many; the others on
+/// an uneven count, keeping the suite's time under the sanitizers).
 struct Case {
     const char* file;
     const char* field;
+    std::vector<int> ranks;
 };
 
 TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
-    const std::vector<Case> cases = {
-        {"bluntfin_tets.vtk", ""}, {"post.vtk", ""}, {"spx.vtk", ""}, {"hexa.vtk", ""}};
+    const std::vector<Case> cases = {{"bluntfin_tets.vtk", "", {2, 3, 5, 8}},
+                                     {"post.vtk", "", {3}},
+                                     {"spx.vtk", "", {5}},
+                                     {"hexa.vtk", "", {3}}};
     for (const Case& c : cases) {
         const std::string path = testing::sharedData(c.file);
         if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
@@ -85,7 +90,7 @@ TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
             for (const Vec4f& p : single.back().image.pixels) covered += p.w > 0.1f;
             ASSERT_GT(covered, single.back().image.pixels.size() / 20) << c.file;
         }
-        for (int ranks : {2, 3, 5, 8}) {
+        for (int ranks : c.ranks) {
             const std::vector<RenderResult> many =
                 dataParallelFrames(mesh, field, ranks, options, frames);
             ASSERT_EQ(many.size(), frames.size());
