@@ -153,6 +153,8 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
             j["prepared_cache"]["read_seconds"] = src.cacheReadSeconds;
         }
         j["prepare_seconds"]["check"] = src.checkSeconds;
+        for (std::size_t r = 0; r < src.rankReadSeconds.size() && r < j["ranks"].size(); ++r)
+            j["ranks"][r]["read_seconds"] = src.rankReadSeconds[r];
         outputs.push_back(std::make_unique<OutputFile>(out.stats));
         outputs.back()->write(jsonText(j) + "\n");
     }
@@ -197,6 +199,7 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
     const int rank = comm.rank(), ranks = comm.size();
     const auto cellsOf = [&](std::uint64_t n, int r) { return n * std::uint64_t(r) / ranks; };
     // This rank's part of the file.
+    const auto readStart = Clock::now();
     MeshPart part = agreeOn(comm, [&] {
         const MeshFormat format = sniffMeshFormat(file);
         ReadOptions read;
@@ -224,8 +227,10 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
         const std::uint64_t n = whole.cellCount();
         return meshPart(whole, cellsOf(n, rank), cellsOf(n, rank + 1));
     });
+    const double readSeconds = std::chrono::duration<double>(Clock::now() - readStart).count();
     const std::uint64_t pointIdEnd = part.pointIds.empty() ? 0 : part.pointIds.back() + 1;
     DistributedSource out;
+    out.source.rankReadSeconds = comm.allGatherValues(readSeconds);
     MeshShare& share = out.share;
     share = shareOfPart(comm, std::move(part), parseFieldSpec(fieldSpec));
     // The checks, over every rank's share.

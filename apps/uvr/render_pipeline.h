@@ -24,6 +24,8 @@ struct RenderSource {
     double checkSeconds = 0.0;  ///< the mesh's check (0 from a cache)
     std::string cacheFile;
     double cacheReadSeconds = 0.0;
+    /// Data-parallel: each rank's seconds to read its part of the file, in rank order.
+    std::vector<double> rankReadSeconds;
 };
 
 /// Prepares, renders and writes the PNG (and stats JSON); returns the result (with --legend, its

@@ -73,8 +73,11 @@ def main():
                     continue
                 with open(stats) as f:
                     report = json.load(f)
-                check(len(report.get("ranks", [])) == n and report.get("imbalance", 0) >= 1,
-                      f"{mesh} {method}: --stats has {n} ranks and the imbalance")
+                ranks = report.get("ranks", [])
+                check(len(ranks) == n and report.get("imbalance", 0) >= 1 and
+                      all("read_seconds" in r and "prepare_seconds" in r for r in ranks),
+                      f"{mesh} {method}: --stats has {n} ranks (read, preparation, frame, "
+                      "compositing) and the imbalance")
                 c = run([args.uvr, "compare", one, many, "--json", "--min-ssim", "0.999",
                          "--max-diff", "2"])
                 detail = c.stdout.strip().replace("\n", " ")[:300]

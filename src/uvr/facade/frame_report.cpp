@@ -153,12 +153,15 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
         // A data-parallel frame: each rank's share and how even they were.
         nlohmann::json ranks = nlohmann::json::array();
         double slowest = 0.0, total = 0.0;
-        for (const RankFrameStats& r : result.ranks) {
+        const std::vector<double>& prepare = renderer.rankPrepareSeconds();
+        for (std::size_t i = 0; i < result.ranks.size(); ++i) {
+            const RankFrameStats& r = result.ranks[i];
             ranks.push_back({{"frame_seconds", r.frameSeconds},
                              {"composite_seconds", r.compositeSeconds},
                              {"composite_bytes_sent", r.bytesSent},
                              {"samples", r.samples},
                              {"cells", r.cells}});
+            if (i < prepare.size()) ranks.back()["prepare_seconds"] = prepare[i];
             slowest = std::max(slowest, r.frameSeconds);
             total += r.frameSeconds;
         }

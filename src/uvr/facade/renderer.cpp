@@ -127,6 +127,7 @@ void Renderer::finishPreparation(const RendererOptions& options, const ProgressF
                                  std::chrono::steady_clock::time_point start) {
     prepareSeconds_ =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (comm_) rankPrepareSeconds_ = comm_->allGatherValues(prepareSeconds_);
     if (progress && resolvesToCuda(options.device))
         progress("uploading " +
                  std::to_string((cudaSceneBytes(*prepared_) + (1u << 20) - 1) >> 20) +

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/mesh.h"
@@ -123,6 +124,9 @@ public:
     Communicator* communicator() const { return comm_; }
     /// True on the rank whose frames are the whole picture (rank 0; any one-process renderer).
     bool isRoot() const;
+    /// A data-parallel renderer's preparation seconds on every rank, in rank order (empty for
+    /// one process).
+    const std::vector<double>& rankPrepareSeconds() const { return rankPrepareSeconds_; }
 
 private:
     /// This rank's frame: its piece's on a data-parallel renderer.
@@ -138,6 +142,7 @@ private:
     double prepareSeconds_ = 0.0;
     Communicator* comm_ = nullptr;
     std::shared_ptr<const Decomposition> decomposition_;
+    std::vector<double> rankPrepareSeconds_;
 };
 
 }  // namespace uvr
