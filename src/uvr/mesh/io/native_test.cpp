@@ -154,6 +154,20 @@ TEST(Native, APartIsTheWholeMeshsCellsWithTheirPointsAndFields) {
             for (std::size_t k = 0; k < part.mesh.cell(c).size(); ++k)
                 EXPECT_EQ(part.mesh.points[part.mesh.cell(c)[k]], m.points[m.cell(a + c)[k]]);
     }
+    // A part reads its cells' offsets and indices itself: a corrupt one is refused there,
+    // naming the byte.
+    const Layout layout = layoutOf(m);
+    std::string bytes = readBytes(path);
+    patch(bytes, layout.indices + 4 * 5, std::uint32_t(m.pointCount()));
+    const std::string badIndex = testing::writeFile(path + ".index.uvrm", bytes);
+    expectError([&] { readNativePart(badIndex, 0, 10); }, ErrorKind::Parse,
+                {"cell indices: index " + std::to_string(m.pointCount()),
+                 "byte " + std::to_string(layout.indices + 20)});
+    bytes = readBytes(path);
+    patch(bytes, layout.offsets + 8 * 3, std::uint64_t(0));
+    const std::string badOffset = testing::writeFile(path + ".offset.uvrm", bytes);
+    expectError([&] { readNativePart(badOffset, 0, 10); }, ErrorKind::Parse,
+                {"cell offsets: offset 0 of cell 3"});
     expectError([&] { readNativePart(path, 10, n + 1); }, ErrorKind::Argument,
                 {"part.uvrm", "cells [10, " + std::to_string(n + 1) + ")"});
     expectError([&] { readNativePart(path, 10, 5); }, ErrorKind::Argument, {"cells [10, 5)"});
