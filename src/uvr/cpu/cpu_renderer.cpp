@@ -65,7 +65,8 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
     const FrameView frame = makeFrameView(
         settings, result.setup, result.image.pixels.data(), result.sampleCounts.data(),
         result.depth.empty() ? nullptr : result.depth.data(),
-        settings.depthIn.empty() ? nullptr : settings.depthIn.data());
+        settings.depthIn.empty() ? nullptr : settings.depthIn.data(),
+        settings.pixelStopAlpha.empty() ? nullptr : settings.pixelStopAlpha.data());
     const auto start = std::chrono::steady_clock::now();
     dispatchKernel(
         mesh.tets.hasNative(), litKernel(result.setup.params), surfacesKernel(result.setup.params),

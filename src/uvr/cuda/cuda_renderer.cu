@@ -214,8 +214,9 @@ struct CudaScene::Impl {
     bool macroActive = false;  ///< macroShading holds this frame's shading (usesMacroCells)
     cuda::DeviceArray<Vec4f> pixels;
     cuda::DeviceArray<std::uint32_t> sampleCounts;
-    cuda::DeviceArray<float> depth;    ///< depth out (RenderSettings::depthAlpha)
-    cuda::DeviceArray<float> depthIn;  ///< depth in (RenderSettings::depthIn)
+    cuda::DeviceArray<float> depth;      ///< depth out (RenderSettings::depthAlpha)
+    cuda::DeviceArray<float> depthIn;    ///< depth in (RenderSettings::depthIn)
+    cuda::DeviceArray<float> stopAlpha;  ///< stop in (RenderSettings::pixelStopAlpha)
     cuda::DeviceArray<unsigned long long> totals;
     double uploadSeconds = 0.0;
     double valueUploadSeconds = 0.0;
@@ -393,10 +394,13 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     const bool depthOut = settings.depthAlpha > 0.f;
     if (depthOut) d.depth.reserve(pixelCount, "the depth image");
     if (!settings.depthIn.empty()) d.depthIn.upload(settings.depthIn, "the depth image given");
+    const bool stopIn = !settings.pixelStopAlpha.empty();
+    if (stopIn) d.stopAlpha.upload(settings.pixelStopAlpha, "the pixels' stop opacities");
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
     const FrameView frame = makeFrameView(
         settings, result.setup, d.pixels.data(), d.sampleCounts.data(),
-        depthOut ? d.depth.data() : nullptr, settings.depthIn.empty() ? nullptr : d.depthIn.data());
+        depthOut ? d.depth.data() : nullptr, settings.depthIn.empty() ? nullptr : d.depthIn.data(),
+        stopIn ? d.stopAlpha.data() : nullptr);
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);

@@ -204,6 +204,53 @@ TEST(DataParallel, ExactGoesOnBehindANearlyOpaqueFrontRankAsOneProcessDoes) {
     EXPECT_LE(cmp.maxAbsDifference, 1.0) << differenceSummary(cmp);
 }
 
+TEST(DataParallel, ARayStopsBehindTheFrontRankWhereOneProcessStops) {
+    // The cube split at x = 0.125 as above, seen from +x: the front rank (0.875 deep) leaves
+    // opacity 0.5, the whole depth would reach 0.795, and the termination opacity 0.7 stops one
+    // process's ray inside the back rank. The back rank's own ray, alone, never reaches 0.7:
+    // without the second pass it would add all its light (alpha 0.795, not 0.7).
+    const Mesh mesh = testing::makeHexGrid(
+        8, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);
+    const ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options;
+    options.device = Device::Cpu;
+    options.leafCells = 64;
+    std::vector<RenderSettings> frames;
+    for (RenderMethod method : {RenderMethod::Reference, RenderMethod::Partitions}) {
+        RenderSettings s;
+        s.width = s.height = 48;
+        s.method = method;
+        s.tf = transferFunctionPreset("viridis");
+        applyOpacitySpec(s.tf, "constant:0.5");
+        s.opacityUnit = 0.5f * 0.875f / std::log(2.f);  // 1 - exp(-0.5 * 0.875 / u) = 0.5
+        s.terminationAlpha = 0.7f;
+        Camera c;
+        c.position = Vec3f(6.f, 0.f, 0.f);
+        c.focalPoint = Vec3f(0.f, 0.f, 0.f);
+        c.viewUp = Vec3f(0.f, 0.f, 1.f);
+        s.camera = c;
+        frames.push_back(s);
+    }
+    const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 2, options, frames);
+    ASSERT_EQ(many.size(), frames.size());
+    Renderer one(mesh, field, options);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        SCOPED_TRACE(methodName(frames[i].method));
+        const Image single = one.render(frames[i]).image;
+        EXPECT_NEAR(single.at(24, 24).w, 0.7f, 0.03f);  // stopped at the termination opacity
+        EXPECT_NEAR(many[i].image.at(24, 24).w, single.at(24, 24).w, 1e-4f);
+        const ImageComparison cmp = compareImages(toRgb8(single), toRgb8(many[i].image));
+        EXPECT_LE(cmp.maxAbsDifference, 1.0) << differenceSummary(cmp);
+        // The back rank rendered the covered pixels again; the front rank none.
+        ASSERT_EQ(many[i].ranks.size(), 2u);
+        const std::uint64_t again =
+            many[i].ranks[0].rerenderedPixels + many[i].ranks[1].rerenderedPixels;
+        EXPECT_GT(again, 48u * 48u / 4);
+        EXPECT_TRUE(many[i].ranks[0].rerenderedPixels == 0 ||
+                    many[i].ranks[1].rerenderedPixels == 0);
+    }
+}
+
 TEST(DataParallel, TooManyRanksForThePartitionsAreRefusedOnEveryRank) {
     const Mesh mesh = testing::makeHexGrid(
         3, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);

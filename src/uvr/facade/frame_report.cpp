@@ -160,7 +160,8 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
                              {"composite_seconds", r.compositeSeconds},
                              {"composite_bytes_sent", r.bytesSent},
                              {"samples", r.samples},
-                             {"cells", r.cells}});
+                             {"cells", r.cells},
+                             {"rerendered_pixels", r.rerenderedPixels}});
             if (i < prepare.size()) ranks.back()["prepare_seconds"] = prepare[i];
             slowest = std::max(slowest, r.frameSeconds);
             total += r.frameSeconds;

@@ -167,14 +167,29 @@ RenderResult Renderer::render(const RenderSettings& settings) {
     const std::vector<int> order = visibilityOrder(*decomposition_, camera.parallelProjection,
                                                    camera.position, result.setup.viewDirection);
     const double frameSeconds = result.stats.seconds;
-    const std::uint64_t samples = result.stats.samples;
     // A pixel stops taking ranks where one process's ray stops (exact integrates on to
     // kOpacityEnd, the sampling methods to the termination opacity).
-    const float stopAlpha = result.setup.method.method == RenderMethod::Exact
-                                ? segment::kOpacityEnd
-                                : settings.terminationAlpha;
+    const bool exact = result.setup.method.method == RenderMethod::Exact;
+    const float stopAlpha = exact ? segment::kOpacityEnd : settings.terminationAlpha;
+    // Where a rank's ray stopped behind other ranks' light, it renders the pixel again to
+    // one process's stop (exact's stop, 1 - 1e-6, leaves nothing to redo; a supersampled
+    // pixel's rays stop each on its own, which one opacity per pixel cannot follow).
+    std::uint64_t samples = result.stats.samples;
+    RerenderPiece rerender;
+    if (!exact && settings.supersample == 1)
+        rerender = [&](const std::vector<float>& stops, Image& image,
+                       std::vector<std::uint32_t>& counts) {
+            RenderSettings again = settings;
+            again.pixelStopAlpha = stops;
+            again.progress = {};
+            RenderResult r = renderLocal(again);
+            samples += r.stats.samples;
+            image = std::move(r.image);
+            counts = std::move(r.sampleCounts);
+        };
     const CompositeStats composited =
-        compositeFrame(*comm_, result.image, result.sampleCounts, order, 0, stopAlpha);
+        compositeFrame(*comm_, result.image, result.sampleCounts, order, 0, stopAlpha, rerender);
+    result.stats.samples = samples;
     // The ranks' counters summed, and each rank's share.
     std::uint64_t counters[5] = {result.stats.samples, result.stats.walkSteps,
                                  result.stats.bvhQueries, result.stats.partitionsVisited,
@@ -184,10 +199,11 @@ RenderResult Renderer::render(const RenderSettings& settings) {
     result.stats.bvhQueries = counters[2], result.stats.partitionsVisited = counters[3];
     result.stats.partitionsSkipped = counters[4];
     RankFrameStats mine;
-    mine.frameSeconds = frameSeconds;
+    mine.frameSeconds = frameSeconds + composited.rerenderSeconds;
     mine.compositeSeconds = composited.seconds;
     mine.bytesSent = composited.bytesSent;
     mine.samples = samples;
+    mine.rerenderedPixels = composited.rerenderedPixels;
     mine.cells = prepared_->tets.cellCount();
     result.ranks = comm_->allGatherValues(mine);
     double slowest = 0.0;

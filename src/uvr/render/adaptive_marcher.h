@@ -222,7 +222,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
 /// partitions with zero maximum opacity; marches each visited partition with its own step s,
 /// locating samples among the partition's cells and integrating between consecutive samples
 /// (SampleSegments; point samples with opacity correction when params.preintegrated is off);
-/// stops early once opaque.
+/// stops early once opaque: at `stop` (kSceneStop: at params.terminationAlpha).
 ///
 /// Sample placement: a partition's piece of the ray owns the reference grid points
 /// t = k * s1 for k in [K0, K1); its samples sit at (K0 + j * s / s1) * s1 and each one stands
@@ -243,7 +243,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
 /// a grazing ray's short chord is not stepped over.
 template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, const Ray& ray,
-                                             RayCounters& counters) {
+                                             RayCounters& counters, float stop = kSceneStop) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
     const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
     float tEnter = 0.f, tExit = INFINITY;
@@ -270,7 +270,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const TetLocator& locator = scene.base.locator;
     const float s1 = scene.base.params.step;
     const float unit = scene.base.params.opacityUnit;
-    const float stopAlpha = scene.base.params.terminationAlpha;
+    const float stopAlpha = stop < 0.f ? scene.base.params.terminationAlpha : stop;
     const TfTableView& tf = scene.base.tf;
     const bool preintegrated = scene.base.params.preintegrated;
     const Lighting lighting = kernelLighting<kLit>(scene.base.params);

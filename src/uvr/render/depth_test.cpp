@@ -2,7 +2,8 @@
 // Depth in and out (issue 32) in every method and on every device. Oracles: the distance of an
 // opaque plane (a linear field's isosurface) along the view direction; where a slab of constant
 // extinction reaches an opacity, in closed form; a depth image given in equal to a clip at its
-// plane; the .npy files numpy writes and reads.
+// plane; the .npy files numpy writes and reads; a per-pixel stop opacity (a data-parallel
+// frame's second pass) against the slab's extinction.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -147,6 +148,54 @@ TEST_P(Depth, GeometryGivenAsDepthEndsTheRaysAsAClipWould) {
             }
         EXPECT_LT(r.image.at(8, 6).w, whole.image.at(8, 6).w - 0.1f) << methodName(m);
     }
+}
+
+TEST_P(Depth, APixelsStopOpacityEndsItsRayThere) {
+    // Stop in (a data-parallel frame's second pass): each pixel's ray stops at its own opacity,
+    // which the slab's extinction (2 per unit, steps of 0.01: 0.02 of what is left per step)
+    // overshoots by less than one step; a pixel with stop 0 is not rendered. Exact runs on.
+    const PreparedMesh pm = cube(true);
+    for (const RenderMethod m : kMethods) {
+        RenderSettings s = alongX(m);
+        s.terminationAlpha = 1.f;
+        const float full = render(pm, s).image.at(8, 6).w;  // about 1 - exp(-2)
+        s.pixelStopAlpha.assign(std::size_t(s.width) * s.height, 0.f);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 1; x < s.width; ++x)
+                s.pixelStopAlpha[std::size_t(y) * s.width + x] = x % 2 ? 0.3f : 0.6f;
+        const RenderResult r = render(pm, s);
+        for (int y = 0; y < s.height; ++y) {
+            EXPECT_EQ(r.image.at(0, y).w, 0.f) << methodName(m);
+            EXPECT_EQ(r.sampleCounts[std::size_t(y) * s.width], 0u) << methodName(m);
+            for (int x = 1; x < s.width; ++x) {
+                const float a = r.image.at(x, y).w, stop = x % 2 ? 0.3f : 0.6f;
+                if (m == RenderMethod::Exact) {
+                    EXPECT_NEAR(a, full, 1e-5f) << " at " << x << ", " << y;
+                } else {
+                    // The adaptive method's steps are longer in the constant field: it stops
+                    // after the step that reaches the stop, short of the slab's end.
+                    const float over = m == RenderMethod::Reference ? 0.021f : 0.2f;
+                    EXPECT_GE(a, stop) << methodName(m) << " at " << x << ", " << y;
+                    EXPECT_LT(a, stop + over * (1.f - stop))
+                        << methodName(m) << " at " << x << ", " << y;
+                    EXPECT_LT(a, full - 0.1f) << methodName(m);
+                }
+            }
+        }
+    }
+    // Bad stops are setting errors.
+    RenderSettings s = alongX(RenderMethod::Reference);
+    s.pixelStopAlpha.assign(15, 0.5f);
+    EXPECT_THROW(checkDepth(s), SettingError);
+    s.pixelStopAlpha.assign(std::size_t(s.width) * s.height, 0.5f);
+    EXPECT_NO_THROW(checkDepth(s));
+    s.pixelStopAlpha[3] = 1.5f;
+    EXPECT_THROW(checkDepth(s), SettingError);
+    s.pixelStopAlpha[3] = NAN;
+    EXPECT_THROW(checkDepth(s), SettingError);
+    s.pixelStopAlpha[3] = 0.5f;
+    s.supersample = 2;
+    EXPECT_THROW(checkDepth(s), SettingError);
 }
 
 TEST(DepthImage, NpyRoundTripsAndBadFilesAreNamed) {

@@ -26,6 +26,10 @@ struct FrameView {
     float* depth = nullptr;
     /// Depth in (null: none): per pixel the view depth of opaque geometry: the rays end there.
     const float* depthIn = nullptr;
+    /// Stop in (null: none; RenderSettings::pixelStopAlpha): per pixel the accumulated opacity
+    /// at which its ray stops (the sampling methods); 0: the pixel is left transparent, without
+    /// a ray. One ray per pixel (supersample 1).
+    const float* stopAlpha = nullptr;
     /// View depths (file units) from ray parameters (rendering units): z = (rayStartDepth + t
     /// dot(dir, viewDirection)) / depthScale.
     Vec3f viewDirection{0.f, 0.f, -1.f};
@@ -67,12 +71,13 @@ UVR_HOST_DEVICE inline void jitterOffsets(int x, int y, int s, float& ox, float&
 
 /// Kernel body for one pixel: traces its N x N rays (frame.supersample; one through the centre
 /// of each cell of an N x N grid over the pixel, or jittered within it) with
-/// `march(ray, counters)`, stores the mean premultiplied colour and the samples summed over the
-/// rays, and returns the counters summed over the rays. With N = 1 the one ray passes through
-/// the pixel's centre and the pixel is exactly that ray's colour. CPU and CUDA backends launch
-/// it. The rays run one after another in this thread, so no buffer grows with N. Supersampled
-/// false is the one-ray body (frame.supersample must be 1): without the loop's sums live across
-/// the integrator, the GPU kernels keep their registers (the loop cost the partition kernel 7%).
+/// `march(ray, counters, stop)` (stop: kSceneStop, or frame.stopAlpha's with one ray), stores the
+/// mean premultiplied colour and the samples summed over the rays, and returns the counters summed
+/// over the rays. With N = 1 the one ray passes through the pixel's centre and the pixel is exactly
+/// that ray's colour. CPU and CUDA backends launch it. The rays run one after another in this
+/// thread, so no buffer grows with N. Supersampled false is the one-ray body (frame.supersample
+/// must be 1): without the loop's sums live across the integrator, the GPU kernels keep their
+/// registers (the loop cost the partition kernel 7%).
 template <bool Supersampled = true, class March>
 UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int y, March&& march) {
     const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
@@ -80,7 +85,14 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
         Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
         if (frame.depthIn) ray.tMax = frame.rayParameter(ray, frame.depthIn[i]);
         RayCounters counters;
-        const Vec4f c = march(ray, counters);
+        const float stop = frame.stopAlpha ? frame.stopAlpha[i] : kSceneStop;
+        if (!(stop != 0.f)) {  // not rendered (a data-parallel second pass's other pixels)
+            frame.pixels[i] = Vec4f(0.f, 0.f, 0.f, 0.f);
+            frame.sampleCounts[i] = 0;
+            if (frame.depth) frame.depth[i] = INFINITY;
+            return counters;
+        }
+        const Vec4f c = march(ray, counters, stop);
         frame.pixels[i] = c;
         frame.sampleCounts[i] = counters.samples;
         if (frame.depth) frame.depth[i] = frame.viewDepth(ray, counters.depth);
@@ -99,7 +111,7 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
         RayCounters counters;
         Ray ray = frame.rays.ray(px, py);
         if (frame.depthIn) ray.tMax = frame.rayParameter(ray, frame.depthIn[i]);
-        sum = sum + march(ray, counters);
+        sum = sum + march(ray, counters, kSceneStop);
         if (frame.depth) {
             const float z = frame.viewDepth(ray, counters.depth);
             nearest = z < nearest ? z : nearest;
@@ -126,16 +138,17 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
 template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct ReferenceMarch {
     SceneView scene;
-    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return marchReference<kNative, kLit, kSurf>(scene, ray, counters);
+    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters, float stop) const {
+        return marchReference<kNative, kLit, kSurf>(scene, ray, counters, stop);
     }
 };
 
-/// The exact integrator as a functor for shadePixel (its "samples" are tetrahedra crossed).
+/// The exact integrator as a functor for shadePixel (its "samples" are tetrahedra crossed; its
+/// rays run on to segment::kOpacityEnd, whatever the stop).
 template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct ExactMarch {
     SceneView scene;
-    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
+    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters, float) const {
         return integrateExact<kNative, kLit, kSurf>(scene, ray, counters);
     }
 };
@@ -144,8 +157,8 @@ struct ExactMarch {
 template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct PartitionMarch {
     PartitionSceneView scene;
-    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters) const {
-        return marchPartitions<kNative, kLit, kSurf>(scene, ray, counters);
+    UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters, float stop) const {
+        return marchPartitions<kNative, kLit, kSurf>(scene, ray, counters, stop);
     }
 };
 

@@ -129,10 +129,10 @@ struct FrameSetup {
 
 /// The frame's output buffers and rays for the shared pixel kernel (both backends): pixels and
 /// counts hold width * height entries on the device that renders, as do depth (depth out, or
-/// null) and depthIn (depth in, or null).
+/// null), depthIn (depth in, or null) and stopAlpha (stop in, or null).
 inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup& setup,
                                Vec4f* pixels, std::uint32_t* sampleCounts, float* depth = nullptr,
-                               const float* depthIn = nullptr) {
+                               const float* depthIn = nullptr, const float* stopAlpha = nullptr) {
     FrameView v;
     v.pixels = pixels;
     v.sampleCounts = sampleCounts;
@@ -143,6 +143,7 @@ inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup&
     v.jitter = settings.jitter && settings.supersample > 1;
     v.depth = depth;
     v.depthIn = depthIn;
+    v.stopAlpha = stopAlpha;
     v.viewDirection = setup.viewDirection;
     v.rayStartDepth = setup.rayStartDepth;
     v.depthScale = static_cast<float>(setup.frame.scale);
@@ -201,11 +202,14 @@ struct RenderStats {
 
 /// One rank's share of a data-parallel frame (RenderResult::ranks).
 struct RankFrameStats {
-    double frameSeconds = 0.0;      ///< its piece's frame
+    double frameSeconds = 0.0;      ///< its piece's frame (both passes)
     double compositeSeconds = 0.0;  ///< its part of the compositing
     std::uint64_t bytesSent = 0;    ///< bytes it sent compositing
     std::uint64_t samples = 0;      ///< samples its rays took
     std::uint64_t cells = 0;        ///< cells it holds (its piece's, with the ghosts)
+    /// Pixels it rendered again, where its rays stopped behind other ranks' light (the
+    /// compositing's second pass).
+    std::uint64_t rerenderedPixels = 0;
 };
 
 /// A rendered frame: image, per-pixel sample counts, statistics.

@@ -304,10 +304,10 @@ UVR_HOST_DEVICE inline Lighting kernelLighting(const MarchParams& params) {
 /// (previous tetrahedron first), interpolates barycentrically and integrates between
 /// consecutive samples (SampleSegments; or, with params.preintegrated off, classifies each sample
 /// through the transfer function and composites it with opacity correction), front to back,
-/// stopping early once opaque.
+/// stopping early once opaque: at `stop` (kSceneStop: at params.terminationAlpha).
 template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& ray,
-                                            RayCounters& counters) {
+                                            RayCounters& counters, float stop = kSceneStop) {
     Vec4f acc(0.f, 0.f, 0.f, 0.f);
     const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
     float t0 = 0.f, t1 = INFINITY;
@@ -347,6 +347,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
     const float unit = scene.params.opacityUnit;
+    const float stopAlpha = stop < 0.f ? scene.params.terminationAlpha : stop;
     SampleSegments<kLit, kSurf> segments;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
     segments.setIsos(scene.params.iso, lighting, ray.dir, scene.params.depthAlpha);
@@ -394,7 +395,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, k * s, counters);
             tNoted = k * s;
         }
-        opaque = acc.w >= scene.params.terminationAlpha;
+        opaque = acc.w >= stopAlpha;
     }
     if (scene.params.preintegrated && !opaque && !pieceEnd) {
         [[maybe_unused]] const float a0 = acc.w;

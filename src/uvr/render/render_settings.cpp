@@ -207,6 +207,18 @@ void checkDepth(const RenderSettings& s) {
         throw SettingError("depth_in", std::to_string(s.depthIn.size()) + " depths",
                            "expected one per pixel: " + std::to_string(s.width) + " x " +
                                std::to_string(s.height));
+    if (s.pixelStopAlpha.empty()) return;
+    if (s.pixelStopAlpha.size() != std::size_t(s.width) * std::size_t(std::max(s.height, 0)))
+        throw SettingError("pixel_stop_alpha", std::to_string(s.pixelStopAlpha.size()) + " stops",
+                           "expected one per pixel: " + std::to_string(s.width) + " x " +
+                               std::to_string(s.height));
+    if (s.supersample != 1)
+        throw SettingError("pixel_stop_alpha", "given", "expected supersample 1 (one ray a pixel)");
+    for (std::size_t i = 0; i < s.pixelStopAlpha.size(); ++i)
+        if (!(s.pixelStopAlpha[i] >= 0.f && s.pixelStopAlpha[i] <= 1.f))
+            throw SettingError("pixel_stop_alpha",
+                               formatG(s.pixelStopAlpha[i], 6) + " at pixel " + std::to_string(i),
+                               "expected opacities in [0, 1]");
 }
 
 void checkClip(const RenderSettings& s) {

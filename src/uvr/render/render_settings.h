@@ -96,6 +96,13 @@ struct RenderSettings {
     /// distance, so the frame composites over that geometry (infinity or NaN: none at that
     /// pixel). Empty: none.
     std::vector<float> depthIn;
+    /// Stop in: width x height accumulated opacities, row 0 at the top, at which each pixel's
+    /// ray stops instead of at terminationAlpha (the sampling methods; exact runs on to its
+    /// opacity end): a data-parallel rank behind others re-renders the pixels where one
+    /// process's ray stops inside its piece, each stopping at what the opacity in front leaves
+    /// (docs/METHOD.md, "Data-parallel rendering"). 0: the pixel is not rendered (transparent,
+    /// no samples). With supersample 1 only. Empty: none.
+    std::vector<float> pixelStopAlpha;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)

@@ -37,6 +37,11 @@ struct MarchParams {
     float depthAlpha = 0.f;
 };
 
+/// The sampling integrators' `stop` argument for a ray that stops at the scene's
+/// MarchParams::terminationAlpha (any other value in (0, 1] is that ray's own stop: a
+/// data-parallel rank's ray behind others stops where one process's would; FrameView::stopAlpha).
+inline constexpr float kSceneStop = -1.f;
+
 /// Whether a frame runs the integrators' instances with isosurfaces, depth and the clip's cut
 /// face (kSurf).
 UVR_HOST_DEVICE inline bool surfacesKernel(const MarchParams& p) {
