@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """The module under mpirun (issue 31): Renderer(comm=MPI.COMM_WORLD) renders data-parallel, rank
-0's image is the one-process image, the other ranks get None; a communicator that is not the
-world is refused."""
+0's image is the one-process image (after set_field too), the other ranks get None; a
+communicator that is not the world is refused."""
 
 import os
 import shutil
@@ -23,11 +23,16 @@ SCRIPT = textwrap.dedent("""
     r = uvr.Renderer(mesh, device="cpu", comm=MPI.COMM_WORLD)
     img = r.render(tf="viridis", opacity="0:0,1:0.5", size=(160, 120), azimuth=30,
                    elevation=20, method=sys.argv[3])
+    # Another field's values reach the pieces (nothing geometric rebuilt).
+    r.set_field("energy")
+    energy = r.render(tf="viridis", opacity="0:0,1:0.5", size=(160, 120), azimuth=30,
+                      elevation=20, method=sys.argv[3])
     if MPI.COMM_WORLD.Get_rank() == 0:
         np.save(sys.argv[2], np.asarray(img))
+        np.save(sys.argv[2] + ".energy.npy", np.asarray(energy))
         assert len(img.stats["ranks"]) == MPI.COMM_WORLD.Get_size()
     else:
-        assert img is None
+        assert img is None and energy is None
 """)
 
 
@@ -45,16 +50,17 @@ def test_data_parallel_under_mpirun_equals_one_process(tmp_path, data_dir, metho
                         str(data_dir / "bluntfin_tets.vtk"), str(out), method],
                        capture_output=True, text=True, env=env, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
-    many = np.load(out)
-    one = uvr.Renderer(uvr.read(str(data_dir / "bluntfin_tets.vtk")), device="cpu").render(
-        tf="viridis", opacity="0:0,1:0.5", size=(160, 120), azimuth=30, elevation=20,
-        method=method)
+    fin = uvr.read(str(data_dir / "bluntfin_tets.vtk"))
     # In 8-bit levels over black, as the PNG holds them (uvr compare's measure).
     def levels(a):
         return np.round(np.clip(np.asarray(a, dtype=np.float64)[..., :3], 0, 1) * 255)
-    diff = np.abs(levels(one) - levels(many))
-    assert diff.max() <= 2, diff.max()
-    assert float(np.asarray(one)[..., 3].max()) > 0.1  # a picture to compare
+    for field, many in (("density", np.load(out)), ("energy", np.load(str(out) + ".energy.npy"))):
+        one = uvr.Renderer(fin, field=field, device="cpu").render(
+            tf="viridis", opacity="0:0,1:0.5", size=(160, 120), azimuth=30, elevation=20,
+            method=method)
+        diff = np.abs(levels(one) - levels(many))
+        assert diff.max() <= 2, (field, diff.max())
+        assert float(np.asarray(one)[..., 3].max()) > 0.1  # a picture to compare
 
 
 def test_a_communicator_that_is_not_mpi4pys_is_refused():

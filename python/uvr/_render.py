@@ -114,10 +114,7 @@ class Renderer:
             raise _uvr.ArgumentError("set_step/set_time: the field was given as values; name "
                                      "it (field='pressure') to follow it through the steps")
         same = self.series._same_geometry(step, self.mesh)
-        if same is not None and self._ranks > 1:
-            self._prepare(same, self._field_key)  # data-parallel: the pieces prepared anew
-            same = None
-        elif same is not None:
+        if same is not None:
             name, assoc, values = _uvr.select_field(same._data, same.fields,
                                                     self._field_key or "")[:3]
             self._core.set_field_values(name, assoc, values)
@@ -162,9 +159,6 @@ class Renderer:
         """New values of the same mesh (a time step; one per point or cell), or another field
         by its spec: the values, value ranges and macrocells are refreshed, nothing geometric is
         rebuilt (on the GPU only the value arrays are uploaded)."""
-        if self._ranks > 1:  # data-parallel: the pieces are prepared anew
-            self._prepare(self.mesh, field, association)
-            return
         name, assoc, values = self._field(field, association)
         self._core.set_field_values(name, assoc, values)
         self._field_key = field if isinstance(field, str) else None

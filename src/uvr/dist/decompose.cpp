@@ -206,6 +206,50 @@ struct CarriedPoint {
 
 }  // namespace
 
+ScalarField routeValues(Communicator& comm, const ValueRoutes& routes, const ScalarField& field) {
+    const int ranks = comm.size();
+    const bool cells = field.association == Association::Cell;
+    agreeOn(comm, [&] {
+        if (!(cells ? routes.cells : routes.points))
+            throwError(ErrorKind::Argument, "",
+                       std::string("new ") + (cells ? "cell" : "point") + " values of field '" +
+                           field.name + "': the ranks' pieces were made without " +
+                           (cells ? "cell" : "point") + " fields, so none can be given");
+        const std::uint64_t expected = cells ? routes.shareCells : routes.sharePoints;
+        if (field.values.size() != expected)
+            throwError(ErrorKind::Argument, "",
+                       "new values of field '" + field.name +
+                           "': " + std::to_string(field.values.size()) + " " +
+                           associationName(field.association) + " values, expected " +
+                           std::to_string(expected) + " (one per " + (cells ? "cell" : "point") +
+                           " of this rank's share)");
+    });
+    const auto& send = cells ? routes.sendCells : routes.sendPoints;
+    const auto& receive = cells ? routes.receiveCells : routes.receivePoints;
+    std::vector<std::vector<std::byte>> toEach(ranks);
+    for (int r = 0; r < ranks; ++r) {
+        std::vector<float> values(send[r].size());
+        for (std::size_t k = 0; k < values.size(); ++k) values[k] = field.values[send[r][k]];
+        toEach[r].resize(values.size() * sizeof(float));
+        if (!values.empty()) std::memcpy(toEach[r].data(), values.data(), toEach[r].size());
+    }
+    const std::vector<std::vector<std::byte>> received = comm.allToAll(toEach);
+    ScalarField out;
+    out.name = field.name;
+    out.association = field.association;
+    out.choice = field.choice;
+    out.values.assign(cells ? routes.pieceCells : routes.piecePoints, 0.f);
+    for (int r = 0; r < ranks; ++r) {
+        UVR_CHECK(received[r].size() == receive[r].size() * sizeof(float),
+                  "rank " << r << " sent " << received[r].size() << " bytes of values for "
+                          << receive[r].size());
+        for (std::size_t k = 0; k < receive[r].size(); ++k)
+            std::memcpy(&out.values[receive[r][k]], received[r].data() + k * sizeof(float),
+                        sizeof(float));
+    }
+    return out;
+}
+
 RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptions& options,
                          float ghostSteps, const ProgressFn& progress) {
     const int ranks = comm.size(), me = comm.rank();
@@ -345,6 +389,15 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     // Step 4: each source cell to every rank whose box, widened by the ghosts, it reaches.
     if (progress) progress("moving cells to the ranks that render them");
     const float ghost = ghostSteps * piece->defaultStep;
+    ValueRoutes& routes = out.routes;
+    routes.sharePoints = share.mesh.points.size();
+    routes.shareCells = share.mesh.cellCount();
+    for (const Field& f : share.mesh.fields)
+        (f.association == Association::Point ? routes.points : routes.cells) = true;
+    (pointData ? routes.points : routes.cells) = true;
+    if (share.mesh.fields.empty()) routes.points = routes.cells = true;  // fields unknown (a view)
+    routes.sendPoints.resize(ranks), routes.sendCells.resize(ranks);
+    routes.receivePoints.resize(ranks), routes.receiveCells.resize(ranks);
     std::vector<std::vector<std::byte>> toEach(ranks);
     for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
         const std::span<const std::uint32_t> corners = share.mesh.cell(c);
@@ -360,6 +413,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
                 reaches = reaches && box.lo[a] <= d.regions[r].hi[a] + ghost &&
                           box.hi[a] >= d.regions[r].lo[a] - ghost;
             if (!reaches) continue;
+            routes.sendCells[r].push_back(static_cast<std::uint32_t>(c));
             std::vector<std::byte>& m = toEach[r];
             put(m, share.cellIds[c]);
             put(m, static_cast<std::uint8_t>(share.mesh.cellTypes[c]));
@@ -372,6 +426,15 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
             if (!pointData) put(m, share.field.values[c]);
         }
     }
+    // The share's points each rank receives, each once, in the order of their first corner.
+    if (routes.points) {
+        std::vector<int> sentTo(share.mesh.points.size(), -1);
+        for (int r = 0; r < ranks; ++r)
+            for (std::uint32_t c : routes.sendCells[r])
+                for (std::uint32_t id : share.mesh.cell(c))
+                    if (sentTo[id] != r) sentTo[id] = r, routes.sendPoints[r].push_back(id);
+    }
+    if (!routes.cells) routes.sendCells.assign(ranks, {});
     share = MeshShare();
     std::vector<std::vector<std::byte>> received = comm.allToAll(toEach);
     toEach = {};
@@ -384,11 +447,15 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     };
     std::vector<CarriedCell> carried;
     std::vector<CarriedPoint> points;
-    for (const std::vector<std::byte>& m : received) {
+    // Per sender, the ids of its cells and of their corners in the order they came (the routes').
+    std::vector<std::vector<std::uint64_t>> cameCells(ranks), cameCorners(ranks);
+    for (int from = 0; from < ranks; ++from) {
+        const std::vector<std::byte>& m = received[from];
         std::size_t at = 0;
         while (at < m.size()) {
             CarriedCell cell;
             cell.id = take<std::uint64_t>(m, at);
+            if (routes.cells) cameCells[from].push_back(cell.id);
             cell.type = static_cast<CellType>(take<std::uint8_t>(m, at));
             const int count = take<std::uint8_t>(m, at);
             for (int k = 0; k < count; ++k) {
@@ -397,6 +464,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
                 p.p = take<Vec3f>(m, at);
                 p.value = take<float>(m, at);
                 cell.corners.push_back(p.id);
+                if (routes.points) cameCorners[from].push_back(p.id);
                 points.push_back(p);
             }
             cell.value = pointData ? 0.f : take<float>(m, at);
@@ -427,6 +495,30 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         }
         out.mesh.addCell(cell.type, ids);
         if (!pointData) out.field.values.push_back(cell.value);
+    }
+    // The routes' receiving ends: the same orders, as the piece's indices.
+    routes.piecePoints = points.size();
+    routes.pieceCells = carried.size();
+    {
+        std::vector<int> cameFrom(points.size(), -1);
+        for (int from = 0; from < ranks; ++from) {
+            for (std::uint64_t id : cameCorners[from]) {
+                const auto it = std::lower_bound(
+                    points.begin(), points.end(), id,
+                    [](const CarriedPoint& p, std::uint64_t v) { return p.id < v; });
+                const std::size_t i = static_cast<std::size_t>(it - points.begin());
+                if (cameFrom[i] != from)
+                    cameFrom[i] = from, routes.receivePoints[from].push_back(std::uint32_t(i));
+            }
+            cameCorners[from] = {};
+            for (std::uint64_t id : cameCells[from]) {
+                const auto it = std::lower_bound(
+                    carried.begin(), carried.end(), id,
+                    [](const CarriedCell& c, std::uint64_t v) { return c.id < v; });
+                routes.receiveCells[from].push_back(std::uint32_t(it - carried.begin()));
+            }
+            cameCells[from] = {};
+        }
     }
     out.piece = std::move(piece);
     return out;

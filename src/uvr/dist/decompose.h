@@ -60,6 +60,28 @@ struct Decomposition {
 /// holds for every pixel.
 std::vector<int> visibilityOrder(const Decomposition& d, bool parallel, Vec3f eye, Vec3f dir);
 
+/// How new values of a field (a time step, another field) reach the ranks' pieces: for every
+/// pair of ranks, the sender's share points (cells) whose values the receiver's piece holds, in
+/// one order both know (distributeMesh notes it while it moves the cells). Routes of an
+/// association no field of the share has are left empty (points: the share's mesh has point
+/// fields or the rendered field is one; cells likewise; both when the share's mesh lists no
+/// fields, as a share of a MeshView). 4 bytes a share and a piece point (cell) on each rank.
+struct ValueRoutes {
+    std::uint64_t sharePoints = 0, shareCells = 0;  ///< this rank's share's
+    std::uint64_t piecePoints = 0, pieceCells = 0;  ///< this rank's piece's
+    bool points = false, cells = false;             ///< which routes were noted
+    /// Per rank r: the share's point (cell) indices whose values go to r, in order.
+    std::vector<std::vector<std::uint32_t>> sendPoints, sendCells;
+    /// Per rank r: the piece's point (cell) indices r's values go to, in the same order.
+    std::vector<std::vector<std::uint32_t>> receivePoints, receiveCells;
+};
+
+/// New values on the pieces (collective): `field` holds one value per point (cell) of this
+/// rank's share, in its order; returns the field on this rank's piece (one value per piece
+/// point or cell, as RankPiece::mesh orders them). Throws Error(Argument) on every rank when
+/// any rank's field has the wrong count or an association whose routes were not noted.
+ScalarField routeValues(Communicator& comm, const ValueRoutes& routes, const ScalarField& field);
+
 /// A rank's piece of the whole mesh, ready for prepareMesh with PrepareOptions::piece.
 struct RankPiece {
     Mesh mesh;          ///< every cell whose bounds reach the rank's box widened by the ghosts
@@ -67,6 +89,7 @@ struct RankPiece {
     std::shared_ptr<const MeshPiece> piece;  ///< what the whole mesh decides
     Decomposition decomposition;             ///< every rank's box
     std::uint64_t shareCells = 0;            ///< cells of this rank's share before
+    ValueRoutes routes;                      ///< how later values reach the piece
 };
 
 /// Distributes a mesh over the ranks of `comm` (collective; every rank passes its share):

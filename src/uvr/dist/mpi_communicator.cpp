@@ -303,7 +303,7 @@ void initializeMpi() {
     if (finalized)
         throwError(ErrorKind::Internal, "", "MPI was finalised before uvr's first use of it");
     int provided = MPI_THREAD_SINGLE;
-    check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+    check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided), "MPI_Init_thread");
     std::atexit(finalizeMpi);
 }
 

@@ -251,6 +251,81 @@ TEST(DataParallel, ARayStopsBehindTheFrontRankWhereOneProcessStops) {
     }
 }
 
+/// Rank 0's frame after new values: a data-parallel renderer prepared with `first`, then
+/// given `then` (the whole mesh's values, or with fromShares each rank's share's).
+RenderResult frameAfterNewValues(const Mesh& mesh, const ScalarField& first,
+                                 const ScalarField& then, int ranks, bool fromShares,
+                                 const RenderSettings& s) {
+    RenderResult out;
+    InProcessGroup::run(ranks, [&](Communicator& comm) {
+        RendererOptions o;
+        o.device = Device::Cpu;
+        o.communicator = &comm;
+        std::unique_ptr<Renderer> r;
+        if (fromShares) {
+            r = std::make_unique<Renderer>(shareOfMesh(mesh, first, comm.rank(), ranks), o);
+            r->setFieldValues(shareOfMesh(mesh, then, comm.rank(), ranks).field);
+        } else {
+            r = std::make_unique<Renderer>(mesh, first, o);
+            r->setFieldValues(then);
+        }
+        RenderResult result = r->render(s);
+        if (comm.rank() == 0) out = std::move(result);
+    });
+    return out;
+}
+
+TEST(DataParallel, NewValuesReachThePiecesAsAFreshPreparationWould) {
+    // A time step's new values (or another field) move to the pieces over the routes the
+    // distribution noted; the frame equals one process's prepared with them from the start,
+    // value range included (energy's is not density's).
+    const std::string path = testing::sharedData("bluntfin_tets.vtk");
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+    const Mesh fin = readMesh(path);
+    const ScalarField density = selectScalarField(fin, parseFieldSpec("density"));
+    const ScalarField energy = selectScalarField(fin, parseFieldSpec("energy"));
+    RendererOptions options;
+    options.device = Device::Cpu;
+    for (RenderMethod m : {RenderMethod::Partitions, RenderMethod::Reference}) {
+        const RenderSettings s = frameOf(fin.bounds(), m, 30.f, 20.f);
+        const Image one = Renderer(fin, energy, options).render(s).image;
+        for (const auto& [ranks, fromShares] : {std::pair{3, false}, std::pair{2, true}}) {
+            SCOPED_TRACE(std::string(methodName(m)) + ", " + std::to_string(ranks) + " ranks" +
+                         (fromShares ? " from shares" : ""));
+            const RenderResult many =
+                frameAfterNewValues(fin, density, energy, ranks, fromShares, s);
+            EXPECT_FLOAT_EQ(many.setup.rangeLo, 0.768957f);
+            const ImageComparison cmp = compareImages(toRgb8(one), toRgb8(many.image));
+            EXPECT_GE(cmp.ssim, kMinSsim);
+            EXPECT_LE(cmp.maxAbsDifference, kMaxLevels) << differenceSummary(cmp);
+        }
+    }
+    // A point field, then a cell field of the same mesh.
+    Mesh grid = testing::makeHexGrid(
+        10, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.2f);
+    Field c{"c", Association::Cell, 1, {}};
+    for (std::uint64_t i = 0; i < grid.cellCount(); ++i) {
+        Vec3f centre(0.f, 0.f, 0.f);
+        for (std::uint32_t id : grid.cell(i)) centre = centre + grid.points[id] * 0.125f;
+        c.values.push_back(std::sin(3.f * centre.x) + centre.y * centre.z);
+    }
+    grid.fields.push_back(c);
+    const ScalarField f = selectScalarField(grid, parseFieldSpec("f"));
+    const ScalarField cells = selectScalarField(grid, parseFieldSpec("c"));
+    const RenderSettings s = frameOf(grid.bounds(), RenderMethod::Partitions, -40.f, 25.f);
+    const Image one = Renderer(grid, cells, options).render(s).image;
+    const ImageComparison cmp =
+        compareImages(toRgb8(one), toRgb8(frameAfterNewValues(grid, f, cells, 2, false, s).image));
+    EXPECT_GE(cmp.ssim, kMinSsim);
+    EXPECT_LE(cmp.maxAbsDifference, kMaxLevels) << differenceSummary(cmp);
+    // The wrong count fails on every rank, naming it.
+    ScalarField bad = energy;
+    bad.values.pop_back();
+    const Error e = catchError([&] { frameAfterNewValues(fin, density, bad, 2, false, s); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(), HasSubstr("expected " + std::to_string(fin.pointCount())));
+}
+
 TEST(DataParallel, TooManyRanksForThePartitionsAreRefusedOnEveryRank) {
     const Mesh mesh = testing::makeHexGrid(
         3, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);

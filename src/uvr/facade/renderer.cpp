@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
@@ -94,7 +95,13 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
     if (options.communicator && options.communicator->size() > 1) {
         // Data-parallel from a whole mesh every rank holds: each starts from its share.
         const Communicator& comm = *options.communicator;
-        prepareShare(shareOfMesh(mesh, field, comm.rank(), comm.size()), options, progress);
+        MeshShare share = shareOfMesh(mesh, field, comm.rank(), comm.size());
+        wholePointIds_ = share.pointIds;
+        wholeCellIds_ = share.cellIds;
+        fromWhole_ = true;
+        wholePointCount_ = mesh.pointCount();
+        wholeCellCount_ = mesh.cellCount();
+        prepareShare(std::move(share), options, progress);
     } else {
         prepared_ = std::make_unique<PreparedMesh>(
             prepareMesh(mesh, field, options.prepareOptions(), progress));
@@ -118,6 +125,7 @@ void Renderer::prepareShare(MeshShare share, const RendererOptions& options,
     PrepareOptions prepare = options.prepareOptions();
     RankPiece piece = distributeMesh(*comm_, std::move(share), prepare, kGhostSteps, progress);
     decomposition_ = std::make_shared<Decomposition>(std::move(piece.decomposition));
+    routes_ = std::make_unique<ValueRoutes>(std::move(piece.routes));
     prepare.piece = piece.piece;
     prepared_ = std::make_unique<PreparedMesh>(
         agreeOn(*comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));
@@ -225,12 +233,48 @@ RenderResult Renderer::renderLocal(const RenderSettings& settings) {
 }
 
 void Renderer::setFieldValues(const ScalarField& field) {
-    if (comm_)
-        throwError(ErrorKind::Unsupported, "",
-                   "new field values (time steps) are not given to a data-parallel renderer yet: "
-                   "prepare each step anew");
-    updateFieldValues(*prepared_, field);
-    if (gpu_) gpu_->updateValues();
+    if (!comm_) {
+        updateFieldValues(*prepared_, field);
+        if (gpu_) gpu_->updateValues();
+        return;
+    }
+    // Data-parallel: this rank's share of the values (from the whole mesh's when it was made
+    // from one), moved to the pieces that hold those points or cells.
+    const bool cells = field.association == Association::Cell;
+    const std::vector<std::uint64_t>& ids = cells ? wholeCellIds_ : wholePointIds_;
+    ScalarField share;
+    agreeOn(*comm_, [&] {
+        if (!fromWhole_) return;  // made from a share: the share's values
+        const std::uint64_t whole = cells ? wholeCellCount_ : wholePointCount_;
+        if (field.values.size() != whole)
+            throwError(ErrorKind::Argument, "",
+                       "new values of field '" + field.name +
+                           "': " + std::to_string(field.values.size()) + " " +
+                           associationName(field.association) + " values, expected " +
+                           std::to_string(whole) + " (one per " + (cells ? "cell" : "point") +
+                           " of the mesh)");
+        share.name = field.name;
+        share.association = field.association;
+        share.choice = field.choice;
+        share.values.reserve(ids.size());
+        for (std::uint64_t i : ids) share.values.push_back(field.values[i]);
+    });
+    ScalarField piece = routeValues(*comm_, *routes_, fromWhole_ ? share : field);
+    share = ScalarField();
+    // The whole field's finite range, as distributeMesh reduced it.
+    double range[2] = {INFINITY, INFINITY};
+    for (float v : piece.values)
+        if (std::isfinite(v))
+            range[0] = std::min(range[0], double(v)), range[1] = std::min(range[1], -double(v));
+    comm_->allReduce(range, ReduceOp::Min);
+    auto whole = std::make_shared<MeshPiece>(*prepared_->piece);
+    whole->valueMin = std::isfinite(range[0]) ? static_cast<float>(range[0]) : 0.f;
+    whole->valueMax = std::isfinite(range[1]) ? static_cast<float>(-range[1]) : 0.f;
+    agreeOn(*comm_, [&] {
+        updateFieldValues(*prepared_, piece);
+        prepared_->piece = std::move(whole);
+        if (gpu_) gpu_->updateValues();
+    });
 }
 
 std::optional<GpuResidency> Renderer::gpuResidency() const {

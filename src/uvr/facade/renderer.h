@@ -19,6 +19,7 @@ class CudaScene;
 class Communicator;
 struct Decomposition;
 struct MeshShare;
+struct ValueRoutes;
 
 /// Where frames render, or where acceleration structures build.
 enum class Device {
@@ -106,6 +107,10 @@ public:
     /// re-uploads only the value-dependent arrays (CudaScene::updateValues). Frames then equal
     /// those of a renderer prepared with these values. Throws Error(Argument) when the field
     /// does not hold one value per point (or cell) of the mesh; the renderer is unchanged then.
+    /// Data-parallel (collective): `field` holds the whole mesh's values on a renderer made from
+    /// a whole mesh, else this rank's share's (one per point or cell of the MeshShare it was
+    /// made from); the values reach the ranks' pieces over the routes the distribution noted
+    /// (routeValues) and the whole field's range is reduced over the ranks.
     void setFieldValues(const ScalarField& field);
 
     /// The prepared mesh.
@@ -142,6 +147,12 @@ private:
     double prepareSeconds_ = 0.0;
     Communicator* comm_ = nullptr;
     std::shared_ptr<const Decomposition> decomposition_;
+    std::unique_ptr<ValueRoutes> routes_;  ///< data-parallel: how new values reach the piece
+    /// Data-parallel from a whole mesh: the whole mesh's point and cell indices of this rank's
+    /// share (setFieldValues takes the whole mesh's values there).
+    std::vector<std::uint64_t> wholePointIds_, wholeCellIds_;
+    bool fromWhole_ = false;                                  ///< made from a whole mesh
+    std::uint64_t wholePointCount_ = 0, wholeCellCount_ = 0;  ///< that mesh's
     std::vector<double> rankPrepareSeconds_;
 };
 
