@@ -150,8 +150,10 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             throwError(ErrorKind::Argument, *folder, "-o: exists and is not a folder");
         const std::unique_ptr<MeshSeries> series = openSeries(*file, ctx);
         const std::vector<std::size_t> chosen = parseSteps(*steps, series->stepCount());
-        fs::create_directories(*folder, ec);
-        if (ec) throwError(ErrorKind::Io, *folder, "cannot create the folder: " + ec.message());
+        ctx.rootWrites([&] {  // rank 0 writes the frames (data-parallel)
+            fs::create_directories(*folder, ec);
+            if (ec) throwError(ErrorKind::Io, *folder, "cannot create the folder: " + ec.message());
+        });
         const FieldSpec spec = parseFieldSpec(flags->field);
 
         // Step 1: the first step read, validated and prepared.
@@ -161,8 +163,10 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             ctx.step("GPU: " + cudaDeviceDescription());
         // A new geometry of a later step is prepared in player.show (phases ended after it).
         PhaseProgress phases(ctx);
-        SeriesPlayer player(std::unique_ptr<MeshSeries>(openSeries(*file, ctx)), spec,
-                            flags->rendererOptions(), chosen[0], phases.callbacks());
+        RendererOptions options = flags->rendererOptions();
+        options.communicator = ctx.comm;  // data-parallel under mpirun: each rank its piece
+        SeriesPlayer player(std::unique_ptr<MeshSeries>(openSeries(*file, ctx)), spec, options,
+                            chosen[0], phases.callbacks());
         phases.finish();
         for (const std::string& note : player.mesh().notes) ctx.step("note: " + note);
         ValidationReport report;
@@ -177,6 +181,9 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                        "no cell has volume (or the mesh has no volumetric cells): nothing to "
                        "render");
         ctx.done("read and prepared step " + std::to_string(chosen[0]) + " (" +
+                     (ctx.dataParallel()
+                          ? std::to_string(ctx.comm->size()) + " ranks' pieces; rank 0's: "
+                          : std::string()) +
                      std::to_string(player.renderer().prepared().tets.tetCount()) +
                      " tetrahedra) of " + std::to_string(series->stepCount()),
                  start);
@@ -229,7 +236,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         // The movie: written frame by frame beside the PNGs, committed after the last.
         std::optional<OutputFile> movieFile;
         std::optional<ApngWriter> movieWriter;
-        if (!movie->empty()) {
+        if (!movie->empty() && ctx.root()) {
             movieFile.emplace(*movie);
             movieWriter.emplace(*movieFile, static_cast<int>(chosen.size()), *fps);
         }
@@ -252,31 +259,31 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             ctx.setActivity(*folder, "rendering time step " + std::to_string(i));
             const RenderResult result = player.renderer().render(settings);
             frames.push_back(result.stats.seconds);
-            Image image = result.image;
-            if (legendFont) {
-                LegendStyle style;
-                style.background = background;
-                drawLegend(image, *legendFont, settings.tf, result.setup.rangeLo,
-                           result.setup.rangeHi,
-                           legendTitle(player.field().name, player.field().association),
-                           settings.tf.logScale, style);
-            }
-            if (labelFont) {
-                LegendStyle style;
-                style.background = background;
-                drawCornerText(image, *labelFont,
-                               "Time: " + formatExact(player.series().times()[i]), style);
-            }
             char name[64];
             std::snprintf(name, sizeof name, "%0*zu.png", digits, i);
             const std::string path = (fs::path(*folder) / (*prefix + name)).string();
-            {
+            ctx.rootWrites([&] {
+                Image image = result.image;
+                if (legendFont) {
+                    LegendStyle style;
+                    style.background = background;
+                    drawLegend(image, *legendFont, settings.tf, result.setup.rangeLo,
+                               result.setup.rangeHi,
+                               legendTitle(player.field().name, player.field().association),
+                               settings.tf.logScale, style);
+                }
+                if (labelFont) {
+                    LegendStyle style;
+                    style.background = background;
+                    drawCornerText(image, *labelFont,
+                                   "Time: " + formatExact(player.series().times()[i]), style);
+                }
                 OutputFile out(path);
                 writePng(out, image, background);
                 out.finish();
                 out.commit();
-            }
-            if (movieWriter) movieWriter->add(image, background);
+                if (movieWriter) movieWriter->add(image, background);
+            });
             for (const std::string& note : result.setup.notes)
                 if (warned.insert(note).second) ctx.warn(*file + ": " + note);
             const std::string empty =
@@ -311,7 +318,8 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                       chosen.size(), folder->c_str(), median(reads), median(updates),
                       median(frames));
         progress.done(summary);
-        if (movieWriter) {
+        ctx.rootWrites([&] {
+            if (!movieWriter) return;
             movieWriter->finish();
             movieFile->finish();
             movieFile->commit();
@@ -319,7 +327,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             std::snprintf(line, sizeof line, "wrote %s (%zu frames at %g per second)",
                           movie->c_str(), chosen.size(), *fps);
             ctx.step(line);
-        }
+        });
     });
 }
 

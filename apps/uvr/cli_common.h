@@ -46,6 +46,15 @@ public:
     bool root() const { return !comm || comm->rank() == 0; }
     /// True in a data-parallel run of more than one rank.
     bool dataParallel() const { return comm && comm->size() > 1; }
+    /// Runs `write` where outputs are written (root()); in a data-parallel run every rank then
+    /// agrees on its failure (collective), so all stop with the root's error.
+    template <class F>
+    void rootWrites(F&& write) const {
+        if (!comm) return write();
+        agreeOn(*comm, [&] {
+            if (root()) write();
+        });
+    }
 
 private:
     mutable std::string activityFile_, activity_;

@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 """Data-parallel rendering under mpirun (issue 31): `mpirun -n N uvr render` on real meshes with
 the CPU renderer, every method, against the one-process image of the same command: SSIM >= 0.999
-and no channel more than 2/255 apart (`uvr compare --min-ssim --max-diff`). Also what a user
+and no channel more than 2/255 apart (`uvr compare --min-ssim --max-diff`); likewise a .uvrm and
+a .pvtu read in parts, `uvr bench` and `uvr animate` (a series' values routed to the pieces). Also what a user
 gets wrong: a bad flag, a missing file and a flag that is not data-parallel each end every rank
 with exit status 2 and one error line, and no output file.
 
@@ -155,6 +156,29 @@ with open({pvtu!r}, "w") as f:
                                                for row in report["rows"])
     check(ok, f"mpirun -n 2 uvr bench: rows with both ranks ({r.stderr[-300:]})")
 
+    # uvr animate under mpirun: a series of one geometry, each step's values routed to the
+    # ranks' pieces (nothing re-prepared), rank 0 writing the frames and the movie.
+    series = os.path.join(args.out, "run.vtkhdf")
+    r = run([args.uvr, "generate", "--cells", "60000", "--steps", "3", "-o", series, "-q"])
+    check(r.returncode == 0, f"generate a series ({r.stderr.strip()})")
+    frames = {}
+    for n in [1, 2]:
+        folder = os.path.join(args.out, f"anim_{n}")
+        shutil.rmtree(folder, ignore_errors=True)
+        movie = os.path.join(args.out, f"anim_{n}.png")
+        r = run((mpirun(n) if n > 1 else []) +
+                [args.uvr, "animate", series, "-o", folder, "--device", "cpu", "--size", SIZE,
+                 "--movie", movie, "--tf", "viridis", "--azimuth", "25"])
+        frames[n] = sorted(os.listdir(folder)) if os.path.isdir(folder) else []
+        check(r.returncode == 0 and len(frames[n]) == 3 and os.path.exists(movie)
+              and (n == 1 or r.stderr.count("values refreshed") == 2),
+              f"animate on {n} rank(s): 3 frames, a movie, steps refreshed ({r.stderr[-300:]})")
+    for name in frames[2]:
+        c = run([args.uvr, "compare", os.path.join(args.out, "anim_1", name),
+                 os.path.join(args.out, "anim_2", name), "--min-ssim", "0.999", "--max-diff", "2"])
+        check(c.returncode == 0,
+              f"animate {name}: 2 ranks = one process ({c.stdout.strip()[-120:]})")
+
     # Bad input: every rank ends, exit status 2, one error line, nothing written.
     blunt = os.path.join(args.data, "bluntfin_tets.vtk")
     out = os.path.join(args.out, "bad.png")
@@ -162,6 +186,7 @@ with open({pvtu!r}, "w") as f:
         ("a bad flag value", ["render", blunt, "--quality", "7", "-o", out], "--quality"),
         ("a missing file", ["render", os.path.join(args.out, "none.vtk"), "-o", out], "none.vtk"),
         ("a command that is not data-parallel", ["info", blunt], "data-parallel"),
+        ("animate into a file", ["animate", blunt, "-o", blunt], "not a folder"),
         ("a prepared cache", ["render", blunt, "--cache", os.path.join(args.out, "x.uvrprep"),
                               "-o", out], "--cache"),
     ]

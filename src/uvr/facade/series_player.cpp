@@ -7,6 +7,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/cpu/background_task.h"
+#include "uvr/dist/communicator.h"
 
 namespace uvr {
 
@@ -36,8 +37,11 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
                            const ProgressFn& progress)
     : series_(std::move(series)), spec_(std::move(spec)), options_(options), progress_(progress) {
     UVR_CHECK(series_ != nullptr, "a player needs a series");
-    mesh_ = series_->readStep(first);
-    field_ = selectScalarField(mesh_, spec_);  // the choice as the first step explains it
+    // Data-parallel, every rank reads the steps: a rank that fails ends every rank.
+    agreed([&] {
+        mesh_ = series_->readStep(first);
+        field_ = selectScalarField(mesh_, spec_);  // the choice as the first step explains it
+    });
     const std::string choice = field_.choice;
     spec_ = pinField(mesh_, spec_);  // every step the field this one chose
     field_.choice = choice;
@@ -46,6 +50,14 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
 }
 
 SeriesPlayer::~SeriesPlayer() = default;
+
+template <class F>
+void SeriesPlayer::agreed(F&& work) {
+    if (options_.communicator)
+        agreeOn(*options_.communicator, std::forward<F>(work));
+    else
+        work();
+}
 
 SeriesPlayer::Read SeriesPlayer::readStep(std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
@@ -74,14 +86,25 @@ StepUpdate SeriesPlayer::show(std::size_t i, std::optional<std::size_t> next) {
     const auto waitStart = std::chrono::steady_clock::now();
     std::unique_ptr<Pending> pending = std::move(pending_);
     Read r;
-    if (pending && pending->step == i) {
-        r = pending->task.take();
-        u.prefetched = true;
-        u.readSeconds = secondsSince(waitStart);
-    } else {
-        pending.reset();  // a read of another step is waited for and dropped
-        r = readStep(i);
-        u.readSeconds = r.seconds;
+    agreed([&] {
+        if (pending && pending->step == i) {
+            r = pending->task.take();
+            u.prefetched = true;
+            u.readSeconds = secondsSince(waitStart);
+        } else {
+            pending.reset();  // a read of another step is waited for and dropped
+            r = readStep(i);
+            u.readSeconds = r.seconds;
+        }
+    });
+    if (Communicator* comm = options_.communicator) {
+        // Every rank takes the same path below (each read the same files).
+        std::uint64_t same[2] = {r.fields ? 1u : 0u, r.fields ? 0u : 1u};
+        comm->allReduce(same, ReduceOp::Max);
+        if (same[0] && same[1])
+            throwError(ErrorKind::Io, series_->stepSource(i),
+                       "the ranks read time step " + std::to_string(i) +
+                           " differently (the same geometry on some, another on others)");
     }
     // Step 2: new values for the same geometry, or the new geometry prepared.
     const auto updateStart = std::chrono::steady_clock::now();
@@ -90,7 +113,8 @@ StepUpdate SeriesPlayer::show(std::size_t i, std::optional<std::size_t> next) {
         if (next) prefetch(*next);
         std::vector<Field> previous = std::exchange(mesh_.fields, std::move(*r.fields));
         try {
-            ScalarField field = selectScalarField(mesh_, spec_);
+            ScalarField field;
+            agreed([&] { field = selectScalarField(mesh_, spec_); });
             renderer_->setFieldValues(field);
             field_ = std::move(field);
         } catch (...) {
@@ -98,7 +122,8 @@ StepUpdate SeriesPlayer::show(std::size_t i, std::optional<std::size_t> next) {
             throw;
         }
     } else {
-        ScalarField field = selectScalarField(*r.mesh, spec_);
+        ScalarField field;
+        agreed([&] { field = selectScalarField(*r.mesh, spec_); });
         auto renderer = std::make_unique<Renderer>(*r.mesh, field, options_, progress_);
         mesh_ = std::move(*r.mesh);
         field_ = std::move(field);

@@ -25,7 +25,9 @@ struct StepUpdate {
 /// step whose points and cells are the same gives the renderer only its new values
 /// (Renderer::setFieldValues, nothing geometric rebuilt), one whose geometry differs is
 /// prepared anew. prefetch(i) reads step i on a thread of its own while the caller renders.
-/// One caller at a time.
+/// One caller at a time. Data-parallel (RendererOptions::communicator): every rank plays the
+/// series with the same calls; each reads every step and gives its piece the new values
+/// (Renderer::setFieldValues routes them), and a rank's failure ends every rank.
 class SeriesPlayer {
 public:
     /// Reads step `first` of the series and prepares the field `spec` names for rendering;
@@ -63,6 +65,9 @@ public:
 private:
     struct Read;
     Read readStep(std::size_t i);
+    /// Runs work(); data-parallel (RendererOptions::communicator), agrees on its failures.
+    template <class F>
+    void agreed(F&& work);
 
     std::unique_ptr<MeshSeries> series_;
     FieldSpec spec_;
