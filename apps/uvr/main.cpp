@@ -33,16 +33,16 @@ int main(int argc, char** argv) {
                        "buffers), and the estimated image buffers of --size and meshes of "
                        "--cells; larger needs are refused before allocating");
     app.parse_complete_callback([&] {
-        // mpirun: one rank per process, data-parallel; `render`, `animate` and `bench` divide
-        // their work.
+        // mpirun: one rank per process, data-parallel; `render`, `view`, `animate` and `bench`
+        // divide their work.
         if (ctx.dataParallel())
             for (const CLI::App* sub : app.get_subcommands())
                 if (sub->get_name() != "render" && sub->get_name() != "bench" &&
-                    sub->get_name() != "animate")
+                    sub->get_name() != "animate" && sub->get_name() != "view")
                     throwError(ErrorKind::Unsupported, "",
                                "uvr " + sub->get_name() +
-                                   " does not run data-parallel yet: run it without mpirun "
-                                   "(`mpirun -n N uvr render`, `uvr animate` and `uvr bench` "
+                                   " does not run data-parallel: run it without mpirun "
+                                   "(`mpirun -n N uvr render`, `view`, `animate` and `bench` "
                                    "do)");
         cli::capEnvironmentThreads();
         ctx.maxMemoryBytes =

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `uvr view`: reads and prepares a mesh once and serves it to browsers (src/uvr/server).
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <memory>
 
@@ -89,7 +90,9 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         so.host = options->first;
         so.port = static_cast<std::uint16_t>(options->second);
         so.token = *token;
-        server::checkServerOptions(so, /*tryAddress=*/true);  // before minutes of reading
+        // Before minutes of reading; rank 0 serves (data-parallel: the other ranks follow it).
+        server::checkServerOptions(so, /*tryAddress=*/false);
+        ctx.rootWrites([&] { server::checkServerOptions(so, /*tryAddress=*/true); });
         // Step 1: read and validate, as `uvr render` does.
         const auto start = std::chrono::steady_clock::now();
         auto mesh = std::make_shared<Mesh>(loadMesh(*file, ctx, *steps));
@@ -152,6 +155,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         // background once it listens, showing the steps in the log and the page.
         scene.rendererOptions = flags->rendererOptions(true);
         scene.rendererOptions.partitions = scene.rendererOptions.meshBvh = true;
+        scene.rendererOptions.communicator = ctx.comm;  // under mpirun: each rank its piece
         if (resolvesToCuda(scene.rendererOptions.device))
             ctx.step("GPU: " + cudaDeviceDescription());
         scene.base = settings;
@@ -161,6 +165,13 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         server::ViewServer server(std::move(scene), so, [&ctx](const std::string& line) {
             ctx.step(line.rfind("view: ", 0) == 0 ? line.substr(6) : line);
         });
+        if (!ctx.root()) {
+            // Data-parallel: this rank renders its piece of every frame rank 0's server asks
+            // for, until it stops (mpirun's Ctrl-C reaches rank 0, which stops the others).
+            std::signal(SIGINT, SIG_IGN);
+            server.follow();
+            return;
+        }
         server.start();
         std::printf("uvr: serving %s (Ctrl-C stops)\n", server.url().c_str());
         std::fflush(stdout);

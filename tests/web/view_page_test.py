@@ -30,8 +30,13 @@
 Screenshots of the whole window go to --screenshots DIR when given. --docs-screenshot PATH instead
 only renders a good-looking view (Blunt Fin) for docs/images/viewer.png.
 
+With --launcher 'mpirun -n 2 ...' the servers run data-parallel (issue 31) and the checks that
+render run: frames, camera, opacity, clip, shading, isosurfaces, the saved PNG against the
+exported one-process command, and the series.
+
 Usage: view_page_test.py --uvr PATH/TO/uvr --data SHARED_DATA_DIR [--mesh bluntfin_tets.vtk]
                          [--screenshots DIR] [--keep DIR] [--docs-screenshot PATH]
+                         [--launcher 'mpirun -n 2 ...']
 
 Exit status: 0 every check passed, 1 one failed, 77 skipped (no Selenium for this Python, no
 chromium or chromedriver, the mesh missing, or a uvr without `view`).
@@ -83,10 +88,12 @@ T0 = time.monotonic()
 class Server:
     """`uvr view` in a child process; its first stdout line names the URL."""
 
+    launcher = []  # e.g. mpirun's words: the server runs data-parallel (--launcher)
+
     def __init__(self, uvr, mesh, extra, log_path):
         self.log = open(log_path, "w")
         self.proc = subprocess.Popen(
-            [uvr, "view", mesh, "--port", "0"] + extra,
+            Server.launcher + [uvr, "view", mesh, "--port", "0"] + extra,
             stdout=subprocess.PIPE, stderr=self.log, text=True)
         lines = queue.Queue()
 
@@ -120,7 +127,7 @@ class Server:
         if self.proc.poll() is None:
             self.proc.terminate()
             try:
-                self.proc.wait(10)
+                self.proc.wait(30)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
@@ -1012,7 +1019,15 @@ def main():
     parser.add_argument("--screenshots", help="save screenshots of the page here")
     parser.add_argument("--keep", help="keep downloads, images and the server's log here")
     parser.add_argument("--docs-screenshot", help="only write the docs screenshot to this path")
+    parser.add_argument("--launcher", default="",
+                        help="start the servers with this before uvr (e.g. 'mpirun -n 2'): the "
+                             "checks that render (frames, camera, opacity, clip, shading, "
+                             "isosurfaces, the saved PNG against the exported command, a series) "
+                             "on a data-parallel server")
     args = parser.parse_args()
+    Server.launcher = shlex.split(args.launcher)
+    if Server.launcher and not shutil.which(Server.launcher[0]):
+        skip(f"no {Server.launcher[0]} for --launcher")
 
     try:
         import selenium  # noqa: F401
@@ -1052,6 +1067,15 @@ def main():
         page.server = server
         if args.docs_screenshot:
             docs_screenshot(page, args.docs_screenshot)
+        elif Server.launcher:  # data-parallel: what the ranks render (the protocol is rank 0's)
+            first_frame(page)
+            rotate(page)
+            drag_opacity_point(page)
+            clip(page)
+            shade(page)
+            isosurfaces(page)
+            save_and_reproduce(page, args.uvr, downloads, tmp)
+            time_series(args.uvr, driver, args.screenshots, work, tmp)
         else:
             check_http(server)
             first_frame(page)

@@ -53,6 +53,9 @@ public:
     virtual void send(int to, std::span<const std::byte> bytes) = 0;
     /// Receives the next message rank `from` sent to this rank with send().
     virtual std::vector<std::byte> receive(int from) = 0;
+    /// Receives as receive() does, for a rank that may wait long for it (a viewer's rank
+    /// between frames): MPI looks for the message every millisecond instead of spinning a core.
+    virtual std::vector<std::byte> receiveIdle(int from) { return receive(from); }
     /// Reduces values element-wise over the ranks, in place, the result on every rank (every
     /// rank gives the same number of values).
     virtual void allReduce(std::span<double> values, ReduceOp op) = 0;

@@ -5,10 +5,12 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cstdlib>
 #include <deque>
 #include <string>
+#include <thread>
 
 #include "uvr/core/error.h"
 #include "uvr/dist/mpi_communicator.h"
@@ -214,6 +216,18 @@ public:
                   "MPI_Recv");
         }
         return bytes;
+    }
+
+    std::vector<std::byte> receiveIdle(int from) override {
+        detail::checkRankArgument(*this, from, "receive", "source");
+        // Open MPI's blocking receive polls without pause: a viewer's ranks wait for the
+        // next frame for minutes.
+        for (int arrived = 0; from != rank_;) {
+            check(MPI_Iprobe(from, kTagSend, comm_, &arrived, MPI_STATUS_IGNORE), "MPI_Iprobe");
+            if (arrived) break;
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        return receive(from);
     }
 
     void allReduce(std::span<double> values, ReduceOp op) override {

@@ -22,7 +22,9 @@
 #include <thread>
 #include <vector>
 
+#include "uvr/dist/communicator.h"
 #include "uvr/server/frame_scheduler.h"
+#include "uvr/server/view_frame.h"
 #include "uvr/server/view_server.h"
 
 namespace uvr::server {
@@ -124,6 +126,19 @@ struct ViewServer::Impl {
     void prepareAtStart();
     void requestStop();
     Json exportMessage(const ViewState& s) const;
+
+    /// Data-parallel: the ranks when there are several (scene.rendererOptions.communicator),
+    /// else null.
+    Communicator* ranks() const;
+    /// Data-parallel, on rank 0: sends every other rank the renderer call it is about to make
+    /// (follow() makes the same call there); nothing otherwise.
+    void lead(const Json& call);
+    /// Data-parallel, on rank 0: tells the other ranks to stop following (once).
+    void releaseFollowers();
+    bool followersReleased = false;
+    /// The frame of `state` as renderViewFrame renders it, on every rank (render thread).
+    ViewFrame frame(const ViewState& state, FrameKind kind, int scale, std::uint64_t seq,
+                    const FrameEncoding& encoding);
 };
 
 }  // namespace uvr::server

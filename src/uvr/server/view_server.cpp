@@ -128,46 +128,86 @@ Json histogramOf(const std::vector<float>& values, std::pair<float, float> range
 
 }  // namespace
 
+Communicator* ViewServer::Impl::ranks() const {
+    Communicator* comm = scene.rendererOptions.communicator;
+    return comm && comm->size() > 1 ? comm : nullptr;
+}
+
+void ViewServer::Impl::lead(const Json& call) {
+    Communicator* comm = ranks();
+    if (!comm || comm->rank() != 0) return;
+    const std::string text = call.dump();
+    for (int r = 1; r < comm->size(); ++r)
+        comm->send(r, std::as_bytes(std::span<const char>(text.data(), text.size())));
+}
+
+void ViewServer::Impl::releaseFollowers() {
+    if (followersReleased) return;
+    followersReleased = true;
+    lead({{"call", "stop"}});
+}
+
+ViewFrame ViewServer::Impl::frame(const ViewState& state, FrameKind kind, int scale,
+                                  std::uint64_t seq, const FrameEncoding& encoding) {
+    lead({{"call", "frame"},
+          {"state", toJson(state)},
+          {"kind", static_cast<int>(kind)},
+          {"scale", scale}});
+    return renderViewFrame(*renderer, state, scene.base, kind, scale, seq, encoding);
+}
+
 FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
                                    const ProgressFn& progress) {
+    lead({{"call", "field"}, {"spec", spec}, {"step", step}});
     const std::string key = fieldKey(spec, step);
     if (renderer && key == rendererKey) {
         std::lock_guard lk(fieldsMutex);
         return fields.at(key);
     }
-    if (step != meshStep) {
-        // Another time step: its fields for the same points and cells, nothing geometric.
-        const auto start = Clock::now();
-        std::optional<std::vector<Field>> stepFields =
-            scene.series->readFieldsIfSameGeometry(step, *scene.mesh);
-        if (!stepFields)
-            throwError(ErrorKind::Unsupported, scene.series->stepSource(step),
-                       "time step " + std::to_string(step) +
-                           " has other points or cells than "
-                           "step " +
-                           std::to_string(meshStep) +
-                           ": the viewer shows the time steps of one geometry (uvr animate renders "
-                           "any)");
-        // The two lists compared as listed (names, associations, components): whether a field
-        // holds one value is the step's values, not its list.
-        std::vector<FieldInfo> infos, listed = fieldInfos;
-        for (const Field& f : *stepFields) infos.push_back({f.name, f.association, f.components});
-        for (FieldInfo& f : listed) f.constant = false;
-        if (resolveField(infos, parseFieldSpec(spec)).index !=
-            resolveField(listed, parseFieldSpec(spec)).index)
-            throwError(ErrorKind::Unsupported, scene.series->stepSource(step),
-                       "time step " + std::to_string(step) +
-                           " lists its fields otherwise than "
-                           "step " +
-                           std::to_string(meshStep) + ": the viewer needs the same fields");
-        scene.mesh->fields = std::move(*stepFields);
-        meshStep = step;
-        char line[160];
-        std::snprintf(line, sizeof line, "view: read time step %zu (time %.9g) in %.3f s", step,
-                      scene.series->times()[step], secondsSince(start));
-        say(line);
-    }
-    const ScalarField values = selectScalarField(*scene.mesh, parseFieldSpec(spec));
+    // Data-parallel, every rank reads the step: a rank that fails ends every rank's call.
+    const auto agreed = [this](auto&& work) {
+        if (Communicator* comm = ranks())
+            agreeOn(*comm, work);
+        else
+            work();
+    };
+    if (step != meshStep)
+        agreed([&] {
+            // Another time step: its fields for the same points and cells, nothing geometric.
+            const auto start = Clock::now();
+            std::optional<std::vector<Field>> stepFields =
+                scene.series->readFieldsIfSameGeometry(step, *scene.mesh);
+            if (!stepFields)
+                throwError(
+                    ErrorKind::Unsupported, scene.series->stepSource(step),
+                    "time step " + std::to_string(step) +
+                        " has other points or cells than "
+                        "step " +
+                        std::to_string(meshStep) +
+                        ": the viewer shows the time steps of one geometry (uvr animate renders "
+                        "any)");
+            // The two lists compared as listed (names, associations, components): whether a field
+            // holds one value is the step's values, not its list.
+            std::vector<FieldInfo> infos, listed = fieldInfos;
+            for (const Field& f : *stepFields)
+                infos.push_back({f.name, f.association, f.components});
+            for (FieldInfo& f : listed) f.constant = false;
+            if (resolveField(infos, parseFieldSpec(spec)).index !=
+                resolveField(listed, parseFieldSpec(spec)).index)
+                throwError(ErrorKind::Unsupported, scene.series->stepSource(step),
+                           "time step " + std::to_string(step) +
+                               " lists its fields otherwise than "
+                               "step " +
+                               std::to_string(meshStep) + ": the viewer needs the same fields");
+            scene.mesh->fields = std::move(*stepFields);
+            meshStep = step;
+            char line[160];
+            std::snprintf(line, sizeof line, "view: read time step %zu (time %.9g) in %.3f s", step,
+                          scene.series->times()[step], secondsSince(start));
+            say(line);
+        });
+    ScalarField values;
+    agreed([&] { values = selectScalarField(*scene.mesh, parseFieldSpec(spec)); });
     FieldEntry entry;
     entry.range = finiteRange(values.values);
     entry.histogram = histogramOf(values.values, entry.range);
@@ -379,8 +419,7 @@ void ViewServer::Impl::renderLoop() {
                     c.sendText(st, "state");
                 });
             }
-            ViewFrame frame =
-                renderViewFrame(*renderer, state, scene.base, kind, scale, seq, encoding);
+            ViewFrame frame = this->frame(state, kind, scale, seq, encoding);
             {
                 std::lock_guard slk(m);
                 s->demand.measured(frame.msPerPixel);
@@ -629,6 +668,10 @@ ViewServer::~ViewServer() {
     stop();
     Impl& d = *impl_;
     if (d.renderThread.joinable()) d.renderThread.join();
+    try {
+        d.releaseFollowers();
+    } catch (...) {  // a destructor does not throw: the ranks were lost already
+    }
     d.ioc.stop();
     if (d.ioThread.joinable()) d.ioThread.join();
 }
@@ -689,6 +732,7 @@ void ViewServer::run(bool handleSignals) {
         d.cv.wait(lk, [&d] { return d.stopping; });
     }
     if (d.renderThread.joinable()) d.renderThread.join();
+    d.releaseFollowers();  // data-parallel: the other ranks stop following
     // Close the listening socket and every connection, then let the network thread finish.
     net::post(d.ioc, [&d] {
         beast::error_code ignored;
@@ -707,6 +751,34 @@ void ViewServer::run(bool handleSignals) {
 
 void ViewServer::stop() {
     impl_->requestStop();
+}
+
+void ViewServer::follow() {
+    Impl& d = *impl_;
+    Communicator* comm = d.ranks();
+    UVR_CHECK(comm && comm->rank() != 0, "follow() is for the ranks after rank 0");
+    for (;;) {
+        const std::vector<std::byte> bytes = comm->receiveIdle(0);
+        const Json call =
+            Json::parse(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+        const std::string what = call.at("call").get<std::string>();
+        if (what == "stop") return;
+        // Every failure of a call is rank 0's too (the same data, and agreed where the ranks
+        // could differ): rank 0 says it to the page, this rank waits for the next call.
+        try {
+            if (what == "field") {
+                d.field(call.at("spec").get<std::string>(), call.at("step").get<std::size_t>(), {});
+            } else if (what == "frame" && d.renderer) {
+                ViewState state = d.scene.initial;
+                applySet(state, call.at("state"), d.stepCount());
+                const auto kind = static_cast<FrameKind>(call.at("kind").get<int>());
+                const int scale = kind == FrameKind::Snapshot ? 1 : call.at("scale").get<int>();
+                d.renderer->render(frameSettings(state, d.scene.base, scale));
+            }
+        } catch (const std::exception& e) {
+            d.say(std::string("view: this rank's part of a call failed: ") + e.what());
+        }
+    }
 }
 
 }  // namespace uvr::server

@@ -104,6 +104,11 @@ public:
     void run(bool handleSignals = true);
     /// Asks a running server to stop (any thread).
     void stop();
+    /// Data-parallel (scene.rendererOptions.communicator of several ranks), on every rank but
+    /// 0: mirrors the renderer calls of rank 0's server (each field it prepares or switches to,
+    /// each frame it renders, the ranks' pieces composited onto rank 0) until rank 0's server
+    /// stops. Every rank makes its ViewServer from the same scene; only rank 0 serves.
+    void follow();
 
     /// The server's inside (server_internal.h); opaque.
     struct Impl;

@@ -106,6 +106,53 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     EXPECT_EQ(toJson(s)["clip_planes"], Json::array());
 }
 
+TEST(ViewState, FollowingRanksRebuildTheFrameSettingsBitForBit) {
+    // A data-parallel viewer's other ranks get each frame's state as its JSON, applied to the
+    // starting state (ViewServer::follow): their settings must be rank 0's exactly, or the
+    // pieces would be composited from different pictures.
+    ViewState s = startState();
+    s.camera.position = Vec3f(0.1f + 1e-7f, -2.3456789f, 7.000001f);
+    s.camera.viewAngle = 29.999998f;
+    s.range = {0.123456789f, 2.000003f};
+    s.tf.opacities = {{0.f, 0.f}, {0.3333333f, 0.7777777f}, {1.f, 0.1f}};
+    s.tf.colors[1].rgb = Vec3f(0.1f, 0.2f, 0.3f);
+    s.clipPlanes = {{Vec3f(0.31415927f, 0.f, 1e-8f), Vec3f(-0.6f, 0.8f, 1e-3f)}};
+    s.isoSurfaces = {parseIsoSurface("1.2345679,0.3333333,#80ff01"),
+                     parseIsoSurface("0.987654321")};
+    s.settings["opacity_unit"] = 0.4258912801742554;
+    s.settings["quality"] = 0.97;
+    s.step = 0;
+    ViewState follower = startState();
+    applySet(follower, Json::parse(toJson(s).dump()));
+    RenderSettings base;
+    base.step = 0.0123f;
+    const RenderSettings a = frameSettings(s, base, 2), b = frameSettings(follower, base, 2);
+    ASSERT_TRUE(a.camera && b.camera && a.range && b.range);
+    EXPECT_EQ(a.camera->position, b.camera->position);
+    EXPECT_EQ(a.camera->viewAngle, b.camera->viewAngle);
+    EXPECT_EQ(*a.range, *b.range);
+    ASSERT_EQ(a.tf.opacities.size(), b.tf.opacities.size());
+    for (std::size_t i = 0; i < a.tf.opacities.size(); ++i) {
+        EXPECT_EQ(a.tf.opacities[i].x, b.tf.opacities[i].x);
+        EXPECT_EQ(a.tf.opacities[i].alpha, b.tf.opacities[i].alpha);
+    }
+    ASSERT_EQ(a.tf.colors.size(), b.tf.colors.size());
+    for (std::size_t i = 0; i < a.tf.colors.size(); ++i)
+        EXPECT_EQ(a.tf.colors[i].rgb, b.tf.colors[i].rgb);
+    ASSERT_EQ(b.clipPlanes.size(), 1u);
+    EXPECT_EQ(a.clipPlanes[0].origin, b.clipPlanes[0].origin);
+    EXPECT_EQ(a.clipPlanes[0].normal, b.clipPlanes[0].normal);
+    ASSERT_EQ(b.isoSurfaces.size(), 2u);
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_EQ(a.isoSurfaces[i].value, b.isoSurfaces[i].value);
+        EXPECT_EQ(a.isoSurfaces[i].opacity, b.isoSurfaces[i].opacity);
+        EXPECT_EQ(a.isoSurfaces[i].color, b.isoSurfaces[i].color);
+    }
+    EXPECT_EQ(a.opacityUnit, b.opacityUnit);
+    EXPECT_EQ(a.quality, b.quality);
+    EXPECT_EQ(a.width, b.width);
+}
+
 TEST(ViewState, IsosurfacesAreSetInTheirCommandLineFormAndReachTheFrame) {
     ViewState s = startState();
     EXPECT_EQ(toJson(s)["iso"], Json::array());
