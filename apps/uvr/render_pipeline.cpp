@@ -216,6 +216,21 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
             ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(pieces) +
                      " pieces for " + std::to_string(ranks) + " ranks");
         }
+        if (format == MeshFormat::VtkHdf) {
+            // A rank reads its run of the step's partitions when there are as many as ranks.
+            const std::size_t step = steps.pick(*openSeries(file, ctx));
+            const std::size_t partitions = vtkHdfPartitionCount(file, step);
+            if (partitions >= std::size_t(ranks)) {
+                ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
+                         " ranks reads about " + std::to_string(partitions / ranks) + " of its " +
+                         std::to_string(partitions) + " partitions");
+                return readVtkHdfPart(file, cellsOf(partitions, rank),
+                                      cellsOf(partitions, rank + 1), read, step);
+            }
+            ctx.step("reading " + file + " whole on every rank: it has " +
+                     std::to_string(partitions) + " partitions for " + std::to_string(ranks) +
+                     " ranks");
+        }
         if (format == MeshFormat::Native && !steps.time && !steps.index) {
             const std::uint64_t n = readNativeSummary(file, false).cellCount;
             ctx.step("reading " + file + ": each of " + std::to_string(ranks) +

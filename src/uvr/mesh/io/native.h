@@ -36,6 +36,11 @@ struct MeshPart {
     std::vector<std::uint64_t> cellIds;   ///< per cell: its index in the file (increasing)
 };
 
+/// In the ids of a part of a file of pieces (a .pvtu's pieces, a VTKHDF file's partitions), the
+/// piece's index sits above this many bits and the point's or cell's index in the piece below,
+/// so the ids sort in the order the whole file's reader merges the pieces.
+inline constexpr int kPieceIdShift = 40;
+
 /// Reads the cells [firstCell, endCell) of a native mesh and what they use (each array read only
 /// where the part lies in it: the points and point values in runs of the ids the cells name),
 /// checked as readNative checks a whole file. Throws Error(Argument) for a range beyond the file's

@@ -70,6 +70,15 @@ Mesh readVtkHdf(const std::string& path, const ReadOptions&) {
     throwNoHdf5(path);
 }
 
+std::size_t vtkHdfPartitionCount(const std::string& path, std::size_t) {
+    throwNoHdf5(path);
+}
+
+MeshPart readVtkHdfPart(const std::string& path, std::size_t, std::size_t, const ReadOptions&,
+                        std::size_t) {
+    throwNoHdf5(path);
+}
+
 void writeVtkHdf(const Mesh&, const std::string& path, const std::function<void(double)>&) {
     throwNoHdf5(path);
 }
@@ -523,6 +532,46 @@ public:
         return fields;
     }
 
+    /// Partitions of step i.
+    std::size_t partitionCount(std::size_t i) const {
+        checkStep(i);
+        return steps_[i].parts;
+    }
+
+    /// Partitions [first, end) of step i, as readStep merges them, with their ids in the whole
+    /// step's order (kPieceIdShift).
+    MeshPart readPart(std::size_t i, std::size_t first, std::size_t end) {
+        checkStep(i);
+        const FormatLibraryLock lock;
+        quietHdf5();
+        const BudgetedOptions budgeted(options());
+        LoadBudget& budget = budgeted.budget();
+        const std::uint64_t heldBefore = budget.used();
+        const std::vector<Partition> parts = partitions(i, budget);
+        if (first >= end || end > parts.size())
+            throwError(ErrorKind::Argument, path(),
+                       where(i) + ": partitions [" + std::to_string(first) + ", " +
+                           std::to_string(end) + ") asked for, but it has " +
+                           std::to_string(parts.size()));
+        MeshPart out;
+        for (std::size_t p = first; p < end; ++p) {
+            KeptCells kept;
+            Mesh piece = readPartition(i, p, parts[p], budget, kept);
+            const std::uint64_t base = std::uint64_t(p) << kPieceIdShift;
+            for (std::uint64_t k = 0; k < piece.pointCount(); ++k) out.pointIds.push_back(base | k);
+            for (std::uint64_t c = 0; c < piece.cellCount(); ++c) out.cellIds.push_back(base | c);
+            if (p == first) {
+                out.mesh = std::move(piece);
+            } else {
+                budget.charge(path(), label(i, p), meshBytes(piece), 1);  // its merged copy
+                appendMeshPiece(out.mesh, piece, false, path(), where(i), label(i, p));
+            }
+            budget.resetTo(heldBefore + meshBytes(out.mesh));
+        }
+        for (const std::string& note : notes_) out.mesh.notes.push_back(note);
+        return out;
+    }
+
 private:
     std::string where(std::size_t i) const {
         return stepCount() > 1 || temporal_ ? "step " + std::to_string(i) : "/VTKHDF";
@@ -882,6 +931,21 @@ bool looksLikeVtkHdf(const std::string& path) {
 
 std::unique_ptr<MeshSeries> openVtkHdfSeries(const std::string& path, const ReadOptions& options) {
     return openSeries(path, options);
+}
+
+std::size_t vtkHdfPartitionCount(const std::string& path, std::size_t step) {
+    const std::unique_ptr<MeshSeries> series = openSeries(path, {});
+    const auto* vtkhdf = dynamic_cast<const VtkHdfSeries*>(series.get());
+    UVR_CHECK(vtkhdf, "a VTKHDF file opens as a VtkHdfSeries");
+    return vtkhdf->partitionCount(step);
+}
+
+MeshPart readVtkHdfPart(const std::string& path, std::size_t first, std::size_t end,
+                        const ReadOptions& options, std::size_t step) {
+    const std::unique_ptr<MeshSeries> series = openSeries(path, options);
+    auto* vtkhdf = dynamic_cast<VtkHdfSeries*>(series.get());
+    UVR_CHECK(vtkhdf, "a VTKHDF file opens as a VtkHdfSeries");
+    return vtkhdf->readPart(step, first, end);
 }
 
 Mesh readVtkHdf(const std::string& path, const ReadOptions& options) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/mesh.h"
@@ -33,6 +34,14 @@ std::unique_ptr<MeshSeries> openVtkHdfSeries(const std::string& path,
 /// Reads the first step of a VTKHDF file: its partitions merged, cells converted as in .vtu
 /// (corners of quadratic cells, voxels as hexahedra, 0D-2D cells dropped with a note).
 Mesh readVtkHdf(const std::string& path, const ReadOptions& options = {});
+/// How many partitions step `step` of a VTKHDF file has (only the step table is read).
+std::size_t vtkHdfPartitionCount(const std::string& path, std::size_t step = 0);
+/// Reads the partitions [first, end) of step `step` as readVtkHdf reads them all (a
+/// data-parallel rank's part): their points and cells, with ids in the whole file's order
+/// (kPieceIdShift). Throws Error(Argument) for an empty range or one beyond the step's
+/// partitions.
+MeshPart readVtkHdfPart(const std::string& path, std::size_t first, std::size_t end,
+                        const ReadOptions& options = {}, std::size_t step = 0);
 
 /// Writes a mesh as VTKHDF version 2.2, one partition, no time steps: float32 points, int64
 /// offsets and connectivity, uint8 types, float32 fields (N or N x components). Written

@@ -144,6 +144,41 @@ TEST(VtkHdf, MergesPartitions) {
     expectPartition(mesh, 1, 10.f, 100.f, 0.f);
 }
 
+TEST(VtkHdf, ARankReadsItsRunOfThePartitions) {
+    // A data-parallel rank's part: partition 1 alone is the merged mesh's second half, with ids
+    // above kPieceIdShift; both parts together are the whole file's cells in order.
+    REQUIRE_CASES();
+    const std::string path = caseFile("parts.vtkhdf");
+    EXPECT_EQ(vtkHdfPartitionCount(path), 2u);
+    const Mesh whole = readMesh(path);
+    const MeshPart second = readVtkHdfPart(path, 1, 2);
+    ASSERT_EQ(second.mesh.pointCount(), 14u);
+    ASSERT_EQ(second.mesh.cellCount(), 5u);
+    EXPECT_EQ(second.pointIds.front(), std::uint64_t(1) << kPieceIdShift);
+    EXPECT_EQ(second.cellIds.back(), (std::uint64_t(1) << kPieceIdShift) | 4u);
+    for (std::uint32_t k = 0; k < 14; ++k) EXPECT_EQ(second.mesh.points[k], whole.points[14 + k]);
+    for (std::uint64_t c = 0; c < 5; ++c) {
+        EXPECT_EQ(second.mesh.cellTypes[c], whole.cellTypes[5 + c]);
+        const auto a = second.mesh.cell(c), b = whole.cell(5 + c);
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k] + 14, b[k]);
+    }
+    EXPECT_EQ(field(second.mesh, "cellid", Association::Cell).values[0], 100.f);
+    const MeshPart both = readVtkHdfPart(path, 0, 2);
+    EXPECT_EQ(both.mesh.points, whole.points);
+    EXPECT_EQ(both.mesh.cellIndices, whole.cellIndices);
+    for (std::size_t k = 0; k < whole.fields.size(); ++k)
+        EXPECT_EQ(both.mesh.fields[k].values, whole.fields[k].values) << whole.fields[k].name;
+    // Ranges outside the partitions are refused, naming them.
+    try {
+        readVtkHdfPart(path, 1, 3);
+        ADD_FAILURE() << "partitions [1, 3) of 2 were read";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Argument);
+        EXPECT_NE(std::string(e.what()).find("it has 2"), std::string::npos) << e.what();
+    }
+}
+
 TEST(VtkHdf, FileWithoutStepsIsOneStepAtTimeZero) {
     REQUIRE_CASES();
     auto series = openMeshSeries(caseFile("parts.vtkhdf"));

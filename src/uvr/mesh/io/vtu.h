@@ -30,12 +30,8 @@ Mesh readPvtu(const std::string& path, const ReadOptions& options = {});
 /// How many pieces a .pvtu lists (its XML only is read).
 std::size_t pvtuPieceCount(const std::string& path);
 
-/// A .pvtu piece's index sits above this many bits of the ids readPvtuPart gives (a piece's
-/// points and cells below), so the ids sort in readPvtu's order.
-inline constexpr int kPieceIdShift = 40;
-
 /// Reads the pieces [firstPiece, endPiece) of a .pvtu as readPvtu reads them all (a data-parallel
-/// rank's part): their points and cells, with ids in the whole file's order. Throws
+/// rank's part): their points and cells, with ids in the whole file's order (kPieceIdShift). Throws
 /// Error(Argument) for an empty range or one beyond the listed pieces.
 MeshPart readPvtuPart(const std::string& path, std::size_t firstPiece, std::size_t endPiece,
                       const ReadOptions& options = {});
