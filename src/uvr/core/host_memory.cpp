@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/core/host_memory.h"
 
+#include <sys/resource.h>
+
 #include <charconv>
 #include <filesystem>
 #include <fstream>
@@ -117,6 +119,12 @@ HostMemory detectHostMemory(const std::string& root, std::uint64_t fallbackBytes
         }
     }
     return m;
+}
+
+std::uint64_t peakResidentBytes() {
+    rusage usage{};
+    if (getrusage(RUSAGE_SELF, &usage) != 0 || usage.ru_maxrss < 0) return 0;
+    return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // Linux counts kilobytes
 }
 
 }  // namespace uvr

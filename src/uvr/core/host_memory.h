@@ -22,4 +22,8 @@ struct HostMemory {
 /// is used when neither MemTotal nor the blocks can be read.
 HostMemory detectHostMemory(const std::string& root, std::uint64_t fallbackBytes);
 
+/// The most host memory this process has held resident so far (getrusage's maximum resident
+/// set size), in bytes; 0 where the system does not say.
+std::uint64_t peakResidentBytes();
+
 }  // namespace uvr

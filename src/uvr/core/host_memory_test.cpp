@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
+#include <vector>
 
 #include "test_support.h"
 
@@ -112,6 +114,15 @@ TEST(HostMemory, GarbageIsIgnored) {
     // A good MemTotal beside garbled blocks is kept.
     write(root, "proc/meminfo", "MemTotal:       33554432 kB\n");
     EXPECT_EQ(detectHostMemory(root, 3 * kGiB).bytes, 32 * kGiB);
+}
+
+TEST(HostMemory, PeakResidentBytesCountTouchedMemory) {
+    // 256 MiB written page by page is resident at once: the peak is at least that.
+    std::vector<char> block(std::size_t(256) << 20);
+    std::memset(block.data(), 1, block.size());
+    volatile char keep = block[block.size() / 2];
+    (void)keep;
+    EXPECT_GE(peakResidentBytes(), std::uint64_t(256) << 20);
 }
 
 }  // namespace

@@ -161,7 +161,8 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
                              {"composite_bytes_sent", r.bytesSent},
                              {"samples", r.samples},
                              {"cells", r.cells},
-                             {"rerendered_pixels", r.rerenderedPixels}});
+                             {"rerendered_pixels", r.rerenderedPixels},
+                             {"peak_host_bytes", r.peakHostBytes}});
             if (i < prepare.size()) ranks.back()["prepare_seconds"] = prepare[i];
             slowest = std::max(slowest, r.frameSeconds);
             total += r.frameSeconds;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "uvr/core/error.h"
+#include "uvr/core/host_memory.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cpu/threads.h"
 #include "uvr/cuda/cuda_build.h"
@@ -212,6 +213,7 @@ RenderResult Renderer::render(const RenderSettings& settings) {
     mine.bytesSent = composited.bytesSent;
     mine.samples = samples;
     mine.rerenderedPixels = composited.rerenderedPixels;
+    mine.peakHostBytes = peakResidentBytes();
     mine.cells = prepared_->tets.cellCount();
     result.ranks = comm_->allGatherValues(mine);
     double slowest = 0.0;

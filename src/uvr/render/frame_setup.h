@@ -210,6 +210,7 @@ struct RankFrameStats {
     /// Pixels it rendered again, where its rays stopped behind other ranks' light (the
     /// compositing's second pass).
     std::uint64_t rerenderedPixels = 0;
+    std::uint64_t peakHostBytes = 0;  ///< the most host memory its process has held so far
 };
 
 /// A rendered frame: image, per-pixel sample counts, statistics.
