@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "progress.h"
+#include "uvr/mesh/io/exodus.h"
 #include "uvr/render/depth_image.h"
 
 namespace uvr::cli {
@@ -230,6 +231,15 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
             ctx.step("reading " + file + " whole on every rank: it has " +
                      std::to_string(partitions) + " partitions for " + std::to_string(ranks) +
                      " ranks");
+        }
+        if (format == MeshFormat::Exodus) {
+            // Each rank reads its run of the cells, block rows and node spans only.
+            const std::size_t step = steps.pick(*openSeries(file, ctx));
+            const std::uint64_t n = exodusCellCount(file);
+            ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
+                     " ranks reads about " + std::to_string(n / ranks) + " of its " +
+                     std::to_string(n) + " cells");
+            return readExodusPart(file, cellsOf(n, rank), cellsOf(n, rank + 1), read, step);
         }
         if (format == MeshFormat::Native && !steps.time && !steps.index) {
             const std::uint64_t n = readNativeSummary(file, false).cellCount;

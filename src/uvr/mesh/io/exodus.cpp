@@ -56,6 +56,17 @@ std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOption
                "libnetcdf-dev and rebuild");
 }
 
+std::uint64_t exodusCellCount(const std::string& path) {
+    (void)openExodus(path, {});
+    return 0;
+}
+
+MeshPart readExodusPart(const std::string& path, std::uint64_t, std::uint64_t,
+                        const ReadOptions& options, std::size_t) {
+    (void)openExodus(path, options);
+    return {};
+}
+
 #else
 
 namespace {
@@ -273,6 +284,19 @@ void readAll(const NcFile& f, int varid, std::vector<T>& out, const std::string&
         ncCheck(nc_get_var_longlong(f.id(), varid, out.data()), f.path(), what);
 }
 
+/// Reads rows [first, first + count) of a 2-D variable (all its columns) as long long or int.
+template <typename T>
+void readRows(const NcFile& f, int varid, std::size_t first, std::size_t count, std::size_t columns,
+              std::vector<T>& out, const std::string& what) {
+    out.resize(count * columns);
+    if (out.empty()) return;
+    const std::size_t start[2] = {first, 0}, counts[2] = {count, columns};
+    if constexpr (std::is_same_v<T, int>)
+        ncCheck(nc_get_vara_int(f.id(), varid, start, counts, out.data()), f.path(), what);
+    else
+        ncCheck(nc_get_vara_longlong(f.id(), varid, start, counts, out.data()), f.path(), what);
+}
+
 /// An Exodus II file's steps: the metadata read at open, the arrays at each step.
 class ExodusSeries final : public MeshSeries {
 public:
@@ -314,8 +338,161 @@ public:
         return readFields(i, budgeted.budget());
     }
 
+    /// Cells the mesh of a step holds (the kept blocks' elements).
+    std::uint64_t cellCount() const { return keptCells_; }
+
+    /// The cells [first, end) of step i and what they use, as meshPart takes them from
+    /// readStep(i): the blocks' connectivity read only over those cells' rows, the coordinates
+    /// and nodal variables over the span of node numbers they use.
+    MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end) {
+        checkStep(i);
+        const FormatLibraryLock lock;
+        if (first > end || end > keptCells_)
+            throwError(ErrorKind::Argument, file(),
+                       "cells [" + std::to_string(first) + ", " + std::to_string(end) +
+                           ") asked for, but the file has " + std::to_string(keptCells_));
+        const BudgetedOptions budgeted(options());
+        LoadBudget& budget = budgeted.budget();
+        MeshPart part;
+        Mesh& mesh = part.mesh;
+        // Step 1: the cells' corners as node numbers (0-based), block by block.
+        std::vector<std::uint64_t> corners;
+        for (const Block& block : blocks_) {
+            if (!block.kept) continue;
+            const std::uint64_t b0 = std::max<std::uint64_t>(first, block.firstCell);
+            const std::uint64_t b1 = std::min<std::uint64_t>(end, block.firstCell + block.elements);
+            if (b0 >= b1) continue;
+            nc_type type = NC_NAT;
+            ncCheck(nc_inq_vartype(file_->id(), block.connectVar, &type), file(), block.label());
+            if (type == NC_INT64 || type == NC_UINT64 || type == NC_UINT)
+                partOfBlock<long long>(block, b0, b1, mesh, corners, budget);
+            else
+                partOfBlock<int>(block, b0, b1, mesh, corners, budget);
+        }
+        for (std::uint64_t c = first; c < end; ++c) part.cellIds.push_back(c);
+        // Step 2: the nodes they use, in the file's order, and the corners as their indices.
+        part.pointIds = corners;
+        std::sort(part.pointIds.begin(), part.pointIds.end());
+        part.pointIds.erase(std::unique(part.pointIds.begin(), part.pointIds.end()),
+                            part.pointIds.end());
+        mesh.cellIndices.reserve(corners.size());
+        for (std::uint64_t id : corners)
+            mesh.cellIndices.push_back(static_cast<std::uint32_t>(
+                std::lower_bound(part.pointIds.begin(), part.pointIds.end(), id) -
+                part.pointIds.begin()));
+        std::vector<std::uint64_t>().swap(corners);
+        // Step 3: coordinates and nodal variables over the span of those nodes.
+        const std::size_t lo = part.pointIds.empty() ? 0 : part.pointIds.front();
+        const std::size_t span = part.pointIds.empty() ? 0 : part.pointIds.back() + 1 - lo;
+        budget.charge(file(), "the part's points", part.pointIds.size(), sizeof(Vec3f));
+        budget.charge(file(), "a span of a nodal array", span, sizeof(float));
+        std::vector<float> window(span);
+        mesh.points.resize(part.pointIds.size());
+        static const char* const kNames[3] = {"coordx", "coordy", "coordz"};
+        for (int d = 0; d < 3 && span > 0; ++d) {
+            if (coordVar_ >= 0) {
+                const std::size_t start[2] = {static_cast<std::size_t>(d), lo};
+                const std::size_t count[2] = {1, span};
+                ncCheck(nc_get_vara_float(file_->id(), coordVar_, start, count, window.data()),
+                        file(), "variable coord");
+            } else {
+                const std::size_t start[1] = {lo}, count[1] = {span};
+                ncCheck(nc_get_vara_float(file_->id(), coordVars_[d], start, count, window.data()),
+                        file(), std::string("variable ") + kNames[d]);
+            }
+            for (std::size_t k = 0; k < part.pointIds.size(); ++k)
+                mesh.points[k][d] = window[part.pointIds[k] - lo];
+        }
+        if (records_ > 0) {
+            for (const FieldGroup& g : pointGroups_) {
+                const int comps = static_cast<int>(g.variables.size());
+                Field field{g.name, Association::Point, comps,
+                            std::vector<float>(part.pointIds.size() * comps)};
+                for (int c = 0; c < comps && span > 0; ++c) {
+                    const std::size_t v = g.variables[c];
+                    const std::string what = "the nodal variable '" + nodVarNames_[v] + "'";
+                    if (combinedNodVar_ >= 0) {
+                        const std::size_t start[3] = {i, v, lo}, count[3] = {1, 1, span};
+                        ncCheck(nc_get_vara_float(file_->id(), combinedNodVar_, start, count,
+                                                  window.data()),
+                                file(), what + " (vals_nod_var)");
+                    } else {
+                        const std::size_t start[2] = {i, lo}, count[2] = {1, span};
+                        ncCheck(nc_get_vara_float(file_->id(), nodVarIds_[v], start, count,
+                                                  window.data()),
+                                file(), what);
+                    }
+                    for (std::size_t k = 0; k < part.pointIds.size(); ++k)
+                        field.values[k * comps + c] = window[part.pointIds[k] - lo];
+                }
+                mesh.fields.push_back(std::move(field));
+            }
+            // Element variables over the part's rows of each block.
+            for (const FieldGroup& g : cellGroups_) {
+                const int comps = static_cast<int>(g.variables.size());
+                Field field{g.name, Association::Cell, comps,
+                            std::vector<float>((end - first) * comps,
+                                               std::numeric_limits<float>::quiet_NaN())};
+                for (const Block& block : blocks_) {
+                    if (!block.kept) continue;
+                    const std::uint64_t b0 = std::max<std::uint64_t>(first, block.firstCell);
+                    const std::uint64_t b1 =
+                        std::min<std::uint64_t>(end, block.firstCell + block.elements);
+                    if (b0 >= b1) continue;
+                    std::vector<float> rows(b1 - b0);
+                    for (int c = 0; c < comps; ++c) {
+                        const std::size_t v = g.variables[c];
+                        const int id = elemVarIds_[v][block.index - 1];
+                        if (id < 0) continue;
+                        const std::size_t start[2] = {i, b0 - block.firstCell},
+                                          count[2] = {1, b1 - b0};
+                        ncCheck(
+                            nc_get_vara_float(file_->id(), id, start, count, rows.data()), file(),
+                            "the element variable '" + elemVarNames_[v] + "' on " + block.label());
+                        for (std::uint64_t e = b0; e < b1; ++e)
+                            field.values[(e - first) * comps + c] = rows[e - b0];
+                    }
+                }
+                mesh.fields.push_back(std::move(field));
+            }
+        }
+        mesh.notes = notes_;
+        return part;
+    }
+
 private:
     const std::string& file() const { return path(); }
+
+    /// The cells [b0, b1) (mesh cell indices) of a kept block: their types and offsets into
+    /// `mesh`, their corners' node numbers (0-based, checked) onto `corners`.
+    template <typename T>
+    void partOfBlock(const Block& block, std::uint64_t b0, std::uint64_t b1, Mesh& mesh,
+                     std::vector<std::uint64_t>& corners, LoadBudget& budget) const {
+        const std::uint64_t rows = b1 - b0;
+        budget.charge(file(), block.label() + ": connectivity", rows * block.nodesPerElement,
+                      sizeof(T));
+        std::vector<T> conn;
+        readRows(*file_, block.connectVar, b0 - block.firstCell, rows, block.nodesPerElement, conn,
+                 "variable connect" + std::to_string(block.index));
+        const CellType cell = block.type.cell;
+        const int count = cornerCount(cell);
+        for (std::uint64_t r = 0; r < rows; ++r) {
+            const T* nodes = conn.data() + r * block.nodesPerElement;
+            for (int k = 0; k < count; ++k) {
+                const long long id = nodes[block.type.corners[k]];
+                if (id < 1 || static_cast<std::uint64_t>(id) > nodes_)
+                    throwError(ErrorKind::Validation, file(),
+                               block.label() + ", element " +
+                                   std::to_string(b0 - block.firstCell + r + 1) + ": node " +
+                                   std::to_string(id) + " out of range [1, " +
+                                   std::to_string(nodes_) + "] (num_nodes)");
+                corners.push_back(static_cast<std::uint64_t>(id - 1));
+            }
+            mesh.cellTypes.push_back(cell);
+            mesh.cellOffsets.push_back(corners.size());
+        }
+        budget.release(rows * block.nodesPerElement * sizeof(T));
+    }
 
     /// Step titles: dimensions, coordinates, blocks, variable names and truth table; every
     /// variable read later is checked for its shape here.
@@ -803,6 +980,21 @@ std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOption
     std::unique_ptr<MeshSeries> series = openExodusHere(path, options);
     expectSameFile(path, identity);
     return series;
+}
+
+std::uint64_t exodusCellCount(const std::string& path) {
+    const std::unique_ptr<MeshSeries> series = openExodus(path, {});
+    const auto* exodus = dynamic_cast<const ExodusSeries*>(series.get());
+    UVR_CHECK(exodus, "an Exodus file opens as an ExodusSeries");
+    return exodus->cellCount();
+}
+
+MeshPart readExodusPart(const std::string& path, std::uint64_t first, std::uint64_t end,
+                        const ReadOptions& options, std::size_t step) {
+    const std::unique_ptr<MeshSeries> series = openExodus(path, options);
+    auto* exodus = dynamic_cast<ExodusSeries*>(series.get());
+    UVR_CHECK(exodus, "an Exodus file opens as an ExodusSeries");
+    return exodus->readPart(step, first, end);
 }
 
 #endif

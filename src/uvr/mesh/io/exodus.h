@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/mesh.h"
@@ -29,5 +30,15 @@ std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOption
 
 /// The first time step of an Exodus II file (openExodus(path)->readStep(0)).
 Mesh readExodus(const std::string& path, const ReadOptions& options = {});
+
+/// Cells of an Exodus II file's mesh: its volumetric blocks' elements (the metadata only).
+std::uint64_t exodusCellCount(const std::string& path);
+
+/// The cells [first, end) of step `step` (blocks in file order) and what they use, as meshPart
+/// takes them from the whole step (a data-parallel rank's part): each block's connectivity read
+/// over those cells' rows only, the coordinates and nodal variables over the span of the node
+/// numbers they use. Throws Error(Argument) for a range beyond the file's cells.
+MeshPart readExodusPart(const std::string& path, std::uint64_t first, std::uint64_t end,
+                        const ReadOptions& options = {}, std::size_t step = 0);
 
 }  // namespace uvr

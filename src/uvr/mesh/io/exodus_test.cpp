@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "test_support.h"
 #include "uvr/core/file_util.h"
@@ -274,6 +275,55 @@ TEST(Exodus, NetcdfWrittenFilesMatchVtk) {
         if (vtk.is_null()) continue;
         expectSameAsVtk(series->readStep(0), vtk["steps"][0]);
         expectSameAsVtk(mesh, vtk["steps"][1]);
+    }
+}
+
+TEST(Exodus, ARankReadsItsRunOfTheCellsAsMeshPartTakesIt) {
+    // A data-parallel rank's part, read over its rows only, equals the part meshPart takes from
+    // the whole step: across blocks (a dropped shell block and a reduced TETRA10 one among
+    // them), in every layout, for the nodal and element variables of step 1.
+    REQUIRE_EXODUS();
+    const std::string dir = testing::scratchDir();
+    const auto same = [](const std::vector<float>& a, const std::vector<float>& b) {
+        if (a.size() != b.size()) return false;
+        for (std::size_t i = 0; i < a.size(); ++i)
+            if (!(a[i] == b[i] || (std::isnan(a[i]) && std::isnan(b[i])))) return false;
+        return true;
+    };
+    for (const auto& [name, combinedCoord, combinedVars, netcdf4] :
+         {std::tuple{"new.exo", false, false, false},
+          std::tuple{"oldcoord.ex2", true, false, false},
+          std::tuple{"oldvars.ex2", false, true, false},
+          std::tuple{"hdf5.e", false, false, true}}) {
+        SCOPED_TRACE(name);
+        testing::ExoFileSpec spec = mixedSpec();
+        spec.combinedCoord = combinedCoord;
+        spec.combinedNodalVars = combinedVars;
+        spec.netcdf4 = netcdf4;
+        const std::string file = writeSpec(spec, dir, name);
+        const Mesh whole = openMeshSeries(file)->readStep(1);
+        ASSERT_EQ(exodusCellCount(file), whole.cellCount());
+        for (const auto& [a, b] :
+             {std::pair<std::uint64_t, std::uint64_t>{0, 10}, {0, 3}, {3, 7}, {7, 10}, {5, 6}}) {
+            SCOPED_TRACE("cells [" + std::to_string(a) + ", " + std::to_string(b) + ")");
+            const MeshPart want = meshPart(whole, a, b);
+            const MeshPart got = readExodusPart(file, a, b, {}, 1);
+            EXPECT_EQ(got.pointIds, want.pointIds);
+            EXPECT_EQ(got.cellIds, want.cellIds);
+            EXPECT_EQ(got.mesh.points, want.mesh.points);
+            EXPECT_EQ(got.mesh.cellTypes, want.mesh.cellTypes);
+            EXPECT_EQ(got.mesh.cellOffsets, want.mesh.cellOffsets);
+            EXPECT_EQ(got.mesh.cellIndices, want.mesh.cellIndices);
+            ASSERT_EQ(got.mesh.fields.size(), want.mesh.fields.size());
+            for (std::size_t k = 0; k < want.mesh.fields.size(); ++k) {
+                EXPECT_EQ(got.mesh.fields[k].name, want.mesh.fields[k].name);
+                EXPECT_EQ(got.mesh.fields[k].association, want.mesh.fields[k].association);
+                EXPECT_TRUE(same(got.mesh.fields[k].values, want.mesh.fields[k].values))
+                    << want.mesh.fields[k].name;
+            }
+            EXPECT_EQ(got.mesh.notes, whole.notes);
+        }
+        EXPECT_THROW(readExodusPart(file, 4, 11), Error);
     }
 }
 
