@@ -495,6 +495,11 @@ RendererOptions RenderFlags::rendererOptions(bool withReference) const {
     o.seedGrids = !noSeedGrid;
     o.splitCells = splitCells;
     o.leafCells = leafCells;
+    // Data-parallel pieces' ghost cells reach the sample distance given (mpirun).
+    if (vocabulary.given("sample_distance")) {
+        const nlohmann::json v = vocabulary.value("sample_distance");
+        if (v.is_number()) o.largestSampleDistance = v.get<float>();
+    }
     return o;
 }
 

@@ -33,16 +33,6 @@ struct StopAsk {
     float stop;
 };
 
-/// Values of a trivially copyable type from bytes (a whole number of them).
-template <class T>
-std::vector<T> fromBytes(const std::vector<std::byte>& bytes, int from) {
-    UVR_CHECK(bytes.size() % sizeof(T) == 0,
-              "rank " << from << " sent " << bytes.size() << " bytes, not whole values");
-    std::vector<T> out(bytes.size() / sizeof(T));
-    if (!out.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());
-    return out;
-}
-
 /// compositeFrame's second pass (collective): each rank renders again the pixels the band
 /// owners ask of it (asks[r]: this band's asks of rank r; fronts[r]: their band index and the
 /// colour in front), and the band takes the new colours behind those fronts.
@@ -64,7 +54,7 @@ void secondCompositingPass(Communicator& comm, const Image& image,
     std::vector<std::vector<StopAsk>> asked(ranks);
     {
         const std::vector<std::vector<std::byte>> in = comm.allToAll(out);
-        for (int r = 0; r < ranks; ++r) asked[r] = fromBytes<StopAsk>(in[r], r);
+        for (int r = 0; r < ranks; ++r) asked[r] = fromBytes<StopAsk>(in[r]);
     }
     for (const std::vector<StopAsk>& a : asked) stats.rerenderedPixels += a.size();
     Image again;

@@ -251,7 +251,7 @@ ScalarField routeValues(Communicator& comm, const ValueRoutes& routes, const Sca
 }
 
 RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptions& options,
-                         float ghostSteps, const ProgressFn& progress) {
+                         float ghostSteps, float reach, const ProgressFn& progress) {
     const int ranks = comm.size(), me = comm.rank();
     const bool pointData = share.field.association == Association::Point;
     RankPiece out;
@@ -388,7 +388,10 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     piece->depth = d.depths[me];
     // Step 4: each source cell to every rank whose box, widened by the ghosts, it reaches.
     if (progress) progress("moving cells to the ranks that render them");
-    const float ghost = ghostSteps * piece->defaultStep;
+    // A little past the farthest sample ending a piece's last segment.
+    const float ghost = std::max(ghostSteps * piece->defaultStep,
+                                 static_cast<float>(1.05 * double(reach) * frame.scale));
+    piece->ghost = ghost;
     ValueRoutes& routes = out.routes;
     routes.sharePoints = share.mesh.points.size();
     routes.shareCells = share.mesh.cellCount();
@@ -398,21 +401,87 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     if (share.mesh.fields.empty()) routes.points = routes.cells = true;  // fields unknown (a view)
     routes.sendPoints.resize(ranks), routes.sendCells.resize(ranks);
     routes.receivePoints.resize(ranks), routes.receiveCells.resize(ranks);
-    std::vector<std::vector<std::byte>> toEach(ranks);
+    // The share's points in the rendering frame, and whether each lies in a rank's widened box.
+    std::vector<Vec3f> local(share.mesh.points.size());
+    for (std::size_t i = 0; i < local.size(); ++i) {
+        double p[3];
+        frame.toLocal(share.mesh.points[i], p);
+        local[i] = Vec3f(float(p[0]), float(p[1]), float(p[2]));
+    }
+    const auto inWidened = [&](Vec3f p, int r) {
+        for (int a = 0; a < 3; ++a)
+            if (!(p[a] >= d.regions[r].lo[a] - ghost && p[a] <= d.regions[r].hi[a] + ghost))
+                return false;
+        return true;
+    };
+    // Which ranks each cell reaches (its bounds against each widened box).
+    std::vector<std::vector<std::uint32_t>> reaching(ranks);
     for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
-        const std::span<const std::uint32_t> corners = share.mesh.cell(c);
         Bounds3f box;
-        for (std::uint32_t id : corners) {
-            double p[3];
-            frame.toLocal(share.mesh.points[id], p);
-            box.extend(Vec3f(float(p[0]), float(p[1]), float(p[2])));
-        }
+        for (std::uint32_t id : share.mesh.cell(c)) box.extend(local[id]);
         for (int r = 0; r < ranks; ++r) {
             bool reaches = !box.empty();
             for (int a = 0; a < 3; ++a)
                 reaches = reaches && box.lo[a] <= d.regions[r].hi[a] + ghost &&
                           box.hi[a] >= d.regions[r].lo[a] - ghost;
-            if (!reaches) continue;
+            if (reaches) reaching[r].push_back(static_cast<std::uint32_t>(c));
+        }
+    }
+    // A smooth normal at a point is the mean over every cell around it, so a piece also takes
+    // the cells around the points its cells have outside its widened box (whichever rank's
+    // share holds them): the ranks' lists of such points (global ids), one all-gather.
+    {
+        std::vector<std::uint64_t> outside;  // per rank r: a count, then r's ids
+        for (int r = 0; r < ranks; ++r) {
+            std::vector<std::uint64_t> ids;
+            for (std::uint32_t c : reaching[r])
+                for (std::uint32_t id : share.mesh.cell(c))
+                    if (!inWidened(local[id], r)) ids.push_back(share.pointIds[id]);
+            std::sort(ids.begin(), ids.end());
+            ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+            outside.push_back(ids.size());
+            outside.insert(outside.end(), ids.begin(), ids.end());
+        }
+        const std::vector<std::vector<std::uint64_t>> all = comm.allGatherValues(outside);
+        for (int r = 0; r < ranks; ++r) {
+            std::vector<std::uint64_t> ring;  // every rank's points outside r's box, sorted
+            for (const std::vector<std::uint64_t>& from : all) {
+                std::size_t at = 0;
+                for (int k = 0; k < r; ++k) at += 1 + from.at(at);
+                const std::uint64_t count = from.at(at);
+                ring.insert(ring.end(), from.begin() + at + 1, from.begin() + at + 1 + count);
+            }
+            std::sort(ring.begin(), ring.end());
+            if (ring.empty()) continue;
+            // This share's cells around those points that do not reach r's widened box.
+            std::vector<std::uint32_t> more;
+            std::size_t next = 0;  // reaching[r] is increasing
+            for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
+                if (next < reaching[r].size() && reaching[r][next] == c) {
+                    ++next;
+                    continue;
+                }
+                for (std::uint32_t id : share.mesh.cell(c))
+                    if (std::binary_search(ring.begin(), ring.end(), share.pointIds[id])) {
+                        more.push_back(static_cast<std::uint32_t>(c));
+                        break;
+                    }
+            }
+            if (more.empty()) continue;
+            std::vector<std::uint32_t> merged;
+            std::merge(reaching[r].begin(), reaching[r].end(), more.begin(), more.end(),
+                       std::back_inserter(merged));
+            reaching[r] = std::move(merged);
+        }
+    }
+    local = {};
+    std::vector<std::vector<std::byte>> toEach(ranks);
+    for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
+        const std::span<const std::uint32_t> corners = share.mesh.cell(c);
+        for (int r = 0; r < ranks; ++r) {
+            if (!std::binary_search(reaching[r].begin(), reaching[r].end(),
+                                    static_cast<std::uint32_t>(c)))
+                continue;
             routes.sendCells[r].push_back(static_cast<std::uint32_t>(c));
             std::vector<std::byte>& m = toEach[r];
             put(m, share.cellIds[c]);

@@ -98,9 +98,12 @@ struct RankPiece {
 /// the single-process build's rules (median of the cell centres on the longest axis of the
 /// occupied region, the same leaf size and 90% rule) by splitting the costliest node until there
 /// is one per rank (Decomposition); then each source cell goes to every rank whose box, widened
-/// by ghostSteps default steps, its bounds reach. A failure on any rank throws on every rank.
-/// Throws Error(Argument) when the tree cannot be split into as many nodes as ranks.
+/// by the ghost width, its bounds reach, and every cell around a point those cells have
+/// outside that box (so a piece's smooth normals are one process's). The ghost width is
+/// ghostSteps default steps, or `reach` (file units; 0: none) when that is more: the largest
+/// sample distance frames will ask for (MeshPiece::ghost). A failure on any rank throws on
+/// every rank. Throws Error(Argument) when the tree cannot be split into as many nodes as ranks.
 RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptions& options,
-                         float ghostSteps, const ProgressFn& progress = {});
+                         float ghostSteps, float reach = 0.f, const ProgressFn& progress = {});
 
 }  // namespace uvr

@@ -326,6 +326,57 @@ TEST(DataParallel, NewValuesReachThePiecesAsAFreshPreparationWould) {
     EXPECT_THAT(e.what(), HasSubstr("expected " + std::to_string(fin.pointCount())));
 }
 
+TEST(DataParallel, LongSampleDistancesAndSmoothShadingGiveOneProcessPicture) {
+    // Sample distances of 6 and 12 default steps: a piece's closing sample lies that far past
+    // its box (the ghosts reach RendererOptions::largestSampleDistance), the run its first
+    // sample continues has its slope from the piece before's last sample (a lead sample in the
+    // ghosts), and a run whose share ends before the next piece ends in its own. Smooth normals:
+    // every cell around a ghost's outer points is a ghost too. The ramp's opacity reaches 1.
+    const std::string path = testing::sharedData("bluntfin_tets.vtk");
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+    const Mesh mesh = readMesh(path);
+    const ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options;
+    options.device = Device::Cpu;
+    options.largestSampleDistance = 1.f;
+    std::vector<RenderSettings> frames;
+    for (RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
+        for (float step : {0.5f, 1.f}) {
+            RenderSettings s = frameOf(mesh.bounds(), m, 35.f, 25.f);
+            applyOpacitySpec(s.tf, "ramp");
+            s.step = step;
+            frames.push_back(s);
+        }
+        RenderSettings lit = frameOf(mesh.bounds(), m, -50.f, 20.f);
+        lit.lighting.on = true;
+        lit.lighting.specular = 0.3f;
+        frames.push_back(lit);
+    }
+    Renderer one(mesh, field, options);
+    for (int ranks : {2, 4}) {
+        const std::vector<RenderResult> many =
+            dataParallelFrames(mesh, field, ranks, options, frames);
+        ASSERT_EQ(many.size(), frames.size());
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            SCOPED_TRACE(std::string(methodName(frames[i].method)) + ", sample distance " +
+                         std::to_string(frames[i].step) +
+                         (frames[i].lighting.on ? ", shaded" : "") + ", " + std::to_string(ranks) +
+                         " ranks");
+            const ImageComparison cmp =
+                compareImages(toRgb8(one.render(frames[i]).image), toRgb8(many[i].image));
+            EXPECT_GE(cmp.ssim, kMinSsim);
+            EXPECT_LE(cmp.maxAbsDifference, kMaxLevels) << differenceSummary(cmp);
+        }
+    }
+    // Past the ghosts' reach, a frame is refused on every rank, naming the largest.
+    RenderSettings far = frames[0];
+    far.step = 1.5f;
+    options.largestSampleDistance = 0.f;  // 2 default steps (0.17)
+    const Error e = catchError([&] { dataParallelFrames(mesh, field, 2, options, {far}); });
+    EXPECT_EQ(e.kind(), ErrorKind::Argument);
+    EXPECT_THAT(e.what(), HasSubstr("sample_distance 1.5: expected at most 0.17"));
+}
+
 TEST(DataParallel, TooManyRanksForThePartitionsAreRefusedOnEveryRank) {
     const Mesh mesh = testing::makeHexGrid(
         3, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);

@@ -124,7 +124,8 @@ void Renderer::prepareShare(MeshShare share, const RendererOptions& options,
     // process would prepare that box (dist/decompose.h).
     comm_ = options.communicator;
     PrepareOptions prepare = options.prepareOptions();
-    RankPiece piece = distributeMesh(*comm_, std::move(share), prepare, kGhostSteps, progress);
+    RankPiece piece = distributeMesh(*comm_, std::move(share), prepare, kGhostSteps,
+                                     options.largestSampleDistance, progress);
     decomposition_ = std::make_shared<Decomposition>(std::move(piece.decomposition));
     routes_ = std::make_unique<ValueRoutes>(std::move(piece.routes));
     prepare.piece = piece.piece;

@@ -59,6 +59,10 @@ struct RendererOptions {
     /// frame is composited onto rank 0, whose RenderResult is the whole picture. Null: one
     /// process. Not owned.
     Communicator* communicator = nullptr;
+    /// Data-parallel: the largest sample distance (file units) frames will ask for; the pieces'
+    /// ghost cells reach that far past their boxes (at least 2 default steps, the default
+    /// step's frames). Frames of a larger one are refused, naming the largest. 0: the default.
+    float largestSampleDistance = 0.f;
 
     /// The preparation these options ask for (the builders of the GPU when buildDevice resolves
     /// to it, the device's default leaf size).

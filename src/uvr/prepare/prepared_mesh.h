@@ -40,7 +40,11 @@ struct MeshPiece {
     Bounds3f bounds;          ///< the whole mesh's bounds (rendering units)
     float valueMin = 0.f;     ///< the whole field's finite range
     float valueMax = 0.f;
-    float defaultStep = 0.f;        ///< defaultStep of the whole mesh
+    float defaultStep = 0.f;  ///< defaultStep of the whole mesh
+    /// How far past the box its ghost cells reach (rendering units): frames of the sampling
+    /// methods take a sample distance of at most this (the sample ending a piece's last
+    /// segment lies one sample distance past the box).
+    float ghost = 0.f;
     std::uint64_t sourceCells = 0;  ///< cells of the whole mesh
     double meanSplitTets = 1.0;     ///< the whole mesh's TetMesh::meanSplitTets
     /// autoMethod of the whole mesh for the CPU and the GPU.

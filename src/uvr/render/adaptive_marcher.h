@@ -262,6 +262,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // A data-parallel frame: this rank's piece of the span (its k-d tree is the whole tree's
     // subtree there, so the partitions' pieces are one process's).
     bool pieceStart = false, pieceEnd = false;
+    const float tSpan = tEnter;  // where one process's span starts
     if (!scene.base.params.piece.narrow(ray.org, inv, tEnter, tExit, pieceStart, pieceEnd))
         return acc;
     if (pieceStart) cut0 = false;
@@ -314,6 +315,10 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                segments.iso->within(b.valueMin, b.valueMax);
     };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
+    // A data-parallel piece's first sample, on its first grid point, may continue the run of
+    // the piece before's last sample one grid point back (SampleSegments::lead).
+    bool leadPending = pieceStart && preintegrated;
+    const float kLeadAt = ceilf(tEnter / s1);
     float kLocated = -INFINITY;  // grid position of the last sample located
     bool marching = true, opaque = false, macro = false;
     // Depth out: the opacity and the end of the stretch of the ray noted last, noted wherever
@@ -428,6 +433,17 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const Vec3f grad =
             sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
         const LightFactors light = lightAt(lighting, tet, grad, ray.dir);
+        if (leadPending) {
+            leadPending = false;
+            if (tet != kNoTet && kSample == kLeadAt && kSample - 1.f >= ceilf(tSpan / s1)) {
+                ++counters.samples;
+                float leadBary[4];
+                const std::uint32_t found = locateFrom(ray.at((kSample - 1.f) * s1), tet, leadBary);
+                if (found != kNoTet)
+                    segments.lead(kSample - 1.f, true,
+                                  locator.mesh.interpolate<kNative>(found, leadBary));
+            }
+        }
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
         // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
@@ -560,6 +576,10 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
             segments.add(tf, kClose, kClose, tet != kNoTet, v, s1, unit, acc,
                          lightAt(lighting, tet, grad, ray.dir), grad);
+        } else {
+            // The run's share ends before the next piece (a skipped partition or empty space
+            // follows it): one process's next sample ends it there, so this piece does.
+            segments.finish(tf, s1, unit, acc);
         }
         note(tExit);
     } else if (preintegrated && !opaque) {

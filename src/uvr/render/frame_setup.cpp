@@ -82,7 +82,8 @@ SceneView FrameSetup::scene(const PreparedMesh& mesh) const {
     SceneView v;
     v.locator = mesh.locator();
     v.tf = tfView();
-    v.bounds = mesh.tets.bounds;
+    v.bounds =
+        mesh.wholeBounds();  // a data-parallel piece: the whole mesh's, as one process cuts rays
     v.params = params;
     return v;
 }
@@ -210,6 +211,15 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     };
     f.params.step =
         settings.step > 0.f ? toLocal(settings.step, "sample_distance") : mesh.wholeDefaultStep();
+    // A data-parallel piece: the sample ending its last segment lies one sample distance past
+    // its box, which its ghost cells must reach (exact cuts the cells at the box instead).
+    if (mesh.piece && f.method.method != RenderMethod::Exact &&
+        f.params.step > mesh.piece->ghost * 1.0001f)
+        throw SettingError("sample_distance", formatG(settings.step, 4),
+                           "expected at most " + formatG(mesh.piece->ghost / frame.scale, 4) +
+                               " for these data-parallel pieces: their ghost cells reach that "
+                               "far past each rank's box (give the largest sample distance "
+                               "when preparing: `--sample-distance` on the command line)");
     if (settings.step > 0.f && !empty) {
         const double across = bounds.diagonal() / f.params.step;
         if (across < kFewSamplesAcross)

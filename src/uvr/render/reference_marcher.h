@@ -68,6 +68,7 @@ struct SampleSegments {
     bool inRun = false;    ///< the sample before the last one is in the last one's run
     bool inside = false;   ///< the last sample found a cell
     bool started = false;  ///< a sample was taken
+    bool led = false;      ///< the last sample is a lead (lead()): no segment up to the next
 
     /// Isosurfaces to composite between samples (kSurf only), lit by `l` along a ray of
     /// direction d, and the opacity whose depth is asked for.
@@ -80,6 +81,19 @@ struct SampleSegments {
         }
     }
 
+    /// A data-parallel piece's start: the sample at grid position k just before the piece's
+    /// first, found in a cell (`in`) with value v, which the piece before integrated. It only
+    /// gives the run that the first sample continues its last slope (endRun): one process's run
+    /// holds it. The next add() integrates nothing up to it (the segment is the other piece's).
+    UVR_HOST_DEVICE void lead(float k, bool in, float v) {
+        kLast = k;
+        kEnd = k + 1.f;
+        vLast = v;
+        inside = in;
+        started = true;
+        led = true;
+    }
+
     /// Adds the sample at grid position k of a piece of the ray that ends at kPieceEnd (the
     /// next piece continues it when it starts there); `in`: it found a cell, with value v,
     /// light f (gradient shading; the segment from the last sample is lit by the mean of their
@@ -88,7 +102,9 @@ struct SampleSegments {
                                         float v, float s1, double unit, Vec4f& acc,
                                         LightFactors f = {}, Vec3f g = Vec3f(0.f)) {
         const bool goesOn = started && inside && in && k <= kEnd;
-        if (goesOn) {
+        if (led) {
+            // From a lead sample: the segment (or the run's end) is the piece before's.
+        } else if (goesOn) {
             bool done = false;
             if constexpr (kSurf) {
                 if (iso) {
@@ -114,10 +130,11 @@ struct SampleSegments {
         if constexpr (kSurf) gradLast = g;
         inside = in;
         started = true;
+        led = false;
     }
-    /// Ends the last run at the end of the ray.
+    /// Ends the last run at the end of the ray (a lead sample's run is the piece before's).
     UVR_HOST_DEVICE void finish(const TfTableView& tf, float s1, double unit, Vec4f& acc) const {
-        if (started && inside) endRun(tf, kEnd - kLast, s1, unit, acc);
+        if (started && inside && !led) endRun(tf, kEnd - kLast, s1, unit, acc);
     }
 
 private:
@@ -325,6 +342,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     // A data-parallel frame: this rank's piece of the span (the cut faces at its ends are the
     // other ranks' where the piece moved them).
     bool pieceStart = false, pieceEnd = false;
+    const float tSpan = t0;  // where one process's span starts
     if (!scene.params.piece.narrow(ray.org, inv, t0, t1, pieceStart, pieceEnd)) return acc;
     if (pieceStart) cut0 = false;
     if (pieceEnd) cut1 = false;
@@ -351,6 +369,14 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     SampleSegments<kLit, kSurf> segments;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
     segments.setIsos(scene.params.iso, lighting, ray.dir, scene.params.depthAlpha);
+    if (pieceStart && scene.params.preintegrated && k - 1.f >= ceilf(tSpan / s)) {
+        // The piece before's last sample, in the ghost cells: the slope of the run the first
+        // sample may continue, as one process's run has it.
+        ++counters.samples;
+        tet = scene.locator.locate<kNative>(ray.at((k - 1.f) * s), kNoTet, bary, counters.locate);
+        segments.lead(k - 1.f, tet != kNoTet,
+                      tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary));
+    }
     PointIsos<kSurf> pointIsos;
     [[maybe_unused]] std::uint32_t lastInside = kNoTet;  // the cell of the last sample inside
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
@@ -370,7 +396,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         if (scene.params.preintegrated) {
             if constexpr (kSurf) {
                 if (segments.iso && (tet != kNoTet) != segments.inside &&
-                    !(pieceStart && !segments.started)) {
+                    !(pieceStart && (!segments.started || segments.led))) {
                     const bool first = !segments.started, in = tet != kNoTet;
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
