@@ -215,14 +215,8 @@ ScalarField routeValues(Communicator& comm, const ValueRoutes& routes, const Sca
                        std::string("new ") + (cells ? "cell" : "point") + " values of field '" +
                            field.name + "': the ranks' pieces were made without " +
                            (cells ? "cell" : "point") + " fields, so none can be given");
-        const std::uint64_t expected = cells ? routes.shareCells : routes.sharePoints;
-        if (field.values.size() != expected)
-            throwError(ErrorKind::Argument, "",
-                       "new values of field '" + field.name +
-                           "': " + std::to_string(field.values.size()) + " " +
-                           associationName(field.association) + " values, expected " +
-                           std::to_string(expected) + " (one per " + (cells ? "cell" : "point") +
-                           " of this rank's share)");
+        checkNewValueCount(field, cells ? routes.shareCells : routes.sharePoints,
+                           "this rank's share");
     });
     const auto& send = cells ? routes.sendCells : routes.sendPoints;
     const auto& receive = cells ? routes.receiveCells : routes.receivePoints;

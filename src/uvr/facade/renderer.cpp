@@ -248,14 +248,7 @@ void Renderer::setFieldValues(const ScalarField& field) {
     ScalarField share;
     agreeOn(*comm_, [&] {
         if (!fromWhole_) return;  // made from a share: the share's values
-        const std::uint64_t whole = cells ? wholeCellCount_ : wholePointCount_;
-        if (field.values.size() != whole)
-            throwError(ErrorKind::Argument, "",
-                       "new values of field '" + field.name +
-                           "': " + std::to_string(field.values.size()) + " " +
-                           associationName(field.association) + " values, expected " +
-                           std::to_string(whole) + " (one per " + (cells ? "cell" : "point") +
-                           " of the mesh)");
+        checkNewValueCount(field, cells ? wholeCellCount_ : wholePointCount_, "the mesh");
         share.name = field.name;
         share.association = field.association;
         share.choice = field.choice;

@@ -222,6 +222,15 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     return out;
 }
 
+void checkNewValueCount(const ScalarField& field, std::uint64_t expected, const std::string& of) {
+    if (field.values.size() == expected) return;
+    throwError(ErrorKind::Argument, "",
+               "new values of field '" + field.name + "': " + std::to_string(field.values.size()) +
+                   " " + associationName(field.association) + " values, expected " +
+                   std::to_string(expected) + " (one per " +
+                   (field.association == Association::Cell ? "cell" : "point") + " of " + of + ")");
+}
+
 void updateFieldValues(PreparedMesh& mesh, const ScalarField& field) {
     const auto start = std::chrono::steady_clock::now();
     if (!mesh.cacheFile.empty())
@@ -230,15 +239,9 @@ void updateFieldValues(PreparedMesh& mesh, const ScalarField& field) {
                        ", which holds only what rendering reads: change fields (or time steps) by "
                        "preparing from the mesh");
     // Checked before anything changes (assignTetValues checks it too).
-    const bool cellData = field.association == Association::Cell;
-    const std::uint64_t expected = cellData ? mesh.sourceCells : mesh.tets.points.size();
-    if (field.values.size() != expected)
-        throwError(ErrorKind::Argument, "",
-                   "new values of field '" + field.name +
-                       "': " + std::to_string(field.values.size()) + " " +
-                       associationName(field.association) + " values, expected " +
-                       std::to_string(expected) + " (one per " + (cellData ? "cell" : "point") +
-                       " of the prepared mesh)");
+    checkNewValueCount(
+        field, field.association == Association::Cell ? mesh.sourceCells : mesh.tets.points.size(),
+        "the prepared mesh");
     assignTetValues(mesh.tets, field);
     // Smooth gradients follow the values once shading has asked for them.
     if (!mesh.tets.blockGradients.empty()) computeSmoothGradients(mesh.tets);

@@ -226,6 +226,11 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field);
 /// new values need are not there); the prepared mesh is unchanged then.
 void updateFieldValues(PreparedMesh& mesh, const ScalarField& field);
 
+/// Throws Error(Argument) naming the field unless it holds `expected` values, one per point
+/// (or cell, by its association) of `of` ("the prepared mesh", "this rank's share", ...): the
+/// one check of new values for every place that takes them.
+void checkNewValueCount(const ScalarField& field, std::uint64_t expected, const std::string& of);
+
 /// Per partition, the diagonal of the bounding box of the field gradients of its cells (each
 /// linear tetrahedron's constant gradient, a native cell's at its corners and centre:
 /// cellGradientBounds): it bounds how much the derivative of the field along

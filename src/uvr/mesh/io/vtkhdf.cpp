@@ -484,18 +484,8 @@ public:
         LoadBudget& budget = budgeted.budget();
         const std::uint64_t heldBefore = budget.used();
         const std::vector<Partition> parts = partitions(i, budget);
-        Mesh mesh;
-        std::vector<KeptCells> kept(parts.size());
-        for (std::size_t p = 0; p < parts.size(); ++p) {
-            Mesh piece = readPartition(i, p, parts[p], budget, kept[p]);
-            if (parts.size() == 1) {
-                mesh = std::move(piece);
-            } else {
-                budget.charge(path(), label(i, p), meshBytes(piece), 1);  // its merged copy
-                appendMeshPiece(mesh, piece, p == 0, path(), where(i), label(i, p));
-            }
-            budget.resetTo(heldBefore + meshBytes(mesh));
-        }
+        std::vector<KeptCells> kept;
+        Mesh mesh = merged(i, parts, 0, parts.size(), budget, heldBefore, kept, nullptr);
         for (const std::string& note : notes_) mesh.notes.push_back(note);
         lastGeometry_ = steps_[i];
         lastKept_ = std::move(kept);
@@ -554,25 +544,41 @@ public:
                            std::to_string(end) + ") asked for, but it has " +
                            std::to_string(parts.size()));
         MeshPart out;
-        for (std::size_t p = first; p < end; ++p) {
-            KeptCells kept;
-            Mesh piece = readPartition(i, p, parts[p], budget, kept);
-            const std::uint64_t base = std::uint64_t(p) << kPieceIdShift;
-            for (std::uint64_t k = 0; k < piece.pointCount(); ++k) out.pointIds.push_back(base | k);
-            for (std::uint64_t c = 0; c < piece.cellCount(); ++c) out.cellIds.push_back(base | c);
-            if (p == first) {
-                out.mesh = std::move(piece);
-            } else {
-                budget.charge(path(), label(i, p), meshBytes(piece), 1);  // its merged copy
-                appendMeshPiece(out.mesh, piece, false, path(), where(i), label(i, p));
-            }
-            budget.resetTo(heldBefore + meshBytes(out.mesh));
-        }
+        std::vector<KeptCells> kept;
+        out.mesh = merged(i, parts, first, end, budget, heldBefore, kept, &out);
         for (const std::string& note : notes_) out.mesh.notes.push_back(note);
         return out;
     }
 
 private:
+    /// Partitions [first, end) of step i merged in order (one alone as it is), the budget
+    /// reset after each to what was held before plus the mesh; kept gets each one's kept cells,
+    /// ids (when given) each point's and cell's id in the whole step (kPieceIdShift).
+    Mesh merged(std::size_t i, const std::vector<Partition>& parts, std::size_t first,
+                std::size_t end, LoadBudget& budget, std::uint64_t heldBefore,
+                std::vector<KeptCells>& kept, MeshPart* ids) const {
+        Mesh mesh;
+        kept.assign(end - first, KeptCells{});
+        for (std::size_t p = first; p < end; ++p) {
+            Mesh piece = readPartition(i, p, parts[p], budget, kept[p - first]);
+            if (ids) {
+                const std::uint64_t base = std::uint64_t(p) << kPieceIdShift;
+                for (std::uint64_t k = 0; k < piece.pointCount(); ++k)
+                    ids->pointIds.push_back(base | k);
+                for (std::uint64_t c = 0; c < piece.cellCount(); ++c)
+                    ids->cellIds.push_back(base | c);
+            }
+            if (end - first == 1) {
+                mesh = std::move(piece);
+            } else {
+                budget.charge(path(), label(i, p), meshBytes(piece), 1);  // its merged copy
+                appendMeshPiece(mesh, piece, p == first, path(), where(i), label(i, p));
+            }
+            budget.resetTo(heldBefore + meshBytes(mesh));
+        }
+        return mesh;
+    }
+
     std::string where(std::size_t i) const {
         return stepCount() > 1 || temporal_ ? "step " + std::to_string(i) : "/VTKHDF";
     }
