@@ -296,6 +296,20 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     }
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
+    if (pieceStart && preintegrated) {
+        // A data-parallel piece that may start inside a run: the piece before's last sample, one
+        // grid point before this piece's first, gives the run's slope (SampleSegments::lead; a
+        // first sample taken later, or outside the mesh, does not continue it).
+        const float kFirst = ceilf(tEnter / s1);
+        if (kFirst - 1.f >= ceilf(tSpan / s1)) {
+            ++counters.samples;
+            float b[4];
+            std::uint32_t found = locateFrom(ray.at(kFirst * s1), kNoTet, b);
+            if (found != kNoTet) found = locateFrom(ray.at((kFirst - 1.f) * s1), found, b);
+            if (found != kNoTet)
+                segments.lead(kFirst - 1.f, true, locator.mesh.interpolate<kNative>(found, b));
+        }
+    }
     // One loop whose every iteration takes a sample, skips a transparent macrocell or moves to
     // the next partition, so GPU threads of a warp crossing partition boundaries at different
     // samples stay together. The loop leaves only through its condition (no break or return
@@ -315,10 +329,6 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                segments.iso->within(b.valueMin, b.valueMax);
     };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
-    // A data-parallel piece's first sample, on its first grid point, may continue the run of
-    // the piece before's last sample one grid point back (SampleSegments::lead).
-    bool leadPending = pieceStart && preintegrated;
-    const float kLeadAt = ceilf(tEnter / s1);
     float kLocated = -INFINITY;  // grid position of the last sample located
     bool marching = true, opaque = false, macro = false;
     // Depth out: the opacity and the end of the stretch of the ray noted last, noted wherever
@@ -397,7 +407,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // long step the mesh may have ended before this point (empty macrocells are
                 // transparent): the sample is then located as usual, which finds the boundary.
                 const bool longGap = preintegrated && segments.started && segments.inside &&
-                                     kSample - segments.kLast > 1.f;
+                                     !segments.led && kSample - segments.kLast > 1.f;
                 if constexpr (kSurf) runFromValid = false;
                 if (!longGap) {
                     if (preintegrated) {
@@ -433,17 +443,6 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const Vec3f grad =
             sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
         const LightFactors light = lightAt(lighting, tet, grad, ray.dir);
-        if (leadPending) {
-            leadPending = false;
-            if (tet != kNoTet && kSample == kLeadAt && kSample - 1.f >= ceilf(tSpan / s1)) {
-                ++counters.samples;
-                float leadBary[4];
-                const std::uint32_t found = locateFrom(ray.at((kSample - 1.f) * s1), tet, leadBary);
-                if (found != kNoTet)
-                    segments.lead(kSample - 1.f, true,
-                                  locator.mesh.interpolate<kNative>(found, leadBary));
-            }
-        }
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
         // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
@@ -537,7 +536,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kRunFrom,
                         runFromOutside, kSample, tet, v, k1, segments, counters, acc);
-                if (!in && segments.iso && segments.started && segments.inside &&
+                if (!in && segments.iso && segments.started && segments.inside && !segments.led &&
                     kSample <= segments.kEnd && !endsRun && isoNear())
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kSample,
