@@ -437,46 +437,56 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
             outside.insert(outside.end(), ids.begin(), ids.end());
         }
         const std::vector<std::vector<std::uint64_t>> all = comm.allGatherValues(outside);
+        outside = {};
+        // Every rank's points outside rank r's box, sorted; and which of this share's points
+        // lie in any such list (one pass over the cells then finds the few cells to check).
+        std::vector<std::vector<std::uint64_t>> rings(ranks);
+        std::vector<std::uint8_t> inRing(share.pointIds.size(), 0);
         for (int r = 0; r < ranks; ++r) {
-            std::vector<std::uint64_t> ring;  // every rank's points outside r's box, sorted
             for (const std::vector<std::uint64_t>& from : all) {
                 std::size_t at = 0;
                 for (int k = 0; k < r; ++k) at += 1 + from.at(at);
                 const std::uint64_t count = from.at(at);
-                ring.insert(ring.end(), from.begin() + at + 1, from.begin() + at + 1 + count);
+                rings[r].insert(rings[r].end(), from.begin() + at + 1,
+                                from.begin() + at + 1 + count);
             }
-            std::sort(ring.begin(), ring.end());
-            if (ring.empty()) continue;
-            // This share's cells around those points that do not reach r's widened box.
-            std::vector<std::uint32_t> more;
-            std::size_t next = 0;  // reaching[r] is increasing
-            for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
-                if (next < reaching[r].size() && reaching[r][next] == c) {
-                    ++next;
-                    continue;
-                }
-                for (std::uint32_t id : share.mesh.cell(c))
-                    if (std::binary_search(ring.begin(), ring.end(), share.pointIds[id])) {
-                        more.push_back(static_cast<std::uint32_t>(c));
-                        break;
-                    }
+            std::sort(rings[r].begin(), rings[r].end());
+            for (std::uint64_t id : rings[r]) {  // share.pointIds is increasing
+                const auto it = std::lower_bound(share.pointIds.begin(), share.pointIds.end(), id);
+                if (it != share.pointIds.end() && *it == id)
+                    inRing[it - share.pointIds.begin()] = 1;
             }
-            if (more.empty()) continue;
+        }
+        // This share's cells around those points, for each rank whose widened box they miss.
+        std::vector<std::vector<std::uint32_t>> more(ranks);
+        for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
+            const std::span<const std::uint32_t> corners = share.mesh.cell(c);
+            if (std::none_of(corners.begin(), corners.end(),
+                             [&](std::uint32_t id) { return inRing[id] != 0; }))
+                continue;
+            const auto cell = static_cast<std::uint32_t>(c);
+            for (int r = 0; r < ranks; ++r)
+                if (!std::binary_search(reaching[r].begin(), reaching[r].end(), cell) &&
+                    std::any_of(corners.begin(), corners.end(), [&](std::uint32_t id) {
+                        return inRing[id] && std::binary_search(rings[r].begin(), rings[r].end(),
+                                                                share.pointIds[id]);
+                    }))
+                    more[r].push_back(cell);
+        }
+        for (int r = 0; r < ranks; ++r) {
+            if (more[r].empty()) continue;
             std::vector<std::uint32_t> merged;
-            std::merge(reaching[r].begin(), reaching[r].end(), more.begin(), more.end(),
+            std::merge(reaching[r].begin(), reaching[r].end(), more[r].begin(), more[r].end(),
                        std::back_inserter(merged));
             reaching[r] = std::move(merged);
         }
     }
     local = {};
     std::vector<std::vector<std::byte>> toEach(ranks);
-    for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
-        const std::span<const std::uint32_t> corners = share.mesh.cell(c);
-        for (int r = 0; r < ranks; ++r) {
-            if (!std::binary_search(reaching[r].begin(), reaching[r].end(),
-                                    static_cast<std::uint32_t>(c)))
-                continue;
-            routes.sendCells[r].push_back(static_cast<std::uint32_t>(c));
+    for (int r = 0; r < ranks; ++r) {
+        for (std::uint32_t c : reaching[r]) {
+            const std::span<const std::uint32_t> corners = share.mesh.cell(c);
+            routes.sendCells[r].push_back(c);
             std::vector<std::byte>& m = toEach[r];
             put(m, share.cellIds[c]);
             put(m, static_cast<std::uint8_t>(share.mesh.cellTypes[c]));
