@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The renderer.
 #include "support.h"
+#include "uvr/core/text.h"
 
 namespace uvr::python {
 
@@ -11,9 +12,14 @@ void bindRenderer(py::module_& m) {
                          const std::string& association, const py::handle& values,
                          const std::string& device, const std::string& buildDevice,
                          std::uint32_t leafCells, bool meshBvh, bool seedGrids, bool splitCells,
-                         bool partitions, bool forAuto, int ranks) {
+                         bool partitions, bool forAuto, int ranks, float largestSampleDistance) {
                  ScalarField field = scalarField(name, association, values);
+                 if (!(largestSampleDistance >= 0.f && largestSampleDistance < INFINITY))
+                     raise(ErrorKind::Argument,
+                           "largest_sample_distance " + formatG(largestSampleDistance, 6) +
+                               ": expected a finite sample distance (0: the default's)");
                  RendererOptions o;
+                 o.largestSampleDistance = largestSampleDistance;
                  o.device = parseDevice(device, "device");
                  o.buildDevice = parseDevice(buildDevice, "build_device");
                  o.leafCells = leafCells;
@@ -52,7 +58,8 @@ void bindRenderer(py::module_& m) {
              py::arg("device") = "auto", py::arg("build_device") = "auto",
              py::arg("leaf_cells") = 0, py::arg("mesh_bvh") = true, py::arg("seed_grids") = true,
              py::arg("split_cells") = false, py::arg("partitions") = true,
-             py::arg("for_auto") = false, py::arg("ranks") = 1)
+             py::arg("for_auto") = false, py::arg("ranks") = 1,
+             py::arg("largest_sample_distance") = 0.f)
         .def(
             "set_field_values",
             [](PyRenderer& self, const std::string& name, const std::string& association,

@@ -23,6 +23,14 @@ SCRIPT = textwrap.dedent("""
     r = uvr.Renderer(mesh, device="cpu", comm=MPI.COMM_WORLD)
     img = r.render(tf="viridis", opacity="0:0,1:0.5", size=(160, 120), azimuth=30,
                    elevation=20, method=sys.argv[3])
+    # Sample distances up to the one given at preparation render; larger ones are refused.
+    far = uvr.Renderer(mesh, device="cpu", comm=MPI.COMM_WORLD, largest_sample_distance=0.5)
+    far.render(size=(32, 24), sample_distance=0.5, method="reference")
+    try:
+        far.render(size=(32, 24), sample_distance=0.8, method="reference")
+        raise SystemExit("a sample distance past the ghosts rendered")
+    except uvr.ArgumentError as e:
+        assert "expected at most 0.525" in str(e), str(e)
     # Another field's values reach the pieces (nothing geometric rebuilt).
     r.set_field("energy")
     energy = r.render(tf="viridis", opacity="0:0,1:0.5", size=(160, 120), azimuth=30,
@@ -61,6 +69,11 @@ def test_data_parallel_under_mpirun_equals_one_process(tmp_path, data_dir, metho
         diff = np.abs(levels(one) - levels(many))
         assert diff.max() <= 2, (field, diff.max())
         assert float(np.asarray(one)[..., 3].max()) > 0.1  # a picture to compare
+
+
+def test_a_bad_largest_sample_distance_is_refused():
+    with pytest.raises(uvr.ArgumentError, match="largest_sample_distance -1"):
+        uvr.Renderer(_two_tets(), largest_sample_distance=-1)
 
 
 def test_a_communicator_that_is_not_mpi4pys_is_refused():

@@ -52,17 +52,20 @@ class Renderer:
     ``comm``: under ``mpirun``, mpi4py's ``MPI.COMM_WORLD`` renders data-parallel as
     ``mpirun -n N uvr render`` does: every rank makes the Renderer and calls ``render`` with the
     same arguments, each rank holds and renders its piece of the mesh, and rank 0's ``render``
-    returns the whole picture (the other ranks' return None).
+    returns the whole picture (the other ranks' return None). ``largest_sample_distance``: the
+    largest ``sample_distance`` its frames will ask for (the pieces' ghost cells reach it; a
+    larger one is refused); None: twice the default.
     """
 
     def __init__(self, mesh, field=None, device="auto", *, build_device="auto", leaf_cells=0,
                  methods=tuple(_uvr.METHODS), seed_grids=True, split_cells=False,
-                 association=None, comm=None):
+                 association=None, comm=None, largest_sample_distance=None):
         self.series = mesh if isinstance(mesh, Series) else None
         self._step = 0
         self._ranks, self._rank = _ranks_of(comm)
         self._options = dict(device=device, build_device=build_device, leaf_cells=leaf_cells,
-                             methods=methods, seed_grids=seed_grids, split_cells=split_cells)
+                             methods=methods, seed_grids=seed_grids, split_cells=split_cells,
+                             largest_sample_distance=float(largest_sample_distance or 0.0))
         self._prepare(as_mesh(mesh), field, association)
 
     def _prepare(self, mesh, field, association=None):
@@ -84,7 +87,9 @@ class Renderer:
                                        seed_grids=bool(seed_grids),
                                        split_cells=bool(self._options["split_cells"]),
                                        partitions="adaptive" in methods,
-                                       for_auto="auto" in methods, ranks=self._ranks)
+                                       for_auto="auto" in methods, ranks=self._ranks,
+                                       largest_sample_distance=self._options[
+                                           "largest_sample_distance"])
         except BaseException:
             self.mesh = previous  # a failed new step leaves the renderer as it was
             raise
