@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include "progress.h"
-#include "uvr/mesh/io/exodus.h"
 #include "uvr/render/depth_image.h"
 
 namespace uvr::cli {
@@ -217,29 +216,21 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
             ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(pieces) +
                      " pieces for " + std::to_string(ranks) + " ranks");
         }
-        if (format == MeshFormat::VtkHdf) {
-            // A rank reads its run of the step's partitions when there are as many as ranks.
-            const std::size_t step = steps.pick(*openSeries(file, ctx));
-            const std::size_t partitions = vtkHdfPartitionCount(file, step);
-            if (partitions >= std::size_t(ranks)) {
+        if (format == MeshFormat::VtkHdf || format == MeshFormat::Exodus) {
+            // Stored in parts (a VTKHDF file's partitions, an Exodus file's cells): a rank
+            // reads its run of them when there are as many as ranks, the file opened once.
+            const std::unique_ptr<MeshSeries> series = openSeries(file, ctx);
+            const std::size_t step = steps.pick(*series);
+            const std::uint64_t parts = series->partCount(step);
+            const char* unit = format == MeshFormat::VtkHdf ? "partitions" : "cells";
+            if (parts >= std::uint64_t(ranks)) {
                 ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
-                         " ranks reads about " + std::to_string(partitions / ranks) + " of its " +
-                         std::to_string(partitions) + " partitions");
-                return readVtkHdfPart(file, cellsOf(partitions, rank),
-                                      cellsOf(partitions, rank + 1), read, step);
+                         " ranks reads about " + std::to_string(parts / ranks) + " of its " +
+                         std::to_string(parts) + " " + unit);
+                return series->readPart(step, cellsOf(parts, rank), cellsOf(parts, rank + 1));
             }
-            ctx.step("reading " + file + " whole on every rank: it has " +
-                     std::to_string(partitions) + " partitions for " + std::to_string(ranks) +
-                     " ranks");
-        }
-        if (format == MeshFormat::Exodus) {
-            // Each rank reads its run of the cells, block rows and node spans only.
-            const std::size_t step = steps.pick(*openSeries(file, ctx));
-            const std::uint64_t n = exodusCellCount(file);
-            ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
-                     " ranks reads about " + std::to_string(n / ranks) + " of its " +
-                     std::to_string(n) + " cells");
-            return readExodusPart(file, cellsOf(n, rank), cellsOf(n, rank + 1), read, step);
+            ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(parts) +
+                     " " + unit + " for " + std::to_string(ranks) + " ranks");
         }
         if (format == MeshFormat::Native && !steps.time && !steps.index) {
             const std::uint64_t n = readNativeSummary(file, false).cellCount;

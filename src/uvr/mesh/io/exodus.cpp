@@ -48,23 +48,21 @@ Mesh readExodus(const std::string& path, const ReadOptions& options) {
     return openExodus(path, options)->readStep(0);
 }
 
+std::uint64_t exodusCellCount(const std::string& path) {
+    return openExodus(path, {})->partCount(0);
+}
+
+MeshPart readExodusPart(const std::string& path, std::uint64_t first, std::uint64_t end,
+                        const ReadOptions& options, std::size_t step) {
+    return openExodus(path, options)->readPart(step, first, end);
+}
+
 #ifndef UVR_HAVE_NETCDF
 
 std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOptions&) {
     throwError(ErrorKind::Unsupported, path,
                "this uvr was built without netCDF, so it cannot read Exodus II files: install "
                "libnetcdf-dev and rebuild");
-}
-
-std::uint64_t exodusCellCount(const std::string& path) {
-    (void)openExodus(path, {});
-    return 0;
-}
-
-MeshPart readExodusPart(const std::string& path, std::uint64_t, std::uint64_t,
-                        const ReadOptions& options, std::size_t) {
-    (void)openExodus(path, options);
-    return {};
 }
 
 #else
@@ -338,13 +336,16 @@ public:
         return readFields(i, budgeted.budget());
     }
 
-    /// Cells the mesh of a step holds (the kept blocks' elements).
-    std::uint64_t cellCount() const { return keptCells_; }
+    /// Cells the mesh of a step holds (the kept blocks' elements): a rank's part is a run of them.
+    std::uint64_t partCount(std::size_t i) const override {
+        checkStep(i);
+        return keptCells_;
+    }
 
     /// The cells [first, end) of step i and what they use, as meshPart takes them from
     /// readStep(i): the blocks' connectivity read only over those cells' rows, the coordinates
     /// and nodal variables over the span of node numbers they use.
-    MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end) {
+    MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end) override {
         checkStep(i);
         const FormatLibraryLock lock;
         if (first > end || end > keptCells_)
@@ -980,21 +981,6 @@ std::unique_ptr<MeshSeries> openExodus(const std::string& path, const ReadOption
     std::unique_ptr<MeshSeries> series = openExodusHere(path, options);
     expectSameFile(path, identity);
     return series;
-}
-
-std::uint64_t exodusCellCount(const std::string& path) {
-    const std::unique_ptr<MeshSeries> series = openExodus(path, {});
-    const auto* exodus = dynamic_cast<const ExodusSeries*>(series.get());
-    UVR_CHECK(exodus, "an Exodus file opens as an ExodusSeries");
-    return exodus->cellCount();
-}
-
-MeshPart readExodusPart(const std::string& path, std::uint64_t first, std::uint64_t end,
-                        const ReadOptions& options, std::size_t step) {
-    const std::unique_ptr<MeshSeries> series = openExodus(path, options);
-    auto* exodus = dynamic_cast<ExodusSeries*>(series.get());
-    UVR_CHECK(exodus, "an Exodus file opens as an ExodusSeries");
-    return exodus->readPart(step, first, end);
 }
 
 #endif

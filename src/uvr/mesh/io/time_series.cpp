@@ -29,6 +29,11 @@ MeshSeries::MeshSeries(std::string path, std::vector<double> times, ReadOptions 
     UVR_CHECK(!times_.empty(), "a series has at least one step");
 }
 
+MeshPart MeshSeries::readPart(std::size_t i, std::uint64_t, std::uint64_t) {
+    checkStep(i);
+    throwError(ErrorKind::Unsupported, path_, "this format is read whole, not in parts");
+}
+
 void MeshSeries::checkStep(std::size_t i) const {
     if (i >= times_.size())
         throwError(ErrorKind::Argument, path_,

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/read_options.h"
 #include "uvr/mesh/mesh.h"
 
@@ -42,6 +43,15 @@ public:
     /// are those readStep(i) would give. The default reads the step whole and compares.
     virtual std::optional<std::vector<Field>> readFieldsIfSameGeometry(std::size_t i,
                                                                        const MeshView& geometry);
+
+    /// How many parts step i is stored in that readPart reads runs of (a data-parallel rank's
+    /// share: a VTKHDF file's partitions, an Exodus II file's cells); 0 for a format read only
+    /// whole.
+    virtual std::uint64_t partCount(std::size_t i) const { return (checkStep(i), 0); }
+    /// The parts [first, end) of step i and what they use, with the ids of their points and
+    /// cells in the whole step (MeshPart). Throws Error(Argument) for a range beyond
+    /// partCount(i), Error(Unsupported) for a format read only whole.
+    virtual MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end);
 
 protected:
     MeshSeries(std::string path, std::vector<double> times, ReadOptions options);

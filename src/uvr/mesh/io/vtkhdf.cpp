@@ -523,14 +523,14 @@ public:
     }
 
     /// Partitions of step i.
-    std::size_t partitionCount(std::size_t i) const {
+    std::uint64_t partCount(std::size_t i) const override {
         checkStep(i);
         return steps_[i].parts;
     }
 
     /// Partitions [first, end) of step i, as readStep merges them, with their ids in the whole
     /// step's order (kPieceIdShift).
-    MeshPart readPart(std::size_t i, std::size_t first, std::size_t end) {
+    MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end) override {
         checkStep(i);
         const FormatLibraryLock lock;
         quietHdf5();
@@ -940,18 +940,12 @@ std::unique_ptr<MeshSeries> openVtkHdfSeries(const std::string& path, const Read
 }
 
 std::size_t vtkHdfPartitionCount(const std::string& path, std::size_t step) {
-    const std::unique_ptr<MeshSeries> series = openSeries(path, {});
-    const auto* vtkhdf = dynamic_cast<const VtkHdfSeries*>(series.get());
-    UVR_CHECK(vtkhdf, "a VTKHDF file opens as a VtkHdfSeries");
-    return vtkhdf->partitionCount(step);
+    return openSeries(path, {})->partCount(step);
 }
 
 MeshPart readVtkHdfPart(const std::string& path, std::size_t first, std::size_t end,
                         const ReadOptions& options, std::size_t step) {
-    const std::unique_ptr<MeshSeries> series = openSeries(path, options);
-    auto* vtkhdf = dynamic_cast<VtkHdfSeries*>(series.get());
-    UVR_CHECK(vtkhdf, "a VTKHDF file opens as a VtkHdfSeries");
-    return vtkhdf->readPart(step, first, end);
+    return openSeries(path, options)->readPart(step, first, end);
 }
 
 Mesh readVtkHdf(const std::string& path, const ReadOptions& options) {
