@@ -54,6 +54,20 @@ def main():
         if not ok:
             failures.append(what)
 
+    def ranks_match_one(name, tag, base, counts, says=None):
+        """`base` (`uvr render` without -o) in one process, then on each rank count: every run
+        succeeds (its stderr holding says(n) when given) and gives one process's picture."""
+        one = os.path.join(args.out, f"{tag}_1.png")
+        r = run(base + ([] if "-q" in base else ["-q"]) + ["-o", one])
+        check(r.returncode == 0, f"{name}: one process ({r.stderr.strip()})")
+        for n in counts:
+            many = os.path.join(args.out, f"{tag}_{n}.png")
+            r = run(mpirun(n) + base + ["-o", many])
+            check(r.returncode == 0 and (says is None or says(n) in r.stderr),
+                  f"{name}: {n} ranks read their parts ({r.stderr[-300:]})")
+            c = run([args.uvr, "compare", one, many, "--min-ssim", "0.999", "--max-diff", "2"])
+            check(c.returncode == 0, f"{name}: {n} ranks = one process ({c.stdout.strip()[-200:]})")
+
     # The same picture as one process.
     for mesh, view in MESHES:
         path = os.path.join(args.data, mesh)
@@ -90,19 +104,10 @@ def main():
     check(r.returncode == 0, f"generate a .uvrm ({r.stderr.strip()})")
     base = [args.uvr, "render", box, "--device", "cpu", "--size", SIZE, "--no-cache", "-q",
             "--azimuth", "20", "--elevation", "30"]
-    one = os.path.join(args.out, "box_1.png")
-    r = run(base + ["-o", one])
-    check(r.returncode == 0, f"box.uvrm: one process ({r.stderr.strip()})")
-    for n in ranks_list + [3]:
-        many = os.path.join(args.out, f"box_{n}.png")
-        r = run(mpirun(n) + base + ["-o", many])
-        check(r.returncode == 0, f"box.uvrm: {n} ranks read their parts ({r.stderr[-300:]})")
-        # The default ramp reaches opacity 1: where one process's ray stops at the termination
-        # opacity (0.99) inside a rank behind, that rank renders the pixel again to one
-        # process's stop (the compositing's second pass; docs/METHOD.md, "Data-parallel
-        # rendering").
-        c = run([args.uvr, "compare", one, many, "--min-ssim", "0.999", "--max-diff", "2"])
-        check(c.returncode == 0, f"box.uvrm: {n} ranks = one process ({c.stdout.strip()[-200:]})")
+    # The default ramp reaches opacity 1: where one process's ray stops at the termination
+    # opacity (0.99) inside a rank behind, that rank renders the pixel again to one process's
+    # stop (the compositing's second pass; docs/METHOD.md, "Data-parallel rendering").
+    ranks_match_one("box.uvrm", "box", base, ranks_list + [3])
 
     # A .pvtu of 4 pieces (VTK's parallel writer): each rank reads its run of the pieces.
     pvtu = os.path.join(args.out, "fin.pvtu")
@@ -133,16 +138,7 @@ with open({pvtu!r}, "w") as f:
     else:
         base = [args.uvr, "render", pvtu, "--device", "cpu", "--size", SIZE, "--no-cache", "-q",
                 "--tf", "viridis", "--opacity", "0:0,0.5:0.3,1:0.8", "--azimuth", "35"]
-        one = os.path.join(args.out, "fin_1.png")
-        r = run(base + ["-o", one])
-        check(r.returncode == 0, f"fin.pvtu: one process ({r.stderr.strip()})")
-        for n in ranks_list:
-            many = os.path.join(args.out, f"fin_{n}.png")
-            r = run(mpirun(n) + base + ["-o", many])
-            check(r.returncode == 0, f"fin.pvtu: {n} ranks read their pieces ({r.stderr[-300:]})")
-            c = run([args.uvr, "compare", one, many, "--min-ssim", "0.999", "--max-diff", "2"])
-            check(c.returncode == 0,
-                  f"fin.pvtu: {n} ranks = one process ({c.stdout.strip()[-200:]})")
+        ranks_match_one("fin.pvtu", "fin", base, ranks_list)
 
     # A VTKHDF file of 4 partitions (VTK's cell extraction, written as Kitware's VTKHDF 1.0
     # layout with h5py): each rank reads its run of the partitions.
@@ -183,17 +179,8 @@ with h5py.File({fin_hdf!r}, "w") as f:
     else:
         base = [args.uvr, "render", fin_hdf, "--device", "cpu", "--size", SIZE, "--no-cache",
                 "--tf", "viridis", "--opacity", "0:0,0.5:0.3,1:0.8", "--azimuth", "-40"]
-        one = os.path.join(args.out, "finhdf_1.png")
-        r = run(base + ["-q", "-o", one])
-        check(r.returncode == 0, f"fin.vtkhdf: one process ({r.stderr.strip()})")
-        for n in ranks_list:
-            many = os.path.join(args.out, f"finhdf_{n}.png")
-            r = run(mpirun(n) + base + ["-o", many])
-            check(r.returncode == 0 and f"ranks reads about {4 // n} of its 4 partitions"
-                  in r.stderr, f"fin.vtkhdf: {n} ranks read their partitions ({r.stderr[-300:]})")
-            c = run([args.uvr, "compare", one, many, "--min-ssim", "0.999", "--max-diff", "2"])
-            check(c.returncode == 0,
-                  f"fin.vtkhdf: {n} ranks = one process ({c.stdout.strip()[-200:]})")
+        ranks_match_one("fin.vtkhdf", "finhdf", base, ranks_list,
+                        lambda n: f"ranks reads about {4 // n} of its 4 partitions")
 
     # Exodus II (ParaView's disk_out_ref.ex2 from Debian's mayavi2): each rank reads its run of
     # the cells, block rows and node spans only; native hexahedra.
@@ -203,17 +190,8 @@ with h5py.File({fin_hdf!r}, "w") as f:
     else:
         base = [args.uvr, "render", disk, "--device", "cpu", "--size", SIZE, "--no-cache",
                 "--tf", "Black-Body Radiation", "--azimuth", "30", "--elevation", "20"]
-        one = os.path.join(args.out, "disk_1.png")
-        r = run(base + ["-q", "-o", one])
-        check(r.returncode == 0, f"disk_out_ref.ex2: one process ({r.stderr.strip()})")
-        for n in ranks_list:
-            many = os.path.join(args.out, f"disk_{n}.png")
-            r = run(mpirun(n) + base + ["-o", many])
-            check(r.returncode == 0 and "ranks reads about" in r.stderr,
-                  f"disk_out_ref.ex2: {n} ranks read their cells ({r.stderr[-300:]})")
-            c = run([args.uvr, "compare", one, many, "--min-ssim", "0.999", "--max-diff", "2"])
-            check(c.returncode == 0,
-                  f"disk_out_ref.ex2: {n} ranks = one process ({c.stdout.strip()[-200:]})")
+        ranks_match_one("disk_out_ref.ex2", "disk", base, ranks_list,
+                        lambda n: "ranks reads about")
 
     # uvr bench under mpirun: every variant timed on the composited frames, rank 0 writes.
     bench = os.path.join(args.out, "bench.json")
