@@ -173,28 +173,47 @@ TEST(DataParallel, OnTheGpuEveryMethodGivesOneProcessPicture) {
     }
 }
 
+/// The unit cube of 8^3 hexahedra with field x, which two ranks split at the median cell centre
+/// x = 0.125 (64 cells a partition, on the CPU).
+struct SplitCube {
+    Mesh mesh = testing::makeHexGrid(
+        8, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);
+    ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options = [] {
+        RendererOptions o;
+        o.device = Device::Cpu;
+        o.leafCells = 64;
+        return o;
+    }();
+
+    /// A 48 x 48 frame along the x axis from x = eyeX, constant opacity 0.5 over `unit`.
+    static RenderSettings alongX(RenderMethod method, float eyeX, float unit) {
+        RenderSettings s;
+        s.width = s.height = 48;
+        s.method = method;
+        s.tf = transferFunctionPreset("viridis");
+        applyOpacitySpec(s.tf, "constant:0.5");
+        s.opacityUnit = unit;
+        Camera c;
+        c.position = Vec3f(eyeX, 0.f, 0.f);
+        c.focalPoint = Vec3f(0.f, 0.f, 0.f);
+        c.viewUp = Vec3f(0.f, 0.f, 1.f);
+        s.camera = c;
+        return s;
+    }
+};
+
 TEST(DataParallel, ExactGoesOnBehindANearlyOpaqueFrontRankAsOneProcessDoes) {
     // Two ranks split the cube at the median cell centre, x = 0.125; seen from -x, the front
     // rank's opacity is 0.9905, above the sampling methods' termination (0.99) but below
     // exact's: one process's exact ray goes on into the back (about 2.3/255 of its colour), so
     // the composite must take the back rank too.
-    const Mesh mesh = testing::makeHexGrid(
-        8, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);
-    const ScalarField field = selectScalarField(mesh, {});
-    RendererOptions options;
-    options.device = Device::Cpu;
-    options.leafCells = 64;
-    RenderSettings s;
-    s.width = s.height = 48;
-    s.method = RenderMethod::Exact;
-    s.tf = transferFunctionPreset("viridis");
-    applyOpacitySpec(s.tf, "constant:0.5");
-    s.opacityUnit = 0.1208f;  // 1 - exp(-0.5 * 1.125 / 0.1208) = 0.9905 in front
-    Camera c;
-    c.position = Vec3f(-6.f, 0.f, 0.f);
-    c.focalPoint = Vec3f(0.f, 0.f, 0.f);
-    c.viewUp = Vec3f(0.f, 0.f, 1.f);
-    s.camera = c;
+    const SplitCube cube;
+    const Mesh& mesh = cube.mesh;
+    const ScalarField& field = cube.field;
+    const RendererOptions& options = cube.options;
+    // 1 - exp(-0.5 * 1.125 / 0.1208) = 0.9905 in front
+    const RenderSettings s = SplitCube::alongX(RenderMethod::Exact, -6.f, 0.1208f);
     const Image one = Renderer(mesh, field, options).render(s).image;
     const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 2, options, {s});
     ASSERT_EQ(many.size(), 1u);
@@ -209,26 +228,15 @@ TEST(DataParallel, ARayStopsBehindTheFrontRankWhereOneProcessStops) {
     // opacity 0.5, the whole depth would reach 0.795, and the termination opacity 0.7 stops one
     // process's ray inside the back rank. The back rank's own ray, alone, never reaches 0.7:
     // without the second pass it would add all its light (alpha 0.795, not 0.7).
-    const Mesh mesh = testing::makeHexGrid(
-        8, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.f);
-    const ScalarField field = selectScalarField(mesh, {});
-    RendererOptions options;
-    options.device = Device::Cpu;
-    options.leafCells = 64;
+    const SplitCube cube;
+    const Mesh& mesh = cube.mesh;
+    const ScalarField& field = cube.field;
+    const RendererOptions& options = cube.options;
     std::vector<RenderSettings> frames;
     for (RenderMethod method : {RenderMethod::Reference, RenderMethod::Partitions}) {
-        RenderSettings s;
-        s.width = s.height = 48;
-        s.method = method;
-        s.tf = transferFunctionPreset("viridis");
-        applyOpacitySpec(s.tf, "constant:0.5");
-        s.opacityUnit = 0.5f * 0.875f / std::log(2.f);  // 1 - exp(-0.5 * 0.875 / u) = 0.5
+        // 1 - exp(-0.5 * 0.875 / u) = 0.5
+        RenderSettings s = SplitCube::alongX(method, 6.f, 0.5f * 0.875f / std::log(2.f));
         s.terminationAlpha = 0.7f;
-        Camera c;
-        c.position = Vec3f(6.f, 0.f, 0.f);
-        c.focalPoint = Vec3f(0.f, 0.f, 0.f);
-        c.viewUp = Vec3f(0.f, 0.f, 1.f);
-        s.camera = c;
         frames.push_back(s);
     }
     const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 2, options, frames);
