@@ -12,7 +12,11 @@
 # python3-selenium for the viewer page's browser test; pytest, meshio, python3-vtk9, scikit-image
 # and matplotlib for the Python tests and benchmark figures; python3-h5py for the VTKHDF test
 # files; mayavi2 for ParaView's disk_out_ref.ex2 the Exodus tests read; python3-mpi4py for the
-# Python module under mpirun.
+# Python module under mpirun; paraview, paraview-dev and libglew-dev for the ParaView plugin
+# (paraview/), whose CMake files and pvbatch also need python3-paraview's files: that package
+# conflicts with python3-vtk9 (installing it removes python3-vtk9 and mayavi2), so its .deb is
+# fetched from the package archive and unpacked into /opt/uvr/python3-paraview, not installed
+# (docs/PARAVIEW.md, "Building").
 set -eu
 export DEBIAN_FRONTEND=noninteractive
 PACKAGES="g++ cmake make ninja-build pkg-config
@@ -28,7 +32,8 @@ TEST_PACKAGES="libgtest-dev libbenchmark-dev
   python3-vtk9 python3-meshio python3-skimage python3-pytest python3-matplotlib
   xvfb xauth
   chromium chromium-driver python3-selenium
-  python3-h5py mayavi2 python3-mpi4py"
+  python3-h5py mayavi2 python3-mpi4py
+  paraview paraview-dev libglew-dev"
 case "${1:-}" in
   --tests) PACKAGES="$PACKAGES $TEST_PACKAGES" ;;
   "") ;;
@@ -41,4 +46,18 @@ done
 if [ -n "$missing" ]; then
   apt-get update -q
   apt-get install -y -q --no-install-recommends $missing
+fi
+# python3-paraview's files, unpacked beside the system's packages (see above).
+PVPY=/opt/uvr/python3-paraview
+if [ "${1:-}" = "--tests" ] && [ ! -d "$PVPY/usr/lib/python3/dist-packages/paraview/modules" ]; then
+  tmp=$(mktemp -d)
+  chmod 755 "$tmp"  # apt-get download writes as the _apt user
+  trap 'rm -rf "$tmp"' EXIT
+  version=$(dpkg-query -W -f='${Version}' paraview)
+  (cd "$tmp" && apt-get download -q "python3-paraview=$version")
+  rm -rf "$PVPY.partial"
+  mkdir -p "$PVPY.partial"
+  dpkg-deb -x "$tmp"/python3-paraview_*.deb "$PVPY.partial"
+  rm -rf "$PVPY"
+  mv "$PVPY.partial" "$PVPY"
 fi

@@ -1,0 +1,418 @@
+// SPDX-License-Identifier: MIT
+#include "vtkUvrVolumeMapper.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "uvr/mesh/io/vtk_cells.h"
+#include "uvr/uvr.h"
+#include "vtkCamera.h"
+#include "vtkCellArray.h"
+#include "vtkCellArrayIterator.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkDataArray.h"
+#include "vtkDataSet.h"
+#include "vtkIdTypeArray.h"
+#include "vtkMatrix4x4.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLState.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPoints.h"
+#include "vtkRenderer.h"
+#include "vtkScalarsToColors.h"
+#include "vtkTextureObject.h"
+#include "vtkUnstructuredGrid.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+#include "vtk_glew.h"
+
+vtkStandardNewMacro(vtkUvrVolumeMapper);
+
+namespace {
+
+/// Control points a ParaView transfer function is sampled at: VTK evaluates its own colour
+/// spaces, midpoints and sharpness, the library interpolates linearly between the samples.
+constexpr int kTfSamples = 1024;
+
+/// FNV-1a over raw bytes: tells whether a new data set has the geometry already prepared.
+std::uint64_t hashBytes(const void* data, std::size_t n, std::uint64_t h) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+}  // namespace
+
+struct vtkUvrVolumeMapper::Internals {
+    uvr::RenderSettings settings;  ///< the vocabulary's settings as the panel set them
+    uvr::RendererOptions options;
+    int vectorMode = vtkScalarsToColors::MAGNITUDE;
+    int vectorComponent = 0;
+
+    // What is prepared.
+    std::unique_ptr<uvr::Mesh> mesh;  ///< geometry and the prepared field's array
+    std::unique_ptr<uvr::Renderer> renderer;
+    std::uint64_t geometryKey = 0;
+    std::string fieldKey;  ///< array, association, component, values' modification time
+    uvr::Association association = uvr::Association::Point;  ///< of the prepared field
+    bool optionsChanged = true;
+
+    std::string report = "{}";
+    vtkNew<vtkTextureObject> texture;
+    std::vector<float> upload;  ///< the frame, rows from the bottom
+};
+
+vtkUvrVolumeMapper::vtkUvrVolumeMapper() : internals_(std::make_unique<Internals>()) {
+    internals_->options.forAuto = true;
+}
+
+vtkUvrVolumeMapper::~vtkUvrVolumeMapper() = default;
+
+void vtkUvrVolumeMapper::SetUvrSetting(const std::string& name, const std::string& jsonValue) {
+    try {
+        uvr::applySetting(internals_->settings, name, nlohmann::json::parse(jsonValue));
+        this->Modified();
+    } catch (const std::exception& e) {
+        vtkErrorMacro(<< "uvr Volume: " << e.what());
+    }
+}
+
+void vtkUvrVolumeMapper::SetUvrDevice(const std::string& device) {
+    try {
+        const uvr::Device d = uvr::parseDevice(device, "Device");
+        if (d != internals_->options.device) {
+            internals_->options.device = d;
+            internals_->optionsChanged = true;
+            this->Modified();
+        }
+    } catch (const std::exception& e) {
+        vtkErrorMacro(<< "uvr Volume: " << e.what());
+    }
+}
+
+void vtkUvrVolumeMapper::SetUvrSplitCells(bool split) {
+    if (split != internals_->options.splitCells) {
+        internals_->options.splitCells = split;
+        internals_->optionsChanged = true;
+        this->Modified();
+    }
+}
+
+void vtkUvrVolumeMapper::SetUvrClipPlane(bool on, const double origin[3], const double normal[3]) {
+    auto& planes = internals_->settings.clipPlanes;
+    planes.clear();
+    if (on) {
+        uvr::ClipPlane p;
+        p.origin = {float(origin[0]), float(origin[1]), float(origin[2])};
+        p.normal = {float(normal[0]), float(normal[1]), float(normal[2])};
+        planes.push_back(p);
+    }
+    this->Modified();
+}
+
+void vtkUvrVolumeMapper::SetUvrIsoSurfaces(const std::vector<double>& values, double opacity) {
+    auto& isos = internals_->settings.isoSurfaces;
+    isos.clear();
+    for (double v : values) {
+        uvr::IsoSurface s;
+        s.value = float(v);
+        s.opacity = float(opacity);
+        isos.push_back(s);
+    }
+    this->Modified();
+}
+
+void vtkUvrVolumeMapper::SetUvrVectorMode(int mode, int component) {
+    if (mode != internals_->vectorMode || component != internals_->vectorComponent) {
+        internals_->vectorMode = mode;
+        internals_->vectorComponent = component;
+        this->Modified();
+    }
+}
+
+const std::string& vtkUvrVolumeMapper::LastReport() const {
+    return internals_->report;
+}
+
+namespace {
+
+/// The grid's points and cells in the library's layout (VTK's cell types, corner nodes of
+/// quadratic cells, polyhedra from their face streams; 2D cells dropped with a note).
+std::unique_ptr<uvr::Mesh> meshOf(vtkUnstructuredGrid* grid) {
+    auto mesh = std::make_unique<uvr::Mesh>();
+    const vtkIdType np = grid->GetNumberOfPoints();
+    mesh->points.resize(std::size_t(np));
+    vtkDataArray* pts = grid->GetPoints() ? grid->GetPoints()->GetData() : nullptr;
+    for (vtkIdType i = 0; i < np; ++i) {
+        double p[3];
+        pts->GetTuple(i, p);
+        mesh->points[std::size_t(i)] = {float(p[0]), float(p[1]), float(p[2])};
+    }
+    uvr::VtkCellArrays cells;
+    const vtkIdType nc = grid->GetNumberOfCells();
+    cells.types.resize(std::size_t(nc));
+    cells.offsets.reserve(std::size_t(nc) + 1);
+    cells.offsets.push_back(0);
+    vtkIdTypeArray* faces = grid->GetFaces();
+    vtkIdTypeArray* faceLocations = grid->GetFaceLocations();
+    if (faces && faceLocations) {
+        cells.polyhedronFaces = uvr::PolyhedronFaces::Separate;
+        cells.faceOffsets.push_back(0);
+    }
+    auto it = vtk::TakeSmartPointer(grid->GetCells()->NewIterator());
+    vtkIdType c = 0;
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell(), ++c) {
+        vtkIdType n = 0;
+        const vtkIdType* ids = nullptr;
+        it->GetCurrentCell(n, ids);
+        cells.types[std::size_t(c)] = grid->GetCellType(c);
+        cells.connectivity.insert(cells.connectivity.end(), ids, ids + n);
+        cells.offsets.push_back(std::int64_t(cells.connectivity.size()));
+        if (cells.polyhedronFaces == uvr::PolyhedronFaces::Separate) {
+            const vtkIdType at = faceLocations->GetValue(c);
+            if (at >= 0) {
+                // The stream [nFaces, n0, ids..., n1, ids...] of this polyhedron.
+                vtkIdType k = at;
+                const vtkIdType nFaces = faces->GetValue(k++);
+                cells.faces.push_back(nFaces);
+                for (vtkIdType f = 0; f < nFaces; ++f) {
+                    const vtkIdType m = faces->GetValue(k++);
+                    cells.faces.push_back(m);
+                    for (vtkIdType j = 0; j < m; ++j) cells.faces.push_back(faces->GetValue(k++));
+                }
+            }
+            cells.faceOffsets.push_back(std::int64_t(cells.faces.size()));
+        }
+    }
+    uvr::appendVtkCells(cells, *mesh, "the ParaView input");
+    return mesh;
+}
+
+/// A key that changes when the grid's points or cells change.
+std::uint64_t geometryKeyOf(vtkUnstructuredGrid* grid) {
+    std::uint64_t h = 1469598103934665603ull;
+    const vtkIdType np = grid->GetNumberOfPoints(), nc = grid->GetNumberOfCells();
+    h = hashBytes(&np, sizeof np, h);
+    h = hashBytes(&nc, sizeof nc, h);
+    if (vtkDataArray* pts = grid->GetPoints() ? grid->GetPoints()->GetData() : nullptr)
+        h = hashBytes(pts->GetVoidPointer(0),
+                      std::size_t(pts->GetNumberOfValues()) * std::size_t(pts->GetDataTypeSize()),
+                      h);
+    vtkCellArray* cells = grid->GetCells();
+    for (vtkDataArray* a : {static_cast<vtkDataArray*>(cells->GetOffsetsArray()),
+                            static_cast<vtkDataArray*>(cells->GetConnectivityArray())})
+        h = hashBytes(a->GetVoidPointer(0),
+                      std::size_t(a->GetNumberOfValues()) * std::size_t(a->GetDataTypeSize()), h);
+    if (vtkDataArray* types = grid->GetCellTypesArray())
+        h = hashBytes(types->GetVoidPointer(0), std::size_t(types->GetNumberOfValues()), h);
+    return h;
+}
+
+/// The transfer function the library renders: ParaView's colour and opacity functions sampled
+/// at kTfSamples values over the colour map's range (on a log scale when it maps so).
+uvr::TransferFunction tfOf(vtkColorTransferFunction* ctf, vtkPiecewiseFunction* pwf,
+                           const double range[2], bool logScale) {
+    uvr::TransferFunction tf;
+    tf.name = "ParaView";
+    tf.logScale = logScale;
+    const double lo = logScale ? std::log10(range[0]) : range[0];
+    const double hi = logScale ? std::log10(range[1]) : range[1];
+    for (int i = 0; i < kTfSamples; ++i) {
+        const double t = double(i) / (kTfSamples - 1);
+        double v = lo + t * (hi - lo);
+        if (logScale) v = std::pow(10.0, v);
+        double rgb[3];
+        ctf->GetColor(v, rgb);
+        tf.colors.push_back({float(t), {float(rgb[0]), float(rgb[1]), float(rgb[2])}});
+        tf.opacities.push_back({float(t), pwf ? float(pwf->GetValue(v)) : 1.f});
+    }
+    const double* nan = ctf->GetNanColor();
+    tf.nanColor = {float(nan[0]), float(nan[1]), float(nan[2])};
+    tf.nanOpacity = 0.f;  // VTK's volume mappers draw no NaN values
+    return tf;
+}
+
+/// The camera of the view in the library's terms.
+uvr::Camera cameraOf(vtkCamera* cam) {
+    uvr::Camera c;
+    const double* p = cam->GetPosition();
+    const double* f = cam->GetFocalPoint();
+    const double* u = cam->GetViewUp();
+    c.position = {float(p[0]), float(p[1]), float(p[2])};
+    c.focalPoint = {float(f[0]), float(f[1]), float(f[2])};
+    c.viewUp = {float(u[0]), float(u[1]), float(u[2])};
+    c.viewAngle = float(cam->GetViewAngle());
+    c.parallelProjection = cam->GetParallelProjection() != 0;
+    c.parallelScale = float(cam->GetParallelScale());
+    return c;
+}
+
+}  // namespace
+
+bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, double), void* client) {
+    Internals& in = *internals_;
+    try {
+        auto* grid = vtkUnstructuredGrid::SafeDownCast(input);
+        if (!grid) {
+            throw uvr::Error(uvr::ErrorKind::Unsupported,
+                             std::string("uvr Volume renders unstructured grids, not ") +
+                                 (input ? input->GetClassName() : "no data"));
+        }
+        int cellFlag = 0;
+        vtkDataArray* array =
+            vtkAbstractMapper::GetScalars(input, this->ScalarMode, this->ArrayAccessMode,
+                                          this->ArrayId, this->ArrayName, cellFlag);
+        if (!array) {
+            throw uvr::Error(uvr::ErrorKind::Argument,
+                             std::string("no array to render") +
+                                 (this->ArrayName && this->ArrayName[0]
+                                      ? std::string(": '") + this->ArrayName + "' is not found"
+                                      : std::string(": colour the data set by a point or cell "
+                                                    "array")));
+        }
+        const int components = array->GetNumberOfComponents();
+        int component = -1;  // the magnitude
+        if (components > 1 && in.vectorMode == vtkScalarsToColors::COMPONENT)
+            component = std::min(in.vectorComponent, components - 1);
+        if (components == 1) component = 0;
+        const std::string fieldKey = std::string(array->GetName() ? array->GetName() : "") +
+                                     (cellFlag ? ":cell:" : ":point:") + std::to_string(component) +
+                                     ":" + std::to_string(array->GetMTime()) + ":" +
+                                     std::to_string(reinterpret_cast<std::uintptr_t>(array));
+        const std::uint64_t geometryKey = geometryKeyOf(grid);
+        const bool sameGeometry =
+            in.renderer && !in.optionsChanged && geometryKey == in.geometryKey;
+        if (sameGeometry && fieldKey == in.fieldKey) return true;
+
+        // The field: the array's values, one component or the magnitude (uvr's own rule).
+        uvr::Field field;
+        field.name = array->GetName() ? array->GetName() : "values";
+        field.association = cellFlag ? uvr::Association::Cell : uvr::Association::Point;
+        field.components = components;
+        const vtkIdType tuples = array->GetNumberOfTuples();
+        field.values.resize(std::size_t(tuples) * std::size_t(components));
+        std::vector<double> tuple(static_cast<std::size_t>(components));
+        for (vtkIdType i = 0; i < tuples; ++i) {
+            array->GetTuple(i, tuple.data());
+            for (int k = 0; k < components; ++k)
+                field.values[std::size_t(i) * components + k] = float(tuple[std::size_t(k)]);
+        }
+
+        if (sameGeometry && in.association == field.association) {
+            // A new time step or array on the same geometry: new values only.
+            in.renderer->setFieldValues(uvr::scalarFieldOf(*in.mesh, field, component));
+            in.fieldKey = fieldKey;
+            return true;
+        }
+        in.renderer.reset();
+        in.mesh = meshOf(grid);
+        if (in.mesh->cellCount() == 0)
+            throw uvr::Error(uvr::ErrorKind::Argument,
+                             "the input has no volume cells (tetrahedra, hexahedra, wedges, "
+                             "pyramids, polyhedra): nothing to render");
+        const uvr::ScalarField scalars = uvr::scalarFieldOf(*in.mesh, field, component);
+        uvr::ProgressFn report;
+        if (progress) report.fraction = [progress, client](double f) { progress(client, f); };
+        in.renderer = std::make_unique<uvr::Renderer>(*in.mesh, scalars, in.options, report);
+        in.geometryKey = geometryKey;
+        in.fieldKey = fieldKey;
+        in.association = field.association;
+        in.optionsChanged = false;
+        return true;
+    } catch (const std::exception& e) {
+        in.renderer.reset();
+        in.fieldKey.clear();
+        in.report = nlohmann::json{{"error", e.what()}}.dump();
+        vtkErrorMacro(<< "uvr Volume: " << e.what());
+        return false;
+    }
+}
+
+void vtkUvrVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol) {
+    Internals& in = *internals_;
+    auto* rw = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+    vtkDataSet* input = this->GetInput();
+    if (!rw || !input || input->GetNumberOfCells() == 0) return;
+    if (!this->Prepare(input, nullptr, nullptr)) return;
+    try {
+        int width = 0, height = 0, x0 = 0, y0 = 0;
+        ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+        if (width < 1 || height < 1) return;
+
+        // The frame's settings: the panel's, the view's camera and the representation's
+        // transfer function, range and opacity unit distance.
+        uvr::RenderSettings s = in.settings;
+        s.width = width;
+        s.height = height;
+        vtkCamera* cam = ren->GetActiveCamera();
+        s.camera = cameraOf(cam);
+        vtkVolumeProperty* prop = vol->GetProperty();
+        vtkColorTransferFunction* ctf = prop->GetRGBTransferFunction(0);
+        vtkPiecewiseFunction* pwf = prop->GetScalarOpacity(0);
+        double range[2];
+        ctf->GetRange(range);
+        const bool logScale = ctf->GetScale() == VTK_CTF_LOG10 && range[0] > 0.0;
+        s.tf = tfOf(ctf, pwf, range, logScale);
+        s.range = std::pair<float, float>(float(range[0]), float(range[1]));
+        s.opacityUnit = float(prop->GetScalarOpacityUnitDistance(0));
+
+        // Depth in: the opaque geometry drawn so far ends the rays. Window depth d becomes eye
+        // z through the projection's third and fourth rows, z_ndc = (A z + B) / (C z + D); the
+        // view depth is -z. The buffer's rows run from the bottom, the library's from the top.
+        std::vector<float> depth(std::size_t(width) * std::size_t(height));
+        glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+        vtkMatrix4x4* proj = cam->GetProjectionTransformMatrix(ren);
+        const double A = proj->GetElement(2, 2), B = proj->GetElement(2, 3);
+        const double C = proj->GetElement(3, 2), D = proj->GetElement(3, 3);
+        s.depthIn.resize(depth.size());
+        for (int y = 0; y < height; ++y) {
+            for (int x = 0; x < width; ++x) {
+                const double d = depth[std::size_t(y) * width + x];
+                float& out = s.depthIn[std::size_t(height - 1 - y) * width + x];
+                if (d >= 1.0) {
+                    out = std::numeric_limits<float>::infinity();
+                    continue;
+                }
+                const double zn = 2.0 * d - 1.0;
+                out = float(-(zn * D - B) / (A - zn * C));
+            }
+        }
+
+        uvr::RenderResult r = in.renderer->render(s);
+        in.report = uvr::frameReport(*in.renderer, s, r).dump();
+
+        // Composite the premultiplied frame over the framebuffer.
+        in.upload.resize(std::size_t(width) * height * 4);
+        for (int y = 0; y < height; ++y)
+            std::memcpy(&in.upload[std::size_t(height - 1 - y) * width * 4],
+                        &r.image.pixels[std::size_t(y) * width], sizeof(float) * 4 * width);
+        in.texture->SetContext(rw);
+        in.texture->Create2DFromRaw(unsigned(width), unsigned(height), 4, VTK_FLOAT,
+                                    in.upload.data());
+        vtkOpenGLState* gl = rw->GetState();
+        vtkOpenGLState::ScopedglEnableDisable blend(gl, GL_BLEND);
+        vtkOpenGLState::ScopedglEnableDisable depthTest(gl, GL_DEPTH_TEST);
+        vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(gl);
+        vtkOpenGLState::ScopedglDepthMask depthMask(gl);
+        gl->vtkglEnable(GL_BLEND);
+        gl->vtkglDisable(GL_DEPTH_TEST);
+        gl->vtkglDepthMask(GL_FALSE);
+        gl->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        in.texture->Activate();
+        in.texture->CopyToFrameBuffer(nullptr, nullptr);  // the whole texture to the viewport
+        in.texture->Deactivate();
+    } catch (const std::exception& e) {
+        in.report = nlohmann::json{{"error", e.what()}}.dump();
+        vtkErrorMacro(<< "uvr Volume: " << e.what());
+    }
+}
+
+void vtkUvrVolumeMapper::ReleaseGraphicsResources(vtkWindow* window) {
+    internals_->texture->ReleaseGraphicsResources(window);
+}
