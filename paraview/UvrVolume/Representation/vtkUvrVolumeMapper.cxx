@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "vtkUvrVolumeMapper.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -18,7 +19,6 @@
 #include "vtkDataArray.h"
 #include "vtkDataSet.h"
 #include "vtkIdTypeArray.h"
-#include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLState.h"
@@ -62,6 +62,9 @@ struct vtkUvrVolumeMapper::Internals {
     std::string fieldKey;  ///< array, association, component, values' modification time
     uvr::Association association = uvr::Association::Point;  ///< of the prepared field
     bool optionsChanged = true;
+    /// The modification time of the input and the mapper when preparing last failed: the
+    /// failure is reported once, not at every frame, until either changes.
+    vtkMTimeType failedStamp = 0;
 
     std::string report = "{}";
     vtkNew<vtkTextureObject> texture;
@@ -257,6 +260,8 @@ uvr::Camera cameraOf(vtkCamera* cam) {
 
 bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, double), void* client) {
     Internals& in = *internals_;
+    const vtkMTimeType stamp = std::max(input ? input->GetMTime() : 0, this->GetMTime());
+    if (stamp == in.failedStamp) return false;
     try {
         auto* grid = vtkUnstructuredGrid::SafeDownCast(input);
         if (!grid) {
@@ -324,10 +329,12 @@ bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, doub
         in.fieldKey = fieldKey;
         in.association = field.association;
         in.optionsChanged = false;
+        in.failedStamp = 0;
         return true;
     } catch (const std::exception& e) {
         in.renderer.reset();
         in.fieldKey.clear();
+        in.failedStamp = stamp;
         in.report = nlohmann::json{{"error", e.what()}}.dump();
         vtkErrorMacro(<< "uvr Volume: " << e.what());
         return false;
@@ -362,14 +369,16 @@ void vtkUvrVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol) {
         s.range = std::pair<float, float>(float(range[0]), float(range[1]));
         s.opacityUnit = float(prop->GetScalarOpacityUnitDistance(0));
 
-        // Depth in: the opaque geometry drawn so far ends the rays. Window depth d becomes eye
-        // z through the projection's third and fourth rows, z_ndc = (A z + B) / (C z + D); the
-        // view depth is -z. The buffer's rows run from the bottom, the library's from the top.
+        // Depth in: the opaque geometry drawn so far ends the rays. The window depth d of a
+        // point at view depth z (along the view direction from the camera) between the clipping
+        // planes n and f is, with w = 2d - 1, perspective: w = ((f + n) - 2fn / z) / (f - n),
+        // parallel: w = (2z - (f + n)) / (f - n). The buffer's rows run from the bottom, the
+        // library's from the top.
         std::vector<float> depth(std::size_t(width) * std::size_t(height));
         glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-        vtkMatrix4x4* proj = cam->GetProjectionTransformMatrix(ren);
-        const double A = proj->GetElement(2, 2), B = proj->GetElement(2, 3);
-        const double C = proj->GetElement(3, 2), D = proj->GetElement(3, 3);
+        const double* clip = cam->GetClippingRange();
+        const double n = clip[0], f = clip[1];
+        const bool parallel = cam->GetParallelProjection() != 0;
         s.depthIn.resize(depth.size());
         for (int y = 0; y < height; ++y) {
             for (int x = 0; x < width; ++x) {
@@ -379,8 +388,9 @@ void vtkUvrVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol) {
                     out = std::numeric_limits<float>::infinity();
                     continue;
                 }
-                const double zn = 2.0 * d - 1.0;
-                out = float(-(zn * D - B) / (A - zn * C));
+                const double w = 2.0 * d - 1.0;
+                out = float(parallel ? ((f - n) * w + f + n) / 2.0
+                                     : 2.0 * f * n / ((f + n) - w * (f - n)));
             }
         }
 
