@@ -108,9 +108,12 @@ def slice_scene(args, out):
     # Its inside: 2 pixels in from its edge, where the rasterised slice and the volume's
     # boundary cover pixels differently.
     mask = covered.copy()
+    near = covered.copy()  # the slice and 2 pixels around it
     for dy in (-2, -1, 0, 1, 2):
         for dx in (-2, -1, 0, 1, 2):
-            mask &= np.roll(np.roll(covered, dy, axis=0), dx, axis=1)
+            shifted = np.roll(np.roll(covered, dy, axis=0), dx, axis=1)
+            mask &= shifted
+            near |= shifted
     check(mask.mean() > 0.05, "the slice covers part of the view (%.1f%%)" % (100 * mask.mean()))
     # The volume in front of the plane: the side of it the camera is on.
     plane = summary["plane"]
@@ -122,7 +125,7 @@ def slice_scene(args, out):
     rgba = mpimg.imread(front).astype(np.float64)  # straight alpha
     expected = rgba[:, :, :3] * rgba[:, :, 3:] + (1 - rgba[:, :, 3:]) * slc
     diff_in = np.abs(both - expected).max(axis=2)[mask] * 255
-    diff_out = np.abs(both - volume).max(axis=2)[~covered] * 255
+    diff_out = np.abs(both - volume).max(axis=2)[~near] * 255
     shown = np.abs(both - volume).max(axis=2)[mask] * 255
     print("      inside the slice: max %.1f, 99.9th percentile %.1f (8-bit levels); outside: "
           "max %.1f" % (diff_in.max(), np.percentile(diff_in, 99.9), diff_out.max()))

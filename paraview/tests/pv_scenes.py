@@ -107,6 +107,11 @@ elif SCENE == "slice":
     sd = Show(s, v)
     ColorBy(sd, None)
     sd.AmbientColor = sd.DiffuseColor = [1.0, 0.6, 0.1]
+    # Translucent geometry beside the volume: VTK would render volumes inside its depth
+    # peeling passes then, unless told not to.
+    ball = Sphere(Center=[b[1] + 2.0, centre[1], centre[2]], Radius=1.5)
+    bd = Show(ball, v)
+    bd.Opacity = 0.4
     v.ResetCamera()
     v.GetActiveCamera().Azimuth(20)
     v.GetActiveCamera().Elevation(30)

@@ -20,12 +20,15 @@
 #include "vtkDataSet.h"
 #include "vtkIdTypeArray.h"
 #include "vtkObjectFactory.h"
+#include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPoints.h"
 #include "vtkRenderer.h"
 #include "vtkScalarsToColors.h"
+#include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkVolume.h"
@@ -39,6 +42,15 @@ namespace {
 /// Control points a ParaView transfer function is sampled at: VTK evaluates its own colour
 /// spaces, midpoints and sharpness, the library interpolates linearly between the samples.
 constexpr int kTfSamples = 1024;
+
+/// The full-screen pass that blends the frame over the viewport (vtkOpenGLQuadHelper's vertex
+/// shader gives texCoord over the viewport).
+constexpr const char* kBlitFragmentShader = R"(//VTK::System::Dec
+in vec2 texCoord;
+uniform sampler2D source;
+//VTK::Output::Dec
+void main() { gl_FragData[0] = texture2D(source, texCoord); }
+)";
 
 /// FNV-1a over raw bytes: tells whether a new data set has the geometry already prepared.
 std::uint64_t hashBytes(const void* data, std::size_t n, std::uint64_t h) {
@@ -68,7 +80,8 @@ struct vtkUvrVolumeMapper::Internals {
 
     std::string report = "{}";
     vtkNew<vtkTextureObject> texture;
-    std::vector<float> upload;  ///< the frame, rows from the bottom
+    std::unique_ptr<vtkOpenGLQuadHelper> quad;  ///< draws the texture over the viewport
+    std::vector<unsigned char> upload;          ///< the frame as 8-bit RGBA, rows from the bottom
 };
 
 vtkUvrVolumeMapper::vtkUvrVolumeMapper() : internals_(std::make_unique<Internals>()) {
@@ -397,14 +410,39 @@ void vtkUvrVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol) {
         uvr::RenderResult r = in.renderer->render(s);
         in.report = uvr::frameReport(*in.renderer, s, r).dump();
 
-        // Composite the premultiplied frame over the framebuffer.
+        // Composite the premultiplied frame over the framebuffer. It goes up as 8-bit RGBA,
+        // what the framebuffer holds (a float texture is read as bytes in ParaView's GUI).
         in.upload.resize(std::size_t(width) * height * 4);
-        for (int y = 0; y < height; ++y)
-            std::memcpy(&in.upload[std::size_t(height - 1 - y) * width * 4],
-                        &r.image.pixels[std::size_t(y) * width], sizeof(float) * 4 * width);
+        for (int y = 0; y < height; ++y) {
+            const uvr::Vec4f* row = &r.image.pixels[std::size_t(y) * width];
+            unsigned char* out = &in.upload[std::size_t(height - 1 - y) * width * 4];
+            for (int x = 0; x < width; ++x)
+                for (int c = 0; c < 4; ++c) {
+                    const float v = row[x][c];
+                    out[4 * x + c] = static_cast<unsigned char>(v >= 1.f  ? 255.f
+                                                                : v > 0.f ? v * 255.f + 0.5f
+                                                                          : 0.f);
+                }
+        }
         in.texture->SetContext(rw);
-        in.texture->Create2DFromRaw(unsigned(width), unsigned(height), 4, VTK_FLOAT,
-                                    in.upload.data());
+        {
+            // Qt's own uploads in ParaView's GUI can leave the unpack state set (rows or pixels
+            // skipped): the upload then reads the wrong memory. Cleared here, restored after.
+            const GLenum keys[] = {GL_UNPACK_ROW_LENGTH, GL_UNPACK_SKIP_ROWS, GL_UNPACK_SKIP_PIXELS,
+                                   GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_IMAGES};
+            GLint saved[5];
+            for (int i = 0; i < 5; ++i) {
+                glGetIntegerv(keys[i], &saved[i]);
+                glPixelStorei(keys[i], 0);
+            }
+            GLint unpackBuffer = 0;
+            glGetIntegerv(GL_PIXEL_UNPACK_BUFFER_BINDING, &unpackBuffer);
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+            in.texture->Create2DFromRaw(unsigned(width), unsigned(height), 4, VTK_UNSIGNED_CHAR,
+                                        in.upload.data());
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, GLuint(unpackBuffer));
+            for (int i = 0; i < 5; ++i) glPixelStorei(keys[i], saved[i]);
+        }
         vtkOpenGLState* gl = rw->GetState();
         vtkOpenGLState::ScopedglEnableDisable blend(gl, GL_BLEND);
         vtkOpenGLState::ScopedglEnableDisable depthTest(gl, GL_DEPTH_TEST);
@@ -414,9 +452,18 @@ void vtkUvrVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol) {
         gl->vtkglDisable(GL_DEPTH_TEST);
         gl->vtkglDepthMask(GL_FALSE);
         gl->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        // VTK's own full-screen pass (vtkTextureObject::CopyToFrameBuffer's quad drew one of
+        // its two triangles from stale vertex data in ParaView's GUI).
+        if (!in.quad)
+            in.quad = std::make_unique<vtkOpenGLQuadHelper>(rw, nullptr, kBlitFragmentShader, "");
+        else
+            rw->GetShaderCache()->ReadyShaderProgram(in.quad->Program);
+        if (!in.quad->Program) throw uvr::Error(uvr::ErrorKind::Internal, "the blit shader failed");
         in.texture->Activate();
-        in.texture->CopyToFrameBuffer(nullptr, nullptr);  // the whole texture to the viewport
+        in.quad->Program->SetUniformi("source", in.texture->GetTextureUnit());
+        in.quad->Render();
         in.texture->Deactivate();
+        gl->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // Create2DFromRaw left 1
     } catch (const std::exception& e) {
         in.report = nlohmann::json{{"error", e.what()}}.dump();
         vtkErrorMacro(<< "uvr Volume: " << e.what());
@@ -424,5 +471,6 @@ void vtkUvrVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol) {
 }
 
 void vtkUvrVolumeMapper::ReleaseGraphicsResources(vtkWindow* window) {
+    internals_->quad.reset();
     internals_->texture->ReleaseGraphicsResources(window);
 }

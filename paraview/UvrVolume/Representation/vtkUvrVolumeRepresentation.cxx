@@ -9,6 +9,8 @@
 #include "vtkInformation.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
+#include "vtkRenderer.h"
 #include "vtkUvrVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 #include "vtkVolumeRepresentationPreprocessor.h"
@@ -184,4 +186,9 @@ void vtkUvrVolumeRepresentation::UpdateMapperParameters() {
     // The component the colour map reads (ParaView's Magnitude / X / Y / Z).
     vtkColorTransferFunction* ctf = this->Property->GetRGBTransferFunction(0);
     if (ctf) this->UvrMapper->SetUvrVectorMode(ctf->GetVectorMode(), ctf->GetVectorComponent());
+    // With translucent geometry in the view (a slice's plane widget), VTK's depth peeling would
+    // render volumes inside its peels, where the mapper's frame does not belong: volumes are
+    // rendered after the translucent geometry instead (docs/PARAVIEW.md).
+    if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
+        if (vtkRenderer* ren = view->GetRenderer()) ren->SetUseDepthPeelingForVolumes(false);
 }
