@@ -62,9 +62,14 @@ if SCENE == "tf_camera":
     # of the log-scaled colour map; each with what `uvr render` needs to make it again.
     reader = LegacyVTKReader(FileNames=[BLUNT_FIN])
     frames = []
-    for name, parallel, log in (("perspective", False, False), ("parallel_log", True, True)):
+    # The third frame's opacity has midpoints and sharpness other than ParaView's defaults: the
+    # plugin samples it (the first two go over node for node).
+    for name, parallel, log, method in (("perspective", False, False, "auto"),
+                                        ("parallel_log", True, True, "exact"),
+                                        ("midpoints", False, False, "reference")):
         v = view(480, 360)
         d = uvr_volume(reader, v)
+        d.UvrMethod = method  # the panel's Method, a name of the vocabulary's choices
         lut = GetColorTransferFunction("density")
         pwf = GetOpacityTransferFunction("density")
         lut.ApplyPreset("Viridis (matplotlib)", True)
@@ -72,6 +77,8 @@ if SCENE == "tf_camera":
         pwf.RescaleTransferFunction(0.2, 4.7)
         pwf.Points = [0.2, 0.0, 0.5, 0.0, 1.5, 0.05, 0.5, 0.0, 3.0, 0.4, 0.5, 0.0,
                       4.7, 0.9, 0.5, 0.0]
+        if name == "midpoints":
+            pwf.Points = [0.2, 0.0, 0.5, 0.0, 2.0, 0.1, 0.3, 0.0, 4.7, 0.8, 0.7, 0.0]
         lut.UseLogScale = 1 if log else 0
         v.ResetCamera()
         cam = v.GetActiveCamera()
@@ -86,7 +93,7 @@ if SCENE == "tf_camera":
         frames.append({"name": name, "png": png, "camera": camera_of(v),
                        "tf": tf_json(lut, pwf), "opacity_unit": d.ScalarOpacityUnitDistance,
                        "range": [lut.RGBPoints[0], lut.RGBPoints[-4]],
-                       "size": [480, 360], "background": [0.1, 0.2, 0.3],
+                       "size": [480, 360], "background": [0.1, 0.2, 0.3], "method": method,
                        "report": report(d)})
         Hide(reader, v)
     summary["frames"] = frames

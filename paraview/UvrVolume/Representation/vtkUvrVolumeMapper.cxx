@@ -230,24 +230,85 @@ std::uint64_t geometryKeyOf(vtkUnstructuredGrid* grid) {
     return h;
 }
 
-/// The transfer function the library renders: ParaView's colour and opacity functions sampled
-/// at kTfSamples values over the colour map's range (on a log scale when it maps so).
+/// A value's position in the map's range [lo, hi] (log-scaled when the map is).
+double positionIn(double v, double lo, double hi, bool logScale) {
+    if (logScale) return (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo));
+    return (v - lo) / (hi - lo);
+}
+
+/// ParaView's colour and opacity functions as the library's transfer function, point for
+/// point, as `uvr render` reads a ParaView colour-map export: where every node has the default
+/// midpoint and sharpness, the colour space is one the library has (RGB, Lab, Diverging) and
+/// the nodes lie in the map's range. Otherwise none.
+std::optional<uvr::TransferFunction> tfFromNodes(vtkColorTransferFunction* ctf,
+                                                 vtkPiecewiseFunction* pwf, const double range[2],
+                                                 bool logScale) {
+    uvr::TransferFunction tf;
+    switch (ctf->GetColorSpace()) {
+        case VTK_CTF_RGB:
+            tf.colorSpace = uvr::ColorSpace::RGB;
+            break;
+        case VTK_CTF_LAB:
+            tf.colorSpace = uvr::ColorSpace::Lab;
+            break;
+        case VTK_CTF_DIVERGING:
+            tf.colorSpace = uvr::ColorSpace::Diverging;
+            break;
+        default:
+            return std::nullopt;
+    }
+    const double lo = range[0], hi = range[1];
+    if (!(hi > lo)) return std::nullopt;
+    const auto inRange = [](double t) { return t >= -1e-6 && t <= 1.0 + 1e-6; };
+    for (int i = 0; i < ctf->GetSize(); ++i) {
+        double n[6];  // x, r, g, b, midpoint, sharpness
+        ctf->GetNodeValue(i, n);
+        const double t = positionIn(n[0], lo, hi, logScale);
+        if (n[4] != 0.5 || n[5] != 0.0 || !inRange(t)) return std::nullopt;
+        tf.colors.push_back(
+            {float(std::clamp(t, 0.0, 1.0)), {float(n[1]), float(n[2]), float(n[3])}});
+    }
+    if (pwf) {
+        for (int i = 0; i < pwf->GetSize(); ++i) {
+            double n[4];  // x, opacity, midpoint, sharpness
+            pwf->GetNodeValue(i, n);
+            const double t = positionIn(n[0], lo, hi, logScale);
+            if (n[2] != 0.5 || n[3] != 0.0 || !inRange(t)) return std::nullopt;
+            tf.opacities.push_back({float(std::clamp(t, 0.0, 1.0)), float(n[1])});
+        }
+    } else {
+        tf.opacities = {{0.f, 1.f}, {1.f, 1.f}};
+    }
+    if (tf.colors.empty() || tf.opacities.empty()) return std::nullopt;
+    return tf;
+}
+
+/// The transfer function the library renders: ParaView's colour and opacity functions node for
+/// node where the library has their interpolation (tfFromNodes), else sampled at kTfSamples
+/// values over the colour map's range (log-spaced on a log scale), where VTK evaluates its own
+/// colour spaces, midpoints and sharpness.
 uvr::TransferFunction tfOf(vtkColorTransferFunction* ctf, vtkPiecewiseFunction* pwf,
                            const double range[2], bool logScale) {
-    uvr::TransferFunction tf;
+    std::optional<uvr::TransferFunction> nodes = tfFromNodes(ctf, pwf, range, logScale);
+    uvr::TransferFunction tf = nodes ? std::move(*nodes) : uvr::TransferFunction{};
+    if (!nodes) {
+        const double lo = logScale ? std::log10(range[0]) : range[0];
+        const double hi = logScale ? std::log10(range[1]) : range[1];
+        for (int i = 0; i < kTfSamples; ++i) {
+            const double t = double(i) / (kTfSamples - 1);
+            double v = lo + t * (hi - lo);
+            if (logScale) v = std::pow(10.0, v);
+            // The continuous function, as VTK's volume mappers read it: ParaView's colour map
+            // is a vtkDiscretizableColorTransferFunction whose own GetColor returns the colour
+            // of its table's bin when "Discretize" is on (its default).
+            double rgb[3];
+            ctf->vtkColorTransferFunction::GetColor(v, rgb);
+            tf.colors.push_back({float(t), {float(rgb[0]), float(rgb[1]), float(rgb[2])}});
+            tf.opacities.push_back({float(t), pwf ? float(pwf->GetValue(v)) : 1.f});
+        }
+    }
     tf.name = "ParaView";
     tf.logScale = logScale;
-    const double lo = logScale ? std::log10(range[0]) : range[0];
-    const double hi = logScale ? std::log10(range[1]) : range[1];
-    for (int i = 0; i < kTfSamples; ++i) {
-        const double t = double(i) / (kTfSamples - 1);
-        double v = lo + t * (hi - lo);
-        if (logScale) v = std::pow(10.0, v);
-        double rgb[3];
-        ctf->GetColor(v, rgb);
-        tf.colors.push_back({float(t), {float(rgb[0]), float(rgb[1]), float(rgb[2])}});
-        tf.opacities.push_back({float(t), pwf ? float(pwf->GetValue(v)) : 1.f});
-    }
     const double* nan = ctf->GetNanColor();
     tf.nanColor = {float(nan[0]), float(nan[1]), float(nan[2])};
     tf.nanOpacity = 0.f;  // VTK's volume mappers draw no NaN values
