@@ -14,13 +14,16 @@ import statistics
 import time
 
 from paraview.simple import (ColorBy, CreateView, Delete, GetColorTransferFunction, LoadPlugin,
-                             OpenDataFile, Render, Show)
+                             OpenDataFile, Render, SaveScreenshot, Show)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("plugin")
 ap.add_argument("files", nargs="+", help="FILE or FILE:ARRAY (default: the first point array)")
 ap.add_argument("--size", type=int, default=1024)
 ap.add_argument("--repeat", type=int, default=3)
+ap.add_argument("--images", help="also save each renderer's last frame into this folder "
+                "(compare them with `uvr compare`, e.g. against uvr Volume with Method exact)")
+ap.add_argument("--method", default="auto", help="uvr Volume's Method")
 ap.add_argument("--mappers", default="uvr Volume,Projected tetra,Z sweep,Bunyk ray cast,"
                 "Resample To Image")
 args = ap.parse_args()
@@ -40,6 +43,7 @@ for spec in args.files:
         array = chosen or reader.PointData.keys()[0]
         if mapper == "uvr Volume":
             d.SetRepresentationType("uvr Volume")
+            d.UvrMethod = args.method
         else:
             d.SetRepresentationType("Volume")
             d.SelectMapper = mapper
@@ -59,6 +63,9 @@ for spec in args.files:
                 d.UpdatePropertyInformation()
                 report = json.loads(d.GetProperty("UvrLastFrameReport").GetElement(0))
                 own.append(report["render_seconds"])
+        if args.images:
+            SaveScreenshot("%s/%s_%s.png" % (args.images, path.split("/")[-1].split(".")[0],
+                                             mapper.replace(" ", "_")), v)
         print("| %s (%s) | %s | %.2f | %.3f | %s |" % (
             path.split("/")[-1], array, mapper, first, statistics.median(times),
             "%.3f" % statistics.median(own) if own else ""), flush=True)
