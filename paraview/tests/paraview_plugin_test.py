@@ -7,6 +7,9 @@ and renders the scenes of pv_scenes.py; this script judges them.
   with a log-scaled map and the exact method; opacity midpoints and sharpness, which the plugin
   samples) equals `uvr render` given that colour map (exported as ParaView's colour-map JSON)
   and camera: SSIM >= 0.99 and no pixel off by more than 4 levels.
+- settings: the panel's Shade (with the Lighting group's Ambient and Specular), Clip with Clip
+  Surface, Isosurfaces, a vector's Magnitude and X component, and cell data: each equals
+  `uvr render` with the matching flags and field.
 - slice: an opaque slice through the volume: inside it, the picture is uvr's rendering of the
   volume in front of the slice's plane (a clip plane) over the slice alone; outside it, the
   volume alone.
@@ -62,8 +65,9 @@ def uvr_render(args, out_png, tf, frame, extra):
     with open(tf_path, "w") as f:
         json.dump(tf, f)
     cam = frame["camera"]
-    cmd = [args.uvr, "-q", "render", os.path.join(args.data, "bluntfin_tets.vtk"), "-o", out_png,
-           "--field", "density", "--tf", tf_path,
+    cmd = [args.uvr, "-q", "render",
+           frame.get("mesh", os.path.join(args.data, "bluntfin_tets.vtk")), "-o", out_png,
+           "--field", frame.get("field", "density"), "--tf", tf_path,
            "--range", "%r,%r" % tuple(frame["range"]),
            "--size", "%dx%d" % tuple(frame["size"]),
            "--camera-position", ",".join(repr(x) for x in cam["position"]),
@@ -109,6 +113,25 @@ def tf_camera(args, out):
         worst = 4 if frame["name"] != "midpoints" else 16
         check(m["max_abs_difference"] <= worst, "%s: its worst pixel is off by %s <= %d levels"
               % (frame["name"], m["max_abs_difference"], worst))
+
+
+def settings(args, out):
+    summary, _ = run_scene(args, "settings", out)
+    if not summary:
+        return
+    for frame in summary["frames"]:
+        check("error" not in frame["report"], "%s: the frame renders (%s)"
+              % (frame["name"], frame["report"].get("error", "")))
+        mine = os.path.join(out, frame["name"] + "_uvr.png")
+        uvr_render(args, mine, frame["tf"], frame,
+                   ["--background", ",".join(map(str, frame["background"]))] + frame["flags"])
+        m = compare(args, mine, frame["png"], frame["background"])
+        print("      %s: SSIM %.4f, 99.9th percentile %s, max %s (8-bit levels)" %
+              (frame["name"], m["ssim"], m["p999_difference"], m["max_abs_difference"]))
+        check(m["ssim"] >= 0.99 and m["max_abs_difference"] <= 4,
+              "%s: ParaView's picture equals uvr render %s's (SSIM %.4f >= 0.99, max %s <= 4)"
+              % (frame["name"], " ".join(frame["flags"]) or "--field " + frame["field"],
+                 m["ssim"], m["max_abs_difference"]))
 
 
 def slice_scene(args, out):
@@ -197,8 +220,8 @@ def main():
         return 77
     with tempfile.TemporaryDirectory(prefix="uvr_paraview_") as tmp:
         out = args.out or tmp
-        for name, fn in (("tf_camera", tf_camera), ("slice", slice_scene), ("series", series),
-                         ("errors", errors)):
+        for name, fn in (("tf_camera", tf_camera), ("settings", settings),
+                         ("slice", slice_scene), ("series", series), ("errors", errors)):
             fn(args, os.path.join(out, name))
     if failures:
         print("%d check(s) failed" % len(failures))

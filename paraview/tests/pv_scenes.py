@@ -2,7 +2,8 @@
 """Scenes of the uvr Volume representation in ParaView, run by pvbatch (paraview_plugin_test.py
 drives them and judges the results): each writes its screenshots and a summary.json into OUT.
 
-    pvbatch pv_scenes.py PLUGIN DATA OUT SCENE    (SCENE: tf_camera, slice, series, errors)
+    pvbatch pv_scenes.py PLUGIN DATA OUT SCENE
+    (SCENE: tf_camera, settings, slice, series, errors)
 """
 import json
 import os
@@ -95,6 +96,59 @@ if SCENE == "tf_camera":
                        "range": [lut.RGBPoints[0], lut.RGBPoints[-4]],
                        "size": [480, 360], "background": [0.1, 0.2, 0.3], "method": method,
                        "report": report(d)})
+        Hide(reader, v)
+    summary["frames"] = frames
+
+elif SCENE == "settings":
+    # The panel's settings and ParaView's array choices, each frame with the `uvr render` flags
+    # that make it: a vector's magnitude shaded, a component clipped with the cut face drawn,
+    # isosurfaces, and cell data of a mesh that has the name as point and cell data.
+    frames = []
+    cases = (
+        ("shaded_magnitude", BLUNT_FIN, ("POINTS", "momentum"), "Magnitude", "momentum:magnitude",
+         {"UvrShade": 1, "Ambient": 0.2, "Specular": 0.3},
+         ["--shade", "--ambient", "0.2", "--specular", "0.3"]),
+        ("clipped_component", BLUNT_FIN, ("POINTS", "momentum"), "X", "momentum:x",
+         {"UvrClip": 1, "UvrClipSurface": 1},
+         ["--clip-surface"]),
+        ("isosurfaces", BLUNT_FIN, ("POINTS", "density"), None, "density",
+         {"UvrIsoValues": [1.5, 3.0], "UvrIsoOpacity": 0.6},
+         ["--iso", "1.5,0.6", "--iso", "3.0,0.6"]),
+        ("cell_data", os.path.join(DATA, "cylinder_quadratic_as_tets.vtk"),
+         ("CELLS", "pressure"), None, "pressure:cell", {}, []),
+    )
+    for name, path, array, mode, field, props, flags in cases:
+        reader = LegacyVTKReader(FileNames=[path])
+        v = view(400, 300)
+        d = Show(reader, v)
+        d.SetRepresentationType("uvr Volume")
+        ColorBy(d, array)
+        lut = GetColorTransferFunction(array[1])
+        if mode:
+            lut.VectorMode = "Magnitude" if mode == "Magnitude" else "Component"
+            lut.VectorComponent = 0
+        d.RescaleTransferFunctionToDataRange(False, True)
+        b = reader.GetDataInformation().GetBounds()
+        centre = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
+        if "UvrClip" in props:
+            d.UvrClipOrigin = centre
+            d.UvrClipNormal = [0.0, 0.0, 1.0]
+            flags = flags + ["--clip-plane", "%r,%r,%r,0,0,1" % tuple(centre)]
+        for key, value in props.items():
+            setattr(d, key, value)
+        v.ResetCamera()
+        v.GetActiveCamera().Azimuth(30)
+        v.GetActiveCamera().Elevation(20)
+        v.ResetCamera()
+        Render(v)
+        png = os.path.join(OUT, name + ".png")
+        SaveScreenshot(png, v)
+        pwf = GetOpacityTransferFunction(array[1])
+        frames.append({"name": name, "png": png, "mesh": path, "field": field,
+                       "flags": flags, "camera": camera_of(v), "tf": tf_json(lut, pwf),
+                       "opacity_unit": d.ScalarOpacityUnitDistance,
+                       "range": [lut.RGBPoints[0], lut.RGBPoints[-4]], "size": [400, 300],
+                       "background": [0.1, 0.2, 0.3], "method": "auto", "report": report(d)})
         Hide(reader, v)
     summary["frames"] = frames
 
