@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
-"""The ParaView plugin end to end (ctest paraview.plugin): pvbatch under Xvfb loads the plugin
+"""The ParaView plugin end to end (ctest paraview.plugin): pvbatch on an Xvfb display loads the plugin
 and renders the scenes of pv_scenes.py; this script judges them.
 
 - tf_camera: the Blunt Fin with a ParaView colour map, opacity and camera (perspective; parallel
@@ -37,13 +37,33 @@ def check(ok, what):
         failures.append(what)
 
 
+def start_xvfb():
+    """One X server for every scene, on a display it picks itself (-displayfd): `xvfb-run -a`
+    races other tests that start X servers at the same moment (ctest -j)."""
+    read, write = os.pipe()
+    server = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1024x768x24",
+                               "-nolisten", "tcp"], pass_fds=(write,),
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write)
+    number = b""
+    while not number.endswith(b"\n"):
+        chunk = os.read(read, 16)
+        if not chunk:
+            break
+        number += chunk
+    os.close(read)
+    if not number.strip():
+        server.kill()
+        raise SystemExit("paraview_plugin_test: Xvfb did not start")
+    return server, ":" + number.decode().strip()
+
+
 def run_scene(args, scene, out):
     os.makedirs(out, exist_ok=True)
-    env = dict(os.environ)
+    env = dict(os.environ, DISPLAY=args.display)
     if args.pythonpath:
         env["PYTHONPATH"] = args.pythonpath + os.pathsep + env.get("PYTHONPATH", "")
-    cmd = ["xvfb-run", "-a", "-s", "-screen 0 1024x768x24", args.pvbatch,
-           os.path.join(os.path.dirname(os.path.abspath(__file__)), "pv_scenes.py"),
+    cmd = [args.pvbatch, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pv_scenes.py"),
            args.plugin, args.data, out, scene]
     p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     log = p.stdout + p.stderr
@@ -218,11 +238,16 @@ def main():
     if not os.path.exists(os.path.join(args.data, "bluntfin_tets.vtk")):
         print("skipped: no %s/bluntfin_tets.vtk" % args.data)
         return 77
-    with tempfile.TemporaryDirectory(prefix="uvr_paraview_") as tmp:
-        out = args.out or tmp
-        for name, fn in (("tf_camera", tf_camera), ("settings", settings),
-                         ("slice", slice_scene), ("series", series), ("errors", errors)):
-            fn(args, os.path.join(out, name))
+    server, args.display = start_xvfb()
+    try:
+        with tempfile.TemporaryDirectory(prefix="uvr_paraview_") as tmp:
+            out = args.out or tmp
+            for name, fn in (("tf_camera", tf_camera), ("settings", settings),
+                             ("slice", slice_scene), ("series", series), ("errors", errors)):
+                fn(args, os.path.join(out, name))
+    finally:
+        server.terminate()
+        server.wait()
     if failures:
         print("%d check(s) failed" % len(failures))
         return 1
