@@ -2,6 +2,7 @@
 #include "vtkUvrVolumeMapper.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -52,10 +53,17 @@ uniform sampler2D source;
 void main() { gl_FragData[0] = texture2D(source, texCoord); }
 )";
 
-/// FNV-1a over raw bytes: tells whether a new data set has the geometry already prepared.
+/// FNV-1a over raw bytes, eight at a time: tells whether a new data set has the geometry
+/// already prepared.
 std::uint64_t hashBytes(const void* data, std::size_t n, std::uint64_t h) {
     const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    std::size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        std::uint64_t word;
+        std::memcpy(&word, p + i, 8);
+        h = (h ^ word) * 1099511628211ull;
+    }
+    for (; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
     return h;
 }
 
@@ -71,6 +79,10 @@ struct vtkUvrVolumeMapper::Internals {
     std::unique_ptr<uvr::Mesh> mesh;  ///< geometry and the prepared field's array
     std::unique_ptr<uvr::Renderer> renderer;
     std::uint64_t geometryKey = 0;
+    /// The grid, its points' and cells' modification times when geometryKey was last worked
+    /// out: the hash is taken again only when one of them changes, not at every frame.
+    std::array<std::uintptr_t, 4> geometryStamp{};
+    std::uint64_t stampedKey = 0;
     std::string fieldKey;  ///< array, association, component, values' modification time
     uvr::Association association = uvr::Association::Point;  ///< of the prepared field
     bool optionsChanged = true;
@@ -364,7 +376,16 @@ bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, doub
                                      (cellFlag ? ":cell:" : ":point:") + std::to_string(component) +
                                      ":" + std::to_string(array->GetMTime()) + ":" +
                                      std::to_string(reinterpret_cast<std::uintptr_t>(array));
-        const std::uint64_t geometryKey = geometryKeyOf(grid);
+        const std::array<std::uintptr_t, 4> stamp{
+            reinterpret_cast<std::uintptr_t>(grid),
+            std::uintptr_t(grid->GetPoints() ? grid->GetPoints()->GetMTime() : 0),
+            std::uintptr_t(grid->GetCells() ? grid->GetCells()->GetMTime() : 0),
+            std::uintptr_t(grid->GetCellTypesArray() ? grid->GetCellTypesArray()->GetMTime() : 0)};
+        if (stamp != in.geometryStamp) {
+            in.stampedKey = geometryKeyOf(grid);
+            in.geometryStamp = stamp;
+        }
+        const std::uint64_t geometryKey = in.stampedKey;
         const bool sameGeometry =
             in.renderer && !in.optionsChanged && geometryKey == in.geometryKey;
         if (sameGeometry && fieldKey == in.fieldKey) return true;
