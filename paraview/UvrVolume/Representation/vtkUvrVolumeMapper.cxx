@@ -344,7 +344,8 @@ uvr::Camera cameraOf(vtkCamera* cam) {
 
 }  // namespace
 
-bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, double), void* client) {
+bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, const char*, double),
+                                 void* client) {
     Internals& in = *internals_;
     const vtkMTimeType stamp = std::max(input ? input->GetMTime() : 0, this->GetMTime());
     if (stamp == in.failedStamp) return false;
@@ -418,7 +419,12 @@ bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, doub
                              "pyramids, polyhedra): nothing to render");
         const uvr::ScalarField scalars = uvr::scalarFieldOf(*in.mesh, field, component);
         uvr::ProgressFn report;
-        if (progress) report.fraction = [progress, client](double f) { progress(client, f); };
+        if (progress) {
+            report.step = [progress, client](const std::string& step) {
+                progress(client, step.c_str(), 0.0);
+            };
+            report.fraction = [progress, client](double f) { progress(client, nullptr, f); };
+        }
         in.renderer = std::make_unique<uvr::Renderer>(*in.mesh, scalars, in.options, report);
         in.geometryKey = geometryKey;
         in.fieldKey = fieldKey;

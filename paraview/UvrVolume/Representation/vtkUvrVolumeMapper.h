@@ -38,8 +38,11 @@ public:
     void SetUvrVectorMode(int mode, int component);
 
     /// Prepares the input for the selected array now (the representation calls this when its
-    /// data changes, reporting `progress` in [0, 1]); returns false after reporting an error.
-    bool Prepare(vtkDataSet* input, void (*progress)(void* client, double fraction), void* client);
+    /// data changes); `progress` hears each phase's name as it starts (fraction 0) and how far
+    /// the phase has come (name null, fraction in [0, 1]). Returns false after reporting an
+    /// error.
+    bool Prepare(vtkDataSet* input,
+                 void (*progress)(void* client, const char* step, double fraction), void* client);
     /// The last frame's report (the library's frameReport) as JSON text, or an error message
     /// {"error": "..."} when the last frame failed; "{}" before any frame.
     const std::string& LastReport() const;

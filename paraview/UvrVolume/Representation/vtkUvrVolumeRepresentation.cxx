@@ -163,8 +163,11 @@ const char* vtkUvrVolumeRepresentation::GetLastFrameReport() {
     return this->LastReport.c_str();
 }
 
-void vtkUvrVolumeRepresentation::ReportProgress(void* self, double fraction) {
-    static_cast<vtkUvrVolumeRepresentation*>(self)->UpdateProgress(fraction);
+void vtkUvrVolumeRepresentation::ReportProgress(void* self, const char* step, double fraction) {
+    // ParaView's progress bar shows the algorithm's progress text and fraction.
+    auto* me = static_cast<vtkUvrVolumeRepresentation*>(self);
+    if (step) me->SetProgressText((std::string("uvr: ") + step).c_str());
+    me->UpdateProgress(fraction);
 }
 
 int vtkUvrVolumeRepresentation::RequestData(vtkInformation* request,

@@ -71,7 +71,7 @@ private:
     void operator=(const vtkUvrVolumeRepresentation&) = delete;
     void UpdateClip();
     void UpdateIsoSurfaces();
-    static void ReportProgress(void* self, double fraction);
+    static void ReportProgress(void* self, const char* step, double fraction);
 
     vtkUvrVolumeMapper* UvrMapper;  // owned
     bool Clip = false;
