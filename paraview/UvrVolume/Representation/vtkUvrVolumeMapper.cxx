@@ -377,14 +377,14 @@ bool vtkUvrVolumeMapper::Prepare(vtkDataSet* input, void (*progress)(void*, cons
                                      (cellFlag ? ":cell:" : ":point:") + std::to_string(component) +
                                      ":" + std::to_string(array->GetMTime()) + ":" +
                                      std::to_string(reinterpret_cast<std::uintptr_t>(array));
-        const std::array<std::uintptr_t, 4> stamp{
+        const std::array<std::uintptr_t, 4> geometryStamp{
             reinterpret_cast<std::uintptr_t>(grid),
             std::uintptr_t(grid->GetPoints() ? grid->GetPoints()->GetMTime() : 0),
             std::uintptr_t(grid->GetCells() ? grid->GetCells()->GetMTime() : 0),
             std::uintptr_t(grid->GetCellTypesArray() ? grid->GetCellTypesArray()->GetMTime() : 0)};
-        if (stamp != in.geometryStamp) {
+        if (geometryStamp != in.geometryStamp) {
             in.stampedKey = geometryKeyOf(grid);
-            in.geometryStamp = stamp;
+            in.geometryStamp = geometryStamp;
         }
         const std::uint64_t geometryKey = in.stampedKey;
         const bool sameGeometry =
