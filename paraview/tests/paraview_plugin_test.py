@@ -14,7 +14,8 @@ and renders the scenes of pv_scenes.py; this script judges them.
   volume in front of the slice's plane (a clip plane) over the slice alone; outside it, the
   volume alone.
 - series: three time steps of one geometry: the pictures change, the preparation is not redone.
-- errors: no array, only 2D cells, a polydata input, a multiblock data set with an empty block:
+- errors: no array, only 2D cells, CUDA asked for without a GPU, a polydata input, a multiblock
+  data set with an empty block:
   ParaView errors naming the problem, no crash, the Blunt Fin block still rendered.
 Exit 77 (skipped) when the shared data is missing.
 """
@@ -219,6 +220,12 @@ def errors(args, out):
           "only 2D cells: %r" % cases["no_volume_cells"].get("error"))
     check(log.count("uvr Volume: no array to render") == 1,
           "the error reaches ParaView's output once, not at every frame")
+    cuda = cases["cuda"]
+    if "error" in cuda:
+        check("CUDA" in cuda["error"] or "cuda" in cuda["error"],
+              "Device cuda without a GPU: %r" % cuda["error"])
+    else:
+        check(cuda.get("device") == "cuda", "Device cuda renders there (%s)" % cuda.get("device"))
     check(cases["polydata_offers"] is False, "a polydata input is not offered uvr Volume")
     check("error" not in cases["multiblock"], "a multiblock data set with an empty block renders")
     img = rgb(cases["multiblock_png"])

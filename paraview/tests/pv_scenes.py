@@ -241,6 +241,13 @@ elif SCENE == "errors":
     v.ResetCamera()
     Render(v)
     cases["no_volume_cells"] = report(d)
+    # CUDA asked for: an error naming it where no GPU can be used, else a CUDA frame.
+    v = view(128, 128)
+    d = uvr_volume(reader, v)
+    d.UvrDevice = "cuda"
+    v.ResetCamera()
+    Render(v)
+    cases["cuda"] = report(d)
     # 3. A polydata input: no uvr Volume representation is offered.
     v = view(128, 128)
     d = Show(Sphere(), v)
