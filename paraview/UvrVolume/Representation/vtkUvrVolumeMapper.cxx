@@ -102,9 +102,9 @@ vtkUvrVolumeMapper::vtkUvrVolumeMapper() : internals_(std::make_unique<Internals
 
 vtkUvrVolumeMapper::~vtkUvrVolumeMapper() = default;
 
-void vtkUvrVolumeMapper::SetUvrSetting(const std::string& name, const std::string& jsonValue) {
+void vtkUvrVolumeMapper::SetUvrSetting(const std::string& name, const nlohmann::json& value) {
     try {
-        uvr::applySetting(internals_->settings, name, nlohmann::json::parse(jsonValue));
+        uvr::applySetting(internals_->settings, name, value);
         this->Modified();
     } catch (const std::exception& e) {
         vtkErrorMacro(<< "uvr Volume: " << e.what());

@@ -9,6 +9,9 @@
 
 #include <memory>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "vtkUnstructuredGridVolumeMapper.h"
 
@@ -22,9 +25,9 @@ public:
     void Render(vtkRenderer* ren, vtkVolume* vol) override;
     void ReleaseGraphicsResources(vtkWindow* window) override;
 
-    /// A setting of the library's vocabulary by name, its value as JSON text ("0.95",
-    /// "\"exact\"", "true"); a refused value is reported and the setting keeps its value.
-    void SetUvrSetting(const std::string& name, const std::string& jsonValue);
+    /// A setting of the library's vocabulary by name and value (JSON null: its default); a
+    /// refused value is reported and the setting keeps its value.
+    void SetUvrSetting(const std::string& name, const nlohmann::json& value);
     /// Where frames render and whether cells are split into tetrahedra: "auto", "cpu", "cuda"
     /// (RendererOptions::device, splitCells); a change prepares the mesh again.
     void SetUvrDevice(const std::string& device);

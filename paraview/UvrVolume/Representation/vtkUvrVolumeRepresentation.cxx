@@ -21,9 +21,11 @@ namespace {
 
 constexpr const char* kMapperName = "uvr";
 
-/// A value as the vocabulary's JSON text.
-std::string jsonText(double v) {
-    return nlohmann::json(v).dump();
+/// Passes a panel value to the mapper's settings by the vocabulary's name; the frame changes.
+void applySetting(vtkUvrVolumeRepresentation* self, vtkUvrVolumeMapper* mapper, const char* name,
+                  const nlohmann::json& value) {
+    mapper->SetUvrSetting(name, value);
+    self->Modified();
 }
 
 }  // namespace
@@ -50,49 +52,40 @@ void vtkUvrVolumeRepresentation::SetMethod(int index) {
                       << choices.size() - 1);
         return;
     }
-    this->UvrMapper->SetUvrSetting("method", nlohmann::json(choices[std::size_t(index)]).dump());
-    this->Modified();
+    applySetting(this, this->UvrMapper, "method", choices[std::size_t(index)]);
 }
 
 void vtkUvrVolumeRepresentation::SetQuality(double quality) {
-    this->UvrMapper->SetUvrSetting("quality", jsonText(quality));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "quality", quality);
 }
 
 void vtkUvrVolumeRepresentation::SetSampleDistance(double distance) {
-    this->UvrMapper->SetUvrSetting("sample_distance",
-                                   distance > 0.0 ? jsonText(distance) : std::string("null"));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "sample_distance",
+                 distance > 0.0 ? nlohmann::json(distance) : nlohmann::json());
 }
 
 void vtkUvrVolumeRepresentation::SetShade(int on) {
-    this->UvrMapper->SetUvrSetting("shade", on ? "true" : "false");
-    this->Modified();
+    applySetting(this, this->UvrMapper, "shade", on != 0);
 }
 
 void vtkUvrVolumeRepresentation::SetAmbient(double v) {
-    this->UvrMapper->SetUvrSetting("ambient", jsonText(v));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "ambient", v);
 }
 
 void vtkUvrVolumeRepresentation::SetDiffuse(double v) {
-    this->UvrMapper->SetUvrSetting("diffuse", jsonText(v));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "diffuse", v);
 }
 
 void vtkUvrVolumeRepresentation::SetSpecular(double v) {
-    this->UvrMapper->SetUvrSetting("specular", jsonText(v));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "specular", v);
 }
 
 void vtkUvrVolumeRepresentation::SetSpecularPower(double v) {
-    this->UvrMapper->SetUvrSetting("specular_power", jsonText(v));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "specular_power", v);
 }
 
 void vtkUvrVolumeRepresentation::SetSupersample(int n) {
-    this->UvrMapper->SetUvrSetting("supersample", std::to_string(n));
-    this->Modified();
+    applySetting(this, this->UvrMapper, "supersample", n);
 }
 
 void vtkUvrVolumeRepresentation::SetDevice(int index) {
@@ -127,8 +120,7 @@ void vtkUvrVolumeRepresentation::SetClipNormal(double x, double y, double z) {
 }
 
 void vtkUvrVolumeRepresentation::SetClipSurface(int on) {
-    this->UvrMapper->SetUvrSetting("clip_surface", on ? "true" : "false");
-    this->Modified();
+    applySetting(this, this->UvrMapper, "clip_surface", on != 0);
 }
 
 void vtkUvrVolumeRepresentation::UpdateClip() {
