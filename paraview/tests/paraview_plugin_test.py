@@ -40,10 +40,12 @@ def check(ok, what):
 
 def start_xvfb():
     """One X server for every scene, on a display it picks itself (-displayfd): `xvfb-run -a`
-    races other tests that start X servers at the same moment (ctest -j)."""
+    races other tests that start X servers at the same moment (ctest -j). -noreset: by default the
+    server resets when its last client leaves, and a pvbatch connecting during the reset fails
+    ("bad X server connection"), as it did under ctest -j2 in CI."""
     read, write = os.pipe()
     server = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1024x768x24",
-                               "-nolisten", "tcp"], pass_fds=(write,),
+                               "-nolisten", "tcp", "-noreset"], pass_fds=(write,),
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     os.close(write)
     number = b""
