@@ -220,10 +220,11 @@ def main():
     write_all(ug, out, "prisms")
     write_volumes(ug, os.path.join(out, "prisms_volumes.txt"))
 
-    ug = grid_mesh(lambda i, j, k: "hex")[0]
-    add_fields(ug)
-    ghost_arrays(ug)
-    write_all(ug, out, "ghosts")
+    for name, kind in (("ghosts", "hex"), ("ghosts_poly", "poly")):
+        ug = grid_mesh(lambda i, j, k, kind=kind: kind)[0]
+        add_fields(ug)
+        ghost_arrays(ug)
+        write_all(ug, out, name)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,8 @@ moved by dx and 'cellid' = base + c.
 
 Files: mixed.vtkhdf (1.0, one partition, float64 points), parts.vtkhdf (1.0, two partitions:
 dx 0 and 10, cellid bases 0 and 100), parts_flat.vtkhdf (a partition of one triangle at z = 5,
-then the mixed one), typeless_1_0.vtkhdf (mixed.vtkhdf without the Type attribute), temporal_shared.vtkhdf (2.0, three steps sharing one
+then the mixed one), typeless_1_0.vtkhdf (mixed.vtkhdf without the Type attribute), ghosts.vtkhdf (mixed.vtkhdf
+with vtkGhostType arrays hiding the hexahedron and the last tetrahedron), temporal_shared.vtkhdf (2.0, three steps sharing one
 geometry; temp + 10 s and cellid + 100 s per step), temporal_changing.vtkhdf (2.0, steps 0 and 1
 share the mixed partition, step 2 holds two partitions at dx 10 and 20), and bad_*.vtkhdf /
 bad_*.hdf: one defect each (the test names the message it expects).
@@ -172,6 +173,19 @@ def main():
     # Version 1.0 without Type, as VTK 9.1-era writers left it (VTK's can_0.hdf): VTK 9.1 reads
     # it as an UnstructuredGrid; with a WholeExtent it would be ImageData.
     write_static(p("typeless_1_0.vtkhdf"), [mixed], edit=lambda root: root.attrs.__delitem__("Type"))
+
+    # VTK's ghost flags: the hexahedron HIDDENCELL (32), the apex (0.5, 0.5, -1) of the last
+    # tetrahedron HIDDENPOINT (2), the wedge EXTERIORCELL (16, kept), point 0 DUPLICATEPOINT (1,
+    # kept).
+    def ghosts(root):
+        cells = np.zeros(len(CELLS), dtype=np.uint8)
+        cells[0], cells[1] = 32, 16
+        points = np.zeros(len(POINTS), dtype=np.uint8)
+        points[13], points[0] = 2, 1
+        root["CellData"]["vtkGhostType"] = cells
+        root["PointData"]["vtkGhostType"] = points
+
+    write_static(p("ghosts.vtkhdf"), [mixed], edit=ghosts)
 
     def typeless_image(root):
         root.attrs.__delitem__("Type")

@@ -315,13 +315,27 @@ std::vector<std::uint64_t> appendVtkCells(const VtkCellArrays& cells, Mesh& mesh
             }
         }
         if (pointGhosts) {
+            const auto isHidden = [&](std::int64_t id) {
+                return id >= 0 && static_cast<std::uint64_t>(id) < pointCount &&
+                       (flags(pointGhosts->values[id]) & kHiddenPoint);
+            };
             bool hiddenPoint = false;
-            for (std::int64_t k = begin; k < end && !hiddenPoint; ++k) {
-                const std::int64_t id = cells.connectivity[k];
-                hiddenPoint = id >= 0 && static_cast<std::uint64_t>(id) < pointCount &&
-                              (flags(pointGhosts->values[id]) & kHiddenPoint);
+            if (cells.types[c] == kPolyhedronType) {
+                // [faces, (points, ids...) per face], checked above; in legacy files this is
+                // the cell's own list, so the point ids lie between the counts.
+                const std::span<const std::int64_t> s = faceStream(c);
+                std::size_t k = 1;
+                for (std::int64_t f = 0; f < s[0] && !hiddenPoint; ++f) {
+                    const auto points = static_cast<std::size_t>(s[k++]);
+                    for (std::size_t j = 0; j < points && !hiddenPoint; ++j)
+                        hiddenPoint = isHidden(s[k + j]);
+                    k += points;
+                }
+            } else {
+                for (std::int64_t k = begin; k < end && !hiddenPoint; ++k)
+                    hiddenPoint = isHidden(cells.connectivity[k]);
             }
-            if (hiddenPoint && cells.types[c] != kPolyhedronType) {
+            if (hiddenPoint) {
                 ++hidden;
                 continue;
             }

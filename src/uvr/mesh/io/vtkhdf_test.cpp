@@ -279,6 +279,22 @@ TEST(VtkHdf, Version1WithoutTypeIsAnUnstructuredGridAsVtk91ReadsIt) {
     EXPECT_TRUE(testing::sameBytes(typeless.cellIndices, typed.cellIndices));
 }
 
+TEST(VtkHdf, GhostFlagsLeaveOutHiddenCellsAsParaViewDoes) {
+    // A HIDDENCELL hexahedron and a tetrahedron with a HIDDENPOINT corner are left out; an
+    // EXTERIORCELL wedge and a DUPLICATEPOINT corner hide nothing (issue 35).
+    REQUIRE_CASES();
+    const Mesh mesh = readMesh(caseFile("ghosts.vtkhdf"));
+    ASSERT_EQ(mesh.cellCount(), 3u);
+    const Field& cellid = field(mesh, "cellid", Association::Cell);
+    EXPECT_EQ(cellid.values, (std::vector<float>{1.f, 2.f, 3.f}));
+    EXPECT_EQ(mesh.cellTypes,
+              (std::vector<CellType>{CellType::Wedge, CellType::Tetra, CellType::Pyramid}));
+    bool noted = false;
+    for (const std::string& n : mesh.notes)
+        noted |= n.find("left out 2 cell(s) that vtkGhostType marks hidden") != std::string::npos;
+    EXPECT_TRUE(noted) << ::testing::PrintToString(mesh.notes);
+}
+
 TEST(VtkHdf, RecognisesHdf5ByItsVtkhdfGroup) {
     REQUIRE_CASES();
     const std::string dir = testing::scratchDir();
