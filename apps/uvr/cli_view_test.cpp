@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `uvr view`'s own flags fail before the mesh is read (the server itself: src/uvr/server).
 #include <arpa/inet.h>
-#include <gtest/gtest.h>
+#include <gmock/gmock.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -14,8 +14,11 @@
 namespace uvr {
 namespace {
 
+using cli_testing::CliRun;
 using cli_testing::expectOneLineError;
 using cli_testing::uvr;
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 TEST(CliView, BadServerFlagsAndABusyPortFailBeforeTheMeshIsRead) {
     const std::string dir = testing::scratchDir();
@@ -50,6 +53,34 @@ TEST(CliView, BadServerFlagsAndABusyPortFailBeforeTheMeshIsRead) {
     const std::string port = std::to_string(ntohs(addr.sin_port));
     expectOneLineError(view("--port " + port), {"cannot listen on 127.0.0.1:" + port}, "busy port");
     ::close(fd);
+}
+
+TEST(CliView, APreparedCacheIsServedWithoutReadingTheMesh) {
+    // Issue 35: `uvr view` takes MESH.uvrprep as `uvr render` does. `timeout` stops each server
+    // once it serves (a server's SIGTERM ends it cleanly).
+    const std::string dir = testing::scratchDir();
+    const std::string m = dir + "/m.uvrm";
+    ASSERT_EQ(uvr("-q generate box --cells 3000 --fields jet,linear -o " + m, dir).code, 0);
+    ASSERT_EQ(uvr("-q prepare " + m + " --field linear", dir).code, 0);
+    const auto view = [&](const std::string& args) {
+        return uvr("view " + m + " --port 0 " + args, dir, "timeout 5 ");
+    };
+    CliRun r = view("--field linear");
+    EXPECT_THAT(r.err, HasSubstr("using the prepared cache " + m + ".uvrprep"));
+    EXPECT_THAT(r.err, HasSubstr("serving the prepared cache's linear (point data) alone "
+                                 "(methods: auto, "));
+    EXPECT_THAT(r.out, HasSubstr("uvr: serving http://127.0.0.1:"));
+    EXPECT_THAT(r.err, Not(HasSubstr("uvr: read ")));
+    // Another field than the cache's: the mesh is read, saying why.
+    r = view("");
+    EXPECT_THAT(r.err, HasSubstr("not using the prepared cache"));
+    EXPECT_THAT(r.err, HasSubstr("uvr: read "));
+    EXPECT_THAT(r.out, HasSubstr("uvr: serving http://127.0.0.1:"));
+    // --no-cache reads the mesh, silently; --cache naming no file is an error before reading.
+    r = view("--field linear --no-cache");
+    EXPECT_THAT(r.err, Not(HasSubstr("prepared cache")));
+    EXPECT_THAT(r.err, HasSubstr("uvr: read "));
+    expectOneLineError(view("--cache " + dir + "/none.uvrprep"), {"none.uvrprep"}, "--cache");
 }
 
 }  // namespace

@@ -320,66 +320,92 @@ std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, con
     return renderer;
 }
 
-bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
-                     const CacheFlags& cache, const Context& ctx) {
-    const bool explicitCache = !cache.file.empty();
-    if (cache.off) return false;
-    const std::string path = explicitCache ? cache.file : meshFile + kPreparedCacheSuffix;
+std::optional<CacheMatch> findCache(const std::string& meshFile, const RenderFlags& flags,
+                                    const StepFlags& steps, const CacheFlags& cache,
+                                    const RendererOptions& options, bool anyMethods,
+                                    RenderSource& src, const Context& ctx) {
+    CacheMatch match;
+    match.explicitCache = !cache.file.empty();
+    if (cache.off) return std::nullopt;
+    match.path = match.explicitCache ? cache.file : meshFile + kPreparedCacheSuffix;
     std::error_code ec;
-    if (!explicitCache && (!std::filesystem::is_regular_file(path, ec) ||
-                           !std::filesystem::is_regular_file(meshFile, ec)))
-        return false;
-    const auto start = Clock::now();
-    const RendererOptions options = flags.rendererOptions();
-    const CacheKey expected =
-        makeCacheKey(meshFile, flags.field, stepKey(steps), options.prepareOptions());
-    // A default cache that is stale, damaged or not trusted (another user's, or writable by
-    // others) is set aside with a warning saying why, and the mesh is prepared instead.
-    const auto notUsing = [&](const Error& e) {
-        const auto* stale = dynamic_cast<const StaleCacheError*>(&e);
-        return "not using the prepared cache " + path + ": " +
-               (stale ? stale->reason() : std::string(e.what())) +
-               "; preparing from the mesh (`uvr prepare` renews the cache)";
-    };
-    // The header first.
-    RenderSource src;
+    if (!match.explicitCache && (!std::filesystem::is_regular_file(match.path, ec) ||
+                                 !std::filesystem::is_regular_file(meshFile, ec)))
+        return std::nullopt;
+    match.start = Clock::now();
+    match.key = makeCacheKey(meshFile, flags.field, stepKey(steps), options.prepareOptions());
+    src = RenderSource{};
     src.path = meshFile;
-    src.cacheFile = path;
-    PreparedMesh prepared;
+    src.cacheFile = match.path;
     try {
-        const CacheHeader header = readPreparedCacheHeader(path);
-        const std::string why = cacheKeyMismatch(header.key, expected);
-        if (!why.empty()) throw StaleCacheError(path, why);
+        const CacheHeader header = readPreparedCacheHeader(match.path);
+        if (anyMethods) {
+            // What the cache was prepared to render with is what the caller may offer.
+            match.key.partitions = header.key.partitions;
+            match.key.meshBvh = header.key.meshBvh;
+            match.key.forAuto = header.key.forAuto;
+            if (!match.key.forAuto) match.key.autoOnGpu = header.key.autoOnGpu;
+        }
+        const std::string why = cacheKeyMismatch(header.key, match.key);
+        if (!why.empty()) throw StaleCacheError(match.path, why);
         src.summary = header.source;
     } catch (const Error& e) {
-        if (explicitCache || e.kind() == ErrorKind::Resource) throw;
-        ctx.warn(notUsing(e));
-        return false;
+        if (match.explicitCache || e.kind() == ErrorKind::Resource) throw;
+        ctx.warn(match.notUsing(e));
+        return std::nullopt;
     }
-    const RenderOutputs out = flags.renderOutputs();
-    const RenderSettings settings = checkedSettings(flags, src, ctx);
-    ctx.setActivity(path, "reading the prepared cache");
+    return match;
+}
+
+std::string CacheMatch::notUsing(const Error& e) const {
+    const auto* stale = dynamic_cast<const StaleCacheError*>(&e);
+    return "not using the prepared cache " + path + ": " +
+           (stale ? stale->reason() : std::string(e.what())) +
+           "; preparing from the mesh (`uvr prepare` renews the cache)";
+}
+
+std::optional<PreparedMesh> readCache(const CacheMatch& match, RenderSource& src,
+                                      const Context& ctx) {
+    // A default cache that is stale, damaged or not trusted (another user's, or writable by
+    // others) is set aside with a warning saying why, and the mesh is prepared instead.
+    ctx.setActivity(match.path, "reading the prepared cache");
+    PreparedMesh prepared;
     try {
         LoadBudget budget(ctx.maxMemoryBytes);
-        Progress progress(ctx, "reading the prepared cache " + path);
-        prepared = readPreparedCache(path, expected, budget, nullptr, progress.callback());
+        Progress progress(ctx, "reading the prepared cache " + match.path);
+        prepared = readPreparedCache(match.path, match.key, budget, nullptr, progress.callback());
     } catch (const Error& e) {
         // Damage past the header (a truncated array, a failed CRC, a crafted index) sets a
         // default cache aside as header damage does; memory limits stay errors.
-        if (explicitCache || e.kind() == ErrorKind::Resource) throw;
-        ctx.warn(notUsing(e));
-        return false;
+        if (match.explicitCache || e.kind() == ErrorKind::Resource) throw;
+        ctx.warn(match.notUsing(e));
+        return std::nullopt;
     }
-    src.cacheReadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    src.cacheReadSeconds = std::chrono::duration<double>(Clock::now() - match.start).count();
     char line[64];
     std::snprintf(line, sizeof line, " (read in %.3f s)", src.cacheReadSeconds);
-    ctx.step("using the prepared cache " + path + line + ": " + describeCells(prepared.tets) +
-             " prepared from " + meshFile);
+    ctx.step("using the prepared cache " + match.path + line + ": " + describeCells(prepared.tets) +
+             " prepared from " + src.path);
     for (const std::string& note : src.summary.notes) ctx.step("note: " + note);
     for (const std::string& f : src.summary.findings) ctx.step("validation: " + f);
-    ctx.setActivity(path, "uploading the prepared mesh");
+    return prepared;
+}
+
+bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
+                     const CacheFlags& cache, const Context& ctx) {
+    const RendererOptions options = flags.rendererOptions();
+    RenderSource src;
+    const std::optional<CacheMatch> match =
+        findCache(meshFile, flags, steps, cache, options, /*anyMethods=*/false, src, ctx);
+    if (!match) return false;
+    // The settings are checked before the arrays are read.
+    const RenderOutputs out = flags.renderOutputs();
+    const RenderSettings settings = checkedSettings(flags, src, ctx);
+    std::optional<PreparedMesh> prepared = readCache(*match, src, ctx);
+    if (!prepared) return false;
+    ctx.setActivity(match->path, "uploading the prepared mesh");
     const std::unique_ptr<Renderer> renderer =
-        makeRenderer(std::move(prepared), options.device, ctx);
+        makeRenderer(std::move(*prepared), options.device, ctx);
     renderPreparedAndWrite(*renderer, src, settings, out, ctx);
     return true;
 }

@@ -3,7 +3,9 @@
 // A render from the command line: the mesh (or its prepared cache) prepared into a Renderer,
 // rendered with the flags' settings and written with the flags' outputs.
 
+#include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "cli_common.h"
@@ -47,6 +49,31 @@ struct CacheFlags {
 /// false is returned and the caller prepares from the mesh). False without a cache.
 bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
                      const CacheFlags& cache, const Context& ctx);
+
+/// A prepared cache found for a mesh file whose header matches what is asked for.
+struct CacheMatch {
+    std::string path;
+    CacheKey key;  ///< the key asked for, which the arrays are read against
+    bool explicitCache = false;
+    std::chrono::steady_clock::time_point start;  ///< when finding it began
+    /// The warning that sets a default cache aside because of `e`.
+    std::string notUsing(const Error& e) const;
+};
+
+/// The prepared cache of a mesh file to use, its header read and matched (the source summary
+/// goes to src): --cache FILE (a mismatch is an error), else MESH.uvrprep when it exists (a
+/// stale or damaged one is set aside with a warning: nothing is returned). Nothing with
+/// --no-cache. anyMethods: the cache may hold the structures of any method (the caller offers
+/// the methods it holds), else those `options` asks for.
+std::optional<CacheMatch> findCache(const std::string& meshFile, const RenderFlags& flags,
+                                    const StepFlags& steps, const CacheFlags& cache,
+                                    const RendererOptions& options, bool anyMethods,
+                                    RenderSource& src, const Context& ctx);
+
+/// Reads the arrays of a cache findCache matched (progress shown, notes and findings printed);
+/// nothing when a default cache turns out damaged (warned), an error for --cache FILE.
+std::optional<PreparedMesh> readCache(const CacheMatch& match, RenderSource& src,
+                                      const Context& ctx);
 
 /// A Renderer over a mesh already prepared (read from a prepared cache) on `device`; prints
 /// where it renders as the other makeRenderer does.

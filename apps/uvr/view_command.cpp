@@ -38,6 +38,135 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
     if (f.splitCells) add("--split-cells", "");
     return out;
 }
+
+/// Every tab's starting state, as `uvr render` would draw the field (of finite range
+/// fieldRange, over cells of bounds `bounds`) with these flags, and the scene's settings
+/// beyond it.
+void startingState(server::ViewScene& scene, const RenderSettings& settings,
+                   const RenderFlags& flags, std::pair<float, float> fieldRange,
+                   std::uint64_t cells) {
+    server::ViewState& s = scene.initial;
+    s.camera = settings.camera.value_or(
+        resetCamera(scene.bounds, float(settings.width) / float(settings.height)));
+    s.tf = settings.tf;
+    s.range = settings.range.value_or(fieldRange);
+    s.clipPlanes = settings.clipPlanes;
+    s.isoSurfaces = settings.isoSurfaces;
+    s.field = flags.field;
+    s.background = flags.backgroundColor().value_or(Vec3f(0.f, 0.f, 0.f));
+    // The page's settings start as the command line set them (or their defaults), the opacity
+    // unit ParaView's of the rendered cells' bounds.
+    for (const char* name : server::kViewerSettings)
+        s.settings[name] = settingNamed(name).get(settings);
+    s.settings["opacity_unit"] =
+        settings.opacityUnit > 0.f ? settings.opacityUnit : defaultOpacityUnit(scene.bounds, cells);
+    s.width = settings.width;
+    s.height = settings.height;
+    scene.base = settings;
+    scene.commandFlags = imageFlags(flags);
+}
+
+/// The scene of a prepared cache (`uvr prepare`, MESH.uvrprep or --cache) when one applies:
+/// the mesh is not read, and the page shows the cache's field with the methods it holds.
+/// Nothing when none applies (a default cache that is stale or damaged is set aside with a
+/// warning, as `uvr render` does).
+std::optional<server::ViewScene> sceneFromCache(const std::string& file, const RenderFlags& flags,
+                                                const StepFlags& steps, const CacheFlags& cache,
+                                                const Context& ctx) {
+    RendererOptions options = flags.rendererOptions(true);
+    options.partitions = options.meshBvh = true;
+    RenderSource src;
+    const std::optional<CacheMatch> match =
+        findCache(file, flags, steps, cache, options, /*anyMethods=*/true, src, ctx);
+    if (!match) return std::nullopt;
+    // A series' time steps are read from the mesh (a cache holds one step).
+    if (const std::size_t n = openSeries(file, ctx)->stepCount(); n > 1) {
+        const std::string why = file + " has " + std::to_string(n) +
+                                " time steps, which the viewer reads from the mesh (a prepared "
+                                "cache holds one)";
+        if (match->explicitCache) throwError(ErrorKind::Unsupported, "", "--cache: " + why);
+        ctx.step("note: not using the prepared cache " + match->path + ": " + why);
+        return std::nullopt;
+    }
+    std::vector<std::string> notes;
+    const RenderSettings settings = flags.settings(src.summary.bounds, file, &notes);
+    for (const std::string& note : notes) ctx.step("note: " + note);
+    validateSettings(settings);
+    std::optional<PreparedMesh> prepared = readCache(*match, src, ctx);
+    if (!prepared) return std::nullopt;
+    server::ViewScene scene;
+    scene.file = file;
+    scene.loadSeconds = src.cacheReadSeconds;
+    scene.bounds = src.summary.bounds;
+    for (const auto* lines : {&src.summary.findings, &src.summary.notes, &notes})
+        scene.notes.insert(scene.notes.end(), lines->begin(), lines->end());
+    ctx.setActivity(match->path, "uploading the prepared mesh");
+    scene.renderer = makeRenderer(std::move(*prepared), options.device, ctx);
+    const TetMesh& t = scene.renderer->prepared().tets;
+    startingState(scene, settings, flags, {t.valueMin, t.valueMax}, src.summary.cells);
+    scene.rendererOptions = options;
+    scene.fromCache = server::ViewScene::FromCache{match->path, flags.field, src.summary};
+    std::string methods;
+    for (RenderMethod m : renderableMethods(scene.renderer->prepared()))
+        methods += std::string(methods.empty() ? "" : ", ") + methodName(m);
+    const std::string line = "serving the prepared cache's " + src.summary.field().describe() +
+                             " alone (methods: " + methods +
+                             "); --no-cache reads the mesh to show other fields";
+    ctx.step(line);
+    scene.notes.push_back(line);
+    return scene;
+}
+/// The scene of a mesh read and checked as `uvr render` does; the server prepares it (for
+/// every method, the field switched without rebuilding geometry).
+server::ViewScene sceneFromMesh(const std::string& file, const RenderFlags& flags,
+                                const StepFlags& steps, const Context& ctx) {
+    const auto start = std::chrono::steady_clock::now();
+    auto mesh = std::make_shared<Mesh>(loadMesh(file, ctx, steps));
+    server::ViewScene scene;
+    std::shared_ptr<MeshSeries> series = openSeries(file, ctx);
+    scene.initial.step = steps.pick(*series);
+    if (series->stepCount() > 1) scene.series = std::move(series);
+    scene.loadSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    scene.file = file;
+    const ValidationReport report = validateMesh(*mesh, file);
+    for (const std::string& f : report.findings()) {
+        ctx.step("validation: " + f);
+        scene.notes.push_back(f);
+    }
+    for (const std::string& n : mesh->notes) scene.notes.push_back(n);
+    if (report.bounds.empty())
+        throwError(ErrorKind::Validation, file,
+                   "no cell has volume (or the mesh has no volumetric cells): nothing to view");
+    const ScalarField field = selectScalarField(*mesh, parseFieldSpec(flags.field));
+    std::vector<std::string> notes;
+    RenderSettings settings = flags.settings(report.bounds, file, &notes);
+    for (const std::string& note : notes) {
+        ctx.step("note: " + note);
+        scene.notes.push_back(note);
+    }
+    validateSettings(settings);
+    scene.bounds = report.bounds;
+    startingState(scene, settings, flags, finiteRange(field.values), mesh->cellCount());
+    // A series shows one field at every step: the default its first step chose (pinField).
+    if (scene.series && flags.field.empty()) {
+        const FieldSpec pinned = pinField(*mesh, parseFieldSpec(""));
+        bool twoOfName = false;
+        for (const Field& f : mesh->fields)
+            twoOfName =
+                twoOfName || (f.name == pinned.name && f.association != *pinned.association);
+        scene.initial.field =
+            pinned.name + (twoOfName && *pinned.association == Association::Cell ? ":cell" : "");
+    }
+    scene.mesh = mesh;
+    // Every method can be picked in the page: the server prepares for all of them, in the
+    // background once it listens, showing the steps in the log and the page.
+    scene.rendererOptions = flags.rendererOptions(true);
+    scene.rendererOptions.partitions = scene.rendererOptions.meshBvh = true;
+    scene.rendererOptions.communicator = ctx.comm;  // under mpirun: each rank its piece
+    if (resolvesToCuda(scene.rendererOptions.device)) ctx.step("GPU: " + cudaDeviceDescription());
+    return scene;
+}
 #endif
 
 }  // namespace
@@ -45,7 +174,8 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
 void addViewCommand(CLI::App& app, Context& ctx) {
     auto* cmd = app.add_subcommand(
         "view",
-        "Explore a mesh in the browser: read and prepare it once, then serve a page (printed URL "
+        "Explore a mesh in the browser: read and prepare it once (or read its prepared cache), "
+        "then serve a page (printed URL "
         "with a token) to orbit, edit the transfer function and switch field, method and "
         "quality, rendered on the GPU or the CPU (docs/VIEWER.md)");
     auto file = std::make_shared<std::string>();
@@ -53,11 +183,13 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     auto options = std::make_shared<std::pair<std::string, int>>("127.0.0.1", 8080);
     auto token = std::make_shared<std::string>();
     auto steps = std::make_shared<StepFlags>();
+    auto cache = std::make_shared<CacheFlags>();
     cmd->add_option("FILE", *file,
                     std::string(kMeshFileHelp) + ": the page gets a time slider for a series")
         ->required();
     flags->registerOn(*cmd, /*oneFrame=*/false, /*withMethod=*/true);
     steps->registerOn(*cmd);
+    cache->registerOn(*cmd);
     cmd->add_option("--host", options->first,
                     "IP address to listen on (localhost is 127.0.0.1; 0.0.0.0: every interface, "
                     "the token still applies)")
@@ -93,75 +225,20 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         // Before minutes of reading; rank 0 serves (data-parallel: the other ranks follow it).
         server::checkServerOptions(so, /*tryAddress=*/false);
         ctx.rootWrites([&] { server::checkServerOptions(so, /*tryAddress=*/true); });
-        // Step 1: read and validate, as `uvr render` does.
-        const auto start = std::chrono::steady_clock::now();
-        auto mesh = std::make_shared<Mesh>(loadMesh(*file, ctx, *steps));
-        server::ViewScene scene;
-        std::shared_ptr<MeshSeries> series = openSeries(*file, ctx);
-        scene.initial.step = steps->pick(*series);
-        if (series->stepCount() > 1) scene.series = std::move(series);
-        scene.loadSeconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        scene.file = *file;
-        const ValidationReport report = validateMesh(*mesh, *file);
-        for (const std::string& f : report.findings()) {
-            ctx.step("validation: " + f);
-            scene.notes.push_back(f);
+        std::optional<server::ViewScene> cached;
+        if (ctx.dataParallel()) {
+            if (!cache->file.empty())
+                throwError(ErrorKind::Unsupported, "",
+                           "--cache: a prepared cache is one process's preparation; a "
+                           "data-parallel view (mpirun) prepares each rank's piece from the "
+                           "mesh");
+        } else {
+            cached = sceneFromCache(*file, *flags, *steps, *cache, ctx);
         }
-        for (const std::string& n : mesh->notes) scene.notes.push_back(n);
-        if (report.bounds.empty())
-            throwError(ErrorKind::Validation, *file,
-                       "no cell has volume (or the mesh has no volumetric cells): nothing to view");
-        const ScalarField field = selectScalarField(*mesh, parseFieldSpec(flags->field));
-        std::vector<std::string> notes;
-        RenderSettings settings = flags->settings(report.bounds, *file, &notes);
-        for (const std::string& note : notes) {
-            ctx.step("note: " + note);
-            scene.notes.push_back(note);
-        }
-        validateSettings(settings);
-        // Step 2: the state every tab starts from, as `uvr render` would draw it (the field's
-        // finite range, ParaView's opacity unit of the rendered cells' bounds).
-        server::ViewState& s = scene.initial;
-        s.camera = settings.camera.value_or(
-            resetCamera(report.bounds, float(settings.width) / float(settings.height)));
-        s.tf = settings.tf;
-        s.range = settings.range.value_or(finiteRange(field.values));
-        s.clipPlanes = settings.clipPlanes;
-        s.isoSurfaces = settings.isoSurfaces;
-        s.field = flags->field;
-        s.background = flags->backgroundColor().value_or(Vec3f(0.f, 0.f, 0.f));
-        // A series shows one field at every step: the default its first step chose (pinField).
-        if (scene.series && flags->field.empty()) {
-            const FieldSpec pinned = pinField(*mesh, parseFieldSpec(""));
-            bool twoOfName = false;
-            for (const Field& f : mesh->fields)
-                twoOfName =
-                    twoOfName || (f.name == pinned.name && f.association != *pinned.association);
-            s.field = pinned.name +
-                      (twoOfName && *pinned.association == Association::Cell ? ":cell" : "");
-        }
-        // The page's settings start as the command line set them (or their defaults).
-        for (const char* name : server::kViewerSettings)
-            s.settings[name] = settingNamed(name).get(settings);
-        s.settings["opacity_unit"] = settings.opacityUnit > 0.f
-                                         ? settings.opacityUnit
-                                         : defaultOpacityUnit(report.bounds, mesh->cellCount());
-        s.width = settings.width;
-        s.height = settings.height;
-        scene.mesh = mesh;
-        scene.bounds = report.bounds;
-        // Every method can be picked in the page: the server prepares for all of them, in the
-        // background once it listens, showing the steps in the log and the page.
-        scene.rendererOptions = flags->rendererOptions(true);
-        scene.rendererOptions.partitions = scene.rendererOptions.meshBvh = true;
-        scene.rendererOptions.communicator = ctx.comm;  // under mpirun: each rank its piece
-        if (resolvesToCuda(scene.rendererOptions.device))
-            ctx.step("GPU: " + cudaDeviceDescription());
-        scene.base = settings;
-        scene.commandFlags = imageFlags(*flags);
+        server::ViewScene scene =
+            cached ? std::move(*cached) : sceneFromMesh(*file, *flags, *steps, ctx);
         scene.sizeGiven = cmd->count("--size") > 0;
-        // Step 3: serve until Ctrl-C.
+        // Serve until Ctrl-C.
         server::ViewServer server(std::move(scene), so, [&ctx](const std::string& line) {
             ctx.step(line.rfind("view: ", 0) == 0 ? line.substr(6) : line);
         });

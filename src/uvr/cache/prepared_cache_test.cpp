@@ -82,6 +82,15 @@ void expectSameFramesFromCache(const Mesh& mesh, const std::string& fieldSpec) {
     EXPECT_TRUE(loaded.neighbors.empty());
     EXPECT_TRUE(loaded.kd->cells.empty());
     EXPECT_GT(budget.peak(), 0u);
+    // The values a histogram of the cache is made of: the fresh preparation's, each at least
+    // once (a tetrahedral point field's come from the blocks).
+    const auto distinct = [](std::vector<float> v) {
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+        return v;
+    };
+    EXPECT_EQ(distinct(preparedValues(loaded)), distinct(preparedValues(fresh)));
+    EXPECT_EQ(renderableMethods(loaded), renderableMethods(fresh));
     for (RenderMethod method :
          {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
         const RenderSettings s = frameOf(mesh.bounds(), method);

@@ -5,6 +5,7 @@
 
 #include "test_meshes.h"
 
+#include <string>
 #include <vector>
 
 #include "uvr/accel/tet_adjacency.h"
@@ -44,6 +45,29 @@ TEST(PrepareMesh, AFaceMatcherIsGivenTheWeldOfThePointsItReads) {
         EXPECT_EQ(given[seams.points.size() / 2], 0u);
         EXPECT_EQ(pm.neighbors, cpu.neighbors);
     }
+}
+
+TEST(PrepareMesh, RenderableMethodsAreThoseItsStructuresServe) {
+    const Mesh m = testing::seamMesh(2000);
+    const ScalarField field = selectScalarField(m, {});
+    const auto methods = [&](bool partitions, bool meshBvh, bool forAuto) {
+        PrepareOptions o;
+        o.partitions = partitions;
+        o.meshBvh = meshBvh;
+        o.forAuto = forAuto;
+        std::vector<std::string> names;
+        for (RenderMethod r : renderableMethods(prepareMesh(m, field, o)))
+            names.push_back(methodName(r));
+        return names;
+    };
+    using V = std::vector<std::string>;
+    EXPECT_EQ(methods(true, true, false), (V{"auto", "adaptive", "reference", "exact"}));
+    EXPECT_EQ(methods(true, false, false), (V{"auto", "adaptive"}));
+    EXPECT_EQ(methods(false, true, false), (V{"auto", "reference", "exact"}));
+    // forAuto alone: what auto picked for this mesh, and auto.
+    const V picked = methods(false, false, true);
+    ASSERT_GE(picked.size(), 2u);
+    EXPECT_EQ(picked[0], "auto");
 }
 
 }  // namespace

@@ -335,4 +335,26 @@ float defaultOpacityUnit(const Bounds3f& bounds, std::uint64_t cellCount) {
     return static_cast<float>(d / std::cbrt(double(cellCount)));
 }
 
+std::vector<RenderMethod> renderableMethods(const PreparedMesh& mesh) {
+    const bool kd = mesh.kd.has_value();
+    const bool bvh = !mesh.bvh.nodes.empty() || mesh.tets.cellCount() == 0;
+    std::vector<RenderMethod> out;
+    for (const MethodName& m : kMethods) {
+        const bool ok = m.method == RenderMethod::Auto         ? kd || bvh
+                        : m.method == RenderMethod::Partitions ? kd
+                                                               : bvh;
+        if (ok) out.push_back(m.method);
+    }
+    return out;
+}
+
+std::vector<float> preparedValues(const PreparedMesh& mesh) {
+    const TetMesh& t = mesh.tets;
+    if (!t.values.empty()) return t.values;
+    std::vector<float> out;
+    out.reserve(t.blockVertices.size());
+    for (const BlockVertex& v : t.blockVertices) out.push_back(v.value);
+    return out;
+}
+
 }  // namespace uvr

@@ -226,6 +226,17 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field);
 /// new values need are not there); the prepared mesh is unchanged then.
 void updateFieldValues(PreparedMesh& mesh, const ScalarField& field);
 
+/// The methods a prepared mesh renders with, in kMethods' order: adaptive where its k-d
+/// partitions were prepared, reference and exact where its mesh BVH was, auto where either was
+/// (resolveMethod then takes the one prepared). A front end offers these alone, e.g. the viewer
+/// serving a prepared cache.
+std::vector<RenderMethod> renderableMethods(const PreparedMesh& mesh);
+
+/// The field's values as prepared, for a histogram of them: TetMesh::values where held, else
+/// (a prepared cache of tetrahedra with a point field keeps them in the blocks alone) the
+/// blocks' vertex values, a point once per block that uses it.
+std::vector<float> preparedValues(const PreparedMesh& mesh);
+
 /// Throws Error(Argument) naming the field unless it holds `expected` values, one per point
 /// (or cell, by its association) of `of` ("the prepared mesh", "this rank's share", ...): the
 /// one check of new values for every place that takes them.

@@ -164,6 +164,11 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
         std::lock_guard lk(fieldsMutex);
         return fields.at(key);
     }
+    if (scene.fromCache)
+        throwError(ErrorKind::Unsupported, scene.fromCache->file,
+                   "served from this prepared cache, which holds " +
+                       scene.fromCache->summary.field().describe() +
+                       " alone: `uvr view --no-cache` reads the mesh, to show other fields");
     // Data-parallel, every rank reads the step: a rank that fails ends every rank's call.
     const auto agreed = [this](auto&& work) {
         if (Communicator* comm = ranks())
@@ -234,10 +239,14 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
 
 /// The vocabulary's entries of the settings the page sets (kViewerSettings): their choices,
 /// ranges and docs for its controls.
-static Json viewerVocabulary() {
+static Json viewerVocabulary(const std::vector<std::string>& methods) {
     Json out = Json::array();
-    for (const Json& d : settingsVocabularyJson())
-        if (isViewerSetting(d["name"].get<std::string>())) out.push_back(d);
+    for (Json d : settingsVocabularyJson()) {
+        const std::string name = d["name"].get<std::string>();
+        if (!isViewerSetting(name)) continue;
+        if (name == "method") d["choices"] = methods;
+        out.push_back(d);
+    }
     return out;
 }
 
@@ -249,7 +258,8 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
         s.range.first = std::fmin(s.range.second * 1e-4f, 1.f);
     std::vector<std::string> args = {"uvr", "render", scene.file};
     if (stepCount() > 1) args.insert(args.end(), {"--step-index", std::to_string(s.step)});
-    if (!s.field.empty()) args.insert(args.end(), {"--field", s.field});
+    const std::string field = scene.fromCache ? scene.fromCache->fieldSpec : s.field;
+    if (!field.empty()) args.insert(args.end(), {"--field", field});
     // The state's settings as the frames use them (the command line's where the page set none).
     const RenderSettings f = frameSettings(s, scene.base);
     args.insert(args.end(), {"--tf", "uvr-tf.json", "--camera", "uvr-camera.pvcc", "--range",
@@ -578,30 +588,57 @@ void checkServerOptions(const ServerOptions& o, bool tryAddress) {
 ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     : impl_(std::make_unique<Impl>()) {
     Impl& d = *impl_;
-    if (!scene.mesh) throwError(ErrorKind::Argument, "", "the viewer needs a mesh");
+    if (!scene.mesh && !(scene.fromCache && scene.renderer))
+        throwError(ErrorKind::Argument, "", "the viewer needs a mesh, or a prepared one");
+    if (scene.fromCache && scene.series)
+        throwError(ErrorKind::Argument, "", "a prepared cache holds one time step");
     checkServerOptions(options, false);
     if (options.token.empty()) options.token = randomToken();
     d.scene = std::move(scene);
     d.opt = std::move(options);
     d.log = std::move(log);
-    const Mesh& mesh = *d.scene.mesh;
-    // The fields as the page lists them, with their ranges.
+    // The fields as the page lists them, with their ranges and their values' constancy, so that
+    // the default resolves as selectScalarField does; from a prepared cache, its one field.
     Json fields = Json::array();
-    // With their values' constancy, so that the default resolves as selectScalarField does.
-    d.fieldInfos = uvr::fieldInfos(mesh);
-    const std::optional<std::size_t> def = defaultFieldIndex(d.fieldInfos);
-    for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
-        const Field& f = mesh.fields[i];
-        const auto range = finiteRange(scalarFieldOf(mesh, f).values);
-        fields.push_back({{"name", f.name},
-                          {"association", associationName(f.association)},
-                          {"components", f.components},
-                          {"range", {range.first, range.second}},
-                          {"default", def == i}});
+    std::map<std::string, std::uint64_t> types;
+    std::uint64_t cellCount = 0, pointCount = 0;
+    std::vector<float> firstValues;  // the starting field's
+    if (const auto& cached = d.scene.fromCache) {
+        const TetMesh& t = d.scene.renderer->prepared().tets;
+        d.fieldInfos = {{cached->summary.fieldName, cached->summary.association, 1}};
+        fields.push_back({{"name", cached->summary.fieldName},
+                          {"association", associationName(cached->summary.association)},
+                          {"components", 1},
+                          {"range", {t.valueMin, t.valueMax}},
+                          {"default", true}});
+        // The rendered cells' kinds (the file's are not read).
+        for (const auto& [type, n] : {std::pair{CellType::Tetra, t.tetCount()},
+                                      {CellType::Pyramid, t.pyramidCount},
+                                      {CellType::Wedge, t.wedgeCount},
+                                      {CellType::Hexahedron, t.hexCount}})
+            if (n) types[cellTypeName(type)] = n;
+        cellCount = cached->summary.cells;
+        pointCount = cached->summary.points;
+        d.scene.initial.field.clear();  // the one field, by any spec the cache was made for
+        firstValues = preparedValues(d.scene.renderer->prepared());
+    } else {
+        const Mesh& mesh = *d.scene.mesh;
+        d.fieldInfos = uvr::fieldInfos(mesh);
+        const std::optional<std::size_t> def = defaultFieldIndex(d.fieldInfos);
+        for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
+            const Field& f = mesh.fields[i];
+            const auto range = finiteRange(scalarFieldOf(mesh, f).values);
+            fields.push_back({{"name", f.name},
+                              {"association", associationName(f.association)},
+                              {"components", f.components},
+                              {"range", {range.first, range.second}},
+                              {"default", def == i}});
+        }
+        for (CellType t : mesh.cellTypes) ++types[cellTypeName(t)];
+        cellCount = mesh.cellCount();
+        pointCount = mesh.pointCount();
     }
     d.fieldKey(d.scene.initial.field);  // the starting field exists
-    std::map<std::string, std::uint64_t> types;
-    for (CellType t : mesh.cellTypes) ++types[cellTypeName(t)];
     const Bounds3f& b = d.scene.bounds;
     std::vector<std::string> presets;
     for (const ColorMapInfo& p : transferFunctionPresets()) presets.push_back(p.name);
@@ -623,10 +660,19 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
             ErrorKind::Argument, d.scene.file,
             "time step " + std::to_string(d.meshStep) + " of " + std::to_string(d.stepCount()));
     {
-        const ScalarField values = selectScalarField(mesh, parseFieldSpec(d.scene.initial.field));
+        if (!d.scene.fromCache)
+            firstValues =
+                selectScalarField(*d.scene.mesh, parseFieldSpec(d.scene.initial.field)).values;
         FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field, d.meshStep)];
-        entry.range = finiteRange(values.values);
-        entry.histogram = histogramOf(values.values, entry.range);
+        entry.range = finiteRange(firstValues);
+        entry.histogram = histogramOf(firstValues, entry.range);
+    }
+    // Every method, or those a prepared cache holds.
+    std::vector<std::string> methods = methodNames();
+    if (d.scene.fromCache) {
+        methods.clear();
+        for (RenderMethod m : renderableMethods(d.scene.renderer->prepared()))
+            methods.push_back(methodName(m));
     }
     if (d.scene.renderer) {
         tets = d.scene.renderer->prepared().tets.tetCount();
@@ -638,16 +684,16 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     }
     d.infoBase = {{"type", "info"},
                   {"file", d.scene.file},
-                  {"cells", mesh.cellCount()},
-                  {"points", mesh.pointCount()},
+                  {"cells", cellCount},
+                  {"points", pointCount},
                   {"tetrahedra", tets},
                   {"rendered_cells", renderedCells},
                   {"cell_types", types},
                   {"bounds", {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}}},
                   {"fields", fields},
                   {"presets", presets},
-                  {"methods", methodNames()},
-                  {"settings", viewerVocabulary()},
+                  {"methods", methods},
+                  {"settings", viewerVocabulary(methods)},
                   {"device", device},
                   {"load_seconds", d.scene.loadSeconds},
                   {"prepare_seconds", prepareSeconds},

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "uvr/cache/prepared_cache.h"
 #include "uvr/facade/renderer.h"
 #include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/mesh.h"
@@ -54,7 +55,8 @@ void checkServerOptions(const ServerOptions& options, bool tryAddress);
 /// render settings the command line fixed and the state every new tab starts from.
 struct ViewScene {
     std::string file;  ///< as named on the command line
-    /// The mesh as read (the server replaces its fields when a tab shows another time step).
+    /// The mesh as read (the server replaces its fields when a tab shows another time step);
+    /// null when served from a prepared cache (fromCache).
     std::shared_ptr<Mesh> mesh;
     /// The time steps of `file` (a series opened on it) when it has more than one; `mesh` holds
     /// step initial.step. Steps must share the mesh's points and cells.
@@ -66,6 +68,15 @@ struct ViewScene {
     /// Prepared for initial.field (the command line's preparation, with its progress); null:
     /// prepared before the first frame.
     std::unique_ptr<Renderer> renderer;
+    /// A scene served from a prepared cache (`uvr view` with MESH.uvrprep): no mesh was read,
+    /// so `renderer` (set) serves the one field it was prepared for, with no other field and
+    /// no time steps, and the page offers the methods it holds (renderableMethods).
+    struct FromCache {
+        std::string file;       ///< the cache
+        std::string fieldSpec;  ///< the `--field` it was prepared for ("" the default)
+        SourceSummary summary;  ///< the mesh's counts and the field's name
+    };
+    std::optional<FromCache> fromCache;
     std::vector<std::string> notes;  ///< validation findings and notes the page shows
     double loadSeconds = 0.0;        ///< reading the file
     /// Flags of the command line that shape the image beyond the state (--sample-distance,

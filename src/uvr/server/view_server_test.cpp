@@ -229,6 +229,71 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
     EXPECT_EQ(cells, "216 cells (216 hexahedra)");  // native, not 1296 tetrahedra
 }
 
+TEST(ViewServer, APreparedSceneServesItsOneFieldWithTheMethodsItHolds) {
+    // As `uvr view` serves a prepared cache: no mesh, a renderer prepared for the cell field g
+    // with the partitions alone.
+    const std::shared_ptr<Mesh> mesh = twoFieldMesh();
+    RendererOptions ro;
+    ro.device = Device::Cpu;
+    ro.leafCells = 64;
+    ro.partitions = true;
+    ro.meshBvh = false;
+    ViewScene scene;
+    scene.file = "grid.vtk";
+    scene.bounds = mesh->bounds();
+    scene.renderer =
+        std::make_unique<Renderer>(*mesh, selectScalarField(*mesh, parseFieldSpec("g")), ro);
+    SourceSummary summary;
+    summary.points = mesh->pointCount();
+    summary.cells = mesh->cellCount();
+    summary.bounds = mesh->bounds();
+    summary.fieldName = "g";
+    summary.association = Association::Cell;
+    scene.fromCache = ViewScene::FromCache{"grid.vtk.uvrprep", "g:cell", summary};
+    ViewState& s = scene.initial;
+    s.camera = resetCamera(scene.bounds, 64.f / 48.f);
+    s.tf = transferFunctionPreset("viridis");
+    s.range = {100.f, 315.f};
+    s.width = 64;
+    s.height = 48;
+    s.field = "g";
+    ServerOptions o;
+    o.port = 0;
+    ViewServer server(std::move(scene), o);
+    server.start();
+    Client c(server.port(), server.token());
+    const Json info = c.next();
+    ASSERT_EQ(info["type"], "info") << info.dump();
+    EXPECT_EQ(info["cells"], 216);
+    ASSERT_EQ(info["fields"].size(), 1u);
+    EXPECT_EQ(info["fields"][0]["name"], "g");
+    EXPECT_EQ(info["fields"][0]["association"], "cell");
+    EXPECT_EQ(info["fields"][0]["range"], Json({100.0, 315.0}));
+    EXPECT_EQ(info["cell_types"], Json({{"hexahedron", 216}}));
+    EXPECT_EQ(info["methods"], Json({"auto", "adaptive"}));
+    for (const Json& d : info["settings"])
+        if (d["name"] == "method") {
+            EXPECT_EQ(d["choices"], Json({"auto", "adaptive"}));
+        }
+    std::uint64_t counted = 0;
+    for (const Json& n : info["histogram"]["counts"]) counted += n.get<std::uint64_t>();
+    EXPECT_EQ(counted, 216u);  // one value per cell
+    const Json f = c.frame();
+    ASSERT_FALSE(f.is_null());
+    EXPECT_TRUE(isPng(c.lastBinary()));
+    EXPECT_GT(f["stats"]["samples"].get<double>(), 0.0);
+    // Another field is not there; a method whose structures were not prepared is refused.
+    c.send({{"type", "set"}, {"field", "f"}});
+    EXPECT_THAT(c.until("error")["message"].get<std::string>(), HasSubstr("f"));
+    c.send({{"type", "set"}, {"seq", 5}, {"method", "reference"}});
+    EXPECT_THAT(c.until("error")["message"].get<std::string>(), HasSubstr("mesh BVH"));
+    // The exported command names the field the cache was prepared for.
+    c.send({{"type", "export"}});
+    const Json ex = c.until("export");
+    ASSERT_FALSE(ex.is_null());
+    EXPECT_THAT(ex["command"].get<std::string>(), HasSubstr("uvr render grid.vtk --field g:cell"));
+}
+
 TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
     auto server = startServer();
     Client c(server->port(), server->token());
