@@ -228,6 +228,15 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             }
         }
 
+        // A reset camera keeps the volume off the legend (its columns with the first step's
+        // range; one camera for every frame).
+        const std::string title = legendTitle(player.field().name, player.field().association);
+        LegendStyle legendStyle;
+        legendStyle.background = background;
+        if (legendFont && flags->cameraIsReset())
+            settings.camera = cameraBesideLegend(player.renderer().prepared(), settings,
+                                                 report.bounds, *legendFont, title);
+
         // Step 3: every step: values refreshed (or the new geometry prepared), rendered, written;
         // the next step read meanwhile.
         const int digits = std::max<int>(4, int(std::to_string(series->stepCount() - 1).size()));
@@ -264,14 +273,9 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             const std::string path = (fs::path(*folder) / (*prefix + name)).string();
             ctx.rootWrites([&] {
                 Image image = result.image;
-                if (legendFont) {
-                    LegendStyle style;
-                    style.background = background;
+                if (legendFont)
                     drawLegend(image, *legendFont, settings.tf, result.setup.rangeLo,
-                               result.setup.rangeHi,
-                               legendTitle(player.field().name, player.field().association),
-                               settings.tf.logScale, style);
-                }
+                               result.setup.rangeHi, title, settings.tf.logScale, legendStyle);
                 if (labelFont) {
                     LegendStyle style;
                     style.background = background;

@@ -135,7 +135,8 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
     if (oneFrame)
         app.add_flag("--legend", legend,
                      "Draw a colour legend at the right edge: the field's name, the colour map "
-                     "and tick values over the value range (needs --size of at least " +
+                     "and tick values over the value range; the reset camera moves the volume "
+                     "off it (needs --size of at least " +
                          std::to_string(kLegendMinWidth) + "x" + std::to_string(kLegendMinHeight) +
                          ")");
     if (oneFrame) app.add_option("--stats", statsFile, "Write render statistics to this JSON file");
@@ -386,6 +387,10 @@ std::optional<Vec3f> RenderFlags::backgroundColor() const {
     return c;
 }
 
+bool RenderFlags::cameraIsReset() const {
+    return cameraFile.empty() && cameraPosition.empty() && cameraFocal.empty() && !parallelScale;
+}
+
 RenderOutputs RenderFlags::renderOutputs() const {
     RenderOutputs out;
     out.image = output;
@@ -395,6 +400,7 @@ RenderOutputs RenderFlags::renderOutputs() const {
     out.depth = depthFile;
     out.background = backgroundColor();
     out.legend = legendFont();
+    out.roomForLegend = out.legend && cameraIsReset();
     return out;
 }
 

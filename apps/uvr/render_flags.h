@@ -20,7 +20,10 @@ struct RenderOutputs {
     std::string stats;                ///< --stats: the frame report as JSON ("" for none)
     std::optional<Vec3f> background;  ///< --background: composited over it (none: RGBA)
     std::optional<Font> legend;       ///< --legend: the font it is drawn in (none: no legend)
-    std::string depth;                ///< --depth: the depth image as a .npy ("" for none)
+    /// With --legend and a camera that is the reset one (turned, or parallel): it is moved back
+    /// to keep the volume off the legend (clearColumns). Not a camera given by file or position.
+    bool roomForLegend = false;
+    std::string depth;  ///< --depth: the depth image as a .npy ("" for none)
 };
 
 /// Render options shared by `render` and `demo`, registered on a subcommand.
@@ -84,6 +87,9 @@ struct RenderFlags {
     std::optional<Vec3f> backgroundColor() const;
     /// The outputs of a single render (-o, --heatmap, --heatmap-max, --stats, --background,
     /// --legend with its font found), checked.
+    /// The camera is the reset one, perhaps turned (--azimuth, --elevation), made parallel
+    /// or given another view angle: no --camera file, position, focal point or parallel scale.
+    bool cameraIsReset() const;
     RenderOutputs renderOutputs() const;
     /// The camera flags' own checks (--parallel-scale without a parallel camera, --view-angle
     /// with one or out of range, non-finite --azimuth/--elevation); fileParallel: the --camera

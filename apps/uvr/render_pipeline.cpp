@@ -66,6 +66,12 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
     const std::string& source = src.path;
     const ScalarField field = src.summary.field();
     const PreparedMesh& prepared = renderer.prepared();
+    const std::string title = legendTitle(field.name, field.association);
+    LegendStyle style;
+    style.background = background;
+    if (out.legend && out.roomForLegend)  // the reset camera keeps the volume off the legend
+        settings.camera =
+            cameraBesideLegend(prepared, settings, src.summary.bounds, *out.legend, title);
     ctx.step("rendering " + field.describe() + (field.choice.empty() ? "" : ", " + field.choice) +
              " at " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
              (settings.supersample > 1
@@ -108,11 +114,8 @@ RenderResult renderPreparedAndWrite(Renderer& renderer, const RenderSource& src,
     const std::string empty = explainEmptyFrame(prepared, settings, result);
     if (!empty.empty()) ctx.warn(source + ": " + empty);
     if (const std::optional<Font>& legendFont = out.legend) {
-        LegendStyle style;
-        style.background = background;
         drawLegend(result.image, *legendFont, settings.tf, result.setup.rangeLo,
-                   result.setup.rangeHi, legendTitle(field.name, field.association),
-                   settings.tf.logScale, style);
+                   result.setup.rangeHi, title, settings.tf.logScale, style);
         ctx.step("drew the legend in " + legendFont->familyName() + " (" + legendFont->path() +
                  ")");
     }

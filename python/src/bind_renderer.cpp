@@ -70,7 +70,8 @@ void bindRenderer(py::module_& m) {
             },
             py::arg("name"), py::arg("association"), py::arg("values"))
         .def("render", &renderFrame, py::arg("tf"), py::arg("range"), py::arg("camera"),
-             py::arg("width"), py::arg("height"), py::arg("settings") = py::dict())
+             py::arg("width"), py::arg("height"), py::arg("settings") = py::dict(),
+             py::arg("room_for_legend") = false)
         .def_property_readonly("device",
                                [](const PyRenderer& r) { return r.renderer->deviceName(); })
         .def_property_readonly("device_description",

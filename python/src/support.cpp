@@ -385,7 +385,7 @@ RenderSettings settingsOf(const py::dict& settings,
 
 py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
-                      int width, int height, const py::dict& settings) {
+                      int width, int height, const py::dict& settings, bool roomForLegend) {
     std::pair<py::ssize_t, py::ssize_t> depthShape{0, 0};
     RenderSettings s = settingsOf(settings, &depthShape);
     if (!s.depthIn.empty() && (depthShape.first != height || depthShape.second != width))
@@ -401,6 +401,11 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
     RenderResult r;
     {
         py::gil_scoped_release release;
+        if (roomForLegend) {  // the reset camera keeps the volume off the legend
+            const PreparedMesh& p = self.renderer->prepared();
+            s.camera = cameraBesideLegend(p, s, fileBox(p), Font(findFontFile()),
+                                          legendTitle(p.tets.fieldName, p.tets.association));
+        }
         r = self.renderer->render(s);
     }
     // The library's frame report (the CLI's --stats, the viewer's frame messages), as a dict.
@@ -411,6 +416,14 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
     py::object depth = py::none();
     if (!r.depth.empty()) depth = vectorArray<float>(std::move(r.depth), {h, w});
     return py::make_tuple(pixels, counts, stats, depth);
+}
+
+Bounds3f fileBox(const PreparedMesh& p) {
+    double lo[3], hi[3];
+    p.tets.frame.toFile(p.wholeBounds().lo, lo);
+    p.tets.frame.toFile(p.wholeBounds().hi, hi);
+    return {Vec3f(float(lo[0]), float(lo[1]), float(lo[2])),
+            Vec3f(float(hi[0]), float(hi[1]), float(hi[2]))};
 }
 
 py::tuple fileBounds(const PreparedMesh& p) {

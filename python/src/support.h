@@ -195,12 +195,16 @@ struct PyRenderer {
 };
 
 /// One frame: (pixels (h, w, 4) float32 premultiplied, sample counts (h, w) uint32, stats).
+/// roomForLegend: the camera (none: the reset one) is moved back to keep the volume off the
+/// legend the caller draws (cameraBesideLegend).
 py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
-                      int width, int height, const py::dict& settings);
+                      int width, int height, const py::dict& settings, bool roomForLegend);
 
 /// The prepared mesh's bounds in the file's coordinates ((lo, hi), each a 3-tuple).
 py::tuple fileBounds(const PreparedMesh& p);
+/// The same bounds as a box (float).
+Bounds3f fileBox(const PreparedMesh& p);
 
 Bounds3f boundsOf(const std::array<std::array<float, 3>, 2>& b);
 

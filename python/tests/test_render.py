@@ -329,3 +329,16 @@ def test_a_legend_is_the_clis(data_dir, cli, tmp_path):
     plain = uvr.render(data_dir / "bluntfin_tets.vtk", size=(256, 192), background=(0, 0, 0),
                        device="cpu")
     assert not np.array_equal(img, plain)
+    # The reset camera, turned, moves the volume off the legend as the CLI's does; a camera
+    # given stays, and the legend then changes only its own columns.
+    cli("render", data_dir / "bluntfin_tets.vtk", "-o", out, "--size", "256x192", "--legend",
+        "--azimuth", "30", "--elevation", "15", "--device", "cpu", "-q")
+    turned = uvr.render(data_dir / "bluntfin_tets.vtk", size=(256, 192), legend=True,
+                        azimuth=30, elevation=15, device="cpu")
+    assert turned.png_bytes() == out.read_bytes()
+    r = uvr.Renderer(data_dir / "bluntfin_tets.vtk", device="cpu")
+    cam = r.camera((256, 192), azimuth=30, elevation=15)
+    placed = r.render(size=(256, 192), camera=cam, legend=True)
+    bare = r.render(size=(256, 192), camera=cam)
+    assert np.array_equal(np.asarray(placed)[:, :128], np.asarray(bare)[:, :128])
+    assert not np.array_equal(np.asarray(turned)[:, :128], np.asarray(bare)[:, :128])

@@ -215,7 +215,8 @@ class Renderer:
         opacity first reaches it, inf where it never does (``--depth``, ``--depth-opacity``);
         `depth_in` a (height, width) array of such distances of opaque geometry rendered
         elsewhere: every ray ends there (``--depth-in``); `legend` True draws ``--legend``'s
-        colour legend (the field, point or cell, the range's ends) onto the image. The same settings give the CLI's
+        colour legend (the field, point or cell, the range's ends) onto the image, the reset
+        camera (no `camera` given) moved back to keep the volume off it. The same settings give the CLI's
         pixels.
 
         `method`, `quality` and the other keywords are the library's settings (uvr.SETTINGS,
@@ -246,6 +247,8 @@ class Renderer:
             except (TypeError, ValueError, IndexError):
                 raise _uvr.ArgumentError(f"range: expected (lo, hi), got {range!r}") from None
             range = (lo, hi)
+        # A camera of the reset one (turned, zoomed) keeps the volume off the legend.
+        room_for_legend = bool(legend) and camera is None
         if camera is None and (azimuth or elevation or zoom != 1.0):
             camera = self.camera((w, h), azimuth, elevation, zoom)
         elif camera is not None:
@@ -264,7 +267,8 @@ class Renderer:
         if method != "auto" and method in _uvr.METHODS and method not in self._methods:
             raise _uvr.ArgumentError(f"method '{method}' was not prepared (methods="
                                      f"{self._methods!r} when the Renderer was made)")
-        pixels, counts, stats, depth = self._core.render(t, range, camera, w, h, settings)
+        pixels, counts, stats, depth = self._core.render(t, range, camera, w, h, settings,
+                                                         room_for_legend)
         if self._rank != 0:
             return None  # data-parallel: rank 0 holds the picture
         if legend:

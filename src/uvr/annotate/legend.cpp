@@ -285,30 +285,44 @@ PixelRect drawCornerText(Image& image, const Font& font, const std::string& text
     return box;
 }
 
-LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
-                        double hi, const std::string& title, bool logScale,
-                        const LegendStyle& style) {
-    requireAnnotatable(image, "a legend");
-    const int W = image.width, H = image.height;
-    legendTicks(lo, hi, logScale);  // a bad range fails before anything is drawn
+namespace {
 
-    // Sizes: everything in units of the label size u, about 1/40 of the height.
+/// A legend's layout and what drawing it needs beyond LegendLayout.
+struct LegendPlan {
     LegendLayout L;
+    std::string shownTitle;
+    float u = 0.f, titleSize = 0.f;
+    int line = 1, tickLength = 1, labelGap = 1, titleAscent = 0, barHeight = 1, margin = 1;
+    TextBox digit;
+};
+
+LegendPlan planLegend(int W, int H, const Font& font, double lo, double hi,
+                      const std::string& title, bool logScale, const LegendStyle& style) {
+    legendTicks(lo, hi, logScale);  // a bad range fails before anything is drawn
+    // Sizes: everything in units of the label size u, about 1/40 of the height.
+    LegendPlan P;
+    LegendLayout& L = P.L;
     const float u = std::max(10.f, std::round(std::min(H / 40.f, W / 24.f)));
-    const float titleSize = std::round(u * 1.15f);
+    P.u = u;
+    P.titleSize = std::round(u * 1.15f);
     L.fontSize = u;
     const auto px = [&](float f) { return std::max(1, static_cast<int>(std::lround(f * u))); };
-    const int margin = px(0.8f), pad = px(0.6f), barWidth = px(1.1f), tickLength = px(0.35f),
-              labelGap = px(0.3f), titleGap = px(0.7f), line = std::max(1, px(1.f / 14.f));
-    const TextBox digit = font.inkBox("0", u);
-    const int digitHeight = std::max(1, digit.y1 - digit.y0);
-    const FontMetrics tm = font.metrics(titleSize);
-    const int titleAscent = static_cast<int>(std::ceil(tm.ascender)),
-              titleHeight = static_cast<int>(std::ceil(tm.ascender + tm.descender));
+    const int margin = px(0.8f), pad = px(0.6f), barWidth = px(1.1f), titleGap = px(0.7f);
+    P.margin = margin;
+    P.tickLength = px(0.35f);
+    P.labelGap = px(0.3f);
+    P.line = std::max(1, px(1.f / 14.f));
+    const int line = P.line;
+    P.digit = font.inkBox("0", u);
+    const int digitHeight = std::max(1, P.digit.y1 - P.digit.y0);
+    const FontMetrics tm = font.metrics(P.titleSize);
+    P.titleAscent = static_cast<int>(std::ceil(tm.ascender));
+    const int titleHeight = static_cast<int>(std::ceil(tm.ascender + tm.descender));
 
     // The bar: half the height, less where the title and the box would not fit.
     const int frame = titleHeight + titleGap + digitHeight + 2 * (pad + margin);
     const int barHeight = std::max(digitHeight * 2, std::min(H / 2, H - frame));
+    P.barHeight = barHeight;
     // Labels at least 1.8 digit heights apart.
     const int maxTicks = std::clamp(barHeight / (digitHeight * 9 / 5) + 1, 2, 8);
     L.ticks = legendTicks(lo, hi, logScale, std::min(5, maxTicks), maxTicks);
@@ -316,11 +330,10 @@ LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& 
     int labelWidth = 0;
     for (const std::string& s : L.ticks.labels)
         labelWidth = std::max(labelWidth, font.advance(s, u));
-    const int scaleWidth = line + barWidth + line + tickLength + labelGap + labelWidth;
-    const std::string shownTitle =
-        fitTitle(font, title, titleSize,
-                 std::max(scaleWidth, static_cast<int>(0.45f * W) - 2 * (pad + margin)));
-    const int titleWidth = font.advance(shownTitle, titleSize);
+    const int scaleWidth = line + barWidth + line + P.tickLength + P.labelGap + labelWidth;
+    P.shownTitle = fitTitle(font, title, P.titleSize,
+                            std::max(scaleWidth, static_cast<int>(0.45f * W) - 2 * (pad + margin)));
+    const int titleWidth = font.advance(P.shownTitle, P.titleSize);
     const int contentWidth = std::max(scaleWidth, titleWidth);
     const int contentHeight =
         titleHeight + titleGap + digitHeight / 2 + barHeight + digitHeight / 2 + line;
@@ -337,13 +350,36 @@ LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& 
     L.bar.x1 = L.bar.x0 + barWidth;
     L.bar.y0 = top + titleHeight + titleGap + digitHeight / 2;
     L.bar.y1 = L.bar.y0 + barHeight;
+    // The columns from the image's edge to the box and its margin again beyond it, at most a
+    // third of the width (a long title's box is wider).
+    L.columns = std::min(
+        W / 3, style.position == LegendPosition::Right ? W - L.box.x0 + margin : L.box.x1 + margin);
+    return P;
+}
+
+}  // namespace
+
+LegendLayout legendLayout(int width, int height, const Font& font, double lo, double hi,
+                          const std::string& title, bool logScale, const LegendStyle& style) {
+    return planLegend(width, height, font, lo, hi, title, logScale, style).L;
+}
+
+LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
+                        double hi, const std::string& title, bool logScale,
+                        const LegendStyle& style) {
+    requireAnnotatable(image, "a legend");
+    const LegendPlan P =
+        planLegend(image.width, image.height, font, lo, hi, title, logScale, style);
+    LegendLayout L = P.L;
+    const int line = P.line, barHeight = P.barHeight;
+    const int top = L.title.y0;
 
     // Colours: the box as the background (white on a transparent image), text contrasting.
     const auto [boxColor, ink] = boxAndInk(style);
 
     // Drawing: box, title, bar with its frame, tick marks and labels.
     fillRect(image, L.box, boxColor, 0.8f);
-    font.draw(image, shownTitle, titleSize, L.title.x0, top + titleAscent, ink);
+    font.draw(image, P.shownTitle, P.titleSize, L.title.x0, top + P.titleAscent, ink);
     for (int y = L.bar.y0; y < L.bar.y1; ++y) {
         const float t = (L.bar.y1 - y - 0.5f) / barHeight;
         fillRect(image, {L.bar.x0, y, L.bar.x1, y + 1}, tf.colorAt(t), 1.f);
@@ -352,20 +388,29 @@ LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& 
     fillRect(image, {L.bar.x0 - line, L.bar.y1, L.bar.x1 + line, L.bar.y1 + line}, ink, 1.f);
     fillRect(image, {L.bar.x0 - line, L.bar.y0, L.bar.x0, L.bar.y1}, ink, 1.f);
     fillRect(image, {L.bar.x1, L.bar.y0, L.bar.x1 + line, L.bar.y1}, ink, 1.f);
-    const int labelX = L.bar.x1 + line + tickLength + labelGap;
+    const int labelX = L.bar.x1 + line + P.tickLength + P.labelGap;
     for (size_t i = 0; i < L.ticks.values.size(); ++i) {
         const double t = legendPosition(L.ticks.values[i], lo, hi, logScale);
         const int row = std::clamp(static_cast<int>(std::floor(L.bar.y1 - t * barHeight)), L.bar.y0,
                                    L.bar.y1 - 1);
         L.tickRows.push_back(row);
         const int y0 = row - (line - 1) / 2;
-        fillRect(image, {L.bar.x1, y0, L.bar.x1 + line + tickLength, y0 + line}, ink, 1.f);
+        fillRect(image, {L.bar.x1, y0, L.bar.x1 + line + P.tickLength, y0 + line}, ink, 1.f);
         // Digits centred on the tick: their ink box runs from digit.y0 to digit.y1 about the
         // baseline.
-        const int baseline = row - (digit.y0 + digit.y1) / 2;
-        font.draw(image, L.ticks.labels[i], u, labelX, baseline, ink);
+        const int baseline = row - (P.digit.y0 + P.digit.y1) / 2;
+        font.draw(image, L.ticks.labels[i], P.u, labelX, baseline, ink);
     }
     return L;
+}
+
+Camera cameraBesideLegend(const PreparedMesh& mesh, const RenderSettings& settings,
+                          const Bounds3f& fileBounds, const Font& font, const std::string& title) {
+    const auto [lo, hi] = frameValueRange(mesh, settings);
+    const int w = settings.width, h = settings.height;
+    const LegendLayout layout = legendLayout(w, h, font, lo, hi, title, settings.tf.logScale);
+    return clearColumns(settings.camera.value_or(resetCamera(fileBounds, float(w) / float(h))), w,
+                        h, layout.columns);
 }
 
 }  // namespace uvr

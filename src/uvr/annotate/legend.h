@@ -8,6 +8,8 @@
 #include "uvr/annotate/font.h"
 #include "uvr/core/vec.h"
 #include "uvr/mesh/mesh.h"
+#include "uvr/render/camera.h"
+#include "uvr/render/frame_setup.h"
 #include "uvr/render/image.h"
 #include "uvr/tf/transfer_function.h"
 
@@ -70,6 +72,10 @@ struct LegendLayout {
     PixelRect title;       ///< the pen box of the title line
     LegendTicks ticks;
     std::vector<int> tickRows;  ///< the row of each tick mark
+    /// The columns at its edge the legend keeps for itself: from the edge to the box and its
+    /// margin again beyond it, at most a third of the width (a long title's box may be
+    /// wider). A reset camera keeps the volume off them (clearColumns).
+    int columns = 0;
 };
 
 /// A legend's title: the field's name and whether it is point or cell data ("density (point)").
@@ -94,6 +100,22 @@ inline constexpr int kLegendMinHeight = 128;
 LegendLayout drawLegend(Image& image, const Font& font, const TransferFunction& tf, double lo,
                         double hi, const std::string& title, bool logScale,
                         const LegendStyle& style = {});
+
+/// Where drawLegend would put a legend of these arguments on an image of width x height,
+/// without drawing: its columns (LegendLayout::columns) are known before the frame is
+/// rendered, so that its camera can keep the volume off them (clearColumns). tickRows stays
+/// empty. Throws as drawLegend for a bad range.
+LegendLayout legendLayout(int width, int height, const Font& font, double lo, double hi,
+                          const std::string& title, bool logScale, const LegendStyle& style = {});
+
+/// The camera of a frame of `mesh` that will carry a legend at the right edge (issue 35):
+/// settings.camera (none: the reset camera of fileBounds, the rendered cells' bounds in the
+/// file's coordinates) moved back by clearColumns so that the volume stays off the columns of
+/// the legend drawn with the frame's range (frameValueRange) and `title`. For a camera that is
+/// the reset one, perhaps turned or zoomed: the CLI's render and animate and Python's
+/// render(legend=True) use it, not for a camera placed by the user.
+Camera cameraBesideLegend(const PreparedMesh& mesh, const RenderSettings& settings,
+                          const Bounds3f& fileBounds, const Font& font, const std::string& title);
 
 /// Draws one line of text at the image's top-left corner on a box as drawLegend's (the
 /// background's colour, 80%; ink contrasting), sized as the legend's labels: ParaView's

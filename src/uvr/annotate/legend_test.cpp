@@ -200,6 +200,40 @@ TEST(LegendDraw, DrawsOnlyInItsBoxAtTheRightEdge) {
               (Labels{kMinus + "5", kMinus + "4", kMinus + "2", "0", "2", "4", "5"}));
 }
 
+TEST(LegendDraw, TheLayoutIsKnownBeforeDrawingWithTheColumnsItKeeps) {
+    // legendLayout says where drawLegend draws, so that a camera can keep off the columns
+    // before the frame is rendered (issue 35): from the edge past the box by a margin, at most
+    // a third of the width.
+    REQUIRE_FONT();
+    const auto same = [](const PixelRect& a, const PixelRect& b) {
+        return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
+    };
+    for (const auto& [w, h] : {std::pair{800, 600}, {320, 240}, {200, 900}})
+        for (const LegendPosition position : {LegendPosition::Right, LegendPosition::Left})
+            for (const std::string& title : {std::string("pressure"), std::string(200, 'w')}) {
+                SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " " + title);
+                LegendStyle style;
+                style.position = position;
+                const TransferFunction tf = transferFunctionPreset("viridis");
+                const LegendLayout before = legendLayout(w, h, font, 0.01, 3e4, title, true, style);
+                Image image(w, h);
+                const LegendLayout L = drawLegend(image, font, tf, 0.01, 3e4, title, true, style);
+                EXPECT_TRUE(same(before.box, L.box));
+                EXPECT_TRUE(same(before.bar, L.bar));
+                EXPECT_TRUE(same(before.title, L.title));
+                EXPECT_EQ(before.ticks.labels, L.ticks.labels);
+                EXPECT_EQ(before.columns, L.columns);
+                // The box's far side from the edge, and the gap between box and edge again.
+                const int columns = position == LegendPosition::Right
+                                        ? (w - L.box.x0) + (w - L.box.x1)
+                                        : L.box.x1 + L.box.x0;
+                EXPECT_EQ(L.columns, std::min(w / 3, columns));
+                if (title.size() > 100) {
+                    EXPECT_EQ(L.columns, w / 3);  // the long title's box
+                }
+            }
+}
+
 TEST(LegendTicks, TheRangeEndsJoinTheTicksAndCrowdedTicksLeave) {
     LegendTicks t = legendTicks(0.1926, 4.9775, false);
     ASSERT_EQ(t.labels, (Labels{"1", "2", "3", "4"}));

@@ -185,6 +185,39 @@ Vec3f toVec3(const std::vector<double>& v) {
 
 }  // namespace
 
+Camera clearColumns(const Camera& camera, int width, int height, int columns) {
+    if (!(width > 0 && height > 0 && columns >= 0 && columns < width))
+        throwError(ErrorKind::Argument, "",
+                   "cannot keep " + std::to_string(columns) + " columns clear of " +
+                       std::to_string(width) + "x" + std::to_string(height) + " pixels");
+    // resetCamera's distance is radius / sin(angle / 2), its parallel scale radius (/ aspect),
+    // with the angle narrowed below aspect 1: the ratio of the two fits is the bounds' own.
+    const double a = double(width) / height, narrow = double(width - columns) / height;
+    const double half = 0.5 * double(camera.viewAngle) * kDegToRad;
+    const auto fitHalfAngle = [&](double aspect) {
+        return aspect < 1.0 ? std::atan(std::tan(half) * aspect) : half;
+    };
+    Camera c = camera;
+    const Vec3d focal = toDouble(c.focalPoint), back = toDouble(c.position) - focal;
+    const double distance = std::sqrt(dot(back, back));
+    double perPixel = 0.0;  // file units per pixel at the focal point, after the move back
+    if (c.parallelProjection) {
+        const double wide = (narrow < 1.0 ? 1.0 / narrow : 1.0) / (a < 1.0 ? 1.0 / a : 1.0);
+        c.parallelScale = static_cast<float>(std::fmin(c.parallelScale * wide, double(FLT_MAX)));
+        perPixel = 2.0 * double(c.parallelScale) / height;
+    } else {
+        const double far = std::sin(fitHalfAngle(a)) / std::sin(fitHalfAngle(narrow));
+        c.position = toFloat(focal + back * far, "the moved camera");
+        perPixel = 2.0 * distance * far * std::tan(half) / height;
+    }
+    // The pan: half the columns to the right, so the volume moves left by as much.
+    const Vec3d right = normalize(cross(back * -1.0, toDouble(c.viewUp)));
+    const Vec3d pan = right * (0.5 * columns * perPixel);
+    c.position = toFloat(toDouble(c.position) + pan, "the panned camera");
+    c.focalPoint = toFloat(focal + pan, "the panned camera's focal point");
+    return c;
+}
+
 Camera resetCamera(const Bounds3f& bounds, float aspect) {
     if (bounds.empty() || !isFinite(bounds.lo) || !isFinite(bounds.hi)) {
         throwError(ErrorKind::Argument, "",

@@ -38,6 +38,15 @@ inline constexpr float kMaxViewAngle = 179.f;
 /// whole sphere; parallelProjection stays off.
 Camera resetCamera(const Bounds3f& bounds, float aspect);
 
+/// A camera fitted as resetCamera fits one to an image of width x height (then turned or
+/// zoomed), moved back along its view direction (its parallel scale widened) as far as the
+/// reset fitting width - columns columns would have placed it, and panned (position and focal
+/// point moved sideways, as ParaView's pan) so that the volume is centred in the columns left
+/// of the image's last `columns`: room at the right edge for a legend (issue 35). Moved back
+/// only where the bounding sphere does not fit those columns already. Throws Error(Argument)
+/// unless 0 <= columns < width.
+Camera clearColumns(const Camera& camera, int width, int height, int columns);
+
 /// Whether the view up `up` is zero or too close to parallel to the view direction from
 /// `position` to `focalPoint` to orient an image (the test validateCamera applies; the points
 /// must be distinct).

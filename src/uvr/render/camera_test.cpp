@@ -10,6 +10,7 @@
 
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/core/vec3d.h"
 
 namespace uvr {
 namespace {
@@ -86,6 +87,83 @@ TEST(Camera, ResetRejectsEmptyBoundsAndBadAspect) {
     Bounds3f b = box({0, 0, 0}, {1, 1, 1});
     EXPECT_EQ(catchError([&] { resetCamera(b, 0.f); }).kind(), ErrorKind::Argument);
     EXPECT_EQ(catchError([&] { resetCamera(b, std::nanf("")); }).kind(), ErrorKind::Argument);
+}
+
+Vec3f f3(Vec3d v) {
+    return Vec3f(float(v.x), float(v.y), float(v.z));
+}
+
+/// Pixel position (x, y) of point p in an image of rays (solving the ray equations).
+std::pair<double, double> project(const CameraRays& r, bool parallel, Vec3f p) {
+    // Perspective: [du dv -(p - o)] (x, y, s) = -topLeft; parallel: [oDu oDv dir] (x, y, t) =
+    // p - origin.
+    const Vec3d a = toDouble(parallel ? r.originDu : r.du),
+                b = toDouble(parallel ? r.originDv : r.dv),
+                c = parallel ? toDouble(r.topLeft) : (toDouble(p) - toDouble(r.origin)) * -1.0,
+                rhs = parallel ? toDouble(p) - toDouble(r.origin) : toDouble(r.topLeft) * -1.0;
+    const double det = dot(a, cross(b, c));
+    return {dot(rhs, cross(b, c)) / det, dot(a, cross(rhs, c)) / det};
+}
+
+TEST(Camera, ClearColumnsKeepsTheBoundingSphereLeftOfThemAndCentred) {
+    // Issue 35: a legend's columns at the right edge. The reset camera, turned, is moved back
+    // and panned: the bounding sphere then projects into the columns left of them, its centre
+    // in their middle. Points on the sphere: its poles along the image's axes and a ring.
+    const Bounds3f b = box({-1.f, -0.5f, -2.f}, {3.f, 0.5f, 2.f});
+    const Vec3d centre = (toDouble(b.lo) + toDouble(b.hi)) * 0.5;
+    const double radius = 0.5 * std::sqrt(dot(toDouble(b.hi - b.lo), toDouble(b.hi - b.lo)));
+    for (const auto& [w, h] : {std::pair{320, 240}, {200, 300}, {640, 240}})
+        for (const bool parallel : {false, true})
+            for (const int columns : {0, 60}) {
+                SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " columns " +
+                             std::to_string(columns) + (parallel ? " parallel" : ""));
+                Camera cam = orbitCamera(resetCamera(b, float(w) / h), 30.f, 20.f);
+                cam.parallelProjection = parallel;
+                const Camera moved = clearColumns(cam, w, h, columns);
+                const CameraRays rays = makeCameraRays(moved, w, h);
+                const auto [cx, cy] = project(rays, parallel, f3(centre));
+                EXPECT_NEAR(cx, 0.5 * (w - columns), 1e-2);
+                EXPECT_NEAR(cy, 0.5 * h, 1e-2);
+                double minX = 1e9, maxX = -1e9, minY = 1e9, maxY = -1e9;
+                const Vec3d dir = normalize(toDouble(moved.focalPoint - moved.position));
+                const Vec3d right = normalize(cross(dir, toDouble(moved.viewUp)));
+                const Vec3d up = cross(right, dir);
+                // The silhouette: for perspective the ring where rays from the eye touch the
+                // sphere (nearer the eye than the centre, and smaller), for parallel the great
+                // circle across the view.
+                const Vec3d eye = toDouble(moved.position), toEye = eye - centre;
+                const double d2 = dot(toEye, toEye), k2 = radius * radius / d2;
+                const Vec3d ringCentre = parallel ? centre : centre + toEye * k2;
+                const double ring = parallel ? radius : radius * std::sqrt(1.0 - k2);
+                const Vec3d a = normalize(cross(toEye, toDouble(moved.viewUp)));
+                const Vec3d c = normalize(cross(toEye, a));
+                for (int k = 0; k < 360; ++k) {
+                    const double t = k * std::numbers::pi / 180.0;
+                    const Vec3d q = parallel
+                                        ? centre + (right * std::cos(t) + up * std::sin(t)) * ring
+                                        : ringCentre + (a * std::cos(t) + c * std::sin(t)) * ring;
+                    const auto [x, y] = project(rays, parallel, f3(q));
+                    minX = std::min(minX, x), maxX = std::max(maxX, x);
+                    minY = std::min(minY, y), maxY = std::max(maxY, y);
+                }
+                // The pan moves the sphere off the axis, where perspective stretches it a
+                // little (half a pixel of 200 here): within 1% of the width.
+                const double tol = parallel ? 0.01 : 0.01 * w;
+                EXPECT_GE(minX, -tol);
+                EXPECT_LE(maxX, w - columns + tol);
+                EXPECT_GE(minY, -tol);
+                EXPECT_LE(maxY, h + tol);
+                // Tight: the reset fits the sphere to the height or to the columns left.
+                EXPECT_TRUE(maxY - minY > h - 2 * tol - 1 ||
+                            maxX - minX > w - columns - 2 * tol - 1);
+                if (columns == 0) {
+                    expectVec(moved.position, cam.position, 1e-5f);
+                    expectVec(moved.focalPoint, cam.focalPoint, 1e-6f);
+                }
+            }
+    Camera cam = resetCamera(b, 1.f);
+    EXPECT_EQ(catchError([&] { clearColumns(cam, 100, 100, 100); }).kind(), ErrorKind::Argument);
+    EXPECT_EQ(catchError([&] { clearColumns(cam, 100, 100, -1); }).kind(), ErrorKind::Argument);
 }
 
 TEST(Camera, CentreRayHitsFocalPointAndEdgesSpanTheViewAngle) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <future>
 #include <string>
+#include <tuple>
 
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
@@ -151,22 +152,29 @@ void checkFrameWork(const PreparedMesh& mesh, const RenderSettings& settings, fl
 
 }  // namespace
 
+std::pair<float, float> frameValueRange(const PreparedMesh& mesh, const RenderSettings& settings) {
+    float lo = settings.range ? settings.range->first : mesh.wholeValueMin();
+    const float hi = settings.range ? settings.range->second : mesh.wholeValueMax();
+    if (settings.tf.logScale && hi > 0.f && !(lo > 0.f))
+        lo = std::fmin(hi * 1e-4f, 1.f);  // ParaView's AdjustRangeForLog
+    return {lo, hi};
+}
+
 FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu) {
     validateSettings(settings);
     FrameSetup f;
     f.method = resolveMethod(mesh, settings, gpu);
     const RenderMethod method = f.method.method;
-    f.rangeLo = settings.range ? settings.range->first : mesh.wholeValueMin();
-    f.rangeHi = settings.range ? settings.range->second : mesh.wholeValueMax();
+    std::tie(f.rangeLo, f.rangeHi) = frameValueRange(mesh, settings);
     // The baked table: linear in the value over [rangeLo, rangeHi]; a log-scale function is
     // evaluated at each entry's log position, on a table fine enough where log changes fastest.
     int tableSize = settings.tfTableSize;
     if (settings.tf.logScale) {
-        const std::string range = "[" + formatG(f.rangeLo, 6) + ", " + formatG(f.rangeHi, 6) + "]";
+        const float given = settings.range ? settings.range->first : mesh.wholeValueMin();
+        const std::string range = "[" + formatG(given, 6) + ", " + formatG(f.rangeHi, 6) + "]";
         const std::string which = settings.range ? "`range` " : "the field's range ";
         if (!(f.rangeHi > 0.f)) refuseLogRange(settings.range.has_value(), f.rangeLo, f.rangeHi);
-        if (!(f.rangeLo > 0.f)) {
-            f.rangeLo = std::fmin(f.rangeHi * 1e-4f, 1.f);  // ParaView's AdjustRangeForLog
+        if (!(given > 0.f)) {  // frameValueRange moved it
             f.notes.push_back("`log`: " + which + range + " is not positive; mapping [" +
                               formatG(f.rangeLo, 6) + ", " + formatG(f.rangeHi, 6) +
                               "] as ParaView does (values below take the lowest colour; "

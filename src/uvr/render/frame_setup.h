@@ -150,6 +150,12 @@ inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup&
     return v;
 }
 
+/// The values a frame's transfer function spans (FrameSetup::rangeLo, rangeHi): `range`, else
+/// the field's whole range; under a log scale a range from 0 or below starts at min(hi / 10^4,
+/// 1) (ParaView's AdjustRangeForLog). A range the log scale refuses (hi <= 0) is returned as
+/// given (makeFrameSetup refuses it).
+std::pair<float, float> frameValueRange(const PreparedMesh& mesh, const RenderSettings& settings);
+
 /// Resolves defaults (the method for the GPU when gpu, else the CPU: resolveMethod) and
 /// validates; throws Error(Argument) on bad settings. For the partition method on the CPU it also
 /// computes the per-partition shading (the CUDA backend computes it on the GPU).
