@@ -25,7 +25,9 @@
   0.99 against the saved PNG (`uvr compare --min-ssim 0.99`);
 - a page opened with a wrong token has no viewer;
 - of a time series (a second server on `uvr generate --steps 3`), the time row shows, its slider
-  and play button change the step and the image, and the exported command names the step.
+  and play button change the step and the image, and the exported command names the step;
+- of a mesh with a prepared cache (a third server, after `uvr prepare`), the mesh is not read,
+  the field list holds the cache's one field and the method list the methods it holds.
 
 Screenshots of the whole window go to --screenshots DIR when given. --docs-screenshot PATH instead
 only renders a good-looking view (Blunt Fin) for docs/images/viewer.png.
@@ -1011,6 +1013,47 @@ def time_series(uvr, driver, shots, work, tmp):
         server.stop()
 
 
+def prepared_cache(uvr, driver, shots, work, tmp):
+    """A mesh with a prepared cache (uvr prepare) in a second server: served without reading
+    the mesh, the page lists the cache's one field and the methods it holds, and draws."""
+    step("a prepared cache: one field, its methods")
+    from selenium.webdriver.common.by import By
+    folder = os.path.join(tmp, "cached")
+    os.makedirs(folder, exist_ok=True)
+    mesh = os.path.join(folder, "m.uvrm")
+    subprocess.run([uvr, "-q", "generate", "box", "--cells", "20000", "--fields", "jet,linear",
+                    "-o", mesh], check=True)
+    subprocess.run([uvr, "-q", "prepare", mesh, "--field", "linear", "--device", "cpu"],
+                   check=True)
+    log = os.path.join(work, "server-cache.log")
+    server = Server(uvr, mesh, ["--size", "128x128", "--device", "cpu", "--field", "linear"], log)
+    try:
+        page = Page(driver, shots)
+        page.server = server
+        page.d.get(server.url)
+        page.wait("v.info && v.state", 60, "the cached mesh's info message")
+        page.wait_settled(0, 60, "the first full frame from the cache")
+        fields = page.js("return [...document.getElementById('field').options].map(o => o.text)")
+        check(len(fields) == 1 and "linear" in fields[0], f"the field list reads {fields!r}")
+        methods = page.js(
+            "return [...document.getElementById('method').options].map(o => o.value)")
+        info_methods = page.hook("info")["methods"]
+        check(methods == info_methods and "auto" in methods and len(methods) < 4,
+              f"the method list reads {methods!r} (info: {info_methods!r})")
+        notes = " ".join(page.hook("info")["notes"])
+        check("prepared cache" in notes, f"no note of the cache in {notes!r}")
+        _, lit = mean_rgb(page.pixels())
+        check(lit > 100, f"the frame from the cache has {lit} lit pixels")
+        page.screenshot("prepared-cache")
+        with open(log) as f:
+            text = f.read()
+        check("using the prepared cache" in text and "uvr: read " not in text,
+              "the server read the mesh instead of its cache")
+        check(server.proc.poll() is None, f"uvr view exited ({server.proc.returncode})")
+    finally:
+        server.stop()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--uvr", required=True, help="the uvr binary")
@@ -1092,6 +1135,7 @@ def main():
             page.screenshot("final")
             wrong_token_page(page)
             time_series(args.uvr, driver, args.screenshots, work, tmp)
+            prepared_cache(args.uvr, driver, args.screenshots, work, tmp)
         check(server.proc.poll() is None, f"uvr view exited ({server.proc.returncode})")
         status = 0
         step("PASSED")
