@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/dist/composite.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <exception>
@@ -25,6 +26,28 @@ void appendBytes(std::vector<std::byte>& out, const T* values, std::size_t n) {
     const std::size_t at = out.size();
     out.resize(at + n * sizeof(T));
     if (n) std::memcpy(out.data() + at, values, n * sizeof(T));
+}
+
+/// The pixels [x0, x1) x [y0, y1) of an image that hold anything: some opacity or some samples
+/// (empty, x0 = x1, when none does). Outside it a rank's image is transparent and sampled
+/// nowhere, so blending it there changes nothing.
+struct PixelBox {
+    std::int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+PixelBox activeBox(const Image& image, const std::vector<std::uint32_t>& counts) {
+    PixelBox b{image.width, image.height, 0, 0};
+    for (int y = 0; y < image.height; ++y) {
+        const std::size_t row = std::size_t(y) * image.width;
+        for (int x = 0; x < image.width; ++x) {
+            const std::size_t i = row + x;
+            if (image.pixels[i].w == 0.f && (counts.empty() || counts[i] == 0)) continue;
+            b.x0 = std::min(b.x0, x), b.x1 = std::max(b.x1, x + 1);
+            b.y0 = std::min(b.y0, y), b.y1 = std::max(b.y1, y + 1);
+        }
+    }
+    if (b.x1 <= b.x0 || b.y1 <= b.y0) return {};
+    return b;
 }
 
 /// A pixel the second pass renders again, and the opacity its ray stops at.
@@ -125,13 +148,22 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     const std::size_t width = static_cast<std::size_t>(image.width);
     const bool withCounts = !counts.empty();
     UVR_CHECK(!withCounts || counts.size() == image.pixels.size(), "sample counts' size");
-    // Every rank's share of band r goes to rank r.
+    // Every rank's share of band r goes to rank r: the part of band r inside the box of its
+    // pixels that hold anything (a header, then the box's rows of colours, then of counts).
+    const PixelBox active = activeBox(image, counts);
     std::vector<std::vector<std::byte>> toEach(ranks);
     for (int r = 0; r < ranks; ++r) {
         const auto [first, end] = compositeBand(image.height, r, ranks);
-        const std::size_t a = first * width, n = (end - first) * width;
-        appendBytes(toEach[r], image.pixels.data() + a, n);
-        if (withCounts) appendBytes(toEach[r], counts.data() + a, n);
+        PixelBox part = active;
+        part.y0 = std::max(part.y0, first), part.y1 = std::min(part.y1, end);
+        if (part.y1 <= part.y0 || part.x1 <= part.x0) part = {};
+        appendBytes(toEach[r], &part, 1);
+        const std::size_t w = part.x1 - part.x0;
+        for (int y = part.y0; y < part.y1; ++y)
+            appendBytes(toEach[r], image.pixels.data() + y * width + part.x0, w);
+        if (withCounts)
+            for (int y = part.y0; y < part.y1; ++y)
+                appendBytes(toEach[r], counts.data() + y * width + part.x0, w);
         if (r != me) stats.bytesSent += toEach[r].size();
     }
     const std::vector<std::vector<std::byte>> parts = comm.allToAll(toEach);
@@ -139,7 +171,6 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     // Band `me`: front to back over the ranks (premultiplied "over").
     const auto [first, end] = compositeBand(image.height, me, ranks);
     const std::size_t n = (end - first) * width;
-    const std::size_t pixelBytes = n * sizeof(Vec4f), countBytes = withCounts ? n * 4 : 0;
     std::vector<Vec4f> band(n, Vec4f(0.f, 0.f, 0.f, 0.f));
     std::vector<std::uint32_t> bandCounts(withCounts ? n : 0, 0);
     // The second pass's asks: per rank, the pixels it renders again (band index, the colour in
@@ -149,17 +180,31 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     const bool secondPass = bool(rerender) && stopAlpha < 1.f;
     for (int r : order) {
         const std::vector<std::byte>& part = parts[r];
-        UVR_CHECK(part.size() == pixelBytes + countBytes, "rank " << r << " sent " << part.size()
-                                                                  << " bytes for a band of " << n
-                                                                  << " pixels");
-        const Vec4f* px = reinterpret_cast<const Vec4f*>(part.data());
-        for (std::size_t i = 0; i < n; ++i) {
+        PixelBox box;
+        UVR_CHECK(part.size() >= sizeof box, "rank " << r << " sent no box");
+        std::memcpy(&box, part.data(), sizeof box);
+        const bool empty = box.x0 == box.x1 || box.y0 == box.y1;
+        UVR_CHECK(empty || (box.x0 >= 0 && box.x0 < box.x1 && box.x1 <= image.width &&
+                            box.y0 >= first && box.y0 < box.y1 && box.y1 <= end),
+                  "rank " << r << " sent a box outside band [" << first << ", " << end << ")");
+        const std::size_t w = empty ? 0 : box.x1 - box.x0, m = empty ? 0 : w * (box.y1 - box.y0);
+        UVR_CHECK(
+            part.size() == sizeof box + m * (sizeof(Vec4f) + (withCounts ? 4 : 0)),
+            "rank " << r << " sent " << part.size() << " bytes for a box of " << m << " pixels");
+        std::vector<Vec4f> px(m);
+        std::vector<std::uint32_t> c(withCounts ? m : 0);
+        if (m) std::memcpy(px.data(), part.data() + sizeof box, m * sizeof(Vec4f));
+        if (m && withCounts)
+            std::memcpy(c.data(), part.data() + sizeof box + m * sizeof(Vec4f), m * 4);
+        for (std::size_t k = 0; k < m; ++k) {
+            const std::size_t i = (box.y0 - first + k / w) * width + box.x0 + k % w;
+            if (withCounts) bandCounts[i] += c[k];
             Vec4f& acc = band[i];
             if (acc.w >= stopAlpha) continue;
             const Vec4f front = acc;
             const float t = 1.f - acc.w;
-            acc.x += t * px[i].x, acc.y += t * px[i].y, acc.z += t * px[i].z;
-            acc.w += t * px[i].w;
+            acc.x += t * px[k].x, acc.y += t * px[k].y, acc.z += t * px[k].z;
+            acc.w += t * px[k].w;
             // Rank r's ray stopped at its own stopAlpha; one process's stopped where the whole
             // opacity reached it, which the light in front moves forward.
             if (secondPass && front.w > 0.f && acc.w >= stopAlpha) {
@@ -167,11 +212,6 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
                                    (stopAlpha - front.w) / (1.f - front.w)});
                 fronts[r].emplace_back(i, front);
             }
-        }
-        if (withCounts) {
-            std::vector<std::uint32_t> c(n);
-            std::memcpy(c.data(), part.data() + pixelBytes, countBytes);
-            for (std::size_t i = 0; i < n; ++i) bandCounts[i] += c[i];
         }
     }
     if (secondPass)

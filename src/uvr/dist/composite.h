@@ -43,9 +43,10 @@ std::pair<int, int> compositeBand(int height, int rank, int ranks);
 /// colour (one more exchange, only when some pixel asks for it).
 ///
 /// Direct send: rank r blends band r of every rank's image (compositeBand), then `root` gathers the
-/// bands. On root, `image` and `counts` become the whole frame's; elsewhere they are left as they
-/// were. Every rank's image must have the same size, and counts width * height entries (or none on
-/// every rank).
+/// bands. A rank sends only the part of each band inside the box of its pixels that hold any
+/// opacity or samples (outside it, blending its image changes nothing). On root, `image` and
+/// `counts` become the whole frame's; elsewhere they are left as they were. Every rank's image
+/// must have the same size, and counts width * height entries (or none on every rank).
 CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std::uint32_t>& counts,
                               const std::vector<int>& order, int root = 0, float stopAlpha = 1.f,
                               const RerenderPiece& rerender = {});
