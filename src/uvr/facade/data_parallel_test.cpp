@@ -107,6 +107,52 @@ TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
     }
 }
 
+TEST(DataParallel, DepthInEndsTheRaysOfEveryRankAsOneProcesss) {
+    // Opaque geometry given as depth (a plane tilted across the view, cutting the volume): every
+    // rank's rays end there, and the composite is one process's frame.
+    const std::string path = testing::sharedData("bluntfin_tets.vtk");
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+    const Mesh mesh = readMesh(path);
+    const ScalarField field = selectScalarField(mesh, {});
+    RendererOptions options;
+    options.device = Device::Cpu;
+    Renderer one(mesh, field, options);
+    const Bounds3f bounds = mesh.bounds();
+    const float radius = 0.5f * length(bounds.hi - bounds.lo);
+    std::vector<RenderSettings> frames;
+    for (RenderMethod m :
+         {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
+        RenderSettings s = frameOf(bounds, m, 30.f, 20.f);
+        const float focal = length(s.camera->focalPoint - s.camera->position);
+        s.depthIn.resize(std::size_t(s.width) * s.height);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 0; x < s.width; ++x)
+                s.depthIn[std::size_t(y) * s.width + x] =
+                    focal - radius + 2.f * radius * float(x) / float(s.width);
+        frames.push_back(s);
+    }
+    for (const RenderSettings& s : frames) {
+        const RenderResult cut = one.render(s);
+        RenderSettings whole = s;
+        whole.depthIn.clear();
+        const ImageComparison against =
+            compareImages(toRgb8(cut.image), toRgb8(one.render(whole).image));
+        EXPECT_GT(against.maxAbsDifference, 20.0) << "the depth cuts nothing";
+        const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 3, options, {s});
+        ASSERT_EQ(many.size(), 1u);
+        const ImageComparison cmp = compareImages(toRgb8(cut.image), toRgb8(many[0].image));
+        SCOPED_TRACE(methodName(s.method));
+        EXPECT_GE(cmp.ssim, kMinSsim);
+        EXPECT_LE(cmp.maxAbsDifference, kMaxLevels) << differenceSummary(cmp);
+    }
+    // Depth out stays one process's.
+    RenderSettings out = frames[0];
+    out.depthAlpha = 0.5f;
+    const Error e = catchError([&] { dataParallelFrames(mesh, field, 2, options, {out}); });
+    EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
+    EXPECT_THAT(e.what(), HasSubstr("`depth`"));
+}
+
 TEST(DataParallel, TheRanksPartitionsAreOneProcessPartitions) {
     for (const char* file : {"bluntfin_tets.vtk", "hexa.vtk"}) {
         const std::string path = testing::sharedData(file);

@@ -166,10 +166,12 @@ bool Renderer::isRoot() const {
 RenderResult Renderer::render(const RenderSettings& settings) {
     if (!comm_) return renderLocal(settings);
     RenderResult result = agreeOn(*comm_, [&] {
-        if (settings.depthAlpha > 0.f || !settings.depthIn.empty())
+        // Depth in ends every rank's rays where one process's end (the same camera, the same
+        // view depths); depth out needs the opacity in front of a rank's box.
+        if (settings.depthAlpha > 0.f)
             throwError(ErrorKind::Unsupported, "",
-                       "depth images (`depth_alpha`, `depth_in`) are not rendered data-parallel "
-                       "yet: render them in one process");
+                       "the depth image out (`depth`) is not rendered data-parallel yet: render "
+                       "it in one process");
         return renderLocal(settings);
     });
     // Every rank's piece composited onto rank 0, front to back in the boxes' order.
