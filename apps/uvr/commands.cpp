@@ -296,11 +296,7 @@ void addRenderCommand(CLI::App& app, Context& ctx) {
         if (ctx.dataParallel()) {
             // Every rank reads its part of the file and prepares its piece; a prepared cache
             // holds one process's preparation.
-            if (!cache->file.empty())
-                throwError(ErrorKind::Unsupported, "",
-                           "--cache: a prepared cache is one process's preparation; a "
-                           "data-parallel render (mpirun) prepares each rank's piece from the "
-                           "mesh");
+            refuseCacheDataParallel(*cache, "render");
             renderDataParallel(*file, *flags, *steps, ctx);
             return;
         }

@@ -323,6 +323,13 @@ std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, con
     return renderer;
 }
 
+void refuseCacheDataParallel(const CacheFlags& cache, const std::string& command) {
+    if (!cache.file.empty())
+        throwError(ErrorKind::Unsupported, "",
+                   "--cache: a prepared cache is one process's preparation; a data-parallel " +
+                       command + " (mpirun) prepares each rank's piece from the mesh");
+}
+
 std::optional<CacheMatch> findCache(const std::string& meshFile, const RenderFlags& flags,
                                     const StepFlags& steps, const CacheFlags& cache,
                                     const RendererOptions& options, bool anyMethods,

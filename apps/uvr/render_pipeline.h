@@ -50,6 +50,10 @@ struct CacheFlags {
 bool renderFromCache(const std::string& meshFile, const RenderFlags& flags, const StepFlags& steps,
                      const CacheFlags& cache, const Context& ctx);
 
+/// Refuses --cache FILE for a data-parallel `command` ("render", "view"): a prepared cache is one
+/// process's preparation, and each rank prepares its piece from the mesh.
+void refuseCacheDataParallel(const CacheFlags& cache, const std::string& command);
+
 /// A prepared cache found for a mesh file whose header matches what is asked for.
 struct CacheMatch {
     std::string path;

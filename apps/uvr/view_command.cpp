@@ -226,15 +226,10 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         server::checkServerOptions(so, /*tryAddress=*/false);
         ctx.rootWrites([&] { server::checkServerOptions(so, /*tryAddress=*/true); });
         std::optional<server::ViewScene> cached;
-        if (ctx.dataParallel()) {
-            if (!cache->file.empty())
-                throwError(ErrorKind::Unsupported, "",
-                           "--cache: a prepared cache is one process's preparation; a "
-                           "data-parallel view (mpirun) prepares each rank's piece from the "
-                           "mesh");
-        } else {
+        if (ctx.dataParallel())
+            refuseCacheDataParallel(*cache, "view");
+        else
             cached = sceneFromCache(*file, *flags, *steps, *cache, ctx);
-        }
         server::ViewScene scene =
             cached ? std::move(*cached) : sceneFromMesh(*file, *flags, *steps, ctx);
         scene.sizeGiven = cmd->count("--size") > 0;
