@@ -40,8 +40,8 @@ std::vector<std::string> imageFlags(const RenderFlags& f) {
 }
 
 /// Every tab's starting state, as `uvr render` would draw the field (of finite range
-/// fieldRange, over cells of bounds `bounds`) with these flags, and the scene's settings
-/// beyond it.
+/// fieldRange, over `cells` cells within scene.bounds) with these flags, and the scene's
+/// settings beyond it.
 void startingState(server::ViewScene& scene, const RenderSettings& settings,
                    const RenderFlags& flags, std::pair<float, float> fieldRange,
                    std::uint64_t cells) {
@@ -116,6 +116,7 @@ std::optional<server::ViewScene> sceneFromCache(const std::string& file, const R
     scene.notes.push_back(line);
     return scene;
 }
+
 /// The scene of a mesh read and checked as `uvr render` does; the server prepares it (for
 /// every method, the field switched without rebuilding geometry).
 server::ViewScene sceneFromMesh(const std::string& file, const RenderFlags& flags,
