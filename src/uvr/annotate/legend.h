@@ -110,10 +110,10 @@ LegendLayout legendLayout(int width, int height, const Font& font, double lo, do
 
 /// The camera of a frame of `mesh` that will carry a legend at the right edge (issue 35):
 /// settings.camera (none: the reset camera of fileBounds, the rendered cells' bounds in the
-/// file's coordinates) moved back by clearColumns so that the volume stays off the columns of
-/// the legend drawn with the frame's range (frameValueRange) and `title`. For a camera that is
-/// the reset one, perhaps turned or zoomed: the CLI's render and animate and Python's
-/// render(legend=True) use it, not for a camera placed by the user.
+/// file's coordinates) moved by clearColumns (back where needed, and sideways) so that the
+/// volume stays off the columns of the legend drawn with the frame's range (frameValueRange)
+/// and `title`. For a camera that is the reset one, perhaps turned or zoomed: the CLI's render
+/// and animate and Python's render(legend=True) use it, not for a camera placed by the user.
 Camera cameraBesideLegend(const PreparedMesh& mesh, const RenderSettings& settings,
                           const Bounds3f& fileBounds, const Font& font, const std::string& title);
 

@@ -191,7 +191,7 @@ Camera clearColumns(const Camera& camera, int width, int height, int columns) {
                    "cannot keep " + std::to_string(columns) + " columns clear of " +
                        std::to_string(width) + "x" + std::to_string(height) + " pixels");
     // resetCamera's distance is radius / sin(angle / 2), its parallel scale radius (/ aspect),
-    // with the angle narrowed below aspect 1: the ratio of the two fits is the bounds' own.
+    // with the angle narrowed below aspect 1: the ratio of two fits does not depend on the bounds.
     const double a = double(width) / height, narrow = double(width - columns) / height;
     const double half = 0.5 * double(camera.viewAngle) * kDegToRad;
     const auto fitHalfAngle = [&](double aspect) {
