@@ -197,7 +197,7 @@ RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const Render
 }
 
 DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
-                                  const StepFlags& steps, const Context& ctx) {
+                                  const StepFlags& steps, const Context& ctx, bool keepFields) {
     Communicator& comm = *ctx.comm;
     const int rank = comm.rank(), ranks = comm.size();
     const auto cellsOf = [&](std::uint64_t n, int r) { return n * std::uint64_t(r) / ranks; };
@@ -251,7 +251,7 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
     DistributedSource out;
     out.source.rankReadSeconds = comm.allGatherValues(readSeconds);
     MeshShare& share = out.share;
-    share = shareOfPart(comm, std::move(part), parseFieldSpec(fieldSpec));
+    share = shareOfPart(comm, std::move(part), parseFieldSpec(fieldSpec), keepFields);
     // The checks, over every rank's share.
     RenderSource& src = out.source;
     src.path = file;

@@ -92,9 +92,11 @@ struct DistributedSource {
 /// Reads this rank's part of a file (a .uvrm only where the part lies, a .pvtu by runs of its
 /// pieces when it has as many as ranks, any other file whole, keeping the part), agrees with
 /// every rank on the field `fieldSpec` names, and reduces the counts, bounds and checks over the
-/// ranks (collective; ctx.comm must be set). Throws on every rank when any rank fails.
+/// ranks (collective; ctx.comm must be set). Throws on every rank when any rank fails. The share
+/// keeps the part's fields with keepFields (shareOfPart).
 DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
-                                  const StepFlags& steps, const Context& ctx);
+                                  const StepFlags& steps, const Context& ctx,
+                                  bool keepFields = false);
 
 /// `mpirun -n N uvr render FILE`: each rank reads its part of the file (a .uvrm only where the
 /// part lies; any other file whole, keeping its part), the ranks agree on the field, the bounds

@@ -117,8 +117,53 @@ std::optional<server::ViewScene> sceneFromCache(const std::string& file, const R
     return scene;
 }
 
+/// Data-parallel, a file of one time step: each rank reads its part of it as `uvr render` under
+/// mpirun does (readDistributed, keeping the part's fields for field changes), and the server
+/// reduces what the page lists over the ranks (ViewScene::part).
+server::ViewScene sceneFromParts(const std::string& file, const RenderFlags& flags,
+                                 const StepFlags& steps, const Context& ctx) {
+    const auto start = std::chrono::steady_clock::now();
+    DistributedSource read = readDistributed(file, flags.field, steps, ctx, /*keepFields=*/true);
+    server::ViewScene scene;
+    scene.loadSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    scene.file = file;
+    const SourceSummary& summary = read.source.summary;
+    for (const auto* lines : {&summary.findings, &summary.notes})
+        scene.notes.insert(scene.notes.end(), lines->begin(), lines->end());
+    for (const std::string& n : summary.notes) ctx.step("note: " + n);
+    std::vector<std::string> notes;
+    const RenderSettings settings = flags.settings(summary.bounds, file, &notes);
+    for (const std::string& note : notes) {
+        ctx.step("note: " + note);
+        scene.notes.push_back(note);
+    }
+    validateSettings(settings);
+    scene.bounds = summary.bounds;
+    // The field's range over every rank's part (its values' finite range, reduced).
+    float r[2] = {INFINITY, INFINITY};
+    for (float v : read.share.field.values)
+        if (std::isfinite(v)) r[0] = std::min(r[0], v), r[1] = std::min(r[1], -v);
+    std::vector<double> range = {r[0], r[1]};
+    ctx.comm->allReduce(range, ReduceOp::Min);
+    startingState(
+        scene, settings, flags,
+        range[0] <= -range[1] ? std::pair{float(range[0]), float(-range[1])} : std::pair{0.f, 0.f},
+        summary.cells);
+    scene.part =
+        server::ViewScene::Part{std::move(read.share.pointIds), std::move(read.share.cellIds),
+                                summary.points, summary.cells};
+    scene.mesh = std::make_shared<Mesh>(std::move(read.share.mesh));
+    scene.rendererOptions = flags.rendererOptions(true);
+    scene.rendererOptions.partitions = scene.rendererOptions.meshBvh = true;
+    scene.rendererOptions.communicator = ctx.comm;
+    if (resolvesToCuda(scene.rendererOptions.device)) ctx.step("GPU: " + cudaDeviceDescription());
+    return scene;
+}
+
 /// The scene of a mesh read and checked as `uvr render` does; the server prepares it (for
-/// every method, the field switched without rebuilding geometry).
+/// every method, the field switched without rebuilding geometry). Data-parallel, every rank
+/// reads a series whole.
 server::ViewScene sceneFromMesh(const std::string& file, const RenderFlags& flags,
                                 const StepFlags& steps, const Context& ctx) {
     const auto start = std::chrono::steady_clock::now();
@@ -226,13 +271,17 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         // Before minutes of reading; rank 0 serves (data-parallel: the other ranks follow it).
         server::checkServerOptions(so, /*tryAddress=*/false);
         ctx.rootWrites([&] { server::checkServerOptions(so, /*tryAddress=*/true); });
-        std::optional<server::ViewScene> cached;
-        if (ctx.dataParallel())
+        std::optional<server::ViewScene> chosen;  // from a prepared cache or the ranks' parts
+        if (ctx.dataParallel()) {
             refuseCacheDataParallel(*cache, "view");
-        else
-            cached = sceneFromCache(*file, *flags, *steps, *cache, ctx);
+            // A file of one time step is read by parts; a series whole on every rank.
+            if (openSeries(*file, ctx)->stepCount() <= 1)
+                chosen = sceneFromParts(*file, *flags, *steps, ctx);
+        } else {
+            chosen = sceneFromCache(*file, *flags, *steps, *cache, ctx);
+        }
         server::ViewScene scene =
-            cached ? std::move(*cached) : sceneFromMesh(*file, *flags, *steps, ctx);
+            chosen ? std::move(*chosen) : sceneFromMesh(*file, *flags, *steps, ctx);
         scene.sizeGiven = cmd->count("--size") > 0;
         // Serve until Ctrl-C.
         server::ViewServer server(std::move(scene), so, [&ctx](const std::string& line) {

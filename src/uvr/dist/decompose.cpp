@@ -31,7 +31,7 @@ MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, 
     return s;
 }
 
-MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec) {
+MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec, bool keepFields) {
     // Which fields hold one value over the whole mesh (NaN left out): their finite ranges
     // reduced over the ranks.
     std::vector<FieldInfo> infos = fieldInfos(part.mesh);
@@ -52,7 +52,7 @@ MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec) 
     share.field = selectScalarField(part.mesh, pinned);
     share.field.choice = std::move(choice.choice);
     share.mesh = std::move(part.mesh);
-    share.mesh.fields.clear();
+    if (!keepFields) share.mesh.fields.clear();
     share.pointIds = std::move(part.pointIds);
     share.cellIds = std::move(part.cellIds);
     return share;

@@ -41,8 +41,10 @@ Bounds3f reduceBounds(Communicator& comm, const Bounds3f& box);
 
 /// A rank's share from the part of a file it read (readNativePart, meshPart) and the field
 /// `spec` names (collective: the default field passes over fields constant over the whole mesh,
-/// as one process's choice does, so every rank renders the same field).
-MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec);
+/// as one process's choice does, so every rank renders the same field). The share's mesh keeps
+/// the part's fields with keepFields (a viewer switching fields), else none.
+MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec,
+                      bool keepFields = false);
 
 /// How the ranks split the whole mesh: the top of its k-d tree down to one node per rank.
 struct Decomposition {

@@ -99,6 +99,12 @@ struct ViewServer::Impl {
         return std::to_string(c.index) + ":" + std::to_string(fs.component) + "@" +
                std::to_string(step);
     }
+    /// The field a spec names on this rank's mesh, chosen by the listed fields (fieldInfos:
+    /// with the whole mesh's constancy when the ranks hold parts, so every rank picks alike).
+    ScalarField valuesOf(const std::string& spec) const;
+    /// A field's finite range and histogram: over every rank's part (collective) when the ranks
+    /// hold parts (scene.part), else over `values`.
+    FieldEntry entryOf(const std::vector<float>& values) const;
     /// Time steps of the file (1 without a series).
     std::size_t stepCount() const { return scene.series ? scene.series->stepCount() : 1; }
     /// The time step whose fields scene.mesh holds (render thread).

@@ -19,6 +19,7 @@
 
 #include "uvr/core/error.h"
 #include "uvr/core/text.h"
+#include "uvr/dist/decompose.h"
 #include "uvr/facade/frame_report.h"
 #include "uvr/mesh/cell_types.h"
 #include "uvr/render/heatmap.h"
@@ -114,7 +115,8 @@ std::string fmtExact(float v) {
     return buf;
 }
 
-Json histogramOf(const std::vector<float>& values, std::pair<float, float> range) {
+std::vector<std::uint64_t> histogramCounts(const std::vector<float>& values,
+                                           std::pair<float, float> range) {
     std::vector<std::uint64_t> counts(kHistogramBins, 0);
     const double lo = range.first, hi = range.second;
     const double scale = hi > lo ? kHistogramBins / (hi - lo) : 0.0;
@@ -123,10 +125,43 @@ Json histogramOf(const std::vector<float>& values, std::pair<float, float> range
         const int bin = std::clamp(static_cast<int>((v - lo) * scale), 0, kHistogramBins - 1);
         ++counts[bin];
     }
-    return {{"range", {range.first, range.second}}, {"counts", counts}};
+    return counts;
+}
+
+/// The finite range of values over every rank (collective; 0, 0 where none is finite).
+std::pair<float, float> reducedRange(Communicator& comm, const std::vector<float>& values) {
+    double r[2] = {INFINITY, INFINITY};  // min, -max
+    for (float v : values)
+        if (std::isfinite(v)) r[0] = std::min(r[0], double(v)), r[1] = std::min(r[1], -double(v));
+    comm.allReduce(std::span<double>(r, 2), ReduceOp::Min);
+    if (!(r[0] <= -r[1])) return {0.f, 0.f};
+    return {float(r[0]), float(-r[1])};
 }
 
 }  // namespace
+
+ScalarField ViewServer::Impl::valuesOf(const std::string& spec) const {
+    const FieldSpec fs = parseFieldSpec(spec);
+    if (!scene.part) return selectScalarField(*scene.mesh, fs);
+    // The listed fields carry the whole mesh's constancy: the default is every rank's.
+    FieldChoice choice = resolveField(fieldInfos, fs);
+    FieldSpec pinned = fs;
+    pinned.name = scene.mesh->fields[choice.index].name;
+    pinned.association = scene.mesh->fields[choice.index].association;
+    ScalarField field = selectScalarField(*scene.mesh, pinned);
+    field.choice = std::move(choice.choice);
+    return field;
+}
+
+FieldEntry ViewServer::Impl::entryOf(const std::vector<float>& values) const {
+    FieldEntry entry;
+    Communicator* comm = scene.part ? ranks() : nullptr;
+    entry.range = comm ? reducedRange(*comm, values) : finiteRange(values);
+    std::vector<std::uint64_t> counts = histogramCounts(values, entry.range);
+    if (comm) comm->allReduce(std::span<std::uint64_t>(counts), ReduceOp::Sum);
+    entry.histogram = {{"range", {entry.range.first, entry.range.second}}, {"counts", counts}};
+    return entry;
+}
 
 Communicator* ViewServer::Impl::ranks() const {
     Communicator* comm = scene.rendererOptions.communicator;
@@ -212,15 +247,19 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
             say(line);
         });
     ScalarField values;
-    agreed([&] { values = selectScalarField(*scene.mesh, parseFieldSpec(spec)); });
-    FieldEntry entry;
-    entry.range = finiteRange(values.values);
-    entry.histogram = histogramOf(values.values, entry.range);
+    agreed([&] { values = valuesOf(spec); });
+    FieldEntry entry = entryOf(values.values);
     const auto start = Clock::now();
     char line[200];
     if (!renderer) {
         say("view: preparing " + values.describe());
-        renderer = std::make_unique<Renderer>(*scene.mesh, values, scene.rendererOptions, progress);
+        if (const auto& part = scene.part)  // this rank's part, as readDistributed gave it
+            renderer = std::make_unique<Renderer>(
+                MeshShare{*scene.mesh, values, part->pointIds, part->cellIds},
+                scene.rendererOptions, progress);
+        else
+            renderer =
+                std::make_unique<Renderer>(*scene.mesh, values, scene.rendererOptions, progress);
         std::snprintf(line, sizeof line, "view: prepared %s in %.2f s", values.describe().c_str(),
                       secondsSince(start));
     } else {
@@ -590,8 +629,10 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     Impl& d = *impl_;
     if (!scene.mesh && !(scene.fromCache && scene.renderer))
         throwError(ErrorKind::Argument, "", "the viewer needs a mesh, or a prepared one");
-    if (scene.fromCache && scene.series)
-        throwError(ErrorKind::Argument, "", "a prepared cache holds one time step");
+    if ((scene.fromCache || scene.part) && scene.series)
+        throwError(ErrorKind::Argument, "",
+                   scene.fromCache ? "a prepared cache holds one time step"
+                                   : "a series is read whole on every rank, not by parts");
     checkServerOptions(options, false);
     if (options.token.empty()) options.token = randomToken();
     d.scene = std::move(scene);
@@ -624,19 +665,44 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     } else {
         const Mesh& mesh = *d.scene.mesh;
         d.fieldInfos = uvr::fieldInfos(mesh);
+        // The ranks' parts: which fields hold one value over the whole mesh (every component's
+        // values, NaN left out, as shareOfPart decides) and the listed ranges, reduced.
+        Communicator* comm = d.scene.part ? d.ranks() : nullptr;
+        std::vector<std::pair<float, float>> ranges;
+        for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
+            const Field& f = mesh.fields[i];
+            ranges.push_back(comm ? reducedRange(*comm, scalarFieldOf(mesh, f).values)
+                                  : finiteRange(scalarFieldOf(mesh, f).values));
+            if (comm) {
+                const auto raw = reducedRange(*comm, f.values);
+                d.fieldInfos[i].constant = !(raw.first < raw.second);
+            }
+        }
         const std::optional<std::size_t> def = defaultFieldIndex(d.fieldInfos);
         for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
             const Field& f = mesh.fields[i];
-            const auto range = finiteRange(scalarFieldOf(mesh, f).values);
             fields.push_back({{"name", f.name},
                               {"association", associationName(f.association)},
                               {"components", f.components},
-                              {"range", {range.first, range.second}},
+                              {"range", {ranges[i].first, ranges[i].second}},
                               {"default", def == i}});
         }
-        for (CellType t : mesh.cellTypes) ++types[cellTypeName(t)];
-        cellCount = mesh.cellCount();
-        pointCount = mesh.pointCount();
+        if (comm) {  // every rank's cells, by kind
+            constexpr CellType kinds[] = {CellType::Tetra, CellType::Pyramid, CellType::Wedge,
+                                          CellType::Hexahedron};
+            std::uint64_t n[4] = {0, 0, 0, 0};
+            for (CellType t : mesh.cellTypes)
+                for (int k = 0; k < 4; ++k) n[k] += t == kinds[k];
+            comm->allReduce(std::span<std::uint64_t>(n, 4), ReduceOp::Sum);
+            for (int k = 0; k < 4; ++k)
+                if (n[k]) types[cellTypeName(kinds[k])] = n[k];
+            cellCount = d.scene.part->cells;
+            pointCount = d.scene.part->points;
+        } else {
+            for (CellType t : mesh.cellTypes) ++types[cellTypeName(t)];
+            cellCount = mesh.cellCount();
+            pointCount = mesh.pointCount();
+        }
     }
     d.fieldKey(d.scene.initial.field);  // the starting field exists
     const Bounds3f& b = d.scene.bounds;
@@ -659,14 +725,8 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
         throwError(
             ErrorKind::Argument, d.scene.file,
             "time step " + std::to_string(d.meshStep) + " of " + std::to_string(d.stepCount()));
-    {
-        if (!d.scene.fromCache)
-            firstValues =
-                selectScalarField(*d.scene.mesh, parseFieldSpec(d.scene.initial.field)).values;
-        FieldEntry& entry = d.fields[d.fieldKey(d.scene.initial.field, d.meshStep)];
-        entry.range = finiteRange(firstValues);
-        entry.histogram = histogramOf(firstValues, entry.range);
-    }
+    if (!d.scene.fromCache) firstValues = d.valuesOf(d.scene.initial.field).values;
+    d.fields[d.fieldKey(d.scene.initial.field, d.meshStep)] = d.entryOf(firstValues);
     // Every method, or those a prepared cache holds.
     std::vector<std::string> methods = methodNames();
     if (d.scene.fromCache) {

@@ -68,6 +68,16 @@ struct ViewScene {
     /// Prepared for initial.field (the command line's preparation, with its progress); null:
     /// prepared before the first frame.
     std::unique_ptr<Renderer> renderer;
+    /// Data-parallel from the file's parts (`uvr view` under mpirun, readDistributed): `mesh` is
+    /// this rank's part (its cells and the points they use, with every field), and these are
+    /// their ids in the whole mesh and the whole mesh's counts. The fields' ranges, which hold
+    /// one value, the histograms and the cell kinds are reduced over the ranks, and the
+    /// renderer is made from the part (Renderer(MeshShare)). None: `mesh` is the whole mesh.
+    struct Part {
+        std::vector<std::uint64_t> pointIds, cellIds;
+        std::uint64_t points = 0, cells = 0;
+    };
+    std::optional<Part> part;
     /// A scene served from a prepared cache (`uvr view` with MESH.uvrprep): no mesh was read,
     /// so `renderer` (set) serves the one field it was prepared for, with no other field and
     /// no time steps, and the page offers the methods it holds (renderableMethods).

@@ -25,7 +25,10 @@
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/dist/decompose.h"
+#include "uvr/dist/in_process_communicator.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/io/native.h"
 #include "uvr/server/web_assets.h"
 
 namespace uvr::server {
@@ -292,6 +295,74 @@ TEST(ViewServer, APreparedSceneServesItsOneFieldWithTheMethodsItHolds) {
     const Json ex = c.until("export");
     ASSERT_FALSE(ex.is_null());
     EXPECT_THAT(ex["command"].get<std::string>(), HasSubstr("uvr render grid.vtk --field g:cell"));
+}
+
+TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
+    // `uvr view` under mpirun reads by parts (ViewScene::part): two in-process ranks, each with
+    // half the cells of the two-field mesh; rank 0 serves, rank 1 follows. The page sees the
+    // whole mesh's counts, ranges and histograms, and a field change reaches both parts.
+    const std::shared_ptr<Mesh> whole = twoFieldMesh();
+    const std::uint64_t n = whole->cellCount();
+    std::uint64_t histogramCells = 0;
+    std::atomic<std::uint64_t> partPoints{0};
+    Json info, g, gFrame;
+    InProcessGroup::run(2, [&](Communicator& comm) {
+        const int me = comm.rank();
+        MeshShare share = shareOfPart(comm, meshPart(*whole, me * n / 2, (me + 1) * n / 2),
+                                      parseFieldSpec(""), /*keepFields=*/true);
+        partPoints += share.mesh.pointCount();
+        ViewScene scene;
+        scene.file = "grid.vtk";
+        scene.bounds = whole->bounds();
+        scene.part = ViewScene::Part{share.pointIds, share.cellIds, whole->pointCount(), n};
+        scene.mesh = std::make_shared<Mesh>(std::move(share.mesh));
+        scene.rendererOptions.device = Device::Cpu;
+        scene.rendererOptions.leafCells = 64;
+        scene.rendererOptions.communicator = &comm;
+        ViewState& s = scene.initial;
+        s.camera = resetCamera(scene.bounds, 64.f / 48.f);
+        s.tf = transferFunctionPreset("viridis");
+        s.range = {-3.f, 3.f};
+        s.width = 64;
+        s.height = 48;
+        ServerOptions o;
+        o.port = 0;
+        ViewServer server(std::move(scene), o);
+        if (me != 0) {
+            server.follow();
+            return;
+        }
+        server.start();
+        {
+            Client c(server.port(), server.token());
+            info = c.next();
+            ASSERT_FALSE(c.frame().is_null());
+            c.send({{"type", "set"}, {"seq", 2}, {"field", "g"}});
+            g = c.until("histogram");
+            gFrame = c.frame();
+        }
+        server.stop();
+    });
+    ASSERT_EQ(info["type"], "info") << info.dump();
+    EXPECT_EQ(info["cells"], 216);
+    EXPECT_EQ(info["cell_types"], Json({{"hexahedron", 216}}));
+    ASSERT_EQ(info["fields"].size(), 2u);
+    // f = x + 2y over [-1, 1]^3 (jittered corners inside), g = 100 + cell: both ranks' values.
+    EXPECT_NEAR(info["fields"][1]["range"][0].get<double>(), 100.0, 1e-3);
+    EXPECT_NEAR(info["fields"][1]["range"][1].get<double>(), 315.0, 1e-3);
+    const auto range = finiteRange(scalarFieldOf(*whole, whole->fields[0]).values);
+    EXPECT_FLOAT_EQ(info["fields"][0]["range"][0].get<float>(), range.first);
+    EXPECT_FLOAT_EQ(info["fields"][0]["range"][1].get<float>(), range.second);
+    // Every part's points: those on the faces the parts share count once for each.
+    for (const Json& c : info["histogram"]["counts"]) histogramCells += c.get<std::uint64_t>();
+    EXPECT_EQ(histogramCells, partPoints);
+    ASSERT_FALSE(g.is_null());
+    EXPECT_EQ(g["field"], "g");
+    std::uint64_t gCells = 0;
+    for (const Json& c : g["counts"]) gCells += c.get<std::uint64_t>();
+    EXPECT_EQ(gCells, 216u);  // one value per cell, over both parts
+    ASSERT_FALSE(gFrame.is_null());
+    EXPECT_EQ(gFrame["seq"], 2);
 }
 
 TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
