@@ -140,16 +140,8 @@ server::ViewScene sceneFromParts(const std::string& file, const RenderFlags& fla
     }
     validateSettings(settings);
     scene.bounds = summary.bounds;
-    // The field's range over every rank's part (its values' finite range, reduced).
-    float r[2] = {INFINITY, INFINITY};
-    for (float v : read.share.field.values)
-        if (std::isfinite(v)) r[0] = std::min(r[0], v), r[1] = std::min(r[1], -v);
-    std::vector<double> range = {r[0], r[1]};
-    ctx.comm->allReduce(range, ReduceOp::Min);
-    startingState(
-        scene, settings, flags,
-        range[0] <= -range[1] ? std::pair{float(range[0]), float(-range[1])} : std::pair{0.f, 0.f},
-        summary.cells);
+    startingState(scene, settings, flags, reduceFiniteRange(*ctx.comm, read.share.field.values),
+                  summary.cells);
     scene.part =
         server::ViewScene::Part{std::move(read.share.pointIds), std::move(read.share.cellIds),
                                 summary.points, summary.cells};

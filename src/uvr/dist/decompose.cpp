@@ -31,6 +31,15 @@ MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, 
     return s;
 }
 
+std::pair<float, float> reduceFiniteRange(Communicator& comm, std::span<const float> values) {
+    double r[2] = {INFINITY, INFINITY};  // min, -max
+    for (float v : values)
+        if (std::isfinite(v)) r[0] = std::min(r[0], double(v)), r[1] = std::min(r[1], -double(v));
+    comm.allReduce(std::span<double>(r, 2), ReduceOp::Min);
+    if (!(r[0] <= -r[1])) return {0.f, 0.f};
+    return {float(r[0]), float(-r[1])};
+}
+
 MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec, bool keepFields) {
     // Which fields hold one value over the whole mesh (NaN left out): their finite ranges
     // reduced over the ranks.

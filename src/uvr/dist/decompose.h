@@ -9,6 +9,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
+#include <utility>
 #include <vector>
 
 #include "uvr/accel/kd_partitions.h"
@@ -35,6 +37,10 @@ struct MeshShare {
 
 /// Share `rank` of `ranks` of a mesh held whole: the cells [rank n / ranks, (rank + 1) n / ranks).
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks);
+
+/// The finite range of every rank's values (collective; 0, 0 where no rank holds a finite one,
+/// as finiteRange gives for none).
+std::pair<float, float> reduceFiniteRange(Communicator& comm, std::span<const float> values);
 
 /// The smallest box holding every rank's box (collective; an empty box adds nothing).
 Bounds3f reduceBounds(Communicator& comm, const Bounds3f& box);

@@ -128,16 +128,6 @@ std::vector<std::uint64_t> histogramCounts(const std::vector<float>& values,
     return counts;
 }
 
-/// The finite range of values over every rank (collective; 0, 0 where none is finite).
-std::pair<float, float> reducedRange(Communicator& comm, const std::vector<float>& values) {
-    double r[2] = {INFINITY, INFINITY};  // min, -max
-    for (float v : values)
-        if (std::isfinite(v)) r[0] = std::min(r[0], double(v)), r[1] = std::min(r[1], -double(v));
-    comm.allReduce(std::span<double>(r, 2), ReduceOp::Min);
-    if (!(r[0] <= -r[1])) return {0.f, 0.f};
-    return {float(r[0]), float(-r[1])};
-}
-
 }  // namespace
 
 ScalarField ViewServer::Impl::valuesOf(const std::string& spec) const {
@@ -156,7 +146,7 @@ ScalarField ViewServer::Impl::valuesOf(const std::string& spec) const {
 FieldEntry ViewServer::Impl::entryOf(const std::vector<float>& values) const {
     FieldEntry entry;
     Communicator* comm = scene.part ? ranks() : nullptr;
-    entry.range = comm ? reducedRange(*comm, values) : finiteRange(values);
+    entry.range = comm ? reduceFiniteRange(*comm, values) : finiteRange(values);
     std::vector<std::uint64_t> counts = histogramCounts(values, entry.range);
     if (comm) comm->allReduce(std::span<std::uint64_t>(counts), ReduceOp::Sum);
     entry.histogram = {{"range", {entry.range.first, entry.range.second}}, {"counts", counts}};
@@ -671,10 +661,10 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
         std::vector<std::pair<float, float>> ranges;
         for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
             const Field& f = mesh.fields[i];
-            ranges.push_back(comm ? reducedRange(*comm, scalarFieldOf(mesh, f).values)
+            ranges.push_back(comm ? reduceFiniteRange(*comm, scalarFieldOf(mesh, f).values)
                                   : finiteRange(scalarFieldOf(mesh, f).values));
             if (comm) {
-                const auto raw = reducedRange(*comm, f.values);
+                const auto raw = reduceFiniteRange(*comm, f.values);
                 d.fieldInfos[i].constant = !(raw.first < raw.second);
             }
         }
