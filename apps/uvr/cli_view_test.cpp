@@ -33,6 +33,7 @@ TEST(CliView, BadServerFlagsAndABusyPortFailBeforeTheMeshIsRead) {
     expectOneLineError(view("--token '0123456789abcdef;x'"), {"--token"}, "--token ;");
     expectOneLineError(view("--host not-an-address"), {"--host not-an-address"}, "--host");
     expectOneLineError(view("--port 70000"), {"--port"}, "--port");
+    expectOneLineError(view("--moving-frame-ms 0"), {"--moving-frame-ms"}, "--moving-frame-ms");
     expectOneLineError(view("--tf nosuch"), {"nosuch"}, "--tf");
     // Issue 28: the page's own limit on a side (4096), not render's 16384.
     expectOneLineError(view("--size 8192x8192"), {"--size '8192x8192'", "from 16 to 4096"},

@@ -235,6 +235,13 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("--port", options->second, "Port to listen on (0: any free port)")
         ->check(CLI::Range(0, 65535))
         ->capture_default_str();
+    auto movingMs = std::make_shared<double>(server::ServerOptions{}.targetFrameMs);
+    cmd->add_option("--moving-frame-ms", *movingMs,
+                    "While the view moves, frames come at the reduced resolution that renders in "
+                    "about this many milliseconds: 30 suits a GPU; on a CPU 50-100 gives sharper "
+                    "moving frames at fewer updates")
+        ->check(CLI::Range(server::kMinTargetFrameMs, server::kMaxTargetFrameMs))
+        ->capture_default_str();
     cmd->add_option("--token", *token,
                     "The secret in the URL (default: 32 random hex characters; at least 16 of "
                     "A-Z a-z 0-9 _ -)");
@@ -260,6 +267,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         so.host = options->first;
         so.port = static_cast<std::uint16_t>(options->second);
         so.token = *token;
+        so.targetFrameMs = *movingMs;
         // Before minutes of reading; rank 0 serves (data-parallel: the other ranks follow it).
         server::checkServerOptions(so, /*tryAddress=*/false);
         ctx.rootWrites([&] { server::checkServerOptions(so, /*tryAddress=*/true); });

@@ -606,6 +606,10 @@ void checkServerOptions(const ServerOptions& o, bool tryAddress) {
         o.maxMessageBytes < 1 || o.maxQueuedBytes < 1 || !(o.idleSeconds > 0.0) ||
         !(o.stalledWriteSeconds > 0.0))
         throwError(ErrorKind::Argument, "", "server limits must be positive");
+    if (!(o.targetFrameMs >= kMinTargetFrameMs && o.targetFrameMs <= kMaxTargetFrameMs))
+        throwError(ErrorKind::Argument, "",
+                   "`moving_frame_ms` " + formatG(o.targetFrameMs, 6) + ": expected a number in [" +
+                       formatG(kMinTargetFrameMs, 6) + ", " + formatG(kMaxTargetFrameMs, 6) + "]");
     hostAddress(o);
     if (tryAddress) {
         net::io_context ioc;

@@ -16,6 +16,9 @@
 
 namespace uvr::server {
 
+/// The range of ServerOptions::targetFrameMs.
+inline constexpr double kMinTargetFrameMs = 5.0, kMaxTargetFrameMs = 1000.0;
+
 /// How the viewer's server listens and what it allows (docs/VIEWER.md).
 struct ServerOptions {
     std::string host = "127.0.0.1";  ///< address to listen on (localhost by default)
@@ -37,10 +40,13 @@ struct ServerOptions {
     double idleSeconds = 30.0;
     /// A WebSocket connection whose write has waited this long (the tab does not read) is closed.
     double stalledWriteSeconds = 30.0;
-    double targetFrameMs = 30.0;  ///< reduced-resolution frames aim at this render time
-    int refineDelayMs = 150;      ///< full resolution once the state has been still this long
-    int maxScale = 8;             ///< coarsest reduced resolution: 1/maxScale of each side
-    int jpegQuality = 80;         ///< of reduced-resolution frames
+    /// Reduced-resolution frames aim at this render time, in [kMinTargetFrameMs,
+    /// kMaxTargetFrameMs] (`uvr view --moving-frame-ms`): 30 suits a GPU (about 30 updates a
+    /// second); a CPU gets sharper moving frames at fewer updates from 50 or more.
+    double targetFrameMs = 30.0;
+    int refineDelayMs = 150;  ///< full resolution once the state has been still this long
+    int maxScale = 8;         ///< coarsest reduced resolution: 1/maxScale of each side
+    int jpegQuality = 80;     ///< of reduced-resolution frames
 };
 
 /// Shortest token ServerOptions::token may be.

@@ -770,6 +770,11 @@ TEST(ViewServer, StopClosesConnectionsAndBadOptionsAreRefused) {
     ServerOptions badHost;
     badHost.host = "not-an-address";
     EXPECT_THAT(refused(badHost), HasSubstr("`host` not-an-address"));
+    for (const double ms : {0.0, 4.9, 1001.0, double(NAN)}) {
+        ServerOptions frameMs;
+        frameMs.targetFrameMs = ms;
+        EXPECT_THAT(refused(frameMs), HasSubstr("`moving_frame_ms`")) << ms;
+    }
     // A port in use is found before any work, and by start.
     auto busy = startServer();
     ServerOptions same;
