@@ -418,18 +418,26 @@ py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
     return py::make_tuple(pixels, counts, stats, depth);
 }
 
-Bounds3f fileBox(const PreparedMesh& p) {
-    double lo[3], hi[3];
+namespace {
+
+/// The prepared mesh's bounds' corners in the file's coordinates.
+void fileCorners(const PreparedMesh& p, double lo[3], double hi[3]) {
     p.tets.frame.toFile(p.wholeBounds().lo, lo);
     p.tets.frame.toFile(p.wholeBounds().hi, hi);
+}
+
+}  // namespace
+
+Bounds3f fileBox(const PreparedMesh& p) {
+    double lo[3], hi[3];
+    fileCorners(p, lo, hi);
     return {Vec3f(float(lo[0]), float(lo[1]), float(lo[2])),
             Vec3f(float(hi[0]), float(hi[1]), float(hi[2]))};
 }
 
 py::tuple fileBounds(const PreparedMesh& p) {
     double lo[3], hi[3];
-    p.tets.frame.toFile(p.wholeBounds().lo, lo);
-    p.tets.frame.toFile(p.wholeBounds().hi, hi);
+    fileCorners(p, lo, hi);
     return py::make_tuple(py::make_tuple(lo[0], lo[1], lo[2]), py::make_tuple(hi[0], hi[1], hi[2]));
 }
 

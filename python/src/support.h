@@ -195,8 +195,8 @@ struct PyRenderer {
 };
 
 /// One frame: (pixels (h, w, 4) float32 premultiplied, sample counts (h, w) uint32, stats).
-/// roomForLegend: the camera (none: the reset one) is moved back to keep the volume off the
-/// legend the caller draws (cameraBesideLegend).
+/// roomForLegend: the camera (none: the reset one) is moved to keep the volume off the legend
+/// the caller draws (cameraBesideLegend).
 py::tuple renderFrame(PyRenderer& self, const TransferFunction& tf,
                       std::optional<std::pair<float, float>> range, std::optional<Camera> camera,
                       int width, int height, const py::dict& settings, bool roomForLegend);

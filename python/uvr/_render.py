@@ -216,8 +216,8 @@ class Renderer:
         `depth_in` a (height, width) array of such distances of opaque geometry rendered
         elsewhere: every ray ends there (``--depth-in``); `legend` True draws ``--legend``'s
         colour legend (the field, point or cell, the range's ends) onto the image, the reset
-        camera (no `camera` given) moved back to keep the volume off it. The same settings give the CLI's
-        pixels.
+        camera (no `camera` given) moved to keep the volume off it. The same settings give the
+        CLI's pixels.
 
         `method`, `quality` and the other keywords are the library's settings (uvr.SETTINGS,
         each named, defaulted and checked there once; None means the default), listed below.

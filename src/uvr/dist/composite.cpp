@@ -196,8 +196,11 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
         if (m) std::memcpy(px.data(), part.data() + sizeof box, m * sizeof(Vec4f));
         if (m && withCounts)
             std::memcpy(c.data(), part.data() + sizeof box + m * sizeof(Vec4f), m * 4);
-        for (std::size_t k = 0; k < m; ++k) {
-            const std::size_t i = (box.y0 - first + k / w) * width + box.x0 + k % w;
+        // k: the box's pixel (row by row), i: the same pixel in the band.
+        for (std::size_t k = 0, x = 0, i = empty ? 0 : (box.y0 - first) * width + box.x0; k < m;
+             ++k, ++i) {
+            if (x == w) x = 0, i += width - w;  // the box's next row
+            ++x;
             if (withCounts) bandCounts[i] += c[k];
             Vec4f& acc = band[i];
             if (acc.w >= stopAlpha) continue;
