@@ -213,6 +213,75 @@ struct CarriedPoint {
     float value;
 };
 
+/// Appends a vector's bytes.
+template <class T>
+void putAll(std::vector<std::byte>& out, const std::vector<T>& v) {
+    const std::size_t at = out.size();
+    out.resize(at + v.size() * sizeof(T));
+    if (!v.empty()) std::memcpy(out.data() + at, v.data(), v.size() * sizeof(T));
+}
+
+/// Reads `count` values at `at` into v, moving past them.
+template <class T>
+void takeAll(const std::vector<std::byte>& in, std::size_t& at, std::uint64_t count,
+             std::vector<T>& v, int from) {
+    UVR_CHECK(count <= (in.size() - std::min(at, in.size())) / sizeof(T),
+              "the cells rank " << from << " sent end early");
+    v.resize(count);
+    if (count) std::memcpy(v.data(), in.data() + at, count * sizeof(T));
+    at += count * sizeof(T);
+}
+
+/// One rank's cells for another (distributeMesh's step 4), as flat arrays: their points once
+/// each, in the order of their first corner, and per cell its id in the whole mesh, type, corner
+/// count, corners as indices into those points, and its value for cell data.
+struct CellMessage {
+    std::vector<CarriedPoint> points;
+    std::vector<std::uint64_t> cellIds;
+    std::vector<std::uint8_t> types, counts;
+    std::vector<std::uint32_t> corners;
+    std::vector<float> values;  ///< cell data only
+
+    std::vector<std::byte> pack() const {
+        std::vector<std::byte> out;
+        out.reserve(3 * sizeof(std::uint64_t) + points.size() * sizeof(CarriedPoint) +
+                    cellIds.size() * (sizeof(std::uint64_t) + 2 + sizeof(float)) +
+                    corners.size() * sizeof(std::uint32_t));
+        put(out, std::uint64_t(points.size()));
+        put(out, std::uint64_t(cellIds.size()));
+        put(out, std::uint64_t(corners.size()));
+        putAll(out, points);
+        putAll(out, cellIds);
+        putAll(out, types);
+        putAll(out, counts);
+        putAll(out, corners);
+        putAll(out, values);
+        return out;
+    }
+
+    /// The message rank `from` packed; throws where it is malformed.
+    static CellMessage unpack(const std::vector<std::byte>& in, bool cellData, int from) {
+        CellMessage m;
+        std::size_t at = 0;
+        const auto points = take<std::uint64_t>(in, at);
+        const auto cells = take<std::uint64_t>(in, at);
+        const auto corners = take<std::uint64_t>(in, at);
+        takeAll(in, at, points, m.points, from);
+        takeAll(in, at, cells, m.cellIds, from);
+        takeAll(in, at, cells, m.types, from);
+        takeAll(in, at, cells, m.counts, from);
+        takeAll(in, at, corners, m.corners, from);
+        if (cellData) takeAll(in, at, cells, m.values, from);
+        UVR_CHECK(at == in.size(), "the cells rank " << from << " sent have bytes left over");
+        std::uint64_t total = 0;
+        for (std::uint8_t c : m.counts) total += c;
+        UVR_CHECK(total == corners, "the cells rank " << from << " sent miscount their corners");
+        for (std::uint32_t c : m.corners)
+            UVR_CHECK(c < points, "a cell rank " << from << " sent names a point it did not send");
+        return m;
+    }
+};
+
 }  // namespace
 
 ScalarField routeValues(Communicator& comm, const ValueRoutes& routes, const ScalarField& field) {
@@ -491,117 +560,120 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         }
     }
     local = {};
+    // The messages: per rank, its cells' points once each and the cells as indices into them.
     std::vector<std::vector<std::byte>> toEach(ranks);
-    for (int r = 0; r < ranks; ++r) {
-        for (std::uint32_t c : reaching[r]) {
-            const std::span<const std::uint32_t> corners = share.mesh.cell(c);
-            routes.sendCells[r].push_back(c);
-            std::vector<std::byte>& m = toEach[r];
-            put(m, share.cellIds[c]);
-            put(m, static_cast<std::uint8_t>(share.mesh.cellTypes[c]));
-            put(m, static_cast<std::uint8_t>(corners.size()));
-            for (std::uint32_t id : corners) {
-                put(m, share.pointIds[id]);
-                put(m, share.mesh.points[id]);
-                put(m, pointData ? share.field.values[id] : 0.f);
+    {
+        std::vector<int> sentTo(share.mesh.points.size(), -1);
+        std::vector<std::uint32_t> slot(share.mesh.points.size());
+        for (int r = 0; r < ranks; ++r) {
+            CellMessage m;
+            std::vector<std::uint32_t>& points = routes.sendPoints[r];
+            m.cellIds.reserve(reaching[r].size());
+            for (std::uint32_t c : reaching[r]) {
+                const std::span<const std::uint32_t> corners = share.mesh.cell(c);
+                routes.sendCells[r].push_back(c);
+                m.cellIds.push_back(share.cellIds[c]);
+                m.types.push_back(static_cast<std::uint8_t>(share.mesh.cellTypes[c]));
+                m.counts.push_back(static_cast<std::uint8_t>(corners.size()));
+                for (std::uint32_t id : corners) {
+                    if (sentTo[id] != r) {
+                        sentTo[id] = r, slot[id] = static_cast<std::uint32_t>(points.size());
+                        points.push_back(id);
+                        m.points.push_back({share.pointIds[id], share.mesh.points[id],
+                                            pointData ? share.field.values[id] : 0.f});
+                    }
+                    m.corners.push_back(slot[id]);
+                }
+                if (!pointData) m.values.push_back(share.field.values[c]);
             }
-            if (!pointData) put(m, share.field.values[c]);
+            reaching[r] = {};
+            toEach[r] = m.pack();
         }
     }
-    // The share's points each rank receives, each once, in the order of their first corner.
-    if (routes.points) {
-        std::vector<int> sentTo(share.mesh.points.size(), -1);
-        for (int r = 0; r < ranks; ++r)
-            for (std::uint32_t c : routes.sendCells[r])
-                for (std::uint32_t id : share.mesh.cell(c))
-                    if (sentTo[id] != r) sentTo[id] = r, routes.sendPoints[r].push_back(id);
-    }
+    if (!routes.points) routes.sendPoints.assign(ranks, {});
     if (!routes.cells) routes.sendCells.assign(ranks, {});
     share = MeshShare();
     std::vector<std::vector<std::byte>> received = comm.allToAll(toEach);
     toEach = {};
     // Step 5: the piece: its points in the whole mesh's order, its cells in the whole mesh's.
-    struct CarriedCell {
-        std::uint64_t id;
-        CellType type;
-        std::vector<std::uint64_t> corners;
-        float value;
-    };
-    std::vector<CarriedCell> carried;
-    std::vector<CarriedPoint> points;
-    // Per sender, the ids of its cells and of their corners in the order they came (the routes').
-    std::vector<std::vector<std::uint64_t>> cameCells(ranks), cameCorners(ranks);
+    std::vector<CellMessage> got(ranks);
+    std::vector<std::uint64_t> pointStart(ranks + 1, 0), cellStart(ranks + 1, 0);
     for (int from = 0; from < ranks; ++from) {
-        const std::vector<std::byte>& m = received[from];
-        std::size_t at = 0;
-        while (at < m.size()) {
-            CarriedCell cell;
-            cell.id = take<std::uint64_t>(m, at);
-            if (routes.cells) cameCells[from].push_back(cell.id);
-            cell.type = static_cast<CellType>(take<std::uint8_t>(m, at));
-            const int count = take<std::uint8_t>(m, at);
-            for (int k = 0; k < count; ++k) {
-                CarriedPoint p;
-                p.id = take<std::uint64_t>(m, at);
-                p.p = take<Vec3f>(m, at);
-                p.value = take<float>(m, at);
-                cell.corners.push_back(p.id);
-                if (routes.points) cameCorners[from].push_back(p.id);
-                points.push_back(p);
-            }
-            cell.value = pointData ? 0.f : take<float>(m, at);
-            carried.push_back(std::move(cell));
-        }
+        got[from] = CellMessage::unpack(received[from], !pointData, from);
+        received[from] = {};
+        pointStart[from + 1] = pointStart[from] + got[from].points.size();
+        cellStart[from + 1] = cellStart[from] + got[from].cellIds.size();
     }
     received = {};
-    std::sort(points.begin(), points.end(),
-              [](const CarriedPoint& a, const CarriedPoint& b) { return a.id < b.id; });
-    points.erase(
-        std::unique(points.begin(), points.end(),
-                    [](const CarriedPoint& a, const CarriedPoint& b) { return a.id == b.id; }),
-        points.end());
-    std::sort(carried.begin(), carried.end(),
-              [](const CarriedCell& a, const CarriedCell& b) { return a.id < b.id; });
-    for (const CarriedPoint& p : points) {
-        out.mesh.points.push_back(p.p);
-        if (pointData) out.field.values.push_back(p.value);
-    }
-    std::vector<std::uint32_t> ids;
-    for (const CarriedCell& cell : carried) {
-        ids.clear();
-        for (std::uint64_t id : cell.corners) {
-            const auto it =
-                std::lower_bound(points.begin(), points.end(), id,
-                                 [](const CarriedPoint& p, std::uint64_t v) { return p.id < v; });
-            ids.push_back(static_cast<std::uint32_t>(it - points.begin()));
-        }
-        out.mesh.addCell(cell.type, ids);
-        if (!pointData) out.field.values.push_back(cell.value);
-    }
-    // The routes' receiving ends: the same orders, as the piece's indices.
-    routes.piecePoints = points.size();
-    routes.pieceCells = carried.size();
+    // Points: each id once (the senders' shares overlap on their common faces), by id.
+    std::vector<std::uint32_t> pieceOf(pointStart[ranks]);
     {
-        std::vector<int> cameFrom(points.size(), -1);
-        for (int from = 0; from < ranks; ++from) {
-            for (std::uint64_t id : cameCorners[from]) {
-                const auto it = std::lower_bound(
-                    points.begin(), points.end(), id,
-                    [](const CarriedPoint& p, std::uint64_t v) { return p.id < v; });
-                const std::size_t i = static_cast<std::size_t>(it - points.begin());
-                if (cameFrom[i] != from)
-                    cameFrom[i] = from, routes.receivePoints[from].push_back(std::uint32_t(i));
+        std::vector<std::pair<std::uint64_t, std::uint64_t>> byId;  // id, index over the senders
+        byId.reserve(pointStart[ranks]);
+        for (int from = 0; from < ranks; ++from)
+            for (std::size_t k = 0; k < got[from].points.size(); ++k)
+                byId.push_back({got[from].points[k].id, pointStart[from] + k});
+        std::sort(byId.begin(), byId.end());
+        for (std::size_t i = 0; i < byId.size(); ++i) {
+            if (i == 0 || byId[i].first != byId[i - 1].first) {
+                const std::uint64_t g = byId[i].second;
+                const int from =
+                    static_cast<int>(std::upper_bound(pointStart.begin(), pointStart.end(), g) -
+                                     pointStart.begin() - 1);
+                const CarriedPoint& p = got[from].points[g - pointStart[from]];
+                out.mesh.points.push_back(p.p);
+                if (pointData) out.field.values.push_back(p.value);
             }
-            cameCorners[from] = {};
-            for (std::uint64_t id : cameCells[from]) {
-                const auto it = std::lower_bound(
-                    carried.begin(), carried.end(), id,
-                    [](const CarriedCell& c, std::uint64_t v) { return c.id < v; });
-                routes.receiveCells[from].push_back(std::uint32_t(it - carried.begin()));
-            }
-            cameCells[from] = {};
+            pieceOf[byId[i].second] = static_cast<std::uint32_t>(out.mesh.points.size() - 1);
         }
     }
+    // Cells: each sender's come in increasing id order and the shares are disjoint, so their
+    // merge is the whole mesh's order.
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> cellOrder;  // id, index over the senders
+    cellOrder.reserve(cellStart[ranks]);
+    bool sorted = true;
+    for (int from = 0; from < ranks; ++from) {
+        const auto begin = cellOrder.size();
+        for (std::size_t k = 0; k < got[from].cellIds.size(); ++k)
+            cellOrder.push_back({got[from].cellIds[k], cellStart[from] + k});
+        sorted = sorted && std::is_sorted(cellOrder.begin() + begin, cellOrder.end());
+        if (sorted)
+            std::inplace_merge(cellOrder.begin(), cellOrder.begin() + begin, cellOrder.end());
+    }
+    if (!sorted) std::sort(cellOrder.begin(), cellOrder.end());
+    std::vector<std::vector<std::uint64_t>> cornerStart(ranks);  // per sender's cell
+    std::uint64_t cornerTotal = 0;
+    for (int from = 0; from < ranks; ++from) {
+        cornerStart[from].resize(got[from].counts.size() + 1, 0);
+        for (std::size_t k = 0; k < got[from].counts.size(); ++k)
+            cornerStart[from][k + 1] = cornerStart[from][k] + got[from].counts[k];
+        cornerTotal += cornerStart[from].back();
+        if (routes.cells) routes.receiveCells[from].resize(got[from].cellIds.size());
+    }
+    out.mesh.cellTypes.reserve(cellOrder.size());
+    out.mesh.cellOffsets.reserve(cellOrder.size() + 1);
+    out.mesh.cellIndices.reserve(cornerTotal);
+    std::vector<std::uint32_t> ids;
+    for (std::size_t s = 0; s < cellOrder.size(); ++s) {
+        const std::uint64_t g = cellOrder[s].second;
+        const int from = static_cast<int>(std::upper_bound(cellStart.begin(), cellStart.end(), g) -
+                                          cellStart.begin() - 1);
+        const std::size_t k = static_cast<std::size_t>(g - cellStart[from]);
+        const CellMessage& m = got[from];
+        ids.clear();
+        for (std::uint64_t j = cornerStart[from][k]; j < cornerStart[from][k + 1]; ++j)
+            ids.push_back(pieceOf[pointStart[from] + m.corners[j]]);
+        out.mesh.addCell(static_cast<CellType>(m.types[k]), ids);
+        if (!pointData) out.field.values.push_back(m.values[k]);
+        if (routes.cells) routes.receiveCells[from][k] = static_cast<std::uint32_t>(s);
+    }
+    // The routes' receiving ends: the senders' orders, as the piece's indices.
+    routes.piecePoints = out.mesh.points.size();
+    routes.pieceCells = cellOrder.size();
+    if (routes.points)
+        for (int from = 0; from < ranks; ++from)
+            routes.receivePoints[from].assign(pieceOf.begin() + pointStart[from],
+                                              pieceOf.begin() + pointStart[from + 1]);
     out.piece = std::move(piece);
     return out;
 }
