@@ -449,10 +449,27 @@ MeshPart readNativePart(const std::string& path, std::uint64_t firstCell, std::u
             throwParseError(path, atByte(arrays[3].start + 4 * (i0 + k)),
                             "cell indices: index " + std::to_string(indices[k]) + " of " +
                                 std::to_string(layout.pointCount) + " points");
-    // The points they use, in the file's order, read in runs of nearby ids.
-    std::vector<std::uint32_t> ids(indices);
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    // The points they use, in the file's order, read in runs of nearby ids. A part of a file
+    // in spatial order uses a narrow band of ids: a table over that band numbers them without
+    // sorting every corner (4 bytes per id of the band, no more than the corners take).
+    std::vector<std::uint32_t> ids;
+    std::vector<std::uint32_t> slot;  // per id of the band from `band` on: 1 + its index in ids
+    std::uint32_t band = 0;
+    if (!indices.empty()) {
+        const auto [mn, mx] = std::minmax_element(indices.begin(), indices.end());
+        band = *mn;
+        if (std::uint64_t(*mx) - band < indices.size()) slot.assign(std::size_t(*mx) - band + 1, 0);
+    }
+    if (!slot.empty()) {
+        for (std::uint32_t id : indices) slot[id - band] = 1;
+        for (std::size_t k = 0; k < slot.size(); ++k)
+            if (slot[k])
+                ids.push_back(band + std::uint32_t(k)), slot[k] = std::uint32_t(ids.size());
+    } else {
+        ids = indices;
+        std::sort(ids.begin(), ids.end());
+        ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    }
     budgeted.budget().charge(path, "the part's points", ids.size(), 20);
     part.pointIds.assign(ids.begin(), ids.end());
     constexpr std::uint64_t kRunGap = 4096;  // ids this close are read in one run
@@ -476,8 +493,10 @@ MeshPart readNativePart(const std::string& path, std::uint64_t firstCell, std::u
     for (std::uint64_t c = 0; c <= n; ++c) mesh.cellOffsets[c] = offsets[c] - i0;
     mesh.cellIndices.resize(indices.size());
     for (std::size_t k = 0; k < indices.size(); ++k)
-        mesh.cellIndices[k] = static_cast<std::uint32_t>(
-            std::lower_bound(ids.begin(), ids.end(), indices[k]) - ids.begin());
+        mesh.cellIndices[k] =
+            !slot.empty() ? slot[indices[k] - band] - 1
+                          : static_cast<std::uint32_t>(
+                                std::lower_bound(ids.begin(), ids.end(), indices[k]) - ids.begin());
     part.cellIds.resize(n);
     for (std::uint64_t c = 0; c < n; ++c) part.cellIds[c] = firstCell + c;
     // Every field on them.

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -142,7 +143,17 @@ TEST(Native, APartIsTheWholeMeshsCellsWithTheirPointsAndFields) {
     m.fields.push_back(cellField);
     writeNative(m, path);
     const std::uint64_t n = m.cellCount();
-    for (auto [a, b] : {std::pair<std::uint64_t, std::uint64_t>{0, n / 3}, {n / 3, n}, {n, n}}) {
+    // Parts of many cells number their points over the band of ids they use; one cell's
+    // corners lie farther apart than its corner count, and are sorted instead.
+    for (auto [a, b] : {std::pair<std::uint64_t, std::uint64_t>{0, n / 3},
+                        {n / 3, n},
+                        {n, n},
+                        {n / 2, n / 2 + 1}}) {
+        if (b == a + 1) {
+            const auto corners = m.cell(a);
+            const auto [lo, hi] = std::minmax_element(corners.begin(), corners.end());
+            ASSERT_GE(*hi - *lo, corners.size()) << "the one-cell part's band";
+        }
         const MeshPart part = readNativePart(path, a, b);
         const MeshPart expected = meshPart(m, a, b);
         EXPECT_EQ(part.pointIds, expected.pointIds);
