@@ -345,9 +345,8 @@ KdPartitions buildKdPartitions(const TetMesh& mesh, const KdBuildOptions& option
         UVR_CHECK(cells < 0xffffffffull, "partition cell lists exceed 32-bit indices");
     }
     // Step 6: each partition's padded shrunk box and its cell list, in partition order.
-    const Vec3f pad =
-        Vec3f(kBoxPadding * (options.root && !options.splitter ? options.root->paddingDiagonal
-                                                               : mesh.bounds.diagonal()));
+    const Vec3f pad = Vec3f(
+        kBoxPadding * (options.root ? options.root->paddingDiagonal : mesh.bounds.diagonal()));
     if (!tree) kd.cells.resize(cells);
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t p = 0; p < leafCount; ++p) {

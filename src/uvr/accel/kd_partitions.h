@@ -209,7 +209,7 @@ struct KdBuildOptions {
     /// When set, the k-d tree (splits, leaves and their cells) comes from this splitter
     /// (buildKdTreeCuda: on the GPU; the same partitions as the CPU's); else the CPU threads.
     KdSplitter splitter;
-    /// When set (and no splitter), the tree is the subtree below this node of a larger mesh's
+    /// When set, the tree (the splitter's too) is the subtree below this node of a larger mesh's
     /// tree: built from the mesh's cells whose boxes reach the node's closed region (the cells
     /// the larger tree hands that node) by the same rules, so its partitions are that tree's
     /// there when the mesh holds every cell reaching the region. kd.bounds stays the mesh's.

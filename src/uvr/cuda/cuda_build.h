@@ -22,8 +22,8 @@ LbvhResult buildLbvhCuda(const LbvhInput& input);
 
 /// Builds the k-d tree of buildKdPartitions on the GPU, one level at a time (every node of a
 /// level at once: bounds, a sort of (node, centre) keys for the medians, scans for the sides): the
-/// same splits, leaves and cell lists as the CPU's build, numbered breadth-first. Throws as
-/// buildLbvhCuda does.
+/// same splits, leaves and cell lists as the CPU's build, numbered breadth-first; below
+/// options.root's node when set, as the CPU's. Throws as buildLbvhCuda does.
 KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
                        const FractionFn& progress = {});
 

@@ -135,6 +135,41 @@ TEST(CudaKd, SameSplitsLeavesAndCellsAsTheCpuBuild) {
     }
 }
 
+TEST(CudaKd, ASubtreeBelowALargerTreesNodeIsTheCpuBuilds) {
+    UVR_REQUIRE_GPU();
+    const TetMesh mesh = proceduralTets(300000);
+    KdBuildOptions whole;
+    whole.leafCells = 4096;
+    const KdPartitions tree = buildKdPartitions(mesh, whole);
+    // The node two levels down on the upper sides (a data-parallel rank's), and a node beside
+    // the mesh that no cell reaches.
+    Bounds3f region = mesh.bounds;
+    std::uint32_t node = 0;
+    for (int depth = 0; depth < 2; ++depth) {
+        const KdNode n = tree.nodes[node];
+        ASSERT_FALSE(n.isLeaf());
+        region.lo[n.axis()] = n.split;
+        node = n.child() + 1;
+    }
+    Bounds3f beside = mesh.bounds;
+    const float width = beside.hi.x - beside.lo.x;
+    beside.lo.x = beside.hi.x + width, beside.hi.x += 2.f * width;
+    for (const auto& [root, depth] : {std::pair{region, 2}, std::pair{beside, 1}}) {
+        KdBuildOptions o = whole;
+        o.root = KdSubtreeRoot{root, depth, mesh.bounds.diagonal()};
+        const KdPartitions cpu = buildKdPartitions(mesh, o);
+        o.splitter = buildKdTreeCuda;
+        const KdPartitions gpu = buildKdPartitions(mesh, o);
+        if (depth == 2)
+            EXPECT_GT(cpu.partitions.size(), 4u);
+        else
+            EXPECT_EQ(cpu.partitions.size(), 1u);
+        ASSERT_EQ(cpu.nodes.size(), gpu.nodes.size()) << "depth " << depth;
+        ASSERT_EQ(cpu.partitions.size(), gpu.partitions.size());
+        EXPECT_TRUE(partitionSet(cpu) == partitionSet(gpu)) << "depth " << depth;
+    }
+}
+
 /// Meshes for the face and seed builders: tetrahedra only, mixed native cells, and tetrahedra
 /// with a seam of duplicated points across every other cell (welded faces) and a face shared by
 /// three tetrahedra (left a boundary).

@@ -122,9 +122,43 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
     cuda::DeviceArray<float> planes;
     cuda::DeviceArray<cuda::ChildPlace> places;
     cuda::DeviceArray<unsigned char> temp;
-    std::vector<cuda::LevelNode> level{{0, mesh.bounds, 0}};
-    std::vector<std::uint64_t> levelBegin{0, n};
+    cuda::LevelNode top{0, mesh.bounds, 0};
     std::uint64_t count = n;
+    if (const std::optional<KdSubtreeRoot>& root = options.root) {
+        // A larger tree's node: the cells whose boxes reach its closed region, in id order (as
+        // the CPU's build hands it them).
+        top.region = root->region, top.depth = root->depth;
+        below.reserve(n + 1, "the cells reaching the subtree (GPU k-d build)");
+        belowScan.reserve(n + 1, "the offsets of the cells reaching the subtree (GPU k-d build)");
+        UVR_CUDA_CHECK(cudaMemset(below.data() + n, 0, sizeof(std::uint32_t)));
+        const Bounds3f region = top.region;
+        const Bounds3f* b = boxes.data();
+        std::uint32_t* reaches = below.data();
+        cuda::forEachElement("k-d subtree cells", n, [=] __device__(std::uint64_t t) {
+            bool in = true;
+            for (int a = 0; a < 3; ++a)
+                in = in && b[t].lo[a] <= region.hi[a] && b[t].hi[a] >= region.lo[a];
+            reaches[t] = in;
+        });
+        cuda::exclusiveSum(below.data(), belowScan.data(), n, temp);
+        const std::uint32_t* at = belowScan.data();
+        std::uint32_t* c = cells.data();
+        cuda::forEachElement("k-d subtree cell list", n, [=] __device__(std::uint64_t t) {
+            if (reaches[t]) c[at[t]] = static_cast<std::uint32_t>(t);  // at[t] <= t: in place
+        });
+        std::uint32_t reaching = 0;
+        UVR_CUDA_CHECK(
+            cudaMemcpy(&reaching, belowScan.data() + n, sizeof reaching, cudaMemcpyDeviceToHost));
+        count = reaching;
+        if (count == 0) {  // one empty partition, as the CPU's build makes
+            tree.nodes[0].bits = 3u;
+            tree.leafShrunk.push_back(kdsplit::shrunkRegion(top.region, Bounds3f{}));
+            tree.leafBegin.push_back(0);
+            return tree;
+        }
+    }
+    std::vector<cuda::LevelNode> level{top};
+    std::vector<std::uint64_t> levelBegin{0, count};
     while (!level.empty()) {
         const std::uint32_t m = static_cast<std::uint32_t>(level.size());
         begin.upload(levelBegin, "the node offsets (GPU k-d build)");

@@ -155,10 +155,8 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                      ")");
         KdBuildOptions kd = kdBuildOptions(out.tets, options);
         if (splitter) kd.splitter = splitter;
-        if (const MeshPiece* piece = options.piece.get()) {
-            kd.splitter = nullptr;
+        if (const MeshPiece* piece = options.piece.get())
             kd.root = KdSubtreeRoot{piece->region, piece->depth, piece->bounds.diagonal()};
-        }
         start = std::chrono::steady_clock::now();
         out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
         // A piece's traversal starts at the whole mesh's bounds and narrows to its box (the
