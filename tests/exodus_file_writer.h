@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "uvr/mesh/mesh.h"
+
 namespace uvr::testing {
 
 /// An element block: its id, elem_type, nodes per element and 1-based connectivity.
@@ -230,6 +232,24 @@ inline void writeExodusFile(const std::string& path, const ExoFileSpec& spec) {
                      "vals_elem_var");
             }
     }
+}
+
+/// A mesh of hexahedra as one HEX8 block with the nodal variable "f" over `steps` time steps
+/// (times 0, 1, ...): value(step, node).
+inline ExoFileSpec hexSeriesSpec(const Mesh& hexes, std::size_t steps,
+                                 std::function<double(std::size_t, std::size_t)> value) {
+    ExoFileSpec spec;
+    for (const Vec3f& p : hexes.points) {
+        spec.x.push_back(p.x);
+        spec.y.push_back(p.y);
+        spec.z.push_back(p.z);
+    }
+    spec.blocks = {{1, "HEX8", 8, {}, "hexes"}};
+    for (std::uint32_t id : hexes.cellIndices) spec.blocks[0].connect.push_back(id + 1);
+    spec.nodalVars = {"f"};
+    for (std::size_t s = 0; s < steps; ++s) spec.times.push_back(double(s));
+    spec.nodal = [value](std::size_t s, std::size_t, std::size_t n) { return value(s, n); };
+    return spec;
 }
 
 }  // namespace uvr::testing

@@ -60,15 +60,6 @@ std::vector<std::size_t> parseSteps(const std::string& text, std::size_t count) 
     return steps;
 }
 
-/// The rendered field's values at a step whose fields are `fields` over `geometry`.
-std::vector<float> fieldValues(const MeshView& geometry, const std::vector<Field>& fields,
-                               const FieldSpec& spec) {
-    std::vector<FieldInfo> infos;
-    for (const Field& f : fields) infos.push_back({f.name, f.association, f.components});
-    const FieldChoice choice = resolveField(infos, spec);
-    return scalarFieldOf(geometry, fields[choice.index], spec.component).values;
-}
-
 std::string timeText(double t) {
     char buf[40];
     std::snprintf(buf, sizeof buf, "%.9g", t);
@@ -169,14 +160,25 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                             chosen[0], phases.callbacks());
         phases.finish();
         for (const std::string& note : player.mesh().notes) ctx.step("note: " + note);
-        ValidationReport report;
-        {
-            Progress checking(ctx, "checking the mesh");
-            report =
-                validateMesh(player.mesh(), series->stepSource(chosen[0]), checking.callback());
+        Bounds3f bounds;         // of the cells that render
+        if (player.byParts()) {  // each rank holds its part: the checks over every rank's
+            ctx.step("read time step " + std::to_string(chosen[0]) + " by parts: each of " +
+                     std::to_string(ctx.comm->size()) + " ranks reads its run of the " +
+                     std::to_string(series->partCount(chosen[0])) + " " +
+                     (sniffMeshFormat(*file) == MeshFormat::VtkHdf ? "partitions" : "cells") +
+                     " of each step");
+            bounds = checkShares(player.mesh(), series->stepSource(chosen[0]), ctx).bounds;
+        } else {
+            ValidationReport report;
+            {
+                Progress checking(ctx, "checking the mesh");
+                report =
+                    validateMesh(player.mesh(), series->stepSource(chosen[0]), checking.callback());
+            }
+            for (const std::string& f : report.findings()) ctx.step("validation: " + f);
+            bounds = report.bounds;
         }
-        for (const std::string& f : report.findings()) ctx.step("validation: " + f);
-        if (report.bounds.empty())
+        if (bounds.empty())
             throwError(ErrorKind::Validation, series->stepSource(chosen[0]),
                        "no cell has volume (or the mesh has no volumetric cells): nothing to "
                        "render");
@@ -188,7 +190,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
                      " tetrahedra) of " + std::to_string(series->stepCount()),
                  start);
         std::vector<std::string> notes;
-        RenderSettings settings = flags->settings(report.bounds, *file, &notes);
+        RenderSettings settings = flags->settings(bounds, *file, &notes);
         for (const std::string& note : notes) ctx.step("note: " + note);
         validateSettings(settings);
         const std::optional<Vec3f> background = flags->backgroundColor();
@@ -206,18 +208,14 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             for (std::size_t k = 0; k < chosen.size(); ++k) {
                 const std::size_t i = chosen[k];
                 ctx.setActivity(series->stepSource(i), "reading time step " + std::to_string(i));
-                std::optional<std::vector<Field>> fields =
-                    series->readFieldsIfSameGeometry(i, player.mesh());
-                std::vector<float> values;
-                if (fields) {
-                    values = fieldValues(player.mesh(), *fields, player.spec());
-                } else {
-                    const Mesh other = series->readStep(i);
-                    values = fieldValues(other, other.fields, player.spec());
-                }
-                for (float v : values)  // finite values only (finiteRange gives 0, 0 for none)
+                for (float v : player.stepValues(i))  // finite only (as finiteRange)
                     if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
                 progress.set(double(k + 1) / double(chosen.size()));
+            }
+            if (ctx.comm) {  // data-parallel: the union over the ranks' values
+                double range[2] = {lo, -double(hi)};
+                ctx.comm->allReduce(range, ReduceOp::Min);
+                lo = static_cast<float>(range[0]), hi = static_cast<float>(-range[1]);
             }
             if (lo < hi) {
                 settings.range = std::pair{lo, hi};
@@ -234,8 +232,8 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         LegendStyle legendStyle;
         legendStyle.background = background;
         if (legendFont && flags->cameraIsReset())
-            settings.camera = cameraBesideLegend(player.renderer().prepared(), settings,
-                                                 report.bounds, *legendFont, title);
+            settings.camera = cameraBesideLegend(player.renderer().prepared(), settings, bounds,
+                                                 *legendFont, title);
 
         // Step 3: every step: values refreshed (or the new geometry prepared), rendered, written;
         // the next step read meanwhile.

@@ -200,9 +200,9 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
                                   const StepFlags& steps, const Context& ctx, bool keepFields) {
     Communicator& comm = *ctx.comm;
     const int rank = comm.rank(), ranks = comm.size();
-    const auto cellsOf = [&](std::uint64_t n, int r) { return n * std::uint64_t(r) / ranks; };
     // This rank's part of the file.
     const auto readStart = Clock::now();
+    std::optional<std::pair<std::uint64_t, std::uint64_t>> seriesParts;
     MeshPart part = agreeOn(comm, [&] {
         const MeshFormat format = sniffMeshFormat(file);
         ReadOptions read;
@@ -214,7 +214,8 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
                 ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
                          " ranks reads about " + std::to_string(pieces / ranks) + " of its " +
                          std::to_string(pieces) + " pieces");
-                return readPvtuPart(file, cellsOf(pieces, rank), cellsOf(pieces, rank + 1), read);
+                const auto [first, end] = rankRun(pieces, rank, ranks);
+                return readPvtuPart(file, first, end, read);
             }
             ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(pieces) +
                      " pieces for " + std::to_string(ranks) + " ranks");
@@ -230,7 +231,8 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
                 ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
                          " ranks reads about " + std::to_string(parts / ranks) + " of its " +
                          std::to_string(parts) + " " + unit);
-                return series->readPart(step, cellsOf(parts, rank), cellsOf(parts, rank + 1));
+                seriesParts = rankRun(parts, rank, ranks);
+                return series->readPart(step, seriesParts->first, seriesParts->second);
             }
             ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(parts) +
                      " " + unit + " for " + std::to_string(ranks) + " ranks");
@@ -240,49 +242,60 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
             ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
                      " ranks reads about " + std::to_string(n / ranks) + " of its " +
                      std::to_string(n) + " cells");
-            return readNativePart(file, cellsOf(n, rank), cellsOf(n, rank + 1), read);
+            const auto [first, end] = rankRun(n, rank, ranks);
+            return readNativePart(file, first, end, read);
         }
         const Mesh whole = loadMesh(file, ctx, steps);
-        const std::uint64_t n = whole.cellCount();
-        return meshPart(whole, cellsOf(n, rank), cellsOf(n, rank + 1));
+        const auto [first, end] = rankRun(whole.cellCount(), rank, ranks);
+        return meshPart(whole, first, end);
     });
     const double readSeconds = std::chrono::duration<double>(Clock::now() - readStart).count();
     const std::uint64_t pointIdEnd = part.pointIds.empty() ? 0 : part.pointIds.back() + 1;
     DistributedSource out;
+    out.seriesParts = seriesParts;
     out.source.rankReadSeconds = comm.allGatherValues(readSeconds);
     MeshShare& share = out.share;
     share = shareOfPart(comm, std::move(part), parseFieldSpec(fieldSpec), keepFields);
     // The checks, over every rank's share.
     RenderSource& src = out.source;
     src.path = file;
-    const ValidationReport report = agreeOn(comm, [&] { return validateMesh(share.mesh, file); });
     std::uint64_t counts[2] = {share.mesh.cellCount(), pointIdEnd};
     comm.allReduce(std::span<std::uint64_t>(counts, 1), ReduceOp::Sum);
     comm.allReduce(std::span<std::uint64_t>(counts + 1, 1), ReduceOp::Max);
     src.summary.cells = counts[0];
     src.summary.points = counts[1];
-    src.summary.bounds = reduceBounds(comm, report.bounds);
     src.summary.fieldName = share.field.name;
     src.summary.association = share.field.association;
     src.summary.fieldChoice = share.field.choice;
     src.summary.notes = share.mesh.notes;
-    std::string mine;
-    for (const std::string& f : report.findings()) mine += f + "\n";
-    const std::vector<std::vector<std::byte>> findings =
-        comm.allGather(std::as_bytes(std::span<const char>(mine)));
-    for (int r = 0; r < ranks; ++r) {
-        const std::string text(reinterpret_cast<const char*>(findings[r].data()),
-                               findings[r].size());
-        for (std::size_t at = 0, end; (end = text.find('\n', at)) != std::string::npos;
-             at = end + 1)
-            src.summary.findings.push_back(text.substr(at, end - at) + " (rank " +
-                                           std::to_string(r) + "'s share)");
-    }
-    for (const std::string& f : src.summary.findings) ctx.step("validation: " + f);
+    const SharesChecked checked = checkShares(share.mesh, file, ctx);
+    src.summary.bounds = checked.bounds;
+    src.summary.findings = checked.findings;
     if (src.summary.bounds.empty())
         throwError(ErrorKind::Validation, file,
                    "no cell has volume: all " + std::to_string(src.summary.cells) +
                        " cell(s) are flat or use NaN/Inf points; nothing to render");
+    return out;
+}
+
+SharesChecked checkShares(const Mesh& share, const std::string& file, const Context& ctx) {
+    Communicator& comm = *ctx.comm;
+    const ValidationReport report = agreeOn(comm, [&] { return validateMesh(share, file); });
+    SharesChecked out;
+    out.bounds = reduceBounds(comm, report.bounds);
+    std::string mine;
+    for (const std::string& f : report.findings()) mine += f + "\n";
+    const std::vector<std::vector<std::byte>> findings =
+        comm.allGather(std::as_bytes(std::span<const char>(mine)));
+    for (int r = 0; r < comm.size(); ++r) {
+        const std::string text(reinterpret_cast<const char*>(findings[r].data()),
+                               findings[r].size());
+        for (std::size_t at = 0, end; (end = text.find('\n', at)) != std::string::npos;
+             at = end + 1)
+            out.findings.push_back(text.substr(at, end - at) + " (rank " + std::to_string(r) +
+                                   "'s share)");
+    }
+    for (const std::string& f : out.findings) ctx.step("validation: " + f);
     return out;
 }
 

@@ -87,6 +87,9 @@ std::unique_ptr<Renderer> makeRenderer(PreparedMesh prepared, Device device, con
 struct DistributedSource {
     MeshShare share;      ///< this rank's cells, with the field the ranks agreed on
     RenderSource source;  ///< the whole mesh's counts, bounds and checks
+    /// This rank's run of the step's parts when the file is a series stored in parts (VTKHDF
+    /// partitions, Exodus II cells: MeshSeries::readPart) and was read by them.
+    std::optional<std::pair<std::uint64_t, std::uint64_t>> seriesParts;
 };
 
 /// Reads this rank's part of a file (a .uvrm only where the part lies, a .pvtu by runs of its
@@ -97,6 +100,15 @@ struct DistributedSource {
 DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
                                   const StepFlags& steps, const Context& ctx,
                                   bool keepFields = false);
+
+/// Every rank's share checked (validateMesh; collective, ctx.comm must be set): the bounds of
+/// the cells that render, reduced over the ranks, and each rank's findings naming the rank,
+/// shown as steps.
+struct SharesChecked {
+    Bounds3f bounds;
+    std::vector<std::string> findings;
+};
+SharesChecked checkShares(const Mesh& share, const std::string& file, const Context& ctx);
 
 /// `mpirun -n N uvr render FILE`: each rank reads its part of the file (a .uvrm only where the
 /// part lies; any other file whole, keeping its part), the ranks agree on the field, the bounds

@@ -117,14 +117,32 @@ std::optional<server::ViewScene> sceneFromCache(const std::string& file, const R
     return scene;
 }
 
-/// Data-parallel, a file of one time step: each rank reads its part of it as `uvr render` under
-/// mpirun does (readDistributed, keeping the part's fields for field changes), and the server
-/// reduces what the page lists over the ranks (ViewScene::part).
+/// The field spec that names `name` of `association` among `fields` ("name", or "name:cell"
+/// where a point field has that name too): a series shows the field its first step chose at
+/// every step.
+std::string pinnedField(const std::vector<Field>& fields, const std::string& name,
+                        Association association) {
+    bool twoOfName = false;
+    for (const Field& f : fields)
+        twoOfName = twoOfName || (f.name == name && f.association != association);
+    return name + (twoOfName && association == Association::Cell ? ":cell" : "");
+}
+
+/// Data-parallel, a file of one time step or a series stored in parts: each rank reads its part
+/// of it as `uvr render` under mpirun does (readDistributed, keeping the part's fields for field
+/// changes; a series' other steps by the same run of parts), and the server reduces what the
+/// page lists over the ranks (ViewScene::part).
 server::ViewScene sceneFromParts(const std::string& file, const RenderFlags& flags,
                                  const StepFlags& steps, const Context& ctx) {
     const auto start = std::chrono::steady_clock::now();
     DistributedSource read = readDistributed(file, flags.field, steps, ctx, /*keepFields=*/true);
     server::ViewScene scene;
+    std::shared_ptr<MeshSeries> series = openSeries(file, ctx);
+    scene.initial.step = steps.pick(*series);
+    if (series->stepCount() > 1) {
+        UVR_CHECK(read.seriesParts, "a series read by parts");
+        scene.series = std::move(series);
+    }
     scene.loadSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     scene.file = file;
@@ -142,9 +160,12 @@ server::ViewScene sceneFromParts(const std::string& file, const RenderFlags& fla
     scene.bounds = summary.bounds;
     startingState(scene, settings, flags, reduceFiniteRange(*ctx.comm, read.share.field.values),
                   summary.cells);
+    if (scene.series && flags.field.empty())  // the field the ranks chose, at every step
+        scene.initial.field = pinnedField(read.share.mesh.fields, read.share.field.name,
+                                          read.share.field.association);
     scene.part =
         server::ViewScene::Part{std::move(read.share.pointIds), std::move(read.share.cellIds),
-                                summary.points, summary.cells};
+                                summary.points, summary.cells, read.seriesParts};
     scene.mesh = std::make_shared<Mesh>(std::move(read.share.mesh));
     scene.rendererOptions = flags.rendererOptions(true);
     scene.rendererOptions.partitions = scene.rendererOptions.meshBvh = true;
@@ -155,7 +176,7 @@ server::ViewScene sceneFromParts(const std::string& file, const RenderFlags& fla
 
 /// The scene of a mesh read and checked as `uvr render` does; the server prepares it (for
 /// every method, the field switched without rebuilding geometry). Data-parallel, every rank
-/// reads a series whole.
+/// reads a series not stored in parts whole.
 server::ViewScene sceneFromMesh(const std::string& file, const RenderFlags& flags,
                                 const StepFlags& steps, const Context& ctx) {
     const auto start = std::chrono::steady_clock::now();
@@ -189,12 +210,7 @@ server::ViewScene sceneFromMesh(const std::string& file, const RenderFlags& flag
     // A series shows one field at every step: the default its first step chose (pinField).
     if (scene.series && flags.field.empty()) {
         const FieldSpec pinned = pinField(*mesh, parseFieldSpec(""));
-        bool twoOfName = false;
-        for (const Field& f : mesh->fields)
-            twoOfName =
-                twoOfName || (f.name == pinned.name && f.association != *pinned.association);
-        scene.initial.field =
-            pinned.name + (twoOfName && *pinned.association == Association::Cell ? ":cell" : "");
+        scene.initial.field = pinnedField(mesh->fields, pinned.name, *pinned.association);
     }
     scene.mesh = mesh;
     // Every method can be picked in the page: the server prepares for all of them, in the
@@ -274,9 +290,16 @@ void addViewCommand(CLI::App& app, Context& ctx) {
         std::optional<server::ViewScene> chosen;  // from a prepared cache or the ranks' parts
         if (ctx.dataParallel()) {
             refuseCacheDataParallel(*cache, "view");
-            // A file of one time step is read by parts; a series whole on every rank.
-            if (openSeries(*file, ctx)->stepCount() <= 1)
+            // A file of one time step, or a series stored in as many parts as ranks, is read by
+            // parts; another series whole on every rank.
+            const std::unique_ptr<MeshSeries> series = openSeries(*file, ctx);
+            if (series->stepCount() <= 1 ||
+                series->partCount(steps->pick(*series)) >= std::uint64_t(ctx.comm->size()))
                 chosen = sceneFromParts(*file, *flags, *steps, ctx);
+            else
+                ctx.step(
+                    "reading the series whole on every rank: it is not stored in as many "
+                    "parts as ranks");
         } else {
             chosen = sceneFromCache(*file, *flags, *steps, *cache, ctx);
         }

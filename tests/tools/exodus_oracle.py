@@ -7,6 +7,10 @@
       x and jittered, blocks (ElementBlockIds) of tetrahedra, hexahedra, wedges, pyramids and
       triangles, the nodal variables temp and vel (a vector), the element variable pres, and
       three time steps (0, 0.5, 1.5) whose values change.
+  exodus_oracle.py series MESH.vtk OUT.e
+      Writes a VTK legacy mesh as an Exodus II series of three time steps (0, 1, 2) of one
+      geometry, its point field "wave" moving with the time (uvr animate under mpirun reads its
+      steps by parts: tests/tools/mpi_render_test.py).
   exodus_oracle.py dump FILE.e OUT.json STEP [STEP...]
       Reads FILE with VTK's vtkExodusIIReader (every nodal and element result array, points not
       squeezed, so point ids are the file's node numbers minus one) and writes, per step, what
@@ -91,9 +95,42 @@ class Source(VTKPythonAlgorithmBase):
         return 1
 
 
-def write(out):
+class MeshSeries(VTKPythonAlgorithmBase):
+    """A VTK legacy mesh (one element block) whose point field "wave" moves over three steps."""
+
+    TIMES = [0.0, 1.0, 2.0]
+
+    def __init__(self, path):
+        super().__init__(nInputPorts=0, nOutputPorts=1, outputType="vtkUnstructuredGrid")
+        r = vtk.vtkUnstructuredGridReader()
+        r.SetFileName(path)
+        r.Update()
+        self.grid = r.GetOutput()
+
+    RequestInformation = Source.RequestInformation
+
+    def RequestData(self, request, inInfo, outInfo):
+        info = outInfo.GetInformationObject(0)
+        sddp = vtk.vtkStreamingDemandDrivenPipeline
+        t = info.Get(sddp.UPDATE_TIME_STEP()) if info.Has(sddp.UPDATE_TIME_STEP()) else 0.0
+        g = vtk.vtkUnstructuredGrid.GetData(outInfo, 0)
+        g.CopyStructure(self.grid)
+        pts = ns.vtk_to_numpy(self.grid.GetPoints().GetData()).astype(float)
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        u = (pts - lo) / np.maximum(hi - lo, 1e-30)
+        wave = np.sin(2.0 * math.pi * u[:, 0] + t) + u[:, 2]
+        a = ns.numpy_to_vtk(np.ascontiguousarray(wave), deep=1)
+        a.SetName("wave")
+        g.GetPointData().AddArray(a)
+        b = ns.numpy_to_vtk(np.ones(g.GetNumberOfCells(), dtype=np.int32), deep=1)
+        b.SetName("ElementBlockIds")
+        g.GetCellData().AddArray(b)
+        return 1
+
+
+def write(out, source=None):
     w = vtk.vtkExodusIIWriter()
-    source = Source()  # kept alive while the writer pulls its steps
+    source = source or Source()  # kept alive while the writer pulls its steps
     w.SetInputConnection(source.GetOutputPort())
     w.SetFileName(out)
     w.WriteAllTimeStepsOn()
@@ -178,6 +215,8 @@ def dump(path, out, steps):
 def main():
     if len(sys.argv) >= 3 and sys.argv[1] == "write":
         write(sys.argv[2])
+    elif len(sys.argv) >= 4 and sys.argv[1] == "series":
+        write(sys.argv[3], MeshSeries(sys.argv[2]))
     elif len(sys.argv) >= 5 and sys.argv[1] == "dump":
         dump(sys.argv[2], sys.argv[3], [int(s) for s in sys.argv[4:]])
     else:

@@ -12,11 +12,15 @@
 
 namespace uvr {
 
+std::pair<std::uint64_t, std::uint64_t> rankRun(std::uint64_t parts, int rank, int ranks) {
+    UVR_CHECK(ranks >= 1 && rank >= 0 && rank < ranks, "run " << rank << " of " << ranks);
+    return {parts * std::uint64_t(rank) / std::uint64_t(ranks),
+            parts * std::uint64_t(rank + 1) / std::uint64_t(ranks)};
+}
+
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks) {
-    UVR_CHECK(ranks >= 1 && rank >= 0 && rank < ranks, "share " << rank << " of " << ranks);
-    const std::uint64_t n = mesh.cellCount();
-    MeshPart part = meshPart(mesh, n * std::uint64_t(rank) / std::uint64_t(ranks),
-                             n * std::uint64_t(rank + 1) / std::uint64_t(ranks));
+    const auto [first, end] = rankRun(mesh.cellCount(), rank, ranks);
+    MeshPart part = meshPart(mesh, first, end);
     MeshShare s;
     s.field.name = field.name;
     s.field.association = field.association;

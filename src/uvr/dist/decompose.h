@@ -35,7 +35,11 @@ struct MeshShare {
     std::vector<std::uint64_t> cellIds;   ///< per cell: its index in the whole mesh (increasing)
 };
 
-/// Share `rank` of `ranks` of a mesh held whole: the cells [rank n / ranks, (rank + 1) n / ranks).
+/// The run [first, end) of `parts` parts (a file's cells, pieces or partitions) that rank `rank`
+/// of `ranks` reads: [rank parts / ranks, (rank + 1) parts / ranks), as even as they allow.
+std::pair<std::uint64_t, std::uint64_t> rankRun(std::uint64_t parts, int rank, int ranks);
+
+/// Share `rank` of `ranks` of a mesh held whole: its cells rankRun(cells, rank, ranks).
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks);
 
 /// The finite range of every rank's values (collective; 0, 0 where no rank holds a finite one,

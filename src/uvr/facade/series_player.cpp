@@ -8,6 +8,7 @@
 #include "uvr/core/error.h"
 #include "uvr/cpu/background_task.h"
 #include "uvr/dist/communicator.h"
+#include "uvr/dist/decompose.h"
 
 namespace uvr {
 
@@ -23,6 +24,7 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 struct SeriesPlayer::Read {
     std::optional<std::vector<Field>> fields;
     std::optional<Mesh> mesh;
+    std::optional<MeshPart> part;  ///< byParts: this rank's parts of another geometry
     double seconds = 0.0;
 };
 
@@ -38,6 +40,17 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
     : series_(std::move(series)), spec_(std::move(spec)), options_(options), progress_(progress) {
     UVR_CHECK(series_ != nullptr, "a player needs a series");
     // Data-parallel, every rank reads the steps: a rank that fails ends every rank.
+    if (const Communicator* comm = options_.communicator; comm && comm->size() > 1) {
+        std::uint64_t parts = 0;
+        agreed([&] { parts = series_->partCount(first); });
+        if (parts >= std::uint64_t(comm->size())) parts_ = partsOf(first);
+    }
+    if (parts_) {
+        agreed([&] { part_ = series_->readPart(first, parts_->first, parts_->second); });
+        renderer_ = partRenderer(part_);
+        step_ = first;
+        return;
+    }
     agreed([&] {
         mesh_ = series_->readStep(first);
         field_ = selectScalarField(mesh_, spec_);  // the choice as the first step explains it
@@ -47,6 +60,28 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
     field_.choice = choice;
     renderer_ = std::make_unique<Renderer>(mesh_, field_, options_, progress_);
     step_ = first;
+}
+
+std::pair<std::uint64_t, std::uint64_t> SeriesPlayer::partsOf(std::size_t i) const {
+    const Communicator& comm = *options_.communicator;
+    const std::uint64_t parts = series_->partCount(i), ranks = std::uint64_t(comm.size());
+    if (parts < ranks)
+        throwError(ErrorKind::Unsupported, series_->stepSource(i),
+                   "time step " + std::to_string(i) + " is stored in " + std::to_string(parts) +
+                       " parts, fewer than the " + std::to_string(ranks) +
+                       " ranks that read the series' steps by parts");
+    return rankRun(parts, comm.rank(), comm.size());
+}
+
+std::unique_ptr<Renderer> SeriesPlayer::partRenderer(const MeshPart& part) {
+    // The part is kept (its fields give the next steps' values); a copy becomes the share.
+    MeshShare share = shareOfPart(*options_.communicator, MeshPart(part), spec_);
+    spec_.name = share.field.name;  // every step the field the ranks chose at this one
+    spec_.association = share.field.association;
+    ScalarField field = share.field;
+    auto renderer = std::make_unique<Renderer>(std::move(share), options_, progress_);
+    field_ = std::move(field);
+    return renderer;
 }
 
 SeriesPlayer::~SeriesPlayer() = default;
@@ -62,10 +97,34 @@ void SeriesPlayer::agreed(F&& work) {
 SeriesPlayer::Read SeriesPlayer::readStep(std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
     Read r;
-    r.fields = series_->readFieldsIfSameGeometry(i, mesh_);
-    if (!r.fields) r.mesh = series_->readStep(i);
+    if (parts_) {
+        const auto [first, end] = partsOf(i);
+        MeshPart part = series_->readPart(i, first, end);
+        if (samePartGeometry(part, part_.mesh, part_.pointIds, part_.cellIds))
+            r.fields = std::move(part.mesh.fields);
+        else
+            r.part = std::move(part);
+    } else {
+        r.fields = series_->readFieldsIfSameGeometry(i, mesh_);
+        if (!r.fields) r.mesh = series_->readStep(i);
+    }
     r.seconds = secondsSince(start);
     return r;
+}
+
+std::vector<float> SeriesPlayer::stepValues(std::size_t i) {
+    pending_.reset();  // one reader at a time: a prefetch is waited for and dropped
+    std::vector<float> values;
+    agreed([&] {
+        Read r = readStep(i);
+        const Mesh& geometry = r.fields ? current() : r.part ? r.part->mesh : *r.mesh;
+        const std::vector<Field>& fields = r.fields ? *r.fields : geometry.fields;
+        std::vector<FieldInfo> infos;
+        for (const Field& f : fields) infos.push_back({f.name, f.association, f.components});
+        const FieldChoice choice = resolveField(infos, spec_);
+        values = scalarFieldOf(geometry, fields[choice.index], spec_.component).values;
+    });
+    return values;
 }
 
 void SeriesPlayer::prefetch(std::size_t i) {
@@ -111,16 +170,22 @@ StepUpdate SeriesPlayer::show(std::size_t i, std::optional<std::size_t> next) {
     if (r.fields) {
         // The geometry stays: the next read (it only reads the points and cells) can start now.
         if (next) prefetch(*next);
-        std::vector<Field> previous = std::exchange(mesh_.fields, std::move(*r.fields));
+        std::vector<Field> previous = std::exchange(current().fields, std::move(*r.fields));
         try {
             ScalarField field;
-            agreed([&] { field = selectScalarField(mesh_, spec_); });
+            agreed([&] { field = selectScalarField(current(), spec_); });
             renderer_->setFieldValues(field);
             field_ = std::move(field);
         } catch (...) {
-            mesh_.fields = std::move(previous);
+            current().fields = std::move(previous);
             throw;
         }
+    } else if (r.part) {
+        agreed([&] { selectScalarField(r.part->mesh, spec_); });  // the field is there
+        auto renderer = partRenderer(*r.part);
+        part_ = std::move(*r.part);
+        renderer_ = std::move(renderer);
+        u.rebuilt = true;
     } else {
         ScalarField field;
         agreed([&] { field = selectScalarField(*r.mesh, spec_); });

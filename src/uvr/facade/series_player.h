@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "uvr/facade/renderer.h"
 #include "uvr/mesh/field_select.h"
@@ -26,8 +28,11 @@ struct StepUpdate {
 /// (Renderer::setFieldValues, nothing geometric rebuilt), one whose geometry differs is
 /// prepared anew. prefetch(i) reads step i on a thread of its own while the caller renders.
 /// One caller at a time. Data-parallel (RendererOptions::communicator): every rank plays the
-/// series with the same calls; each reads every step and gives its piece the new values
-/// (Renderer::setFieldValues routes them), and a rank's failure ends every rank.
+/// series with the same calls, gives its piece the new values (Renderer::setFieldValues routes
+/// them), and a rank's failure ends every rank. A series stored in parts, at least one a rank
+/// (MeshSeries::partCount: a VTKHDF file's partitions, an Exodus II file's cells), is read by
+/// parts: each rank reads only its run of each step's parts (byParts); any other series is read
+/// whole on every rank.
 class SeriesPlayer {
 public:
     /// Reads step `first` of the series and prepares the field `spec` names for rendering;
@@ -50,13 +55,22 @@ public:
 
     /// The renderer, prepared for the current step.
     Renderer& renderer() { return *renderer_; }
-    /// The current step's mesh: the geometry and that step's fields.
-    const Mesh& mesh() const { return mesh_; }
+    /// The current step's mesh: the geometry and that step's fields (this rank's part when
+    /// byParts()).
+    const Mesh& mesh() const { return parts_ ? part_.mesh : mesh_; }
     /// The rendered field's values at the current step.
     const ScalarField& field() const { return field_; }
     /// The field spec every step renders: the one given, its default resolved at the first step
     /// (pinField).
     const FieldSpec& spec() const { return spec_; }
+    /// Whether each rank reads only its parts of each step (data-parallel, a series stored in
+    /// parts): mesh() and field() are then this rank's part's.
+    bool byParts() const { return parts_.has_value(); }
+    /// The rendered field's values at step i (a value range over the steps): of this rank's
+    /// part when byParts(), else of the whole mesh. A prefetch is waited for and dropped.
+    /// Collective data-parallel; throws reader errors, Error(Argument) for an unknown step or a
+    /// step without the field.
+    std::vector<float> stepValues(std::size_t i);
     /// The series.
     const MeshSeries& series() const { return *series_; }
     /// The step shown.
@@ -65,6 +79,13 @@ public:
 private:
     struct Read;
     Read readStep(std::size_t i);
+    /// This rank's parts of step i (byParts): its run of the step's partCount.
+    std::pair<std::uint64_t, std::uint64_t> partsOf(std::size_t i) const;
+    /// A renderer for this rank's part (byParts; collective): its share moved to the pieces,
+    /// spec_ pinned to the field the ranks chose; sets field_.
+    std::unique_ptr<Renderer> partRenderer(const MeshPart& part);
+    /// The mesh of the current step: the part's (byParts) or the whole mesh.
+    Mesh& current() { return parts_ ? part_.mesh : mesh_; }
     /// Runs work(); data-parallel (RendererOptions::communicator), agrees on its failures.
     template <class F>
     void agreed(F&& work);
@@ -73,7 +94,10 @@ private:
     FieldSpec spec_;
     RendererOptions options_;
     ProgressFn progress_;
-    Mesh mesh_;
+    Mesh mesh_;  ///< the current step read whole (not byParts)
+    /// byParts: this rank's parts of the current step, and what was read.
+    std::optional<std::pair<std::uint64_t, std::uint64_t>> parts_;
+    MeshPart part_;
     ScalarField field_;
     std::unique_ptr<Renderer> renderer_;
     std::size_t step_ = 0;

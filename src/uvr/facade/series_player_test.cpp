@@ -8,7 +8,14 @@
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/dist/in_process_communicator.h"
+#include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/render/image_metrics.h"
+
+#ifdef UVR_HAVE_NETCDF
+#include "exodus_file_writer.h"
+#endif
 
 namespace uvr {
 namespace {
@@ -128,6 +135,75 @@ TEST(SeriesPlayer, TheDefaultFieldOfTheFirstStepStaysAtEveryStep) {
     const RenderSettings s = frameOf(player.mesh().bounds());
     expectSameImage(player.renderer().render(s), freshFrame(stepMesh(1.f), s, o), "step 1");
 }
+
+#ifdef UVR_HAVE_NETCDF
+TEST(SeriesPlayer, DataParallelASeriesStoredInPartsIsReadByPartsAsOneProcessShowsIt) {
+    // An Exodus II series (its cells are its parts) of one geometry: on 3 in-process ranks each
+    // reads only its run of cells of each step, and every step's frame and values are one
+    // process's.
+    if (!exodusSupported()) GTEST_SKIP() << "built without netCDF";
+    const Mesh grid = stepMesh(0.f, 8);
+    const testing::ExoFileSpec spec =
+        testing::hexSeriesSpec(grid, 3, [&](std::size_t step, std::size_t n) {
+            const Vec3f p = grid.points[n];
+            return double(std::sin(3.f * p.x + float(step)) * p.y + p.z);
+        });
+    const std::string file = testing::scratchDir() + "/grid.exo";
+    testing::writeExodusFile(file, spec);
+
+    RendererOptions o;
+    o.device = Device::Cpu;
+    SeriesPlayer one(openMeshSeries(file), parseFieldSpec(""), o);
+    EXPECT_FALSE(one.byParts());
+    const RenderSettings s = frameOf(one.mesh().bounds());
+    std::vector<Image> expected;
+    std::vector<std::pair<float, float>> ranges;
+    for (std::size_t i = 0; i < 3; ++i) {
+        if (i) one.show(i);
+        expected.push_back(one.renderer().render(s).image);
+        const std::vector<float> v = one.stepValues(i);
+        ranges.push_back(
+            {*std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())});
+    }
+    std::vector<Image> got;
+    std::vector<std::uint64_t> cells(3), rebuilt(3);
+    std::vector<std::pair<float, float>> rankRanges(3);
+    InProcessGroup::run(3, [&](Communicator& comm) {
+        RendererOptions ro = o;
+        ro.communicator = &comm;
+        SeriesPlayer player(openMeshSeries(file), parseFieldSpec(""), ro);
+        ASSERT_TRUE(player.byParts());
+        cells[comm.rank()] = player.mesh().cellCount();
+        for (std::size_t i = 0; i < 3; ++i) {
+            if (i)
+                rebuilt[comm.rank()] +=
+                    player.show(i, i + 1 < 3 ? std::optional(i + 1) : std::nullopt).rebuilt;
+            RenderResult r = player.renderer().render(s);
+            if (comm.rank() == 0) got.push_back(std::move(r.image));
+        }
+        const std::vector<float> v = player.stepValues(2);
+        double range[2] = {*std::min_element(v.begin(), v.end()),
+                           -*std::max_element(v.begin(), v.end())};
+        comm.allReduce(range, ReduceOp::Min);
+        rankRanges[comm.rank()] = {float(range[0]), float(-range[1])};
+    });
+    // Each rank read a third of the cells, and no step was prepared anew.
+    EXPECT_EQ(cells[0] + cells[1] + cells[2], grid.cellCount());
+    for (std::uint64_t c : cells) EXPECT_LT(c, grid.cellCount() / 2);
+    EXPECT_EQ(rebuilt, std::vector<std::uint64_t>(3, 0));
+    ASSERT_EQ(got.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+        const ImageComparison cmp = compareImages(toRgb8(expected[i]), toRgb8(got[i]));
+        EXPECT_GE(cmp.ssim, 0.999) << "step " << i;
+        EXPECT_LE(cmp.maxAbsDifference, 2.0) << "step " << i << ": " << differenceSummary(cmp);
+    }
+    EXPECT_GT(compareImages(toRgb8(got[0]), toRgb8(got[2])).maxAbsDifference, 10.0);
+    for (const auto& [lo, hi] : rankRanges) {
+        EXPECT_EQ(lo, ranges[2].first);
+        EXPECT_EQ(hi, ranges[2].second);
+    }
+}
+#endif
 
 }  // namespace
 }  // namespace uvr

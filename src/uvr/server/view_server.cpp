@@ -205,8 +205,17 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
         agreed([&] {
             // Another time step: its fields for the same points and cells, nothing geometric.
             const auto start = Clock::now();
-            std::optional<std::vector<Field>> stepFields =
-                scene.series->readFieldsIfSameGeometry(step, *scene.mesh);
+            std::optional<std::vector<Field>> stepFields;
+            if (scene.part) {  // this rank's run of the step's parts
+                const Communicator& comm = *ranks();
+                const auto [first, end] =
+                    rankRun(scene.series->partCount(step), comm.rank(), comm.size());
+                MeshPart part = scene.series->readPart(step, first, end);
+                if (samePartGeometry(part, *scene.mesh, scene.part->pointIds, scene.part->cellIds))
+                    stepFields = std::move(part.mesh.fields);
+            } else {
+                stepFields = scene.series->readFieldsIfSameGeometry(step, *scene.mesh);
+            }
             if (!stepFields)
                 throwError(
                     ErrorKind::Unsupported, scene.series->stepSource(step),
@@ -623,10 +632,10 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
     Impl& d = *impl_;
     if (!scene.mesh && !(scene.fromCache && scene.renderer))
         throwError(ErrorKind::Argument, "", "the viewer needs a mesh, or a prepared one");
-    if ((scene.fromCache || scene.part) && scene.series)
+    if ((scene.fromCache || (scene.part && !scene.part->steps)) && scene.series)
         throwError(ErrorKind::Argument, "",
                    scene.fromCache ? "a prepared cache holds one time step"
-                                   : "a series is read whole on every rank, not by parts");
+                                   : "a series read by parts needs its run of parts");
     checkServerOptions(options, false);
     if (options.token.empty()) options.token = randomToken();
     d.scene = std::move(scene);

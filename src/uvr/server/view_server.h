@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "uvr/cache/prepared_cache.h"
@@ -82,6 +83,9 @@ struct ViewScene {
     struct Part {
         std::vector<std::uint64_t> pointIds, cellIds;
         std::uint64_t points = 0, cells = 0;
+        /// A series (`series` set): this rank's run of each step's parts (MeshSeries::readPart),
+        /// a step's fields read from those.
+        std::optional<std::pair<std::uint64_t, std::uint64_t>> steps;
     };
     std::optional<Part> part;
     /// A scene served from a prepared cache (`uvr view` with MESH.uvrprep): no mesh was read,

@@ -27,9 +27,15 @@
 #include "uvr/core/error.h"
 #include "uvr/dist/decompose.h"
 #include "uvr/dist/in_process_communicator.h"
+#include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/native.h"
+#include "uvr/render/image_metrics.h"
 #include "uvr/server/web_assets.h"
+
+#ifdef UVR_HAVE_NETCDF
+#include "exodus_file_writer.h"
+#endif
 
 namespace uvr::server {
 namespace {
@@ -314,7 +320,8 @@ TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
         ViewScene scene;
         scene.file = "grid.vtk";
         scene.bounds = whole->bounds();
-        scene.part = ViewScene::Part{share.pointIds, share.cellIds, whole->pointCount(), n};
+        scene.part =
+            ViewScene::Part{share.pointIds, share.cellIds, whole->pointCount(), n, std::nullopt};
         scene.mesh = std::make_shared<Mesh>(std::move(share.mesh));
         scene.rendererOptions.device = Device::Cpu;
         scene.rendererOptions.leafCells = 64;
@@ -364,6 +371,96 @@ TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
     ASSERT_FALSE(gFrame.is_null());
     EXPECT_EQ(gFrame["seq"], 2);
 }
+
+#ifdef UVR_HAVE_NETCDF
+TEST(ViewServer, RanksHoldingPartsOfASeriesShowItsSteps) {
+    // `uvr view` under mpirun on a series stored in parts (an Exodus II file: its cells): each
+    // of two in-process ranks reads its run of each step's cells, and a step change reaches
+    // both parts: the page sees the whole step's range, and the frame is one process's.
+    if (!exodusSupported()) GTEST_SKIP() << "built without netCDF";
+    const Mesh grid = testing::makeHexGrid(
+        6, -1.f, 1.f, [](Vec3f p) { return p.x; }, 0.2f);
+    const std::string file = testing::scratchDir() + "/series.exo";
+    testing::writeExodusFile(file,
+                             testing::hexSeriesSpec(grid, 3, [&](std::size_t s, std::size_t n) {
+                                 const Vec3f p = grid.points[n];
+                                 return double(p.x + 2.f * p.y * std::cos(float(s)));
+                             }));
+    const auto sceneOf = [&](std::shared_ptr<MeshSeries> series, Communicator* comm) {
+        ViewScene scene;
+        scene.file = file;
+        if (comm) {
+            const auto run = rankRun(series->partCount(0), comm->rank(), comm->size());
+            MeshShare share = shareOfPart(*comm, series->readPart(0, run.first, run.second),
+                                          parseFieldSpec(""), /*keepFields=*/true);
+            scene.part = ViewScene::Part{share.pointIds, share.cellIds, grid.pointCount(),
+                                         grid.cellCount(), run};
+            scene.mesh = std::make_shared<Mesh>(std::move(share.mesh));
+            scene.rendererOptions.communicator = comm;
+        } else {
+            scene.mesh = std::make_shared<Mesh>(series->readStep(0));
+        }
+        scene.series = std::move(series);
+        scene.bounds = grid.bounds();
+        scene.rendererOptions.device = Device::Cpu;
+        scene.rendererOptions.leafCells = 64;
+        ViewState& st = scene.initial;
+        st.camera = resetCamera(scene.bounds, 64.f / 48.f);
+        st.tf = transferFunctionPreset("viridis");
+        applyOpacitySpec(st.tf, "0:0,1:0.6");
+        st.range = {-3.f, 3.f};
+        st.width = 64;
+        st.height = 48;
+        return scene;
+    };
+    // What the page gets at step 2: the histogram's range and the frame.
+    const auto step2 = [](ViewServer& server, Json& histogram, std::string& frame) {
+        server.start();
+        {
+            Client c(server.port(), server.token());
+            ASSERT_FALSE(c.frame().is_null());
+            c.send({{"type", "set"}, {"seq", 2}, {"step", 2}});
+            histogram = c.until("histogram");
+            const Json f = c.frame();
+            ASSERT_FALSE(f.is_null());
+            EXPECT_EQ(f["seq"], 2);
+            frame = c.lastBinary();
+        }
+        server.stop();
+    };
+    Json oneHistogram, histogram;
+    std::string oneFrame, frame;
+    {
+        ServerOptions o;
+        o.port = 0;
+        ViewServer one(sceneOf(openMeshSeries(file), nullptr), o);
+        step2(one, oneHistogram, oneFrame);
+    }
+    std::vector<std::uint64_t> cells(2);
+    InProcessGroup::run(2, [&](Communicator& comm) {
+        ViewScene scene = sceneOf(openMeshSeries(file), &comm);
+        cells[comm.rank()] = scene.mesh->cellCount();
+        ServerOptions o;
+        o.port = 0;
+        ViewServer server(std::move(scene), o);
+        if (comm.rank() != 0) {
+            server.follow();
+            return;
+        }
+        step2(server, histogram, frame);
+    });
+    EXPECT_EQ(cells[0] + cells[1], grid.cellCount());  // each rank read half the cells
+    ASSERT_FALSE(histogram.is_null());
+    ASSERT_FALSE(oneHistogram.is_null());
+    EXPECT_EQ(histogram["range"], oneHistogram["range"]);
+    const std::string dir = testing::scratchDir();
+    const Image a = readPng(testing::writeFile(dir + "/one.png", oneFrame));
+    const Image b = readPng(testing::writeFile(dir + "/two.png", frame));
+    const ImageComparison cmp = compareImages(toRgb8(a), toRgb8(b));
+    EXPECT_GE(cmp.ssim, 0.999);
+    EXPECT_LE(cmp.maxAbsDifference, 2.0) << differenceSummary(cmp);
+}
+#endif
 
 TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
     auto server = startServer();

@@ -57,6 +57,13 @@ bool sameGeometry(const MeshView& a, const MeshView& b) {
            same(a.cellOffsets, b.cellOffsets) && same(a.cellIndices, b.cellIndices);
 }
 
+bool samePartGeometry(const MeshPart& part, const MeshView& geometry,
+                      std::span<const std::uint64_t> pointIds,
+                      std::span<const std::uint64_t> cellIds) {
+    return std::ranges::equal(part.pointIds, pointIds) &&
+           std::ranges::equal(part.cellIds, cellIds) && sameGeometry(part.mesh, geometry);
+}
+
 std::size_t stepAtTime(const std::vector<double>& times, double t) {
     if (!std::isfinite(t))
         throw SettingError("time", std::to_string(t), "expected a finite number");

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -84,5 +85,12 @@ std::size_t stepAtTime(const std::vector<double>& times, double t);
 
 /// True when both views hold the same points (bit for bit), cell types, offsets and indices.
 bool sameGeometry(const MeshView& a, const MeshView& b);
+
+/// Whether a part read (readPart) holds the points and cells of another step's part, given by its
+/// geometry and the ids of its points and cells in the whole mesh: the same ids, positions and
+/// cells.
+bool samePartGeometry(const MeshPart& part, const MeshView& geometry,
+                      std::span<const std::uint64_t> pointIds,
+                      std::span<const std::uint64_t> cellIds);
 
 }  // namespace uvr
