@@ -93,6 +93,16 @@ inline void checkGather(Communicator& comm) {
             EXPECT_TRUE(isPattern(all[r], r * 3 + root, varyingSize(r, root)))
                 << "root " << root << " holds rank " << r << "'s part";
     }
+    // gatherInto twice onto rank 0, into buffers that held other bytes: as gather.
+    std::vector<std::vector<std::byte>> into(comm.size() + 1, pattern(99, kLargeMessage));
+    for (int round = 1; round <= 2; ++round) {
+        comm.gatherInto(pattern(me * 5 + round, varyingSize(me + round, 0)), 0, into);
+        if (me != 0) continue;
+        EXPECT_EQ(int(into.size()), comm.size());
+        for (int r = 0; r < int(into.size()); ++r)
+            EXPECT_TRUE(isPattern(into[r], r * 5 + round, varyingSize(r + round, 0)))
+                << "gatherInto, round " << round << ": rank " << r << "'s part";
+    }
 }
 
 /// allToAll with a size per (sender, receiver) pair (empty and large among them).
@@ -105,6 +115,18 @@ inline void checkAllToAll(Communicator& comm) {
     for (int s = 0; s < int(fromEach.size()); ++s)
         EXPECT_TRUE(isPattern(fromEach[s], s * 100 + me, varyingSize(s, me)))
             << "rank " << me << " from rank " << s;
+    // allToAllInto twice into buffers that held other bytes (more of them, and more buffers),
+    // the second call's messages of other sizes: each time what allToAll gives.
+    std::vector<std::vector<std::byte>> into(n + 1, pattern(99, kLargeMessage));
+    for (int round = 1; round <= 2; ++round) {
+        for (int r = 0; r < n; ++r)
+            toEach[r] = pattern(me * 100 + r + round, varyingSize(me + round, r));
+        comm.allToAllInto(toEach, into);
+        EXPECT_EQ(int(into.size()), n);
+        for (int s = 0; s < int(into.size()); ++s)
+            EXPECT_TRUE(isPattern(into[s], s * 100 + me + round, varyingSize(s + round, me)))
+                << "allToAllInto, round " << round << ": rank " << me << " from rank " << s;
+    }
 }
 
 /// exchange between the pairs (r, r xor mask) for masks 1, 2, 4 (a rank without a partner

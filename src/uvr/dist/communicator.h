@@ -45,6 +45,18 @@ public:
     /// one, indexed by sender.
     virtual std::vector<std::vector<std::byte>> allToAll(
         const std::vector<std::vector<std::byte>>& toEach) = 0;
+    /// allToAll into `fromEach`, and gather into `all` (resized; on root only): for a caller
+    /// exchanging a frame every frame, each message's vector keeps its capacity from the last
+    /// call where the implementation can (MPI), so no page is touched anew. The defaults call
+    /// allToAll and gather.
+    virtual void allToAllInto(const std::vector<std::vector<std::byte>>& toEach,
+                              std::vector<std::vector<std::byte>>& fromEach) {
+        fromEach = allToAll(toEach);
+    }
+    virtual void gatherInto(std::span<const std::byte> mine, int root,
+                            std::vector<std::vector<std::byte>>& all) {
+        all = gather(mine, root);
+    }
     /// Sends to and receives from peer at once (deadlock-free, as MPI_Sendrecv; the two sizes may
     /// differ); peer calls exchange with this rank.
     virtual std::vector<std::byte> exchange(int peer, std::span<const std::byte> send) = 0;

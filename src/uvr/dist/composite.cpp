@@ -23,9 +23,8 @@ namespace {
 /// Appends n values of a trivially copyable type as bytes.
 template <class T>
 void appendBytes(std::vector<std::byte>& out, const T* values, std::size_t n) {
-    const std::size_t at = out.size();
-    out.resize(at + n * sizeof(T));
-    if (n) std::memcpy(out.data() + at, values, n * sizeof(T));
+    const auto* bytes = reinterpret_cast<const std::byte*>(values);
+    out.insert(out.end(), bytes, bytes + n * sizeof(T));
 }
 
 /// The pixels [x0, x1) x [y0, y1) of an image that hold anything: some opacity or some samples
@@ -139,8 +138,10 @@ void secondCompositingPass(Communicator& comm, const Image& image,
 
 CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std::uint32_t>& counts,
                               const std::vector<int>& order, int root, float stopAlpha,
-                              const RerenderPiece& rerender) {
+                              const RerenderPiece& rerender, CompositeBuffers* buffers) {
     const auto start = std::chrono::steady_clock::now();
+    CompositeBuffers own;
+    CompositeBuffers& b = buffers ? *buffers : own;
     CompositeStats stats;
     const int ranks = comm.size(), me = comm.rank();
     UVR_CHECK(int(order.size()) == ranks,
@@ -151,8 +152,10 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     // Every rank's share of band r goes to rank r: the part of band r inside the box of its
     // pixels that hold anything (a header, then the box's rows of colours, then of counts).
     const PixelBox active = activeBox(image, counts);
-    std::vector<std::vector<std::byte>> toEach(ranks);
+    std::vector<std::vector<std::byte>>& toEach = b.toEach;
+    toEach.resize(ranks);
     for (int r = 0; r < ranks; ++r) {
+        toEach[r].clear();
         const auto [first, end] = compositeBand(image.height, r, ranks);
         PixelBox part = active;
         part.y0 = std::max(part.y0, first), part.y1 = std::min(part.y1, end);
@@ -166,13 +169,16 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
                 appendBytes(toEach[r], counts.data() + y * width + part.x0, w);
         if (r != me) stats.bytesSent += toEach[r].size();
     }
-    const std::vector<std::vector<std::byte>> parts = comm.allToAll(toEach);
-    toEach = {};
-    // Band `me`: front to back over the ranks (premultiplied "over").
+    comm.allToAllInto(toEach, b.parts);
+    const std::vector<std::vector<std::byte>>& parts = b.parts;
+    // Band `me`: front to back over the ranks (premultiplied "over"), blended straight from the
+    // bytes received.
     const auto [first, end] = compositeBand(image.height, me, ranks);
     const std::size_t n = (end - first) * width;
-    std::vector<Vec4f> band(n, Vec4f(0.f, 0.f, 0.f, 0.f));
-    std::vector<std::uint32_t> bandCounts(withCounts ? n : 0, 0);
+    std::vector<Vec4f>& band = b.band;
+    band.assign(n, Vec4f(0.f, 0.f, 0.f, 0.f));
+    std::vector<std::uint32_t>& bandCounts = b.bandCounts;
+    bandCounts.assign(withCounts ? n : 0, 0);
     // The second pass's asks: per rank, the pixels it renders again (band index, the colour in
     // front of it there, the stop sent to it).
     std::vector<std::vector<StopAsk>> asks(ranks);
@@ -191,23 +197,26 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
         UVR_CHECK(
             part.size() == sizeof box + m * (sizeof(Vec4f) + (withCounts ? 4 : 0)),
             "rank " << r << " sent " << part.size() << " bytes for a box of " << m << " pixels");
-        std::vector<Vec4f> px(m);
-        std::vector<std::uint32_t> c(withCounts ? m : 0);
-        if (m) std::memcpy(px.data(), part.data() + sizeof box, m * sizeof(Vec4f));
-        if (m && withCounts)
-            std::memcpy(c.data(), part.data() + sizeof box + m * sizeof(Vec4f), m * 4);
+        const std::byte* colours = part.data() + sizeof box;
+        const std::byte* samples = colours + m * sizeof(Vec4f);
         // k: the box's pixel (row by row), i: the same pixel in the band.
         for (std::size_t k = 0, x = 0, i = empty ? 0 : (box.y0 - first) * width + box.x0; k < m;
              ++k, ++i) {
             if (x == w) x = 0, i += width - w;  // the box's next row
             ++x;
-            if (withCounts) bandCounts[i] += c[k];
+            if (withCounts) {
+                std::uint32_t c;
+                std::memcpy(&c, samples + k * sizeof c, sizeof c);
+                bandCounts[i] += c;
+            }
             Vec4f& acc = band[i];
             if (acc.w >= stopAlpha) continue;
+            Vec4f px;
+            std::memcpy(&px, colours + k * sizeof px, sizeof px);
             const Vec4f front = acc;
             const float t = 1.f - acc.w;
-            acc.x += t * px[k].x, acc.y += t * px[k].y, acc.z += t * px[k].z;
-            acc.w += t * px[k].w;
+            acc.x += t * px.x, acc.y += t * px.y, acc.z += t * px.z;
+            acc.w += t * px.w;
             // Rank r's ray stopped at its own stopAlpha; one process's stopped where the whole
             // opacity reached it, which the light in front moves forward.
             if (secondPass && front.w > 0.f && acc.w >= stopAlpha) {
@@ -220,11 +229,13 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     if (secondPass)
         secondCompositingPass(comm, image, asks, fronts, band, bandCounts, rerender, stats);
     // The bands to root.
-    std::vector<std::byte> mine;
+    std::vector<std::byte>& mine = b.mine;
+    mine.clear();
     appendBytes(mine, band.data(), n);
     if (withCounts) appendBytes(mine, bandCounts.data(), n);
     if (me != root) stats.bytesSent += mine.size();
-    const std::vector<std::vector<std::byte>> bands = comm.gather(mine, root);
+    comm.gatherInto(mine, root, b.bands);
+    const std::vector<std::vector<std::byte>>& bands = b.bands;
     if (me == root) {
         for (int r = 0; r < ranks; ++r) {
             const auto [f, e] = compositeBand(image.height, r, ranks);

@@ -27,6 +27,15 @@ struct CompositeStats {
 using RerenderPiece = std::function<void(const std::vector<float>& stops, Image& image,
                                          std::vector<std::uint32_t>& counts)>;
 
+/// What compositeFrame keeps from one frame to the next: the messages sent and received, the
+/// band being blended and the bands root gathers.
+struct CompositeBuffers {
+    std::vector<std::vector<std::byte>> toEach, parts, bands;
+    std::vector<Vec4f> band;
+    std::vector<std::uint32_t> bandCounts;
+    std::vector<std::byte> mine;
+};
+
 /// The rows [first, end) of an image of `height` rows that rank `rank` of `ranks` composites
 /// (direct send: one band of rows each, as even as the rows allow).
 std::pair<int, int> compositeBand(int height, int rank, int ranks);
@@ -47,8 +56,12 @@ std::pair<int, int> compositeBand(int height, int rank, int ranks);
 /// opacity or samples (outside it, blending its image changes nothing). On root, `image` and
 /// `counts` become the whole frame's; elsewhere they are left as they were. Every rank's image
 /// must have the same size, and counts width * height entries (or none on every rank).
+///
+/// `buffers` (a renderer's, kept from frame to frame; null: the call's own) hold the messages
+/// and the band, so their pages stay mapped: fresh ones cost more than the exchange itself.
 CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std::uint32_t>& counts,
                               const std::vector<int>& order, int root = 0, float stopAlpha = 1.f,
-                              const RerenderPiece& rerender = {});
+                              const RerenderPiece& rerender = {},
+                              CompositeBuffers* buffers = nullptr);
 
 }  // namespace uvr

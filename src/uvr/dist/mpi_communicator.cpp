@@ -114,12 +114,18 @@ public:
     }
 
     std::vector<std::vector<std::byte>> gather(std::span<const std::byte> mine, int root) override {
+        std::vector<std::vector<std::byte>> all;
+        gatherInto(mine, root, all);
+        return all;
+    }
+
+    void gatherInto(std::span<const std::byte> mine, int root,
+                    std::vector<std::vector<std::byte>>& all) override {
         detail::checkRankArgument(*this, root, "gather", "root");
         std::uint64_t count = mine.size();
         std::vector<std::uint64_t> counts(rank_ == root ? size_ : 0);
         check(MPI_Gather(&count, 1, MPI_UINT64_T, counts.data(), 1, MPI_UINT64_T, root, comm_),
               "MPI_Gather");
-        std::vector<std::vector<std::byte>> all;
         std::vector<MPI_Request> requests;
         if (rank_ == root) {
             all.resize(size_);
@@ -132,14 +138,21 @@ public:
                 }
             }
         } else {
+            all.clear();
             postSends(mine.data(), mine.size(), root, kTagGather, requests);
         }
         waitAll(requests);
-        return all;
     }
 
     std::vector<std::vector<std::byte>> allToAll(
         const std::vector<std::vector<std::byte>>& toEach) override {
+        std::vector<std::vector<std::byte>> fromEach;
+        allToAllInto(toEach, fromEach);
+        return fromEach;
+    }
+
+    void allToAllInto(const std::vector<std::vector<std::byte>>& toEach,
+                      std::vector<std::vector<std::byte>>& fromEach) override {
         if (int(toEach.size()) != size_)
             throwError(ErrorKind::Argument, "",
                        "allToAll: " + std::to_string(toEach.size()) + " messages for " +
@@ -149,7 +162,7 @@ public:
         check(MPI_Alltoall(sendCounts.data(), 1, MPI_UINT64_T, receiveCounts.data(), 1,
                            MPI_UINT64_T, comm_),
               "MPI_Alltoall");
-        std::vector<std::vector<std::byte>> fromEach(size_);
+        fromEach.resize(size_);
         std::vector<MPI_Request> requests;
         for (int r = 0; r < size_; ++r) {
             if (r == rank_) continue;
@@ -159,9 +172,8 @@ public:
         for (int r = 0; r < size_; ++r)
             if (r != rank_)
                 postSends(toEach[r].data(), toEach[r].size(), r, kTagAllToAll, requests);
-        fromEach[rank_] = toEach[rank_];
+        fromEach[rank_].assign(toEach[rank_].begin(), toEach[rank_].end());
         waitAll(requests);
-        return fromEach;
     }
 
     std::vector<std::byte> exchange(int peer, std::span<const std::byte> send) override {

@@ -199,8 +199,10 @@ RenderResult Renderer::render(const RenderSettings& settings) {
             image = std::move(r.image);
             counts = std::move(r.sampleCounts);
         };
+    if (!compositeBuffers_) compositeBuffers_ = std::make_unique<CompositeBuffers>();
     const CompositeStats composited =
-        compositeFrame(*comm_, result.image, result.sampleCounts, order, 0, stopAlpha, rerender);
+        compositeFrame(*comm_, result.image, result.sampleCounts, order, 0, stopAlpha, rerender,
+                       compositeBuffers_.get());
     result.stats.samples = samples;
     // The ranks' counters summed, and each rank's share.
     std::uint64_t counters[5] = {result.stats.samples, result.stats.walkSteps,

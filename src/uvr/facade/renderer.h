@@ -17,6 +17,7 @@ namespace uvr {
 
 class CudaScene;
 class Communicator;
+struct CompositeBuffers;
 struct Decomposition;
 struct MeshShare;
 struct ValueRoutes;
@@ -152,6 +153,8 @@ private:
     Communicator* comm_ = nullptr;
     std::shared_ptr<const Decomposition> decomposition_;
     std::unique_ptr<ValueRoutes> routes_;  ///< data-parallel: how new values reach the piece
+    /// Data-parallel: the compositing's messages and band, kept from frame to frame.
+    std::unique_ptr<CompositeBuffers> compositeBuffers_;
     /// Data-parallel from a whole mesh: the whole mesh's point and cell indices of this rank's
     /// share (setFieldValues takes the whole mesh's values there).
     std::vector<std::uint64_t> wholePointIds_, wholeCellIds_;
