@@ -60,12 +60,9 @@ std::shared_ptr<Mesh> twoFieldMesh() {
     return m;
 }
 
-/// A server on a free port of 127.0.0.1 over the two-field mesh, on the CPU, 64x48 frames.
-std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
-    ViewScene scene;
-    scene.file = "grid.vtk";
-    scene.mesh = twoFieldMesh();
-    scene.bounds = scene.mesh->bounds();
+/// The tests' scenes: the CPU, leaves of 64 cells, and 64x48 viridis frames of scene.bounds over
+/// [-3, 3].
+void useTestFrames(ViewScene& scene) {
     scene.rendererOptions.device = Device::Cpu;
     scene.rendererOptions.leafCells = 64;
     ViewState& s = scene.initial;
@@ -75,6 +72,16 @@ std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
     s.range = {-3.f, 3.f};
     s.width = 64;
     s.height = 48;
+}
+
+/// A server on a free port of 127.0.0.1 over the two-field mesh, on the CPU, 64x48 frames.
+std::unique_ptr<ViewServer> startServer(ServerOptions o = {}, LogFn log = {}) {
+    ViewScene scene;
+    scene.file = "grid.vtk";
+    scene.mesh = twoFieldMesh();
+    scene.bounds = scene.mesh->bounds();
+    useTestFrames(scene);
+    ViewState& s = scene.initial;
     s.settings["opacity_unit"] = 0.5;
     scene.commandFlags = {"--sample-distance", "0.01"};
     o.port = 0;
@@ -402,15 +409,7 @@ TEST(ViewServer, RanksHoldingPartsOfASeriesShowItsSteps) {
         }
         scene.series = std::move(series);
         scene.bounds = grid.bounds();
-        scene.rendererOptions.device = Device::Cpu;
-        scene.rendererOptions.leafCells = 64;
-        ViewState& st = scene.initial;
-        st.camera = resetCamera(scene.bounds, 64.f / 48.f);
-        st.tf = transferFunctionPreset("viridis");
-        applyOpacitySpec(st.tf, "0:0,1:0.6");
-        st.range = {-3.f, 3.f};
-        st.width = 64;
-        st.height = 48;
+        useTestFrames(scene);
         return scene;
     };
     // What the page gets at step 2: the histogram's range and the frame.
