@@ -165,8 +165,7 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
             ctx.step("read time step " + std::to_string(chosen[0]) + " by parts: each of " +
                      std::to_string(ctx.comm->size()) + " ranks reads its run of the " +
                      std::to_string(series->partCount(chosen[0])) + " " +
-                     (sniffMeshFormat(*file) == MeshFormat::VtkHdf ? "partitions" : "cells") +
-                     " of each step");
+                     partUnit(sniffMeshFormat(*file)) + " of each step");
             bounds = checkShares(player.mesh(), series->stepSource(chosen[0]), ctx).bounds;
         } else {
             ValidationReport report;

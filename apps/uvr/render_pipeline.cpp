@@ -196,6 +196,12 @@ RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const Render
     return renderPreparedAndWrite(*renderer, src, settings, out, ctx);
 }
 
+const char* partUnit(MeshFormat format) {
+    return format == MeshFormat::VtkHdf   ? "partitions"
+           : format == MeshFormat::Exodus ? "cells"
+                                          : "pieces";
+}
+
 DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
                                   const StepFlags& steps, const Context& ctx, bool keepFields) {
     Communicator& comm = *ctx.comm;
@@ -203,39 +209,49 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
     // This rank's part of the file.
     const auto readStart = Clock::now();
     std::optional<std::pair<std::uint64_t, std::uint64_t>> seriesParts;
+    // Each rank reads whole pieces or partitions (ids: the piece above kPieceIdShift), not a run
+    // of cells whose points the neighbouring runs share.
+    bool byPieces = false;
     MeshPart part = agreeOn(comm, [&] {
         const MeshFormat format = sniffMeshFormat(file);
         ReadOptions read;
         read.maxMemoryBytes = ctx.maxMemoryBytes;
         if (format == MeshFormat::Pvtu) {
             // A rank reads its run of the pieces when there are as many as ranks.
-            const std::size_t pieces = pvtuPieceCount(file);
-            if (pieces >= std::size_t(ranks)) {
+            const std::size_t pieceCount = pvtuPieceCount(file);
+            if (pieceCount >= std::size_t(ranks)) {
                 ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
-                         " ranks reads about " + std::to_string(pieces / ranks) + " of its " +
-                         std::to_string(pieces) + " pieces");
-                const auto [first, end] = rankRun(pieces, rank, ranks);
+                         " ranks reads about " + std::to_string(pieceCount / ranks) + " of its " +
+                         std::to_string(pieceCount) + " pieces");
+                const auto [first, end] = rankRun(pieceCount, rank, ranks);
+                byPieces = true;
                 return readPvtuPart(file, first, end, read);
             }
-            ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(pieces) +
-                     " pieces for " + std::to_string(ranks) + " ranks");
+            ctx.step("reading " + file + " whole on every rank: it has " +
+                     std::to_string(pieceCount) + " pieces for " + std::to_string(ranks) +
+                     " ranks");
         }
-        if (format == MeshFormat::VtkHdf || format == MeshFormat::Exodus) {
-            // Stored in parts (a VTKHDF file's partitions, an Exodus file's cells): a rank
-            // reads its run of them when there are as many as ranks, the file opened once.
+        if (format == MeshFormat::VtkHdf || format == MeshFormat::Exodus ||
+            format == MeshFormat::Pvd) {
+            // Stored in parts (a VTKHDF file's partitions, an Exodus file's cells, the pieces of
+            // a collection's .pvtu step): a rank reads its run of them when there are as many as
+            // ranks, the file opened once.
             const std::unique_ptr<MeshSeries> series = openSeries(file, ctx);
             const std::size_t step = steps.pick(*series);
             const std::uint64_t parts = series->partCount(step);
-            const char* unit = format == MeshFormat::VtkHdf ? "partitions" : "cells";
+            const char* unit = partUnit(format);
             if (parts >= std::uint64_t(ranks)) {
                 ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
                          " ranks reads about " + std::to_string(parts / ranks) + " of its " +
                          std::to_string(parts) + " " + unit);
                 seriesParts = rankRun(parts, rank, ranks);
+                byPieces = format != MeshFormat::Exodus;
                 return series->readPart(step, seriesParts->first, seriesParts->second);
             }
-            ctx.step("reading " + file + " whole on every rank: it has " + std::to_string(parts) +
-                     " " + unit + " for " + std::to_string(ranks) + " ranks");
+            ctx.step("reading " + file + " whole on every rank: " +
+                     (parts ? "it has " + std::to_string(parts) + " " + unit + " for " +
+                                  std::to_string(ranks) + " ranks"
+                            : std::string("its time steps are not stored in pieces (.pvtu)")));
         }
         if (format == MeshFormat::Native && !steps.time && !steps.index) {
             const std::uint64_t n = readNativeSummary(file, false).cellCount;
@@ -251,6 +267,7 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
     });
     const double readSeconds = std::chrono::duration<double>(Clock::now() - readStart).count();
     const std::uint64_t pointIdEnd = part.pointIds.empty() ? 0 : part.pointIds.back() + 1;
+    const std::uint64_t pieceVertexCount = part.pointIds.size();
     DistributedSource out;
     out.seriesParts = seriesParts;
     out.source.rankReadSeconds = comm.allGatherValues(readSeconds);
@@ -259,9 +276,10 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
     // The checks, over every rank's share.
     RenderSource& src = out.source;
     src.path = file;
-    std::uint64_t counts[2] = {share.mesh.cellCount(), pointIdEnd};
-    comm.allReduce(std::span<std::uint64_t>(counts, 1), ReduceOp::Sum);
-    comm.allReduce(std::span<std::uint64_t>(counts + 1, 1), ReduceOp::Max);
+    // The whole file's points: every rank's pieces' points, or the highest id of a run's.
+    std::uint64_t counts[2] = {share.mesh.cellCount(), byPieces ? pieceVertexCount : pointIdEnd};
+    comm.allReduce(std::span<std::uint64_t>(counts, byPieces ? 2 : 1), ReduceOp::Sum);
+    if (!byPieces) comm.allReduce(std::span<std::uint64_t>(counts + 1, 1), ReduceOp::Max);
     src.summary.cells = counts[0];
     src.summary.points = counts[1];
     src.summary.fieldName = share.field.name;

@@ -55,19 +55,33 @@ def main():
         if not ok:
             failures.append(what)
 
+    def mesh_counts(stats):
+        try:
+            with open(stats) as f:
+                mesh = json.load(f)["mesh"]
+            return mesh["points"], mesh["cells"]
+        except (OSError, ValueError, KeyError):
+            return None
+
     def ranks_match_one(name, tag, base, counts, says=None):
         """`base` (`uvr render` without -o) in one process, then on each rank count: every run
-        succeeds (its stderr holding says(n) when given) and gives one process's picture."""
+        succeeds (its stderr holding says(n) when given), gives one process's picture and reports
+        the whole file's points and cells as one process does."""
         one = os.path.join(args.out, f"{tag}_1.png")
-        r = run(base + ([] if "-q" in base else ["-q"]) + ["-o", one])
+        stats_one = os.path.join(args.out, f"{tag}_1.json")
+        r = run(base + ([] if "-q" in base else ["-q"]) + ["-o", one, "--stats", stats_one])
         check(r.returncode == 0, f"{name}: one process ({r.stderr.strip()})")
         for n in counts:
             many = os.path.join(args.out, f"{tag}_{n}.png")
-            r = run(mpirun(n) + base + ["-o", many])
+            stats = os.path.join(args.out, f"{tag}_{n}.json")
+            r = run(mpirun(n) + base + ["-o", many, "--stats", stats])
             check(r.returncode == 0 and (says is None or says(n) in r.stderr),
                   f"{name}: {n} ranks read their parts ({r.stderr[-300:]})")
             c = run([args.uvr, "compare", one, many, "--min-ssim", "0.999", "--max-diff", "2"])
             check(c.returncode == 0, f"{name}: {n} ranks = one process ({c.stdout.strip()[-200:]})")
+            check(mesh_counts(stats) is not None and mesh_counts(stats) == mesh_counts(stats_one),
+                  f"{name}: {n} ranks report the points and cells one process does "
+                  f"({mesh_counts(stats)} against {mesh_counts(stats_one)})")
 
     # The same picture as one process.
     for mesh, view in MESHES:
@@ -140,6 +154,21 @@ with open({pvtu!r}, "w") as f:
         base = [args.uvr, "render", pvtu, "--device", "cpu", "--size", SIZE, "--no-cache", "-q",
                 "--tf", "viridis", "--opacity", "0:0,0.5:0.3,1:0.8", "--azimuth", "35"]
         ranks_match_one("fin.pvtu", "fin", base, ranks_list)
+        # A collection listing that .pvtu at three times (a parallel run's output): animate
+        # reads each step by its pieces.
+        pvd = os.path.join(args.out, "fin_run.pvd")
+        with open(pvd, "w") as f:
+            f.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1"><Collection>' +
+                    "".join(f'<DataSet timestep="{t}" file="fin.pvtu"/>' for t in range(3)) +
+                    "</Collection></VTKFile>\n")
+        folder = os.path.join(args.out, "pvd_anim")
+        shutil.rmtree(folder, ignore_errors=True)
+        r = run(mpirun(2) + [args.uvr, "animate", pvd, "-o", folder, "--device", "cpu",
+                             "--size", SIZE, "--tf", "viridis"])
+        check(r.returncode == 0 and len(os.listdir(folder)) == 3 and
+              "each of 2 ranks reads its run of the 4 pieces of each step" in r.stderr and
+              r.stderr.count("values refreshed") == 2,
+              f"animate a .pvd of .pvtu steps on 2 ranks: read by pieces ({r.stderr[-300:]})")
 
     # A VTKHDF file of 4 partitions (VTK's cell extraction, written as Kitware's VTKHDF 1.0
     # layout with h5py): each rank reads its run of the partitions.

@@ -8,9 +8,11 @@
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
+#include "uvr/dist/decompose.h"
 #include "uvr/dist/in_process_communicator.h"
 #include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/io/native.h"
 #include "uvr/render/image_metrics.h"
 
 #ifdef UVR_HAVE_NETCDF
@@ -136,21 +138,10 @@ TEST(SeriesPlayer, TheDefaultFieldOfTheFirstStepStaysAtEveryStep) {
     expectSameImage(player.renderer().render(s), freshFrame(stepMesh(1.f), s, o), "step 1");
 }
 
-#ifdef UVR_HAVE_NETCDF
-TEST(SeriesPlayer, DataParallelASeriesStoredInPartsIsReadByPartsAsOneProcessShowsIt) {
-    // An Exodus II series (its cells are its parts) of one geometry: on 3 in-process ranks each
-    // reads only its run of cells of each step, and every step's frame and values are one
-    // process's.
-    if (!exodusSupported()) GTEST_SKIP() << "built without netCDF";
-    const Mesh grid = stepMesh(0.f, 8);
-    const testing::ExoFileSpec spec =
-        testing::hexSeriesSpec(grid, 3, [&](std::size_t step, std::size_t n) {
-            const Vec3f p = grid.points[n];
-            return double(std::sin(3.f * p.x + float(step)) * p.y + p.z);
-        });
-    const std::string file = testing::scratchDir() + "/grid.exo";
-    testing::writeExodusFile(file, spec);
-
+/// A data-parallel series read by parts: on 3 in-process ranks each reads only its run of each
+/// step's parts of `file` (three steps of one geometry of `cells` cells), no step is prepared
+/// anew, and every step's frame and the value range over the ranks are one process's.
+void expectPlayedByPartsAsOneProcess(const std::string& file, std::uint64_t cells) {
     RendererOptions o;
     o.device = Device::Cpu;
     SeriesPlayer one(openMeshSeries(file), parseFieldSpec(""), o);
@@ -166,14 +157,14 @@ TEST(SeriesPlayer, DataParallelASeriesStoredInPartsIsReadByPartsAsOneProcessShow
             {*std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())});
     }
     std::vector<Image> got;
-    std::vector<std::uint64_t> cells(3), rebuilt(3);
+    std::vector<std::uint64_t> rankCells(3), rebuilt(3);
     std::vector<std::pair<float, float>> rankRanges(3);
     InProcessGroup::run(3, [&](Communicator& comm) {
         RendererOptions ro = o;
         ro.communicator = &comm;
         SeriesPlayer player(openMeshSeries(file), parseFieldSpec(""), ro);
         ASSERT_TRUE(player.byParts());
-        cells[comm.rank()] = player.mesh().cellCount();
+        rankCells[comm.rank()] = player.mesh().cellCount();
         for (std::size_t i = 0; i < 3; ++i) {
             if (i)
                 rebuilt[comm.rank()] +=
@@ -187,9 +178,9 @@ TEST(SeriesPlayer, DataParallelASeriesStoredInPartsIsReadByPartsAsOneProcessShow
         comm.allReduce(range, ReduceOp::Min);
         rankRanges[comm.rank()] = {float(range[0]), float(-range[1])};
     });
-    // Each rank read a third of the cells, and no step was prepared anew.
-    EXPECT_EQ(cells[0] + cells[1] + cells[2], grid.cellCount());
-    for (std::uint64_t c : cells) EXPECT_LT(c, grid.cellCount() / 2);
+    // Each rank read about a third of the cells, and no step was prepared anew.
+    EXPECT_EQ(rankCells[0] + rankCells[1] + rankCells[2], cells);
+    for (std::uint64_t c : rankCells) EXPECT_LT(c, cells / 2);
     EXPECT_EQ(rebuilt, std::vector<std::uint64_t>(3, 0));
     ASSERT_EQ(got.size(), 3u);
     for (std::size_t i = 0; i < 3; ++i) {
@@ -203,7 +194,52 @@ TEST(SeriesPlayer, DataParallelASeriesStoredInPartsIsReadByPartsAsOneProcessShow
         EXPECT_EQ(hi, ranges[2].second);
     }
 }
+
+#ifdef UVR_HAVE_NETCDF
+TEST(SeriesPlayer, DataParallelAnExodusSeriesIsReadByItsCellsAsOneProcessShowsIt) {
+    // An Exodus II series: its cells are its parts.
+    if (!exodusSupported()) GTEST_SKIP() << "built without netCDF";
+    const Mesh grid = stepMesh(0.f, 8);
+    const std::string file = testing::scratchDir() + "/grid.exo";
+    testing::writeExodusFile(file,
+                             testing::hexSeriesSpec(grid, 3, [&](std::size_t step, std::size_t n) {
+                                 const Vec3f p = grid.points[n];
+                                 return double(std::sin(3.f * p.x + float(step)) * p.y + p.z);
+                             }));
+    expectPlayedByPartsAsOneProcess(file, grid.cellCount());
+}
 #endif
+
+TEST(SeriesPlayer, DataParallelACollectionOfPvtuStepsIsReadByPiecesAsOneProcessShowsIt) {
+    // A parallel simulation's output: a .pvd listing one .pvtu a step, each of 6 pieces.
+    const std::string dir = testing::scratchDir();
+    std::string pvd =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
+        "<Collection>\n";
+    std::uint64_t cells = 0;
+    for (int k = 0; k < 3; ++k) {
+        const Mesh step = stepMesh(float(k), 8);
+        cells = step.cellCount();
+        std::string pvtu =
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\">\n"
+            "<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData><PDataArray type=\"Float32\" "
+            "Name=\"f\"/></PPointData>\n<PPoints><PDataArray type=\"Float32\" "
+            "NumberOfComponents=\"3\"/></PPoints>\n";
+        for (int piece = 0; piece < 6; ++piece) {
+            const auto [first, end] = rankRun(step.cellCount(), piece, 6);
+            const std::string name = "s" + std::to_string(k) + "_" + std::to_string(piece) + ".vtu";
+            writeMesh(meshPart(step, first, end).mesh, dir + "/" + name);
+            pvtu += "<Piece Source=\"" + name + "\"/>\n";
+        }
+        const std::string name = "s" + std::to_string(k) + ".pvtu";
+        testing::writeFile(dir + "/" + name, pvtu + "</PUnstructuredGrid>\n</VTKFile>\n");
+        pvd += "<DataSet timestep=\"" + std::to_string(k) + "\" file=\"" + name + "\"/>\n";
+    }
+    const std::string file =
+        testing::writeFile(dir + "/run.pvd", pvd + "</Collection>\n</VTKFile>\n");
+    EXPECT_EQ(openMeshSeries(file)->partCount(1), 6u);
+    expectPlayedByPartsAsOneProcess(file, cells);
+}
 
 }  // namespace
 }  // namespace uvr

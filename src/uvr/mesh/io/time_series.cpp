@@ -19,6 +19,7 @@
 #include "uvr/mesh/io/mesh_reader.h"
 #include "uvr/mesh/io/vtk_number.h"
 #include "uvr/mesh/io/vtkhdf.h"
+#include "uvr/mesh/io/vtu.h"
 
 namespace uvr {
 
@@ -143,6 +144,21 @@ public:
                             "part " + std::to_string(k) + " ('" + step.files[k] + "')");
         }
         return mesh;
+    }
+
+    /// A step that is one .pvtu (a parallel simulation's output, a .pvd listing one per time) is
+    /// stored in its pieces; a step of other files is read whole.
+    std::uint64_t partCount(std::size_t i) const override {
+        checkStep(i);
+        const FileStep& step = steps_[i];
+        if (step.files.size() != 1 || sniffMeshFormat(step.files[0]) != MeshFormat::Pvtu) return 0;
+        return pvtuPieceCount(step.files[0]);
+    }
+
+    MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end) override {
+        if (partCount(i) == 0) return MeshSeries::readPart(i, first, end);  // refused there
+        const StepReadGuard guard(path(), steps_[i].where);
+        return readPvtuPart(steps_[i].files[0], first, end, options());
     }
 
 private:

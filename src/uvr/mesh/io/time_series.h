@@ -46,8 +46,8 @@ public:
                                                                        const MeshView& geometry);
 
     /// How many parts step i is stored in that readPart reads runs of (a data-parallel rank's
-    /// share: a VTKHDF file's partitions, an Exodus II file's cells); 0 for a format read only
-    /// whole.
+    /// share: a VTKHDF file's partitions, an Exodus II file's cells, the pieces of a step that is
+    /// one .pvtu); 0 for a format read only whole.
     virtual std::uint64_t partCount(std::size_t i) const { return (checkStep(i), 0); }
     /// The parts [first, end) of step i and what they use, with the ids of their points and
     /// cells in the whole step (MeshPart). Throws Error(Argument) for a range beyond
