@@ -164,8 +164,8 @@ void addAnimateCommand(CLI::App& app, Context& ctx) {
         if (player.byParts()) {  // each rank holds its part: the checks over every rank's
             ctx.step("read time step " + std::to_string(chosen[0]) + " by parts: each of " +
                      std::to_string(ctx.comm->size()) + " ranks reads its run of the " +
-                     std::to_string(series->partCount(chosen[0])) + " " +
-                     partUnit(sniffMeshFormat(*file)) + " of each step");
+                     std::to_string(series->partCount(chosen[0])) + " " + series->partName() +
+                     " of each step");
             bounds = checkShares(player.mesh(), series->stepSource(chosen[0]), ctx).bounds;
         } else {
             ValidationReport report;

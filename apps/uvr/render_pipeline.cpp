@@ -196,12 +196,6 @@ RenderResult renderAndWrite(Mesh&& mesh, const std::string& source, const Render
     return renderPreparedAndWrite(*renderer, src, settings, out, ctx);
 }
 
-const char* partUnit(MeshFormat format) {
-    return format == MeshFormat::VtkHdf   ? "partitions"
-           : format == MeshFormat::Exodus ? "cells"
-                                          : "pieces";
-}
-
 DistributedSource readDistributed(const std::string& file, const std::string& fieldSpec,
                                   const StepFlags& steps, const Context& ctx, bool keepFields) {
     Communicator& comm = *ctx.comm;
@@ -213,7 +207,8 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
     // of cells whose points the neighbouring runs share.
     bool byPieces = false;
     MeshPart part = agreeOn(comm, [&] {
-        const MeshFormat format = sniffMeshFormat(file);
+        // A numbered series' pattern names no one file: its steps are read as a .pvd's.
+        const MeshFormat format = isSeriesPattern(file) ? MeshFormat::Pvd : sniffMeshFormat(file);
         ReadOptions read;
         read.maxMemoryBytes = ctx.maxMemoryBytes;
         if (format == MeshFormat::Pvtu) {
@@ -239,7 +234,7 @@ DistributedSource readDistributed(const std::string& file, const std::string& fi
             const std::unique_ptr<MeshSeries> series = openSeries(file, ctx);
             const std::size_t step = steps.pick(*series);
             const std::uint64_t parts = series->partCount(step);
-            const char* unit = partUnit(format);
+            const char* unit = series->partName();
             if (parts >= std::uint64_t(ranks)) {
                 ctx.step("reading " + file + ": each of " + std::to_string(ranks) +
                          " ranks reads about " + std::to_string(parts / ranks) + " of its " +

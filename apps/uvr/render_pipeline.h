@@ -92,10 +92,6 @@ struct DistributedSource {
     std::optional<std::pair<std::uint64_t, std::uint64_t>> seriesParts;
 };
 
-/// What a series' parts (MeshSeries::partCount) are called in the log: a VTKHDF file's
-/// partitions, an Exodus II file's cells, a .pvtu step's pieces.
-const char* partUnit(MeshFormat format);
-
 /// Reads this rank's part of a file (a .uvrm only where the part lies, a .pvtu by runs of its
 /// pieces when it has as many as ranks, any other file whole, keeping the part), agrees with
 /// every rank on the field `fieldSpec` names, and reduces the counts, bounds and checks over the

@@ -169,6 +169,13 @@ with open({pvtu!r}, "w") as f:
               "each of 2 ranks reads its run of the 4 pieces of each step" in r.stderr and
               r.stderr.count("values refreshed") == 2,
               f"animate a .pvd of .pvtu steps on 2 ranks: read by pieces ({r.stderr[-300:]})")
+        # The same steps as a numbered series (a pattern, not a file): render reads by pieces.
+        for t in range(3):
+            shutil.copyfile(pvtu, os.path.join(args.out, f"fin_step_{t}.pvtu"))
+        base = [args.uvr, "render", os.path.join(args.out, "fin_step_*.pvtu"), "--device", "cpu",
+                "--size", SIZE, "--no-cache", "--tf", "viridis", "--step-index", "1"]
+        ranks_match_one("fin_step_*.pvtu", "finstep", base, [2],
+                        lambda n: "ranks reads about 2 of its 4 pieces")
 
     # A VTKHDF file of 4 partitions (VTK's cell extraction, written as Kitware's VTKHDF 1.0
     # layout with h5py): each rank reads its run of the partitions.

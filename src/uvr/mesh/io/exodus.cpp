@@ -337,6 +337,7 @@ public:
     }
 
     /// Cells the mesh of a step holds (the kept blocks' elements): a rank's part is a run of them.
+    const char* partName() const override { return "cells"; }
     std::uint64_t partCount(std::size_t i) const override {
         checkStep(i);
         return keptCells_;

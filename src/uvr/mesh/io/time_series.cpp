@@ -148,6 +148,7 @@ public:
 
     /// A step that is one .pvtu (a parallel simulation's output, a .pvd listing one per time) is
     /// stored in its pieces; a step of other files is read whole.
+    const char* partName() const override { return "pieces"; }
     std::uint64_t partCount(std::size_t i) const override {
         checkStep(i);
         const FileStep& step = steps_[i];

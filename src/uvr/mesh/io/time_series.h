@@ -49,6 +49,8 @@ public:
     /// share: a VTKHDF file's partitions, an Exodus II file's cells, the pieces of a step that is
     /// one .pvtu); 0 for a format read only whole.
     virtual std::uint64_t partCount(std::size_t i) const { return (checkStep(i), 0); }
+    /// What those parts are, for messages: "partitions", "cells", "pieces".
+    virtual const char* partName() const { return "parts"; }
     /// The parts [first, end) of step i and what they use, with the ids of their points and
     /// cells in the whole step (MeshPart). Throws Error(Argument) for a range beyond
     /// partCount(i), Error(Unsupported) for a format read only whole.

@@ -523,6 +523,7 @@ public:
     }
 
     /// Partitions of step i.
+    const char* partName() const override { return "partitions"; }
     std::uint64_t partCount(std::size_t i) const override {
         checkStep(i);
         return steps_[i].parts;
