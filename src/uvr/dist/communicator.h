@@ -103,6 +103,13 @@ auto agreeOn(Communicator& comm, F&& work) -> std::invoke_result_t<F&&>;
 template <TriviallyCopyable T>
 std::vector<T> fromBytes(std::span<const std::byte> bytes);
 
+/// Appends n values of a trivially copyable T to a message as bytes (fromBytes reads them).
+template <TriviallyCopyable T>
+void appendBytes(std::vector<std::byte>& out, const T* values, std::size_t n) {
+    const auto* bytes = reinterpret_cast<const std::byte*>(values);
+    out.insert(out.end(), bytes, bytes + n * sizeof(T));
+}
+
 // Implementation.
 
 namespace detail {

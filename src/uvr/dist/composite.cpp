@@ -20,13 +20,6 @@ std::pair<int, int> compositeBand(int height, int rank, int ranks) {
 
 namespace {
 
-/// Appends n values of a trivially copyable type as bytes.
-template <class T>
-void appendBytes(std::vector<std::byte>& out, const T* values, std::size_t n) {
-    const auto* bytes = reinterpret_cast<const std::byte*>(values);
-    out.insert(out.end(), bytes, bytes + n * sizeof(T));
-}
-
 /// The pixels [x0, x1) x [y0, y1) of an image that hold anything: some opacity or some samples
 /// (empty, x0 = x1, when none does). Outside it a rank's image is transparent and sampled
 /// nowhere, so blending it there changes nothing.

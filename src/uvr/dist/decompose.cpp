@@ -18,6 +18,17 @@ std::pair<std::uint64_t, std::uint64_t> rankRun(std::uint64_t parts, int rank, i
             parts * std::uint64_t(rank + 1) / std::uint64_t(ranks)};
 }
 
+std::pair<std::uint64_t, std::uint64_t> rankRunOfStep(const MeshSeries& series, std::size_t step,
+                                                      const Communicator& comm) {
+    const std::uint64_t parts = series.partCount(step), ranks = std::uint64_t(comm.size());
+    if (parts < ranks)
+        throwError(ErrorKind::Unsupported, series.stepSource(step),
+                   "time step " + std::to_string(step) + " is stored in " + std::to_string(parts) +
+                       " parts, fewer than the " + std::to_string(ranks) +
+                       " ranks that read the series' steps by parts");
+    return rankRun(parts, comm.rank(), comm.size());
+}
+
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks) {
     const auto [first, end] = rankRun(mesh.cellCount(), rank, ranks);
     MeshPart part = meshPart(mesh, first, end);
@@ -44,20 +55,24 @@ std::pair<float, float> reduceFiniteRange(Communicator& comm, std::span<const fl
     return {float(r[0]), float(-r[1])};
 }
 
-MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec, bool keepFields) {
+std::vector<FieldInfo> reducedFieldInfos(Communicator& comm, const Mesh& part) {
     // Which fields hold one value over the whole mesh (NaN left out): their finite ranges
-    // reduced over the ranks.
-    std::vector<FieldInfo> infos = fieldInfos(part.mesh);
+    // reduced over the ranks, in one reduction.
+    std::vector<FieldInfo> infos = fieldInfos(part);
     std::vector<double> range(2 * infos.size(), INFINITY);
     for (std::size_t f = 0; f < infos.size(); ++f)
-        for (float v : part.mesh.fields[f].values)
+        for (float v : part.fields[f].values)
             if (std::isfinite(v))
                 range[2 * f] = std::min(range[2 * f], double(v)),
                           range[2 * f + 1] = std::min(range[2 * f + 1], -double(v));
     comm.allReduce(range, ReduceOp::Min);
     for (std::size_t f = 0; f < infos.size(); ++f)
         infos[f].constant = !(range[2 * f] < -range[2 * f + 1]);
-    FieldChoice choice = resolveField(infos, spec);
+    return infos;
+}
+
+MeshShare shareOfPart(Communicator& comm, MeshPart part, const FieldSpec& spec, bool keepFields) {
+    FieldChoice choice = resolveField(reducedFieldInfos(comm, part.mesh), spec);
     FieldSpec pinned = spec;
     pinned.name = part.mesh.fields[choice.index].name;
     pinned.association = part.mesh.fields[choice.index].association;
@@ -192,14 +207,6 @@ bool splitNode(Communicator& comm, std::vector<TopNode>& nodes, int index,
     return true;
 }
 
-/// Appends a trivially copyable value's bytes.
-template <class T>
-void put(std::vector<std::byte>& out, const T& v) {
-    const std::size_t at = out.size();
-    out.resize(at + sizeof(T));
-    std::memcpy(out.data() + at, &v, sizeof(T));
-}
-
 /// Reads a trivially copyable value at `at`, moving past it.
 template <class T>
 T take(const std::vector<std::byte>& in, std::size_t& at) {
@@ -216,14 +223,6 @@ struct CarriedPoint {
     Vec3f p;
     float value;
 };
-
-/// Appends a vector's bytes.
-template <class T>
-void putAll(std::vector<std::byte>& out, const std::vector<T>& v) {
-    const std::size_t at = out.size();
-    out.resize(at + v.size() * sizeof(T));
-    if (!v.empty()) std::memcpy(out.data() + at, v.data(), v.size() * sizeof(T));
-}
 
 /// Reads `count` values at `at` into v, moving past them.
 template <class T>
@@ -251,15 +250,14 @@ struct CellMessage {
         out.reserve(3 * sizeof(std::uint64_t) + points.size() * sizeof(CarriedPoint) +
                     cellIds.size() * (sizeof(std::uint64_t) + 2 + sizeof(float)) +
                     corners.size() * sizeof(std::uint32_t));
-        put(out, std::uint64_t(points.size()));
-        put(out, std::uint64_t(cellIds.size()));
-        put(out, std::uint64_t(corners.size()));
-        putAll(out, points);
-        putAll(out, cellIds);
-        putAll(out, types);
-        putAll(out, counts);
-        putAll(out, corners);
-        putAll(out, values);
+        const std::uint64_t header[3] = {points.size(), cellIds.size(), corners.size()};
+        appendBytes(out, header, 3);
+        appendBytes(out, points.data(), points.size());
+        appendBytes(out, cellIds.data(), cellIds.size());
+        appendBytes(out, types.data(), types.size());
+        appendBytes(out, counts.data(), counts.size());
+        appendBytes(out, corners.data(), corners.size());
+        appendBytes(out, values.data(), values.size());
         return out;
     }
 

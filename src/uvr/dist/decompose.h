@@ -20,6 +20,7 @@
 #include "uvr/dist/communicator.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/io/native.h"
+#include "uvr/mesh/io/time_series.h"
 #include "uvr/mesh/mesh.h"
 #include "uvr/prepare/prepared_mesh.h"
 
@@ -39,6 +40,11 @@ struct MeshShare {
 /// of `ranks` reads: [rank parts / ranks, (rank + 1) parts / ranks), as even as they allow.
 std::pair<std::uint64_t, std::uint64_t> rankRun(std::uint64_t parts, int rank, int ranks);
 
+/// This rank's run of time step `step`'s parts of a series read by parts (MeshSeries::partCount,
+/// rankRun); Error(Unsupported) naming the step when it is stored in fewer parts than ranks.
+std::pair<std::uint64_t, std::uint64_t> rankRunOfStep(const MeshSeries& series, std::size_t step,
+                                                      const Communicator& comm);
+
 /// Share `rank` of `ranks` of a mesh held whole: its cells rankRun(cells, rank, ranks).
 MeshShare shareOfMesh(const MeshView& mesh, const ScalarField& field, int rank, int ranks);
 
@@ -48,6 +54,11 @@ std::pair<float, float> reduceFiniteRange(Communicator& comm, std::span<const fl
 
 /// The smallest box holding every rank's box (collective; an empty box adds nothing).
 Bounds3f reduceBounds(Communicator& comm, const Bounds3f& box);
+
+/// fieldInfos of this rank's part with each field's constancy over every rank's part
+/// (collective: one value when the finite values of every rank, NaN left out, are one value),
+/// so every rank resolves the default field alike.
+std::vector<FieldInfo> reducedFieldInfos(Communicator& comm, const Mesh& part);
 
 /// A rank's share from the part of a file it read (readNativePart, meshPart) and the field
 /// `spec` names (collective: the default field passes over fields constant over the whole mesh,

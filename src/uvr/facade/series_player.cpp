@@ -43,7 +43,7 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
     if (const Communicator* comm = options_.communicator; comm && comm->size() > 1) {
         std::uint64_t parts = 0;
         agreed([&] { parts = series_->partCount(first); });
-        if (parts >= std::uint64_t(comm->size())) parts_ = partsOf(first);
+        if (parts >= std::uint64_t(comm->size())) parts_ = rankRunOfStep(*series_, first, *comm);
     }
     if (parts_) {
         agreed([&] { part_ = series_->readPart(first, parts_->first, parts_->second); });
@@ -60,17 +60,6 @@ SeriesPlayer::SeriesPlayer(std::unique_ptr<MeshSeries> series, FieldSpec spec,
     field_.choice = choice;
     renderer_ = std::make_unique<Renderer>(mesh_, field_, options_, progress_);
     step_ = first;
-}
-
-std::pair<std::uint64_t, std::uint64_t> SeriesPlayer::partsOf(std::size_t i) const {
-    const Communicator& comm = *options_.communicator;
-    const std::uint64_t parts = series_->partCount(i), ranks = std::uint64_t(comm.size());
-    if (parts < ranks)
-        throwError(ErrorKind::Unsupported, series_->stepSource(i),
-                   "time step " + std::to_string(i) + " is stored in " + std::to_string(parts) +
-                       " parts, fewer than the " + std::to_string(ranks) +
-                       " ranks that read the series' steps by parts");
-    return rankRun(parts, comm.rank(), comm.size());
 }
 
 std::unique_ptr<Renderer> SeriesPlayer::partRenderer(const MeshPart& part) {
@@ -98,7 +87,7 @@ SeriesPlayer::Read SeriesPlayer::readStep(std::size_t i) {
     const auto start = std::chrono::steady_clock::now();
     Read r;
     if (parts_) {
-        const auto [first, end] = partsOf(i);
+        const auto [first, end] = rankRunOfStep(*series_, i, *options_.communicator);
         MeshPart part = series_->readPart(i, first, end);
         if (samePartGeometry(part, part_.mesh, part_.pointIds, part_.cellIds))
             r.fields = std::move(part.mesh.fields);

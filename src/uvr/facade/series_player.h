@@ -79,8 +79,6 @@ public:
 private:
     struct Read;
     Read readStep(std::size_t i);
-    /// This rank's parts of step i (byParts): its run of the step's partCount.
-    std::pair<std::uint64_t, std::uint64_t> partsOf(std::size_t i) const;
     /// A renderer for this rank's part (byParts; collective): its share moved to the pieces,
     /// spec_ pinned to the field the ranks chose; sets field_.
     std::unique_ptr<Renderer> partRenderer(const MeshPart& part);

@@ -207,9 +207,7 @@ FieldEntry ViewServer::Impl::field(const std::string& spec, std::size_t step,
             const auto start = Clock::now();
             std::optional<std::vector<Field>> stepFields;
             if (scene.part) {  // this rank's run of the step's parts
-                const Communicator& comm = *ranks();
-                const auto [first, end] =
-                    rankRun(scene.series->partCount(step), comm.rank(), comm.size());
+                const auto [first, end] = rankRunOfStep(*scene.series, step, *ranks());
                 MeshPart part = scene.series->readPart(step, first, end);
                 if (samePartGeometry(part, *scene.mesh, scene.part->pointIds, scene.part->cellIds))
                     stepFields = std::move(part.mesh.fields);
@@ -667,19 +665,14 @@ ViewServer::ViewServer(ViewScene scene, ServerOptions options, LogFn log)
         firstValues = preparedValues(d.scene.renderer->prepared());
     } else {
         const Mesh& mesh = *d.scene.mesh;
-        d.fieldInfos = uvr::fieldInfos(mesh);
-        // The ranks' parts: which fields hold one value over the whole mesh (every component's
-        // values, NaN left out, as shareOfPart decides) and the listed ranges, reduced.
+        // The ranks' parts: which fields hold one value over the whole mesh (as shareOfPart
+        // decides) and the listed ranges, reduced.
         Communicator* comm = d.scene.part ? d.ranks() : nullptr;
+        d.fieldInfos = comm ? reducedFieldInfos(*comm, mesh) : uvr::fieldInfos(mesh);
         std::vector<std::pair<float, float>> ranges;
-        for (std::size_t i = 0; i < mesh.fields.size(); ++i) {
-            const Field& f = mesh.fields[i];
-            ranges.push_back(comm ? reduceFiniteRange(*comm, scalarFieldOf(mesh, f).values)
-                                  : finiteRange(scalarFieldOf(mesh, f).values));
-            if (comm) {
-                const auto raw = reduceFiniteRange(*comm, f.values);
-                d.fieldInfos[i].constant = !(raw.first < raw.second);
-            }
+        for (const Field& f : mesh.fields) {
+            const std::vector<float> values = scalarFieldOf(mesh, f).values;
+            ranges.push_back(comm ? reduceFiniteRange(*comm, values) : finiteRange(values));
         }
         const std::optional<std::size_t> def = defaultFieldIndex(d.fieldInfos);
         for (std::size_t i = 0; i < mesh.fields.size(); ++i) {

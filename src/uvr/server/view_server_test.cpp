@@ -330,15 +330,8 @@ TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
         scene.part =
             ViewScene::Part{share.pointIds, share.cellIds, whole->pointCount(), n, std::nullopt};
         scene.mesh = std::make_shared<Mesh>(std::move(share.mesh));
-        scene.rendererOptions.device = Device::Cpu;
-        scene.rendererOptions.leafCells = 64;
+        useTestFrames(scene);
         scene.rendererOptions.communicator = &comm;
-        ViewState& s = scene.initial;
-        s.camera = resetCamera(scene.bounds, 64.f / 48.f);
-        s.tf = transferFunctionPreset("viridis");
-        s.range = {-3.f, 3.f};
-        s.width = 64;
-        s.height = 48;
         ServerOptions o;
         o.port = 0;
         ViewServer server(std::move(scene), o);
