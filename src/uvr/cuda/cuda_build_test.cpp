@@ -15,6 +15,7 @@
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/facade/renderer.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/render/frame_setup.h"
 #include "uvr/render/image_metrics.h"
@@ -170,6 +171,35 @@ TEST(CudaKd, ASubtreeBelowALargerTreesNodeIsTheCpuBuilds) {
     }
 }
 
+TEST(CudaKd, TheBuildHoldsTheBoxesAndAboutTwentyBytesPerListedCell) {
+    UVR_REQUIRE_GPU();
+    // The bound of kd_build.cu: the boxes (24 bytes a cell) and the level's list (4 bytes a
+    // listed cell) throughout, and at most 16 more a listed cell (the sort's keys, or the side
+    // scans and the next list); or, while the boxes are made, the cells as uploaded. A billion
+    // tetrahedra must build well inside an 80 GB card. The build of before held 48 bytes a
+    // listed cell besides the boxes.
+    const TetMesh mesh = proceduralTets(2000000);
+    const std::uint64_t n = mesh.cellCount();
+    KdBuildOptions o;
+    o.leafCells = 4096;
+    o.splitter = buildKdTreeCuda;
+    resetCudaMemoryPeak();
+    const std::uint64_t before = cudaMemoryUse().bytes;
+    const KdPartitions kd = buildKdPartitions(mesh, o);
+    const std::uint64_t peak = cudaMemoryUse().peakBytes - before;
+    EXPECT_EQ(cudaMemoryUse().bytes, before);      // all of it given back
+    const std::uint64_t listed = kd.cells.size();  // the last level's, the most of any
+    ASSERT_GE(listed, n);
+    const std::uint64_t uploads = 24 * n + 4 * n + mesh.tets.size() * sizeof(Tet) +
+                                  mesh.points.size() * sizeof(Vec3f) +
+                                  mesh.nativeCorners.size() * sizeof(std::uint32_t);
+    const std::uint64_t bound = std::max(uploads, 24 * n + 20 * listed);
+    EXPECT_LE(peak, bound + bound / 50 + (std::uint64_t(32) << 20))
+        << peak / double(n) << " bytes a cell at the peak, " << listed / double(n)
+        << " listed cells a cell";
+    EXPECT_GT(peak, 24 * n);  // the count sees the build at all
+}
+
 /// Meshes for the face and seed builders: tetrahedra only, mixed native cells, and tetrahedra
 /// with a seam of duplicated points across every other cell (welded faces) and a face shared by
 /// three tetrahedra (left a boundary).
@@ -297,6 +327,77 @@ TEST(CudaKd, PreparedOnTheGpuRendersAsOnTheCpu) {
     const RenderResult a = renderCpu(cpu, s), b = renderCpu(gpu, s);
     EXPECT_GE(compareImages(toRgb8(a.image), toRgb8(b.image)).ssim, 0.999);
     EXPECT_NEAR(double(b.stats.samples), double(a.stats.samples), 1e-3 * a.stats.samples);
+}
+
+/// Holds uvr's device memory to `bytes` while it lives.
+struct CudaMemoryLimit {
+    explicit CudaMemoryLimit(std::uint64_t bytes) { setCudaMemoryLimit(bytes); }
+    ~CudaMemoryLimit() { setCudaMemoryLimit(0); }
+    CudaMemoryLimit(const CudaMemoryLimit&) = delete;
+    CudaMemoryLimit& operator=(const CudaMemoryLimit&) = delete;
+};
+
+TEST(CudaPrepare, WhenTheGpuLacksMemoryTheCpuBuildsTheSameMesh) {
+    UVR_REQUIRE_GPU();
+    const Mesh m = generateMesh([] {
+        ProceduralSpec spec;
+        spec.targetCells = 200000;
+        return spec;
+    }());
+    const ScalarField f = selectScalarField(m, {});
+    RendererOptions options;
+    options.device = Device::Cpu;  // frames on the CPU: only the builders want the GPU
+    options.buildDevice = Device::Cuda;
+    options.leafCells = 4096;
+    PreparedMesh fell;
+    std::vector<std::string> heard;
+    {
+        const CudaMemoryLimit limit(std::uint64_t(1) << 20);  // a card of 1 MiB
+        fell = prepareMesh(m, f, options.prepareOptions(),
+                           ProgressFn([&](const std::string& line) { heard.push_back(line); }));
+    }
+    options.buildDevice = Device::Cpu;
+    const PreparedMesh cpu = prepareMesh(m, f, options.prepareOptions());
+    EXPECT_EQ(fell.builtOnCpuInstead,
+              (std::vector<std::string>{"split", "bvh", "neighbours", "partitions", "seed_grids",
+                                        "macrocells"}));
+    EXPECT_FALSE(fell.builtElsewhere);
+    EXPECT_TRUE(cpu.builtOnCpuInstead.empty());
+    const auto says = [&](const std::string& what) {
+        return std::any_of(heard.begin(), heard.end(), [&](const std::string& line) {
+            return line.find("out of GPU memory allocating") != std::string::npos &&
+                   line.find(what) != std::string::npos;
+        });
+    };
+    EXPECT_TRUE(says("building the partitions on the CPU instead of the GPU"));
+    EXPECT_TRUE(says("building the neighbours on the CPU instead of the GPU"));
+    // The same mesh as the CPU's build, so the same frames.
+    EXPECT_TRUE(testing::sameBytes(cpu.tets.tets, fell.tets.tets));
+    EXPECT_EQ(cpu.neighbors, fell.neighbors);
+    EXPECT_TRUE(sameNodes(cpu.bvh.nodes, fell.bvh.nodes));
+    ASSERT_TRUE(cpu.kd && fell.kd);
+    EXPECT_EQ(cpu.kd->cells, fell.kd->cells);
+    ASSERT_TRUE(cpu.seeds && fell.seeds);
+    EXPECT_EQ(cpu.seeds->seeds, fell.seeds->seeds);
+    ASSERT_TRUE(cpu.macro && fell.macro);
+    EXPECT_TRUE(testing::sameBytes(cpu.macro->cells, fell.macro->cells));
+    RenderSettings s;
+    s.width = 96;
+    s.height = 72;
+    s.tf = transferFunctionPreset("cool-to-warm");
+    for (const RenderMethod method : {RenderMethod::Partitions, RenderMethod::Reference}) {
+        s.method = method;
+        EXPECT_TRUE(
+            testing::sameBytes(renderCpu(cpu, s).image.pixels, renderCpu(fell, s).image.pixels))
+            << methodName(method);
+    }
+    // Without the limit the GPU builds again, and gives back all it took.
+    const std::uint64_t held = cudaMemoryUse().bytes;
+    options.buildDevice = Device::Cuda;
+    const PreparedMesh again = prepareMesh(m, f, options.prepareOptions());
+    EXPECT_TRUE(again.builtOnCpuInstead.empty());
+    EXPECT_TRUE(again.builtElsewhere);
+    EXPECT_EQ(cudaMemoryUse().bytes, held);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cuda_runtime.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,14 @@ void check(cudaError_t status, const char* call, const char* file, int line);
 
 /// Throws Error(Resource) naming what could not be allocated, its size and the free memory.
 [[noreturn]] void outOfMemory(const std::string& what, std::size_t bytes);
+
+/// Counts `bytes` more as held by DeviceArrays, and the peak (cudaMemoryUse); false, counting
+/// nothing, when that would pass setCudaMemoryLimit's limit.
+bool takeDeviceBytes(std::size_t bytes);
+/// Counts `bytes` as no longer held.
+void returnDeviceBytes(std::size_t bytes);
+/// Free device memory in bytes: the card's, or less under setCudaMemoryLimit.
+std::size_t freeDeviceMemory();
 
 /// A device array owned by RAII; upload() allocates and copies, naming `what` on failure.
 template <class T>
@@ -34,10 +43,14 @@ public:
             return;
         }
         release();
-        if (n > 0 && cudaMalloc(reinterpret_cast<void**>(&ptr_), n * sizeof(T)) != cudaSuccess) {
-            cudaGetLastError();  // clear the sticky-free allocation error
-            ptr_ = nullptr;
-            outOfMemory(what, n * sizeof(T));
+        if (n > 0) {
+            if (!takeDeviceBytes(n * sizeof(T))) outOfMemory(what, n * sizeof(T));
+            if (cudaMalloc(reinterpret_cast<void**>(&ptr_), n * sizeof(T)) != cudaSuccess) {
+                cudaGetLastError();  // clear the sticky-free allocation error
+                ptr_ = nullptr;
+                returnDeviceBytes(n * sizeof(T));
+                outOfMemory(what, n * sizeof(T));
+            }
         }
         capacity_ = size_ = n;
     }
@@ -73,7 +86,10 @@ public:
 
 private:
     void release() {
-        if (ptr_) cudaFree(ptr_);
+        if (ptr_) {
+            cudaFree(ptr_);
+            returnDeviceBytes(capacity_ * sizeof(T));
+        }
         ptr_ = nullptr;
         capacity_ = size_ = 0;
     }

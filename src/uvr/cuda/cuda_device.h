@@ -32,4 +32,18 @@ void startCudaWarmUp();
 /// Waits for startCudaWarmUp's thread when one runs (call it before the process exits).
 void finishCudaWarmUp();
 
+/// Device memory held by uvr's arrays in this process (renderers' scenes, builders' scratch).
+struct CudaMemoryUse {
+    std::uint64_t bytes = 0;      ///< held now
+    std::uint64_t peakBytes = 0;  ///< the most held at once since resetCudaMemoryPeak
+};
+/// What uvr's arrays hold on the GPU now and at most (zeros in a build without CUDA).
+CudaMemoryUse cudaMemoryUse();
+/// Starts a new peak from what is held now.
+void resetCudaMemoryPeak();
+/// The most device memory uvr's arrays may hold at once (0: no limit but the card's). An
+/// allocation that would pass it fails as one the card cannot hold does (Error(Resource)), so a
+/// test can see what a smaller card does.
+void setCudaMemoryLimit(std::uint64_t bytes);
+
 }  // namespace uvr

@@ -19,26 +19,6 @@ namespace uvr {
 
 namespace cuda {
 
-void check(cudaError_t status, const char* call, const char* file, int line) {
-    if (status == cudaSuccess) return;
-    if (status == cudaErrorMemoryAllocation) outOfMemory(call, 0);
-    const std::string where =
-        file ? std::string(" at ") + file + ":" + std::to_string(line) : std::string();
-    throw Error(ErrorKind::Internal,
-                std::string("CUDA error in ") + call + where + ": " + cudaGetErrorString(status));
-}
-
-void outOfMemory(const std::string& what, std::size_t bytes) {
-    std::size_t freeBytes = 0, totalBytes = 0;
-    cudaMemGetInfo(&freeBytes, &totalBytes);
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "out of GPU memory allocating %s: need %.2f GiB more, %.2f GiB free of %.2f GiB",
-                  what.c_str(), bytes / 1073741824.0, freeBytes / 1073741824.0,
-                  totalBytes / 1073741824.0);
-    throw Error(ErrorKind::Resource, buf);
-}
-
 namespace {
 
 /// Walk length on the GPU before the BVH takes over.

@@ -30,19 +30,33 @@ __device__ void flushBounds(const Bounds3f& b, std::uint32_t* keys) {
     }
 }
 
+/// The node of the level that element i of the level's cell list belongs to: the s with
+/// first[s] <= i < first[s + 1] (first: the m + 1 node offsets; empty nodes are skipped).
+__device__ std::uint32_t nodeAt(const std::uint64_t* first, std::uint32_t m, std::uint64_t i) {
+    std::uint32_t lo = 0, hi = m;  // first[lo] <= i < first[hi]
+    while (hi - lo > 1) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (first[mid] <= i)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 /// Bounds of each node's cells over one chunk of kBoundsChunk consecutive elements, flushed
 /// whenever the node changes.
 __device__ void chunkBounds(std::uint64_t chunk, const std::uint32_t* cells,
-                            const std::uint32_t* nodeOf, std::uint64_t count, const Bounds3f* boxes,
-                            std::uint32_t* keys) {
+                            const std::uint64_t* first, std::uint32_t m, std::uint64_t count,
+                            const Bounds3f* boxes, std::uint32_t* keys) {
     const std::uint64_t begin = chunk * kBoundsChunk;
     const std::uint64_t end = begin + kBoundsChunk < count ? begin + kBoundsChunk : count;
-    std::uint32_t node = nodeOf[begin];
+    std::uint32_t node = nodeAt(first, m, begin);
     Bounds3f b;
     for (std::uint64_t i = begin; i < end; ++i) {
-        if (nodeOf[i] != node) {
+        if (i >= first[node + 1]) {
             flushBounds(b, keys + 6 * node);
-            node = nodeOf[i];
+            while (i >= first[node + 1]) ++node;
             b = Bounds3f{};
         }
         b.extend(boxes[cells[i]]);
@@ -54,15 +68,15 @@ __device__ void chunkBounds(std::uint64_t chunk, const std::uint32_t* cells,
 struct ChildPlace {
     std::uint64_t belowBegin, aboveBegin;  ///< first element of each child
     std::uint64_t belowBase, aboveBase;    ///< the scans' values at the node's first element
-    std::uint32_t below, above;            ///< the children's indices in the next level
     std::uint32_t split;                   ///< 0: the node became a leaf
 };
 
-/// Exclusive sum of count + 1 flags (the last is 0): scan[count] is the total.
-void exclusiveSum(const std::uint32_t* in, std::uint32_t* out, std::uint64_t count,
-                  DeviceArray<unsigned char>& temp) {
+/// Exclusive sum, in place, of count + 1 flags (the last is 0): data[count] is then the total,
+/// and element i's flag is data[i + 1] - data[i].
+void exclusiveSumInPlace(std::uint32_t* data, std::uint64_t count,
+                         DeviceArray<unsigned char>& temp) {
     withScratch(temp, "the scan's scratch (GPU k-d build)", [&](void* scratch, std::size_t& bytes) {
-        return cub::DeviceScan::ExclusiveSum(scratch, bytes, in, out, count + 1);
+        return cub::DeviceScan::ExclusiveSum(scratch, bytes, data, count + 1);
     });
 }
 
@@ -92,11 +106,16 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
         return tree;
     }
     tree.leafCells.reserve(n + n / 4);
+    // Device memory, c the cells of a level (n and more, cells reaching both sides of a plane
+    // counted twice): the boxes (24 n bytes) and the level's cell list (4 c) throughout; the
+    // sort's keys (16 c) while the medians are found; the side scans (8 c) and the next level's
+    // list (4 c) while the cells move down. The node of an element is found from the level's
+    // offsets (nodeAt), not kept per element. So the peak is about 24 n + 20 c bytes: 46 GB at a
+    // billion tetrahedra (docs/PERFORMANCE.md).
     cuda::DeviceArray<Bounds3f> boxes;
-    cuda::DeviceArray<std::uint32_t> cells, nodeOf, nextCells, nextNodeOf;
+    cuda::DeviceArray<std::uint32_t> cells, nextCells;
     boxes.reserve(n, "the tetrahedron boxes (GPU k-d build)");
     cells.reserve(n, "the cell lists (GPU k-d build)");
-    nodeOf.reserve(n, "the cells' nodes (GPU k-d build)");
     {
         cuda::DeviceArray<Vec3f> points;
         cuda::DeviceArray<Tet> tets;
@@ -109,16 +128,15 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
         view.nativeCorners = nativeCorners.data();
         // Cell boxes, and the first level: every cell in node 0.
         Bounds3f* b = boxes.data();
-        std::uint32_t *c = cells.data(), *o = nodeOf.data();
+        std::uint32_t* c = cells.data();
         cuda::forEachElement("k-d cell boxes", n, [=] __device__(std::uint64_t t) {
             b[t] = view.cellBounds(t);
             c[t] = static_cast<std::uint32_t>(t);
-            o[t] = 0;
         });
         UVR_CUDA_CHECK(cudaDeviceSynchronize());
     }
     cuda::DeviceArray<std::uint64_t> keys[2], begin, counts;
-    cuda::DeviceArray<std::uint32_t> boundKeys, axis, splitting, below, above, belowScan, aboveScan;
+    cuda::DeviceArray<std::uint32_t> boundKeys, axis, splitting, belowScan, aboveScan;
     cuda::DeviceArray<float> planes;
     cuda::DeviceArray<cuda::ChildPlace> places;
     cuda::DeviceArray<unsigned char> temp;
@@ -128,23 +146,21 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
         // A larger tree's node: the cells whose boxes reach its closed region, in id order (as
         // the CPU's build hands it them).
         top.region = root->region, top.depth = root->depth;
-        below.reserve(n + 1, "the cells reaching the subtree (GPU k-d build)");
         belowScan.reserve(n + 1, "the offsets of the cells reaching the subtree (GPU k-d build)");
-        UVR_CUDA_CHECK(cudaMemset(below.data() + n, 0, sizeof(std::uint32_t)));
+        UVR_CUDA_CHECK(cudaMemset(belowScan.data() + n, 0, sizeof(std::uint32_t)));
         const Bounds3f region = top.region;
         const Bounds3f* b = boxes.data();
-        std::uint32_t* reaches = below.data();
+        std::uint32_t* at = belowScan.data();
         cuda::forEachElement("k-d subtree cells", n, [=] __device__(std::uint64_t t) {
             bool in = true;
             for (int a = 0; a < 3; ++a)
                 in = in && b[t].lo[a] <= region.hi[a] && b[t].hi[a] >= region.lo[a];
-            reaches[t] = in;
+            at[t] = in;
         });
-        cuda::exclusiveSum(below.data(), belowScan.data(), n, temp);
-        const std::uint32_t* at = belowScan.data();
+        cuda::exclusiveSumInPlace(at, n, temp);
         std::uint32_t* c = cells.data();
         cuda::forEachElement("k-d subtree cell list", n, [=] __device__(std::uint64_t t) {
-            if (reaches[t]) c[at[t]] = static_cast<std::uint32_t>(t);  // at[t] <= t: in place
+            if (at[t + 1] != at[t]) c[at[t]] = static_cast<std::uint32_t>(t);  // at[t] <= t
         });
         std::uint32_t reaching = 0;
         UVR_CUDA_CHECK(
@@ -162,6 +178,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
     while (!level.empty()) {
         const std::uint32_t m = static_cast<std::uint32_t>(level.size());
         begin.upload(levelBegin, "the node offsets (GPU k-d build)");
+        const std::uint64_t* first = begin.data();
         // Bounds of every node's cells, then the shrunk regions and split axes on the host.
         std::vector<std::uint32_t> hostKeys(6 * std::size_t(m));
         for (std::uint32_t s = 0; s < m; ++s)
@@ -169,13 +186,13 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
                 hostKeys[6 * s + a] = 0xffffffffu, hostKeys[6 * s + 3 + a] = 0;
         boundKeys.upload(hostKeys, "the node bounds (GPU k-d build)");
         {
-            const std::uint32_t *c = cells.data(), *o = nodeOf.data();
+            const std::uint32_t* c = cells.data();
             const Bounds3f* b = boxes.data();
             std::uint32_t* k = boundKeys.data();
             cuda::forEachElement("k-d node bounds",
                                  (count + cuda::kBoundsChunk - 1) / cuda::kBoundsChunk,
                                  [=] __device__(std::uint64_t chunk) {
-                                     cuda::chunkBounds(chunk, c, o, count, b, k);
+                                     cuda::chunkBounds(chunk, c, first, m, count, b, k);
                                  });
         }
         boundKeys.download(hostKeys.data(), hostKeys.size());
@@ -204,11 +221,11 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             keys[0].reserve(count, "the centre keys (GPU k-d build)");
             keys[1].reserve(count, "the sorted centre keys (GPU k-d build)");
             // Sort keys: the node in the high word, the cell centre on the node's axis in the low.
-            const std::uint32_t *c = cells.data(), *o = nodeOf.data(), *ax = axis.data();
+            const std::uint32_t *c = cells.data(), *ax = axis.data();
             const Bounds3f* b = boxes.data();
             std::uint64_t* k = keys[0].data();
             cuda::forEachElement("k-d centre keys", count, [=] __device__(std::uint64_t i) {
-                const std::uint32_t s = o[i];
+                const std::uint32_t s = cuda::nodeAt(first, m, i);
                 k[i] = (static_cast<std::uint64_t>(s) << 32) |
                        kdsplit::floatKey(b[c[i]].center()[ax[s]]);
             });
@@ -222,7 +239,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             planes.reserve(m, "the split planes (GPU k-d build)");
             // Each node's median centre: the (count / 2)-th smallest, as the CPU's selection
             // picks.
-            const std::uint64_t *sorted = keyBuffer.Current(), *first = begin.data();
+            const std::uint64_t* sorted = keyBuffer.Current();
             float* pl = planes.data();
             cuda::forEachElement("k-d medians", m, [=] __device__(std::uint64_t s) {
                 const std::uint64_t cellsOfNode = first[s + 1] - first[s];
@@ -230,27 +247,29 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
                     static_cast<std::uint32_t>(sorted[first[s] + cellsOfNode / 2]));
             });
             planes.download(hostPlanes.data(), m);
-            // Sides and their counts.
-            below.reserve(count + 1, "the below flags (GPU k-d build)");
-            above.reserve(count + 1, "the above flags (GPU k-d build)");
+            // The keys' memory goes back before the sides take theirs (the build's peak).
+            keys[0].clear();
+            keys[1].clear();
+            temp.clear();
+            // Which side(s) of its node's plane each cell goes to (nodes not splitting: neither),
+            // as flags scanned in place into each side's offsets.
             belowScan.reserve(count + 1, "the below offsets (GPU k-d build)");
             aboveScan.reserve(count + 1, "the above offsets (GPU k-d build)");
-            UVR_CUDA_CHECK(cudaMemset(below.data() + count, 0, sizeof(std::uint32_t)));
-            UVR_CUDA_CHECK(cudaMemset(above.data() + count, 0, sizeof(std::uint32_t)));
-            // Which side(s) of its node's plane each cell goes to (nodes not splitting: neither).
+            UVR_CUDA_CHECK(cudaMemset(belowScan.data() + count, 0, sizeof(std::uint32_t)));
+            UVR_CUDA_CHECK(cudaMemset(aboveScan.data() + count, 0, sizeof(std::uint32_t)));
             const std::uint32_t* split = splitting.data();
-            std::uint32_t *lo = below.data(), *hi = above.data();
+            std::uint32_t *lo = belowScan.data(), *hi = aboveScan.data();
             cuda::forEachElement("k-d sides", count, [=] __device__(std::uint64_t i) {
-                const std::uint32_t s = o[i];
+                const std::uint32_t s = cuda::nodeAt(first, m, i);
                 const Bounds3f& box = b[c[i]];
                 lo[i] = split[s] && kdsplit::goesBelow(box, static_cast<int>(ax[s]), pl[s]);
                 hi[i] = split[s] && kdsplit::goesAbove(box, static_cast<int>(ax[s]), pl[s]);
             });
-            cuda::exclusiveSum(below.data(), belowScan.data(), count, temp);
-            cuda::exclusiveSum(above.data(), aboveScan.data(), count, temp);
+            cuda::exclusiveSumInPlace(lo, count, temp);
+            cuda::exclusiveSumInPlace(hi, count, temp);
             counts.reserve(4 * std::size_t(m), "the side counts (GPU k-d build)");
             // Per node: how many cells go below and above (differences of the exclusive scans).
-            const std::uint32_t *bs = belowScan.data(), *as = aboveScan.data();
+            const std::uint32_t *bs = lo, *as = hi;
             std::uint64_t* n4 = counts.data();
             cuda::forEachElement("k-d side counts", m, [=] __device__(std::uint64_t s) {
                 n4[4 * s + 0] = bs[first[s]];
@@ -286,11 +305,9 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
                 p.split = 1;
                 p.belowBase = hostCounts[4 * s + 0];
                 p.aboveBase = hostCounts[4 * s + 2];
-                p.below = static_cast<std::uint32_t>(next.size());
                 p.belowBegin = nextBegin.back();
                 next.push_back({child, lower, ln.depth + 1});
                 nextBegin.push_back(nextBegin.back() + nBelow);
-                p.above = static_cast<std::uint32_t>(next.size());
                 p.aboveBegin = nextBegin.back();
                 next.push_back({child + 1, upper, ln.depth + 1});
                 nextBegin.push_back(nextBegin.back() + nAbove);
@@ -313,30 +330,24 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
         UVR_CHECK(nextCount < 0xffffffffull, "k-d cell lists exceed 32-bit offsets");
         places.upload(hostPlaces, "the child places (GPU k-d build)");
         nextCells.reserve(nextCount, "the next level's cells (GPU k-d build)");
-        nextNodeOf.reserve(nextCount, "the next level's nodes (GPU k-d build)");
         {
-            // Order-preserving scatter of the cells of split nodes into the next level.
-            const std::uint32_t *c = cells.data(), *o = nodeOf.data(), *lo = below.data(),
-                                *hi = above.data(), *bs = belowScan.data(), *as = aboveScan.data();
+            // Order-preserving scatter of the cells of split nodes into the next level: a cell's
+            // flag on a side is the step of that side's scan at it.
+            const std::uint32_t *c = cells.data(), *bs = belowScan.data(), *as = aboveScan.data();
             const cuda::ChildPlace* pl = places.data();
-            std::uint32_t *nc = nextCells.data(), *no = nextNodeOf.data();
+            std::uint32_t* nc = nextCells.data();
             cuda::forEachElement("k-d scatter", count, [=] __device__(std::uint64_t i) {
-                const cuda::ChildPlace& p = pl[o[i]];
+                const cuda::ChildPlace& p = pl[cuda::nodeAt(first, m, i)];
                 if (!p.split) return;
-                if (lo[i]) {
-                    const std::uint64_t k = p.belowBegin + bs[i] - p.belowBase;
-                    nc[k] = c[i];
-                    no[k] = p.below;
-                }
-                if (hi[i]) {
-                    const std::uint64_t k = p.aboveBegin + as[i] - p.aboveBase;
-                    nc[k] = c[i];
-                    no[k] = p.above;
-                }
+                if (bs[i + 1] != bs[i]) nc[p.belowBegin + bs[i] - p.belowBase] = c[i];
+                if (as[i + 1] != as[i]) nc[p.aboveBegin + as[i] - p.aboveBase] = c[i];
             });
         }
         cells.swap(nextCells);
-        nodeOf.swap(nextNodeOf);
+        // The scans' and the old list's memory goes back before the next level's sort.
+        nextCells.clear();
+        belowScan.clear();
+        aboveScan.clear();
         level = std::move(next);
         levelBegin = std::move(nextBegin);
         count = nextCount;

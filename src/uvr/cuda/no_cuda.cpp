@@ -3,6 +3,7 @@
 #include "uvr/core/error.h"
 #include "uvr/core/setting_error.h"
 #include "uvr/cuda/cuda_build.h"
+#include "uvr/cuda/cuda_device.h"
 #include "uvr/cuda/cuda_renderer.h"
 
 namespace uvr {
@@ -32,6 +33,14 @@ std::string cudaDeviceDescription() {
 void startCudaWarmUp() {}
 
 void finishCudaWarmUp() {}
+
+CudaMemoryUse cudaMemoryUse() {
+    return {};
+}
+
+void resetCudaMemoryPeak() {}
+
+void setCudaMemoryLimit(std::uint64_t) {}
 
 CudaScene::CudaScene(const PreparedMesh&, const FractionFn&) {
     throw SettingError("device", "cuda",

@@ -206,13 +206,6 @@ void requireDevice(const char* build) {
         throwError(ErrorKind::Unsupported, "", std::string(build) + ": no CUDA device found");
 }
 
-/// Free device memory in bytes.
-std::size_t freeDeviceMemory() {
-    std::size_t freeBytes = 0, totalBytes = 0;
-    UVR_CUDA_CHECK(cudaMemGetInfo(&freeBytes, &totalBytes));
-    return freeBytes;
-}
-
 /// The cells in the kernels' layout (the blocks' corners and vertices; the points and corners of
 /// native cells; the values when `values` is true and the cells read them: cell data, native
 /// cells) on the GPU, and a view of them: what the seed and macrocell builders read.

@@ -61,7 +61,8 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
                     // between native and split cells.
                     {"bytes_per_tetrahedron",
                      bytes / double(std::max<std::uint64_t>(1, prepared.tets.splitTetCount()))},
-                    {"upload_seconds", gpu->uploadSeconds}};
+                    {"upload_seconds", gpu->uploadSeconds},
+                    {"build_peak_bytes", gpu->buildPeakBytes}};
     }
     j["threads"] = cpu::threadCount();
     // The method that rendered; with auto, also what was asked and why.
@@ -137,6 +138,8 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     j["prepare_seconds"] = {{"bvh", prepared.bvhSeconds}, {"adjacency", prepared.adjacencySeconds}};
     for (const auto& [phase, seconds] : prepared.phaseSeconds)
         j["prepare_seconds"][phase] = seconds;
+    if (!prepared.builtOnCpuInstead.empty())
+        j["prepare_on_cpu_instead"] = prepared.builtOnCpuInstead;
     j["render_seconds"] = result.stats.seconds;
     j["samples"] = result.stats.samples;
     j["mean_samples_per_pixel"] = result.stats.meanSamplesPerPixel();

@@ -92,7 +92,7 @@ std::unique_ptr<CudaScene> uploadIf(Device device, const PreparedMesh& prepared,
 Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const RendererOptions& options,
                    const ProgressFn& progress) {
     checkDeviceUsable(options.device);
-    const auto start = std::chrono::steady_clock::now();
+    const PreparationStart start = startPreparation();
     if (options.communicator && options.communicator->size() > 1) {
         // Data-parallel from a whole mesh every rank holds: each starts from its share.
         const Communicator& comm = *options.communicator;
@@ -113,7 +113,7 @@ Renderer::Renderer(const MeshView& mesh, const ScalarField& field, const Rendere
 Renderer::Renderer(MeshShare share, const RendererOptions& options, const ProgressFn& progress) {
     checkDeviceUsable(options.device);
     UVR_CHECK(options.communicator, "a renderer from a share needs a communicator");
-    const auto start = std::chrono::steady_clock::now();
+    const PreparationStart start = startPreparation();
     prepareShare(std::move(share), options, progress);
     finishPreparation(options, progress, start);
 }
@@ -133,10 +133,17 @@ void Renderer::prepareShare(MeshShare share, const RendererOptions& options,
         agreeOn(*comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));
 }
 
+Renderer::PreparationStart Renderer::startPreparation() {
+    resetCudaMemoryPeak();
+    return {std::chrono::steady_clock::now(), cudaMemoryUse().bytes};
+}
+
 void Renderer::finishPreparation(const RendererOptions& options, const ProgressFn& progress,
-                                 std::chrono::steady_clock::time_point start) {
+                                 const PreparationStart& start) {
     prepareSeconds_ =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start.time).count();
+    const std::uint64_t peak = cudaMemoryUse().peakBytes;
+    buildPeakBytes_ = peak > start.gpuBytes ? peak - start.gpuBytes : 0;
     if (comm_) rankPrepareSeconds_ = comm_->allGatherValues(prepareSeconds_);
     if (progress && resolvesToCuda(options.device))
         progress("uploading " +
@@ -279,7 +286,8 @@ void Renderer::setFieldValues(const ScalarField& field) {
 
 std::optional<GpuResidency> Renderer::gpuResidency() const {
     if (!gpu_) return std::nullopt;
-    return GpuResidency{gpu_->geometryBytes(), gpu_->uploadSeconds(), gpu_->valueUploadSeconds()};
+    return GpuResidency{gpu_->geometryBytes(), gpu_->uploadSeconds(), gpu_->valueUploadSeconds(),
+                        buildPeakBytes_};
 }
 
 std::string Renderer::deviceDescription() const {

@@ -76,6 +76,9 @@ struct GpuResidency {
     std::uint64_t geometryBytes = 0;
     double uploadSeconds = 0.0;       ///< the upload's time
     double valueUploadSeconds = 0.0;  ///< the last setFieldValues' upload of new values
+    /// The most device memory the GPU's builders held at once while this renderer prepared
+    /// (beyond what uvr held before it began); 0 when nothing built on the GPU.
+    std::uint64_t buildPeakBytes = 0;
 };
 
 /// The one renderer object of the library: a mesh prepared once for one field (tetrahedra,
@@ -143,9 +146,16 @@ private:
     RenderResult renderLocal(const RenderSettings& settings);
     /// Data-parallel: distributes this rank's share and prepares its piece (comm_ set).
     void prepareShare(MeshShare share, const RendererOptions& options, const ProgressFn& progress);
+    /// When a preparation began, and the device memory uvr held then (the GPU builders' peak
+    /// counts from there: the constructor resets it).
+    struct PreparationStart {
+        std::chrono::steady_clock::time_point time;
+        std::uint64_t gpuBytes = 0;
+    };
+    static PreparationStart startPreparation();
     /// The upload to the GPU (when rendering there) after the preparation that began at start.
     void finishPreparation(const RendererOptions& options, const ProgressFn& progress,
-                           std::chrono::steady_clock::time_point start);
+                           const PreparationStart& start);
 
     std::unique_ptr<PreparedMesh> prepared_;
     std::unique_ptr<CudaScene> gpu_;
@@ -161,6 +171,7 @@ private:
     bool fromWhole_ = false;                                  ///< made from a whole mesh
     std::uint64_t wholePointCount_ = 0, wholeCellCount_ = 0;  ///< that mesh's
     std::vector<double> rankPrepareSeconds_;
+    std::uint64_t buildPeakBytes_ = 0;  ///< GpuResidency::buildPeakBytes
 };
 
 }  // namespace uvr

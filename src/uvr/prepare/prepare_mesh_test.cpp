@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "test_support.h"
 #include "uvr/accel/tet_adjacency.h"
+#include "uvr/core/error.h"
+#include "uvr/cpu/cpu_renderer.h"
 #include "uvr/render/frame_setup.h"
 
 namespace uvr {
@@ -44,6 +47,81 @@ TEST(PrepareMesh, AFaceMatcherIsGivenTheWeldOfThePointsItReads) {
         // The seam's copies are welded to the first points.
         EXPECT_EQ(given[seams.points.size() / 2], 0u);
         EXPECT_EQ(pm.neighbors, cpu.neighbors);
+    }
+}
+
+/// What a GPU builder throws when the card lacks the memory for `what`.
+[[noreturn]] void outOfMemory(const std::string& what) {
+    throw Error(ErrorKind::Resource,
+                "out of GPU memory allocating " + what + ": need 1.00 GiB more");
+}
+
+TEST(PrepareMesh, WhatTheBuildersDeviceLacksMemoryForTheCpuBuilds) {
+    const Mesh seams = testing::seamMesh(20000);
+    const ScalarField field = selectScalarField(seams, {});
+    PrepareOptions cpuOptions;
+    cpuOptions.meshBvh = true;
+    cpuOptions.kd.leafCells = 512;
+    const PreparedMesh cpu = prepareMesh(seams, field, cpuOptions);
+    // A device whose memory holds the face neighbours but not the rest.
+    PrepareOptions o = cpuOptions;
+    o.builderDevice = "the test device";
+    o.cells.sorter = [](const std::uint64_t*, std::uint64_t, std::uint32_t*) {
+        outOfMemory("the sort keys");
+    };
+    o.lbvh = [](const LbvhInput&) -> LbvhResult { outOfMemory("the Morton keys"); };
+    int matched = 0;
+    o.faceMatcher = [&](const TetMesh& m, const std::vector<std::uint32_t>&,
+                        const FractionFn& progress) {
+        ++matched;
+        return buildTetNeighbors(m, progress);
+    };
+    o.kdSplitter = [](const TetMesh&, const KdBuildOptions&, const FractionFn&) -> KdTree {
+        outOfMemory("the centre keys");
+    };
+    o.seedBuilder = [](const TetMesh&, const KdPartitions&, float, const FractionFn&) -> SeedGrids {
+        outOfMemory("the seed keys");
+    };
+    o.macroBuilder = [](const TetMesh&, const KdPartitions&, const std::vector<std::uint32_t>&,
+                        float, const FractionFn&) -> MacroBuild { outOfMemory("the macrocells"); };
+    std::vector<std::string> heard;
+    const PreparedMesh fell = prepareMesh(
+        seams, field, o, ProgressFn([&](const std::string& line) { heard.push_back(line); }));
+    EXPECT_EQ(matched, 1);
+    EXPECT_TRUE(fell.builtElsewhere);  // the neighbours
+    EXPECT_EQ(fell.builtOnCpuInstead,
+              (std::vector<std::string>{"split", "bvh", "partitions", "seed_grids", "macrocells"}));
+    EXPECT_NE(std::find(heard.begin(), heard.end(),
+                        "out of GPU memory allocating the centre keys: need 1.00 GiB more; "
+                        "building the partitions on the CPU instead of the test device"),
+              heard.end());
+    // The CPU's structures, so the CPU's frames.
+    EXPECT_EQ(fell.tets.tets.size(), cpu.tets.tets.size());
+    EXPECT_EQ(fell.neighbors, cpu.neighbors);
+    ASSERT_TRUE(fell.kd && cpu.kd && fell.seeds && cpu.seeds && fell.macro && cpu.macro);
+    EXPECT_EQ(fell.kd->cells, cpu.kd->cells);
+    EXPECT_EQ(fell.seeds->seeds, cpu.seeds->seeds);
+    EXPECT_EQ(fell.bvh.nodes.size(), cpu.bvh.nodes.size());
+    EXPECT_EQ(fell.gradientSpread, cpu.gradientSpread);
+    RenderSettings s;
+    s.width = 64;
+    s.height = 48;
+    s.tf = transferFunctionPreset("cool-to-warm");
+    for (const RenderMethod method : {RenderMethod::Partitions, RenderMethod::Reference}) {
+        s.method = method;
+        EXPECT_TRUE(
+            testing::sameBytes(renderCpu(cpu, s).image.pixels, renderCpu(fell, s).image.pixels))
+            << methodName(method);
+    }
+    // Any other failure of a builder is the preparation's.
+    o.kdSplitter = [](const TetMesh&, const KdBuildOptions&, const FractionFn&) -> KdTree {
+        throw Error(ErrorKind::Internal, "CUDA error in a kernel");
+    };
+    try {
+        prepareMesh(seams, field, o);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Internal);
     }
 }
 

@@ -30,6 +30,27 @@ auto beside(Fn fn) {
     });
 }
 
+/// Runs `build`, a builder of PrepareOptions::builderDevice (the GPU's), and says whether it
+/// built: false when that device ran out of memory for it (Error(Resource)), after which the
+/// caller builds `phase` on the CPU. The switch is heard through `progress` and noted in
+/// out.builtOnCpuInstead: the picture comes without the user choosing another build device.
+template <class Build>
+bool buildElsewhere(PreparedMesh& out, const char* phase, const PrepareOptions& options,
+                    const ProgressFn& progress, Build&& build) {
+    try {
+        build();
+        out.builtElsewhere = true;
+        return true;
+    } catch (const Error& e) {
+        if (e.kind() != ErrorKind::Resource) throw;
+        if (progress)
+            progress(std::string(e.what()) + "; building the " + phase + " on the CPU instead of " +
+                     options.builderDevice);
+        out.builtOnCpuInstead.emplace_back(phase);
+        return false;
+    }
+}
+
 /// Meshes of up to this many cells get cell-tree leaves of at most kCpuCellTreeLeaf whatever
 /// PrepareOptions::cellTreeLeaf asks (the GPU's kCellTreeLeaf): on small non-convex meshes
 /// searches are not rare (SPX: one sample in five on an H200; disk_out_ref.ex2: one in seven),
@@ -69,7 +90,12 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     std::future<std::pair<std::vector<std::uint32_t>, double>> welding;
     if (large && options.faceMatcher)
         welding = beside([points = mesh.points] { return coincidentPointIds(points); });
-    out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
+    if (!(cells.sorter && buildElsewhere(out, "split", options, progress, [&] {
+              out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
+          }))) {
+        cells.sorter = nullptr;
+        out.tets = tetrahedralize(mesh, field, cells, progress.fraction);
+    }
     if (options.piece) out.tets.wholeMeanSplitTets = options.piece->meanSplitTets;
     std::vector<std::uint32_t> welded;
     if (welding.valid()) welded = std::move(welding.get().first);  // before the points are freed
@@ -96,16 +122,13 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     const SeedBuilder seedBuilder = elsewhere ? options.seedBuilder : nullptr;
     const MacroBuilder macroBuilder =
         elsewhere && options.macroGrids ? options.macroBuilder : nullptr;
-    out.builtElsewhere =
-        elsewhere && (lbvh || splitter || faceMatcher || seedBuilder || macroBuilder);
     if (withBvh) {
         start = std::chrono::steady_clock::now();
         if (progress)
             progress("building the BVH over " + std::to_string(out.tets.cellCount()) + " cells" +
                      (lbvh ? " (LBVH on " + options.builderDevice + ")" : ""));
-        if (lbvh) {
-            out.bvh = buildMeshLbvh(out.tets, lbvh);
-        } else {
+        if (!(lbvh && buildElsewhere(out, "bvh", options, progress,
+                                     [&] { out.bvh = buildMeshLbvh(out.tets, lbvh); }))) {
             std::vector<Bounds3f> boxes;
             std::vector<Vec3f> centers;
             tetBoxesAndCenters(out.tets, boxes, centers);
@@ -129,17 +152,19 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     // On the CPU their codes take 0.74 of 4.91 seconds at 100M tetrahedra.
     constexpr double kNeighborsEnd = 4.17 / 4.91;
     std::future<std::pair<CompactNeighbors, double>> codes;
-    if (faceMatcher) {
-        // Welded again where the split moved the points into a frame (equal points stay equal,
-        // but the weld is of the points the matcher reads), or where none were welded.
-        if (welded.size() != out.tets.points.size() || !out.tets.frame.identity())
-            welded = coincidentPointIds(out.tets.points);
-        out.neighbors = faceMatcher(out.tets, welded, progress.fraction);
+    if (faceMatcher && buildElsewhere(out, "neighbours", options, progress, [&] {
+            // Welded again where the split moved the points into a frame (equal points stay
+            // equal, but the weld is of the points the matcher reads), or where none were.
+            if (welded.size() != out.tets.points.size() || !out.tets.frame.identity())
+                welded = coincidentPointIds(out.tets.points);
+            out.neighbors = faceMatcher(out.tets, welded, progress.fraction);
+        })) {
         welded = {};
         codes = beside([&tets = out.tets, &neighbors = out.neighbors] {
             return compactNeighbors(tets, neighbors);
         });
     } else {
+        welded = {};
         out.neighbors =
             buildTetNeighbors(out.tets, subRange(progress.fraction, 0.0, kNeighborsEnd));
         out.neighborCodes = compactNeighbors(out.tets, out.neighbors,
@@ -158,7 +183,12 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         if (const MeshPiece* piece = options.piece.get())
             kd.root = KdSubtreeRoot{piece->region, piece->depth, piece->bounds.diagonal()};
         start = std::chrono::steady_clock::now();
-        out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
+        if (!(splitter && buildElsewhere(out, "partitions", options, progress, [&] {
+                  out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
+              }))) {
+            kd.splitter = options.kd.splitter;
+            out.kd = buildKdPartitions(out.tets, kd, progress.fraction);
+        }
         // A piece's traversal starts at the whole mesh's bounds and narrows to its box (the
         // marchers' PieceView), as one process's does.
         if (options.piece) out.kd->bounds = options.piece->bounds;
@@ -178,23 +208,28 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
                 progress("building seed grids" +
                          (seedBuilder ? " (on " + options.builderDevice + ")" : std::string()));
             start = std::chrono::steady_clock::now();
-            out.seeds =
-                seedBuilder
-                    ? seedBuilder(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction)
-                    : buildSeedGrids(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction);
+            if (!(seedBuilder && buildElsewhere(out, "seed_grids", options, progress, [&] {
+                      out.seeds =
+                          seedBuilder(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction);
+                  })))
+                out.seeds = buildSeedGrids(out.tets, *out.kd, kTetsPerSeedCell, progress.fraction);
             out.phaseSeconds.emplace_back("seed_grids", secondsSince(start));
         }
+        bool macroElsewhere = false;
         if (macroBuilder) {
             if (progress)
                 progress("building macrocell grids and gradient spreads (on " +
                          options.builderDevice + ")");
             start = std::chrono::steady_clock::now();
-            MacroBuild built = macroBuilder(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,
-                                            progress.fraction);
-            out.gradientSpread = std::move(built.gradientSpread);
-            out.macro = std::move(built.macro);
-            out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
-        } else {
+            macroElsewhere = buildElsewhere(out, "macrocells", options, progress, [&] {
+                MacroBuild built = macroBuilder(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,
+                                                progress.fraction);
+                out.gradientSpread = std::move(built.gradientSpread);
+                out.macro = std::move(built.macro);
+            });
+            if (macroElsewhere) out.phaseSeconds.emplace_back("macrocells", secondsSince(start));
+        }
+        if (!macroElsewhere) {
             if (progress) progress("measuring the partitions' gradient spreads");
             start = std::chrono::steady_clock::now();
             out.gradientSpread = partitionGradientSpread(out.tets, *out.kd, progress.fraction);
@@ -204,7 +239,7 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
         start = std::chrono::steady_clock::now();
         out.partitionNan = partitionNanFlags(out.tets, *out.kd);
         out.phaseSeconds.emplace_back("nan_flags", secondsSince(start));
-        if (options.macroGrids && !macroBuilder) {
+        if (options.macroGrids && !macroElsewhere) {
             if (progress) progress("building macrocell grids");
             start = std::chrono::steady_clock::now();
             out.macro = buildMacroGrids(out.tets, *out.kd, out.neighbors, kTetsPerMacroCell,

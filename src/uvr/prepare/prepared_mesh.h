@@ -132,6 +132,10 @@ struct PreparedMesh {
     double bvhSeconds = 0.0;        ///< time to build the BVH
     double adjacencySeconds = 0.0;  ///< time to find face neighbours
     bool builtElsewhere = false;    ///< PrepareOptions' builders (the GPU's) built parts of it
+    /// The phases whose builder of PrepareOptions (the GPU's) ran out of its device's memory, so
+    /// that the CPU built them instead ("split", "bvh", "neighbours", "partitions", "seed_grids",
+    /// "macrocells"): the same structures, later.
+    std::vector<std::string> builtOnCpuInstead;
     /// Wall seconds of every phase prepareMesh ran, in order: "split" (with the Morton order and
     /// the kernels' blocks), "bvh", "neighbours" (with their codes), "partitions" (with their
     /// value ranges), "cell_tree", "seed_grids", "gradient_spreads", "nan_flags", "macrocells"
