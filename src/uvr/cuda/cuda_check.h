@@ -97,6 +97,31 @@ private:
     std::size_t size_ = 0, capacity_ = 0;
 };
 
+/// Page-locked host memory owned by RAII, kept for reuse: what device-to-host copies run
+/// fastest into (the frame's read-back stages through it). Not counted as device memory.
+class PinnedBuffer {
+public:
+    PinnedBuffer() = default;
+    PinnedBuffer(const PinnedBuffer&) = delete;
+    PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+    ~PinnedBuffer() {
+        if (ptr_) cudaFreeHost(ptr_);
+    }
+    /// Makes room for `bytes` (keeps the allocation when it is large enough).
+    void reserve(std::size_t bytes, const char* what) {
+        if (bytes <= capacity_) return;
+        if (ptr_) cudaFreeHost(ptr_);
+        ptr_ = nullptr, capacity_ = 0;
+        check(cudaMallocHost(&ptr_, bytes), what, __FILE__, __LINE__);
+        capacity_ = bytes;
+    }
+    unsigned char* data() const { return static_cast<unsigned char*>(ptr_); }
+
+private:
+    void* ptr_ = nullptr;
+    std::size_t capacity_ = 0;
+};
+
 }  // namespace uvr::cuda
 
 /// Checks a CUDA runtime call (GUIDE.md §5): the call text, file and line go into the error.

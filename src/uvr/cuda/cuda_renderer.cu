@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 #include <thread>
 
@@ -198,6 +199,7 @@ struct CudaScene::Impl {
     cuda::DeviceArray<float> depthIn;    ///< depth in (RenderSettings::depthIn)
     cuda::DeviceArray<float> stopAlpha;  ///< stop in (RenderSettings::pixelStopAlpha)
     cuda::DeviceArray<unsigned long long> totals;
+    cuda::PinnedBuffer readBack;  ///< the frame's image, counts and depth on their way back
     double uploadSeconds = 0.0;
     double valueUploadSeconds = 0.0;
 
@@ -410,22 +412,44 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
                                d.devicePartitionScene(result.setup, settings.skip), native, lit,
                                surfaces, d.totals.data());
     UVR_CUDA_CHECK(cudaEventRecord(end));
+    // While the kernel runs: the result's host arrays (their pages touched now, not during the
+    // copies), and the page-locked buffer the copies stage through.
+    result.image = Image(settings.width, settings.height);
+    result.sampleCounts.resize(pixelCount);
+    if (depthOut) result.depth.resize(pixelCount);
+    const std::size_t imageBytes = pixelCount * sizeof(Vec4f);
+    const std::size_t countBytes = pixelCount * sizeof(std::uint32_t);
+    const std::size_t depthBytes = depthOut ? pixelCount * sizeof(float) : 0;
+    d.readBack.reserve(imageBytes + countBytes + depthBytes,
+                       "cudaMallocHost(the frame's read-back)");
     UVR_CUDA_CHECK(cudaEventSynchronize(end));
     float ms = 0.f;
     UVR_CUDA_CHECK(cudaEventElapsedTime(&ms, begin, end));
     UVR_CUDA_CHECK(cudaEventDestroy(begin));
     UVR_CUDA_CHECK(cudaEventDestroy(end));
-    // Results back to the host.
-    result.image = Image(settings.width, settings.height);
-    result.sampleCounts.resize(pixelCount);
-    UVR_CUDA_CHECK(cudaMemcpy(result.image.pixels.data(), d.pixels.data(),
-                              pixelCount * sizeof(Vec4f), cudaMemcpyDeviceToHost));
-    UVR_CUDA_CHECK(cudaMemcpy(result.sampleCounts.data(), d.sampleCounts.data(),
-                              pixelCount * sizeof(std::uint32_t), cudaMemcpyDeviceToHost));
-    if (depthOut) {
-        result.depth.resize(pixelCount);
-        UVR_CUDA_CHECK(cudaMemcpy(result.depth.data(), d.depth.data(), pixelCount * sizeof(float),
+    // Results back to the host: at the bus's speed into page-locked memory (pageable memory
+    // copies at a fraction of it), then into the result on the CPU threads.
+    unsigned char* staged = d.readBack.data();
+    UVR_CUDA_CHECK(cudaMemcpy(staged, d.pixels.data(), imageBytes, cudaMemcpyDeviceToHost));
+    UVR_CUDA_CHECK(
+        cudaMemcpy(staged + imageBytes, d.sampleCounts.data(), countBytes, cudaMemcpyDeviceToHost));
+    if (depthOut)
+        UVR_CUDA_CHECK(cudaMemcpy(staged + imageBytes + countBytes, d.depth.data(), depthBytes,
                                   cudaMemcpyDeviceToHost));
+    unsigned char* const targets[3] = {reinterpret_cast<unsigned char*>(result.image.pixels.data()),
+                                       reinterpret_cast<unsigned char*>(result.sampleCounts.data()),
+                                       reinterpret_cast<unsigned char*>(result.depth.data())};
+    const std::size_t sizes[3] = {imageBytes, countBytes, depthBytes};
+    constexpr std::size_t kChunk = std::size_t(1) << 18;
+    std::size_t chunks[4] = {0, 0, 0, 0};  // chunks before each array
+    for (int a = 0; a < 3; ++a) chunks[a + 1] = chunks[a] + (sizes[a] + kChunk - 1) / kChunk;
+#pragma omp parallel for schedule(static)
+    for (std::int64_t c = 0; c < std::int64_t(chunks[3]); ++c) {
+        int a = 0;
+        while (std::size_t(c) >= chunks[a + 1]) ++a;
+        const std::size_t at = (std::size_t(c) - chunks[a]) * kChunk;
+        const std::size_t offset = a == 0 ? 0 : a == 1 ? imageBytes : imageBytes + countBytes;
+        std::memcpy(targets[a] + at, staged + offset + at, std::min(kChunk, sizes[a] - at));
     }
     unsigned long long totals[cuda::kCounters];
     UVR_CUDA_CHECK(cudaMemcpy(totals, d.totals.data(), sizeof totals, cudaMemcpyDeviceToHost));

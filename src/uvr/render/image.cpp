@@ -184,8 +184,9 @@ std::vector<std::uint8_t> toPngBytes(const Image& image, const std::optional<Vec
     const bool alpha = !background.has_value();
     const size_t channels = alpha ? 4 : 3;
     std::vector<std::uint8_t> bytes(image.pixels.size() * channels);
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-        Vec4f p = image.pixels[i];
+#pragma omp parallel for schedule(static) if (image.pixels.size() >= (1u << 16))
+    for (std::int64_t i = 0; i < std::int64_t(image.pixels.size()); ++i) {
+        Vec4f p = image.pixels[std::size_t(i)];
         std::uint8_t* px = &bytes[i * channels];
         if (alpha) {
             float inv = p.w > 0.f ? 1.f / p.w : 0.f;
@@ -235,19 +236,6 @@ void writePng(OutputFile& out, const Image& image, const std::optional<Vec3f>& b
     encodeImage(sink, out.path(), image, background);
 }
 
-std::vector<std::uint8_t> encodePng(const Image& image, const std::optional<Vec3f>& background,
-                                    int level) {
-    if (level < -1 || level > 9)
-        throwError(ErrorKind::Argument, "",
-                   "PNG compression level " + std::to_string(level) + ": expected -1 to 9");
-    std::vector<std::uint8_t> bytes;
-    PngSink sink;
-    sink.memory = &bytes;
-    sink.level = level;
-    encodeImage(sink, "PNG in memory", image, background);
-    return bytes;
-}
-
 namespace {
 
 void putU32(std::vector<std::uint8_t>& v, std::uint32_t x) {
@@ -265,6 +253,106 @@ std::uint32_t getU32(const std::uint8_t* p) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Appends a PNG chunk (length, type, data, CRC) to `out`.
+void appendChunk(std::vector<std::uint8_t>& out, const char* type, const std::uint8_t* data,
+                 std::size_t size) {
+    for (int k = 0; k < 4; ++k) out.push_back(static_cast<std::uint8_t>(size >> (24 - 8 * k)));
+    const std::size_t at = out.size();
+    out.insert(out.end(), type, type + 4);
+    if (size > 0) out.insert(out.end(), data, data + size);
+    const uLong crc = crc32(0L, out.data() + at, static_cast<uInt>(4 + size));
+    for (int k = 0; k < 4; ++k) out.push_back(static_cast<std::uint8_t>(crc >> (24 - 8 * k)));
+}
+
+/// encodePng at level 1 of an image of more than kPngStripRows rows: each row SUB-filtered (the
+/// filter libpng is told to use at that level), the rows deflated by zlib (level 1, run-length
+/// matching, as there) in strips of kPngStripRows on the CPU threads and joined into one zlib
+/// stream, as pigz joins its blocks: every strip but the last ends on a sync flush (a byte
+/// boundary, no final block), and the stream's Adler-32 is combined from the strips'. One IDAT.
+std::vector<std::uint8_t> encodePngInStrips(const Image& image,
+                                            const std::optional<Vec3f>& background) {
+    const bool alpha = !background.has_value();
+    const std::size_t channels = alpha ? 4 : 3;
+    const std::size_t row = static_cast<std::size_t>(image.width) * channels;
+    const std::vector<std::uint8_t> bytes = toPngBytes(image, background);
+    const int strips = (image.height + kPngStripRows - 1) / kPngStripRows;
+    std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(strips));
+    std::vector<uLong> adlers(static_cast<std::size_t>(strips));
+    std::vector<std::size_t> lengths(static_cast<std::size_t>(strips));
+    std::vector<int> failures(static_cast<std::size_t>(strips), Z_OK);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int k = 0; k < strips; ++k) {
+        const int y0 = k * kPngStripRows, y1 = std::min(image.height, y0 + kPngStripRows);
+        std::vector<std::uint8_t> filtered(std::size_t(y1 - y0) * (row + 1));
+        for (int y = y0; y < y1; ++y) {
+            const std::uint8_t* in = &bytes[std::size_t(y) * row];
+            std::uint8_t* out = &filtered[std::size_t(y - y0) * (row + 1)];
+            out[0] = 1;  // SUB: each byte less the one a pixel to its left
+            for (std::size_t i = 0; i < row; ++i)
+                out[1 + i] =
+                    static_cast<std::uint8_t>(in[i] - (i >= channels ? in[i - channels] : 0));
+        }
+        const std::size_t at = static_cast<std::size_t>(k);
+        adlers[at] = adler32(1L, filtered.data(), static_cast<uInt>(filtered.size()));
+        lengths[at] = filtered.size();
+        z_stream z{};
+        int rc = deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_RLE);  // raw: no header, no trailer
+        if (rc == Z_OK) {
+            packed[at].resize(deflateBound(&z, static_cast<uLong>(filtered.size())) + 16);
+            z.next_in = filtered.data();
+            z.avail_in = static_cast<uInt>(filtered.size());
+            z.next_out = packed[at].data();
+            z.avail_out = static_cast<uInt>(packed[at].size());
+            rc = deflate(&z, k + 1 == strips ? Z_FINISH : Z_SYNC_FLUSH);
+            const bool done = k + 1 == strips ? rc == Z_STREAM_END : rc == Z_OK && z.avail_in == 0;
+            packed[at].resize(z.total_out);
+            deflateEnd(&z);
+            rc = done ? Z_OK : Z_BUF_ERROR;
+        }
+        failures[at] = rc;
+    }
+    for (const int rc : failures)
+        if (rc != Z_OK)
+            throwError(ErrorKind::Resource, "",
+                       "PNG compression failed: zlib error " + std::to_string(rc));
+    std::vector<std::uint8_t> out = {137, 80, 78, 71, 13, 10, 26, 10};
+    std::vector<std::uint8_t> header;
+    putU32(header, static_cast<std::uint32_t>(image.width));
+    putU32(header, static_cast<std::uint32_t>(image.height));
+    header.insert(header.end(), {8, std::uint8_t(alpha ? 6 : 2), 0, 0, 0});
+    appendChunk(out, "IHDR", header.data(), header.size());
+    std::vector<std::uint8_t> data = {0x78, 0x01};  // zlib: deflate, 32 KiB window, level 1
+    uLong adler = adlers[0];
+    for (std::size_t k = 0; k < packed.size(); ++k) {
+        data.insert(data.end(), packed[k].begin(), packed[k].end());
+        if (k) adler = adler32_combine(adler, adlers[k], static_cast<z_off_t>(lengths[k]));
+    }
+    putU32(data, static_cast<std::uint32_t>(adler));
+    appendChunk(out, "IDAT", data.data(), data.size());
+    appendChunk(out, "IEND", nullptr, 0);
+    return out;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encodePng(const Image& image, const std::optional<Vec3f>& background,
+                                    int level) {
+    if (level < -1 || level > 9)
+        throwError(ErrorKind::Argument, "",
+                   "PNG compression level " + std::to_string(level) + ": expected -1 to 9");
+    if (level == 1 && image.height > kPngStripRows && image.width > 0 &&
+        image.pixels.size() == static_cast<size_t>(image.width) * image.height)
+        return encodePngInStrips(image, background);
+    std::vector<std::uint8_t> bytes;
+    PngSink sink;
+    sink.memory = &bytes;
+    sink.level = level;
+    encodeImage(sink, "PNG in memory", image, background);
+    return bytes;
+}
 
 ApngWriter::ApngWriter(OutputFile& out, int frameCount, double fps)
     : out_(out), frameCount_(frameCount) {
@@ -284,16 +372,10 @@ ApngWriter::ApngWriter(OutputFile& out, int frameCount, double fps)
 }
 
 void ApngWriter::chunk(const char* type, const std::uint8_t* data, std::size_t size) {
-    std::uint8_t head[8];
-    for (int k = 0; k < 4; ++k) head[k] = static_cast<std::uint8_t>(size >> (24 - 8 * k));
-    std::memcpy(head + 4, type, 4);
-    uLong crc = crc32(0L, head + 4, 4);
-    if (size > 0) crc = crc32(crc, data, static_cast<uInt>(size));
-    out_.write(head, sizeof head);
-    if (size > 0) out_.write(data, size);
-    std::uint8_t tail[4];
-    for (int k = 0; k < 4; ++k) tail[k] = static_cast<std::uint8_t>(crc >> (24 - 8 * k));
-    out_.write(tail, sizeof tail);
+    std::vector<std::uint8_t> bytes;
+    bytes.reserve(size + 12);
+    appendChunk(bytes, type, data, size);
+    out_.write(bytes.data(), bytes.size());
 }
 
 void ApngWriter::add(const Image& image, const std::optional<Vec3f>& background) {

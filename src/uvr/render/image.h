@@ -48,8 +48,13 @@ void writePng(OutputFile& out, const Image& image,
 std::vector<std::uint8_t> toPngBytes(const Image& image,
                                      const std::optional<Vec3f>& background = std::nullopt);
 
+/// Rows of the strips encodePng deflates at once at level 1.
+inline constexpr int kPngStripRows = 128;
+
 /// The PNG writePng writes, encoded in memory; level is zlib's compression level 0 (fastest) to
-/// 9 (smallest), -1 libpng's default.
+/// 9 (smallest), -1 libpng's default. Level 1 (the viewer's full frames) filters every row with
+/// SUB and, for images of more than kPngStripRows rows, deflates strips of that many rows on the
+/// CPU threads into one zlib stream: the same pixels, in a fraction of the time.
 std::vector<std::uint8_t> encodePng(const Image& image,
                                     const std::optional<Vec3f>& background = std::nullopt,
                                     int level = -1);

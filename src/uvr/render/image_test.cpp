@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -105,6 +106,33 @@ TEST(Png, EncodedInMemoryAsTheFileIsAtEveryLevel) {
     }
     EXPECT_THROW(encodePng(img, std::nullopt, 10), Error);
     EXPECT_THROW(encodePng(Image(), std::nullopt), Error);
+}
+
+TEST(Png, LevelOneInStripsDecodesAsLibpngsEncoding) {
+    // Rows past one strip (and not a multiple of it), noise and gradients, varying opacity.
+    Image img(301, 2 * kPngStripRows + 37);
+    std::uint32_t noise = 7;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            noise = noise * 1664525u + 1013904223u;
+            const float a = float((x + y) % 7 == 0 ? 0 : noise >> 24) / 255.f;
+            img.at(x, y) = Vec4f(a * x / 300.f, a * float(noise >> 28) / 15.f, a * 0.5f, a);
+        }
+    for (const std::optional<Vec3f> background :
+         {std::optional<Vec3f>(), std::optional<Vec3f>(Vec3f(0.1f, 0.9f, 0.3f))}) {
+        SCOPED_TRACE(background ? "over a background" : "with alpha");
+        const auto decoded = [&](const std::vector<std::uint8_t>& bytes, const char* name) {
+            const std::string p = scratchDir() + "/" + name + ".png";
+            std::ofstream(p, std::ios::binary)
+                .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+            return readPng(p);  // libpng: the CRCs and the zlib stream's Adler-32 are checked
+        };
+        const Image strips = decoded(encodePng(img, background, 1), "strips");
+        const Image whole = decoded(encodePng(img, background, 6), "whole");
+        ASSERT_EQ(strips.width, img.width);
+        ASSERT_EQ(strips.height, img.height);
+        EXPECT_TRUE(testing::sameBytes(strips.pixels, whole.pixels));
+    }
 }
 
 TEST(Png, CompositesOverBackgroundAndClamps) {
