@@ -21,8 +21,19 @@ void FrameDemand::start(FrameKind kind) {
     inFlight = true;
 }
 
-void FrameDemand::measured(double frameMsPerPixel) {
-    msPerPixel = msPerPixel > 0.0 ? 0.5 * (msPerPixel + frameMsPerPixel) : frameMsPerPixel;
+namespace {
+
+/// An average that weighs the newest measurement as much as all before it.
+void average(double& into, double value) {
+    into = into > 0.0 ? 0.5 * (into + value) : value;
+}
+
+}  // namespace
+
+void FrameDemand::measured(double frameMsPerPixel, int scale) {
+    average(msPerPixel, frameMsPerPixel);
+    if (scale >= 1 && scale <= kMaxReducedScale)
+        average(reducedMsPerPixel[std::size_t(scale)], frameMsPerPixel);
 }
 
 FramePick pickFrame(const std::vector<const FrameDemand*>& tabs, std::size_t from,
@@ -51,13 +62,21 @@ FramePick pickFrame(const std::vector<const FrameDemand*>& tabs, std::size_t fro
     return pick;
 }
 
-int reducedScale(double msPerPixel, double pixels, const ScheduleOptions& options) {
-    if (!(msPerPixel > 0.0)) return std::min(2, std::max(1, options.maxScale));  // none measured
-    int scale = 1;
-    while (scale < options.maxScale &&
-           msPerPixel * pixels / (double(scale) * scale) > options.targetFrameMs)
-        ++scale;
-    return scale;
+int reducedScale(const FrameDemand& demand, double pixels, const ScheduleOptions& options) {
+    const int most = std::clamp(options.maxScale, 1, kMaxReducedScale);
+    if (!(demand.msPerPixel > 0.0)) return std::min(2, most);  // none measured
+    const auto costAt = [&](int scale) {
+        const double perPixel = demand.reducedMsPerPixel[std::size_t(scale)];
+        return (perPixel > 0.0 ? perPixel : demand.msPerPixel) * pixels / (double(scale) * scale);
+    };
+    for (int scale = 1; scale < most; ++scale) {
+        const bool measured = demand.reducedMsPerPixel[std::size_t(scale)] > 0.0;
+        if (!measured && demand.reducedMsPerPixel[std::size_t(scale) + 1] > 0.0 &&
+            costAt(scale + 1) <= 0.5 * options.targetFrameMs)
+            return scale;  // worth a try: its frames then say what it costs
+        if (costAt(scale) <= options.targetFrameMs) return scale;
+    }
+    return most;
 }
 
 }  // namespace uvr::server

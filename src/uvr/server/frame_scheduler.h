@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <optional>
@@ -14,6 +15,9 @@ namespace uvr::server {
 /// state has been still for a while; a snapshot is one full-size PNG.
 
 using Clock = std::chrono::steady_clock;
+
+/// The coarsest reduction a reduced frame can have (ScheduleOptions::maxScale is capped to it).
+inline constexpr int kMaxReducedScale = 16;
 
 /// The kinds of frame a tab gets.
 enum class FrameKind {
@@ -32,6 +36,11 @@ struct FrameDemand {
     bool needsFull = false;    ///< the last frame was reduced: refine when still
     Clock::time_point lastChange = Clock::now();
     double msPerPixel = 0.0;  ///< what a frame costs per pixel, averaged (0: none measured)
+    /// What a reduced frame at scale s costs per pixel, averaged (0: none at that scale yet). A
+    /// part of a frame's cost does not grow with its pixels (launches, read-back, encoding's
+    /// setup), so a finer scale costs less per pixel than a coarser one measured: what a scale
+    /// was measured at is trusted over msPerPixel.
+    std::array<double, kMaxReducedScale + 1> reducedMsPerPixel{};
 
     /// Records a change of the state at `now` (interactive: part of a drag).
     void changed(bool interactive, Clock::time_point now);
@@ -39,8 +48,9 @@ struct FrameDemand {
     void start(FrameKind kind);
     /// A frame has been sent (or failed): the tab may get the next.
     void finished() { inFlight = false; }
-    /// Averages a frame's measured cost per pixel into msPerPixel.
-    void measured(double frameMsPerPixel);
+    /// Averages a frame's measured cost per pixel into msPerPixel, and for a reduced frame
+    /// (`scale` > 0, its reduction) into reducedMsPerPixel[scale].
+    void measured(double frameMsPerPixel, int scale = 0);
 };
 
 /// How frames are scheduled (ServerOptions' values).
@@ -65,9 +75,12 @@ struct FramePick {
 FramePick pickFrame(const std::vector<const FrameDemand*>& tabs, std::size_t from,
                     Clock::time_point now, const ScheduleOptions& options);
 
-/// The reduction of a reduced frame of `pixels` pixels: the smallest scale (pixels / scale^2
-/// rendered) whose measured cost fits targetFrameMs, at most maxScale; 2 before any
-/// measurement.
-int reducedScale(double msPerPixel, double pixels, const ScheduleOptions& options);
+/// The reduction of a reduced frame of `pixels` pixels for a tab of `demand`: the smallest scale
+/// (pixels / scale^2 rendered) whose cost fits targetFrameMs, at most maxScale; 2 before any
+/// measurement. A scale's cost is what frames at it cost (reducedMsPerPixel), else what
+/// msPerPixel makes of its pixels; a scale not measured yet is tried when the next coarser one
+/// took at most half the target (so a GPU whose frames cost little beyond their launch gets
+/// full-size moving frames, though the per-pixel estimate says otherwise).
+int reducedScale(const FrameDemand& demand, double pixels, const ScheduleOptions& options);
 
 }  // namespace uvr::server

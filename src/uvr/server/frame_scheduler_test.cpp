@@ -108,17 +108,47 @@ TEST(FrameScheduler, TheEarliestRefinementIsTheWakeUp) {
     EXPECT_EQ(p.wakeAt, t0 + milliseconds(220));
 }
 
+/// A tab whose frames cost msPerPixel, none reduced yet.
+FrameDemand costing(double msPerPixel) {
+    FrameDemand d;
+    d.msPerPixel = msPerPixel;
+    return d;
+}
+
 TEST(FrameScheduler, ReducedScaleFitsTheTargetTime) {
     const ScheduleOptions o{milliseconds(150), 30.0, 8};
-    EXPECT_EQ(reducedScale(0.0, 1e6, o), 2);  // nothing measured yet
+    EXPECT_EQ(reducedScale(costing(0.0), 1e6, o), 2);  // nothing measured yet
     // 1e-5 ms a pixel: 1M pixels take 10 ms, within 30 ms at full size.
-    EXPECT_EQ(reducedScale(1e-5, 1e6, o), 1);
+    EXPECT_EQ(reducedScale(costing(1e-5), 1e6, o), 1);
     // 1e-4 ms a pixel: 100 ms at full size; a quarter of the pixels (scale 2) take 25 ms.
-    EXPECT_EQ(reducedScale(1e-4, 1e6, o), 2);
+    EXPECT_EQ(reducedScale(costing(1e-4), 1e6, o), 2);
     // 1e-3: 1000 ms; scale 6 renders 1/36 (27.8 ms), 5 would be 40 ms.
-    EXPECT_EQ(reducedScale(1e-3, 1e6, o), 6);
+    EXPECT_EQ(reducedScale(costing(1e-3), 1e6, o), 6);
     // Never coarser than maxScale.
-    EXPECT_EQ(reducedScale(1.0, 1e6, o), 8);
+    EXPECT_EQ(reducedScale(costing(1.0), 1e6, o), 8);
+}
+
+TEST(FrameScheduler, AFinerScaleIsTriedWhenTheCoarserTookHalfTheTarget) {
+    // The viewer at 100M tetrahedra on an H100 (docs/PERFORMANCE.md): 512x512 moving frames took
+    // 9.4 ms, which per pixel says 37.6 ms at 1024x1024; full size took 17 ms.
+    const ScheduleOptions o{milliseconds(150), 30.0, 8};
+    const double pixels = 1024.0 * 1024.0;
+    FrameDemand d;
+    EXPECT_EQ(reducedScale(d, pixels, o), 2);
+    d.measured(9.4 / (pixels / 4), 2);
+    EXPECT_EQ(reducedScale(d, pixels, o), 1);  // 9.4 ms is under half the target: try
+    d.measured(17.0 / pixels, 1);
+    EXPECT_EQ(reducedScale(d, pixels, o), 1);  // and it fits
+    // A full scale that did not fit is not tried again while its measure stands.
+    FrameDemand slow;
+    slow.measured(14.0 / (pixels / 4), 2);
+    EXPECT_EQ(reducedScale(slow, pixels, o), 1);
+    slow.measured(45.0 / pixels, 1);
+    EXPECT_EQ(reducedScale(slow, pixels, o), 2);
+    // Where the coarser scale took more than half the target, the per-pixel estimate decides.
+    FrameDemand busy;
+    busy.measured(20.0 / (pixels / 4), 2);
+    EXPECT_EQ(reducedScale(busy, pixels, o), 2);
 }
 
 TEST(FrameScheduler, MeasuredCostsAreAveraged) {
@@ -127,6 +157,10 @@ TEST(FrameScheduler, MeasuredCostsAreAveraged) {
     EXPECT_DOUBLE_EQ(d.msPerPixel, 4.0);
     d.measured(2.0);
     EXPECT_DOUBLE_EQ(d.msPerPixel, 3.0);
+    EXPECT_DOUBLE_EQ(d.reducedMsPerPixel[2], 0.0);  // full frames: no scale's
+    d.measured(1.0, 2);
+    EXPECT_DOUBLE_EQ(d.msPerPixel, 2.0);
+    EXPECT_DOUBLE_EQ(d.reducedMsPerPixel[2], 1.0);
 }
 
 }  // namespace

@@ -422,7 +422,7 @@ void ViewServer::Impl::renderLoop() {
         const std::uint64_t seq = s->seq;
         const int scale =
             kind == FrameKind::Reduced
-                ? reducedScale(s->demand.msPerPixel, double(state.width) * state.height, schedule)
+                ? reducedScale(s->demand, double(state.width) * state.height, schedule)
                 : 1;
         s->demand.start(kind);
         const bool resetRange = s->resetRange;
@@ -468,7 +468,7 @@ void ViewServer::Impl::renderLoop() {
             ViewFrame frame = this->frame(state, kind, scale, seq, encoding);
             {
                 std::lock_guard slk(m);
-                s->demand.measured(frame.msPerPixel);
+                s->demand.measured(frame.msPerPixel, kind == FrameKind::Reduced ? scale : 0);
             }
             post([meta = frame.meta.dump(), bytes = std::move(frame.bytes)](Session& c) mutable {
                 c.sendImage(meta, std::string(bytes.begin(), bytes.end()));
