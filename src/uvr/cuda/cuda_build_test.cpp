@@ -10,6 +10,7 @@
 #include <random>
 #include <tuple>
 
+#include "prepared_checks.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -372,25 +373,8 @@ TEST(CudaPrepare, WhenTheGpuLacksMemoryTheCpuBuildsTheSameMesh) {
     EXPECT_TRUE(says("building the partitions on the CPU instead of the GPU"));
     EXPECT_TRUE(says("building the neighbours on the CPU instead of the GPU"));
     // The same mesh as the CPU's build, so the same frames.
-    EXPECT_TRUE(testing::sameBytes(cpu.tets.tets, fell.tets.tets));
-    EXPECT_EQ(cpu.neighbors, fell.neighbors);
+    testing::expectSamePreparation(cpu, fell);
     EXPECT_TRUE(sameNodes(cpu.bvh.nodes, fell.bvh.nodes));
-    ASSERT_TRUE(cpu.kd && fell.kd);
-    EXPECT_EQ(cpu.kd->cells, fell.kd->cells);
-    ASSERT_TRUE(cpu.seeds && fell.seeds);
-    EXPECT_EQ(cpu.seeds->seeds, fell.seeds->seeds);
-    ASSERT_TRUE(cpu.macro && fell.macro);
-    EXPECT_TRUE(testing::sameBytes(cpu.macro->cells, fell.macro->cells));
-    RenderSettings s;
-    s.width = 96;
-    s.height = 72;
-    s.tf = transferFunctionPreset("cool-to-warm");
-    for (const RenderMethod method : {RenderMethod::Partitions, RenderMethod::Reference}) {
-        s.method = method;
-        EXPECT_TRUE(
-            testing::sameBytes(renderCpu(cpu, s).image.pixels, renderCpu(fell, s).image.pixels))
-            << methodName(method);
-    }
     // Without the limit the GPU builds again, and gives back all it took.
     const std::uint64_t held = cudaMemoryUse().bytes;
     options.buildDevice = Device::Cuda;

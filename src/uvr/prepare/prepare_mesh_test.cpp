@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "test_support.h"
+#include "prepared_checks.h"
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
@@ -96,23 +96,7 @@ TEST(PrepareMesh, WhatTheBuildersDeviceLacksMemoryForTheCpuBuilds) {
                         "building the partitions on the CPU instead of the test device"),
               heard.end());
     // The CPU's structures, so the CPU's frames.
-    EXPECT_EQ(fell.tets.tets.size(), cpu.tets.tets.size());
-    EXPECT_EQ(fell.neighbors, cpu.neighbors);
-    ASSERT_TRUE(fell.kd && cpu.kd && fell.seeds && cpu.seeds && fell.macro && cpu.macro);
-    EXPECT_EQ(fell.kd->cells, cpu.kd->cells);
-    EXPECT_EQ(fell.seeds->seeds, cpu.seeds->seeds);
-    EXPECT_EQ(fell.bvh.nodes.size(), cpu.bvh.nodes.size());
-    EXPECT_EQ(fell.gradientSpread, cpu.gradientSpread);
-    RenderSettings s;
-    s.width = 64;
-    s.height = 48;
-    s.tf = transferFunctionPreset("cool-to-warm");
-    for (const RenderMethod method : {RenderMethod::Partitions, RenderMethod::Reference}) {
-        s.method = method;
-        EXPECT_TRUE(
-            testing::sameBytes(renderCpu(cpu, s).image.pixels, renderCpu(fell, s).image.pixels))
-            << methodName(method);
-    }
+    testing::expectSamePreparation(cpu, fell);
     // Any other failure of a builder is the preparation's.
     o.kdSplitter = [](const TetMesh&, const KdBuildOptions&, const FractionFn&) -> KdTree {
         throw Error(ErrorKind::Internal, "CUDA error in a kernel");
