@@ -16,6 +16,7 @@
 #include "uvr/core/error.h"
 #include "uvr/cpu/cpu_renderer.h"
 #include "uvr/cuda/cuda_renderer.h"
+#include "uvr/facade/frame_report.h"
 #include "uvr/facade/renderer.h"
 #include "uvr/mesh/procedural.h"
 #include "uvr/render/frame_setup.h"
@@ -382,6 +383,57 @@ TEST(CudaPrepare, WhenTheGpuLacksMemoryTheCpuBuildsTheSameMesh) {
     EXPECT_TRUE(again.builtOnCpuInstead.empty());
     EXPECT_TRUE(again.builtElsewhere);
     EXPECT_EQ(cudaMemoryUse().bytes, held);
+}
+
+TEST(CudaPrepare, WhenTheGpuCannotHoldTheMeshAutoRendersOnTheCpu) {
+    UVR_REQUIRE_GPU();
+    const Mesh m = generateMesh([] {
+        ProceduralSpec spec;
+        spec.targetCells = 100000;
+        return spec;
+    }());
+    const ScalarField f = selectScalarField(m, {});
+    RenderSettings s;
+    s.width = 80;
+    s.height = 60;
+    s.tf = transferFunctionPreset("cool-to-warm");
+    RendererOptions cpuOnly;
+    cpuOnly.device = Device::Cpu;
+    Renderer onCpu(m, f, cpuOnly);
+    const RenderResult want = onCpu.render(s);
+    std::vector<std::string> heard;
+    {
+        const CudaMemoryLimit limit(std::uint64_t(1) << 20);  // a card of 1 MiB
+        Renderer r(m, f, RendererOptions{},
+                   ProgressFn([&](const std::string& line) { heard.push_back(line); }));
+        EXPECT_FALSE(r.onGpu());
+        EXPECT_STREQ(r.deviceName(), "cpu");
+        EXPECT_NE(r.deviceFallback().find("out of GPU memory allocating"), std::string::npos);
+        EXPECT_NE(r.deviceFallback().find("rendering on the CPU instead"), std::string::npos);
+        EXPECT_NE(std::find(heard.begin(), heard.end(), r.deviceFallback()), heard.end());
+        EXPECT_EQ(frameReport(r, s, r.render(s)).value("device_fallback", ""), r.deviceFallback());
+        // The CPU's choice of method, and its picture.
+        EXPECT_FALSE(r.prepared().autoChoice->gpu);
+        const RenderResult got = r.render(s);
+        EXPECT_GE(compareImages(toRgb8(want.image), toRgb8(got.image)).ssim, 0.99);
+        // Asking for the GPU keeps the error.
+        EXPECT_THROW(
+            {
+                try {
+                    RendererOptions cuda;
+                    cuda.device = Device::Cuda;
+                    Renderer(m, f, cuda);
+                } catch (const Error& e) {
+                    EXPECT_EQ(e.kind(), ErrorKind::Resource);
+                    throw;
+                }
+            },
+            Error);
+    }
+    // With the memory back, frames render on the GPU again.
+    const Renderer onGpu(m, f);
+    EXPECT_TRUE(onGpu.onGpu());
+    EXPECT_TRUE(onGpu.deviceFallback().empty());
 }
 
 }  // namespace

@@ -51,6 +51,7 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     j["field"] = prepared.tets.fieldName;
     j["field_association"] = associationName(prepared.tets.association);
     j["device"] = renderer.deviceName();
+    if (!renderer.deviceFallback().empty()) j["device_fallback"] = renderer.deviceFallback();
     if (const std::optional<GpuResidency> gpu = renderer.gpuResidency()) {
         const double bytes = double(gpu->geometryBytes);
         j["gpu"] = {{"description", cudaDeviceDescription()},

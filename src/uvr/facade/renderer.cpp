@@ -82,9 +82,24 @@ void checkDeviceUsable(Device device) {
                    "rendering on CUDA was asked for, but " + cudaDeviceDescription());
 }
 
-std::unique_ptr<CudaScene> uploadIf(Device device, const PreparedMesh& prepared,
-                                    const FractionFn& progress = {}) {
-    return resolvesToCuda(device) ? std::make_unique<CudaScene>(prepared, progress) : nullptr;
+/// The GPU's scene of the prepared mesh when frames render there, else null. Under
+/// Device::Auto a GPU without the memory for the scene leaves the frames to the CPU, as a GPU
+/// without the memory for a build leaves that build to the CPU (prepareMesh): the picture comes
+/// without the user choosing another device. `fallback` then says why (the progress hears it),
+/// and the mesh's Auto choice is made again for the CPU. Device::Cuda keeps the error.
+std::unique_ptr<CudaScene> uploadIf(Device device, PreparedMesh& prepared,
+                                    const ProgressFn& progress, std::string& fallback) {
+    if (!resolvesToCuda(device)) return nullptr;
+    try {
+        return std::make_unique<CudaScene>(prepared, progress.fraction);
+    } catch (const Error& e) {
+        if (device != Device::Auto || e.kind() != ErrorKind::Resource) throw;
+        fallback = std::string(e.what()) + "; rendering on the CPU instead";
+        if (progress) progress(fallback);
+        prepared.autoChoice =
+            prepared.piece ? prepared.piece->autoCpu : autoMethod(prepared.tets, /*gpu=*/false);
+        return nullptr;
+    }
 }
 
 }  // namespace
@@ -149,9 +164,11 @@ void Renderer::finishPreparation(const RendererOptions& options, const ProgressF
         progress("uploading " +
                  std::to_string((cudaSceneBytes(*prepared_) + (1u << 20) - 1) >> 20) +
                  " MiB to the GPU");
-    gpu_ = comm_ ? agreeOn(*comm_,
-                           [&] { return uploadIf(options.device, *prepared_, progress.fraction); })
-                 : uploadIf(options.device, *prepared_, progress.fraction);
+    gpu_ =
+        comm_ ? agreeOn(
+                    *comm_,
+                    [&] { return uploadIf(options.device, *prepared_, progress, deviceFallback_); })
+              : uploadIf(options.device, *prepared_, progress, deviceFallback_);
 }
 
 Renderer::Renderer(PreparedMesh prepared, Device device)
@@ -161,7 +178,7 @@ Renderer::Renderer(PreparedMesh prepared, Device device)
     const bool cuda = resolvesToCuda(device);
     if (!prepared_->autoChoice || prepared_->autoChoice->gpu != cuda)
         prepared_->autoChoice = autoMethod(prepared_->tets, cuda);
-    gpu_ = uploadIf(device, *prepared_);
+    gpu_ = uploadIf(device, *prepared_, {}, deviceFallback_);
 }
 
 Renderer::~Renderer() = default;

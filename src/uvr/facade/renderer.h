@@ -24,7 +24,7 @@ struct ValueRoutes;
 
 /// Where frames render, or where acceleration structures build.
 enum class Device {
-    Auto,  ///< CUDA when a CUDA device can be used, else the CPU
+    Auto,  ///< CUDA when a CUDA device can be used (and, for frames, holds the mesh), else the CPU
     Cpu,
     Cuda,
 };
@@ -127,6 +127,9 @@ public:
     bool onGpu() const { return gpu_ != nullptr; }
     /// "cpu" or "cuda".
     const char* deviceName() const { return gpu_ ? "cuda" : "cpu"; }
+    /// Why frames render on the CPU though RendererOptions::device was Auto and a GPU is there:
+    /// the GPU lacked the memory for the scene (the out-of-memory message); else empty.
+    const std::string& deviceFallback() const { return deviceFallback_; }
     /// One line naming the device: the GPU and its memory, or the CPU threads.
     std::string deviceDescription() const;
     /// What the renderer holds on the GPU when it renders there (else nothing).
@@ -172,6 +175,7 @@ private:
     std::uint64_t wholePointCount_ = 0, wholeCellCount_ = 0;  ///< that mesh's
     std::vector<double> rankPrepareSeconds_;
     std::uint64_t buildPeakBytes_ = 0;  ///< GpuResidency::buildPeakBytes
+    std::string deviceFallback_;        ///< deviceFallback()
 };
 
 }  // namespace uvr
