@@ -169,6 +169,20 @@ void Renderer::finishPreparation(const RendererOptions& options, const ProgressF
                     *comm_,
                     [&] { return uploadIf(options.device, *prepared_, progress, deviceFallback_); })
               : uploadIf(options.device, *prepared_, progress, deviceFallback_);
+    if (comm_) {
+        // The ranks render on one device (one method under Auto, one picture): where one rank's
+        // GPU could not hold its piece, every rank renders on the CPU.
+        const std::vector<std::uint64_t> fell =
+            comm_->allGatherValues(std::uint64_t(!deviceFallback_.empty()));
+        const auto first = std::find(fell.begin(), fell.end(), std::uint64_t(1));
+        if (first != fell.end() && gpu_) {
+            gpu_.reset();
+            prepared_->autoChoice = prepared_->piece->autoCpu;
+            deviceFallback_ = "rank " + std::to_string(first - fell.begin()) +
+                              "'s GPU lacked the memory for its piece; rendering on the CPU";
+            if (progress) progress(deviceFallback_);
+        }
+    }
 }
 
 Renderer::Renderer(PreparedMesh prepared, Device device)
