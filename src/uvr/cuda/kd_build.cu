@@ -110,8 +110,8 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
     // counted twice): the boxes (24 n bytes) and the level's cell list (4 c) throughout; the
     // sort's keys (16 c) while the medians are found; the side scans (8 c) and the next level's
     // list (4 c) while the cells move down. The node of an element is found from the level's
-    // offsets (nodeAt), not kept per element. So the peak is about 24 n + 20 c bytes: 46 GB at a
-    // billion tetrahedra (docs/PERFORMANCE.md).
+    // offsets (nodeAt), not kept per element. So the peak is about 24 n + 20 c bytes: 50 GB for
+    // a billion graded tetrahedra, c = 1.32 n (docs/PERFORMANCE.md).
     cuda::DeviceArray<Bounds3f> boxes;
     cuda::DeviceArray<std::uint32_t> cells, nextCells;
     boxes.reserve(n, "the tetrahedron boxes (GPU k-d build)");
