@@ -25,6 +25,7 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/morton.h"
+#include "uvr/core/runs.h"
 #include "uvr/mesh/tet_mesh.h"
 
 namespace uvr {
@@ -83,21 +84,6 @@ UVR_HOST_DEVICE inline LbvhInner lbvhInnerNode(const std::uint64_t* keys, std::i
     return r;
 }
 
-/// Index of the segment holding element x: the last s with begin[s] <= x (begin ascending, of
-/// `count` + 1 entries, begin[0] = 0 <= x < begin[count]); empty segments are passed over.
-UVR_HOST_DEVICE inline std::uint32_t lbvhSegmentOf(const std::uint64_t* begin, std::uint32_t count,
-                                                   std::uint64_t x) {
-    std::uint32_t lo = 0, hi = count;  // begin[lo] <= x < begin[hi]
-    while (hi - lo > 1) {
-        const std::uint32_t mid = lo + (hi - lo) / 2;
-        if (begin[mid] <= x)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /// The arrays of one build (host vectors for buildLbvhCpu, device memory for buildLbvhCuda), with
 /// the per-element work of each step: the drivers only sort, scan, loop or launch over the
 /// elements and, for the refit, supply the atomic count and the box loads.
@@ -120,7 +106,7 @@ struct LbvhBuildView {
     BvhNode* nodes = nullptr;
 
     UVR_HOST_DEVICE std::uint32_t segmentOf(std::uint64_t g) const {
-        return lbvhSegmentOf(segmentBegin, segments, g);
+        return runOf(segmentBegin, segments, g);
     }
     UVR_HOST_DEVICE Bounds3f primBounds(std::uint64_t prim) const {
         return mesh.cellBounds(tetIds ? tetIds[prim] : prim);

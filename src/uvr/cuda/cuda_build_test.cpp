@@ -32,10 +32,15 @@ bool sameNodes(const std::vector<BvhNode>& a, const std::vector<BvhNode>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(BvhNode)) == 0;
 }
 
-TetMesh proceduralTets(std::uint64_t cells) {
+/// The built-in procedural mesh of about `cells` cells.
+Mesh proceduralMesh(std::uint64_t cells) {
     ProceduralSpec spec;
     spec.targetCells = cells;
-    const Mesh m = generateMesh(spec);
+    return generateMesh(spec);
+}
+
+TetMesh proceduralTets(std::uint64_t cells) {
+    const Mesh m = proceduralMesh(cells);
     return tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
 }
 
@@ -290,11 +295,7 @@ TEST(CudaPrepare, MacrocellsAndGradientSpreadsEqualTheCpus) {
 TEST(CudaPrepare, MortonOrderEqualsTheCpus) {
     UVR_REQUIRE_GPU();
     for (const bool mixed : {false, true}) {
-        const Mesh m = mixed ? generateMixedCellMesh(24) : generateMesh([] {
-            ProceduralSpec spec;
-            spec.targetCells = 300000;
-            return spec;
-        }());
+        const Mesh m = mixed ? generateMixedCellMesh(24) : proceduralMesh(300000);
         const ScalarField f = selectScalarField(m, {});
         const TetMesh cpu = tetrahedralize(m, f, {});
         const TetMesh gpu = tetrahedralize(m, f, {.sorter = sortCellKeysCuda});
@@ -308,11 +309,7 @@ TEST(CudaPrepare, MortonOrderEqualsTheCpus) {
 
 TEST(CudaKd, PreparedOnTheGpuRendersAsOnTheCpu) {
     UVR_REQUIRE_GPU();
-    const Mesh m = generateMesh([] {
-        ProceduralSpec spec;
-        spec.targetCells = 200000;
-        return spec;
-    }());
+    const Mesh m = proceduralMesh(200000);
     PrepareOptions o;
     o.kd.leafCells = 4096;
     const PreparedMesh cpu = prepareMesh(m, selectScalarField(m, {}), o);
@@ -341,11 +338,7 @@ struct CudaMemoryLimit {
 
 TEST(CudaPrepare, WhenTheGpuLacksMemoryTheCpuBuildsTheSameMesh) {
     UVR_REQUIRE_GPU();
-    const Mesh m = generateMesh([] {
-        ProceduralSpec spec;
-        spec.targetCells = 200000;
-        return spec;
-    }());
+    const Mesh m = proceduralMesh(200000);
     const ScalarField f = selectScalarField(m, {});
     RendererOptions options;
     options.device = Device::Cpu;  // frames on the CPU: only the builders want the GPU
@@ -387,11 +380,7 @@ TEST(CudaPrepare, WhenTheGpuLacksMemoryTheCpuBuildsTheSameMesh) {
 
 TEST(CudaPrepare, WhenTheGpuCannotHoldTheMeshAutoRendersOnTheCpu) {
     UVR_REQUIRE_GPU();
-    const Mesh m = generateMesh([] {
-        ProceduralSpec spec;
-        spec.targetCells = 100000;
-        return spec;
-    }());
+    const Mesh m = proceduralMesh(100000);
     const ScalarField f = selectScalarField(m, {});
     RenderSettings s;
     s.width = 80;

@@ -17,6 +17,11 @@ namespace {
 
 std::atomic<std::uint64_t> heldBytes{0}, peakBytes{0}, limitBytes{0};
 
+/// What uvr's arrays may still take under a limit of `limit` bytes.
+std::uint64_t leftUnder(std::uint64_t limit) {
+    return limit - std::min(limit, heldBytes.load());
+}
+
 }  // namespace
 
 void check(cudaError_t status, const char* call, const char* file, int line) {
@@ -33,7 +38,7 @@ void outOfMemory(const std::string& what, std::size_t bytes) {
     cudaMemGetInfo(&freeBytes, &totalBytes);
     const char* of = "";
     if (const std::uint64_t limit = limitBytes.load()) {
-        freeBytes = limit - std::min(limit, heldBytes.load());
+        freeBytes = leftUnder(limit);
         totalBytes = limit;
         of = " (uvr's limit)";
     }
@@ -67,7 +72,7 @@ std::size_t freeDeviceMemory() {
     std::size_t freeBytes = 0, totalBytes = 0;
     UVR_CUDA_CHECK(cudaMemGetInfo(&freeBytes, &totalBytes));
     if (const std::uint64_t limit = limitBytes.load())
-        freeBytes = std::min<std::uint64_t>(freeBytes, limit - std::min(limit, heldBytes.load()));
+        freeBytes = std::min<std::uint64_t>(freeBytes, leftUnder(limit));
     return freeBytes;
 }
 

@@ -9,6 +9,7 @@
 #include <bit>
 
 #include "uvr/core/error.h"
+#include "uvr/core/runs.h"
 #include "uvr/cuda/cuda_build.h"
 #include "uvr/cuda/cuda_check.h"
 #include "uvr/cuda/cuda_renderer.h"
@@ -30,20 +31,6 @@ __device__ void flushBounds(const Bounds3f& b, std::uint32_t* keys) {
     }
 }
 
-/// The node of the level that element i of the level's cell list belongs to: the s with
-/// first[s] <= i < first[s + 1] (first: the m + 1 node offsets; empty nodes are skipped).
-__device__ std::uint32_t nodeAt(const std::uint64_t* first, std::uint32_t m, std::uint64_t i) {
-    std::uint32_t lo = 0, hi = m;  // first[lo] <= i < first[hi]
-    while (hi - lo > 1) {
-        const std::uint32_t mid = lo + (hi - lo) / 2;
-        if (first[mid] <= i)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /// Bounds of each node's cells over one chunk of kBoundsChunk consecutive elements, flushed
 /// whenever the node changes.
 __device__ void chunkBounds(std::uint64_t chunk, const std::uint32_t* cells,
@@ -51,7 +38,7 @@ __device__ void chunkBounds(std::uint64_t chunk, const std::uint32_t* cells,
                             const Bounds3f* boxes, std::uint32_t* keys) {
     const std::uint64_t begin = chunk * kBoundsChunk;
     const std::uint64_t end = begin + kBoundsChunk < count ? begin + kBoundsChunk : count;
-    std::uint32_t node = nodeAt(first, m, begin);
+    std::uint32_t node = runOf(first, m, begin);
     Bounds3f b;
     for (std::uint64_t i = begin; i < end; ++i) {
         if (i >= first[node + 1]) {
@@ -110,7 +97,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
     // counted twice): the boxes (24 n bytes) and the level's cell list (4 c) throughout; the
     // sort's keys (16 c) while the medians are found; the side scans (8 c) and the next level's
     // list (4 c) while the cells move down. The node of an element is found from the level's
-    // offsets (nodeAt), not kept per element. So the peak is about 24 n + 20 c bytes: 50 GB for
+    // offsets (runOf), not kept per element. So the peak is about 24 n + 20 c bytes: 50 GB for
     // a billion graded tetrahedra, c = 1.32 n (docs/PERFORMANCE.md).
     cuda::DeviceArray<Bounds3f> boxes;
     cuda::DeviceArray<std::uint32_t> cells, nextCells;
@@ -225,7 +212,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             const Bounds3f* b = boxes.data();
             std::uint64_t* k = keys[0].data();
             cuda::forEachElement("k-d centre keys", count, [=] __device__(std::uint64_t i) {
-                const std::uint32_t s = cuda::nodeAt(first, m, i);
+                const std::uint32_t s = runOf(first, m, i);
                 k[i] = (static_cast<std::uint64_t>(s) << 32) |
                        kdsplit::floatKey(b[c[i]].center()[ax[s]]);
             });
@@ -260,7 +247,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             const std::uint32_t* split = splitting.data();
             std::uint32_t *lo = belowScan.data(), *hi = aboveScan.data();
             cuda::forEachElement("k-d sides", count, [=] __device__(std::uint64_t i) {
-                const std::uint32_t s = cuda::nodeAt(first, m, i);
+                const std::uint32_t s = runOf(first, m, i);
                 const Bounds3f& box = b[c[i]];
                 lo[i] = split[s] && kdsplit::goesBelow(box, static_cast<int>(ax[s]), pl[s]);
                 hi[i] = split[s] && kdsplit::goesAbove(box, static_cast<int>(ax[s]), pl[s]);
@@ -337,7 +324,7 @@ KdTree buildKdTreeCuda(const TetMesh& mesh, const KdBuildOptions& options,
             const cuda::ChildPlace* pl = places.data();
             std::uint32_t* nc = nextCells.data();
             cuda::forEachElement("k-d scatter", count, [=] __device__(std::uint64_t i) {
-                const cuda::ChildPlace& p = pl[cuda::nodeAt(first, m, i)];
+                const cuda::ChildPlace& p = pl[runOf(first, m, i)];
                 if (!p.split) return;
                 if (bs[i + 1] != bs[i]) nc[p.belowBegin + bs[i] - p.belowBase] = c[i];
                 if (as[i + 1] != as[i]) nc[p.aboveBegin + as[i] - p.aboveBase] = c[i];

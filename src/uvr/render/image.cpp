@@ -252,10 +252,6 @@ std::uint32_t getU32(const std::uint8_t* p) {
            std::uint32_t(p[3]);
 }
 
-}  // namespace
-
-namespace {
-
 /// Appends a PNG chunk (length, type, data, CRC) to `out`.
 void appendChunk(std::vector<std::uint8_t>& out, const char* type, const std::uint8_t* data,
                  std::size_t size) {
