@@ -63,12 +63,17 @@ int main(int argc, char** argv) {
             }
         std::vector<int> order(ranks);
         for (int r = 0; r < ranks; ++r) order[r] = r;
-        const RerenderPiece again = [&](const std::vector<float>& stops, Image& image,
-                                        std::vector<std::uint32_t>& c) {
-            image = Image(width, height);  // an empty second pass: the asks and answers only
-            c.assign(stops.size(), 0);
-        };
         CompositeBuffers buffers;  // kept from call to call, as a renderer keeps them
+        CompositeOptions options;
+        options.stopAlpha = 0.99f;
+        options.restop = true;
+        options.rerender = [&](const PieceAsks& asks, PieceFrame& again) {
+            // An empty second pass: the asks and answers only.
+            again.image = Image(width, height);
+            again.counts.assign(asks.stops.size(), 0);
+        };
+        options.buffers = fresh ? nullptr : &buffers;
+        std::vector<float> depth;  // no depth out
         std::vector<double> seconds;
         std::uint64_t bytes = 0;
         for (int k = 0; k < repeat + 2; ++k) {
@@ -76,8 +81,7 @@ int main(int argc, char** argv) {
             std::vector<std::uint32_t> c = counts;
             comm.barrier();
             const auto start = std::chrono::steady_clock::now();
-            const CompositeStats stats =
-                compositeFrame(comm, image, c, order, 0, 0.99f, again, fresh ? nullptr : &buffers);
+            const CompositeStats stats = compositeFrame(comm, image, c, depth, order, options);
             const double s =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             if (k >= 2) seconds.push_back(s);  // two warm-up calls

@@ -2,9 +2,9 @@
 # SPDX-License-Identifier: MIT
 """Data-parallel rendering under mpirun (issue 31): `mpirun -n N uvr render` on real meshes with
 the CPU renderer, every method, against the one-process image of the same command: SSIM >= 0.999
-and no channel more than 2/255 apart (`uvr compare --min-ssim --max-diff`); likewise a .uvrm and
-a .pvtu read in parts, `uvr bench` and `uvr animate` (a series' values routed to the pieces; an
-Exodus II series read by parts). Also what a user gets wrong: a bad flag, a missing file and a
+and no channel more than 2/255 apart (`uvr compare --min-ssim --max-diff`); likewise the depth
+image out, a .uvrm and a .pvtu read in parts, `uvr bench` and `uvr animate` (a series' values
+routed to the pieces; an Exodus II series read by parts). Also what a user gets wrong: a bad flag, a missing file and a
 flag that is not data-parallel each end every rank with exit status 2 and one error line, and
 no output file.
 
@@ -112,6 +112,49 @@ def main():
                          "--max-diff", "2"])
                 detail = c.stdout.strip().replace("\n", " ")[:300]
                 check(c.returncode == 0, f"{mesh} {method}: {n} ranks = one process ({detail})")
+
+    # Depth out: where the whole opacity reaches --depth-opacity, noted by the rank whose light
+    # takes it there (a second pass for the pixels behind other ranks' light).
+    mesh, view = MESHES[0]
+    for method in METHODS:
+        base = [args.uvr, "render", os.path.join(args.data, mesh), "--device", "cpu", "--size",
+                SIZE, "--no-cache", "--method", method, "--tf", "viridis", "--opacity",
+                "0:0,0.5:0.3,1:0.8", "--depth-opacity", "0.4", "-q"] + view
+        depths = {}
+        for n in [1, 2]:
+            depths[n] = os.path.join(args.out, f"depth_{method}_{n}.npy")
+            image = os.path.join(args.out, f"depth_{method}_{n}.png")
+            stats = os.path.join(args.out, f"depth_{method}_{n}.json")
+            r = run((mpirun(n) if n > 1 else []) + base + ["-o", image, "--depth", depths[n],
+                                                           "--stats", stats])
+            check(r.returncode == 0, f"{mesh} {method}: depth out on {n} rank(s) "
+                  f"({r.stderr.strip()[-300:]})")
+        try:
+            with open(stats) as f:
+                step = json.load(f)["sample_distance"]
+        except (OSError, ValueError, KeyError):
+            step = 0.0
+        # Where the one-process depth is finite, the ranks' is too (but for a thousandth of the
+        # pixels). A piece's end also ends the stretch a depth is read in, so the sampling
+        # methods' depth may move there by less than a sample distance; elsewhere by less than
+        # a thousandth of the farthest depth (99% of the pixels).
+        compare = run(["/usr/bin/python3", "-c", f"""
+import numpy as np
+a = np.load({depths[1]!r}); b = np.load({depths[2]!r})
+fa, fb = np.isfinite(a), np.isfinite(b)
+both = fa & fb
+d = np.abs(a[both] - b[both])
+worst = float(d.max()) if both.any() else 0.0
+scale = float(np.abs(a[fa]).max()) if fa.any() else 1.0
+far = int((d > 1e-3 * scale).sum())
+print(int(fa.sum()), int((fa != fb).sum()), far, worst, {step!r})
+ok = (fa.sum() > a.size // 20 and (fa != fb).sum() <= fa.sum() // 1000 and
+      far <= fa.sum() // 100 and worst <= {step!r})
+raise SystemExit(0 if ok else 1)
+"""])
+        check(compare.returncode == 0, f"{mesh} {method}: depth on 2 ranks = one process "
+              f"(finite, disagreeing, far, worst, step: {compare.stdout.strip()} "
+              f"{compare.stderr[-200:]})")
 
     # A .uvrm: each rank reads only its part of the file.
     box = os.path.join(args.out, "box.uvrm")

@@ -66,7 +66,8 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
         settings, result.setup, result.image.pixels.data(), result.sampleCounts.data(),
         result.depth.empty() ? nullptr : result.depth.data(),
         settings.depthIn.empty() ? nullptr : settings.depthIn.data(),
-        settings.pixelStopAlpha.empty() ? nullptr : settings.pixelStopAlpha.data());
+        settings.pixelStopAlpha.empty() ? nullptr : settings.pixelStopAlpha.data(),
+        settings.pixelDepthAlpha.empty() ? nullptr : settings.pixelDepthAlpha.data());
     const auto start = std::chrono::steady_clock::now();
     dispatchKernel(
         mesh.tets.hasNative(), litKernel(result.setup.params), surfacesKernel(result.setup.params),

@@ -195,9 +195,10 @@ struct CudaScene::Impl {
     bool macroActive = false;  ///< macroShading holds this frame's shading (usesMacroCells)
     cuda::DeviceArray<Vec4f> pixels;
     cuda::DeviceArray<std::uint32_t> sampleCounts;
-    cuda::DeviceArray<float> depth;      ///< depth out (RenderSettings::depthAlpha)
-    cuda::DeviceArray<float> depthIn;    ///< depth in (RenderSettings::depthIn)
-    cuda::DeviceArray<float> stopAlpha;  ///< stop in (RenderSettings::pixelStopAlpha)
+    cuda::DeviceArray<float> depth;        ///< depth out (RenderSettings::depthAlpha)
+    cuda::DeviceArray<float> depthIn;      ///< depth in (RenderSettings::depthIn)
+    cuda::DeviceArray<float> stopAlpha;    ///< stop in (RenderSettings::pixelStopAlpha)
+    cuda::DeviceArray<float> depthAlphas;  ///< depth alpha in (RenderSettings::pixelDepthAlpha)
     cuda::DeviceArray<unsigned long long> totals;
     cuda::PinnedBuffer readBack;  ///< the frame's image, counts and depth on their way back
     double uploadSeconds = 0.0;
@@ -378,11 +379,13 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     if (!settings.depthIn.empty()) d.depthIn.upload(settings.depthIn, "the depth image given");
     const bool stopIn = !settings.pixelStopAlpha.empty();
     if (stopIn) d.stopAlpha.upload(settings.pixelStopAlpha, "the pixels' stop opacities");
+    const bool depthAlphaIn = !settings.pixelDepthAlpha.empty();
+    if (depthAlphaIn) d.depthAlphas.upload(settings.pixelDepthAlpha, "the pixels' depth opacities");
     UVR_CUDA_CHECK(cudaMemset(d.totals.data(), 0, cuda::kCounters * sizeof(unsigned long long)));
     const FrameView frame = makeFrameView(
         settings, result.setup, d.pixels.data(), d.sampleCounts.data(),
         depthOut ? d.depth.data() : nullptr, settings.depthIn.empty() ? nullptr : d.depthIn.data(),
-        stopIn ? d.stopAlpha.data() : nullptr);
+        stopIn ? d.stopAlpha.data() : nullptr, depthAlphaIn ? d.depthAlphas.data() : nullptr);
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);

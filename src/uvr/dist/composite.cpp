@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <span>
@@ -42,25 +43,35 @@ PixelBox activeBox(const Image& image, const std::vector<std::uint32_t>& counts)
     return b;
 }
 
-/// A pixel the second pass renders again, and the opacity its ray stops at.
+/// A pixel the second pass renders again: the opacity its ray stops at, and the one whose
+/// depth it notes (0: none).
 struct StopAsk {
     std::uint32_t pixel;  ///< index in the whole image
     float stop;
+    float depthAlpha;
+};
+
+/// What a band owner keeps of an ask: the band's pixel, the colour in front of the rank asked,
+/// and what the answer replaces (the colour behind that front: a stop asked; the depth: a
+/// depth asked).
+struct AskFront {
+    std::size_t i;
+    Vec4f front;
+    bool restop, depth;
 };
 
 /// compositeFrame's second pass (collective): each rank renders again the pixels the band
-/// owners ask of it (asks[r]: this band's asks of rank r; fronts[r]: their band index and the
-/// colour in front), and the band takes the new colours behind those fronts.
-void secondCompositingPass(Communicator& comm, const Image& image,
+/// owners ask of it (asks[r]: this band's asks of rank r; fronts[r]: what the band keeps of
+/// them), and the band takes the new colours behind those fronts and the depths asked for.
+void secondCompositingPass(Communicator& comm, const Image& image, bool depthOn,
                            const std::vector<std::vector<StopAsk>>& asks,
-                           const std::vector<std::vector<std::pair<std::size_t, Vec4f>>>& fronts,
-                           std::vector<Vec4f>& band, std::vector<std::uint32_t>& bandCounts,
+                           const std::vector<std::vector<AskFront>>& fronts, CompositeBuffers& b,
                            const RerenderPiece& rerender, CompositeStats& stats) {
     const int ranks = comm.size(), me = comm.rank();
     std::uint64_t total = 0;
     for (const std::vector<StopAsk>& a : asks) total += a.size();
     comm.allReduce(std::span<std::uint64_t>(&total, 1), ReduceOp::Sum);
-    if (total == 0) return;  // no ray stopped behind another rank's light: nothing to redo
+    if (total == 0) return;  // nothing to redo
     std::vector<std::vector<std::byte>> out(ranks);
     for (int r = 0; r < ranks; ++r) {
         appendBytes(out[r], asks[r].data(), asks[r].size());
@@ -72,23 +83,28 @@ void secondCompositingPass(Communicator& comm, const Image& image,
         for (int r = 0; r < ranks; ++r) asked[r] = fromBytes<StopAsk>(in[r]);
     }
     for (const std::vector<StopAsk>& a : asked) stats.rerenderedPixels += a.size();
-    Image again;
-    std::vector<std::uint32_t> againCounts;
+    PieceFrame again;
     std::exception_ptr failure;
     if (stats.rerenderedPixels > 0) {
         const auto start = std::chrono::steady_clock::now();
         try {
-            std::vector<float> stops(image.pixels.size(), 0.f);
+            PieceAsks piece;
+            piece.stops.assign(image.pixels.size(), 0.f);
+            if (depthOn) piece.depthAlphas.assign(image.pixels.size(), 0.f);
             for (int r = 0; r < ranks; ++r)
                 for (const StopAsk& a : asked[r]) {
-                    UVR_CHECK(
-                        a.pixel < stops.size() && a.stop > 0.f && a.stop <= 1.f,
-                        "rank " << r << " asked for pixel " << a.pixel << " to stop at " << a.stop);
-                    stops[a.pixel] = a.stop;
+                    UVR_CHECK(a.pixel < piece.stops.size() && a.stop > 0.f && a.stop <= 1.f &&
+                                  a.depthAlpha >= 0.f && a.depthAlpha <= 1.f &&
+                                  (depthOn || a.depthAlpha == 0.f),
+                              "rank " << r << " asked for pixel " << a.pixel << " to stop at "
+                                      << a.stop << " with depth at " << a.depthAlpha);
+                    piece.stops[a.pixel] = a.stop;
+                    if (depthOn) piece.depthAlphas[a.pixel] = a.depthAlpha;
                 }
-            rerender(stops, again, againCounts);
-            UVR_CHECK(again.pixels.size() == stops.size() &&
-                          (againCounts.empty() || againCounts.size() == stops.size()),
+            rerender(piece, again);
+            UVR_CHECK(again.image.pixels.size() == piece.stops.size() &&
+                          (again.counts.empty() || again.counts.size() == piece.stops.size()) &&
+                          (!depthOn || again.depth.size() == piece.stops.size()),
                       "the second pass's frame has the first one's size");
         } catch (...) {
             failure = std::current_exception();
@@ -97,32 +113,39 @@ void secondCompositingPass(Communicator& comm, const Image& image,
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     comm.agree(failure);
-    // The answers, in each asker's order: colour and samples.
+    // The answers, in each asker's order: colour, samples and, with depth out, depth.
     for (int r = 0; r < ranks; ++r) {
         out[r].clear();
         for (const StopAsk& a : asked[r]) {
-            const std::uint32_t c = againCounts.empty() ? 0u : againCounts[a.pixel];
-            appendBytes(out[r], &again.pixels[a.pixel], 1);
+            const std::uint32_t c = again.counts.empty() ? 0u : again.counts[a.pixel];
+            appendBytes(out[r], &again.image.pixels[a.pixel], 1);
             appendBytes(out[r], &c, 1);
+            if (depthOn) appendBytes(out[r], &again.depth[a.pixel], 1);
         }
         if (r != me) stats.bytesSent += out[r].size();
     }
     const std::vector<std::vector<std::byte>> answers = comm.allToAll(out);
-    constexpr std::size_t kAnswer = sizeof(Vec4f) + sizeof(std::uint32_t);
+    const std::size_t answer =
+        sizeof(Vec4f) + sizeof(std::uint32_t) + (depthOn ? sizeof(float) : 0);
     for (int r = 0; r < ranks; ++r) {
-        UVR_CHECK(answers[r].size() == fronts[r].size() * kAnswer,
+        UVR_CHECK(answers[r].size() == fronts[r].size() * answer,
                   "rank " << r << " answered " << answers[r].size() << " bytes for "
                           << fronts[r].size() << " pixels");
         for (std::size_t k = 0; k < fronts[r].size(); ++k) {
-            const auto& [i, front] = fronts[r][k];
+            const AskFront& f = fronts[r][k];
+            const std::byte* at = answers[r].data() + k * answer;
             Vec4f px;
             std::uint32_t c = 0;
-            std::memcpy(&px, answers[r].data() + k * kAnswer, sizeof(Vec4f));
-            std::memcpy(&c, answers[r].data() + k * kAnswer + sizeof(Vec4f), sizeof(c));
-            const float t = 1.f - front.w;
-            band[i] = Vec4f(front.x + t * px.x, front.y + t * px.y, front.z + t * px.z,
-                            front.w + t * px.w);
-            if (!bandCounts.empty()) bandCounts[i] += c;
+            std::memcpy(&px, at, sizeof(Vec4f));
+            std::memcpy(&c, at + sizeof(Vec4f), sizeof(c));
+            if (f.restop) {  // no rank was blended behind it: its opacity reached the stop
+                const float t = 1.f - f.front.w;
+                b.band[f.i] = Vec4f(f.front.x + t * px.x, f.front.y + t * px.y,
+                                    f.front.z + t * px.z, f.front.w + t * px.w);
+            }
+            if (f.depth)
+                std::memcpy(&b.bandDepth[f.i], at + sizeof(Vec4f) + sizeof(c), sizeof(float));
+            if (!b.bandCounts.empty()) b.bandCounts[f.i] += c;
         }
     }
 }
@@ -130,11 +153,11 @@ void secondCompositingPass(Communicator& comm, const Image& image,
 }  // namespace
 
 CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std::uint32_t>& counts,
-                              const std::vector<int>& order, int root, float stopAlpha,
-                              const RerenderPiece& rerender, CompositeBuffers* buffers) {
+                              std::vector<float>& depth, const std::vector<int>& order,
+                              const CompositeOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     CompositeBuffers own;
-    CompositeBuffers& b = buffers ? *buffers : own;
+    CompositeBuffers& b = options.buffers ? *options.buffers : own;
     CompositeStats stats;
     const int ranks = comm.size(), me = comm.rank();
     UVR_CHECK(int(order.size()) == ranks,
@@ -142,8 +165,19 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     const std::size_t width = static_cast<std::size_t>(image.width);
     const bool withCounts = !counts.empty();
     UVR_CHECK(!withCounts || counts.size() == image.pixels.size(), "sample counts' size");
+    const float depthAlpha = options.depthAlpha;
+    const bool depthOn = depthAlpha > 0.f;
+    UVR_CHECK(depthOn ? depth.size() == image.pixels.size() : depth.empty(),
+              "depths' size: " << depth.size() << " for " << image.pixels.size() << " pixels");
+    UVR_CHECK(depthAlpha <= 1.f, "depth out at opacity " << depthAlpha);
+    const bool secondPass = options.restop || depthOn;
+    UVR_CHECK(!secondPass || options.rerender, "a second pass without a renderer");
+    const float stopAlpha = options.stopAlpha;
+    // What each pixel of the messages and the bands holds: a colour, then a count and a depth.
+    const std::size_t pixelBytes =
+        sizeof(Vec4f) + (withCounts ? sizeof(std::uint32_t) : 0) + (depthOn ? sizeof(float) : 0);
     // Every rank's share of band r goes to rank r: the part of band r inside the box of its
-    // pixels that hold anything (a header, then the box's rows of colours, then of counts).
+    // pixels that hold anything (a header, then the box's rows of colours, of counts, of depths).
     const PixelBox active = activeBox(image, counts);
     std::vector<std::vector<std::byte>>& toEach = b.toEach;
     toEach.resize(ranks);
@@ -160,6 +194,9 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
         if (withCounts)
             for (int y = part.y0; y < part.y1; ++y)
                 appendBytes(toEach[r], counts.data() + y * width + part.x0, w);
+        if (depthOn)
+            for (int y = part.y0; y < part.y1; ++y)
+                appendBytes(toEach[r], depth.data() + y * width + part.x0, w);
         if (r != me) stats.bytesSent += toEach[r].size();
     }
     comm.allToAllInto(toEach, b.parts);
@@ -172,11 +209,12 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     band.assign(n, Vec4f(0.f, 0.f, 0.f, 0.f));
     std::vector<std::uint32_t>& bandCounts = b.bandCounts;
     bandCounts.assign(withCounts ? n : 0, 0);
-    // The second pass's asks: per rank, the pixels it renders again (band index, the colour in
-    // front of it there, the stop sent to it).
+    std::vector<float>& bandDepth = b.bandDepth;
+    bandDepth.assign(depthOn ? n : 0, INFINITY);
+    // The second pass's asks: per rank, the pixels it renders again, and what the band keeps of
+    // each.
     std::vector<std::vector<StopAsk>> asks(ranks);
-    std::vector<std::vector<std::pair<std::size_t, Vec4f>>> fronts(ranks);
-    const bool secondPass = bool(rerender) && stopAlpha < 1.f;
+    std::vector<std::vector<AskFront>> fronts(ranks);
     for (int r : order) {
         const std::vector<std::byte>& part = parts[r];
         PixelBox box;
@@ -188,10 +226,11 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
                   "rank " << r << " sent a box outside band [" << first << ", " << end << ")");
         const std::size_t w = empty ? 0 : box.x1 - box.x0, m = empty ? 0 : w * (box.y1 - box.y0);
         UVR_CHECK(
-            part.size() == sizeof box + m * (sizeof(Vec4f) + (withCounts ? 4 : 0)),
+            part.size() == sizeof box + m * pixelBytes,
             "rank " << r << " sent " << part.size() << " bytes for a box of " << m << " pixels");
         const std::byte* colours = part.data() + sizeof box;
         const std::byte* samples = colours + m * sizeof(Vec4f);
+        const std::byte* depths = samples + (withCounts ? m * sizeof(std::uint32_t) : 0);
         // k: the box's pixel (row by row), i: the same pixel in the band.
         for (std::size_t k = 0, x = 0, i = empty ? 0 : (box.y0 - first) * width + box.x0; k < m;
              ++k, ++i) {
@@ -212,20 +251,33 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
             acc.w += t * px.w;
             // Rank r's ray stopped at its own stopAlpha; one process's stopped where the whole
             // opacity reached it, which the light in front moves forward.
-            if (secondPass && front.w > 0.f && acc.w >= stopAlpha) {
+            const bool restop = options.restop && front.w > 0.f && acc.w >= stopAlpha;
+            // The whole opacity reaches depthAlpha in rank r's light: where its own does, with
+            // no light in front; else where its own reaches what the front leaves.
+            float depthAsk = 0.f;
+            if (depthOn && front.w < depthAlpha && acc.w >= depthAlpha) {
+                if (front.w > 0.f)
+                    depthAsk = (depthAlpha - front.w) / (1.f - front.w);
+                else
+                    std::memcpy(&bandDepth[i], depths + k * sizeof(float), sizeof(float));
+            }
+            if (restop || depthAsk > 0.f) {
                 asks[r].push_back({static_cast<std::uint32_t>(first * width + i),
-                                   (stopAlpha - front.w) / (1.f - front.w)});
-                fronts[r].emplace_back(i, front);
+                                   restop ? (stopAlpha - front.w) / (1.f - front.w) : stopAlpha,
+                                   depthAsk});
+                fronts[r].push_back({i, front, restop, depthAsk > 0.f});
             }
         }
     }
     if (secondPass)
-        secondCompositingPass(comm, image, asks, fronts, band, bandCounts, rerender, stats);
+        secondCompositingPass(comm, image, depthOn, asks, fronts, b, options.rerender, stats);
     // The bands to root.
     std::vector<std::byte>& mine = b.mine;
     mine.clear();
     appendBytes(mine, band.data(), n);
     if (withCounts) appendBytes(mine, bandCounts.data(), n);
+    if (depthOn) appendBytes(mine, bandDepth.data(), n);
+    const int root = options.root;
     if (me != root) stats.bytesSent += mine.size();
     comm.gatherInto(mine, root, b.bands);
     const std::vector<std::vector<std::byte>>& bands = b.bands;
@@ -233,11 +285,15 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
         for (int r = 0; r < ranks; ++r) {
             const auto [f, e] = compositeBand(image.height, r, ranks);
             const std::size_t m = (e - f) * width;
-            UVR_CHECK(bands[r].size() == m * (sizeof(Vec4f) + (withCounts ? 4 : 0)),
-                      "rank " << r << "'s band");
-            std::memcpy(image.pixels.data() + f * width, bands[r].data(), m * sizeof(Vec4f));
-            if (withCounts)
-                std::memcpy(counts.data() + f * width, bands[r].data() + m * sizeof(Vec4f), m * 4);
+            UVR_CHECK(bands[r].size() == m * pixelBytes, "rank " << r << "'s band");
+            const std::byte* at = bands[r].data();
+            std::memcpy(image.pixels.data() + f * width, at, m * sizeof(Vec4f));
+            at += m * sizeof(Vec4f);
+            if (withCounts) {
+                std::memcpy(counts.data() + f * width, at, m * sizeof(std::uint32_t));
+                at += m * sizeof(std::uint32_t);
+            }
+            if (depthOn) std::memcpy(depth.data() + f * width, at, m * sizeof(float));
         }
     }
     stats.seconds =

@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <mutex>
 #include <random>
 #include <vector>
 
+#include "uvr/core/error.h"
 #include "uvr/dist/in_process_communicator.h"
 
 namespace uvr {
@@ -64,7 +66,8 @@ TEST(Composite, OnlyEachRanksBoxIsSentAndTheFrameIsTheWholeBlend) {
         const int me = comm.rank();
         Image image = images[me];
         std::vector<std::uint32_t> c = counts[me];
-        const CompositeStats s = compositeFrame(comm, image, c, order, 0);
+        std::vector<float> depth;  // no depth out
+        const CompositeStats s = compositeFrame(comm, image, c, depth, order);
         std::lock_guard lk(mu);
         stats[me] = s;
         if (me == 0) frame = image, frameCounts = c;
@@ -87,6 +90,112 @@ TEST(Composite, OnlyEachRanksBoxIsSentAndTheFrameIsTheWholeBlend) {
     // corner: still less than the whole image it used to send.
     const std::uint64_t whole = std::uint64_t(kWidth) * kHeight * 20;
     EXPECT_LT(stats[1].bytesSent, whole * 2 / 3 + bandRows(1) * bandBytes);
+}
+
+/// Depth out, analytically: rank r's piece is, at every pixel, a slab of constant extinction
+/// from view depth 10 r' + 1 to 10 r' + 5 (r' its place in the order) of opacity a; its opacity
+/// reaches u at 1 + 4 ln(1 - u) / ln(1 - a) into it.
+float slabDepth(int place, float a, float u) {
+    if (!(u > 0.f) || !(a >= u)) return INFINITY;
+    const float f = a < 1.f ? std::log1p(-u) / std::log1p(-a) : 0.f;
+    return 10.f * float(place) + 1.f + 4.f * f;
+}
+
+TEST(Composite, DepthIsWhereTheWholeOpacityReachesItInTheRankWhoseLightTakesItThere) {
+    const std::vector<int> order = {2, 0, 1};
+    const float depthAlpha = 0.6f;
+    std::vector<int> place(3);
+    for (int k = 0; k < 3; ++k) place[order[k]] = k;
+    // Opacities: random per rank and pixel, some pixels with one rank alone.
+    std::vector<std::vector<float>> alpha(3, std::vector<float>(std::size_t(kWidth) * kHeight));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (std::size_t i = 0; i < alpha[0].size(); ++i)
+        for (int r = 0; r < 3; ++r) alpha[r][i] = (i % 7 == 0 && r != 1) ? 0.f : 0.9f * u(rng);
+    const auto colourOf = [&](int r, std::size_t i) {
+        const float a = alpha[r][i];
+        return Vec4f(0.3f * a, 0.5f * a, 0.2f * a, a);
+    };
+    // One process's depth: the first slab in order where the whole opacity reaches depthAlpha.
+    std::vector<float> expected(alpha[0].size(), INFINITY);
+    std::size_t behind = 0;  // pixels whose depth lies behind some light
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        float front = 0.f;
+        for (int r : order) {
+            const float after = front + (1.f - front) * alpha[r][i];
+            if (front < depthAlpha && after >= depthAlpha) {
+                expected[i] =
+                    slabDepth(place[r], alpha[r][i], (depthAlpha - front) / (1.f - front));
+                behind += front > 0.f;
+                break;
+            }
+            front = after;
+        }
+    }
+    ASSERT_GT(behind, expected.size() / 4);
+    std::mutex mu;
+    std::vector<float> depth;
+    std::uint64_t rerendered = 0;
+    Image frame;
+    InProcessGroup::run(3, [&](Communicator& comm) {
+        const int me = comm.rank();
+        Image image(kWidth, kHeight);
+        std::vector<std::uint32_t> counts(image.pixels.size(), 1u);
+        std::vector<float> mine(image.pixels.size());
+        for (std::size_t i = 0; i < mine.size(); ++i) {
+            image.pixels[i] = colourOf(me, i);
+            mine[i] = slabDepth(place[me], alpha[me][i], depthAlpha);
+        }
+        CompositeOptions options;
+        options.depthAlpha = depthAlpha;
+        options.rerender = [&](const PieceAsks& asks, PieceFrame& again) {
+            again.image = Image(kWidth, kHeight);
+            again.counts.assign(asks.stops.size(), 0u);
+            again.depth.assign(asks.stops.size(), INFINITY);
+            ASSERT_EQ(asks.depthAlphas.size(), asks.stops.size());
+            for (std::size_t i = 0; i < asks.stops.size(); ++i) {
+                if (asks.stops[i] == 0.f) continue;
+                again.image.pixels[i] = colourOf(me, i);
+                again.depth[i] = slabDepth(place[me], alpha[me][i], asks.depthAlphas[i]);
+            }
+        };
+        const CompositeStats s = compositeFrame(comm, image, counts, mine, order, options);
+        std::lock_guard lk(mu);
+        rerendered += s.rerenderedPixels;
+        if (me == 0) depth = mine, frame = image;
+    });
+    EXPECT_EQ(rerendered, behind);  // the depth in the first slab with light needs no second pass
+    ASSERT_EQ(depth.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        if (!(expected[i] < INFINITY)) {
+            EXPECT_FALSE(depth[i] < INFINITY) << "pixel " << i;
+            continue;
+        }
+        EXPECT_NEAR(depth[i], expected[i], 1e-4f * expected[i]) << "pixel " << i;
+        // The colour is the plain blend: the second pass asked for depth only.
+        Vec4f acc(0.f, 0.f, 0.f, 0.f);
+        for (int r : order) {
+            const Vec4f p = colourOf(r, i);
+            const float t = 1.f - acc.w;
+            acc = Vec4f(acc.x + t * p.x, acc.y + t * p.y, acc.z + t * p.z, acc.w + t * p.w);
+        }
+        EXPECT_EQ(frame.pixels[i].w, acc.w) << "pixel " << i;
+    }
+}
+
+TEST(Composite, BadDepthsAreRefused) {
+    InProcessGroup::run(2, [&](Communicator& comm) {
+        Image image(kWidth, kHeight);
+        std::vector<std::uint32_t> counts;
+        std::vector<float> depth(3);  // not one per pixel
+        CompositeOptions options;
+        options.depthAlpha = 0.5f;
+        options.rerender = [](const PieceAsks&, PieceFrame&) {};
+        EXPECT_THROW(compositeFrame(comm, image, counts, depth, {0, 1}, options), Error);
+        options.rerender = {};
+        depth.assign(image.pixels.size(), INFINITY);
+        EXPECT_THROW(compositeFrame(comm, image, counts, depth, {0, 1}, options), Error);
+    });
 }
 
 }  // namespace

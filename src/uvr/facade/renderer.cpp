@@ -205,11 +205,14 @@ RenderResult Renderer::render(const RenderSettings& settings) {
     if (!comm_) return renderLocal(settings);
     RenderResult result = agreeOn(*comm_, [&] {
         // Depth in ends every rank's rays where one process's end (the same camera, the same
-        // view depths); depth out needs the opacity in front of a rank's box.
-        if (settings.depthAlpha > 0.f)
+        // view depths); depth out asks a rank behind others' light for the depth of what that
+        // light leaves, at one ray a pixel.
+        if (settings.depthAlpha > 0.f && settings.supersample != 1)
             throwError(ErrorKind::Unsupported, "",
-                       "the depth image out (`depth`) is not rendered data-parallel yet: render "
-                       "it in one process");
+                       "the depth image out (`depth`) with supersample " +
+                           std::to_string(settings.supersample) +
+                           " is not rendered data-parallel: render it at supersample 1 or in "
+                           "one process");
         return renderLocal(settings);
     });
     // Every rank's piece composited onto rank 0, front to back in the boxes' order.
@@ -220,27 +223,29 @@ RenderResult Renderer::render(const RenderSettings& settings) {
     // A pixel stops taking ranks where one process's ray stops (exact integrates on to
     // kOpacityEnd, the sampling methods to the termination opacity).
     const bool exact = result.setup.method.method == RenderMethod::Exact;
-    const float stopAlpha = exact ? segment::kOpacityEnd : settings.terminationAlpha;
+    CompositeOptions composite;
+    composite.stopAlpha = exact ? segment::kOpacityEnd : settings.terminationAlpha;
     // Where a rank's ray stopped behind other ranks' light, it renders the pixel again to
     // one process's stop (exact's stop, 1 - 1e-6, leaves nothing to redo; a supersampled
     // pixel's rays stop each on its own, which one opacity per pixel cannot follow).
+    composite.restop = !exact && settings.supersample == 1;
+    composite.depthAlpha = settings.depthAlpha;
     std::uint64_t samples = result.stats.samples;
-    RerenderPiece rerender;
-    if (!exact && settings.supersample == 1)
-        rerender = [&](const std::vector<float>& stops, Image& image,
-                       std::vector<std::uint32_t>& counts) {
-            RenderSettings again = settings;
-            again.pixelStopAlpha = stops;
-            again.progress = {};
-            RenderResult r = renderLocal(again);
-            samples += r.stats.samples;
-            image = std::move(r.image);
-            counts = std::move(r.sampleCounts);
-        };
+    composite.rerender = [&](const PieceAsks& asks, PieceFrame& frame) {
+        RenderSettings again = settings;
+        again.pixelStopAlpha = asks.stops;
+        again.pixelDepthAlpha = asks.depthAlphas;
+        again.progress = {};
+        RenderResult r = renderLocal(again);
+        samples += r.stats.samples;
+        frame.image = std::move(r.image);
+        frame.counts = std::move(r.sampleCounts);
+        frame.depth = std::move(r.depth);
+    };
     if (!compositeBuffers_) compositeBuffers_ = std::make_unique<CompositeBuffers>();
+    composite.buffers = compositeBuffers_.get();
     const CompositeStats composited =
-        compositeFrame(*comm_, result.image, result.sampleCounts, order, 0, stopAlpha, rerender,
-                       compositeBuffers_.get());
+        compositeFrame(*comm_, result.image, result.sampleCounts, result.depth, order, composite);
     result.stats.samples = samples;
     // The ranks' counters summed, and each rank's share.
     std::uint64_t counters[5] = {result.stats.samples, result.stats.walkSteps,

@@ -276,7 +276,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const bool preintegrated = scene.base.params.preintegrated;
     const Lighting lighting = kernelLighting<kLit>(scene.base.params);
     SampleSegments<kLit, kSurf> segments;
-    segments.setIsos(scene.base.params.iso, lighting, ray.dir, scene.base.params.depthAlpha);
+    segments.setIsos(scene.base.params.iso, lighting, ray.dir,
+                     rayDepthAlpha(scene.base.params, counters));
     PointIsos<kSurf> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     // Isosurfaces: where a run may start at the mesh's boundary (sampleAtBoundary): after the
@@ -334,7 +335,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // Depth out: the opacity and the end of the stretch of the ray noted last, noted wherever
     // the run composites (after each sample, and where a transparent macrocell ends a run).
     [[maybe_unused]] float aNoted = 0.f, tNoted = tEnter;
-    [[maybe_unused]] const float depthAlpha = scene.base.params.depthAlpha;
+    [[maybe_unused]] const float depthAlpha = rayDepthAlpha(scene.base.params, counters);
     auto note = [&](float tNow) {
         if constexpr (kSurf) {
             if (segments.kDepth < INFINITY && !(counters.depth < INFINITY))

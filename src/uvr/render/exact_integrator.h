@@ -421,7 +421,8 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
             const float a0 = acc.w;
             smoothLitSegment<kNative>(mesh, scene.tf, tet, ray, ta, tb, va, vb, unit, light, acc);
             if constexpr (kSurf)
-                noteDepth(scene.params.depthAlpha, a0, acc.w, float(ta), float(tb), counters);
+                noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, float(ta), float(tb),
+                          counters);
             return;
         }
     }
@@ -430,7 +431,8 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
     if constexpr (kLit) {
         if (light.on) lightSegment(before, lightInTet<kNative>(mesh, tet, ray, tb, light), acc);
         if constexpr (kSurf)
-            noteDepth(scene.params.depthAlpha, before.w, acc.w, float(ta), float(tb), counters);
+            noteDepth(rayDepthAlpha(scene.params, counters), before.w, acc.w, float(ta), float(tb),
+                      counters);
     }
 }
 
@@ -456,7 +458,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void isoTetSegment(const SceneView& scene, std::uin
             lightInTet<kNative>(scene.locator.mesh, tet, ray, tc, surfaceLighting(light));
         const float a0 = acc.w;
         compositeIso(iso, scene.tf.sample(iso.value).xyz(), lit, acc);
-        noteDepth(scene.params.depthAlpha, a0, acc.w, float(tc), float(tc), counters);
+        noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, float(tc), float(tc), counters);
         ta = tc, va = iso.value;
     });
     if (acc.w < segment::kOpacityEnd)
@@ -536,7 +538,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
         if (tEnd > t) {
             ++counters.samples;  // one segment per cell crossed
             float s1;
-            [[maybe_unused]] const float depthAlpha = scene.params.depthAlpha;
+            [[maybe_unused]] const float depthAlpha = rayDepthAlpha(scene.params, counters);
             if (kNative && continuous && tet >= loc.mesh.tetCount) {
                 [[maybe_unused]] const float a0 = acc.w;
                 s1 = exact::nativeSegment<kLit, kSurf>(loc.mesh, scene.tf, tet, ray, t, tEnd,

@@ -30,6 +30,9 @@ struct FrameView {
     /// at which its ray stops (the sampling methods); 0: the pixel is left transparent, without
     /// a ray. One ray per pixel (supersample 1).
     const float* stopAlpha = nullptr;
+    /// Depth alpha in (null: the frame's; RenderSettings::pixelDepthAlpha): per pixel the
+    /// opacity whose depth its ray notes (0: none). One ray per pixel (supersample 1).
+    const float* depthAlphas = nullptr;
     /// View depths (file units) from ray parameters (rendering units): z = (rayStartDepth + t
     /// dot(dir, viewDirection)) / depthScale.
     Vec3f viewDirection{0.f, 0.f, -1.f};
@@ -85,6 +88,7 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
         Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
         if (frame.depthIn) ray.tMax = frame.rayParameter(ray, frame.depthIn[i]);
         RayCounters counters;
+        if (frame.depthAlphas) counters.depthAlpha = frame.depthAlphas[i];
         const float stop = frame.stopAlpha ? frame.stopAlpha[i] : kSceneStop;
         if (!(stop != 0.f)) {  // not rendered (a data-parallel second pass's other pixels)
             frame.pixels[i] = Vec4f(0.f, 0.f, 0.f, 0.f);

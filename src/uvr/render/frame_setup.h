@@ -132,7 +132,8 @@ struct FrameSetup {
 /// null), depthIn (depth in, or null) and stopAlpha (stop in, or null).
 inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup& setup,
                                Vec4f* pixels, std::uint32_t* sampleCounts, float* depth = nullptr,
-                               const float* depthIn = nullptr, const float* stopAlpha = nullptr) {
+                               const float* depthIn = nullptr, const float* stopAlpha = nullptr,
+                               const float* depthAlphas = nullptr) {
     FrameView v;
     v.pixels = pixels;
     v.sampleCounts = sampleCounts;
@@ -144,6 +145,7 @@ inline FrameView makeFrameView(const RenderSettings& settings, const FrameSetup&
     v.depth = depth;
     v.depthIn = depthIn;
     v.stopAlpha = stopAlpha;
+    v.depthAlphas = depthAlphas;
     v.viewDirection = setup.viewDirection;
     v.rayStartDepth = setup.rayStartDepth;
     v.depthScale = static_cast<float>(setup.frame.scale);

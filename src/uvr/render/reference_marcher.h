@@ -59,7 +59,7 @@ struct SampleSegments {
     const IsoView* iso = nullptr;   ///< the isosurfaces (null: none)
     Lighting surface;               ///< their lighting (surfaceLighting)
     Vec3f dir{0.f, 0.f, 1.f};       ///< the ray's direction
-    float depthAlpha = 0.f;         ///< depth out (MarchParams::depthAlpha)
+    float depthAlpha = 0.f;         ///< depth out (the ray's: rayDepthAlpha)
     /// Depth out: the grid position where an isosurface took the opacity to depthAlpha
     /// (infinity: none did); the marchers prefer it to their coarser stretches.
     float kDepth = INFINITY;
@@ -287,7 +287,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
 /// surface coloured by the transfer function at the field's value there, lit by the headlight
 /// with normal n (`surface`: the frame's coefficients, always on), composited under what acc
 /// holds and ending the ray. Returns whether the point lay inside the mesh. The depth asked for
-/// (params.depthAlpha) is reached there if not before.
+/// (rayDepthAlpha) is reached there if not before.
 template <bool kNative, class Locate>
 UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParams& params,
                                           const TetMeshView& mesh, const TfTableView& tf,
@@ -301,7 +301,7 @@ UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParam
     // are.
     compositeIso(IsoSurface{}, tf.sample(mesh.interpolate<kNative>(c, bary)).xyz(),
                  lightFactors(surfaceLighting(params.light), n, ray.dir), acc);
-    if (params.depthAlpha > 0.f && !(counters.depth < INFINITY)) counters.depth = t;
+    if (rayDepthAlpha(params, counters) > 0.f && !(counters.depth < INFINITY)) counters.depth = t;
     return true;
 }
 
@@ -368,7 +368,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float stopAlpha = stop < 0.f ? scene.params.terminationAlpha : stop;
     SampleSegments<kLit, kSurf> segments;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
-    segments.setIsos(scene.params.iso, lighting, ray.dir, scene.params.depthAlpha);
+    segments.setIsos(scene.params.iso, lighting, ray.dir, rayDepthAlpha(scene.params, counters));
     if (pieceStart && scene.params.preintegrated && k - 1.f >= ceilf(tSpan / s)) {
         // The piece before's last sample, in the ghost cells: the slope of the run the first
         // sample may continue, as one process's run has it.
@@ -418,7 +418,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         if constexpr (kSurf) {
             if (segments.kDepth < INFINITY && !(counters.depth < INFINITY))
                 counters.depth = segments.kDepth * s;
-            noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, k * s, counters);
+            noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, tNoted, k * s, counters);
             tNoted = k * s;
         }
         opaque = acc.w >= stopAlpha;
@@ -436,7 +436,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             }
         }
         segments.finish(scene.tf, s, unit, acc);
-        if constexpr (kSurf) noteDepth(scene.params.depthAlpha, a0, acc.w, tNoted, t1, counters);
+        if constexpr (kSurf)
+            noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, tNoted, t1, counters);
     }
     if constexpr (kSurf) {  // the cut face behind the volume
         if (cut1 && !opaque)

@@ -199,6 +199,27 @@ void validateSettings(const RenderSettings& s) {
     checkDepth(s);
 }
 
+namespace {
+
+/// A per-pixel opacity setting (pixelStopAlpha, pixelDepthAlpha): none, or one opacity in [0, 1]
+/// per pixel with one ray a pixel.
+void checkPixelOpacities(const RenderSettings& s, const std::vector<float>& v, const char* name,
+                         const char* what) {
+    if (v.empty()) return;
+    if (v.size() != std::size_t(s.width) * std::size_t(std::max(s.height, 0)))
+        throw SettingError(name, std::to_string(v.size()) + " " + what,
+                           "expected one per pixel: " + std::to_string(s.width) + " x " +
+                               std::to_string(s.height));
+    if (s.supersample != 1)
+        throw SettingError(name, "given", "expected supersample 1 (one ray a pixel)");
+    for (std::size_t i = 0; i < v.size(); ++i)
+        if (!(v[i] >= 0.f && v[i] <= 1.f))
+            throw SettingError(name, formatG(v[i], 6) + " at pixel " + std::to_string(i),
+                               "expected opacities in [0, 1]");
+}
+
+}  // namespace
+
 void checkDepth(const RenderSettings& s) {
     if (!(s.depthAlpha >= 0.f && s.depthAlpha <= 1.f))
         throw SettingError("depth_alpha", formatG(s.depthAlpha, 6), "expected a number in [0, 1]");
@@ -207,18 +228,11 @@ void checkDepth(const RenderSettings& s) {
         throw SettingError("depth_in", std::to_string(s.depthIn.size()) + " depths",
                            "expected one per pixel: " + std::to_string(s.width) + " x " +
                                std::to_string(s.height));
-    if (s.pixelStopAlpha.empty()) return;
-    if (s.pixelStopAlpha.size() != std::size_t(s.width) * std::size_t(std::max(s.height, 0)))
-        throw SettingError("pixel_stop_alpha", std::to_string(s.pixelStopAlpha.size()) + " stops",
-                           "expected one per pixel: " + std::to_string(s.width) + " x " +
-                               std::to_string(s.height));
-    if (s.supersample != 1)
-        throw SettingError("pixel_stop_alpha", "given", "expected supersample 1 (one ray a pixel)");
-    for (std::size_t i = 0; i < s.pixelStopAlpha.size(); ++i)
-        if (!(s.pixelStopAlpha[i] >= 0.f && s.pixelStopAlpha[i] <= 1.f))
-            throw SettingError("pixel_stop_alpha",
-                               formatG(s.pixelStopAlpha[i], 6) + " at pixel " + std::to_string(i),
-                               "expected opacities in [0, 1]");
+    checkPixelOpacities(s, s.pixelStopAlpha, "pixel_stop_alpha", "stops");
+    checkPixelOpacities(s, s.pixelDepthAlpha, "pixel_depth_alpha", "opacities");
+    if (!s.pixelDepthAlpha.empty() && !(s.depthAlpha > 0.f))
+        throw SettingError("pixel_depth_alpha", "given",
+                           "expected depth_alpha above 0 (depth out)");
 }
 
 void checkClip(const RenderSettings& s) {

@@ -103,6 +103,12 @@ struct RenderSettings {
     /// (docs/METHOD.md, "Data-parallel rendering"). 0: the pixel is not rendered (transparent,
     /// no samples). With supersample 1 only. Empty: none.
     std::vector<float> pixelStopAlpha;
+    /// Depth alpha in: width x height opacities, row 0 at the top, each the opacity whose depth
+    /// that pixel's ray notes instead of depthAlpha (which must be above 0): a data-parallel
+    /// rank behind others' light notes the depth where one process's ray reaches depthAlpha,
+    /// at what the opacity in front leaves. 0: no depth at that pixel. With supersample 1 only.
+    /// Empty: none.
+    std::vector<float> pixelDepthAlpha;
     /// Called during a CPU render with the fraction of the frame done, increasing, the last call
     /// with 1; from one thread at a time, and it must not throw. Empty: no reports. (A CUDA frame
     /// is one launch and reports nothing.)

@@ -71,7 +71,16 @@ struct RayCounters {
     /// Depth out (MarchParams::depthAlpha): the ray parameter where the accumulated opacity
     /// first reached it; infinity where it never did.
     float depth = INFINITY;
+    /// Depth out, in: the opacity whose depth this ray notes, when it is its own (a
+    /// data-parallel rank's pixel behind others' light: FrameView::depthAlphas; 0: none);
+    /// negative: the frame's, MarchParams::depthAlpha (rayDepthAlpha).
+    float depthAlpha = -1.f;
 };
+
+/// The opacity whose depth a ray notes: its own (RayCounters::depthAlpha) or the frame's.
+UVR_HOST_DEVICE inline float rayDepthAlpha(const MarchParams& p, const RayCounters& c) {
+    return c.depthAlpha >= 0.f ? c.depthAlpha : p.depthAlpha;
+}
 
 /// Depth out: a stretch [t0, t1] of the ray took the accumulated opacity from a0 to a1; where
 /// that first reaches `alpha` (> 0) the ray's depth is noted, read within the stretch as if its
