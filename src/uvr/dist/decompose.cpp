@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "uvr/dist/decompose.h"
 
+#include <omp.h>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <parallel/algorithm>
 #include <string>
 
 #include "uvr/core/error.h"
@@ -116,6 +119,35 @@ Bounds3f reduceBounds(Communicator& comm, const Bounds3f& b) {
 }
 
 namespace {
+
+/// Runs body(first, end, run) over [0, n) cut into one contiguous run per thread (OpenMP's),
+/// run k holding [k n / runs, (k + 1) n / runs), and returns the run count. What each run appends
+/// to lists of its own, joined in run order (joinRuns), is what one loop over [0, n) appends.
+template <class Body>
+int inRuns(std::size_t n, Body&& body) {
+    const int runs =
+        static_cast<int>(std::clamp<std::size_t>(n / 4096, 1, std::size_t(omp_get_max_threads())));
+#pragma omp parallel for schedule(static, 1) num_threads(runs)
+    for (int k = 0; k < runs; ++k)
+        body(n * std::size_t(k) / std::size_t(runs), n * std::size_t(k + 1) / std::size_t(runs), k);
+    return runs;
+}
+
+/// The runs' lists of each rank joined in run order: out[r] = runs[0][r], runs[1][r], ...
+std::vector<std::vector<std::uint32_t>> joinRuns(
+    std::vector<std::vector<std::vector<std::uint32_t>>>& runs, int ranks) {
+    std::vector<std::vector<std::uint32_t>> out(ranks);
+    for (int r = 0; r < ranks; ++r) {
+        std::size_t total = 0;
+        for (const auto& run : runs) total += run[r].size();
+        out[r].reserve(total);
+        for (auto& run : runs) {
+            out[r].insert(out[r].end(), run[r].begin(), run[r].end());
+            run[r] = {};
+        }
+    }
+    return out;
+}
 
 /// The volume of a box (0 when empty).
 double volumeOf(const Bounds3f& b) {
@@ -333,6 +365,12 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     out.field.association = share.field.association;
     out.field.choice = share.field.choice;
     out.shareCells = share.mesh.cellCount();
+    auto since = std::chrono::steady_clock::now();
+    const auto phaseDone = [&](const char* name) {
+        const auto now = std::chrono::steady_clock::now();
+        out.phaseSeconds.emplace_back(name, std::chrono::duration<double>(now - since).count());
+        since = now;
+    };
     // Step 1: the share split as one process splits it, in the whole mesh's frame (found from
     // every share's kept cells, as tetrahedralize finds it from the whole mesh's).
     if (progress)
@@ -374,6 +412,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         piece->autoCpu = autoMethodFor(sums[2], piece->bounds, false);
         piece->autoGpu = autoMethodFor(sums[3], piece->bounds, true);
     }
+    phaseDone("distribute_split");
     // Step 3: the top of the whole tree, the costliest node split until there is one per rank.
     if (progress)
         progress("splitting the whole mesh's k-d tree among " + std::to_string(ranks) + " ranks");
@@ -386,7 +425,8 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     std::vector<Vec3f> centres(n);
     {
         const TetMeshView view = tets.view();
-        for (std::size_t t = 0; t < n; ++t)
+#pragma omp parallel for schedule(static)
+        for (std::int64_t t = 0; t < std::int64_t(n); ++t)
             boxes[t] = view.cellBounds(t), centres[t] = boxes[t].center();
     }
     tets = TetMesh();
@@ -460,6 +500,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     centres = {};
     piece->region = d.regions[me];
     piece->depth = d.depths[me];
+    phaseDone("distribute_tree");
     // Step 4: each source cell to every rank whose box, widened by the ghosts, it reaches.
     if (progress) progress("moving cells to the ranks that render them");
     // A little past the farthest sample ending a piece's last segment.
@@ -477,7 +518,8 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     routes.receivePoints.resize(ranks), routes.receiveCells.resize(ranks);
     // The share's points in the rendering frame, and whether each lies in a rank's widened box.
     std::vector<Vec3f> local(share.mesh.points.size());
-    for (std::size_t i = 0; i < local.size(); ++i) {
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < std::int64_t(local.size()); ++i) {
         double p[3];
         frame.toLocal(share.mesh.points[i], p);
         local[i] = Vec3f(float(p[0]), float(p[1]), float(p[2]));
@@ -489,28 +531,40 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         return true;
     };
     // Which ranks each cell reaches (its bounds against each widened box).
-    std::vector<std::vector<std::uint32_t>> reaching(ranks);
-    for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
-        Bounds3f box;
-        for (std::uint32_t id : share.mesh.cell(c)) box.extend(local[id]);
-        for (int r = 0; r < ranks; ++r) {
-            bool reaches = !box.empty();
-            for (int a = 0; a < 3; ++a)
-                reaches = reaches && box.lo[a] <= d.regions[r].hi[a] + ghost &&
-                          box.hi[a] >= d.regions[r].lo[a] - ghost;
-            if (reaches) reaching[r].push_back(static_cast<std::uint32_t>(c));
+    const std::size_t shareCells = share.mesh.cellCount();
+    std::vector<std::vector<std::vector<std::uint32_t>>> runs(
+        omp_get_max_threads(), std::vector<std::vector<std::uint32_t>>(ranks));
+    runs.resize(inRuns(shareCells, [&](std::size_t first, std::size_t end, int run) {
+        std::vector<std::vector<std::uint32_t>>& lists = runs[run];
+        for (std::size_t c = first; c < end; ++c) {
+            Bounds3f box;
+            for (std::uint32_t id : share.mesh.cell(c)) box.extend(local[id]);
+            for (int r = 0; r < ranks; ++r) {
+                bool reaches = !box.empty();
+                for (int a = 0; a < 3; ++a)
+                    reaches = reaches && box.lo[a] <= d.regions[r].hi[a] + ghost &&
+                              box.hi[a] >= d.regions[r].lo[a] - ghost;
+                if (reaches) lists[r].push_back(static_cast<std::uint32_t>(c));
+            }
         }
-    }
+    }));
+    std::vector<std::vector<std::uint32_t>> reaching = joinRuns(runs, ranks);
     // A smooth normal at a point is the mean over every cell around it, so a piece also takes
     // the cells around the points its cells have outside its widened box (whichever rank's
     // share holds them): the ranks' lists of such points (global ids), one all-gather.
     {
         std::vector<std::uint64_t> outside;  // per rank r: a count, then r's ids
         for (int r = 0; r < ranks; ++r) {
+            std::vector<std::vector<std::uint64_t>> idRuns(omp_get_max_threads());
+            idRuns.resize(
+                inRuns(reaching[r].size(), [&](std::size_t first, std::size_t end, int run) {
+                    for (std::size_t k = first; k < end; ++k)
+                        for (std::uint32_t id : share.mesh.cell(reaching[r][k]))
+                            if (!inWidened(local[id], r)) idRuns[run].push_back(share.pointIds[id]);
+                }));
             std::vector<std::uint64_t> ids;
-            for (std::uint32_t c : reaching[r])
-                for (std::uint32_t id : share.mesh.cell(c))
-                    if (!inWidened(local[id], r)) ids.push_back(share.pointIds[id]);
+            for (const std::vector<std::uint64_t>& run : idRuns)
+                ids.insert(ids.end(), run.begin(), run.end());
             std::sort(ids.begin(), ids.end());
             ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
             outside.push_back(ids.size());
@@ -538,21 +592,26 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
             }
         }
         // This share's cells around those points, for each rank whose widened box they miss.
-        std::vector<std::vector<std::uint32_t>> more(ranks);
-        for (std::uint64_t c = 0; c < share.mesh.cellCount(); ++c) {
-            const std::span<const std::uint32_t> corners = share.mesh.cell(c);
-            if (std::none_of(corners.begin(), corners.end(),
-                             [&](std::uint32_t id) { return inRing[id] != 0; }))
-                continue;
-            const auto cell = static_cast<std::uint32_t>(c);
-            for (int r = 0; r < ranks; ++r)
-                if (!std::binary_search(reaching[r].begin(), reaching[r].end(), cell) &&
-                    std::any_of(corners.begin(), corners.end(), [&](std::uint32_t id) {
-                        return inRing[id] && std::binary_search(rings[r].begin(), rings[r].end(),
-                                                                share.pointIds[id]);
-                    }))
-                    more[r].push_back(cell);
-        }
+        runs.assign(omp_get_max_threads(), std::vector<std::vector<std::uint32_t>>(ranks));
+        runs.resize(inRuns(shareCells, [&](std::size_t first, std::size_t end, int run) {
+            for (std::size_t c = first; c < end; ++c) {
+                const std::span<const std::uint32_t> corners = share.mesh.cell(c);
+                if (std::none_of(corners.begin(), corners.end(),
+                                 [&](std::uint32_t id) { return inRing[id] != 0; }))
+                    continue;
+                const auto cell = static_cast<std::uint32_t>(c);
+                for (int r = 0; r < ranks; ++r)
+                    if (!std::binary_search(reaching[r].begin(), reaching[r].end(), cell) &&
+                        std::any_of(corners.begin(), corners.end(), [&](std::uint32_t id) {
+                            return inRing[id] &&
+                                   std::binary_search(rings[r].begin(), rings[r].end(),
+                                                      share.pointIds[id]);
+                        }))
+                        runs[run][r].push_back(cell);
+            }
+        }));
+        const std::vector<std::vector<std::uint32_t>> more = joinRuns(runs, ranks);
+        runs = {};
         for (int r = 0; r < ranks; ++r) {
             if (more[r].empty()) continue;
             std::vector<std::uint32_t> merged;
@@ -562,8 +621,10 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         }
     }
     local = {};
+    phaseDone("distribute_reach");
     // The messages: per rank, its cells' points once each and the cells as indices into them.
     std::vector<std::vector<std::byte>> toEach(ranks);
+    CellMessage own;  // this rank's cells for itself: kept as they are, not packed
     {
         std::vector<int> sentTo(share.mesh.points.size(), -1);
         std::vector<std::uint32_t> slot(share.mesh.points.size());
@@ -589,7 +650,10 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
                 if (!pointData) m.values.push_back(share.field.values[c]);
             }
             reaching[r] = {};
-            toEach[r] = m.pack();
+            if (r == me)
+                own = std::move(m);
+            else
+                toEach[r] = m.pack();
         }
     }
     if (!routes.points) routes.sendPoints.assign(ranks, {});
@@ -597,11 +661,13 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
     share = MeshShare();
     std::vector<std::vector<std::byte>> received = comm.allToAll(toEach);
     toEach = {};
+    phaseDone("distribute_exchange");
     // Step 5: the piece: its points in the whole mesh's order, its cells in the whole mesh's.
     std::vector<CellMessage> got(ranks);
     std::vector<std::uint64_t> pointStart(ranks + 1, 0), cellStart(ranks + 1, 0);
     for (int from = 0; from < ranks; ++from) {
-        got[from] = CellMessage::unpack(received[from], !pointData, from);
+        got[from] =
+            from == me ? std::move(own) : CellMessage::unpack(received[from], !pointData, from);
         received[from] = {};
         pointStart[from + 1] = pointStart[from] + got[from].points.size();
         cellStart[from + 1] = cellStart[from] + got[from].cellIds.size();
@@ -642,7 +708,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         if (sorted)
             std::inplace_merge(cellOrder.begin(), cellOrder.begin() + begin, cellOrder.end());
     }
-    if (!sorted) std::sort(cellOrder.begin(), cellOrder.end());
+    if (!sorted) __gnu_parallel::sort(cellOrder.begin(), cellOrder.end());
     std::vector<std::vector<std::uint64_t>> cornerStart(ranks);  // per sender's cell
     std::uint64_t cornerTotal = 0;
     for (int from = 0; from < ranks; ++from) {
@@ -652,21 +718,34 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         cornerTotal += cornerStart[from].back();
         if (routes.cells) routes.receiveCells[from].resize(got[from].cellIds.size());
     }
-    out.mesh.cellTypes.reserve(cellOrder.size());
-    out.mesh.cellOffsets.reserve(cellOrder.size() + 1);
-    out.mesh.cellIndices.reserve(cornerTotal);
-    std::vector<std::uint32_t> ids;
-    for (std::size_t s = 0; s < cellOrder.size(); ++s) {
+    // Each cell's corners start where the cells before it end (a prefix sum), so every cell is
+    // written on its own.
+    const std::size_t pieceCells = cellOrder.size();
+    std::vector<int> senderOf(pieceCells);
+    out.mesh.cellOffsets.assign(pieceCells + 1, 0);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t s = 0; s < std::int64_t(pieceCells); ++s) {
         const std::uint64_t g = cellOrder[s].second;
         const int from = static_cast<int>(std::upper_bound(cellStart.begin(), cellStart.end(), g) -
                                           cellStart.begin() - 1);
-        const std::size_t k = static_cast<std::size_t>(g - cellStart[from]);
+        senderOf[s] = from;
+        out.mesh.cellOffsets[s + 1] = got[from].counts[g - cellStart[from]];
+    }
+    for (std::size_t s = 0; s < pieceCells; ++s)
+        out.mesh.cellOffsets[s + 1] += out.mesh.cellOffsets[s];
+    out.mesh.cellTypes.resize(pieceCells);
+    out.mesh.cellIndices.resize(cornerTotal);
+    if (!pointData) out.field.values.resize(pieceCells);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t s = 0; s < std::int64_t(pieceCells); ++s) {
+        const int from = senderOf[s];
+        const std::size_t k = static_cast<std::size_t>(cellOrder[s].second - cellStart[from]);
         const CellMessage& m = got[from];
-        ids.clear();
+        out.mesh.cellTypes[s] = static_cast<CellType>(m.types[k]);
+        std::uint64_t at = out.mesh.cellOffsets[s];
         for (std::uint64_t j = cornerStart[from][k]; j < cornerStart[from][k + 1]; ++j)
-            ids.push_back(pieceOf[pointStart[from] + m.corners[j]]);
-        out.mesh.addCell(static_cast<CellType>(m.types[k]), ids);
-        if (!pointData) out.field.values.push_back(m.values[k]);
+            out.mesh.cellIndices[at++] = pieceOf[pointStart[from] + m.corners[j]];
+        if (!pointData) out.field.values[s] = m.values[k];
         if (routes.cells) routes.receiveCells[from][k] = static_cast<std::uint32_t>(s);
     }
     // The routes' receiving ends: the senders' orders, as the piece's indices.
@@ -677,6 +756,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
             routes.receivePoints[from].assign(pieceOf.begin() + pointStart[from],
                                               pieceOf.begin() + pointStart[from + 1]);
     out.piece = std::move(piece);
+    phaseDone("distribute_assemble");
     return out;
 }
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -113,6 +114,11 @@ struct RankPiece {
     Decomposition decomposition;             ///< every rank's box
     std::uint64_t shareCells = 0;            ///< cells of this rank's share before
     ValueRoutes routes;                      ///< how later values reach the piece
+    /// This rank's seconds in each step of distributeMesh ("distribute_split": its share split
+    /// into tetrahedra; "distribute_tree": the ranks' boxes; "distribute_reach": which ranks each
+    /// cell reaches, ghost rings included; "distribute_exchange": the messages packed and sent;
+    /// "distribute_assemble": the piece made from those received).
+    std::vector<std::pair<std::string, double>> phaseSeconds;
 };
 
 /// Distributes a mesh over the ranks of `comm` (collective; every rank passes its share):

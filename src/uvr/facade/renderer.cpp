@@ -146,6 +146,8 @@ void Renderer::prepareShare(MeshShare share, const RendererOptions& options,
     prepare.piece = piece.piece;
     prepared_ = std::make_unique<PreparedMesh>(
         agreeOn(*comm_, [&] { return prepareMesh(piece.mesh, piece.field, prepare, progress); }));
+    prepared_->phaseSeconds.insert(prepared_->phaseSeconds.begin(), piece.phaseSeconds.begin(),
+                                   piece.phaseSeconds.end());
 }
 
 Renderer::PreparationStart Renderer::startPreparation() {
