@@ -3,6 +3,7 @@
 // (InProcessGroup), each holding its piece of the whole mesh and composited onto rank 0.
 #include <gmock/gmock.h>
 
+#include <memory>
 #include <mutex>
 #include <tuple>
 
@@ -54,6 +55,23 @@ std::vector<RenderResult> dataParallelFrames(const Mesh& mesh, const ScalarField
     });
     return out;
 }
+
+/// A mesh file, its default field and one CPU process's renderer of it.
+struct OneProcess {
+    Mesh mesh;
+    ScalarField field;
+    RendererOptions options;
+    std::unique_ptr<Renderer> renderer;
+    Bounds3f bounds;
+    float radius = 0.f;  ///< half the bounds' diagonal
+
+    explicit OneProcess(const std::string& path)
+        : mesh(readMesh(path)), field(selectScalarField(mesh, {})), bounds(mesh.bounds()) {
+        options.device = Device::Cpu;
+        renderer = std::make_unique<Renderer>(mesh, field, options);
+        radius = 0.5f * length(bounds.hi - bounds.lo);
+    }
+};
 
 /// A mesh and the rank counts it is rendered on (Blunt Fin, the largest, on many; the others on
 /// an uneven count, keeping the suite's time under the sanitizers).
@@ -112,33 +130,28 @@ TEST(DataParallel, DepthInEndsTheRaysOfEveryRankAsOneProcesss) {
     // rank's rays end there, and the composite is one process's frame.
     const std::string path = testing::sharedData("bluntfin_tets.vtk");
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
-    const Mesh mesh = readMesh(path);
-    const ScalarField field = selectScalarField(mesh, {});
-    RendererOptions options;
-    options.device = Device::Cpu;
-    Renderer one(mesh, field, options);
-    const Bounds3f bounds = mesh.bounds();
-    const float radius = 0.5f * length(bounds.hi - bounds.lo);
+    const OneProcess fin(path);
     std::vector<RenderSettings> frames;
     for (RenderMethod m :
          {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
-        RenderSettings s = frameOf(bounds, m, 30.f, 20.f);
+        RenderSettings s = frameOf(fin.bounds, m, 30.f, 20.f);
         const float focal = length(s.camera->focalPoint - s.camera->position);
         s.depthIn.resize(std::size_t(s.width) * s.height);
         for (int y = 0; y < s.height; ++y)
             for (int x = 0; x < s.width; ++x)
                 s.depthIn[std::size_t(y) * s.width + x] =
-                    focal - radius + 2.f * radius * float(x) / float(s.width);
+                    focal - fin.radius + 2.f * fin.radius * float(x) / float(s.width);
         frames.push_back(s);
     }
     for (const RenderSettings& s : frames) {
-        const RenderResult cut = one.render(s);
+        const RenderResult cut = fin.renderer->render(s);
         RenderSettings whole = s;
         whole.depthIn.clear();
         const ImageComparison against =
-            compareImages(toRgb8(cut.image), toRgb8(one.render(whole).image));
+            compareImages(toRgb8(cut.image), toRgb8(fin.renderer->render(whole).image));
         EXPECT_GT(against.maxAbsDifference, 20.0) << "the depth cuts nothing";
-        const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 3, options, {s});
+        const std::vector<RenderResult> many =
+            dataParallelFrames(fin.mesh, fin.field, 3, fin.options, {s});
         ASSERT_EQ(many.size(), 1u);
         const ImageComparison cmp = compareImages(toRgb8(cut.image), toRgb8(many[0].image));
         SCOPED_TRACE(methodName(s.method));
@@ -153,19 +166,14 @@ TEST(DataParallel, DepthOutIsOneProcesssForEveryMethod) {
     // for the pixels behind others' light).
     const std::string path = testing::sharedData("bluntfin_tets.vtk");
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
-    const Mesh mesh = readMesh(path);
-    const ScalarField field = selectScalarField(mesh, {});
-    RendererOptions options;
-    options.device = Device::Cpu;
-    Renderer one(mesh, field, options);
-    const Bounds3f bounds = mesh.bounds();
-    const float radius = 0.5f * length(bounds.hi - bounds.lo);
+    const OneProcess fin(path);
     for (RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact})
         for (float depthAlpha : {0.3f, 0.6f}) {
-            RenderSettings s = frameOf(bounds, m, 30.f, 20.f);
+            RenderSettings s = frameOf(fin.bounds, m, 30.f, 20.f);
             s.depthAlpha = depthAlpha;
-            const RenderResult single = one.render(s);
-            const std::vector<RenderResult> many = dataParallelFrames(mesh, field, 3, options, {s});
+            const RenderResult single = fin.renderer->render(s);
+            const std::vector<RenderResult> many =
+                dataParallelFrames(fin.mesh, fin.field, 3, fin.options, {s});
             ASSERT_EQ(many.size(), 1u);
             SCOPED_TRACE(std::string(methodName(m)) + " at opacity " + std::to_string(depthAlpha));
             const ImageComparison cmp = compareImages(toRgb8(single.image), toRgb8(many[0].image));
@@ -183,7 +191,7 @@ TEST(DataParallel, DepthOutIsOneProcesssForEveryMethod) {
                 if (!(a < INFINITY)) continue;
                 ++finite;
                 worst = std::max(worst, double(std::abs(a - b)));
-                far += std::abs(a - b) > 1e-3f * radius;
+                far += std::abs(a - b) > 1e-3f * fin.radius;
             }
             EXPECT_GT(finite, single.depth.size() / 20) << "the depth reaches too few pixels";
             EXPECT_LE(disagree, finite / 1000);
@@ -196,10 +204,11 @@ TEST(DataParallel, DepthOutIsOneProcesssForEveryMethod) {
         }
     // Supersampled rays stop and note depth each on its own, which one opacity per pixel in
     // front cannot follow.
-    RenderSettings s = frameOf(bounds, RenderMethod::Reference, 30.f, 20.f);
+    RenderSettings s = frameOf(fin.bounds, RenderMethod::Reference, 30.f, 20.f);
     s.depthAlpha = 0.5f;
     s.supersample = 2;
-    const Error e = catchError([&] { dataParallelFrames(mesh, field, 2, options, {s}); });
+    const Error e =
+        catchError([&] { dataParallelFrames(fin.mesh, fin.field, 2, fin.options, {s}); });
     EXPECT_EQ(e.kind(), ErrorKind::Unsupported);
     EXPECT_THAT(e.what(), HasSubstr("supersample 2"));
 }
