@@ -212,6 +212,30 @@ with open({pvtu!r}, "w") as f:
               "each of 2 ranks reads its run of the 4 pieces of each step" in r.stderr and
               r.stderr.count("values refreshed") == 2,
               f"animate a .pvd of .pvtu steps on 2 ranks: read by pieces ({r.stderr[-300:]})")
+        # ParaView's own parallel output: a .pvd listing each time's parts (the .pvtu's four
+        # .vtu files) as DataSets of one timestep; animate reads each step by its parts.
+        parts_pvd = os.path.join(args.out, "fin_parts.pvd")
+        with open(parts_pvd, "w") as f:
+            f.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1"><Collection>' +
+                    "".join(f'<DataSet timestep="{t}" part="{k}" file="fin_{k}.vtu"/>'
+                            for t in range(3) for k in range(4)) +
+                    "</Collection></VTKFile>\n")
+        frames = {}
+        for n in [1, 2]:
+            frames[n] = os.path.join(args.out, f"parts_anim_{n}")
+            shutil.rmtree(frames[n], ignore_errors=True)
+            r = run((mpirun(n) if n > 1 else []) +
+                    [args.uvr, "animate", parts_pvd, "-o", frames[n], "--device", "cpu",
+                     "--size", SIZE, "--tf", "viridis"])
+            check(r.returncode == 0 and len(os.listdir(frames[n])) == 3 and
+                  (n == 1 or "each of 2 ranks reads its run of the 4 pieces of each step"
+                   in r.stderr), f"animate a .pvd of each time's parts on {n} rank(s): read by "
+                  f"parts ({r.stderr[-300:]})")
+        for name in sorted(os.listdir(frames[1])):
+            c = run([args.uvr, "compare", os.path.join(frames[1], name),
+                     os.path.join(frames[2], name), "--min-ssim", "0.999", "--max-diff", "2"])
+            check(c.returncode == 0, f"animate the .pvd of parts, {name}: 2 ranks = one process "
+                  f"({c.stdout.strip()[-120:]})")
         # The same steps as a numbered series (a pattern, not a file): render reads by pieces.
         for t in range(3):
             shutil.copyfile(pvtu, os.path.join(args.out, f"fin_step_{t}.pvtu"))

@@ -210,35 +210,68 @@ TEST(SeriesPlayer, DataParallelAnExodusSeriesIsReadByItsCellsAsOneProcessShowsIt
 }
 #endif
 
+/// Writes time step k (stepMesh(k, 8)) as 6 .vtu pieces in `dir` (each a run of its cells),
+/// returning their names.
+std::vector<std::string> writeStepPieces(const std::string& dir, int k) {
+    const Mesh step = stepMesh(float(k), 8);
+    std::vector<std::string> names;
+    for (int piece = 0; piece < 6; ++piece) {
+        const auto [first, end] = rankRun(step.cellCount(), piece, 6);
+        names.push_back("s" + std::to_string(k) + "_" + std::to_string(piece) + ".vtu");
+        writeMesh(meshPart(step, first, end).mesh, dir + "/" + names.back());
+    }
+    return names;
+}
+
+constexpr const char* kPvdHead =
+    "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+constexpr const char* kPvdTail = "</Collection>\n</VTKFile>\n";
+
 TEST(SeriesPlayer, DataParallelACollectionOfPvtuStepsIsReadByPiecesAsOneProcessShowsIt) {
     // A parallel simulation's output: a .pvd listing one .pvtu a step, each of 6 pieces.
     const std::string dir = testing::scratchDir();
-    std::string pvd =
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
-        "<Collection>\n";
-    std::uint64_t cells = 0;
+    std::string pvd = kPvdHead;
     for (int k = 0; k < 3; ++k) {
-        const Mesh step = stepMesh(float(k), 8);
-        cells = step.cellCount();
         std::string pvtu =
             "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\">\n"
             "<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData><PDataArray type=\"Float32\" "
             "Name=\"f\"/></PPointData>\n<PPoints><PDataArray type=\"Float32\" "
             "NumberOfComponents=\"3\"/></PPoints>\n";
-        for (int piece = 0; piece < 6; ++piece) {
-            const auto [first, end] = rankRun(step.cellCount(), piece, 6);
-            const std::string name = "s" + std::to_string(k) + "_" + std::to_string(piece) + ".vtu";
-            writeMesh(meshPart(step, first, end).mesh, dir + "/" + name);
+        for (const std::string& name : writeStepPieces(dir, k))
             pvtu += "<Piece Source=\"" + name + "\"/>\n";
-        }
         const std::string name = "s" + std::to_string(k) + ".pvtu";
         testing::writeFile(dir + "/" + name, pvtu + "</PUnstructuredGrid>\n</VTKFile>\n");
         pvd += "<DataSet timestep=\"" + std::to_string(k) + "\" file=\"" + name + "\"/>\n";
     }
-    const std::string file =
-        testing::writeFile(dir + "/run.pvd", pvd + "</Collection>\n</VTKFile>\n");
+    const std::string file = testing::writeFile(dir + "/run.pvd", pvd + kPvdTail);
     EXPECT_EQ(openMeshSeries(file)->partCount(1), 6u);
-    expectPlayedByPartsAsOneProcess(file, cells);
+    expectPlayedByPartsAsOneProcess(file, stepMesh(0.f, 8).cellCount());
+}
+
+TEST(SeriesPlayer, DataParallelACollectionListingEachTimesPartsIsReadByPartsAsOneProcessShowsIt) {
+    // ParaView's own parallel output: a .pvd listing each time's parts as DataSets of one
+    // timestep (part="0", "1", ...), each part a .vtu of its own.
+    const std::string dir = testing::scratchDir();
+    std::string pvd = kPvdHead;
+    for (int k = 0; k < 3; ++k) {
+        const std::vector<std::string> names = writeStepPieces(dir, k);
+        for (std::size_t part = 0; part < names.size(); ++part)
+            pvd += "<DataSet timestep=\"" + std::to_string(k) + "\" part=\"" +
+                   std::to_string(part) + "\" file=\"" + names[part] + "\"/>\n";
+    }
+    const std::string file = testing::writeFile(dir + "/parts.pvd", pvd + kPvdTail);
+    const std::unique_ptr<MeshSeries> series = openMeshSeries(file);
+    EXPECT_EQ(series->partCount(1), 6u);
+    // A run of parts holds their cells and points, ids in the whole step's order.
+    const MeshPart part = series->readPart(1, 2, 4);
+    const Mesh whole = series->readStep(1);
+    EXPECT_GT(part.mesh.cellCount(), 0u);
+    EXPECT_LT(part.mesh.cellCount(), whole.cellCount());
+    EXPECT_TRUE(std::is_sorted(part.cellIds.begin(), part.cellIds.end()));
+    EXPECT_EQ(part.cellIds.size(), part.mesh.cellCount());
+    EXPECT_EQ(part.pointIds.size(), part.mesh.points.size());
+    EXPECT_EQ(catchError([&] { series->readPart(1, 5, 7); }).kind(), ErrorKind::Argument);
+    expectPlayedByPartsAsOneProcess(file, stepMesh(0.f, 8).cellCount());
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "uvr/mesh/io/exodus.h"
 #include "uvr/mesh/io/mesh_merge.h"
 #include "uvr/mesh/io/mesh_reader.h"
+#include "uvr/mesh/io/native.h"
 #include "uvr/mesh/io/vtk_number.h"
 #include "uvr/mesh/io/vtkhdf.h"
 #include "uvr/mesh/io/vtu.h"
@@ -147,19 +148,41 @@ public:
     }
 
     /// A step that is one .pvtu (a parallel simulation's output, a .pvd listing one per time) is
-    /// stored in its pieces; a step of other files is read whole.
+    /// stored in its pieces, a step of several files (a .pvd listing a time's parts) in its
+    /// files; a step of one other file is read whole.
     const char* partName() const override { return "pieces"; }
     std::uint64_t partCount(std::size_t i) const override {
         checkStep(i);
         const FileStep& step = steps_[i];
-        if (step.files.size() != 1 || sniffMeshFormat(step.files[0]) != MeshFormat::Pvtu) return 0;
+        if (step.files.size() > 1) return step.files.size();
+        if (sniffMeshFormat(step.files[0]) != MeshFormat::Pvtu) return 0;
         return pvtuPieceCount(step.files[0]);
     }
 
     MeshPart readPart(std::size_t i, std::uint64_t first, std::uint64_t end) override {
         if (partCount(i) == 0) return MeshSeries::readPart(i, first, end);  // refused there
-        const StepReadGuard guard(path(), steps_[i].where);
-        return readPvtuPart(steps_[i].files[0], first, end, options());
+        const FileStep& step = steps_[i];
+        const StepReadGuard guard(path(), step.where);
+        if (step.files.size() == 1) return readPvtuPart(step.files[0], first, end, options());
+        if (first >= end || end > step.files.size())
+            throwError(ErrorKind::Argument, path(),
+                       step.where + ": parts [" + std::to_string(first) + ", " +
+                           std::to_string(end) + ") asked for, but the step lists " +
+                           std::to_string(step.files.size()));
+        // The files [first, end) as readStep appends them, with ids in the whole step's order:
+        // the file's index above kPieceIdShift bits, the point's or cell's in the file below.
+        MeshPart part;
+        for (std::uint64_t k = first; k < end; ++k) {
+            checkStepFile(step, k);
+            Mesh piece = readMesh(step.files[k], options());
+            const std::uint64_t base = k << kPieceIdShift;
+            for (std::uint64_t p = 0; p < piece.points.size(); ++p)
+                part.pointIds.push_back(base | p);
+            for (std::uint64_t c = 0; c < piece.cellCount(); ++c) part.cellIds.push_back(base | c);
+            appendMeshPiece(part.mesh, piece, k == first, path(), step.where,
+                            "part " + std::to_string(k) + " ('" + step.files[k] + "')");
+        }
+        return part;
     }
 
 private:
