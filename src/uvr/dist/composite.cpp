@@ -29,18 +29,37 @@ struct PixelBox {
 };
 
 PixelBox activeBox(const Image& image, const std::vector<std::uint32_t>& counts) {
-    PixelBox b{image.width, image.height, 0, 0};
-    for (int y = 0; y < image.height; ++y) {
-        const std::size_t row = std::size_t(y) * image.width;
-        for (int x = 0; x < image.width; ++x) {
-            const std::size_t i = row + x;
-            if (image.pixels[i].w == 0.f && (counts.empty() || counts[i] == 0)) continue;
-            b.x0 = std::min(b.x0, x), b.x1 = std::max(b.x1, x + 1);
-            b.y0 = std::min(b.y0, y), b.y1 = std::max(b.y1, y + 1);
-        }
+    const int w = image.width, h = image.height;
+    const auto holds = [&](int x, int y) {
+        const std::size_t i = std::size_t(y) * w + x;
+        return image.pixels[i].w != 0.f || (!counts.empty() && counts[i] != 0);
+    };
+    const auto rowHolds = [&](int y) {
+        for (int x = 0; x < w; ++x)
+            if (holds(x, y)) return true;
+        return false;
+    };
+    // The first and last rows holding anything, then in the rows between each row's first and
+    // last pixel, scanning only as far as the box so far: a frame the piece fills costs a few
+    // pixels a row, not every pixel.
+    int y0 = 0, y1 = h;
+    while (y0 < h && !rowHolds(y0)) ++y0;
+    if (y0 == h) return {};
+    while (!rowHolds(y1 - 1)) --y1;
+    int x0 = w, x1 = 0;
+    for (int y = y0; y < y1; ++y) {
+        for (int x = 0; x < x0; ++x)
+            if (holds(x, y)) {
+                x0 = x;
+                break;
+            }
+        for (int x = w - 1; x >= x1; --x)
+            if (holds(x, y)) {
+                x1 = x + 1;
+                break;
+            }
     }
-    if (b.x1 <= b.x0 || b.y1 <= b.y0) return {};
-    return b;
+    return {x0, y0, x1, y1};
 }
 
 /// A pixel the second pass renders again: the opacity its ray stops at, and the one whose
@@ -181,12 +200,17 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     const PixelBox active = activeBox(image, counts);
     std::vector<std::vector<std::byte>>& toEach = b.toEach;
     toEach.resize(ranks);
-    for (int r = 0; r < ranks; ++r) {
-        toEach[r].clear();
+    const auto partOfBand = [&](int r) {
         const auto [first, end] = compositeBand(image.height, r, ranks);
         PixelBox part = active;
         part.y0 = std::max(part.y0, first), part.y1 = std::min(part.y1, end);
         if (part.y1 <= part.y0 || part.x1 <= part.x0) part = {};
+        return part;
+    };
+    for (int r = 0; r < ranks; ++r) {
+        toEach[r].clear();
+        if (r == me) continue;  // blended straight from the image
+        const PixelBox part = partOfBand(r);
         appendBytes(toEach[r], &part, 1);
         const std::size_t w = part.x1 - part.x0;
         for (int y = part.y0; y < part.y1; ++y)
@@ -197,7 +221,7 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
         if (depthOn)
             for (int y = part.y0; y < part.y1; ++y)
                 appendBytes(toEach[r], depth.data() + y * width + part.x0, w);
-        if (r != me) stats.bytesSent += toEach[r].size();
+        stats.bytesSent += toEach[r].size();
     }
     comm.allToAllInto(toEach, b.parts);
     const std::vector<std::vector<std::byte>>& parts = b.parts;
@@ -216,73 +240,101 @@ CompositeStats compositeFrame(Communicator& comm, Image& image, std::vector<std:
     std::vector<std::vector<StopAsk>> asks(ranks);
     std::vector<std::vector<AskFront>> fronts(ranks);
     for (int r : order) {
-        const std::vector<std::byte>& part = parts[r];
+        // Rank r's part of the band: its box, and its rows of colours, counts and depths, each
+        // row `stride` pixels after the one before (the bytes received, or this rank's image).
         PixelBox box;
-        UVR_CHECK(part.size() >= sizeof box, "rank " << r << " sent no box");
-        std::memcpy(&box, part.data(), sizeof box);
+        const std::byte *colours, *samples, *depths;
+        std::size_t stride;
+        if (r == me) {
+            box = partOfBand(me);
+            const std::size_t at = std::size_t(box.y0) * width + box.x0;
+            colours = reinterpret_cast<const std::byte*>(image.pixels.data() + at);
+            samples = withCounts ? reinterpret_cast<const std::byte*>(counts.data() + at) : nullptr;
+            depths = depthOn ? reinterpret_cast<const std::byte*>(depth.data() + at) : nullptr;
+            stride = width;
+        } else {
+            const std::vector<std::byte>& part = parts[r];
+            UVR_CHECK(part.size() >= sizeof box, "rank " << r << " sent no box");
+            std::memcpy(&box, part.data(), sizeof box);
+            const bool none = box.x0 == box.x1 || box.y0 == box.y1;
+            UVR_CHECK(none || (box.x0 >= 0 && box.x0 < box.x1 && box.x1 <= image.width &&
+                               box.y0 >= first && box.y0 < box.y1 && box.y1 <= end),
+                      "rank " << r << " sent a box outside band [" << first << ", " << end << ")");
+            const std::size_t pixels = none ? 0 : std::size_t(box.x1 - box.x0) * (box.y1 - box.y0);
+            UVR_CHECK(part.size() == sizeof box + pixels * pixelBytes,
+                      "rank " << r << " sent " << part.size() << " bytes for a box of " << pixels
+                              << " pixels");
+            colours = part.data() + sizeof box;
+            samples = colours + pixels * sizeof(Vec4f);
+            depths = samples + (withCounts ? pixels * sizeof(std::uint32_t) : 0);
+            stride = box.x1 - box.x0;
+        }
         const bool empty = box.x0 == box.x1 || box.y0 == box.y1;
-        UVR_CHECK(empty || (box.x0 >= 0 && box.x0 < box.x1 && box.x1 <= image.width &&
-                            box.y0 >= first && box.y0 < box.y1 && box.y1 <= end),
-                  "rank " << r << " sent a box outside band [" << first << ", " << end << ")");
-        const std::size_t w = empty ? 0 : box.x1 - box.x0, m = empty ? 0 : w * (box.y1 - box.y0);
-        UVR_CHECK(
-            part.size() == sizeof box + m * pixelBytes,
-            "rank " << r << " sent " << part.size() << " bytes for a box of " << m << " pixels");
-        const std::byte* colours = part.data() + sizeof box;
-        const std::byte* samples = colours + m * sizeof(Vec4f);
-        const std::byte* depths = samples + (withCounts ? m * sizeof(std::uint32_t) : 0);
-        // k: the box's pixel (row by row), i: the same pixel in the band.
-        for (std::size_t k = 0, x = 0, i = empty ? 0 : (box.y0 - first) * width + box.x0; k < m;
-             ++k, ++i) {
-            if (x == w) x = 0, i += width - w;  // the box's next row
-            ++x;
-            if (withCounts) {
-                std::uint32_t c;
-                std::memcpy(&c, samples + k * sizeof c, sizeof c);
-                bandCounts[i] += c;
-            }
-            Vec4f& acc = band[i];
-            if (acc.w >= stopAlpha) continue;
-            Vec4f px;
-            std::memcpy(&px, colours + k * sizeof px, sizeof px);
-            const Vec4f front = acc;
-            const float t = 1.f - acc.w;
-            acc.x += t * px.x, acc.y += t * px.y, acc.z += t * px.z;
-            acc.w += t * px.w;
-            // Rank r's ray stopped at its own stopAlpha; one process's stopped where the whole
-            // opacity reached it, which the light in front moves forward.
-            const bool restop = options.restop && front.w > 0.f && acc.w >= stopAlpha;
-            // The whole opacity reaches depthAlpha in rank r's light: where its own does, with
-            // no light in front; else where its own reaches what the front leaves.
-            float depthAsk = 0.f;
-            if (depthOn && front.w < depthAlpha && acc.w >= depthAlpha) {
-                if (front.w > 0.f)
-                    depthAsk = (depthAlpha - front.w) / (1.f - front.w);
-                else
-                    std::memcpy(&bandDepth[i], depths + k * sizeof(float), sizeof(float));
-            }
-            if (restop || depthAsk > 0.f) {
-                asks[r].push_back({static_cast<std::uint32_t>(first * width + i),
-                                   restop ? (stopAlpha - front.w) / (1.f - front.w) : stopAlpha,
-                                   depthAsk});
-                fronts[r].push_back({i, front, restop, depthAsk > 0.f});
+        const std::size_t w = empty ? 0 : box.x1 - box.x0;
+        // One thread: the blend is bound by memory, and OpenMP's waiting threads cost ranks
+        // that share cores more than threads gain (4 ranks on 2 cores: 3-4x slower).
+        const int rows = empty ? 0 : box.y1 - box.y0;
+        for (int row = 0; row < rows; ++row) {
+            // k: the source's pixel, i: the same pixel in the band.
+            std::size_t k = std::size_t(row) * stride;
+            std::size_t i = (std::size_t(box.y0 + row) - first) * width + box.x0;
+            for (std::size_t x = 0; x < w; ++x, ++k, ++i) {
+                if (withCounts) {
+                    std::uint32_t c;
+                    std::memcpy(&c, samples + k * sizeof c, sizeof c);
+                    bandCounts[i] += c;
+                }
+                Vec4f& acc = band[i];
+                if (acc.w >= stopAlpha) continue;
+                Vec4f px;
+                std::memcpy(&px, colours + k * sizeof px, sizeof px);
+                const Vec4f front = acc;
+                const float t = 1.f - acc.w;
+                acc.x += t * px.x, acc.y += t * px.y, acc.z += t * px.z;
+                acc.w += t * px.w;
+                // Rank r's ray stopped at its own stopAlpha; one process's stopped where the
+                // whole opacity reached it, which the light in front moves forward.
+                const bool restop = options.restop && front.w > 0.f && acc.w >= stopAlpha;
+                // The whole opacity reaches depthAlpha in rank r's light: where its own
+                // does, with no light in front; else where its own reaches what the front
+                // leaves.
+                float depthAsk = 0.f;
+                if (depthOn && front.w < depthAlpha && acc.w >= depthAlpha) {
+                    if (front.w > 0.f)
+                        depthAsk = (depthAlpha - front.w) / (1.f - front.w);
+                    else
+                        std::memcpy(&bandDepth[i], depths + k * sizeof(float), sizeof(float));
+                }
+                if (restop || depthAsk > 0.f) {
+                    asks[r].push_back({static_cast<std::uint32_t>(first * width + i),
+                                       restop ? (stopAlpha - front.w) / (1.f - front.w) : stopAlpha,
+                                       depthAsk});
+                    fronts[r].push_back({i, front, restop, depthAsk > 0.f});
+                }
             }
         }
     }
     if (secondPass)
         secondCompositingPass(comm, image, depthOn, asks, fronts, b, options.rerender, stats);
     // The bands to root.
+    const int root = options.root;
     std::vector<std::byte>& mine = b.mine;
     mine.clear();
-    appendBytes(mine, band.data(), n);
-    if (withCounts) appendBytes(mine, bandCounts.data(), n);
-    if (depthOn) appendBytes(mine, bandDepth.data(), n);
-    const int root = options.root;
-    if (me != root) stats.bytesSent += mine.size();
+    if (me != root) {  // root's own band goes straight into its image
+        appendBytes(mine, band.data(), n);
+        if (withCounts) appendBytes(mine, bandCounts.data(), n);
+        if (depthOn) appendBytes(mine, bandDepth.data(), n);
+        stats.bytesSent += mine.size();
+    }
     comm.gatherInto(mine, root, b.bands);
     const std::vector<std::vector<std::byte>>& bands = b.bands;
     if (me == root) {
+        std::copy(band.begin(), band.end(), image.pixels.begin() + first * width);
+        if (withCounts)
+            std::copy(bandCounts.begin(), bandCounts.end(), counts.begin() + first * width);
+        if (depthOn) std::copy(bandDepth.begin(), bandDepth.end(), depth.begin() + first * width);
         for (int r = 0; r < ranks; ++r) {
+            if (r == root) continue;
             const auto [f, e] = compositeBand(image.height, r, ranks);
             const std::size_t m = (e - f) * width;
             UVR_CHECK(bands[r].size() == m * pixelBytes, "rank " << r << "'s band");
