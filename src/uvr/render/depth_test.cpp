@@ -3,7 +3,8 @@
 // opaque plane (a linear field's isosurface) along the view direction; where a slab of constant
 // extinction reaches an opacity, in closed form; a depth image given in equal to a clip at its
 // plane; the .npy files numpy writes and reads; a per-pixel stop opacity (a data-parallel
-// frame's second pass) against the slab's extinction.
+// frame's second pass) against the slab's extinction, and a per-pixel depth opacity against
+// frames asking that opacity of every pixel.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -195,6 +196,50 @@ TEST_P(Depth, APixelsStopOpacityEndsItsRayThere) {
     EXPECT_THROW(checkDepth(s), SettingError);
     s.pixelStopAlpha[3] = 0.5f;
     s.supersample = 2;
+    EXPECT_THROW(checkDepth(s), SettingError);
+}
+
+TEST_P(Depth, APixelsDepthOpacityIsWhereItsRayReachesIt) {
+    // Depth alpha in (a data-parallel frame's second pass): each pixel's ray notes the depth of
+    // its own opacity, exactly where a frame asking that opacity of every pixel notes it; 0: no
+    // depth there. The colours are the frame's without it.
+    const PreparedMesh pm = cube(true);
+    for (const RenderMethod m : kMethods) {
+        RenderSettings s = alongX(m);
+        s.depthAlpha = 0.5f;
+        const RenderResult plain = render(pm, s);
+        s.depthAlpha = 0.3f;
+        const RenderResult at3 = render(pm, s);
+        s.depthAlpha = 0.6f;
+        const RenderResult at6 = render(pm, s);
+        s.pixelDepthAlpha.assign(std::size_t(s.width) * s.height, 0.f);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 1; x < s.width; ++x)
+                s.pixelDepthAlpha[std::size_t(y) * s.width + x] = x % 2 ? 0.3f : 0.6f;
+        const RenderResult r = render(pm, s);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                const std::size_t i = std::size_t(y) * s.width + x;
+                SCOPED_TRACE(std::string(methodName(m)) + " at " + std::to_string(x) + ", " +
+                             std::to_string(y));
+                if (x == 0)
+                    EXPECT_FALSE(r.depth[i] < INFINITY);
+                else
+                    EXPECT_EQ(r.depth[i], (x % 2 ? at3 : at6).depth[i]);
+                EXPECT_EQ(r.image.pixels[i].w, plain.image.pixels[i].w);
+            }
+    }
+    // Bad opacities are setting errors, and depth alpha in needs depth out.
+    RenderSettings s = alongX(RenderMethod::Reference);
+    s.depthAlpha = 0.5f;
+    s.pixelDepthAlpha.assign(15, 0.5f);
+    EXPECT_THROW(checkDepth(s), SettingError);
+    s.pixelDepthAlpha.assign(std::size_t(s.width) * s.height, 0.5f);
+    EXPECT_NO_THROW(checkDepth(s));
+    s.pixelDepthAlpha[3] = -0.5f;
+    EXPECT_THROW(checkDepth(s), SettingError);
+    s.pixelDepthAlpha[3] = 0.5f;
+    s.depthAlpha = 0.f;
     EXPECT_THROW(checkDepth(s), SettingError);
 }
 
