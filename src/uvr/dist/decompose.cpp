@@ -10,6 +10,7 @@
 #include <string>
 
 #include "uvr/core/error.h"
+#include "uvr/mesh/cell_types.h"
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/prepare/render_method.h"
 
@@ -308,7 +309,11 @@ struct CellMessage {
         if (cellData) takeAll(in, at, cells, m.values, from);
         UVR_CHECK(at == in.size(), "the cells rank " << from << " sent have bytes left over");
         std::uint64_t total = 0;
-        for (std::uint8_t c : m.counts) total += c;
+        for (std::uint64_t k = 0; k < cells; ++k) {
+            UVR_CHECK(m.counts[k] == cornerCount(static_cast<CellType>(m.types[k])),
+                      "a cell rank " << from << " sent has " << int(m.counts[k]) << " corners");
+            total += m.counts[k];
+        }
         UVR_CHECK(total == corners, "the cells rank " << from << " sent miscount their corners");
         for (std::uint32_t c : m.corners)
             UVR_CHECK(c < points, "a cell rank " << from << " sent names a point it did not send");
@@ -681,7 +686,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         for (int from = 0; from < ranks; ++from)
             for (std::size_t k = 0; k < got[from].points.size(); ++k)
                 byId.push_back({got[from].points[k].id, pointStart[from] + k});
-        std::sort(byId.begin(), byId.end());
+        __gnu_parallel::sort(byId.begin(), byId.end());
         for (std::size_t i = 0; i < byId.size(); ++i) {
             if (i == 0 || byId[i].first != byId[i - 1].first) {
                 const std::uint64_t g = byId[i].second;
