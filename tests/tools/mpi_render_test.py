@@ -114,9 +114,10 @@ def main():
                 check(c.returncode == 0, f"{mesh} {method}: {n} ranks = one process ({detail})")
 
     # Depth out: where the whole opacity reaches --depth-opacity, noted by the rank whose light
-    # takes it there (a second pass for the pixels behind other ranks' light).
+    # takes it there (a second pass for the pixels behind other ranks' light). The reference's
+    # is in DataParallel.DepthOutIsOneProcesssForEveryMethod; here the two that differ most.
     mesh, view = MESHES[0]
-    for method in METHODS:
+    for method in ["adaptive", "exact"]:
         base = [args.uvr, "render", os.path.join(args.data, mesh), "--device", "cpu", "--size",
                 SIZE, "--no-cache", "--method", method, "--tf", "viridis", "--opacity",
                 "0:0,0.5:0.3,1:0.8", "--depth-opacity", "0.4", "-q"] + view
