@@ -10,6 +10,7 @@
 #include <string>
 
 #include "uvr/core/error.h"
+#include "uvr/core/runs.h"
 #include "uvr/mesh/cell_types.h"
 #include "uvr/mesh/tet_mesh.h"
 #include "uvr/prepare/render_method.h"
@@ -690,9 +691,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
         for (std::size_t i = 0; i < byId.size(); ++i) {
             if (i == 0 || byId[i].first != byId[i - 1].first) {
                 const std::uint64_t g = byId[i].second;
-                const int from =
-                    static_cast<int>(std::upper_bound(pointStart.begin(), pointStart.end(), g) -
-                                     pointStart.begin() - 1);
+                const int from = static_cast<int>(runOf(pointStart.data(), ranks, g));
                 const CarriedPoint& p = got[from].points[g - pointStart[from]];
                 out.mesh.points.push_back(p.p);
                 if (pointData) out.field.values.push_back(p.value);
@@ -731,8 +730,7 @@ RankPiece distributeMesh(Communicator& comm, MeshShare share, const PrepareOptio
 #pragma omp parallel for schedule(static)
     for (std::int64_t s = 0; s < std::int64_t(pieceCells); ++s) {
         const std::uint64_t g = cellOrder[s].second;
-        const int from = static_cast<int>(std::upper_bound(cellStart.begin(), cellStart.end(), g) -
-                                          cellStart.begin() - 1);
+        const int from = static_cast<int>(runOf(cellStart.data(), ranks, g));
         senderOf[s] = from;
         out.mesh.cellOffsets[s + 1] = got[from].counts[g - cellStart[from]];
     }
