@@ -262,7 +262,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // A data-parallel frame: this rank's piece of the span (its k-d tree is the whole tree's
     // subtree there, so the partitions' pieces are one process's).
     bool pieceStart = false, pieceEnd = false;
-    const float tSpan = tEnter;  // where one process's span starts
+    const float tSpan = tEnter, tSpanEnd = tExit;  // where one process's span starts and ends
     if (!scene.base.params.piece.narrow(ray.org, inv, tEnter, tExit, pieceStart, pieceEnd))
         return acc;
     if (pieceStart) cut0 = false;
@@ -282,9 +282,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     // Isosurfaces: where a run may start at the mesh's boundary (sampleAtBoundary): after the
     // grid position kRunFrom, outside the mesh when runFromOutside (else the span's start), while
-    // runFromValid (no sample inside and nothing skipped since).
+    // runFromValid (no sample inside and nothing skipped since; a data-parallel piece's start
+    // takes them from the piece before's last grid point, below).
     [[maybe_unused]] float kRunFrom = tEnter / s1;
     [[maybe_unused]] bool runFromOutside = false, runFromValid = !pieceStart;
+    [[maybe_unused]] bool skipped = false;  // a transparent partition or macrocell since a sample
     [[maybe_unused]] const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b) {
         std::uint32_t found = locator.walk<kNative>(q, from, b, counters.locate);
         if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, counters.locate);
@@ -306,9 +308,24 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             ++counters.samples;
             float b[4];
             std::uint32_t found = locateFrom(ray.at(kFirst * s1), kNoTet, b);
-            if (found != kNoTet) found = locateFrom(ray.at((kFirst - 1.f) * s1), found, b);
+            const bool firstIn = found != kNoTet;
+            if (firstIn) found = locateFrom(ray.at((kFirst - 1.f) * s1), found, b);
             if (found != kNoTet)
                 segments.lead(kFirst - 1.f, true, locator.mesh.interpolate<kNative>(found, b));
+            if constexpr (kSurf) {
+                // Isosurfaces: where that sample lies outside the mesh, a run starting in this
+                // piece starts at the boundary after it (sampleAtBoundary), as one process's
+                // does; a surface between the boundary and the run's first grid sample is
+                // crossed there.
+                if (segments.iso && !firstIn)
+                    found = locateFrom(ray.at((kFirst - 1.f) * s1), kNoTet, b);
+                if (segments.iso && found == kNoTet)
+                    kRunFrom = kFirst - 1.f, runFromOutside = true, runFromValid = true;
+            }
+        } else if constexpr (kSurf) {
+            // No grid point of the span lies before the piece: one process's run may start at
+            // the span's start, in the piece before (its ghost cells hold it).
+            kRunFrom = tSpan / s1, runFromValid = true;
         }
     }
     // One loop whose every iteration takes a sample, skips a transparent macrocell or moves to
@@ -329,6 +346,22 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         return segments.iso->within(a.valueMin, a.valueMax) ||
                segments.iso->within(b.valueMin, b.valueMax);
     };
+    // Isosurfaces: a run whose share ends before the next sample (empty space or the next rank's
+    // piece follows), or before the span's end, ends at its share's end kEnd: a surface between
+    // its last sample and the mesh's boundary (or kEnd) is crossed there (sampleAtBoundary),
+    // where its partition's values reach one, whatever follows the share (so a piece of the ray
+    // gives one process's run). Unless a transparent partition or macrocell was skipped, no
+    // partition holds kEnd (else a sample would be there): it lies outside the mesh, and a run
+    // after it starts at the boundary, as after an outside sample.
+    [[maybe_unused]] const auto endRunAtShare = [&]() {
+        const KdPartition& a = scene.kd.partitions[pInside];
+        if (segments.iso->within(a.valueMin, a.valueMax))
+            sampleAtBoundary<kNative, kLit, kSurf>(
+                locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, segments.kEnd, true,
+                segments.kLast, lastInside, segments.vLast, segments.kEnd, segments, counters, acc);
+        if (!skipped) kRunFrom = segments.kEnd, runFromOutside = true, runFromValid = true;
+        segments.close(tf, s1, unit, acc);
+    };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
     float kLocated = -INFINITY;  // grid position of the last sample located
     bool marching = true, opaque = false, macro = false;
@@ -346,7 +379,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         }
     };
     while (marching) {
-        if (!(k < kStop)) {
+        // The piece's grid points end before K1 (a step of one s1 from K1 - 1 outside the mesh
+        // would reach the next partition's first).
+        if (!(k < kStop && k < k1)) {
             float t0, t1;
             if (!leaves.next(scene.kd, ray, inv, p, t0, t1)) {
                 marching = false;
@@ -358,7 +393,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if (part.cellCount == 0) continue;
             if (scene.skipTransparent && !(shade.maxOpacity > 0.f)) {
                 ++counters.partitionsSkipped;
-                if constexpr (kSurf) runFromValid = false;
+                if constexpr (kSurf) runFromValid = false, skipped = true;
                 continue;
             }
             // Only the part of [t0, t1) inside the shrunk box can hold cells.
@@ -409,7 +444,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // transparent): the sample is then located as usual, which finds the boundary.
                 const bool longGap = preintegrated && segments.started && segments.inside &&
                                      !segments.led && kSample - segments.kLast > 1.f;
-                if constexpr (kSurf) runFromValid = false;
+                if constexpr (kSurf) runFromValid = false, skipped = true;
                 if (!longGap) {
                     if (preintegrated) {
                         segments.add(tf, kSample, kSample, false, 0.f, s1, unit, acc);
@@ -462,6 +497,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const float length = ((kNext < k1 ? kNext : k1) - kSample) * s1;
         k = kNext;
         if (preintegrated) {
+            if constexpr (kSurf) {
+                if (segments.iso && segments.started && segments.inside && !segments.led &&
+                    kSample > segments.kEnd)
+                    endRunAtShare();
+            }
             // A step longer than s1 from inside the mesh to outside it, or back in: the mesh's
             // boundary lies somewhere in the step. Bisect for it with point locations (walks
             // from the inside end) to within s1, so a run ends or starts there to within a
@@ -548,6 +588,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 } else {
                     kRunFrom = kSample, runFromOutside = true, runFromValid = true;
                 }
+                skipped = false;
             }
             segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light, grad);
         } else {
@@ -562,15 +603,19 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         opaque = acc.w >= stopAlpha;
         marching = !opaque;
     }
-    if (preintegrated && !opaque && pieceEnd) {
-        // The span goes on in the next rank's piece, whose first grid point is kClose: a run
-        // reaching it ends its last segment at the sample there, as one process's run does
-        // when the next partition is marched (its share is the next piece's).
-        const float kClose = ceilf(tExit / s1);
+    // The span goes on past this piece to a grid point (kClose) in the next rank's piece (else it
+    // ends before any: one process's run ends at the span's end, as below).
+    const float kClose = ceilf(tExit / s1);
+    if (preintegrated && !opaque && pieceEnd && kClose < ceilf(tSpanEnd / s1)) {
+        // A run reaching kClose ends its last segment at the sample there, as one process's run
+        // does when the next partition is marched (its share is the next piece's).
         if (segments.started && segments.inside && segments.kEnd >= kClose) {
             ++counters.samples;
             const Vec3f q = ray.at(kClose * s1);
             tet = locateFrom(q, lastInside, bary);
+            if constexpr (kSurf) {  // outside the mesh: the run ends at the boundary before it
+                if (tet == kNoTet && segments.iso && !segments.led) endRunAtShare();
+            }
             const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
             const Vec3f grad =
                 sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
@@ -579,21 +624,29 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         } else {
             // The run's share ends before the next piece (a skipped partition or empty space
             // follows it): one process's next sample ends it there, so this piece does.
+            if constexpr (kSurf) {
+                if (segments.iso && segments.started && segments.inside && !segments.led)
+                    endRunAtShare();
+            }
             segments.finish(tf, s1, unit, acc);
         }
         note(tExit);
     } else if (preintegrated && !opaque) {
         if constexpr (kSurf) {
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
-            // the run's last sample at the end.
-            if (segments.iso && segments.inside && isoNear())
-                sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator.mesh,
-                                                       tf, ray, lighting, tExit / s1, true,
-                                                       segments.kLast, lastInside, segments.vLast,
-                                                       segments.kEnd, segments, counters, acc);
+            // the run's last sample at the end; a run whose share ends before it ends there.
+            if (segments.iso && segments.started && segments.inside && !segments.led) {
+                if (segments.kEnd < tSpanEnd / s1)
+                    endRunAtShare();
+                else if (isoNear())
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
+                        tSpanEnd / s1, true, segments.kLast, lastInside, segments.vLast,
+                        segments.kEnd, segments, counters, acc);
+            }
         }
         segments.finish(tf, s1, unit, acc);
-        note(tExit);
+        note(tSpanEnd);
     }
     if constexpr (kSurf) {  // the cut face behind the volume
         if (cut1 && !opaque)
