@@ -352,7 +352,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // where its partition's values reach one, whatever follows the share (so a piece of the ray
     // gives one process's run). Unless a transparent partition or macrocell was skipped, no
     // partition holds kEnd (else a sample would be there): it lies outside the mesh, and a run
-    // after it starts at the boundary, as after an outside sample.
+    // after it starts at the boundary, as after an outside sample. (The next add() or finish()
+    // ends the run at kEnd.)
     [[maybe_unused]] const auto endRunAtShare = [&]() {
         const KdPartition& a = scene.kd.partitions[pInside];
         if (segments.iso->within(a.valueMin, a.valueMax))
@@ -360,7 +361,6 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, segments.kEnd, true,
                 segments.kLast, lastInside, segments.vLast, segments.kEnd, segments, counters, acc);
         if (!skipped) kRunFrom = segments.kEnd, runFromOutside = true, runFromValid = true;
-        segments.close(tf, s1, unit, acc);
     };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
     float kLocated = -INFINITY;  // grid position of the last sample located
@@ -572,8 +572,10 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if constexpr (kSurf) {
                 if (in) pInside = p;
                 // With isosurfaces a run starts (not after a long step: bisected above) at the
-                // mesh's boundary or the span's start, and ends at the boundary.
-                if (in && segments.iso && runFromValid && !segments.inside && isoNear())
+                // mesh's boundary or the span's start, and ends at the boundary. (A run whose
+                // share ended before this sample goes on no further.)
+                const bool runGoesOn = segments.inside && kSample <= segments.kEnd;
+                if (in && segments.iso && runFromValid && !runGoesOn && isoNear())
                     sampleAtBoundary<kNative, kLit, kSurf>(
                         locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kRunFrom,
                         runFromOutside, kSample, tet, v, k1, segments, counters, acc);

@@ -136,12 +136,6 @@ struct SampleSegments {
     UVR_HOST_DEVICE void finish(const TfTableView& tf, float s1, double unit, Vec4f& acc) const {
         if (started && inside && !led) endRun(tf, kEnd - kLast, s1, unit, acc);
     }
-    /// Ends the last run at the end of its piece now, as the next sample past kEnd would; the
-    /// next add() starts a new one.
-    UVR_HOST_DEVICE void close(const TfTableView& tf, float s1, double unit, Vec4f& acc) {
-        finish(tf, s1, unit, acc);
-        inside = false;
-    }
 
 private:
     /// The segment from the last sample to one of value v and gradient g over len, split at
