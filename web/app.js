@@ -53,7 +53,7 @@ function send(message) {
 const kStateKeys = ["camera", "tf", "range", "field", "method", "quality", "heatmap", "size",
                     "opacity_unit", "opacity_law", "step", "clip_planes", "shade", "ambient",
                     "diffuse", "specular", "specular_power", "normals", "iso", "clip_surface",
-                    "background"];
+                    "gradient_opacity", "background"];
 
 // Gradient shading's coefficients: the slider's id and the setting it sets.
 const kLightSliders = [["ambient", "ambient"], ["diffuse", "diffuse"], ["specular", "specular"],
@@ -636,8 +636,11 @@ function updateControls() {
     // The coefficients light the volume when shaded, and isosurfaces and the cut face always.
     const lit = !!s.shade || (s.iso || []).length > 0 ||
                 (!!s.clip_surface && (s.clip_planes || []).length > 0);
-    $("normals").disabled = !lit;
+    // The normals' gradients are the gradient opacity's too.
+    $("normals").disabled = !lit && !s.gradient_opacity;
     if (s.normals) $("normals").value = s.normals;
+    if (document.activeElement !== $("gradient-opacity"))
+        $("gradient-opacity").value = s.gradient_opacity || "";
     $("clip-surface").checked = !!s.clip_surface;
     for (const [id, name] of kLightSliders) {
         $(id).disabled = !lit;  // read only then
@@ -753,6 +756,9 @@ $("heatmap").addEventListener("change", (e) => sendSet({heatmap: e.target.checke
 
 $("shade").addEventListener("change", (e) => sendSet({shade: e.target.checked}));
 $("normals").addEventListener("change", (e) => sendSet({normals: e.target.value}));
+// The server checks the text; a bad one comes back as an error and the state keeps the last.
+$("gradient-opacity").addEventListener("change", (e) =>
+    sendSet({gradient_opacity: e.target.value.trim()}));
 for (const [id, name] of kLightSliders) {
     let pending = 0;
     $(id).addEventListener("input", (e) => {

@@ -559,6 +559,54 @@ TEST(Cli, ShadeLightsTheVolumeAndIsReported) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
 }
 
+TEST(Cli, GradientOpacityScalesTheOpacityAndIsReported) {
+    // Issue 32: --gradient-opacity scales the opacity by the gradient's magnitude (a constant
+    // function here: 1 changes no pixel, 0 hides everything, 0.5 lies between); the stats give
+    // it as written; --normals is read with it; bad ones are refused in one line, and cell data
+    // has no gradient.
+    if (!testing::haveSharedData()) GTEST_SKIP() << "no ../shared/data";
+    const std::string dir = testing::scratchDir();
+    const std::string fin = "-q render " + testing::sharedData("bluntfin_tets.vtk") +
+                            " --size 48x32 --method exact --azimuth 30 --elevation 20 ";
+    ASSERT_EQ(uvr(fin + "-o plain.png", dir).code, 0);
+    for (const auto& [name, f] : {std::pair{"one", "0:1"}, {"zero", "0:0"}, {"half", "0:0.5"}}) {
+        const CliRun r = uvr(
+            fin + "-o " + name + ".png --gradient-opacity " + f + " --normals cell --stats s.json",
+            dir);
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    std::ifstream in(dir + "/s.json");
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["gradient_opacity"], "0:0.5");
+    EXPECT_EQ(j["normals"], "cell");
+    EXPECT_EQ(j["shade"], false);
+    const Image plain = readPng(dir + "/plain.png"), one = readPng(dir + "/one.png"),
+                zero = readPng(dir + "/zero.png"), half = readPng(dir + "/half.png");
+    double sumPlain = 0.0, sumHalf = 0.0, sumZero = 0.0;
+    for (std::size_t i = 0; i < plain.pixels.size(); ++i) {
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(one.pixels[i][k], plain.pixels[i][k]) << i;
+        sumPlain += plain.pixels[i].w, sumHalf += half.pixels[i].w, sumZero += zero.pixels[i].w;
+    }
+    EXPECT_GT(sumPlain, 10.0);
+    EXPECT_EQ(sumZero, 0.0);
+    EXPECT_LT(sumHalf, 0.9 * sumPlain);
+    EXPECT_GT(sumHalf, 0.3 * sumPlain);
+    const std::pair<const char*, const char*> bad[] = {
+        {"--gradient-opacity 1:2", "--gradient-opacity 1:2: expected MAGNITUDE:SCALE"},
+        {"--gradient-opacity 2:1,1:0", "--gradient-opacity 2:1,1:0: expected MAGNITUDE:SCALE"},
+        {"--gradient-opacity x", "--gradient-opacity x: expected MAGNITUDE:SCALE"},
+    };
+    for (const auto& [flags, says] : bad)
+        expectOneLineError(uvr(fin + "-o x.png " + flags, dir), {says}, flags);
+    const CliRun cells = uvr("-q render " + testing::sharedData("cylinder_quadratic_as_tets.vtk") +
+                                 " --field pressure:cell --size 16x16 --gradient-opacity 0:1 "
+                                 "-o x.png",
+                             dir);
+    expectOneLineError(cells, {"--gradient-opacity 0:1: a gradient opacity needs a point field"},
+                       "cell data");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
+}
+
 TEST(Cli, IsoDrawsSurfacesInsideTheVolumeAndIsReported) {
     // Issue 32: --iso draws opaque or translucent surfaces, lit with the shading coefficients
     // (read with --iso even without --shade); the stats list them as written; bad ones are

@@ -103,6 +103,15 @@ void RenderFlags::registerOn(CLI::App& app, bool oneFrame, bool withMethod) {
         ->type_name("VALUE[,OPACITY[,#RRGGBB]]")
         ->allow_extra_args(false)  // one value per occurrence: the mesh file may follow
         ->take_all();
+    app.add_option("--gradient-opacity", gradientOpacity,
+                   "Scale the opacity by the field gradient's magnitude, as VTK's gradient "
+                   "opacity: a piecewise linear function through up to " +
+                       std::to_string(kMaxGradientOpacityPoints) +
+                       " points MAGNITUDE:SCALE (magnitudes in the field's units per file unit, "
+                       "non-decreasing; scales in [0, 1]; constant beyond the ends), e.g. "
+                       "0:0,0.5:1 fades regions flatter than 0.5 per unit; shaded or not "
+                       "(--normals picks the gradients; a point field only)")
+        ->type_name("MAGNITUDE:SCALE,...");
     // The library's settings, each once (the vocabulary): its name, doc, default and check.
     std::vector<std::string> except;
     if (!withMethod) except.push_back("method");
@@ -200,6 +209,7 @@ RenderSettings RenderFlags::baseSettings() const {
         s.clipBox = Bounds3f{Vec3f(v[0], v[1], v[2]), Vec3f(v[3], v[4], v[5])};
     }
     for (const std::string& text : isoSurfaces) s.isoSurfaces.push_back(parseIsoSurface(text));
+    if (gradientOpacity) s.lighting.gradientOpacity = parseGradientOpacity(*gradientOpacity);
     if (!depthFile.empty()) s.depthAlpha = depthOpacity.value_or(0.5f);
     if (!depthInFile.empty()) s.depthIn = readDepthNpy(depthInFile, s.width, s.height);
     // The settings of the library's vocabulary are checked there (main re-spells its errors

@@ -43,9 +43,10 @@ struct RenderFlags {
     float azimuth = 0.f, elevation = 0.f;
     /// The settings of the library's vocabulary (--method, --quality, --sample-distance, ...).
     SettingFlags vocabulary;
-    std::vector<std::string> clipPlanes;   ///< --clip-plane ox,oy,oz,nx,ny,nz (repeatable)
-    std::string clipBox;                   ///< --clip-box x0,y0,z0,x1,y1,z1
-    std::vector<std::string> isoSurfaces;  ///< --iso VALUE[,OPACITY[,#RRGGBB]] (repeatable)
+    std::vector<std::string> clipPlanes;         ///< --clip-plane ox,oy,oz,nx,ny,nz (repeatable)
+    std::string clipBox;                         ///< --clip-box x0,y0,z0,x1,y1,z1
+    std::vector<std::string> isoSurfaces;        ///< --iso VALUE[,OPACITY[,#RRGGBB]] (repeatable)
+    std::optional<std::string> gradientOpacity;  ///< --gradient-opacity MAGNITUDE:SCALE,...
     std::uint32_t leafCells = 0;
     bool noSeedGrid = false;
     bool splitCells = false;

@@ -338,6 +338,45 @@ RenderSettings settingsOf(const py::dict& settings,
             }
             continue;
         }
+        // Gradient opacity: (magnitude, scale) pairs or the CLI's text "MAGNITUDE:SCALE,...";
+        // None is off.
+        if (key == "gradient_opacity") {
+            const std::string text = py::str(py::repr(v)).cast<std::string>();
+            const std::string expected =
+                "expected up to " + std::to_string(kMaxGradientOpacityPoints) +
+                " (magnitude, scale) pairs, magnitudes finite, >= 0 and non-decreasing, scales "
+                "in [0, 1], or the text 'MAGNITUDE:SCALE,...'";
+            if (v.is_none()) continue;
+            if (py::isinstance<py::str>(v)) {
+                s.lighting.gradientOpacity = parseGradientOpacity(v.cast<std::string>());
+                continue;
+            }
+            if (!py::hasattr(v, "__iter__")) throw SettingError(key, text, expected);
+            GradientOpacity g;
+            try {
+                for (const py::handle& item : py::iter(v)) {
+                    if (py::isinstance<py::str>(item) || !py::hasattr(item, "__iter__"))
+                        throw SettingError(key, text, expected);
+                    const py::tuple t = py::tuple(py::reinterpret_borrow<py::object>(item));
+                    if (t.size() != 2 || g.count == kMaxGradientOpacityPoints ||
+                        py::isinstance<py::bool_>(t[0]) || py::isinstance<py::bool_>(t[1]))
+                        throw SettingError(key, text, expected);
+                    g.magnitude[g.count] = t[0].cast<float>();
+                    g.scale[g.count] = t[1].cast<float>();
+                    ++g.count;
+                }
+                if (g.count == 0) throw SettingError(key, text, expected);
+                checkGradientOpacity(g);
+            } catch (const py::error_already_set&) {
+                throw SettingError(key, text, expected);
+            } catch (const py::cast_error&) {
+                throw SettingError(key, text, expected);
+            } catch (const SettingError&) {
+                throw SettingError(key, text, expected);
+            }
+            s.lighting.gradientOpacity = g;
+            continue;
+        }
         // Depth out: the opacity whose depth the frame reports (Image.depth); depth in: a 2-D
         // array of view depths of geometry rendered elsewhere (inf or NaN: none).
         if (key == "depth") {

@@ -43,6 +43,10 @@ def python_frame(renderer, **kw):
     ("bluntfin_tets.vtk", ["--iso", "0.9", "--iso", "1.2,0.5,#ff8000", "--specular", "0.2",
                            "--method", "adaptive"],
      dict(iso=[0.9, (1.2, 0.5, "#ff8000")], specular=0.2, method="adaptive")),
+    ("bluntfin_tets.vtk", ["--gradient-opacity", "0:0.2,0.5:1", "--shade", "--normals", "cell",
+                           "--method", "adaptive"],
+     dict(gradient_opacity=[(0, 0.2), (0.5, 1)], shade=True, normals="cell",
+          method="adaptive")),
 ], ids=lambda c: c[0])
 def test_the_same_settings_give_the_clis_pixels(data_dir, cli, tmp_path, case):
     name, flags, kwargs = case
@@ -262,6 +266,21 @@ def test_bad_render_arguments_are_refused_with_the_librarys_messages(data_dir):
         r.render(iso=list(range(9)))
     assert r.render(size=(8, 8), iso=[(2, 0.5, (1, 0, 0)), "2.5,1,#00ff00"]).stats["iso"] == [
         "2,0.5,#ff0000", "2.5,1,#00ff00"]
+    # Gradient opacity (issue 32): (magnitude, scale) pairs or the CLI's text.
+    expected = r"expected up to 8 \(magnitude, scale\) pairs"
+    with pytest.raises(uvr.ArgumentError, match=r"^gradient_opacity=0.5: " + expected):
+        r.render(gradient_opacity=0.5)
+    with pytest.raises(uvr.ArgumentError, match=r"^gradient_opacity=\[\(1, 2\)\]: " + expected):
+        r.render(gradient_opacity=[(1, 2)])
+    with pytest.raises(uvr.ArgumentError, match=r"^gradient_opacity=\[\(2, 1\), \(1, 0\)\]"):
+        r.render(gradient_opacity=[(2, 1), (1, 0)])
+    with pytest.raises(uvr.ArgumentError, match=r"^gradient_opacity=\[\(True, 1\)\]"):
+        r.render(gradient_opacity=[(True, 1)])
+    with pytest.raises(uvr.ArgumentError, match=r"^gradient_opacity=1:2: expected MAGNITUDE"):
+        r.render(gradient_opacity="1:2")
+    pairs = r.render(size=(8, 8), gradient_opacity=[(0, 0), (1.5, 1)])
+    assert pairs.stats["gradient_opacity"] == "0:0,1.5:1"
+    assert np.array_equal(pairs, r.render(size=(8, 8), gradient_opacity="0:0,1.5:1"))
     # Still usable after every refusal.
     assert r.render(size=(8, 8)).stats["samples"] > 0
 

@@ -195,8 +195,8 @@ class Renderer:
     def render(self, field=None, tf=None, opacity=None, range=None, camera=None,
                size=None, method=None, quality=None, *, azimuth=0.0,
                elevation=0.0, zoom=1.0, background=None, log_scale=None, nan_color=None,
-               clip_planes=None, clip_box=None, iso=None, depth=None, depth_in=None,
-               legend=False, **settings):
+               clip_planes=None, clip_box=None, iso=None, gradient_opacity=None, depth=None,
+               depth_in=None, legend=False, **settings):
         """Renders a frame; returns a uvr.Image (float32 (h, w, 4), premultiplied RGBA) with
         ``.stats`` and ``.sample_counts``.
 
@@ -210,7 +210,9 @@ class Renderer:
         `clip_box` (lo, hi) keeping its inside, in the file's coordinates (``--clip-plane``,
         ``--clip-box``); `iso` a list of up to eight isosurfaces, each a value, (value, opacity)
         or (value, opacity, colour) with colour "#RRGGBB" or (r, g, b) (``--iso``; default
-        opaque, coloured by the colour map); `depth` an opacity in (0, 1]: the image's ``.depth``
+        opaque, coloured by the colour map); `gradient_opacity` up to eight (magnitude, scale)
+        pairs scaling the opacity by the field gradient's magnitude (VTK's gradient opacity; the
+        field's units per file unit, scales in [0, 1]; ``--gradient-opacity``); `depth` an opacity in (0, 1]: the image's ``.depth``
         then holds per pixel the distance along the view direction (file units) where the
         opacity first reaches it, inf where it never does (``--depth``, ``--depth-opacity``);
         `depth_in` a (height, width) array of such distances of opaque geometry rendered
@@ -261,7 +263,8 @@ class Renderer:
         # "auto" renders with whatever was prepared (its pick, else the other of exact and
         # adaptive; the stats say which).
         settings = _settings(method=method, quality=quality, clip_planes=clip_planes,
-                             clip_box=clip_box, iso=iso, depth=depth, depth_in=depth_in,
+                             clip_box=clip_box, iso=iso, gradient_opacity=gradient_opacity,
+                             depth=depth, depth_in=depth_in,
                              **settings)
         method = settings.get("method", "auto")
         if method != "auto" and method in _uvr.METHODS and method not in self._methods:

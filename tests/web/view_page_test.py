@@ -742,6 +742,39 @@ def shade(page):
     check(page.hook("errorCount") == errors0, f"shading gave an error: {page.hook('lastError')}")
 
 
+def gradient_opacity(page):
+    step("the Gradient opacity box scales the opacity; a bad text is refused")
+    errors0 = page.hook("errorCount")
+    page.quiet()
+    before = page.pixels()
+    check(not page.js("return document.getElementById('normals').disabled"),
+          "the Normals menu is disabled with Shade on")
+
+    def enter(text):
+        page.js("const b = document.getElementById('gradient-opacity');"
+                f" b.value = {json.dumps(text)}; b.dispatchEvent(new Event('change'));")
+
+    frames0 = page.hook("frameCount")
+    enter("0:0.3")  # a constant: the whole volume at 0.3 of its opacity
+    settled(page, frames0, "the frame with a gradient opacity")
+    state = page.hook("state")
+    check(state["gradient_opacity"] == "0:0.3",
+          f"the state's gradient_opacity is {state['gradient_opacity']!r}")
+    check(changed_pixels(before, page.pixels()) > 40,
+          "a gradient opacity of 0.3 changed nothing")
+    enter("2:1,1:0")
+    page.wait(f"v.errorCount > {errors0}", 10, "the error for a decreasing gradient opacity")
+    error = page.hook("lastError")
+    check("gradient_opacity" in error["message"] and "non-decreasing" in error["message"],
+          f"the error names neither the key nor the rule: {error}")
+    frames0 = page.hook("frameCount")
+    enter("")
+    settled(page, frames0, "the frame without a gradient opacity")
+    check(page.hook("state")["gradient_opacity"] == "", "the gradient opacity did not go off")
+    check(changed_pixels(before, page.pixels()) <= 2,
+          "the frame without a gradient opacity is not the one before it")
+
+
 def overlay_painted(page):
     """Pixels the annotations' canvas paints (alpha above 0), in all and in its right quarter."""
     return page.js("""
@@ -1129,6 +1162,7 @@ def main():
             flood(page)
             clip(page)
             shade(page)
+            gradient_opacity(page)
             isosurfaces(page)
             view_section(page)
             save_and_reproduce(page, args.uvr, downloads, tmp)

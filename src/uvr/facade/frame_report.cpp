@@ -121,8 +121,12 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
         j["iso"] = std::move(iso);
     }
     // Gradient shading, with its coefficients when on (they light isosurfaces and the cut face
-    // too).
+    // too); the gradient opacity, as the CLI's --gradient-opacity writes it.
     j["shade"] = settings.lighting.on;
+    if (settings.lighting.gradientOpacity.active())
+        j["gradient_opacity"] = gradientOpacityText(settings.lighting.gradientOpacity);
+    if (settings.lighting.readsGradient())
+        j["normals"] = settings.lighting.smooth ? "smooth" : "cell";
     if (settings.lighting.on || !settings.isoSurfaces.empty() || j.contains("clip_surface")) {
         j["normals"] = settings.lighting.smooth ? "smooth" : "cell";
         j["ambient"] = settings.lighting.ambient;

@@ -598,7 +598,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         }
         if (!preintegrated && tet != kNoTet) {
             const Vec4f c = tf.sample(v);
-            const float a = correctOpacity(c.w, length, unit, tf.law);
+            const float a = correctOpacity(c.w, length * light.opacity, unit, tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
         note(kSample * s1);

@@ -128,8 +128,8 @@ UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t,
     return clipNative(mesh, t, ray, tMin);
 }
 
-/// Most pieces smoothLitSegment cuts a segment into, and the change of light (scale plus add)
-/// a piece may span.
+/// Most pieces smoothLitSegment cuts a segment into, and the change of light (scale plus add,
+/// plus the gradient opacity's) a piece may span.
 inline constexpr int kLightMaxPieces = 8;
 inline constexpr float kLightPieceChange = 0.01f;
 
@@ -138,9 +138,11 @@ inline constexpr float kLightPieceChange = 0.01f;
 /// distance from the ends' mean), at most kLightMaxPieces.
 UVR_HOST_DEVICE inline int lightPieces(const LightFactors& a, const LightFactors& c,
                                        const LightFactors& b) {
-    const float ends = fabsf(b.scale - a.scale) + fabsf(b.add - a.add);
+    const float ends =
+        fabsf(b.scale - a.scale) + fabsf(b.add - a.add) + fabsf(b.opacity - a.opacity);
     const float bend =
-        4.f * (fabsf(c.scale - 0.5f * (a.scale + b.scale)) + fabsf(c.add - 0.5f * (a.add + b.add)));
+        4.f * (fabsf(c.scale - 0.5f * (a.scale + b.scale)) + fabsf(c.add - 0.5f * (a.add + b.add)) +
+               fabsf(c.opacity - 0.5f * (a.opacity + b.opacity)));
     const float want = ceilf((ends > bend ? ends : bend) / kLightPieceChange);
     return want <= 1.f ? 1 : (want < kLightMaxPieces ? int(want) : kLightMaxPieces);
 }
@@ -149,7 +151,8 @@ UVR_HOST_DEVICE inline int lightPieces(const LightFactors& a, const LightFactors
 UVR_HOST_DEVICE inline LightFactors simpsonLight(const LightFactors& a, const LightFactors& c,
                                                  const LightFactors& b) {
     return {(a.scale + 4.f * c.scale + b.scale) * (1.f / 6.f),
-            (a.add + 4.f * c.add + b.add) * (1.f / 6.f)};
+            (a.add + 4.f * c.add + b.add) * (1.f / 6.f),
+            (a.opacity + 4.f * c.opacity + b.opacity) * (1.f / 6.f)};
 }
 
 /// Most pieces a native cell's segment is cut into (nativeSegment).
@@ -200,7 +203,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     };
     // The light at the parametric coordinates rst of the last point valueAt took.
     auto lightWith = [&](const Lighting& l) {
-        if (!kLit || !l.on) return LightFactors{};
+        if (!kLit || !l.readsGradient()) return LightFactors{};
         const float at[4] = {rst.x, rst.y, rst.z, 0.f};
         return lightFactors(l, mesh.gradient(t, at, l.smooth), ray.dir);
     };
@@ -211,7 +214,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     if (!(v0 == v0)) {
         v0 = valueAt(t0);
         lightA = lightHere();
-    } else if (kLit && light.on) {
+    } else if (kLit && light.readsGradient()) {
         (void)valueAt(t0);  // for its coordinates only
         lightA = lightHere();
         rst = rstMid;  // t1's Newton starts where it would unlit
@@ -227,7 +230,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     }
     // Lit: also as many pieces as the light's change asks (the gradient turns in the cell).
     LightFactors lightMid;
-    if (kLit && light.on) {
+    if (kLit && light.readsGradient()) {
         const Vec3f at = rst;
         rst = rstMid;
         lightMid = lightHere();
@@ -236,9 +239,8 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         pieces = lit > pieces ? lit : pieces;
     }
     if (pieces == 1 && !(kSurf && iso)) {
-        const Vec4f before = acc;
-        segment::integrate(tf, v0, vEnd, t1 - t0, unit, acc, true);
-        if constexpr (kLit) lightSegment(before, simpsonLight(lightA, lightMid, lightEnd), acc);
+        integrateLit<kLit>(tf, v0, vEnd, t1 - t0, unit, simpsonLight(lightA, lightMid, lightEnd),
+                           acc);
         return vEnd;
     }
     rst = rstMid;  // a good start for the pieces' points in the middle; each follows the last
@@ -267,20 +269,14 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
                         ((fc < 0.f) == (flo < 0.f) ? lo : hi) = tc;
                         ((fc < 0.f) == (flo < 0.f) ? flo : fhi) = fc;
                     }
-                    const Vec4f before = acc;
-                    segment::integrate(tf, va, c, tc - ta, unit, acc, true);
-                    lightSegment(before, vol, acc);
+                    integrateLit<kLit>(tf, va, c, tc - ta, unit, vol, acc);
                     (void)valueAt(tc);  // the surface's coordinates, for its normal
                     compositeIso(iso->surfaces[j], tf.sample(c).xyz(), lightWith(surface), acc);
                     ta = tc, va = c, len = tb - tc;
                 });
             }
         }
-        if (acc.w < segment::kOpacityEnd) {
-            const Vec4f before = acc;
-            segment::integrate(tf, va, b, len, unit, acc, true);
-            if constexpr (kLit) lightSegment(before, vol, acc);
-        }
+        if (acc.w < segment::kOpacityEnd) integrateLit<kLit>(tf, va, b, len, unit, vol, acc);
         a = b;
         lightA = lightB;
     }
@@ -322,9 +318,7 @@ UVR_HOST_DEVICE inline void smoothLitSegment(const TetMeshView& m, const TfTable
     const LightFactors c = lightInTet<kNative>(m, tet, ray, 0.5 * (t0 + t1), light);
     const int n = lightPieces(a, c, b);
     if (n == 1) {
-        const Vec4f before = acc;
-        segment::integrate(tf, v0, v1, t1 - t0, unit, acc, true);
-        lightSegment(before, simpsonLight(a, c, b), acc);
+        integrateLit(tf, v0, v1, t1 - t0, unit, simpsonLight(a, c, b), acc);
         return;
     }
     LightFactors la = a;
@@ -333,9 +327,7 @@ UVR_HOST_DEVICE inline void smoothLitSegment(const TetMeshView& m, const TfTable
     for (int i = 1; i <= n && acc.w < segment::kOpacityEnd; ++i) {
         const float vb = i == n ? v1 : v0 + (v1 - v0) * (float(i) / float(n));
         const LightFactors lb = i == n ? b : lightInTet<kNative>(m, tet, ray, t0 + h * i, light);
-        const Vec4f before = acc;
-        segment::integrate(tf, va, vb, h, unit, acc, true);
-        lightSegment(before, la.mean(lb), acc);
+        integrateLit(tf, va, vb, h, unit, la.mean(lb), acc);
         va = vb;
         la = lb;
     }
@@ -417,7 +409,7 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
     const TetMeshView& mesh = scene.locator.mesh;
     const double unit = scene.params.opacityUnit;
     if constexpr (kLit) {
-        if (light.on && light.smooth && mesh.blockGradients && continuous) {
+        if (light.readsGradient() && light.smooth && mesh.blockGradients && continuous) {
             const float a0 = acc.w;
             smoothLitSegment<kNative>(mesh, scene.tf, tet, ray, ta, tb, va, vb, unit, light, acc);
             if constexpr (kSurf)
@@ -426,14 +418,13 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
             return;
         }
     }
-    const Vec4f before = acc;
-    segment::integrate(scene.tf, va, vb, tb - ta, unit, acc, true);
-    if constexpr (kLit) {
-        if (light.on) lightSegment(before, lightInTet<kNative>(mesh, tet, ray, tb, light), acc);
-        if constexpr (kSurf)
-            noteDepth(rayDepthAlpha(scene.params, counters), before.w, acc.w, float(ta), float(tb),
-                      counters);
-    }
+    [[maybe_unused]] const float a0 = acc.w;
+    LightFactors f;
+    if constexpr (kLit)
+        if (light.readsGradient()) f = lightInTet<kNative>(mesh, tet, ray, tb, light);
+    integrateLit<kLit>(scene.tf, va, vb, tb - ta, unit, f, acc);
+    if constexpr (kSurf)
+        noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, float(ta), float(tb), counters);
 }
 
 /// A tetrahedron's segment [t, tEnd] (scalar linear from s0 to s1) with the frame's

@@ -112,11 +112,8 @@ struct SampleSegments {
                     done = true;
                 }
             }
-            if (!done) {
-                const Vec4f before = acc;
-                segment::integrate(tf, vLast, v, double(k - kLast) * s1, unit, acc, true);
-                if constexpr (kLit) lightSegment(before, light.mean(f), acc);
-            }
+            if (!done)
+                integrateLit<kLit>(tf, vLast, v, double(k - kLast) * s1, unit, light.mean(f), acc);
         } else if (started && inside) {  // the run ends
             endRun(tf, (k < kEnd ? k : kEnd) - kLast, s1, unit, acc);
         }
@@ -149,9 +146,7 @@ private:
         iso->crossings(vLast, v, [&](int i, float f) {
             if (acc.w >= segment::kOpacityEnd) return;
             const IsoSurface& s = iso->surfaces[i];
-            const Vec4f before = acc;
-            segment::integrate(tf, va, s.value, double(f - f0) * len, unit, acc, true);
-            lightSegment(before, vol, acc);
+            integrateLit(tf, va, s.value, double(f - f0) * len, unit, vol, acc);
             const Vec3f gi = gradLast + (g - gradLast) * f;
             const float a0 = acc.w;
             compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
@@ -160,9 +155,7 @@ private:
             f0 = f, va = s.value;
         });
         if (acc.w >= segment::kOpacityEnd) return;
-        const Vec4f before = acc;
-        segment::integrate(tf, va, v, double(1.f - f0) * len, unit, acc, true);
-        lightSegment(before, vol, acc);
+        integrateLit(tf, va, v, double(1.f - f0) * len, unit, vol, acc);
     }
 
     /// The last sample's share: `steps` grid steps along the run's last slope (in double: the
@@ -171,9 +164,7 @@ private:
                                 Vec4f& acc) const {
         double end = vLast;
         if (inRun) end += (double(vLast) - vPrev) * (double(steps) / (double(kLast) - kPrev));
-        const Vec4f before = acc;
-        segment::integrate(tf, vLast, end, double(steps) * s1, unit, acc, true);
-        if constexpr (kLit) lightSegment(before, light, acc);
+        integrateLit<kLit>(tf, vLast, end, double(steps) * s1, unit, light, acc);
     }
 };
 
@@ -184,7 +175,7 @@ template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec3f sampleGradient(const MarchParams& params, const TetMeshView& mesh,
                                             std::uint32_t tet, const float bary[4]) {
     if constexpr (kLit) {
-        if (tet != kNoTet && (params.light.on || (kSurf && params.iso.active())))
+        if (tet != kNoTet && (params.light.readsGradient() || (kSurf && params.iso.active())))
             return mesh.gradient<kNative>(tet, bary, params.light.smooth);
     }
     return Vec3f(0.f);
@@ -194,7 +185,7 @@ UVR_HOST_DEVICE inline Vec3f sampleGradient(const MarchParams& params, const Tet
 /// lighting is off or no cell holds the sample.
 UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, std::uint32_t tet, Vec3f g,
                                             Vec3f dir) {
-    if (!light.on || tet == kNoTet) return {};
+    if (!light.readsGradient() || tet == kNoTet) return {};
     return lightFactors(light, g, dir);
 }
 
@@ -412,7 +403,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         }
         if (!scene.params.preintegrated && tet != kNoTet && own) {
             const Vec4f c = scene.tf.sample(v);
-            const float a = correctOpacity(c.w, s, unit, scene.tf.law);
+            const float a = correctOpacity(c.w, s * light.opacity, unit, scene.tf.law);
             if (a > 0.f) compositeFrontToBack(acc, light.apply(c.xyz()), a);
         }
         if constexpr (kSurf) {

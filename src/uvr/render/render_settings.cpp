@@ -175,6 +175,61 @@ void checkIso(const RenderSettings& s) {
     }
 }
 
+namespace {
+
+constexpr const char* kGradientOpacityForm =
+    "expected MAGNITUDE:SCALE[,MAGNITUDE:SCALE...]: up to 8 points of a gradient magnitude (the "
+    "field's units per length in the file, finite, >= 0, non-decreasing) and the opacity scale "
+    "there, in [0, 1]";
+
+}  // namespace
+
+std::string gradientOpacityText(const GradientOpacity& g) {
+    std::string out;
+    for (int i = 0; i < g.count; ++i)
+        out += (i ? "," : "") + shortest(g.magnitude[i]) + ":" + shortest(g.scale[i]);
+    return out;
+}
+
+GradientOpacity parseGradientOpacity(const std::string& text) {
+    auto bad = [&]() { throw SettingError("gradient_opacity", text, kGradientOpacityForm); };
+    auto number = [&](const std::string& t) {
+        char* end = nullptr;
+        const float v = std::strtof(t.c_str(), &end);
+        if (t.empty() || *end != '\0' || !std::isfinite(v) || std::isspace((unsigned char)t[0]))
+            bad();
+        return v;
+    };
+    GradientOpacity g;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t comma = text.find(',', start);
+        const std::string point = text.substr(start, comma - start);
+        const std::size_t colon = point.find(':');
+        if (colon == std::string::npos || g.count == kMaxGradientOpacityPoints) bad();
+        g.magnitude[g.count] = number(point.substr(0, colon));
+        g.scale[g.count] = number(point.substr(colon + 1));
+        ++g.count;
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    checkGradientOpacity(g, text);
+    return g;
+}
+
+void checkGradientOpacity(const GradientOpacity& g, const std::string& text) {
+    const std::string shown = text.empty() ? gradientOpacityText(g) : text;
+    if (g.count < 0 || g.count > kMaxGradientOpacityPoints)
+        throw SettingError("gradient_opacity", std::to_string(g.count) + " points",
+                           kGradientOpacityForm);
+    for (int i = 0; i < g.count; ++i) {
+        const float m = g.magnitude[i], a = g.scale[i];
+        if (!(std::isfinite(m) && m >= 0.f && a >= 0.f && a <= 1.f) ||
+            (i > 0 && !(m >= g.magnitude[i - 1])))
+            throw SettingError("gradient_opacity", shown, kGradientOpacityForm);
+    }
+}
+
 void validateSettings(const RenderSettings& s) {
     auto bad = [](const std::string& msg) { throwError(ErrorKind::Argument, "", msg); };
     constexpr int kMaxSide = 16384;
@@ -196,6 +251,7 @@ void validateSettings(const RenderSettings& s) {
     if (s.camera) validateCamera(*s.camera);
     checkClip(s);
     checkIso(s);
+    checkGradientOpacity(s.lighting.gradientOpacity);
     checkDepth(s);
 }
 

@@ -80,7 +80,8 @@ struct RenderSettings {
     /// the face's normal by the lighting coefficients.
     bool clipSurface = false;
     /// Gradient shading (issue 32; lighting.h): off by default; ParaView's Ambient, Diffuse,
-    /// Specular and SpecularPower and their defaults.
+    /// Specular and SpecularPower and their defaults; and the gradient opacity (off by default;
+    /// magnitudes in the file's units).
     Lighting lighting;
     /// Isosurfaces inside the volume (issue 32; isosurface.h), at most kMaxIsoSurfaces, in any
     /// order: each lit by `lighting`'s coefficients whether or not the volume is shaded. A point
@@ -149,6 +150,19 @@ std::string isoText(const IsoSurface& iso);
 /// naming the text and the form otherwise.
 IsoSurface parseIsoSurface(const std::string& text);
 
+/// A gradient opacity as every front end writes it: "MAGNITUDE:SCALE,..." (shortest decimals;
+/// "" when off).
+std::string gradientOpacityText(const GradientOpacity& g);
+
+/// Reads gradientOpacityText's form (1 to kMaxGradientOpacityPoints points); throws
+/// SettingError (gradient_opacity) naming the text and the form otherwise.
+GradientOpacity parseGradientOpacity(const std::string& text);
+
+/// Throws SettingError (gradient_opacity, naming `text`, else the function's own text) for a
+/// point count above kMaxGradientOpacityPoints, a magnitude not finite, negative or below the
+/// one before, or a scale outside [0, 1]. (validateSettings calls it.)
+void checkGradientOpacity(const GradientOpacity& g, const std::string& text = "");
+
 /// Throws SettingError (depth_alpha, depth_in) for an opacity outside [0, 1] or a depth image
 /// that is not width x height. (validateSettings calls it.)
 void checkDepth(const RenderSettings& settings);
@@ -175,7 +189,9 @@ inline constexpr float kDefaultMaxStepFactor = 16.f;
 /// The default s2 of shaded frames (Lighting::on), in s1: the error-bound rule sees the transfer
 /// function and the field's gradients, not how fast their direction turns, and long steps under
 /// a headlight lose the lit detail (Blunt Fin, shaded, adaptive against exact: SSIM 0.96 at 16
-/// s1; docs/PERFORMANCE.md, "Shaded frames: the step rule").
+/// s1; docs/PERFORMANCE.md, "Shaded frames: the step rule"). Also the default with a gradient
+/// opacity, whose scale changes with the gradient's magnitude, which the rule does not see
+/// either.
 inline constexpr float kShadedMaxStepFactor = 3.f;
 
 }  // namespace uvr

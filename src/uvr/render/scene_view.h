@@ -48,10 +48,11 @@ UVR_HOST_DEVICE inline bool surfacesKernel(const MarchParams& p) {
     return p.iso.active() || p.depthAlpha > 0.f || (p.clip.surface && p.clip.active());
 }
 
-/// Whether a frame runs the integrators' lit instances (kLit): shaded, or with the surfaces'
-/// instances (isosurfaces are lit and need the gradients).
+/// Whether a frame runs the integrators' lit instances (kLit): shaded or with a gradient opacity
+/// (Lighting::readsGradient), or with the surfaces' instances (isosurfaces are lit and need the
+/// gradients).
 UVR_HOST_DEVICE inline bool litKernel(const MarchParams& p) {
-    return p.light.on || surfacesKernel(p);
+    return p.light.readsGradient() || surfacesKernel(p);
 }
 
 /// Everything a ray needs, as plain data for CPU and GPU.

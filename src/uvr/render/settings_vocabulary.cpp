@@ -133,9 +133,9 @@ std::vector<SettingDef> makeVocabulary() {
     step.set = [](RenderSettings& s, const Json& x) { s.step = lengthOf(x); };
     v.push_back(step);
 
-    SettingDef maxStep =
-        setting("max_sample_distance", SettingType::Number,
-                "Adaptive: the largest step s2 in the file's units (default: 16 s1; 3 s1 shaded)");
+    SettingDef maxStep = setting("max_sample_distance", SettingType::Number,
+                                 "Adaptive: the largest step s2 in the file's units (default: "
+                                 "16 s1; 3 s1 shaded or with a gradient opacity)");
     maxStep.min = 0.0, maxStep.max = kInf, maxStep.minOpen = true, maxStep.nullDefault = true;
     maxStep.tunesAdaptive = true;
     maxStep.readBy = {RenderMethod::Partitions};
@@ -392,6 +392,9 @@ bool settingNeedMet(const SettingDef& d, const RenderSettings& settings) {
     if (std::string_view(d.needs) == "shade" &&
         (!settings.isoSurfaces.empty() || settings.clipSurface))
         return true;
+    // The normals' gradients are the gradient opacity's too.
+    if (std::string_view(d.name) == "normals" && settings.lighting.gradientOpacity.active())
+        return true;
     return settingNamed(d.needs).get(settings) == true;
 }
 
@@ -403,11 +406,14 @@ void refuseUnreadSettings(const RenderSettings& settings, const std::vector<std:
                                "read only with clip planes or a clip box: there is no cut face");
     for (const std::string& name : given)
         if (const SettingDef* d = findSetting(name); d && !settingNeedMet(*d, settings))
-            throw SettingError(d->name, settingValueText(d->get(settings)),
-                               std::string("read only with `") + d->needs + "` on" +
-                                   (std::string_view(d->needs) == "shade"
-                                        ? " or an `iso` surface or `clip_surface`"
-                                        : ""));
+            throw SettingError(
+                d->name, settingValueText(d->get(settings)),
+                std::string("read only with `") + d->needs + "` on" +
+                    (std::string_view(d->needs) == "shade"
+                         ? std::string(" or an `iso` surface or `clip_surface`") +
+                               (std::string_view(d->name) == "normals" ? " or a `gradient_opacity`"
+                                                                       : "")
+                         : std::string()));
 }
 
 Json settingDefault(const SettingDef& d) {

@@ -329,6 +329,8 @@ Json ViewServer::Impl::exportMessage(const ViewState& state) const {
         args.insert(args.end(), {"--clip-plane", plane});
     }
     for (const IsoSurface& iso : s.isoSurfaces) args.insert(args.end(), {"--iso", isoText(iso)});
+    if (s.gradientOpacity.active())
+        args.insert(args.end(), {"--gradient-opacity", gradientOpacityText(s.gradientOpacity)});
     args.insert(args.end(), scene.commandFlags.begin(), scene.commandFlags.end());
     // The background the page shows (uvr render's default is a transparent PNG).
     args.insert(args.end(),

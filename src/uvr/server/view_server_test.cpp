@@ -634,6 +634,15 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
                 HasSubstr("--iso 0.5 --iso '1,0.5,#00ff00' --sample-distance 0.01"));
     c.send({{"type", "set"}, {"iso", Json::array()}});
+    // So does its gradient opacity, with the normals it reads.
+    c.send({{"type", "set"}, {"gradient_opacity", "0:0,2:1"}, {"normals", "cell"}});
+    c.send({{"type", "export"}});
+    {
+        const std::string gop = c.until("export")["command"].get<std::string>();
+        EXPECT_THAT(gop, HasSubstr("--normals cell"));
+        EXPECT_THAT(gop, HasSubstr("--gradient-opacity 0:0,2:1 --sample-distance 0.01"));
+    }
+    c.send({{"type", "set"}, {"gradient_opacity", ""}, {"normals", "smooth"}});
     // The cut face exports with a clip plane, and not without one (the CLI refuses it then).
     c.send({{"type", "set"}, {"clip_surface", true}, {"clip_planes", {{0.25, 0, 0, 1, 0, 0}}}});
     c.send({{"type", "export"}});

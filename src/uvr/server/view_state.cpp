@@ -263,6 +263,7 @@ Json toJson(const ViewState& s) {
               {"heatmap", s.heatmap},
               {"clip_planes", clipPlanesJson(s.clipPlanes)},
               {"iso", isoSurfacesJson(s.isoSurfaces)},
+              {"gradient_opacity", gradientOpacityText(s.gradientOpacity)},
               {"size", {s.width, s.height}},
               {"step", s.step},
               {"background", vec(s.background)}};
@@ -360,6 +361,16 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.clipPlanes = clipPlanes(k, v);
         } else if (k == "iso") {
             next.isoSurfaces = isoSurfaces(k, v);
+        } else if (k == "gradient_opacity") {
+            if (!v.is_string() || v.get_ref<const std::string&>().size() > 256)
+                bad(k, "\"MAGNITUDE:SCALE,...\" (up to 8 points) or \"\" (off)", v);
+            try {
+                const std::string& text = v.get_ref<const std::string&>();
+                next.gradientOpacity =
+                    text.empty() ? GradientOpacity{} : parseGradientOpacity(text);
+            } catch (const SettingError& e) {
+                throwError(ErrorKind::Argument, "", e.spelledAs("\"" + k + "\":", " "));
+            }
         } else if (k == "size") {
             if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() ||
                 !v[1].is_number_integer())
@@ -390,7 +401,8 @@ SetResult applySet(ViewState& state, const Json& message, std::size_t stepCount)
             next.step = v.get<std::size_t>();
         } else {
             std::string keys =
-                "camera, tf, range, field, heatmap, clip_planes, iso, size, step, background, "
+                "camera, tf, range, field, heatmap, clip_planes, iso, gradient_opacity, size, "
+                "step, background, "
                 "preset, "
                 "colormap_json";
             for (const char* name : kViewerSettings) keys += std::string(", ") + name;
@@ -416,6 +428,7 @@ RenderSettings frameSettings(const ViewState& state, const RenderSettings& base,
     s.range = state.range;
     s.clipPlanes = state.clipPlanes;
     s.isoSurfaces = state.isoSurfaces;
+    s.lighting.gradientOpacity = state.gradientOpacity;
     for (const auto& [name, value] : state.settings.items()) applySetting(s, name, value);
     scale = std::max(scale, 1);
     s.width = std::max(1, state.width / scale);

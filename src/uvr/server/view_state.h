@@ -48,6 +48,9 @@ struct ViewState {
     /// Isosurfaces (RenderSettings::isoSurfaces), up to kMaxIsoSurfaces; the protocol writes
     /// each as `--iso` does: "VALUE[,OPACITY[,#RRGGBB]]".
     std::vector<IsoSurface> isoSurfaces;
+    /// The gradient opacity (RenderSettings::lighting's; off unless set); the protocol writes it
+    /// as `--gradient-opacity` does, "MAGNITUDE:SCALE,...", or "" when off.
+    GradientOpacity gradientOpacity;
     int width = 1024, height = 1024;
     std::size_t step = 0;  ///< the time step shown (0 for a file without time steps)
     /// What frames and snapshots composite over (r, g, b in [0, 1]; `--background`, black by

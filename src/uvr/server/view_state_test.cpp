@@ -182,6 +182,28 @@ TEST(ViewState, IsosurfacesAreSetInTheirCommandLineFormAndReachTheFrame) {
                 HasSubstr("at most 8 isosurfaces"));
 }
 
+TEST(ViewState, AGradientOpacityIsSetInItsCommandLineFormAndReachesTheFrame) {
+    ViewState s = startState();
+    EXPECT_EQ(toJson(s)["gradient_opacity"], "");
+    applySet(s, {{"gradient_opacity", "0:0,0.50:1"}});
+    ASSERT_EQ(s.gradientOpacity.count, 2);
+    EXPECT_EQ(toJson(s)["gradient_opacity"], "0:0,0.5:1");  // as --gradient-opacity writes it
+    RenderSettings f = frameSettings(s, RenderSettings{});
+    EXPECT_EQ(gradientOpacityText(f.lighting.gradientOpacity), "0:0,0.5:1");
+    // The normals it reads may be set with shading off.
+    applySet(s, {{"normals", "cell"}});
+    EXPECT_FALSE(frameSettings(s, RenderSettings{}).lighting.smooth);
+    applySet(s, {{"gradient_opacity", ""}});
+    EXPECT_FALSE(frameSettings(s, RenderSettings{}).lighting.gradientOpacity.active());
+    // Bad ones are refused naming the key, with the library's expected form.
+    EXPECT_THAT(refusal({{"gradient_opacity", "1:2"}}),
+                HasSubstr("\"gradient_opacity\": 1:2: expected MAGNITUDE:SCALE"));
+    EXPECT_THAT(refusal({{"gradient_opacity", "2:1,1:0"}}), HasSubstr("non-decreasing"));
+    EXPECT_THAT(refusal({{"gradient_opacity", 0.5}}), HasSubstr("gradient_opacity"));
+    EXPECT_THAT(refusal({{"gradient_opacity", std::string(300, '1')}}),
+                HasSubstr("gradient_opacity"));
+}
+
 TEST(ViewState, PresetsAndUploadedColourMapsReplaceColoursAndAskForTheStateBack) {
     ViewState s = startState();
     applySet(s, {{"tf", {{"opacity", {{0, 0}, {1, 0.3}}}}}});
