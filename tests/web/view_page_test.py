@@ -762,6 +762,7 @@ def gradient_opacity(page):
           f"the state's gradient_opacity is {state['gradient_opacity']!r}")
     check(changed_pixels(before, page.pixels()) > 40,
           "a gradient opacity of 0.3 changed nothing")
+    page.screenshot("gradient-opacity")
     enter("2:1,1:0")
     page.wait(f"v.errorCount > {errors0}", 10, "the error for a decreasing gradient opacity")
     error = page.hook("lastError")
