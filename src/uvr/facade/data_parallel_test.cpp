@@ -226,11 +226,14 @@ TEST(DataParallel, IsosurfacesAtThePiecesEndsAreOneProcesss) {
     // ended outside the mesh; a run whose share ends (at the boundary, or at the span's end in
     // another rank's piece) is probed for the surface as one process's is, whatever follows it;
     // no rank samples the next rank's first grid point. Before: Blunt Fin up to 105/255 in 15
-    // pixels of 65,536 (the surface missing at a piece's start); SPX 5/255 on 3 ranks.
+    // pixels of 65,536 (the surface missing at a piece's start); SPX 5/255 on 3 ranks. Also a
+    // shaded frame with a gradient opacity: the pieces' runs scale their segments as one
+    // process's do.
     struct View {
         float azimuth, elevation;
         std::vector<const char*> isos;
         bool shaded;
+        const char* gradientOpacity;  ///< or null
     };
     struct Scene {
         const char* file;
@@ -240,10 +243,11 @@ TEST(DataParallel, IsosurfacesAtThePiecesEndsAreOneProcesss) {
     const std::vector<Scene> scenes = {
         {"bluntfin_tets.vtk",
          4,
-         {{200.f, -30.f, {"0.8,0.5"}, false},
-          {200.f, -30.f, {"1.5,0.6", "3,1"}, true},
-          {60.f, 20.f, {"0.8,0.5", "2,0.7"}, true}}},
-        {"spx.vtk", 3, {{320.f, 60.f, {"0.3381,0.4", "1.9159,1"}, false}}}};
+         {{200.f, -30.f, {"0.8,0.5"}, false, nullptr},
+          {200.f, -30.f, {"1.5,0.6", "3,1"}, true, nullptr},
+          {60.f, 20.f, {"0.8,0.5", "2,0.7"}, true, nullptr},
+          {35.f, 25.f, {}, true, "0:0,5:1"}}},
+        {"spx.vtk", 3, {{320.f, 60.f, {"0.3381,0.4", "1.9159,1"}, false, nullptr}}}};
     for (const Scene& scene : scenes) {
         const std::string path = testing::sharedData(scene.file);
         if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
@@ -257,6 +261,8 @@ TEST(DataParallel, IsosurfacesAtThePiecesEndsAreOneProcesss) {
             s.camera = orbitCamera(resetCamera(one.bounds, 1.f), v.azimuth, v.elevation);
             for (const char* iso : v.isos) s.isoSurfaces.push_back(parseIsoSurface(iso));
             s.lighting.on = v.shaded;
+            if (v.gradientOpacity)
+                s.lighting.gradientOpacity = parseGradientOpacity(v.gradientOpacity);
             frames.push_back(s);
         }
         const std::vector<RenderResult> many =
