@@ -260,7 +260,8 @@ TEST_P(GradientOpacityOn, CellDataIsRefusedNamingTheField) {
     Mesh m = testing::makeHexGrid(3, 0.f, 1.f, linearField);
     Field cells{"c", Association::Cell, 1, std::vector<float>(27, 1.f)};
     m.fields.push_back(cells);
-    const PreparedMesh pm = prepareMesh(m, selectScalarField(m, parseFieldSpec("c")), PrepareOptions{});
+    const PreparedMesh pm =
+        prepareMesh(m, selectScalarField(m, parseFieldSpec("c")), PrepareOptions{});
     RenderSettings s = alongX(RenderMethod::Exact);
     s.lighting.gradientOpacity = parseGradientOpacity("0:0,1:1");
     try {
