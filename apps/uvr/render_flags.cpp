@@ -209,7 +209,7 @@ RenderSettings RenderFlags::baseSettings() const {
         s.clipBox = Bounds3f{Vec3f(v[0], v[1], v[2]), Vec3f(v[3], v[4], v[5])};
     }
     for (const std::string& text : isoSurfaces) s.isoSurfaces.push_back(parseIsoSurface(text));
-    if (gradientOpacity) s.lighting.gradientOpacity = parseGradientOpacity(*gradientOpacity);
+    if (gradientOpacity) s.gradientOpacity = parseGradientOpacity(*gradientOpacity);
     if (!depthFile.empty()) s.depthAlpha = depthOpacity.value_or(0.5f);
     if (!depthInFile.empty()) s.depthIn = readDepthNpy(depthInFile, s.width, s.height);
     // The settings of the library's vocabulary are checked there (main re-spells its errors

@@ -52,7 +52,7 @@ void startingState(server::ViewScene& scene, const RenderSettings& settings,
     s.range = settings.range.value_or(fieldRange);
     s.clipPlanes = settings.clipPlanes;
     s.isoSurfaces = settings.isoSurfaces;
-    s.gradientOpacity = settings.lighting.gradientOpacity;
+    s.gradientOpacity = settings.gradientOpacity;
     s.field = flags.field;
     s.background = flags.backgroundColor().value_or(Vec3f(0.f, 0.f, 0.f));
     // The page's settings start as the command line set them (or their defaults), the opacity

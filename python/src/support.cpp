@@ -348,7 +348,7 @@ RenderSettings settingsOf(const py::dict& settings,
                 "in [0, 1], or the text 'MAGNITUDE:SCALE,...'";
             if (v.is_none()) continue;
             if (py::isinstance<py::str>(v)) {
-                s.lighting.gradientOpacity = parseGradientOpacity(v.cast<std::string>());
+                s.gradientOpacity = parseGradientOpacity(v.cast<std::string>());
                 continue;
             }
             if (!py::hasattr(v, "__iter__")) throw SettingError(key, text, expected);
@@ -374,7 +374,7 @@ RenderSettings settingsOf(const py::dict& settings,
             } catch (const SettingError&) {
                 throw SettingError(key, text, expected);
             }
-            s.lighting.gradientOpacity = g;
+            s.gradientOpacity = g;
             continue;
         }
         // Depth out: the opacity whose depth the frame reports (Image.depth); depth in: a 2-D

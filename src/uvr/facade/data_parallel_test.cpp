@@ -261,8 +261,7 @@ TEST(DataParallel, IsosurfacesAtThePiecesEndsAreOneProcesss) {
             s.camera = orbitCamera(resetCamera(one.bounds, 1.f), v.azimuth, v.elevation);
             for (const char* iso : v.isos) s.isoSurfaces.push_back(parseIsoSurface(iso));
             s.lighting.on = v.shaded;
-            if (v.gradientOpacity)
-                s.lighting.gradientOpacity = parseGradientOpacity(v.gradientOpacity);
+            if (v.gradientOpacity) s.gradientOpacity = parseGradientOpacity(v.gradientOpacity);
             frames.push_back(s);
         }
         const std::vector<RenderResult> many =

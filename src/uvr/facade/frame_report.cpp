@@ -123,9 +123,9 @@ nlohmann::json frameReport(const Renderer& renderer, const RenderSettings& setti
     // Gradient shading, with its coefficients when on (they light isosurfaces and the cut face
     // too); the gradient opacity, as the CLI's --gradient-opacity writes it.
     j["shade"] = settings.lighting.on;
-    if (settings.lighting.gradientOpacity.active())
-        j["gradient_opacity"] = gradientOpacityText(settings.lighting.gradientOpacity);
-    if (settings.lighting.readsGradient())
+    if (settings.gradientOpacity.active())
+        j["gradient_opacity"] = gradientOpacityText(settings.gradientOpacity);
+    if (readsGradient(settings.lighting, settings.gradientOpacity))
         j["normals"] = settings.lighting.smooth ? "smooth" : "cell";
     if (settings.lighting.on || !settings.isoSurfaces.empty() || j.contains("clip_surface")) {
         j["normals"] = settings.lighting.smooth ? "smooth" : "cell";

@@ -276,7 +276,8 @@ RenderResult Renderer::render(const RenderSettings& settings) {
 RenderResult Renderer::renderLocal(const RenderSettings& settings) {
     // Smooth shading's gradients are made when a frame first needs them (shaded, a gradient
     // opacity, or the isosurfaces' normals) and kept, remade with new values.
-    const bool lit = settings.lighting.readsGradient() || !settings.isoSurfaces.empty();
+    const bool lit =
+        readsGradient(settings.lighting, settings.gradientOpacity) || !settings.isoSurfaces.empty();
     if (lit && settings.lighting.smooth && !hasSmoothGradients(prepared_->tets)) {
         computeSmoothGradients(prepared_->tets);
         if (gpu_) gpu_->uploadGradients();

@@ -208,13 +208,14 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
             hi = mid, vHi = vMid, gradHi = gradMid, tetHi = found, haveHi = true;
         } else {  // after it: the run goes on to mid
             segments.add(scene.base.tf, mid, k1, true, vMid, s1, params.opacityUnit, acc,
-                         lightAt(params.light, found, gradMid, ray.dir), gradMid);
+                         lightAt(params.light, params.gradientOpacity, found, gradMid, ray.dir),
+                         gradMid);
             lo = mid, vLo = vMid;
         }
     }
     if (haveHi)
         segments.add(scene.base.tf, hi, k1, true, vHi, s1, params.opacityUnit, acc,
-                     lightAt(params.light, tetHi, gradHi, ray.dir), gradHi);
+                     lightAt(params.light, params.gradientOpacity, tetHi, gradHi, ray.dir), gradHi);
 }
 
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
@@ -478,7 +479,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
         const Vec3f grad =
             sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
-        const LightFactors light = lightAt(lighting, tet, grad, ray.dir);
+        const LightFactors light =
+            lightAt<kLit>(lighting, scene.base.params.gradientOpacity, tet, grad, ray.dir);
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
         // short chord through the mesh, which the reference's s1 steps see: the next sample is
         // one s1 on, or past the seed grid's cell when no cell of the partition overlaps it.
@@ -530,7 +532,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
                     const Vec3f gradMid = sampleGradient<kNative, kLit, kSurf>(
                         scene.base.params, locator.mesh, found, probeBary);
-                    const LightFactors lightMid = lightAt(lighting, found, gradMid, ray.dir);
+                    const LightFactors lightMid = lightAt<kLit>(
+                        lighting, scene.base.params.gradientOpacity, found, gradMid, ray.dir);
                     if (found != kNoTet) from = found;
                     if ((found != kNoTet) == in) {  // the mid is on the current sample's side
                         hi = mid;
@@ -621,8 +624,10 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
             const Vec3f grad =
                 sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
-            segments.add(tf, kClose, kClose, tet != kNoTet, v, s1, unit, acc,
-                         lightAt(lighting, tet, grad, ray.dir), grad);
+            segments.add(
+                tf, kClose, kClose, tet != kNoTet, v, s1, unit, acc,
+                lightAt<kLit>(lighting, scene.base.params.gradientOpacity, tet, grad, ray.dir),
+                grad);
         } else {
             // The run's share ends before the next piece (a skipped partition or empty space
             // follows it): one process's next sample ends it there, so this piece does.

@@ -169,13 +169,15 @@ inline constexpr int kIsoRefinements = 4;
 /// table entry's value width, at most kNativeMaxPieces. `v0` is the value at t0 (the previous
 /// cell's exit value, or NaN: computed here); returns the value at t1. Composites into acc; lit
 /// (gradient shading), each piece by the mean of its ends' lights (the gradient through the
-/// cell's Jacobian at the Newton iterate's coordinates). With isosurfaces (iso, kSurf), a piece
+/// cell's Jacobian at the Newton iterate's coordinates), and scaled likewise by the gradient
+/// opacity `gop`. With isosurfaces (iso, kSurf), a piece
 /// crossing one is cut where the cell's own field meets its value (regula falsi from the
 /// piece's linear reading, kIsoRefinements evaluations) and the surface composited there.
 template <bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTableView& tf,
                                            std::uint32_t t, const Ray& ray, double t0, double t1,
-                                           float v0, double unit, const Lighting& light, Vec4f& acc,
+                                           float v0, double unit, const Lighting& light,
+                                           const GradientOpacity& gop, Vec4f& acc,
                                            const IsoView* iso = nullptr) {
     Vec3f x[kMaxCellCorners];
     float cv[kMaxCellCorners];
@@ -202,19 +204,19 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         return v < cvLo ? cvLo : (v > cvHi ? cvHi : v);  // NaN stays NaN
     };
     // The light at the parametric coordinates rst of the last point valueAt took.
-    auto lightWith = [&](const Lighting& l) {
-        if (!kLit || !l.readsGradient()) return LightFactors{};
+    auto lightWith = [&](const Lighting& l, const GradientOpacity& g) {
+        if (!kLit || !readsGradient(l, g)) return LightFactors{};
         const float at[4] = {rst.x, rst.y, rst.z, 0.f};
-        return lightFactors(l, mesh.gradient(t, at, l.smooth), ray.dir);
+        return lightFactors(l, g, mesh.gradient(t, at, l.smooth), ray.dir);
     };
-    auto lightHere = [&]() { return lightWith(light); };
+    auto lightHere = [&]() { return lightWith(light, gop); };
     const float vMid = valueAt(0.5 * (t0 + t1));
     const Vec3f rstMid = rst;
     LightFactors lightA;  // at the start of the piece
     if (!(v0 == v0)) {
         v0 = valueAt(t0);
         lightA = lightHere();
-    } else if (kLit && light.readsGradient()) {
+    } else if (kLit && readsGradient(light, gop)) {
         (void)valueAt(t0);  // for its coordinates only
         lightA = lightHere();
         rst = rstMid;  // t1's Newton starts where it would unlit
@@ -230,7 +232,7 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     }
     // Lit: also as many pieces as the light's change asks (the gradient turns in the cell).
     LightFactors lightMid;
-    if (kLit && light.readsGradient()) {
+    if (kLit && readsGradient(light, gop)) {
         const Vec3f at = rst;
         rst = rstMid;
         lightMid = lightHere();
@@ -271,7 +273,8 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
                     }
                     integrateLit<kLit>(tf, va, c, tc - ta, unit, vol, acc);
                     (void)valueAt(tc);  // the surface's coordinates, for its normal
-                    compositeIso(iso->surfaces[j], tf.sample(c).xyz(), lightWith(surface), acc);
+                    compositeIso(iso->surfaces[j], tf.sample(c).xyz(),
+                                 lightWith(surface, GradientOpacity{}), acc);
                     ta = tc, va = c, len = tb - tc;
                 });
             }
@@ -283,11 +286,13 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
     return vEnd;
 }
 
-/// The light at parameter t of the ray inside tetrahedron tet: smooth, its corners' gradients
-/// at the point's barycentrics (clamped to the cell); per cell, its constant gradient.
+/// The light (and gradient opacity gop) at parameter t of the ray inside tetrahedron tet:
+/// smooth, its corners' gradients at the point's barycentrics (clamped to the cell); per cell,
+/// its constant gradient.
 template <bool kNative = true>
 UVR_HOST_DEVICE inline LightFactors lightInTet(const TetMeshView& m, std::uint32_t tet,
-                                               const Ray& ray, double t, const Lighting& light) {
+                                               const Ray& ray, double t, const Lighting& light,
+                                               const GradientOpacity& gop = GradientOpacity{}) {
     float bary[4] = {0.25f, 0.25f, 0.25f, 0.25f};
     if (light.smooth && m.blockGradients) {
         BlockVertex x[4];
@@ -300,7 +305,7 @@ UVR_HOST_DEVICE inline LightFactors lightInTet(const TetMeshView& m, std::uint32
                 for (int i = 0; i < 4; ++i) bary[i] = b[i] / sum;
         }
     }
-    return lightFactors(light, m.gradient<kNative>(tet, bary, light.smooth), ray.dir);
+    return lightFactors(light, gop, m.gradient<kNative>(tet, bary, light.smooth), ray.dir);
 }
 
 /// A tetrahedron's segment [t0, t1] (scalar linear from v0 to v1) lit by smooth normals, into
@@ -312,10 +317,11 @@ template <bool kNative = true>
 UVR_HOST_DEVICE inline void smoothLitSegment(const TetMeshView& m, const TfTableView& tf,
                                              std::uint32_t tet, const Ray& ray, double t0,
                                              double t1, float v0, float v1, double unit,
-                                             const Lighting& light, Vec4f& acc) {
-    const LightFactors a = lightInTet<kNative>(m, tet, ray, t0, light);
-    const LightFactors b = lightInTet<kNative>(m, tet, ray, t1, light);
-    const LightFactors c = lightInTet<kNative>(m, tet, ray, 0.5 * (t0 + t1), light);
+                                             const Lighting& light, const GradientOpacity& gop,
+                                             Vec4f& acc) {
+    const LightFactors a = lightInTet<kNative>(m, tet, ray, t0, light, gop);
+    const LightFactors b = lightInTet<kNative>(m, tet, ray, t1, light, gop);
+    const LightFactors c = lightInTet<kNative>(m, tet, ray, 0.5 * (t0 + t1), light, gop);
     const int n = lightPieces(a, c, b);
     if (n == 1) {
         integrateLit(tf, v0, v1, t1 - t0, unit, simpsonLight(a, c, b), acc);
@@ -326,7 +332,8 @@ UVR_HOST_DEVICE inline void smoothLitSegment(const TetMeshView& m, const TfTable
     const double h = (t1 - t0) / n;
     for (int i = 1; i <= n && acc.w < segment::kOpacityEnd; ++i) {
         const float vb = i == n ? v1 : v0 + (v1 - v0) * (float(i) / float(n));
-        const LightFactors lb = i == n ? b : lightInTet<kNative>(m, tet, ray, t0 + h * i, light);
+        const LightFactors lb =
+            i == n ? b : lightInTet<kNative>(m, tet, ray, t0 + h * i, light, gop);
         integrateLit(tf, va, vb, h, unit, la.mean(lb), acc);
         va = vb;
         la = lb;
@@ -409,9 +416,11 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
     const TetMeshView& mesh = scene.locator.mesh;
     const double unit = scene.params.opacityUnit;
     if constexpr (kLit) {
-        if (light.readsGradient() && light.smooth && mesh.blockGradients && continuous) {
+        if (readsGradient(light, scene.params.gradientOpacity) && light.smooth &&
+            mesh.blockGradients && continuous) {
             const float a0 = acc.w;
-            smoothLitSegment<kNative>(mesh, scene.tf, tet, ray, ta, tb, va, vb, unit, light, acc);
+            smoothLitSegment<kNative>(mesh, scene.tf, tet, ray, ta, tb, va, vb, unit, light,
+                                      scene.params.gradientOpacity, acc);
             if constexpr (kSurf)
                 noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, float(ta), float(tb),
                           counters);
@@ -421,7 +430,8 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
     [[maybe_unused]] const float a0 = acc.w;
     LightFactors f;
     if constexpr (kLit)
-        if (light.readsGradient()) f = lightInTet<kNative>(mesh, tet, ray, tb, light);
+        if (readsGradient(light, scene.params.gradientOpacity))
+            f = lightInTet<kNative>(mesh, tet, ray, tb, light, scene.params.gradientOpacity);
     integrateLit<kLit>(scene.tf, va, vb, tb - ta, unit, f, acc);
     if constexpr (kSurf)
         noteDepth(rayDepthAlpha(scene.params, counters), a0, acc.w, float(ta), float(tb), counters);
@@ -534,7 +544,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 [[maybe_unused]] const float a0 = acc.w;
                 s1 = exact::nativeSegment<kLit, kSurf>(loc.mesh, scene.tf, tet, ray, t, tEnd,
                                                        haveEntry ? sEntry : NAN, unit, lighting,
-                                                       acc, isos);
+                                                       scene.params.gradientOpacity, acc, isos);
                 if constexpr (kSurf) noteDepth(depthAlpha, a0, acc.w, t, tEnd, counters);
             } else {
                 const float s0 =

@@ -246,14 +246,14 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     if (mesh.piece) f.params.piece = {true, mesh.piece->region};
     f.params.light = settings.lighting;  // directions only: the frame's scaling keeps them
     // A gradient's magnitude per rendering unit is the file's over the frame's scale.
-    GradientOpacity& gop = f.params.light.gradientOpacity;
+    f.params.gradientOpacity = settings.gradientOpacity;
+    GradientOpacity& gop = f.params.gradientOpacity;
     for (int i = 0; i < gop.count; ++i)
         gop.magnitude[i] = static_cast<float>(std::fmin(gop.magnitude[i] / frame.scale, FLT_MAX));
     f.params.iso = isoView(settings);
     f.params.depthAlpha = settings.depthAlpha;
     if (gop.active() && mesh.tets.association == Association::Cell)
-        throw SettingError("gradient_opacity",
-                           gradientOpacityText(settings.lighting.gradientOpacity),
+        throw SettingError("gradient_opacity", gradientOpacityText(settings.gradientOpacity),
                            "a gradient opacity needs a point field, and '" + mesh.tets.fieldName +
                                "' is cell data (constant in each cell: its gradient is 0)");
     if (f.params.iso.active() && mesh.tets.association == Association::Cell)
@@ -265,7 +265,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     // gradient opacity, they would miss where the gradient's magnitude changes.
     const Lighting& light = settings.lighting;
     const bool turns = (light.on && (light.diffuse > 0.f || light.specular > 0.f)) ||
-                       light.gradientOpacity.active();
+                       settings.gradientOpacity.active();
     const float defaultFactor = turns ? kShadedMaxStepFactor : kDefaultMaxStepFactor;
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_sample_distance")
                                        : std::fmin(defaultFactor * f.params.step, FLT_MAX);

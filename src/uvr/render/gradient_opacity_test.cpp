@@ -114,13 +114,14 @@ TEST(GradientOpacity, PiecewiseLinearAndConstantBeyondItsEnds) {
     EXPECT_TRUE(std::isnan(gradientMagnitude(Vec3f(NAN, 0.f, 1.f))));
     EXPECT_TRUE(std::isnan(gradientMagnitude(Vec3f(INFINITY, 0.f, 1.f))));
     // The light's factors carry it, shaded or not; off, the opacity is 1.
-    Lighting l;
-    l.gradientOpacity = g;
-    EXPECT_TRUE(l.readsGradient());
-    EXPECT_FLOAT_EQ(lightFactors(l, Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)).opacity, 0.5f);
-    EXPECT_TRUE(lightFactors(l, Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)).identity());
-    EXPECT_FLOAT_EQ(lightFactors(Lighting{}, Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)).opacity,
-                    1.f);
+    const Lighting l;
+    EXPECT_TRUE(readsGradient(l, g));
+    EXPECT_FALSE(readsGradient(l, GradientOpacity{}));
+    EXPECT_FLOAT_EQ(lightFactors(l, g, Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)).opacity, 0.5f);
+    EXPECT_TRUE(lightFactors(l, g, Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)).identity());
+    EXPECT_FLOAT_EQ(
+        lightFactors(l, GradientOpacity{}, Vec3f(1.f, 0.f, 0.f), Vec3f(0.f, 0.f, 1.f)).opacity,
+        1.f);
 }
 
 TEST(GradientOpacity, BadTextsAreRefusedNamingTheSetting) {
@@ -142,12 +143,12 @@ TEST(GradientOpacity, BadTextsAreRefusedNamingTheSetting) {
     RenderSettings s;
     s.tf = transferFunctionPreset("viridis");
     validateSettings(s);
-    s.lighting.gradientOpacity = parseGradientOpacity("1:0,2:1");
+    s.gradientOpacity = parseGradientOpacity("1:0,2:1");
     validateSettings(s);
-    s.lighting.gradientOpacity.scale[1] = 2.f;
+    s.gradientOpacity.scale[1] = 2.f;
     EXPECT_THROW(validateSettings(s), SettingError);
-    s.lighting.gradientOpacity.scale[1] = 1.f;
-    s.lighting.gradientOpacity.magnitude[0] = NAN;
+    s.gradientOpacity.scale[1] = 1.f;
+    s.gradientOpacity.magnitude[0] = NAN;
     EXPECT_THROW(validateSettings(s), SettingError);
 }
 
@@ -177,7 +178,7 @@ TEST_P(GradientOpacityOn, OverALinearFieldAScaleDividesTheOpacityUnit) {
                     scaled.opacityUnit = 1.f / 0.4f;
                     const RenderResult want = render(pm, scaled);
                     // 0.4 at the gradient's magnitude (between the points at 0 and 2 m).
-                    s.lighting.gradientOpacity =
+                    s.gradientOpacity =
                         parseGradientOpacity("0:0.1," + std::to_string(2.f * m) + ":0.7");
                     const RenderResult got = render(pm, s);
                     ASSERT_GT(want.image.at(12, 8).w, 0.1f) << what;
@@ -199,7 +200,7 @@ TEST_P(GradientOpacityOn, ZeroHidesFlatRegionsAndOneChangesNoBit) {
             s.maxStep = 0.03f;  // the adaptive steps a gradient opacity takes by default
             const RenderResult plain = render(steep, s);
             ASSERT_GT(render(flat, s).image.at(12, 8).w, 0.1f) << what;
-            s.lighting.gradientOpacity = parseGradientOpacity("0:0,0.1:1");
+            s.gradientOpacity = parseGradientOpacity("0:0,0.1:1");
             for (const Vec4f& p : render(flat, s).image.pixels) ASSERT_EQ(p.w, 0.f) << what;
             EXPECT_TRUE(testing::samePixels(render(steep, s).image, plain.image)) << what;
         }
@@ -217,11 +218,11 @@ TEST_P(GradientOpacityOn, SamplingConvergesToTheExactIntegrator) {
             RenderSettings s = alongX(RenderMethod::Exact);
             applyOpacitySpec(s.tf, "constant:0.9");
             s.lighting.smooth = smooth;
-            s.lighting.gradientOpacity = parseGradientOpacity("0:0,1:0.2,2:1");
+            s.gradientOpacity = parseGradientOpacity("0:0,1:0.2,2:1");
             const Image exact = render(pm, s).image;
-            s.lighting.gradientOpacity = GradientOpacity{};
+            s.gradientOpacity = GradientOpacity{};
             const Image without = render(pm, s).image;
-            s.lighting.gradientOpacity = parseGradientOpacity("0:0,1:0.2,2:1");
+            s.gradientOpacity = parseGradientOpacity("0:0,1:0.2,2:1");
             // The function changes the picture well beyond the methods' differences.
             EXPECT_GT(worstDifference(exact, without), 0.1f);
             for (const RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
@@ -249,7 +250,7 @@ TEST_P(GradientOpacityOn, MagnitudesAreTheFilesOnAMeshRenderedScaled) {
         RenderSettings scaled = s;
         scaled.opacityUnit = size / 0.5f;
         const RenderResult want = render(pm, scaled);
-        s.lighting.gradientOpacity = parseGradientOpacity("0:0," + std::to_string(2.f * m) + ":1");
+        s.gradientOpacity = parseGradientOpacity("0:0," + std::to_string(2.f * m) + ":1");
         const RenderResult got = render(pm, s);
         ASSERT_GT(want.image.at(12, 8).w, 0.1f) << methodName(method);
         EXPECT_LT(worstDifference(got.image, want.image), 2e-5f) << methodName(method);
@@ -263,7 +264,7 @@ TEST_P(GradientOpacityOn, CellDataIsRefusedNamingTheField) {
     const PreparedMesh pm =
         prepareMesh(m, selectScalarField(m, parseFieldSpec("c")), PrepareOptions{});
     RenderSettings s = alongX(RenderMethod::Exact);
-    s.lighting.gradientOpacity = parseGradientOpacity("0:0,1:1");
+    s.gradientOpacity = parseGradientOpacity("0:0,1:1");
     try {
         render(pm, s);
         ADD_FAILURE() << "rendered a gradient opacity on cell data";

@@ -90,11 +90,9 @@ UVR_HOST_DEVICE inline void compositeIso(const IsoSurface& s, Vec3f mapped,
 }
 
 /// The lighting of isosurfaces: the frame's coefficients, always on (a surface is lit whether or
-/// not the volume is shaded), without the volume's gradient opacity (a surface's opacity is its
-/// own).
+/// not the volume is shaded; the volume's gradient opacity is not theirs).
 UVR_HOST_DEVICE inline Lighting surfaceLighting(Lighting l) {
     l.on = true;
-    l.gradientOpacity.count = 0;
     return l;
 }
 

@@ -61,24 +61,25 @@ struct GradientOpacity {
     }
 };
 
-/// The lighting of a frame, as plain data for the integrators, and the gradient opacity, which
-/// reads the same gradients.
+/// The lighting of a frame, as plain data for the integrators.
 struct Lighting {
     bool on = false;  ///< off: colours as the transfer function gives them
     /// Normals from the smooth gradients (computeSmoothGradients), interpolated in each cell;
-    /// false: each cell's own gradient (constant in a linear tetrahedron: exact per cell). The
+    /// false: each cell's own gradient (constant in a linear tetrahedron: exact per cell). A
     /// gradient opacity reads the same gradients.
     bool smooth = true;
     float ambient = kDefaultAmbient;
     float diffuse = kDefaultDiffuse;
     float specular = kDefaultSpecular;
     float specularPower = kDefaultSpecularPower;
-    /// Gradient opacity (off unless given; shaded or not).
-    GradientOpacity gradientOpacity;
-
-    /// Whether a point's gradient changes what it adds: shaded, or with a gradient opacity.
-    UVR_HOST_DEVICE bool readsGradient() const { return on || gradientOpacity.active(); }
 };
+
+/// Whether a point's gradient changes what it adds: shaded, or with a gradient opacity. (The
+/// gradient opacity is kept apart from the lighting, which isosurfaces and the cut face copy:
+/// its table would cost their kernels' local memory.)
+UVR_HOST_DEVICE inline bool readsGradient(const Lighting& l, const GradientOpacity& g) {
+    return l.on || g.active();
+}
 
 /// What a point's gradient does to what it adds: its lit colour as an affine map of the transfer
 /// function's, scale c_tf + add (grey), and its extinction times `opacity` (the gradient
@@ -122,14 +123,20 @@ UVR_HOST_DEVICE inline float gradientMagnitude(Vec3f g) {
 }
 
 /// The light a point with field gradient g receives along a ray of unit direction dir (the
-/// identity when lighting is off), and its gradient opacity (1 without one).
+/// identity when lighting is off).
 UVR_HOST_DEVICE inline LightFactors lightFactors(const Lighting& l, Vec3f g, Vec3f dir) {
-    LightFactors f;
-    if (l.gradientOpacity.active()) f.opacity = l.gradientOpacity.at(gradientMagnitude(g));
-    if (!l.on) return f;
+    if (!l.on) return {};
     const float c = lightCosine(g, dir);
-    f.scale = l.ambient + l.diffuse * c;
-    f.add = l.specular > 0.f ? l.specular * powf(c, l.specularPower) : 0.f;
+    const float spec = l.specular > 0.f ? l.specular * powf(c, l.specularPower) : 0.f;
+    return {l.ambient + l.diffuse * c, spec};
+}
+
+/// The light and the gradient opacity of a point of the volume with field gradient g (its
+/// opacity 1 without a gradient opacity).
+UVR_HOST_DEVICE inline LightFactors lightFactors(const Lighting& l, const GradientOpacity& gop,
+                                                 Vec3f g, Vec3f dir) {
+    LightFactors f = lightFactors(l, g, dir);
+    if (gop.active()) f.opacity = gop.at(gradientMagnitude(g));
     return f;
 }
 

@@ -175,18 +175,25 @@ template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 UVR_HOST_DEVICE inline Vec3f sampleGradient(const MarchParams& params, const TetMeshView& mesh,
                                             std::uint32_t tet, const float bary[4]) {
     if constexpr (kLit) {
-        if (tet != kNoTet && (params.light.readsGradient() || (kSurf && params.iso.active())))
+        if (tet != kNoTet &&
+            (readsGradient(params.light, params.gradientOpacity) || (kSurf && params.iso.active())))
             return mesh.gradient<kNative>(tet, bary, params.light.smooth);
     }
     return Vec3f(0.f);
 }
 
-/// The light of a sample of gradient g along a ray of unit direction dir: the identity when
-/// lighting is off or no cell holds the sample.
-UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, std::uint32_t tet, Vec3f g,
-                                            Vec3f dir) {
-    if (!light.readsGradient() || tet == kNoTet) return {};
-    return lightFactors(light, g, dir);
+/// The light and gradient opacity of a sample of gradient g along a ray of unit direction dir:
+/// the identity where an instance is compiled unlit (kLit false), when neither is on, or where
+/// no cell holds the sample.
+template <bool kLit = true>
+UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, const GradientOpacity& gop,
+                                            std::uint32_t tet, Vec3f g, Vec3f dir) {
+    if constexpr (!kLit) {
+        return {};
+    } else {
+        if (!readsGradient(light, gop) || tet == kNoTet) return {};
+        return lightFactors(light, gop, g, dir);
+    }
 }
 
 /// Point sampling with isosurfaces (kSurf): the surfaces crossed between consecutive samples
@@ -270,7 +277,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
         return;
     const Vec3f g = sampleGradient<kNative, kLit, kSurf>(params, mesh, tetHi, baryHi);
     segments.add(tf, hi, kPieceEnd, true, v, s1, params.opacityUnit, acc,
-                 lightAt(lighting, tetHi, g, ray.dir), g);
+                 lightAt<kLit>(lighting, params.gradientOpacity, tetHi, g, ray.dir), g);
 }
 
 /// The clip region's cut face (ClipView::surface; kSurf instances): the point at parameter t of
@@ -383,7 +390,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
         const Vec3f g =
             sampleGradient<kNative, kLit, kSurf>(scene.params, scene.locator.mesh, tet, bary);
-        const LightFactors light = lightAt(lighting, tet, g, ray.dir);
+        const LightFactors light =
+            lightAt<kLit>(lighting, scene.params.gradientOpacity, tet, g, ray.dir);
         if (scene.params.preintegrated) {
             if constexpr (kSurf) {
                 if (segments.iso && (tet != kNoTet) != segments.inside &&

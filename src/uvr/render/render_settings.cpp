@@ -251,7 +251,7 @@ void validateSettings(const RenderSettings& s) {
     if (s.camera) validateCamera(*s.camera);
     checkClip(s);
     checkIso(s);
-    checkGradientOpacity(s.lighting.gradientOpacity);
+    checkGradientOpacity(s.gradientOpacity);
     checkDepth(s);
 }
 

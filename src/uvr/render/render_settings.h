@@ -80,9 +80,11 @@ struct RenderSettings {
     /// the face's normal by the lighting coefficients.
     bool clipSurface = false;
     /// Gradient shading (issue 32; lighting.h): off by default; ParaView's Ambient, Diffuse,
-    /// Specular and SpecularPower and their defaults; and the gradient opacity (off by default;
-    /// magnitudes in the file's units).
+    /// Specular and SpecularPower and their defaults.
     Lighting lighting;
+    /// Gradient opacity (issue 32; lighting.h): off by default; magnitudes in the file's units.
+    /// It reads the gradients `lighting.smooth` picks.
+    GradientOpacity gradientOpacity;
     /// Isosurfaces inside the volume (issue 32; isosurface.h), at most kMaxIsoSurfaces, in any
     /// order: each lit by `lighting`'s coefficients whether or not the volume is shaded. A point
     /// field only.

@@ -30,6 +30,9 @@ struct MarchParams {
     PieceView piece;
     /// Gradient shading (off: the transfer function's colours as they are).
     Lighting light;
+    /// Gradient opacity (off: the transfer function's opacity as it is), magnitudes in
+    /// rendering units.
+    GradientOpacity gradientOpacity;
     /// Isosurfaces inside the volume (none: the volume alone).
     IsoView iso;
     /// Depth out: each ray reports where its accumulated opacity first reaches this (0: no
@@ -49,10 +52,10 @@ UVR_HOST_DEVICE inline bool surfacesKernel(const MarchParams& p) {
 }
 
 /// Whether a frame runs the integrators' lit instances (kLit): shaded or with a gradient opacity
-/// (Lighting::readsGradient), or with the surfaces' instances (isosurfaces are lit and need the
+/// (readsGradient), or with the surfaces' instances (isosurfaces are lit and need the
 /// gradients).
 UVR_HOST_DEVICE inline bool litKernel(const MarchParams& p) {
-    return p.light.readsGradient() || surfacesKernel(p);
+    return readsGradient(p.light, p.gradientOpacity) || surfacesKernel(p);
 }
 
 /// Everything a ray needs, as plain data for CPU and GPU.

@@ -393,8 +393,7 @@ bool settingNeedMet(const SettingDef& d, const RenderSettings& settings) {
         (!settings.isoSurfaces.empty() || settings.clipSurface))
         return true;
     // The normals' gradients are the gradient opacity's too.
-    if (std::string_view(d.name) == "normals" && settings.lighting.gradientOpacity.active())
-        return true;
+    if (std::string_view(d.name) == "normals" && settings.gradientOpacity.active()) return true;
     return settingNamed(d.needs).get(settings) == true;
 }
 

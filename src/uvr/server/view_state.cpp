@@ -428,7 +428,7 @@ RenderSettings frameSettings(const ViewState& state, const RenderSettings& base,
     s.range = state.range;
     s.clipPlanes = state.clipPlanes;
     s.isoSurfaces = state.isoSurfaces;
-    s.lighting.gradientOpacity = state.gradientOpacity;
+    s.gradientOpacity = state.gradientOpacity;
     for (const auto& [name, value] : state.settings.items()) applySetting(s, name, value);
     scale = std::max(scale, 1);
     s.width = std::max(1, state.width / scale);

@@ -189,12 +189,12 @@ TEST(ViewState, AGradientOpacityIsSetInItsCommandLineFormAndReachesTheFrame) {
     ASSERT_EQ(s.gradientOpacity.count, 2);
     EXPECT_EQ(toJson(s)["gradient_opacity"], "0:0,0.5:1");  // as --gradient-opacity writes it
     RenderSettings f = frameSettings(s, RenderSettings{});
-    EXPECT_EQ(gradientOpacityText(f.lighting.gradientOpacity), "0:0,0.5:1");
+    EXPECT_EQ(gradientOpacityText(f.gradientOpacity), "0:0,0.5:1");
     // The normals it reads may be set with shading off.
     applySet(s, {{"normals", "cell"}});
     EXPECT_FALSE(frameSettings(s, RenderSettings{}).lighting.smooth);
     applySet(s, {{"gradient_opacity", ""}});
-    EXPECT_FALSE(frameSettings(s, RenderSettings{}).lighting.gradientOpacity.active());
+    EXPECT_FALSE(frameSettings(s, RenderSettings{}).gradientOpacity.active());
     // Bad ones are refused naming the key, with the library's expected form.
     EXPECT_THAT(refusal({{"gradient_opacity", "1:2"}}),
                 HasSubstr("\"gradient_opacity\": 1:2: expected MAGNITUDE:SCALE"));
