@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include "uvr/core/error.h"
@@ -111,6 +112,15 @@ std::string hexByte(float c) {
     return buf;
 }
 
+/// A finite number written alone (no space before it, nothing after it), or nullopt.
+std::optional<float> finiteNumber(const std::string& t) {
+    char* end = nullptr;
+    const float v = std::strtof(t.c_str(), &end);
+    if (t.empty() || *end != '\0' || !std::isfinite(v) || std::isspace((unsigned char)t[0]))
+        return std::nullopt;
+    return v;
+}
+
 /// The shortest decimal that reads back as the same float ("0.1", not "0.100000001").
 std::string shortest(float v) {
     char buf[32];
@@ -140,11 +150,9 @@ IsoSurface parseIsoSurface(const std::string& text) {
     }
     if (parts.size() > 3) bad();
     auto number = [&](const std::string& t) {
-        char* end = nullptr;
-        const float v = std::strtof(t.c_str(), &end);
-        if (t.empty() || *end != '\0' || !std::isfinite(v) || std::isspace((unsigned char)t[0]))
-            bad();
-        return v;
+        const std::optional<float> v = finiteNumber(t);
+        if (!v) bad();
+        return *v;
     };
     IsoSurface iso;
     iso.value = number(parts[0]);
@@ -194,11 +202,9 @@ std::string gradientOpacityText(const GradientOpacity& g) {
 GradientOpacity parseGradientOpacity(const std::string& text) {
     auto bad = [&]() { throw SettingError("gradient_opacity", text, kGradientOpacityForm); };
     auto number = [&](const std::string& t) {
-        char* end = nullptr;
-        const float v = std::strtof(t.c_str(), &end);
-        if (t.empty() || *end != '\0' || !std::isfinite(v) || std::isspace((unsigned char)t[0]))
-            bad();
-        return v;
+        const std::optional<float> v = finiteNumber(t);
+        if (!v) bad();
+        return *v;
     };
     GradientOpacity g;
     std::size_t start = 0;
