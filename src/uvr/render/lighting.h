@@ -75,8 +75,8 @@ struct Lighting {
 };
 
 /// Whether a point's gradient changes what it adds: shaded, or with a gradient opacity. (The
-/// gradient opacity is kept apart from the lighting, which isosurfaces and the cut face copy:
-/// its table would cost their kernels' local memory.)
+/// gradient opacity is kept apart from the lighting: isosurfaces and the cut face copy the
+/// lighting, and their opacity is their own.)
 UVR_HOST_DEVICE inline bool readsGradient(const Lighting& l, const GradientOpacity& g) {
     return l.on || g.active();
 }
