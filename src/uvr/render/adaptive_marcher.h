@@ -41,6 +41,10 @@ struct StepRuleParams {
     float tolerance = 0.05f;
     /// ErrorBound: value change per table entry, (hi - lo) / (count - 1) of the baked table.
     float valuePerEntry = 1.f;
+    /// Shaded frames (shadeLit): a visible partition or macrocell of maximum opacity a steps at
+    /// most max(litMinStep, litStepScale / a). Infinite (unshaded frames): no limit.
+    float litStepScale = INFINITY;
+    float litMinStep = 0.f;
 };
 
 /// Adaptive step (Morrical et al. 2019, Sec. 2.4): s = max(s1 + (s2 - s1) |min(v, 1) - 1|^p, s1)
@@ -68,20 +72,42 @@ UVR_HOST_DEVICE inline float errorBoundStep(float maxRate, float spread, const S
     return h < r.s2 ? h : r.s2;
 }
 
+/// The longest step of a visible region of maximum opacity a in a shaded frame (StepRuleParams::
+/// litStepScale): the rules above see the transfer function and the field's gradients, not the
+/// light, and where the field is nearly flat its normals (and so its light) change from cell to
+/// cell however slowly the value does. A step of optical depth at most a h / u carries at most
+/// that share of the pixel, and its light may be anywhere in [ambient, ambient + diffuse +
+/// specular] (the light's rate, diffuse + specular sqrt(power), bounds how far it moves): so h
+/// <= kLitError u / (rate a), here litStepScale / a, keeps that error at kLitError, and never
+/// below litMinStep (3 s1, which kept Blunt Fin's freestream). docs/METHOD.md, "Shaded frames:
+/// the step rule".
+UVR_HOST_DEVICE inline void shadeLit(PartitionShading& s, const StepRuleParams& r) {
+    if (!(s.maxOpacity > 0.f) || !(r.litStepScale < INFINITY)) return;
+    float h = r.litStepScale / s.maxOpacity;
+    h = h > r.litMinStep ? h : r.litMinStep;
+    s.step = s.step < h ? s.step : h;
+}
+
 /// Shading of one partition: its maximum opacity (0: skipped) and step. ErrorBound:
 /// errorBoundStep from the range statistics and the partition's gradient spread. Variance
 /// (Morrical et al. 2019, Sec. 2.1, 2.4): the variance normalised by the minimum lo and maximum
 /// hi over the visible partitions (1 when they are all equal and positive), invisible partitions
-/// at v = 0 (s2), and the adaptive step. Every step is s1 when adaptive is false. Shared by the
-/// CPU loop and the CUDA kernel.
+/// at v = 0 (s2), and the adaptive step; shaded, at most shadeLit's step. Every step is s1 when
+/// adaptive is false. Shared by the CPU loop and the CUDA kernel.
 UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, float spread, float lo,
                                                        float hi, const StepRuleParams& r) {
     if (!r.adaptive) return {st.maxOpacity, r.s1};
-    if (r.rule == StepRule::ErrorBound)
-        return {st.maxOpacity, st.maxOpacity > 0.f ? errorBoundStep(st.maxRate, spread, r) : r.s2};
-    float v = 0.f;
-    if (st.maxOpacity > 0.f) v = hi > lo ? (st.variance - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
-    return {st.maxOpacity, adaptiveStep(v, r.s1, r.s2, r.power)};
+    PartitionShading s{st.maxOpacity, r.s2};
+    if (r.rule == StepRule::ErrorBound) {
+        if (st.maxOpacity > 0.f) s.step = errorBoundStep(st.maxRate, spread, r);
+    } else {
+        float v = 0.f;
+        if (st.maxOpacity > 0.f)
+            v = hi > lo ? (st.variance - lo) / (hi - lo) : (hi > 0.f ? 1.f : 0.f);
+        s.step = adaptiveStep(v, r.s1, r.s2, r.power);
+    }
+    shadeLit(s, r);
+    return s;
 }
 
 /// Shading of one macrocell under the error-bound rule: transparent when no tetrahedron with a

@@ -110,23 +110,60 @@ TEST_P(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
     }
 }
 
-TEST_P(PartitionIntegrator, ShadedFramesStepAtMostThreeS1UnlessTold) {
-    // The error-bound rule does not see the normals turn: shaded frames default to s2 = 3 s1
-    // (kShadedMaxStepFactor), unshaded ones to 16 s1; a max_sample_distance given stands either
-    // way.
+TEST_P(PartitionIntegrator, ShadedFramesStepByTheirOpacityUnlessTold) {
+    // The error-bound rule does not see the light: in shaded frames each visible region of
+    // maximum opacity a steps at most max(3 s1, kLitError u / (rate a)) (shadeLit), s2 staying
+    // 16 s1; with a gradient opacity s2 is 3 s1; a max_sample_distance given stands either way.
     const PreparedMesh pm = jitteredGrid();
     RenderSettings s = baseSettings();
     s.method = RenderMethod::Partitions;
     const RenderResult plain = render(pm, s);
     const float s1 = plain.setup.params.step;
+    const float u = plain.setup.params.opacityUnit;
     EXPECT_FLOAT_EQ(plain.setup.maxStep, kDefaultMaxStepFactor * s1);
+    EXPECT_EQ(plain.setup.stepRule.litStepScale, INFINITY);
     s.lighting.on = true;
     s.lighting.smooth = false;  // per-cell normals: no smooth gradients needed
+    s.lighting.specular = 0.5f;
+    s.lighting.specularPower = 16.f;  // rate 1 + 0.5 x 4
     const RenderResult lit = render(pm, s);
-    EXPECT_FLOAT_EQ(lit.setup.maxStep, kShadedMaxStepFactor * s1);
-    for (const PartitionShading& sh : lit.setup.shading) EXPECT_LE(sh.step, 3.f * s1 * 1.001f);
+    EXPECT_FLOAT_EQ(lit.setup.maxStep, kDefaultMaxStepFactor * s1);
+    EXPECT_FLOAT_EQ(lit.setup.stepRule.litStepScale, kLitError * u / 3.f);
+    EXPECT_FLOAT_EQ(lit.setup.stepRule.litMinStep, kShadedMaxStepFactor * s1);
+    // Each region's step: the unshaded one's, at most the opacity's limit, never below 3 s1
+    // unless the unshaded one is. (The CPU's shading; the GPU's stays on the GPU.)
+    const auto expectLimited = [&](const std::vector<PartitionShading>& unshaded,
+                                   const std::vector<PartitionShading>& shaded, int& limited) {
+        ASSERT_EQ(unshaded.size(), shaded.size());
+        for (std::size_t i = 0; i < shaded.size(); ++i) {
+            const float a = shaded[i].maxOpacity;
+            EXPECT_EQ(a, unshaded[i].maxOpacity) << i;
+            const float limit = a > 0.f ? std::fmax(3.f * s1, kLitError * u / (3.f * a)) : INFINITY;
+            EXPECT_FLOAT_EQ(shaded[i].step, std::fmin(unshaded[i].step, limit)) << i;
+            limited += unshaded[i].step > limit;
+        }
+    };
+    int limited = 0;
+    expectLimited(plain.setup.shading, lit.setup.shading, limited);
+    expectLimited(plain.setup.macroShading, lit.setup.macroShading, limited);
+    if (!lit.setup.macroShading.empty()) {
+        EXPECT_GT(limited, 0);
+    }
+    // A brighter light, a shorter limit; a light that does not turn (ambient only), none.
+    s.lighting.specular = 1.f;
+    EXPECT_FLOAT_EQ(render(pm, s).setup.stepRule.litStepScale, kLitError * u / 5.f);
+    s.lighting.diffuse = s.lighting.specular = 0.f;
+    s.lighting.ambient = 0.5f;
+    EXPECT_EQ(render(pm, s).setup.stepRule.litStepScale, INFINITY);
+    s.lighting.diffuse = 1.f;
     s.maxStep = 8.f * s1;
-    EXPECT_FLOAT_EQ(render(pm, s).setup.maxStep, 8.f * s1);
+    const RenderResult told = render(pm, s);
+    EXPECT_FLOAT_EQ(told.setup.maxStep, 8.f * s1);
+    EXPECT_EQ(told.setup.stepRule.litStepScale, INFINITY);
+    s.maxStep = 0.f;
+    s.lighting.on = false;
+    s.gradientOpacity = parseGradientOpacity("0:0.5,1:1");
+    EXPECT_FLOAT_EQ(render(pm, s).setup.maxStep, kShadedMaxStepFactor * s1);
 }
 
 // The correctness bar of the method: with s1 == s2 the partition integrator reproduces the

@@ -261,12 +261,11 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                            "isosurfaces need a point field, and '" + mesh.tets.fieldName +
                                "' is cell data (constant in each cell: it has no surfaces "
                                "inside a cell)");
-    // Shaded with a light that depends on the normal: long steps would miss it turning; with a
-    // gradient opacity, they would miss where the gradient's magnitude changes.
-    const Lighting& light = settings.lighting;
-    const bool turns = (light.on && (light.diffuse > 0.f || light.specular > 0.f)) ||
-                       settings.gradientOpacity.active();
-    const float defaultFactor = turns ? kShadedMaxStepFactor : kDefaultMaxStepFactor;
+    // With a gradient opacity, long steps would miss where the gradient's magnitude changes:
+    // every step is at most kShadedMaxStepFactor s1 by default. (Shaded frames limit their
+    // visible regions' steps by their opacity: shadeLit, below.)
+    const float defaultFactor =
+        settings.gradientOpacity.active() ? kShadedMaxStepFactor : kDefaultMaxStepFactor;
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_sample_distance")
                                        : std::fmin(defaultFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
@@ -360,6 +359,16 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.stepRule.tolerance = toleranceForQuality(settings.quality);
     f.stepRule.valuePerEntry =
         static_cast<float>((double(f.rangeHi) - double(f.rangeLo)) / (f.tfTable.size() - 1));
+    // Shaded with a light that depends on the normal, s2 left to the default: shadeLit's limit.
+    const Lighting& light = settings.lighting;
+    const float lightRate = light.on
+                                ? std::fmax(light.diffuse, 0.f) + std::fmax(light.specular, 0.f) *
+                                                                      std::sqrt(light.specularPower)
+                                : 0.f;
+    if (lightRate > 0.f && !(settings.maxStep > 0.f)) {
+        f.stepRule.litStepScale = std::fmin(kLitError * f.params.opacityUnit / lightRate, FLT_MAX);
+        f.stepRule.litMinStep = std::fmin(kShadedMaxStepFactor * f.params.step, f.maxStep);
+    }
     if (method == RenderMethod::Partitions && !gpu) {
         const auto start = std::chrono::steady_clock::now();
         const TfTableView table = f.tfView();
