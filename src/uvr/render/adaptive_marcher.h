@@ -79,8 +79,8 @@ UVR_HOST_DEVICE inline float errorBoundStep(float maxRate, float spread, const S
 /// that share of the pixel, and its light may be anywhere in [ambient, ambient + diffuse +
 /// specular] (the light's rate, diffuse + specular sqrt(power), bounds how far it moves): so h
 /// <= kLitError u / (rate a), here litStepScale / a, keeps that error at kLitError, and never
-/// below litMinStep (3 s1, which kept Blunt Fin's freestream). docs/METHOD.md, "Shaded frames:
-/// the step rule".
+/// below litMinStep (3 s1, which kept Blunt Fin's freestream). docs/METHOD.md, "The adaptive
+/// step rule in shaded frames".
 UVR_HOST_DEVICE inline void shadeLit(PartitionShading& s, const StepRuleParams& r) {
     if (!(s.maxOpacity > 0.f) || !(r.litStepScale < INFINITY)) return;
     float h = r.litStepScale / s.maxOpacity;
