@@ -215,7 +215,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
     bool haveHi = false;  // a probe found at hi (else hi is the sample itself)
     float vHi = 0.f;
     Vec3f gradHi(0.f);
-    std::uint32_t tetHi = tet;
+    SamplePoint atHi;
     float bary[4];
     std::uint32_t from = tet;
     while (hi - lo > 1.f) {
@@ -231,17 +231,18 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
         const float vMid = locator.mesh.interpolate<kNative>(found, bary);
         const Vec3f gradMid = sampleGradient<kNative, true>(params, locator.mesh, found, bary);
         if (iso.crossesOdd(vLo, vMid)) {  // the crossing lies before mid
-            hi = mid, vHi = vMid, gradHi = gradMid, tetHi = found, haveHi = true;
+            hi = mid, vHi = vMid, gradHi = gradMid, atHi = SamplePoint(found, bary), haveHi = true;
         } else {  // after it: the run goes on to mid
             segments.add(scene.base.tf, mid, k1, true, vMid, s1, params.opacityUnit, acc,
                          lightAt(params.light, params.gradientOpacity, found, gradMid, ray.dir),
-                         gradMid);
+                         SamplePoint(found, bary));
             lo = mid, vLo = vMid;
         }
     }
     if (haveHi)
         segments.add(scene.base.tf, hi, k1, true, vHi, s1, params.opacityUnit, acc,
-                     lightAt(params.light, params.gradientOpacity, tetHi, gradHi, ray.dir), gradHi);
+                     lightAt(params.light, params.gradientOpacity, atHi.cell, gradHi, ray.dir),
+                     atHi);
 }
 
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
@@ -304,7 +305,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const Lighting lighting = kernelLighting<kLit>(scene.base.params);
     SampleSegments<kLit, kSurf> segments;
     segments.setIsos(scene.base.params.iso, lighting, ray.dir,
-                     rayDepthAlpha(scene.base.params, counters));
+                     rayDepthAlpha(scene.base.params, counters), locator.mesh);
     PointIsos<kSurf> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     // Isosurfaces: where a run may start at the mesh's boundary (sampleAtBoundary): after the
@@ -504,7 +505,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
         const Vec3f grad =
-            sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
+            sampleGradient<kNative, kLit>(scene.base.params, locator.mesh, tet, bary);
         const LightFactors light =
             lightAt<kLit>(lighting, scene.base.params.gradientOpacity, tet, grad, ray.dir);
         // Outside the mesh (in the piece's box), a long step could jump over a grazing ray's
@@ -540,8 +541,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 kSample - segments.kLast > 1.f) {
                 float lo = segments.kLast, hi = kSample;  // inside end first when leaving
                 float vHi = v;  // entering: the value at hi, the first position found inside
-                LightFactors lightHi = light;  // and its light and gradient
-                Vec3f gradHi = grad;
+                LightFactors lightHi = light;  // and its light and where it lies
+                SamplePoint atHi(tet, bary);
                 std::uint32_t from = in ? tet : lastInside;
                 float probeBary[4] = {bary[0], bary[1], bary[2], bary[3]};
                 while (fabsf(hi - lo) > 1.f) {
@@ -556,7 +557,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                             locator.search<kNative>(scene.cells, 0, q, probeBary, counters.locate);
                     const float vMid =
                         found == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(found, probeBary);
-                    const Vec3f gradMid = sampleGradient<kNative, kLit, kSurf>(
+                    const Vec3f gradMid = sampleGradient<kNative, kLit>(
                         scene.base.params, locator.mesh, found, probeBary);
                     const LightFactors lightMid = lightAt<kLit>(
                         lighting, scene.base.params.gradientOpacity, found, gradMid, ray.dir);
@@ -565,11 +566,12 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                         hi = mid;
                         vHi = vMid;
                         lightHi = lightMid;
-                        gradHi = gradMid;
+                        atHi = SamplePoint(found, probeBary);
                     } else {
                         // Leaving: the run goes on to the mid.
                         if (found != kNoTet)
-                            segments.add(tf, mid, k1, true, vMid, s1, unit, acc, lightMid, gradMid);
+                            segments.add(tf, mid, k1, true, vMid, s1, unit, acc, lightMid,
+                                         SamplePoint(found, probeBary));
                         lo = mid;
                     }
                 }
@@ -585,7 +587,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                     if (in) runFromValid = false;
                 }
                 if (in && hi < kSample)
-                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi, gradHi);
+                    segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi, atHi);
                 else if (!in)
                     segments.add(tf, hi, k1, false, 0.f, s1, unit, acc);
             }
@@ -621,9 +623,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 }
                 skipped = false;
             }
-            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light, grad);
+            segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light,
+                         SamplePoint(tet, bary));
         } else {
-            pointIsos.add(scene.base.params, tf, ray.dir, tet != kNoTet, v, grad, acc);
+            pointIsos.add(scene.base.params, locator.mesh, tf, ray.dir, tet != kNoTet, v,
+                          SamplePoint(tet, bary), acc);
         }
         if (!preintegrated && tet != kNoTet) {
             const Vec4f c = tf.sample(v);
@@ -649,11 +653,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             }
             const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
             const Vec3f grad =
-                sampleGradient<kNative, kLit, kSurf>(scene.base.params, locator.mesh, tet, bary);
+                sampleGradient<kNative, kLit>(scene.base.params, locator.mesh, tet, bary);
             segments.add(
                 tf, kClose, kClose, tet != kNoTet, v, s1, unit, acc,
                 lightAt<kLit>(lighting, scene.base.params.gradientOpacity, tet, grad, ray.dir),
-                grad);
+                SamplePoint(tet, bary));
         } else {
             // The run's share ends before the next piece (a skipped partition or empty space
             // follows it): one process's next sample ends it there, so this piece does.

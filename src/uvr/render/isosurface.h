@@ -70,6 +70,11 @@ struct IsoView {
         return n;
     }
 
+    /// True when a field running linearly from v0 to v1 crosses a surface (crossings).
+    UVR_HOST_DEVICE bool crosses(float v0, float v1) const {
+        return crossings(v0, v1, [](int, float) {}) > 0;
+    }
+
     /// True when a field running linearly from v0 to v1 crosses an odd number of surfaces (a
     /// step whose ends lie on either side of one: bisectIso narrows it).
     UVR_HOST_DEVICE bool crossesOdd(float v0, float v1) const {

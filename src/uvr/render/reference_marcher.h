@@ -34,6 +34,23 @@ UVR_HOST_DEVICE inline void compositeFrontToBack(Vec4f& acc, Vec3f rgb, float a)
     acc.w += w;
 }
 
+/// Where a sample lies: its cell (kNoTet: outside the mesh) and its local coordinates there
+/// (TetMeshView::interpolate's). The isosurfaces' normals are computed from it only where a
+/// surface is crossed (SampleSegments, PointIsos), not at every sample.
+struct SamplePoint {
+    std::uint32_t cell = kNoTet;
+    float bary[4] = {0.f, 0.f, 0.f, 0.f};
+
+    UVR_HOST_DEVICE SamplePoint() {}
+    UVR_HOST_DEVICE SamplePoint(std::uint32_t c, const float b[4]) : cell(c) {
+        for (int i = 0; i < 4; ++i) bary[i] = b[i];
+    }
+    /// The field's gradient there (TetMeshView::gradient; 0 outside the mesh).
+    UVR_HOST_DEVICE Vec3f gradient(const TetMeshView& mesh, bool smooth) const {
+        return cell == kNoTet ? Vec3f(0.f) : mesh.gradient(cell, bary, smooth);
+    }
+};
+
 /// Pre-integration for the sample-based methods (issue 11): the segment between two consecutive
 /// samples inside the mesh, at grid positions k (in units of s1), is integrated with the scalar
 /// running linearly from one sample's value to the next (segment::integrate), so a
@@ -48,18 +65,21 @@ UVR_HOST_DEVICE inline void compositeFrontToBack(Vec4f& acc, Vec3f rgb, float a)
 /// (an unshaded kernel holds none of their registers); kSurf false: without isosurfaces and
 /// depth. With isosurfaces (setIsos), a segment crossing one is integrated up to the crossing
 /// (where the linear value meets it), the surface composited there, lit by the gradient
-/// interpolated between the two samples', and the rest integrated after it.
+/// interpolated between the two samples', and the rest integrated after it. Those gradients are
+/// computed only there, from where the samples lie (SamplePoint): a frame with isosurfaces
+/// reads no gradient at the samples between them.
 template <bool kLit = true, bool kSurf = kLit>
 struct SampleSegments {
-    float kLast = 0.f;              ///< grid position of the last sample
-    float kEnd = 0.f;               ///< end of the piece of the ray the last sample belongs to
-    float vLast = 0.f;              ///< its value (when inside)
-    LightFactors light;             ///< its light (when inside; the identity unlit)
-    Vec3f gradLast{0.f, 0.f, 0.f};  ///< its gradient (with isosurfaces)
-    const IsoView* iso = nullptr;   ///< the isosurfaces (null: none)
-    Lighting surface;               ///< their lighting (surfaceLighting)
-    Vec3f dir{0.f, 0.f, 1.f};       ///< the ray's direction
-    float depthAlpha = 0.f;         ///< depth out (the ray's: rayDepthAlpha)
+    float kLast = 0.f;                  ///< grid position of the last sample
+    float kEnd = 0.f;                   ///< end of the piece of the ray the last sample belongs to
+    float vLast = 0.f;                  ///< its value (when inside)
+    LightFactors light;                 ///< its light (when inside; the identity unlit)
+    SamplePoint atLast;                 ///< where it lies (with isosurfaces: their normals)
+    const IsoView* iso = nullptr;       ///< the isosurfaces (null: none)
+    const TetMeshView* mesh = nullptr;  ///< their normals' mesh
+    Lighting surface;                   ///< their lighting (surfaceLighting)
+    Vec3f dir{0.f, 0.f, 1.f};           ///< the ray's direction
+    float depthAlpha = 0.f;             ///< depth out (the ray's: rayDepthAlpha)
     /// Depth out: the grid position where an isosurface took the opacity to depthAlpha
     /// (infinity: none did); the marchers prefer it to their coarser stretches.
     float kDepth = INFINITY;
@@ -71,11 +91,13 @@ struct SampleSegments {
     bool led = false;      ///< the last sample is a lead (lead()): no segment up to the next
 
     /// Isosurfaces to composite between samples (kSurf only), lit by `l` along a ray of
-    /// direction d, and the opacity whose depth is asked for.
-    UVR_HOST_DEVICE void setIsos(const IsoView& isos, const Lighting& l, Vec3f d, float alpha) {
+    /// direction d with the gradients of mesh m, and the opacity whose depth is asked for.
+    UVR_HOST_DEVICE void setIsos(const IsoView& isos, const Lighting& l, Vec3f d, float alpha,
+                                 const TetMeshView& m) {
         if constexpr (kSurf) {
             depthAlpha = alpha;
             iso = isos.active() ? &isos : nullptr;
+            mesh = &m;
             surface = surfaceLighting(l);
             dir = d;
         }
@@ -97,18 +119,20 @@ struct SampleSegments {
     /// Adds the sample at grid position k of a piece of the ray that ends at kPieceEnd (the
     /// next piece continues it when it starts there); `in`: it found a cell, with value v,
     /// light f (gradient shading; the segment from the last sample is lit by the mean of their
-    /// lights, the run's last share by its last sample's) and gradient g (isosurfaces).
+    /// lights, the run's last share by its last sample's), lying at `at` (isosurfaces).
     UVR_HOST_DEVICE UVR_INLINE void add(const TfTableView& tf, float k, float kPieceEnd, bool in,
                                         float v, float s1, double unit, Vec4f& acc,
-                                        LightFactors f = {}, Vec3f g = Vec3f(0.f)) {
+                                        LightFactors f = {}, const SamplePoint& at = {}) {
         const bool goesOn = started && inside && in && k <= kEnd;
         if (led) {
             // From a lead sample: the segment (or the run's end) is the piece before's.
         } else if (goesOn) {
             bool done = false;
             if constexpr (kSurf) {
-                if (iso) {
-                    withIsos(tf, v, k, s1, unit, light.mean(f), g, acc);
+                // (Called only where a surface is crossed: a call at every sample cost the
+                // isosurfaces' kernels most of their time.)
+                if (iso && iso->crosses(vLast, v)) {
+                    withIsos(tf, v, k, s1, unit, light.mean(f), at, acc);
                     done = true;
                 }
             }
@@ -124,7 +148,7 @@ struct SampleSegments {
         kEnd = kPieceEnd;
         vLast = v;
         if constexpr (kLit) light = f;
-        if constexpr (kSurf) gradLast = g;
+        if constexpr (kSurf) atLast = at;
         inside = in;
         started = true;
         led = false;
@@ -135,19 +159,26 @@ struct SampleSegments {
     }
 
 private:
-    /// The segment from the last sample to one of value v and gradient g over len, split at
+    /// The segment from the last sample to one of value v lying at `at` over len, split at
     /// the isosurfaces it crosses (volume lit by vol). Not inlined: only frames with
     /// isosurfaces call it, and inlined it cost the shaded kernel its inlined add().
     UVR_HOST_DEVICE UVR_NOINLINE void withIsos(const TfTableView& tf, float v, float k, float s1,
-                                               double unit, const LightFactors& vol, Vec3f g,
-                                               Vec4f& acc) {
+                                               double unit, const LightFactors& vol,
+                                               const SamplePoint& at, Vec4f& acc) {
         const double len = double(k - kLast) * s1;
         float f0 = 0.f, va = vLast;
+        Vec3f gLast(0.f), g(0.f);
+        bool normals = false;  // the samples' gradients, read at the first crossing
         iso->crossings(vLast, v, [&](int i, float f) {
             if (acc.w >= segment::kOpacityEnd) return;
             const IsoSurface& s = iso->surfaces[i];
             integrateLit(tf, va, s.value, double(f - f0) * len, unit, vol, acc);
-            const Vec3f gi = gradLast + (g - gradLast) * f;
+            if (!normals) {
+                gLast = atLast.gradient(*mesh, surface.smooth);
+                g = at.gradient(*mesh, surface.smooth);
+                normals = true;
+            }
+            const Vec3f gi = gLast + (g - gLast) * f;
             const float a0 = acc.w;
             compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
             if (depthAlpha > 0.f && !(kDepth < INFINITY) && a0 < depthAlpha && acc.w >= depthAlpha)
@@ -169,14 +200,14 @@ private:
 };
 
 /// The gradient at a sample in cell `tet` at local coordinates bary (TetMeshView::gradient,
-/// smooth as the lighting asks) where an instance needs it (kLit: shaded; kSurf: also with
-/// isosurfaces); else, or outside the mesh, 0.
-template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
+/// smooth as the lighting asks) where the sample's light reads it (kLit, readsGradient); else,
+/// or outside the mesh, 0. (The isosurfaces' normals are computed where they are crossed:
+/// SamplePoint.)
+template <bool kNative = true, bool kLit = true>
 UVR_HOST_DEVICE inline Vec3f sampleGradient(const MarchParams& params, const TetMeshView& mesh,
                                             std::uint32_t tet, const float bary[4]) {
     if constexpr (kLit) {
-        if (tet != kNoTet &&
-            (readsGradient(params.light, params.gradientOpacity) || (kSurf && params.iso.active())))
+        if (tet != kNoTet && readsGradient(params.light, params.gradientOpacity))
             return mesh.gradient<kNative>(tet, bary, params.light.smooth);
     }
     return Vec3f(0.f);
@@ -202,22 +233,31 @@ UVR_HOST_DEVICE inline LightFactors lightAt(const Lighting& light, const Gradien
 template <bool kSurf = true>
 struct PointIsos {
     float vLast = 0.f;
-    Vec3f gradLast{0.f, 0.f, 0.f};
+    SamplePoint atLast;
     bool inside = false;
 
-    UVR_HOST_DEVICE void add(const MarchParams& params, const TfTableView& tf, Vec3f dir, bool in,
-                             float v, Vec3f g, Vec4f& acc) {
+    /// The sample of value v lying at `at` in mesh (`in`: inside it).
+    UVR_HOST_DEVICE void add(const MarchParams& params, const TetMeshView& mesh,
+                             const TfTableView& tf, Vec3f dir, bool in, float v,
+                             const SamplePoint& at, Vec4f& acc) {
         if constexpr (kSurf) {
             const IsoView& iso = params.iso;
             if (in && inside && iso.active()) {
                 const Lighting surface = surfaceLighting(params.light);
+                Vec3f gLast(0.f), g(0.f);
+                bool normals = false;  // read at the first crossing
                 iso.crossings(vLast, v, [&](int i, float f) {
                     const IsoSurface& s = iso.surfaces[i];
-                    const Vec3f gi = gradLast + (g - gradLast) * f;
+                    if (!normals) {
+                        gLast = atLast.gradient(mesh, surface.smooth);
+                        g = at.gradient(mesh, surface.smooth);
+                        normals = true;
+                    }
+                    const Vec3f gi = gLast + (g - gLast) * f;
                     compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
                 });
             }
-            inside = in, vLast = v, gradLast = g;
+            inside = in, vLast = v, atLast = at;
         }
     }
 };
@@ -275,9 +315,10 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
     const bool entering = hi < kIn;
     if (segments.iso->crossings(entering ? v : vIn, entering ? vIn : v, [](int, float) {}) == 0)
         return;
-    const Vec3f g = sampleGradient<kNative, kLit, kSurf>(params, mesh, tetHi, baryHi);
+    const Vec3f g = sampleGradient<kNative, kLit>(params, mesh, tetHi, baryHi);
     segments.add(tf, hi, kPieceEnd, true, v, s1, params.opacityUnit, acc,
-                 lightAt<kLit>(lighting, params.gradientOpacity, tetHi, g, ray.dir), g);
+                 lightAt<kLit>(lighting, params.gradientOpacity, tetHi, g, ray.dir),
+                 SamplePoint(tetHi, baryHi));
 }
 
 /// The clip region's cut face (ClipView::surface; kSurf instances): the point at parameter t of
@@ -366,7 +407,8 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float stopAlpha = stop < 0.f ? scene.params.terminationAlpha : stop;
     SampleSegments<kLit, kSurf> segments;
     const Lighting lighting = kernelLighting<kLit>(scene.params);
-    segments.setIsos(scene.params.iso, lighting, ray.dir, rayDepthAlpha(scene.params, counters));
+    segments.setIsos(scene.params.iso, lighting, ray.dir, rayDepthAlpha(scene.params, counters),
+                     scene.locator.mesh);
     if (pieceStart && scene.params.preintegrated && k - 1.f >= ceilf(tSpan / s)) {
         // The piece before's last sample, in the ghost cells: the slope of the run the first
         // sample may continue, as one process's run has it.
@@ -388,8 +430,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         ++counters.samples;
         tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
-        const Vec3f g =
-            sampleGradient<kNative, kLit, kSurf>(scene.params, scene.locator.mesh, tet, bary);
+        const Vec3f g = sampleGradient<kNative, kLit>(scene.params, scene.locator.mesh, tet, bary);
         const LightFactors light =
             lightAt<kLit>(lighting, scene.params.gradientOpacity, tet, g, ray.dir);
         if (scene.params.preintegrated) {
@@ -405,9 +446,11 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
                 }
                 if (tet != kNoTet) lastInside = tet;
             }
-            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light, g);
+            segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light,
+                         SamplePoint(tet, bary));
         } else {
-            pointIsos.add(scene.params, scene.tf, ray.dir, tet != kNoTet, v, g, acc);
+            pointIsos.add(scene.params, scene.locator.mesh, scene.tf, ray.dir, tet != kNoTet, v,
+                          SamplePoint(tet, bary), acc);
         }
         if (!scene.params.preintegrated && tet != kNoTet && own) {
             const Vec4f c = scene.tf.sample(v);
