@@ -41,8 +41,9 @@ struct StepRuleParams {
     float tolerance = 0.05f;
     /// ErrorBound: value change per table entry, (hi - lo) / (count - 1) of the baked table.
     float valuePerEntry = 1.f;
-    /// Shaded frames (shadeLit): a visible partition or macrocell of maximum opacity a steps at
-    /// most max(litMinStep, litStepScale / a). Infinite (unshaded frames): no limit.
+    /// Shaded frames and those with a gradient opacity (shadeLit): a visible partition or
+    /// macrocell of maximum opacity a steps at most max(litMinStep, litStepScale / a).
+    /// Infinite (frames that read no gradient): no limit.
     float litStepScale = INFINITY;
     float litMinStep = 0.f;
 };
@@ -79,8 +80,9 @@ UVR_HOST_DEVICE inline float errorBoundStep(float maxRate, float spread, const S
 /// that share of the pixel, and its light may be anywhere in [ambient, ambient + diffuse +
 /// specular] (the light's rate, diffuse + specular sqrt(power), bounds how far it moves): so h
 /// <= kLitError u / (rate a), here litStepScale / a, keeps that error at kLitError, and never
-/// below litMinStep (3 s1, which kept Blunt Fin's freestream). docs/METHOD.md, "The adaptive
-/// step rule in shaded frames".
+/// below litMinStep (3 s1, which kept Blunt Fin's freestream). A gradient opacity's scale, as
+/// noisy, adds its largest value to the rate (setupFrame). docs/METHOD.md, "The adaptive step
+/// rule in shaded frames".
 UVR_HOST_DEVICE inline void shadeLit(PartitionShading& s, const StepRuleParams& r) {
     if (!(s.maxOpacity > 0.f) || !(r.litStepScale < INFINITY)) return;
     float h = r.litStepScale / s.maxOpacity;

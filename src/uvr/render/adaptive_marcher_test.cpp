@@ -113,7 +113,8 @@ TEST_P(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
 TEST_P(PartitionIntegrator, ShadedFramesStepByTheirOpacityUnlessTold) {
     // The error-bound rule does not see the light: in shaded frames each visible region of
     // maximum opacity a steps at most max(3 s1, kLitError u / (rate a)) (shadeLit), s2 staying
-    // 16 s1; with a gradient opacity s2 is 3 s1; a max_sample_distance given stands either way.
+    // 16 s1; a gradient opacity adds its largest scale to the rate; a max_sample_distance given
+    // stands either way.
     const PreparedMesh pm = jitteredGrid();
     RenderSettings s = baseSettings();
     s.method = RenderMethod::Partitions;
@@ -133,19 +134,21 @@ TEST_P(PartitionIntegrator, ShadedFramesStepByTheirOpacityUnlessTold) {
     // Each region's step: the unshaded one's, at most the opacity's limit, never below 3 s1
     // unless the unshaded one is. (The CPU's shading; the GPU's stays on the GPU.)
     const auto expectLimited = [&](const std::vector<PartitionShading>& unshaded,
-                                   const std::vector<PartitionShading>& shaded, int& limited) {
+                                   const std::vector<PartitionShading>& shaded, float rate,
+                                   int& limited) {
         ASSERT_EQ(unshaded.size(), shaded.size());
         for (std::size_t i = 0; i < shaded.size(); ++i) {
             const float a = shaded[i].maxOpacity;
             EXPECT_EQ(a, unshaded[i].maxOpacity) << i;
-            const float limit = a > 0.f ? std::fmax(3.f * s1, kLitError * u / (3.f * a)) : INFINITY;
+            const float limit =
+                a > 0.f ? std::fmax(3.f * s1, kLitError * u / (rate * a)) : INFINITY;
             EXPECT_FLOAT_EQ(shaded[i].step, std::fmin(unshaded[i].step, limit)) << i;
             limited += unshaded[i].step > limit;
         }
     };
     int limited = 0;
-    expectLimited(plain.setup.shading, lit.setup.shading, limited);
-    expectLimited(plain.setup.macroShading, lit.setup.macroShading, limited);
+    expectLimited(plain.setup.shading, lit.setup.shading, 3.f, limited);
+    expectLimited(plain.setup.macroShading, lit.setup.macroShading, 3.f, limited);
     if (!lit.setup.macroShading.empty()) {
         EXPECT_GT(limited, 0);
     }
@@ -161,9 +164,17 @@ TEST_P(PartitionIntegrator, ShadedFramesStepByTheirOpacityUnlessTold) {
     EXPECT_FLOAT_EQ(told.setup.maxStep, 8.f * s1);
     EXPECT_EQ(told.setup.stepRule.litStepScale, INFINITY);
     s.maxStep = 0.f;
+    s.gradientOpacity = parseGradientOpacity("0:0.5,1:0.75,2:0.25");
+    EXPECT_FLOAT_EQ(render(pm, s).setup.stepRule.litStepScale, kLitError * u / 1.75f);
     s.lighting.on = false;
-    s.gradientOpacity = parseGradientOpacity("0:0.5,1:1");
-    EXPECT_FLOAT_EQ(render(pm, s).setup.maxStep, kShadedMaxStepFactor * s1);
+    const RenderResult faded = render(pm, s);
+    EXPECT_FLOAT_EQ(faded.setup.maxStep, kDefaultMaxStepFactor * s1);
+    EXPECT_FLOAT_EQ(faded.setup.stepRule.litStepScale, kLitError * u / 0.75f);
+    limited = 0;
+    expectLimited(plain.setup.shading, faded.setup.shading, 0.75f, limited);
+    expectLimited(plain.setup.macroShading, faded.setup.macroShading, 0.75f, limited);
+    s.gradientOpacity = parseGradientOpacity("0:0,1:0");
+    EXPECT_EQ(render(pm, s).setup.stepRule.litStepScale, INFINITY);
 }
 
 // The correctness bar of the method: with s1 == s2 the partition integrator reproduces the

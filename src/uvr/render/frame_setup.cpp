@@ -261,13 +261,10 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                            "isosurfaces need a point field, and '" + mesh.tets.fieldName +
                                "' is cell data (constant in each cell: it has no surfaces "
                                "inside a cell)");
-    // With a gradient opacity, long steps would miss where the gradient's magnitude changes:
-    // every step is at most kShadedMaxStepFactor s1 by default. (Shaded frames limit their
-    // visible regions' steps by their opacity: shadeLit, below.)
-    const float defaultFactor =
-        settings.gradientOpacity.active() ? kShadedMaxStepFactor : kDefaultMaxStepFactor;
+    // (Frames that read the gradient limit their visible regions' steps by their opacity:
+    // shadeLit, below.)
     f.maxStep = settings.maxStep > 0.f ? toLocal(settings.maxStep, "max_sample_distance")
-                                       : std::fmin(defaultFactor * f.params.step, FLT_MAX);
+                                       : std::fmin(kDefaultMaxStepFactor * f.params.step, FLT_MAX);
     if (f.maxStep < f.params.step)
         throw SettingError("max_sample_distance", formatG(f.maxStep / frame.scale, 3),
                            "below `sample_distance` " + formatG(f.params.step / frame.scale, 3) +
@@ -359,14 +356,21 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
     f.stepRule.tolerance = toleranceForQuality(settings.quality);
     f.stepRule.valuePerEntry =
         static_cast<float>((double(f.rangeHi) - double(f.rangeLo)) / (f.tfTable.size() - 1));
-    // Shaded with a light that depends on the normal, s2 left to the default: shadeLit's limit.
+    // Shaded with a light that depends on the normal, or with a gradient opacity, s2 left to
+    // the default: shadeLit's limit. Where the gradient is noise a sample's light may be
+    // anywhere within the light's rate, and its gradient opacity's scale anywhere between 0 and
+    // the function's largest: their sum bounds how far what a step adds can be off, per unit
+    // of its optical depth.
     const Lighting& light = settings.lighting;
     const float lightRate = light.on
                                 ? std::fmax(light.diffuse, 0.f) + std::fmax(light.specular, 0.f) *
                                                                       std::sqrt(light.specularPower)
                                 : 0.f;
-    if (lightRate > 0.f && !(settings.maxStep > 0.f)) {
-        f.stepRule.litStepScale = std::fmin(kLitError * f.params.opacityUnit / lightRate, FLT_MAX);
+    float scaleRate = 0.f;
+    for (int i = 0; i < gop.count; ++i) scaleRate = std::fmax(scaleRate, gop.scale[i]);
+    const float rate = lightRate + scaleRate;
+    if (rate > 0.f && !(settings.maxStep > 0.f)) {
+        f.stepRule.litStepScale = std::fmin(kLitError * f.params.opacityUnit / rate, FLT_MAX);
         f.stepRule.litMinStep = std::fmin(kShadedMaxStepFactor * f.params.step, f.maxStep);
     }
     if (method == RenderMethod::Partitions && !gpu) {

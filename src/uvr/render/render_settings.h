@@ -46,8 +46,8 @@ struct RenderSettings {
     /// Sample-based methods integrate between consecutive samples (false: point samples with
     /// opacity correction, as in Morrical et al. 2019).
     bool preintegrated = true;
-    float maxStep = 0.f;   ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1 (with a
-                           ///< gradient opacity kShadedMaxStepFactor * s1; shaded: shadeLit)
+    float maxStep = 0.f;   ///< s2 of the adaptive step; 0 = kDefaultMaxStepFactor * s1 (shaded
+                           ///< or with a gradient opacity, limited by shadeLit)
     float power = 2.f;     ///< variance rule: adaptive power p >= 1
     bool skip = true;      ///< skip partitions of zero maximum opacity
     bool adaptive = true;  ///< adaptive steps (false: every partition at s1)
@@ -192,8 +192,8 @@ inline constexpr float kDefaultMaxStepFactor = 16.f;
 /// error-bound rule sees the transfer function and the field's gradients, not how fast their
 /// direction turns, and long steps under a headlight lose the lit detail (Blunt Fin, shaded,
 /// adaptive against exact: SSIM 0.96 at 16 s1, 0.993 at 3 s1; docs/PERFORMANCE.md, "Shaded
-/// frames: the step rule"). Also the default s2 with a gradient opacity, whose scale changes
-/// with the gradient's magnitude, which the rule does not see either.
+/// frames: the step rule"). Also with a gradient opacity, whose scale changes with the
+/// gradient's magnitude, which the rule does not see either.
 inline constexpr float kShadedMaxStepFactor = 3.f;
 /// The share of a pixel's colour a shaded frame's step may get wrong by missing its light's
 /// changes (shadeLit: a step of optical depth d, its light anywhere within the light's rate,

@@ -135,7 +135,7 @@ std::vector<SettingDef> makeVocabulary() {
 
     SettingDef maxStep = setting("max_sample_distance", SettingType::Number,
                                  "Adaptive: the largest step s2 in the file's units (default: "
-                                 "16 s1, 3 s1 with a gradient opacity; shaded, from 3 s1 in "
+                                 "16 s1; shaded or with a gradient opacity, from 3 s1 in "
                                  "opaque regions up to 16 s1 in faint ones)");
     maxStep.min = 0.0, maxStep.max = kInf, maxStep.minOpen = true, maxStep.nullDefault = true;
     maxStep.tunesAdaptive = true;
