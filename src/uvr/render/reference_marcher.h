@@ -51,6 +51,23 @@ struct SamplePoint {
     }
 };
 
+/// The normals of the isosurfaces crossed between two samples lying at a and b: their
+/// gradients, read at the first crossing only, interpolated to the crossing's fraction f.
+struct CrossingNormals {
+    Vec3f ga{0.f, 0.f, 0.f}, gb{0.f, 0.f, 0.f};
+    bool read = false;
+
+    UVR_HOST_DEVICE Vec3f at(const TetMeshView& mesh, bool smooth, const SamplePoint& a,
+                             const SamplePoint& b, float f) {
+        if (!read) {
+            ga = a.gradient(mesh, smooth);
+            gb = b.gradient(mesh, smooth);
+            read = true;
+        }
+        return ga + (gb - ga) * f;
+    }
+};
+
 /// Pre-integration for the sample-based methods (issue 11): the segment between two consecutive
 /// samples inside the mesh, at grid positions k (in units of s1), is integrated with the scalar
 /// running linearly from one sample's value to the next (segment::integrate), so a
@@ -167,18 +184,12 @@ private:
                                                const SamplePoint& at, Vec4f& acc) {
         const double len = double(k - kLast) * s1;
         float f0 = 0.f, va = vLast;
-        Vec3f gLast(0.f), g(0.f);
-        bool normals = false;  // the samples' gradients, read at the first crossing
+        CrossingNormals normals;
         iso->crossings(vLast, v, [&](int i, float f) {
             if (acc.w >= segment::kOpacityEnd) return;
             const IsoSurface& s = iso->surfaces[i];
             integrateLit(tf, va, s.value, double(f - f0) * len, unit, vol, acc);
-            if (!normals) {
-                gLast = atLast.gradient(*mesh, surface.smooth);
-                g = at.gradient(*mesh, surface.smooth);
-                normals = true;
-            }
-            const Vec3f gi = gLast + (g - gLast) * f;
+            const Vec3f gi = normals.at(*mesh, surface.smooth, atLast, at, f);
             const float a0 = acc.w;
             compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
             if (depthAlpha > 0.f && !(kDepth < INFINITY) && a0 < depthAlpha && acc.w >= depthAlpha)
@@ -244,16 +255,10 @@ struct PointIsos {
             const IsoView& iso = params.iso;
             if (in && inside && iso.active()) {
                 const Lighting surface = surfaceLighting(params.light);
-                Vec3f gLast(0.f), g(0.f);
-                bool normals = false;  // read at the first crossing
+                CrossingNormals normals;
                 iso.crossings(vLast, v, [&](int i, float f) {
                     const IsoSurface& s = iso.surfaces[i];
-                    if (!normals) {
-                        gLast = atLast.gradient(mesh, surface.smooth);
-                        g = at.gradient(mesh, surface.smooth);
-                        normals = true;
-                    }
-                    const Vec3f gi = gLast + (g - gLast) * f;
+                    const Vec3f gi = normals.at(mesh, surface.smooth, atLast, at, f);
                     compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
                 });
             }
@@ -313,8 +318,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
     // Only where a surface lies between the boundary and the sample (else the run, and every
     // pixel without a surface there, stays as it was).
     const bool entering = hi < kIn;
-    if (segments.iso->crossings(entering ? v : vIn, entering ? vIn : v, [](int, float) {}) == 0)
-        return;
+    if (!segments.iso->crosses(entering ? v : vIn, entering ? vIn : v)) return;
     const Vec3f g = sampleGradient<kNative, kLit>(params, mesh, tetHi, baryHi);
     segments.add(tf, hi, kPieceEnd, true, v, s1, params.opacityUnit, acc,
                  lightAt<kLit>(lighting, params.gradientOpacity, tetHi, g, ray.dir),
