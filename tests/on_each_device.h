@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <ostream>
 #include <string>
@@ -51,6 +53,14 @@ inline bool samePixels(const Image& a, const Image& b) {
            std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec4f)) == 0;
 }
 
+/// The largest difference of two images' components.
+inline float maxPixelDifference(const Image& a, const Image& b) {
+    float d = 0.f;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 4; ++c) d = std::fmax(d, std::fabs(a.pixels[i][c] - b.pixels[i][c]));
+    return d;
+}
+
 /// How gtest prints the parameter ("cpu", "cuda") in test listings and failures.
 inline void PrintTo(TestDevice device, std::ostream* os) {
     *os << (device == TestDevice::Cpu ? "cpu" : "cuda");
@@ -69,3 +79,10 @@ inline std::string testDeviceName(const ::testing::TestParamInfo<TestDevice>& in
         Devices, Suite,                                                                       \
         ::testing::Values(::uvr::testing::TestDevice::Cpu, ::uvr::testing::TestDevice::Cuda), \
         ::uvr::testing::testDeviceName)
+
+/// Skips the test, saying why, where this uvr has no CUDA device.
+#define UVR_REQUIRE_GPU()                                                         \
+    do {                                                                          \
+        if (!::uvr::cudaDeviceAvailable())                                        \
+            GTEST_SKIP() << "no CUDA device: " << ::uvr::cudaDeviceDescription(); \
+    } while (false)

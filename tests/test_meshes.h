@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -100,6 +101,25 @@ inline Mesh makeHexGrid(
             }
     mesh.fields.push_back(std::move(field));
     return mesh;
+}
+
+/// An n^3 grid of hexahedra over [-1, 1]^3, jittered by 0.3 of the spacing, with the point field
+/// f = xy + z.
+inline Mesh jitteredHexGrid(int n) {
+    return makeHexGrid(
+        n, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+}
+
+/// Signed volume of tetrahedron c of a mesh (as stored, not re-oriented), in double.
+inline double tetVolume(const Mesh& m, std::uint64_t c) {
+    const auto v = m.cell(c);
+    double e[3][3];
+    for (int i = 0; i < 3; ++i)
+        for (int a = 0; a < 3; ++a) e[i][a] = double(m.points[v[i + 1]][a]) - m.points[v[0]][a];
+    return (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+            e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+            e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+           6.0;
 }
 
 }  // namespace uvr::testing

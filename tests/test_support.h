@@ -7,6 +7,7 @@
 #include "uvr/core/vec.h"
 #include "uvr/tf/tf_table.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -49,12 +50,12 @@ inline bool haveSharedData() {
 
 /// Path of a helper script in tests/tools.
 inline std::string testTool(const std::string& name) {
-    return std::string(UVR_TEST_TOOLS_DIR) + "/" + name;
+    return UVR_TEST_TOOLS_DIR "/" + name;  // not std::string(dir) + "/": GCC 12's -Warray-bounds
 }
 
 /// Path of a data file in tests/data (the repository's own small inputs).
 inline std::string testData(const std::string& name) {
-    return std::string(UVR_TEST_TOOLS_DIR) + "/../data/" + name;
+    return UVR_TEST_TOOLS_DIR "/../data/" + name;
 }
 
 /// A fresh, empty folder for this test's files under the system temp folder.
@@ -141,6 +142,26 @@ Error catchError(F&& f) {
     }
     ADD_FAILURE() << "expected a uvr::Error";
     return Error(ErrorKind::Internal, "no error");
+}
+
+/// Runs f, expecting a uvr::Error of `kind` whose one-line message holds every part.
+template <typename F>
+void expectError(F&& f, ErrorKind kind, const std::vector<std::string>& parts) {
+    try {
+        f();
+        ADD_FAILURE() << "no error thrown";
+    } catch (const Error& e) {
+        EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(kind)) << e.what();
+        for (const std::string& p : parts)
+            EXPECT_NE(std::string(e.what()).find(p), std::string::npos)
+                << "no '" << p << "' in: " << e.what();
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line";
+    }
+}
+
+/// Lines of a text (its newlines).
+inline int lineCount(const std::string& s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
 }
 
 /// Runs a Python script with the system Python in dir and returns its stdout parsed as numbers.

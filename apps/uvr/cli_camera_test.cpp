@@ -20,15 +20,12 @@ using cli_testing::CliRun;
 using cli_testing::expectOneLineError;
 using cli_testing::uvr;
 
-/// The unit cube of five tetrahedra with the point field f = 1.
-std::string unitCube(const std::string& dir) {
+/// Writes the unit cube of five tetrahedra with the point field f = 1 into dir; its path.
+std::string writeUnitCube(const std::string& dir) {
     return testing::writeFile(
         dir + "/cube.vtk",
-        "# vtk DataFile Version 3.0\nfive tetrahedra\nASCII\nDATASET UNSTRUCTURED_GRID\n"
-        "POINTS 8 float\n0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1\n"
-        "CELLS 5 25\n4 0 1 3 4\n4 1 2 3 6\n4 1 4 5 6\n4 3 4 6 7\n4 1 3 4 6\n"
-        "CELL_TYPES 5\n10 10 10 10 10\nPOINT_DATA 8\nSCALARS f float 1\nLOOKUP_TABLE default\n"
-        "1 1 1 1 1 1 1 1\n");
+        cli_testing::fiveTetCubeVtk(
+            "POINT_DATA 8\nSCALARS f float 1\nLOOKUP_TABLE default\n1 1 1 1 1 1 1 1\n"));
 }
 
 nlohmann::json readJson(const std::string& path) {
@@ -83,7 +80,7 @@ int covered(const Image& img) {
 
 TEST(CliCamera, ParallelRendersTheCubesSquareAndStatesItsScale) {
     const std::string dir = testing::scratchDir();
-    const std::string cube = unitCube(dir);
+    const std::string cube = writeUnitCube(dir);
     // --parallel with ParaView's reset: scale = the bounding sphere's radius, sqrt(3) / 2. The
     // cube seen face on is a square 1 / (2 radius) = 0.577 of the image height.
     const CliRun r = uvr("-q render " + cube +
@@ -124,7 +121,7 @@ TEST(CliCamera, ParallelRendersTheCubesSquareAndStatesItsScale) {
 
 TEST(CliCamera, ParallelCameraFilesRoundTripThroughTheStats) {
     const std::string dir = testing::scratchDir();
-    const std::string cube = unitCube(dir) + " --opacity constant:0.5";
+    const std::string cube = writeUnitCube(dir) + " --opacity constant:0.5";
     const std::string pvcc = parallelPvcc(dir, true, "0.75");
     ASSERT_EQ(uvr("-q render " + cube + " --camera " + pvcc + " --size 40x30 -o " + dir +
                       "/c.png --stats " + dir + "/c.json",
@@ -171,7 +168,8 @@ TEST(CliCamera, ParallelCameraFilesRoundTripThroughTheStats) {
 
 TEST(CliCamera, MeaninglessParallelCombinationsAreRefusedInOneLine) {
     const std::string dir = testing::scratchDir();
-    const std::string render = "-q render " + unitCube(dir) + " --size 8x8 -o " + dir + "/o.png ";
+    const std::string render =
+        "-q render " + writeUnitCube(dir) + " --size 8x8 -o " + dir + "/o.png ";
     expectOneLineError(uvr(render + "--parallel --view-angle 20", dir),
                        {"--view-angle", "--parallel", "use --parallel-scale"}, "view angle");
     expectOneLineError(
@@ -187,7 +185,8 @@ TEST(CliCamera, MeaninglessParallelCombinationsAreRefusedInOneLine) {
 
 TEST(CliCamera, DefaultViewUpAlongTheViewDirectionIsReplacedWithANote) {
     const std::string dir = testing::scratchDir();
-    const std::string render = "render " + unitCube(dir) + " --size 16x16 --opacity constant:0.5 ";
+    const std::string render =
+        "render " + writeUnitCube(dir) + " --size 16x16 --opacity constant:0.5 ";
     // Looking down -Y with the default up +Y: ParaView's "look along -Y" up, +Z, with a note.
     const CliRun r = uvr(render + "--camera-position 0.5,5,0.5 --camera-focal 0.5,0.5,0.5 -o " +
                              dir + "/y.png --stats " + dir + "/y.json",
@@ -229,7 +228,7 @@ TEST(CliCamera, DefaultViewUpAlongTheViewDirectionIsReplacedWithANote) {
 
 TEST(CliCamera, SupersampleAveragesRaysAndStatesItsCounts) {
     const std::string dir = testing::scratchDir();
-    const std::string render = "-q render " + unitCube(dir) +
+    const std::string render = "-q render " + writeUnitCube(dir) +
                                " --size 24x16 --opacity constant:0.5 --method reference -o ";
     ASSERT_EQ(uvr(render + dir + "/one.png --stats " + dir + "/one.json", dir).code, 0);
     ASSERT_EQ(uvr(render + dir + "/four.png --supersample 4 --stats " + dir +

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <regex>
 #include <set>
@@ -20,13 +19,6 @@ namespace {
 
 using cli_testing::CliRun;
 using cli_testing::uvr;
-
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 std::filesystem::path repoRoot() {
     return std::filesystem::path(UVR_TEST_TOOLS_DIR).parent_path().parent_path();
@@ -86,7 +78,7 @@ TEST(CliDocs, EveryCommandLineInTheReadmeAndDocsParses) {
     const std::regex flag("(?:^|\\s)(--[a-z][a-z0-9-]*)");
     int lines = 0;
     for (const auto& file : files) {
-        std::istringstream text(slurp(file));
+        std::istringstream text(testing::readFile(file));
         std::string line;
         int number = 0;
         while (std::getline(text, line)) {
@@ -114,7 +106,7 @@ TEST(CliDocs, EveryCommandLineInTheReadmeAndDocsParses) {
 TEST(CliDocs, EveryRenderOptionTheReadmeListsExists) {
     const std::string dir = testing::scratchDir();
     HelpIndex help(dir);
-    std::istringstream text(slurp(repoRoot() / "README.md"));
+    std::istringstream text(testing::readFile(repoRoot() / "README.md"));
     std::string line;
     int rows = 0;
     const std::regex flag("--[a-z][a-z0-9-]*");

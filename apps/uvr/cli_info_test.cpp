@@ -18,19 +18,9 @@ using cli_testing::CliRun;
 using cli_testing::expectOneLineError;
 using cli_testing::uvr;
 
-/// Five tetrahedra filling the unit cube, legacy VTK, with the given data sections appended
-/// (CELL_DATA before POINT_DATA as VTK's legacy writer puts them).
-std::string cube(const std::string& data) {
-    return "# vtk DataFile Version 3.0\nfive tetrahedra\nASCII\nDATASET UNSTRUCTURED_GRID\n"
-           "POINTS 8 float\n0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1\n"
-           "CELLS 5 25\n4 0 1 3 4\n4 1 2 3 6\n4 1 4 5 6\n4 3 4 6 7\n4 1 3 4 6\n"
-           "CELL_TYPES 5\n10 10 10 10 10\n" +
-           data;
-}
-
 /// Cell data `pressure` and `GlobalElementId` first, then point data `GlobalNodeId` and
 /// `pressure`: the layout of the files the issue names.
-const std::string kCrashLike = cube(
+const std::string kCrashLike = cli_testing::fiveTetCubeVtk(
     "CELL_DATA 5\nSCALARS GlobalElementId int 1\nLOOKUP_TABLE default\n1 2 3 4 5\n"
     "SCALARS pressure float 1\nLOOKUP_TABLE default\n10 20 30 40 50\n"
     "POINT_DATA 8\nSCALARS GlobalNodeId int 1\nLOOKUP_TABLE default\n1 2 3 4 5 6 7 8\n"
@@ -106,7 +96,8 @@ TEST(CliFields, IdArraysAreRenderedOnlyWhenNamedOrAlone) {
     const std::string dir = testing::scratchDir();
     const std::string ids = testing::writeFile(
         dir + "/ids.vtk",
-        cube("POINT_DATA 8\nSCALARS GlobalNodeId int 1\nLOOKUP_TABLE default\n1 2 3 4 5 6 7 8\n"));
+        cli_testing::fiveTetCubeVtk(
+            "POINT_DATA 8\nSCALARS GlobalNodeId int 1\nLOOKUP_TABLE default\n1 2 3 4 5 6 7 8\n"));
     const CliRun info = uvr("-q info --json " + ids, dir);
     ASSERT_EQ(info.code, 0) << info.err;
     EXPECT_EQ(defaultOf(nlohmann::json::parse(info.out)), "GlobalNodeId:point");

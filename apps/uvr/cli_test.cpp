@@ -33,7 +33,6 @@ namespace {
 
 using cli_testing::CliRun;
 using cli_testing::expectOneLineError;
-using cli_testing::lineCount;
 using cli_testing::uvr;
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -70,7 +69,7 @@ TEST(Cli, BadFlagsExitWithCode2AndOneLine) {
              "render " + spx + " --bogus -o " + out, "render " + spx, "frobnicate"}) {
         const CliRun r = uvr("-q " + args, dir);
         EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
-        EXPECT_EQ(lineCount(r.err), 1) << args << "\n" << r.err;
+        EXPECT_EQ(testing::lineCount(r.err), 1) << args << "\n" << r.err;
         EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << r.err;
         EXPECT_FALSE(std::filesystem::exists(out)) << args;
     }
@@ -88,7 +87,7 @@ TEST(Cli, GpuBuildRendersTheSameImageOrIsRefusedClearly) {
         const CliRun gpu = uvr(args + dir + "/gpu.png --build-device cuda", dir);
         if (!cudaDeviceAvailable()) {
             EXPECT_NE(gpu.code, 0);
-            EXPECT_EQ(lineCount(gpu.err), 1) << gpu.err;
+            EXPECT_EQ(testing::lineCount(gpu.err), 1) << gpu.err;
             EXPECT_NE(gpu.err.find("CUDA"), std::string::npos) << gpu.err;
             EXPECT_FALSE(std::filesystem::exists(dir + "/gpu.png"));
             continue;
@@ -111,7 +110,7 @@ TEST(Cli, BadFilesExitWithCode2NamingTheFile) {
         const CliRun r = uvr("-q render " + file + " -o " + dir + "/o.png", dir);
         EXPECT_EQ(r.code, 2) << r.err;
         EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
-        EXPECT_EQ(lineCount(r.err), 1) << r.err;
+        EXPECT_EQ(testing::lineCount(r.err), 1) << r.err;
     }
     EXPECT_FALSE(std::filesystem::exists(dir + "/o.png"));
 }
@@ -127,7 +126,7 @@ TEST(Cli, MaxMemoryRefusesLargerArraysBeforeAllocating) {
     EXPECT_EQ(uvr("-q info " + post + " --max-memory 1G", dir).code, 0);
     r = uvr("-q info " + post + " --max-memory 12Q", dir);
     EXPECT_EQ(r.code, 2);
-    EXPECT_EQ(lineCount(r.err), 1) << r.err;
+    EXPECT_EQ(testing::lineCount(r.err), 1) << r.err;
 }
 
 TEST(Cli, InfoAndRenderOnEveryRealFile) {
@@ -980,11 +979,8 @@ TEST(Cli, InterruptedConvertLeavesNoTemporary) {
 
 /// A legacy VTK cube of five tetrahedra with point field `name` holding `values` (8 numbers).
 std::string fiveTetCube(const std::string& name, const std::string& values) {
-    return "# vtk DataFile Version 3.0\nfive tetrahedra\nASCII\nDATASET UNSTRUCTURED_GRID\n"
-           "POINTS 8 float\n0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1\n"
-           "CELLS 5 25\n4 0 1 3 4\n4 1 2 3 6\n4 1 4 5 6\n4 3 4 6 7\n4 1 3 4 6\n"
-           "CELL_TYPES 5\n10 10 10 10 10\nPOINT_DATA 8\nSCALARS " +
-           name + " float 1\nLOOKUP_TABLE default\n" + values + "\n";
+    return cli_testing::fiveTetCubeVtk("POINT_DATA 8\nSCALARS " + name +
+                                       " float 1\nLOOKUP_TABLE default\n" + values + "\n");
 }
 
 TEST(Cli, FieldSpanningTheWholeFloatRangeRendersWithBothMethods) {

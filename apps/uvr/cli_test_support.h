@@ -4,9 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -28,20 +25,19 @@ inline CliRun uvr(const std::string& args, const std::string& dir, const std::st
     CliRun r;
     r.code = testing::runCommand("cd " + dir + " && " + env + testing::uvrBinary() + " " + args +
                                  " >" + out + " 2>" + err);
-    auto slurp = [](const std::string& p) {
-        std::ifstream in(p, std::ios::binary);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        return ss.str();
-    };
-    r.out = slurp(out);
-    r.err = slurp(err);
+    r.out = testing::readFile(out);
+    r.err = testing::readFile(err);
     return r;
 }
 
-/// Lines of a text (its newlines).
-inline int lineCount(const std::string& s) {
-    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+/// Five tetrahedra filling the unit cube, legacy VTK, with the given data sections appended
+/// (CELL_DATA before POINT_DATA as VTK's legacy writer puts them).
+inline std::string fiveTetCubeVtk(const std::string& data) {
+    return "# vtk DataFile Version 3.0\nfive tetrahedra\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+           "POINTS 8 float\n0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1\n"
+           "CELLS 5 25\n4 0 1 3 4\n4 1 2 3 6\n4 1 4 5 6\n4 3 4 6 7\n4 1 3 4 6\n"
+           "CELL_TYPES 5\n10 10 10 10 10\n" +
+           data;
 }
 
 /// Expects a refusal: exit code 2 and exactly one stderr line "uvr: error: ..." holding every
@@ -49,7 +45,7 @@ inline int lineCount(const std::string& s) {
 inline void expectOneLineError(const CliRun& r, const std::vector<std::string>& pieces,
                                const std::string& what = "") {
     EXPECT_EQ(r.code, 2) << what << "\n" << r.err;
-    EXPECT_EQ(lineCount(r.err), 1) << what << "\n" << r.err;
+    EXPECT_EQ(testing::lineCount(r.err), 1) << what << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("uvr: error: ", 0), 0u) << what << "\n" << r.err;
     for (const std::string& p : pieces)
         EXPECT_NE(r.err.find(p), std::string::npos) << what << ": no '" << p << "' in " << r.err;

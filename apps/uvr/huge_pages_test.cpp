@@ -11,15 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "test_support.h"
+
 namespace uvr::cli {
 namespace {
-
-std::string readAll(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 /// The kB of huge pages (smaps' AnonHugePages) of the mapping that holds `p`; -1 when none
 /// holds it.
@@ -48,7 +43,7 @@ TEST(HugePages, LargeAllocationsStartOnAHugePageAndGetHugePages) {
     auto* array = new std::uint32_t[kHugeAllocationBytes / 4];
     EXPECT_EQ(reinterpret_cast<std::uintptr_t>(array) % kHugePageBytes, 0u);
     delete[] array;
-    const std::string thp = readAll("/sys/kernel/mm/transparent_hugepage/enabled");
+    const std::string thp = testing::readFile("/sys/kernel/mm/transparent_hugepage/enabled");
     if (thp.empty() || thp.find("[never]") != std::string::npos)
         GTEST_SKIP() << "this kernel gives no transparent huge pages";
     for (std::size_t i = 0; i < large.size(); i += 4096) large[i] = 1;

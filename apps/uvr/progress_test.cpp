@@ -3,11 +3,11 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <chrono>
 #include <thread>
 
 #include "cli_common.h"
+#include "test_support.h"
 
 namespace uvr::cli {
 namespace {
@@ -60,10 +60,6 @@ TEST(Progress, LongPhasesReportWhileTheyRunWhenNotATerminal) {
     EXPECT_NE(err.find("uvr: refined ("), std::string::npos) << err;
 }
 
-int lineCount(const std::string& s) {
-    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
-}
-
 TEST(PhaseProgress, StepsPrintTheirNameAndOnlyLongPhasesTheirEnd) {
     Context ctx;
     ::testing::internal::CaptureStderr();
@@ -92,7 +88,7 @@ TEST(PhaseProgress, StepsPrintTheirNameAndOnlyLongPhasesTheirEnd) {
     const std::size_t b = err.find(" s)\nuvr: b\nuvr: b: done (");
     EXPECT_NE(b, std::string::npos) << err;
     EXPECT_EQ(err.find("b: done", err.find("b: done") + 1), std::string::npos) << err;
-    EXPECT_EQ(lineCount(err), 4) << err;
+    EXPECT_EQ(testing::lineCount(err), 4) << err;
 }
 
 TEST(PhaseProgress, FractionsShowWithAnEtaInLongPhases) {

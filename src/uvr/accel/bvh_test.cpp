@@ -15,7 +15,7 @@ namespace uvr {
 namespace {
 
 /// A jittered 6^3 hex grid over [-1, 1]^3 split into tetrahedra, with f = x + 2y - z.
-PreparedMesh jitteredGrid() {
+PreparedMesh splitJitteredGrid() {
     Mesh m = testing::makeHexGrid(
         6, -1.f, 1.f, [](Vec3f p) { return p.x + 2 * p.y - p.z; }, 0.3f);
     PrepareOptions o;
@@ -33,7 +33,7 @@ std::vector<std::uint32_t> containingTets(const TetLocator& loc, Vec3f p) {
 }
 
 TEST(Bvh, EveryPrimitiveInExactlyOneLeafAndBoxesNest) {
-    const PreparedMesh pm = jitteredGrid();
+    const PreparedMesh pm = splitJitteredGrid();
     const Bvh& bvh = pm.bvh;
     std::vector<int> seen(pm.tets.tets.size(), 0);
     std::vector<std::pair<std::uint32_t, int>> stack{{0, 1}};
@@ -95,7 +95,7 @@ TEST(Bvh, CentresApartByDenormalsBuild) {
 }
 
 TEST(PointLocation, BvhAndWalkAgreeWithBruteForce) {
-    const PreparedMesh pm = jitteredGrid();
+    const PreparedMesh pm = splitJitteredGrid();
     const TetLocator loc = pm.locator();
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-1.2f, 1.2f);
@@ -123,7 +123,7 @@ TEST(PointLocation, BvhAndWalkAgreeWithBruteForce) {
 }
 
 TEST(TetAdjacency, NeighboursAreMutualAndShareTheFace) {
-    const PreparedMesh pm = jitteredGrid();
+    const PreparedMesh pm = splitJitteredGrid();
     const auto& nb = pm.neighbors;
     int boundary = 0;
     for (std::uint32_t t = 0; t < pm.tets.tets.size(); ++t)
@@ -156,7 +156,7 @@ PreparedMesh blockBox(std::uint64_t cells) {
 }
 
 TEST(CompactNeighbors, DecodeToTheNeighbourTable) {
-    for (const PreparedMesh& pm : {blockBox(50000), jitteredGrid()}) {
+    for (const PreparedMesh& pm : {blockBox(50000), splitJitteredGrid()}) {
         const TetMeshView v = pm.tets.view();
         const NeighborView nb = pm.neighborCodes.view();
         for (std::uint32_t c = 0; c < v.cellCount(); ++c)

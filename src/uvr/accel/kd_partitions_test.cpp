@@ -12,9 +12,8 @@
 namespace uvr {
 namespace {
 
-PreparedMesh grid(std::uint32_t leafCells) {
-    Mesh m = testing::makeHexGrid(
-        8, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+PreparedMesh splitGrid(std::uint32_t leafCells) {
+    const Mesh m = testing::jitteredHexGrid(8);
     PrepareOptions o;
     o.kd.leafCells = leafCells;
     o.cells.splitCells = true;  // the tests below check the tetrahedra's lists
@@ -36,7 +35,7 @@ std::uint32_t leafOf(const KdPartitions& kd, Vec3f p, Bounds3f* region = nullptr
 }
 
 TEST(KdPartitions, EveryCellInAPartitionWithItsValuesInRange) {
-    const PreparedMesh pm = grid(64);
+    const PreparedMesh pm = splitGrid(64);
     const KdPartitions& kd = *pm.kd;
     ASSERT_GT(kd.partitions.size(), 20u);
     std::vector<int> seen(pm.tets.tets.size(), 0);
@@ -56,7 +55,7 @@ TEST(KdPartitions, EveryCellInAPartitionWithItsValuesInRange) {
 }
 
 TEST(KdPartitions, APointsCellIsInThePartitionWhoseRegionHoldsIt) {
-    const PreparedMesh pm = grid(32);
+    const PreparedMesh pm = splitGrid(32);
     const KdPartitions& kd = *pm.kd;
     const TetLocator loc = pm.locator();
     std::mt19937 rng(11);
@@ -80,7 +79,7 @@ TEST(KdPartitions, APointsCellIsInThePartitionWhoseRegionHoldsIt) {
 }
 
 TEST(KdPartitions, TraversalVisitsExactlyTheCrossedLeavesInOrder) {
-    const PreparedMesh pm = grid(16);
+    const PreparedMesh pm = splitGrid(16);
     const KdPartitions& kd = *pm.kd;
     const KdView view = kd.view();
     std::mt19937 rng(5);
@@ -153,8 +152,8 @@ TEST(KdPartitions, TraversalVisitsExactlyTheCrossedLeavesInOrder) {
 }
 
 TEST(KdPartitions, SmallLeavesGiveMorePartitions) {
-    EXPECT_GT(grid(16).kd->partitions.size(), grid(256).kd->partitions.size());
-    const PreparedMesh one = grid(1u << 20);
+    EXPECT_GT(splitGrid(16).kd->partitions.size(), splitGrid(256).kd->partitions.size());
+    const PreparedMesh one = splitGrid(1u << 20);
     EXPECT_EQ(one.kd->partitions.size(), 1u);
     EXPECT_EQ(one.kd->cells.size(), one.tets.tets.size());
 }

@@ -16,12 +16,7 @@
 namespace uvr {
 namespace {
 
-Mesh jitteredGrid(int n) {
-    return testing::makeHexGrid(
-        n, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
-}
-
-PreparedMesh prepared(const Mesh& m, bool lbvh, bool partitions = false) {
+PreparedMesh preparedTets(const Mesh& m, bool lbvh, bool partitions = false) {
     PrepareOptions o;
     o.partitions = partitions;
     o.kd.leafCells = 128;
@@ -114,7 +109,7 @@ TEST(Lbvh, InnerNodesAreTheRadixTreeOfTheKeys) {
 }
 
 TEST(Lbvh, MeshTreeHoldsEveryTetrahedronOnceInExactNestedBoxes) {
-    const PreparedMesh pm = prepared(jitteredGrid(9), /*lbvh=*/true);
+    const PreparedMesh pm = preparedTets(testing::jitteredHexGrid(9), /*lbvh=*/true);
     const Bvh& bvh = pm.bvh;
     const std::size_t n = pm.tets.tets.size();
     EXPECT_EQ(bvh.nodes.size() % 2, 1u);                 // 2 K + 1
@@ -129,7 +124,7 @@ TEST(Lbvh, MeshTreeHoldsEveryTetrahedronOnceInExactNestedBoxes) {
 }
 
 TEST(Lbvh, PointQueriesFindExactlyTheContainingTetrahedra) {
-    const PreparedMesh pm = prepared(jitteredGrid(7), /*lbvh=*/true);
+    const PreparedMesh pm = preparedTets(testing::jitteredHexGrid(7), /*lbvh=*/true);
     const TetLocator loc = pm.locator();
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-1.1f, 1.1f);
@@ -164,7 +159,7 @@ TEST(Lbvh, CoincidentCentresGiveABalancedTree) {
 }
 
 TEST(Lbvh, SegmentsGetTheirOwnTreesIncludingEmptyAndSingleLeafOnes) {
-    const Mesh m = jitteredGrid(5);
+    const Mesh m = testing::jitteredHexGrid(5);
     const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
     const std::uint32_t n = static_cast<std::uint32_t>(mesh.tets.size());
     // Segments: all tets reversed, nothing, three tets, the first half again.
@@ -199,7 +194,7 @@ TEST(Lbvh, SegmentsGetTheirOwnTreesIncludingEmptyAndSingleLeafOnes) {
 }
 
 TEST(Lbvh, BadSegmentsAreRefused) {
-    const Mesh m = jitteredGrid(2);
+    const Mesh m = testing::jitteredHexGrid(2);
     const TetMesh mesh = tetrahedralize(m, selectScalarField(m, {}), {.splitCells = true});
     LbvhInput in;
     in.mesh = &mesh;
@@ -224,10 +219,10 @@ TEST(Lbvh, EmptyMeshGivesAnEmptyTree) {
 TEST(Lbvh, RendersMatchThoseWithSahTrees) {
     // Same mesh, same partitions, only the BVHs differ: a sample on a face shared by two cells may
     // resolve to either, so images agree to rounding.
-    const Mesh m = jitteredGrid(10);
+    const Mesh m = testing::jitteredHexGrid(10);
     for (const bool partitions : {false, true}) {
-        const PreparedMesh sah = prepared(m, false, partitions);
-        const PreparedMesh lbvh = prepared(m, true, partitions);
+        const PreparedMesh sah = preparedTets(m, false, partitions);
+        const PreparedMesh lbvh = preparedTets(m, true, partitions);
         RenderSettings s;
         s.width = 96;
         s.height = 80;

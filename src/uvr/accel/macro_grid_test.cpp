@@ -19,7 +19,7 @@ namespace {
 
 /// A procedural mesh of about `cells` tetrahedra (the shell is non-convex, with a hole: empty
 /// macrocells exist there).
-PreparedMesh prepared(ProceduralShape shape, ProceduralField field, std::uint64_t cells) {
+PreparedMesh preparedProcedural(ProceduralShape shape, ProceduralField field, std::uint64_t cells) {
     ProceduralSpec spec;
     spec.shape = shape;
     spec.targetCells = cells;
@@ -81,18 +81,19 @@ void checkAgainstBruteForce(const PreparedMesh& pm, int& empty, int& inner, int&
 
 TEST(MacroGrid, RangesHoldEveryOverlappingCellAndEmptyCellsHoldNone) {
     int empty, inner, edge;
-    checkAgainstBruteForce(prepared(ProceduralShape::Box, ProceduralField::Jet, 60000), empty,
-                           inner, edge);
+    checkAgainstBruteForce(preparedProcedural(ProceduralShape::Box, ProceduralField::Jet, 60000),
+                           empty, inner, edge);
     EXPECT_GT(inner, 0);
     EXPECT_GT(edge, 0);
-    checkAgainstBruteForce(prepared(ProceduralShape::Shell, ProceduralField::Jet, 60000), empty,
-                           inner, edge);
+    checkAgainstBruteForce(preparedProcedural(ProceduralShape::Shell, ProceduralField::Jet, 60000),
+                           empty, inner, edge);
     EXPECT_GT(empty, 0);  // the shell's hole
     EXPECT_GT(edge, 0);
 }
 
 TEST(MacroGrid, LinearFieldHasNoSpreadInsideAndCellDataHasNoBound) {
-    const PreparedMesh linear = prepared(ProceduralShape::Box, ProceduralField::Linear, 60000);
+    const PreparedMesh linear =
+        preparedProcedural(ProceduralShape::Box, ProceduralField::Linear, 60000);
     int inner = 0;
     for (const MacroCell& c : linear.macro->cells)
         if (!c.empty() && c.gradientSpread < INFINITY) {

@@ -24,7 +24,7 @@ PreparedMesh preparedShell(std::uint32_t leafCells) {
     return prepareMesh(mesh, selectScalarField(mesh, {}), o);
 }
 
-bool contains(const TetLocator& loc, std::uint32_t t, Vec3f p) {
+bool tetHolds(const TetLocator& loc, std::uint32_t t, Vec3f p) {
     float bary[4];
     return loc.inside(t, p, bary);
 }
@@ -49,7 +49,7 @@ TEST(SeedGrid, EmptyCellsHoldNoTetrahedronAndSeedsLeadToThePoint) {
                           part.box.lo.z + u(rng) * e.z);
             std::uint32_t truth = kNoTet;
             for (std::uint32_t k = 0; k < part.cellCount && truth == kNoTet; ++k)
-                if (contains(loc, kd.cells[part.firstCell + k], x))
+                if (tetHolds(loc, kd.cells[part.firstCell + k], x))
                     truth = kd.cells[part.firstCell + k];
             const std::uint32_t s = seeds.seed(p, x);
             if (truth == kNoTet) {
@@ -62,7 +62,7 @@ TEST(SeedGrid, EmptyCellsHoldNoTetrahedronAndSeedsLeadToThePoint) {
             float bary[4];
             const std::uint32_t found = loc.locateIn(pm.cellTree.view(), 0, x, s, bary, c);
             ASSERT_NE(found, kNoTet);
-            EXPECT_TRUE(contains(loc, found, x));
+            EXPECT_TRUE(tetHolds(loc, found, x));
             walked += c.bvhQueries == 0;
         }
     }
@@ -90,11 +90,11 @@ TEST(SeedGrid, CentreSeedsContainTheirCentre) {
                     const KdPartition& part = pm.kd->partitions[p];
                     bool inAny = false;
                     for (std::uint32_t k = 0; k < part.cellCount && !inAny; ++k)
-                        inAny = contains(loc, pm.kd->cells[part.firstCell + k], c);
+                        inAny = tetHolds(loc, pm.kd->cells[part.firstCell + k], c);
                     if (!inAny) continue;
                     ++checked;
                     ASSERT_NE(s, kNoTet);
-                    EXPECT_TRUE(contains(loc, s, c)) << "partition " << p;
+                    EXPECT_TRUE(tetHolds(loc, s, c)) << "partition " << p;
                 }
     }
     EXPECT_GT(checked, 500);

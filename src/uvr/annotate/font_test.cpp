@@ -4,26 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <memory>
 #include <string>
 
+#include "font_support.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
 
 namespace uvr {
 namespace {
-
-/// The system's default font (DejaVu Sans), loaded once; null when this build has no text.
-const Font* defaultFont() {
-    static std::unique_ptr<Font> font =
-        textEngineAvailable() ? std::make_unique<Font>(findFontFile()) : nullptr;
-    return font.get();
-}
-
-#define REQUIRE_FONT()                                                        \
-    const Font* fontPtr = defaultFont();                                      \
-    if (!fontPtr) GTEST_SKIP() << "built without text (UVR_ENABLE_TEXT=OFF)"; \
-    const Font& font = *fontPtr
 
 /// The box of the pixels with any alpha; empty when none.
 TextBox inkedPixels(const Image& image) {
@@ -38,7 +26,7 @@ TextBox inkedPixels(const Image& image) {
 }
 
 TEST(LegendFont, FontconfigFindsDejaVuSans) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     EXPECT_EQ(font.familyName(), "DejaVu Sans") << font.path();
     const FontMetrics m = font.metrics(20.f);
     EXPECT_GT(m.ascender, 14.f);
@@ -48,7 +36,7 @@ TEST(LegendFont, FontconfigFindsDejaVuSans) {
 }
 
 TEST(LegendFont, TextInksOnlyItsBoxAboveAndBelowTheBaseline) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     Image image(200, 80);
     const int x = 20, baseline = 50;
     const int advance = font.draw(image, "Hg 0.5", 20.f, x, baseline, {1.f, 0.f, 0.f});
@@ -82,7 +70,7 @@ TEST(LegendFont, TextInksOnlyItsBoxAboveAndBelowTheBaseline) {
 }
 
 TEST(LegendFont, AdvanceGrowsWithLengthAndSize) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     EXPECT_EQ(font.advance("", 16.f), 0);
     EXPECT_TRUE(font.inkBox("", 16.f).empty());
     EXPECT_TRUE(font.inkBox("   ", 16.f).empty());
@@ -102,7 +90,7 @@ TEST(LegendFont, AdvanceGrowsWithLengthAndSize) {
 }
 
 TEST(LegendFont, AnyBytesDrawWithoutCrashing) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     Image image(64, 32);
     const std::string replacement = "\xEF\xBF\xBD";  // U+FFFD
     EXPECT_EQ(font.advance("\xFF\xFE", 12.f), font.advance(replacement + replacement, 12.f));
@@ -117,7 +105,7 @@ TEST(LegendFont, AnyBytesDrawWithoutCrashing) {
 }
 
 TEST(LegendFont, BadFilesAndSizesAreClearErrors) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     const std::string dir = testing::scratchDir();
     try {
         Font missing(dir + "/missing.ttf");

@@ -4,10 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <memory>
 #include <string>
 #include <vector>
 
+#include "font_support.h"
 #include "uvr/core/error.h"
 
 namespace uvr {
@@ -123,24 +123,12 @@ TEST(LegendTicks, PositionsAreLinearOrLogarithmic) {
     EXPECT_DOUBLE_EQ(legendPosition(7.0, 7.0, 7.0, false), 0.5);
 }
 
-/// The system's default font, loaded once; null when this build has no text.
-const Font* legendFont() {
-    static std::unique_ptr<Font> font =
-        textEngineAvailable() ? std::make_unique<Font>(findFontFile()) : nullptr;
-    return font.get();
-}
-
-#define REQUIRE_FONT()                                                        \
-    const Font* fontPtr = legendFont();                                       \
-    if (!fontPtr) GTEST_SKIP() << "built without text (UVR_ENABLE_TEXT=OFF)"; \
-    const Font& font = *fontPtr
-
 bool inside(const PixelRect& r, int x, int y) {
     return x >= r.x0 && x < r.x1 && y >= r.y0 && y < r.y1;
 }
 
 TEST(LegendDraw, BarShowsTheTransferFunctionsColoursBottomToTop) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     const TransferFunction tf = transferFunctionPreset("viridis");
     Image image(800, 600);
     const LegendLayout L = drawLegend(image, font, tf, 0.0, 1.0, "density", false);
@@ -170,7 +158,7 @@ TEST(LegendDraw, BarShowsTheTransferFunctionsColoursBottomToTop) {
 }
 
 TEST(LegendDraw, DrawsOnlyInItsBoxAtTheRightEdge) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     Image image(800, 600);
     const LegendLayout L = drawLegend(image, font, transferFunctionPreset("cool-to-warm"), -5.0,
                                       5.0, "pressure", false);
@@ -204,7 +192,7 @@ TEST(LegendDraw, TheLayoutIsKnownBeforeDrawingWithTheColumnsItKeeps) {
     // legendLayout says where drawLegend draws, so that a camera can keep off the columns
     // before the frame is rendered (issue 35): from the edge past the box by a margin, at most
     // a third of the width.
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     const auto same = [](const PixelRect& a, const PixelRect& b) {
         return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
     };
@@ -251,7 +239,7 @@ TEST(LegendTicks, TheRangeEndsJoinTheTicksAndCrowdedTicksLeave) {
 }
 
 TEST(LegendDraw, TextContrastsWithTheBackground) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     for (const Vec3f bg : {Vec3f{0.f, 0.f, 0.f}, Vec3f{1.f, 1.f, 1.f}, Vec3f{0.1f, 0.1f, 0.12f}}) {
         Image image(400, 300);
         LegendStyle style;
@@ -279,7 +267,7 @@ TEST(LegendDraw, TextContrastsWithTheBackground) {
 }
 
 TEST(LegendDraw, ScalesWithTheImageHeight) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     const TransferFunction tf = transferFunctionPreset("viridis");
     float previousSize = 0.f;
     int previousBar = 0;
@@ -302,7 +290,7 @@ TEST(LegendDraw, ScalesWithTheImageHeight) {
 }
 
 TEST(LegendDraw, LogScaleSpacesDecadesEvenly) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     Image image(600, 600);
     const LegendLayout L =
         drawLegend(image, font, transferFunctionPreset("viridis"), 1.0, 1e6, "energy", true);
@@ -315,7 +303,7 @@ TEST(LegendDraw, LogScaleSpacesDecadesEvenly) {
 }
 
 TEST(LegendDraw, AnyTitleIsDrawnAndLongOnesAreShortened) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     const TransferFunction tf = transferFunctionPreset("viridis");
     for (const std::string& title : {std::string("bad \xFF\xFE utf-8 \xC3"),
                                      std::string("tab\tnew\nline\0nul", 17), std::string(""),
@@ -338,7 +326,7 @@ TEST(LegendDraw, AnyTitleIsDrawnAndLongOnesAreShortened) {
 }
 
 TEST(LegendDraw, LeftPositionAndTooSmallImages) {
-    REQUIRE_FONT();
+    UVR_REQUIRE_FONT();
     const TransferFunction tf = transferFunctionPreset("viridis");
     Image image(800, 600);
     LegendStyle style;

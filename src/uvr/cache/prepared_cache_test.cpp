@@ -27,7 +27,7 @@ namespace {
 using ::testing::HasSubstr;
 using uvr::testing::catchError;
 
-RenderSettings frameOf(const Bounds3f& bounds, RenderMethod method) {
+RenderSettings cacheFrameOf(const Bounds3f& bounds, RenderMethod method) {
     RenderSettings s;
     s.width = 48;
     s.height = 40;
@@ -93,7 +93,7 @@ void expectSameFramesFromCache(const Mesh& mesh, const std::string& fieldSpec) {
     EXPECT_EQ(renderableMethods(loaded), renderableMethods(fresh));
     for (RenderMethod method :
          {RenderMethod::Partitions, RenderMethod::Reference, RenderMethod::Exact}) {
-        const RenderSettings s = frameOf(mesh.bounds(), method);
+        const RenderSettings s = cacheFrameOf(mesh.bounds(), method);
         const RenderResult a = renderCpu(fresh, s), b = renderCpu(loaded, s);
         ASSERT_EQ(a.image.pixels.size(), b.image.pixels.size());
         EXPECT_EQ(a.stats.samples, b.stats.samples) << int(method);
@@ -131,7 +131,7 @@ void expectSameSmoothGradientsFromCache(const Mesh& mesh, const std::string& fie
     for (std::size_t i = 0; i < fresh.tets.pointGradients.size(); ++i)
         ASSERT_TRUE(near(loaded.tets.pointGradients[i], fresh.tets.pointGradients[i]))
             << "point " << i;
-    RenderSettings s = frameOf(mesh.bounds(), RenderMethod::Exact);
+    RenderSettings s = cacheFrameOf(mesh.bounds(), RenderMethod::Exact);
     s.lighting.on = true;
     const RenderResult a = renderCpu(fresh, s), b = renderCpu(loaded, s);
     float worst = 0.f;

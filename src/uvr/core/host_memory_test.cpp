@@ -14,17 +14,16 @@
 namespace uvr {
 namespace {
 
-namespace fs = std::filesystem;
-
 constexpr std::uint64_t kGiB = 1ull << 30;
 
 /// An empty fake root folder for one test.
 std::string fakeRoot(const std::string& name) {
-    const fs::path root = fs::path(testing::scratchDir()) / ("host_memory_" + name);
-    fs::remove_all(root);
-    fs::create_directories(root / "proc");
-    fs::create_directories(root / "sys/devices/system/memory");
-    fs::create_directories(root / "sys/fs/cgroup/memory");
+    const std::filesystem::path root =
+        std::filesystem::path(testing::scratchDir()) / ("host_memory_" + name);
+    std::filesystem::remove_all(root);
+    std::filesystem::create_directories(root / "proc");
+    std::filesystem::create_directories(root / "sys/devices/system/memory");
+    std::filesystem::create_directories(root / "sys/fs/cgroup/memory");
     return root.string();
 }
 
@@ -36,8 +35,9 @@ void write(const std::string& root, const std::string& file, const std::string& 
 void addBlocks(const std::string& root, int n, const std::string& hexSize) {
     write(root, "sys/devices/system/memory/block_size_bytes", hexSize + "\n");
     for (int i = 0; i < n; ++i)
-        fs::create_directories(root + "/sys/devices/system/memory/memory" + std::to_string(i));
-    fs::create_directories(root + "/sys/devices/system/memory/power");  // not a block
+        std::filesystem::create_directories(root + "/sys/devices/system/memory/memory" +
+                                            std::to_string(i));
+    std::filesystem::create_directories(root + "/sys/devices/system/memory/power");  // not a block
 }
 
 TEST(HostMemory, MemTotalAlone) {

@@ -26,12 +26,11 @@
 namespace uvr {
 namespace {
 
-namespace fs = std::filesystem;
-
 /// Names in a folder, sorted.
 std::vector<std::string> listing(const std::string& dir) {
     std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename());
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        names.push_back(e.path().filename());
     std::sort(names.begin(), names.end());
     return names;
 }
@@ -95,23 +94,24 @@ TEST(OutputFile, AbandonedOutputLeavesTheOldFileAndNoTemporary) {
 
 TEST(OutputFile, SymbolicLinksAreWrittenThroughAndKept) {
     const std::string dir = testing::scratchDir();
-    fs::create_directories(dir + "/runs/42");
+    std::filesystem::create_directories(dir + "/runs/42");
     const std::string target = testing::writeFile(dir + "/runs/42/out.png", "old");
-    fs::create_symlink("runs/42/out.png", dir + "/latest.png");   // relative link
-    fs::create_symlink(dir + "/latest.png", dir + "/chain.png");  // absolute link to a link
+    std::filesystem::create_symlink("runs/42/out.png", dir + "/latest.png");  // relative link
+    std::filesystem::create_symlink(dir + "/latest.png",
+                                    dir + "/chain.png");  // absolute link to a link
     writeTextOutput(dir + "/chain.png", "new");
-    EXPECT_TRUE(fs::is_symlink(dir + "/latest.png"));
-    EXPECT_TRUE(fs::is_symlink(dir + "/chain.png"));
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/latest.png"));
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/chain.png"));
     EXPECT_EQ(testing::readFile(target), "new");
     EXPECT_EQ(listing(dir + "/runs/42"), std::vector<std::string>{"out.png"});
     // A dangling link: the file it names is created.
-    fs::create_symlink("runs/42/next.png", dir + "/next.png");
+    std::filesystem::create_symlink("runs/42/next.png", dir + "/next.png");
     writeTextOutput(dir + "/next.png", "created");
-    EXPECT_TRUE(fs::is_symlink(dir + "/next.png"));
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/next.png"));
     EXPECT_EQ(testing::readFile(dir + "/runs/42/next.png"), "created");
     // A loop is an error, not a hang.
-    fs::create_symlink(dir + "/loop-b", dir + "/loop-a");
-    fs::create_symlink(dir + "/loop-a", dir + "/loop-b");
+    std::filesystem::create_symlink(dir + "/loop-b", dir + "/loop-a");
+    std::filesystem::create_symlink(dir + "/loop-a", dir + "/loop-b");
     EXPECT_TRUE(contains(errorOf([&] { writeTextOutput(dir + "/loop-a", "x"); }),
                          "too many levels of symbolic links"));
 }
@@ -119,7 +119,7 @@ TEST(OutputFile, SymbolicLinksAreWrittenThroughAndKept) {
 /// A folder like /tmp: sticky and writable by everyone.
 std::string sharedFolder(const std::string& parent) {
     const std::string dir = parent + "/shared";
-    fs::create_directories(dir);
+    std::filesystem::create_directories(dir);
     EXPECT_EQ(::chmod(dir.c_str(), 01777), 0);
     return dir;
 }
@@ -132,7 +132,7 @@ TEST(OutputFile, LinksPlantedByAnotherUserInASharedFolderAreNotFollowed) {
     const std::string shared = sharedFolder(dir);
     const std::string victim = testing::writeFile(dir + "/victim", "precious");
     const std::string link = shared + "/frame_0000.png";
-    fs::create_symlink(victim, link);
+    std::filesystem::create_symlink(victim, link);
     ASSERT_EQ(::lchown(link.c_str(), kOtherUser, kOtherUser), 0);
     const std::string error = errorOf([&] { writeTextOutput(link, "png"); });
     EXPECT_TRUE(contains(error, "refusing to follow the symbolic link '" + link + "'")) << error;
@@ -140,11 +140,11 @@ TEST(OutputFile, LinksPlantedByAnotherUserInASharedFolderAreNotFollowed) {
     EXPECT_TRUE(contains(error, "in the shared folder '" + shared + "'")) << error;
     EXPECT_EQ(testing::readFile(victim), "precious");
     EXPECT_EQ(listing(shared), std::vector<std::string>{"frame_0000.png"});
-    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_TRUE(std::filesystem::is_symlink(link));
 
     // At every link of a chain: our own link to the planted one is refused too.
     const std::string own = shared + "/own.png";
-    fs::create_symlink(link, own);
+    std::filesystem::create_symlink(link, own);
     EXPECT_TRUE(contains(errorOf([&] { writeTextOutput(own, "png"); }),
                          "refusing to follow the symbolic link '" + link + "'"));
     EXPECT_EQ(testing::readFile(victim), "precious");
@@ -154,19 +154,19 @@ TEST(OutputFile, LinksPlantedByAnotherUserInASharedFolderAreNotFollowed) {
     writeTextOutput(own, "mine");
     EXPECT_EQ(testing::readFile(victim), "mine");
     const std::string owned = dir + "/owned";
-    fs::create_directories(owned);
+    std::filesystem::create_directories(owned);
     ASSERT_EQ(::chmod(owned.c_str(), 01777), 0);
     ASSERT_EQ(::chown(owned.c_str(), kOtherUser, kOtherUser), 0);
-    fs::create_symlink(victim, owned + "/theirs.png");
+    std::filesystem::create_symlink(victim, owned + "/theirs.png");
     ASSERT_EQ(::lchown((owned + "/theirs.png").c_str(), kOtherUser, kOtherUser), 0);
     writeTextOutput(owned + "/theirs.png", "folder owner's link");
     EXPECT_EQ(testing::readFile(victim), "folder owner's link");
 
     // Outside sticky world-writable folders the rule does not apply (as in the kernel).
     const std::string open = dir + "/open";
-    fs::create_directories(open);
+    std::filesystem::create_directories(open);
     ASSERT_EQ(::chmod(open.c_str(), 0777), 0);
-    fs::create_symlink(victim, open + "/x.png");
+    std::filesystem::create_symlink(victim, open + "/x.png");
     ASSERT_EQ(::lchown((open + "/x.png").c_str(), kOtherUser, kOtherUser), 0);
     writeTextOutput(open + "/x.png", "not shared");
     EXPECT_EQ(testing::readFile(victim), "not shared");
@@ -247,7 +247,7 @@ TEST(OutputFile, CharacterDevicesAreWrittenInPlaceAndAFullDeviceIsAnError) {
     struct stat st;
     ASSERT_EQ(::stat("/dev/null", &st), 0);
     EXPECT_TRUE(S_ISCHR(st.st_mode));
-    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
     const std::string msg = errorOf([] { writeTextOutput("/dev/full", "no room"); });
     EXPECT_TRUE(contains(msg, "/dev/full: cannot write")) << msg;
     EXPECT_TRUE(contains(msg, "No space left on device")) << msg;
@@ -261,7 +261,7 @@ TEST(OutputFile, FoldersMissingFoldersAndBlockDevicesAreRefused) {
     EXPECT_TRUE(contains(errorOf([&] { resolveOutput(dir + "/missing/a.png"); }),
                          "folder '" + dir + "/missing' does not exist"));
     EXPECT_TRUE(contains(errorOf([&] { resolveOutput(""); }), "empty output file name"));
-    for (const auto& e : fs::directory_iterator("/dev")) {
+    for (const auto& e : std::filesystem::directory_iterator("/dev")) {
         if (!e.is_block_file()) continue;
         EXPECT_TRUE(contains(errorOf([&] { resolveOutput(e.path()); }), "is a block device"));
         break;
@@ -366,12 +366,12 @@ TEST(OutputFile, TerminatingSignalsRemoveTemporaries) {
 TEST(OutputFile, OutputsNamingAnInputOrEachOtherAreRefused) {
     const std::string dir = testing::scratchDir();
     const std::string mesh = testing::writeFile(dir + "/mesh.vtk", "mesh");
-    fs::create_symlink(mesh, dir + "/alias.vtk");
+    std::filesystem::create_symlink(mesh, dir + "/alias.vtk");
     const std::vector<NamedFile> inputs{{"the input mesh", mesh}, {"--tf", "cool-to-warm"}};
     EXPECT_EQ(errorOf([&] { checkOutputsDistinct(inputs, {{"-o", dir + "/a.png"}}); }), "");
     for (const std::string& out :
          {mesh, dir + "/alias.vtk",
-          dir + "/../" + fs::path(dir).filename().string() + "/mesh.vtk"}) {
+          dir + "/../" + std::filesystem::path(dir).filename().string() + "/mesh.vtk"}) {
         const std::string msg = errorOf([&] { checkOutputsDistinct(inputs, {{"-o", out}}); });
         EXPECT_EQ(msg,
                   out + ": -o names the input mesh '" + mesh + "': refusing to overwrite an input");

@@ -10,6 +10,7 @@
 #include <random>
 #include <tuple>
 
+#include "on_each_device.h"
 #include "prepared_checks.h"
 #include "test_meshes.h"
 #include "test_support.h"
@@ -24,9 +25,6 @@
 
 namespace uvr {
 namespace {
-
-#define UVR_REQUIRE_GPU() \
-    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription()
 
 bool sameNodes(const std::vector<BvhNode>& a, const std::vector<BvhNode>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(BvhNode)) == 0;

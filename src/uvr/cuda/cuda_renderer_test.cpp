@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "on_each_device.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -16,9 +17,6 @@
 
 namespace uvr {
 namespace {
-
-#define UVR_REQUIRE_GPU() \
-    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription()
 
 RenderSettings settingsFor(const PreparedMesh& pm, RenderMethod method) {
     RenderSettings s;

@@ -71,3 +71,5 @@ TEST(MpiCommunicator, PiecesOutsideOneToIntMaxAreArgumentErrors) {
 
 }  // namespace
 }  // namespace uvr
+
+#undef UVR_SKIP_UNLESS_UNDER_MPI  // file-local: the unity build joins test files

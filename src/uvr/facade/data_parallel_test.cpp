@@ -27,8 +27,8 @@ using uvr::testing::catchError;
 constexpr double kMinSsim = 0.999;
 constexpr double kMaxLevels = 2.0;
 
-RenderSettings frameOf(const Bounds3f& bounds, RenderMethod method, float azimuth,
-                       float elevation) {
+RenderSettings orbitFrameOf(const Bounds3f& bounds, RenderMethod method, float azimuth,
+                            float elevation) {
     RenderSettings s;
     s.width = 160;
     s.height = 120;
@@ -75,18 +75,18 @@ struct OneProcess {
 
 /// A mesh and the rank counts it is rendered on (Blunt Fin, the largest, on many; the others on
 /// an uneven count, keeping the suite's time under the sanitizers).
-struct Case {
+struct MeshOnRanks {
     const char* file;
     const char* field;
     std::vector<int> ranks;
 };
 
 TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
-    const std::vector<Case> cases = {{"bluntfin_tets.vtk", "", {2, 3, 5, 8}},
-                                     {"post.vtk", "", {3}},
-                                     {"spx.vtk", "", {5}},
-                                     {"hexa.vtk", "", {3}}};
-    for (const Case& c : cases) {
+    const std::vector<MeshOnRanks> cases = {{"bluntfin_tets.vtk", "", {2, 3, 5, 8}},
+                                            {"post.vtk", "", {3}},
+                                            {"spx.vtk", "", {5}},
+                                            {"hexa.vtk", "", {3}}};
+    for (const MeshOnRanks& c : cases) {
         const std::string path = testing::sharedData(c.file);
         if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
         const Mesh mesh = readMesh(path);
@@ -99,7 +99,7 @@ TEST(DataParallel, EveryMethodGivesOneProcessPictureOnRealMeshes) {
         for (RenderMethod m :
              {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact})
             for (auto [az, el] : {std::pair{30.f, 20.f}, std::pair{-120.f, -35.f}})
-                frames.push_back(frameOf(bounds, m, az, el));
+                frames.push_back(orbitFrameOf(bounds, m, az, el));
         std::vector<RenderResult> single;
         for (const RenderSettings& s : frames) {
             single.push_back(one.render(s));
@@ -134,7 +134,7 @@ TEST(DataParallel, DepthInEndsTheRaysOfEveryRankAsOneProcesss) {
     std::vector<RenderSettings> frames;
     for (RenderMethod m :
          {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact}) {
-        RenderSettings s = frameOf(fin.bounds, m, 30.f, 20.f);
+        RenderSettings s = orbitFrameOf(fin.bounds, m, 30.f, 20.f);
         const float focal = length(s.camera->focalPoint - s.camera->position);
         s.depthIn.resize(std::size_t(s.width) * s.height);
         for (int y = 0; y < s.height; ++y)
@@ -172,7 +172,7 @@ TEST(DataParallel, DepthOutIsOneProcesssForEveryMethod) {
     for (const auto& [m, depthAlpha] :
          {std::pair{RenderMethod::Reference, 0.3f}, std::pair{RenderMethod::Partitions, 0.3f},
           std::pair{RenderMethod::Partitions, 0.6f}, std::pair{RenderMethod::Exact, 0.3f}}) {
-        frames.push_back(frameOf(fin.bounds, m, 30.f, 20.f));
+        frames.push_back(orbitFrameOf(fin.bounds, m, 30.f, 20.f));
         frames.back().depthAlpha = depthAlpha;
     }
     const std::vector<RenderResult> many =
@@ -211,7 +211,7 @@ TEST(DataParallel, DepthOutIsOneProcesssForEveryMethod) {
     }
     // Supersampled rays stop and note depth each on its own, which one opacity per pixel in
     // front cannot follow.
-    RenderSettings s = frameOf(fin.bounds, RenderMethod::Reference, 30.f, 20.f);
+    RenderSettings s = orbitFrameOf(fin.bounds, RenderMethod::Reference, 30.f, 20.f);
     s.depthAlpha = 0.5f;
     s.supersample = 2;
     const Error e =
@@ -327,7 +327,7 @@ TEST(DataParallel, OnTheGpuEveryMethodGivesOneProcessPicture) {
     Renderer one(mesh, field, options);
     std::vector<RenderSettings> frames;
     for (RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions, RenderMethod::Exact})
-        frames.push_back(frameOf(mesh.bounds(), m, 30.f, 20.f));
+        frames.push_back(orbitFrameOf(mesh.bounds(), m, 30.f, 20.f));
     for (int ranks : {2, 3}) {
         const std::vector<RenderResult> many =
             dataParallelFrames(mesh, field, ranks, options, frames);
@@ -465,7 +465,7 @@ TEST(DataParallel, NewValuesReachThePiecesAsAFreshPreparationWould) {
     RendererOptions options;
     options.device = Device::Cpu;
     for (RenderMethod m : {RenderMethod::Partitions, RenderMethod::Reference}) {
-        const RenderSettings s = frameOf(fin.bounds(), m, 30.f, 20.f);
+        const RenderSettings s = orbitFrameOf(fin.bounds(), m, 30.f, 20.f);
         const Image one = Renderer(fin, energy, options).render(s).image;
         for (const auto& [ranks, fromShares] : {std::pair{3, false}, std::pair{2, true}}) {
             SCOPED_TRACE(std::string(methodName(m)) + ", " + std::to_string(ranks) + " ranks" +
@@ -490,7 +490,7 @@ TEST(DataParallel, NewValuesReachThePiecesAsAFreshPreparationWould) {
     grid.fields.push_back(c);
     const ScalarField f = selectScalarField(grid, parseFieldSpec("f"));
     const ScalarField cells = selectScalarField(grid, parseFieldSpec("c"));
-    const RenderSettings s = frameOf(grid.bounds(), RenderMethod::Partitions, -40.f, 25.f);
+    const RenderSettings s = orbitFrameOf(grid.bounds(), RenderMethod::Partitions, -40.f, 25.f);
     const Image one = Renderer(grid, cells, options).render(s).image;
     const ImageComparison cmp =
         compareImages(toRgb8(one), toRgb8(frameAfterNewValues(grid, f, cells, 2, false, s).image));
@@ -520,12 +520,12 @@ TEST(DataParallel, LongSampleDistancesAndSmoothShadingGiveOneProcessPicture) {
     std::vector<RenderSettings> frames;
     for (RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
         for (float step : {0.5f, 1.f}) {
-            RenderSettings s = frameOf(mesh.bounds(), m, 35.f, 25.f);
+            RenderSettings s = orbitFrameOf(mesh.bounds(), m, 35.f, 25.f);
             applyOpacitySpec(s.tf, "ramp");
             s.step = step;
             frames.push_back(s);
         }
-        RenderSettings lit = frameOf(mesh.bounds(), m, -50.f, 20.f);
+        RenderSettings lit = orbitFrameOf(mesh.bounds(), m, -50.f, 20.f);
         lit.lighting.on = true;
         lit.lighting.specular = 0.3f;
         frames.push_back(lit);

@@ -10,14 +10,13 @@
 namespace uvr {
 namespace {
 
-Mesh grid(float scale) {
-    Mesh m = testing::makeHexGrid(
-        8, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
+Mesh scaledGrid(float scale) {
+    Mesh m = testing::jitteredHexGrid(8);
     for (Vec3f& p : m.points) p = p * scale;
     return m;
 }
 
-RenderSettings settingsFor(const Mesh& m, RenderMethod method) {
+RenderSettings smallFrame(const Mesh& m, RenderMethod method) {
     RenderSettings s;
     s.width = 48;
     s.height = 32;
@@ -36,9 +35,9 @@ Renderer cpuRenderer(const Mesh& m) {
 }
 
 TEST(FrameReport, SaysWhatTheFrameAndThePreparedMeshHold) {
-    const Mesh m = grid(1.f);
+    const Mesh m = scaledGrid(1.f);
     Renderer r = cpuRenderer(m);
-    const RenderSettings s = settingsFor(m, RenderMethod::Partitions);
+    const RenderSettings s = smallFrame(m, RenderMethod::Partitions);
     const RenderResult res = r.render(s);
     const nlohmann::json j = frameReport(r, s, res);
     EXPECT_EQ(j["method"], "adaptive");
@@ -68,9 +67,9 @@ TEST(FrameReport, SaysWhatTheFrameAndThePreparedMeshHold) {
 }
 
 TEST(FrameReport, AutoSaysWhatItPickedAndWhyAndExactHasNoSampling) {
-    const Mesh m = grid(1.f);
+    const Mesh m = scaledGrid(1.f);
     Renderer r = cpuRenderer(m);
-    RenderSettings s = settingsFor(m, RenderMethod::Auto);
+    RenderSettings s = smallFrame(m, RenderMethod::Auto);
     nlohmann::json j = frameReport(r, s, r.render(s));
     EXPECT_EQ(j["method_asked"], "auto");
     const RenderResult picked = r.render(s);
@@ -88,12 +87,12 @@ TEST(FrameReport, LengthsAndPositionsAreInTheFilesUnits) {
     // The same grid 2^30 times larger renders in a scaled frame (kFrameScaleExponent), to the
     // same samples; its report's lengths and positions are 2^30 times larger.
     const float k = 1073741824.f;
-    const Mesh small = grid(1.f), large = grid(k);
+    const Mesh small = scaledGrid(1.f), large = scaledGrid(k);
     Renderer a = cpuRenderer(small), b = cpuRenderer(large);
     ASSERT_EQ(a.prepared().tets.frame.scale, 1.0);
     ASSERT_LT(b.prepared().tets.frame.scale, 1.0 / k);
-    const RenderSettings sa = settingsFor(small, RenderMethod::Partitions);
-    const RenderSettings sb = settingsFor(large, RenderMethod::Partitions);
+    const RenderSettings sa = smallFrame(small, RenderMethod::Partitions);
+    const RenderSettings sb = smallFrame(large, RenderMethod::Partitions);
     const RenderResult ra = a.render(sa), rb = b.render(sb);
     EXPECT_EQ(ra.stats.samples, rb.stats.samples);
     const nlohmann::json ja = frameReport(a, sa, ra), jb = frameReport(b, sb, rb);
@@ -106,9 +105,9 @@ TEST(FrameReport, LengthsAndPositionsAreInTheFilesUnits) {
 }
 
 TEST(FrameReport, AnEmptyFrameSaysWhy) {
-    const Mesh m = grid(1.f);
+    const Mesh m = scaledGrid(1.f);
     Renderer r = cpuRenderer(m);
-    RenderSettings s = settingsFor(m, RenderMethod::Reference);
+    RenderSettings s = smallFrame(m, RenderMethod::Reference);
     applyOpacitySpec(s.tf, "constant:0");
     const nlohmann::json j = frameReport(r, s, r.render(s));
     EXPECT_NE(j["empty_frame"].get<std::string>(), "");

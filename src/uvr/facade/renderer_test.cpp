@@ -19,11 +19,6 @@ namespace {
 using ::testing::HasSubstr;
 using uvr::testing::catchError;
 
-Mesh jitteredGrid() {
-    return testing::makeHexGrid(
-        10, -1.f, 1.f, [](Vec3f p) { return p.x * p.y + p.z; }, 0.3f);
-}
-
 RenderSettings frameOf(const Bounds3f& bounds, RenderMethod method) {
     RenderSettings s;
     s.width = 96;
@@ -36,7 +31,7 @@ RenderSettings frameOf(const Bounds3f& bounds, RenderMethod method) {
 }
 
 TEST(Renderer, RendersEveryMethodAsTheBackendDoesOnThePreparedMesh) {
-    const Mesh m = jitteredGrid();
+    const Mesh m = testing::jitteredHexGrid(10);
     const ScalarField f = selectScalarField(m, {});
     RendererOptions o;
     o.device = Device::Cpu;
@@ -67,7 +62,7 @@ TEST(Renderer, RendersEveryMethodAsTheBackendDoesOnThePreparedMesh) {
 }
 
 TEST(Renderer, TheSourceMeshFreedOnceSplitChangesNoFrame) {
-    const Mesh kept = jitteredGrid();
+    const Mesh kept = testing::jitteredHexGrid(10);
     Mesh freed = kept;
     const ScalarField f = selectScalarField(kept, {});
     RendererOptions o;
@@ -91,7 +86,7 @@ TEST(Renderer, TheSourceMeshFreedOnceSplitChangesNoFrame) {
 }
 
 TEST(Renderer, AMethodWhoseStructuresWereNotPreparedIsRefused) {
-    const Mesh m = jitteredGrid();
+    const Mesh m = testing::jitteredHexGrid(10);
     RendererOptions o;
     o.device = Device::Cpu;
     o.meshBvh = false;
@@ -119,7 +114,7 @@ TEST(Renderer, DevicesParseAndCudaWithoutADeviceIsRefused) {
     EXPECT_FALSE(resolvesToCuda(Device::Cpu));
     EXPECT_EQ(resolvesToCuda(Device::Auto), cudaDeviceAvailable());
     if (cudaDeviceAvailable()) return;
-    const Mesh m = jitteredGrid();
+    const Mesh m = testing::jitteredHexGrid(10);
     RendererOptions o;
     o.device = Device::Cuda;
     EXPECT_EQ(catchError([&] { Renderer r(m, selectScalarField(m, {}), o); }).kind(),
@@ -128,7 +123,7 @@ TEST(Renderer, DevicesParseAndCudaWithoutADeviceIsRefused) {
 
 TEST(Renderer, OnTheGpuFramesMatchTheCpu) {
     if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
-    const Mesh m = jitteredGrid();
+    const Mesh m = testing::jitteredHexGrid(10);
     const ScalarField f = selectScalarField(m, {});
     RendererOptions o;
     o.leafCells = 64;

@@ -26,14 +26,14 @@ using ::testing::HasSubstr;
 using uvr::testing::catchError;
 
 /// A jittered hexahedral grid of n cells a side whose point field "f" moves with t.
-Mesh stepMesh(float t, int n = 6, const std::string& name = "f") {
+Mesh movingMesh(float t, int n = 6, const std::string& name = "f") {
     Mesh m = testing::makeHexGrid(
         n, -1.f, 1.f, [t](Vec3f p) { return std::sin(3.f * p.x + t) * p.y + p.z; }, 0.2f);
     m.fields[0].name = name;
     return m;
 }
 
-RenderSettings frameOf(const Bounds3f& bounds) {
+RenderSettings seriesFrameOf(const Bounds3f& bounds) {
     RenderSettings s;
     s.width = 64;
     s.height = 48;
@@ -62,16 +62,16 @@ void expectSameImage(const RenderResult& a, const RenderResult& b, const std::st
 TEST(SeriesPlayer, StepsOfOneGeometryRefreshValuesAndFramesEqualAFreshPreparation) {
     const std::string dir = testing::scratchDir();
     for (int k = 0; k < 3; ++k)
-        writeMesh(stepMesh(float(k)), dir + "/s_" + std::to_string(k) + ".vtu");
-    writeMesh(stepMesh(3.f, 5), dir + "/s_3.vtu");       // another geometry
-    writeMesh(stepMesh(4.f, 6, "g"), dir + "/s_4.vtu");  // the field is missing
+        writeMesh(movingMesh(float(k)), dir + "/s_" + std::to_string(k) + ".vtu");
+    writeMesh(movingMesh(3.f, 5), dir + "/s_3.vtu");       // another geometry
+    writeMesh(movingMesh(4.f, 6, "g"), dir + "/s_4.vtu");  // the field is missing
     RendererOptions o;
     o.device = Device::Cpu;
     SeriesPlayer player(openMeshSeries(dir + "/s_*.vtu"), parseFieldSpec("f"), o);
     ASSERT_EQ(player.series().stepCount(), 5u);
     EXPECT_EQ(player.step(), 0u);
-    const RenderSettings s = frameOf(player.mesh().bounds());
-    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(0.f), s, o), "step 0");
+    const RenderSettings s = seriesFrameOf(player.mesh().bounds());
+    expectSameImage(player.renderer().render(s), freshFrame(movingMesh(0.f), s, o), "step 0");
     const PreparedMesh* prepared = &player.renderer().prepared();
 
     // Step 1, read in the background while step 0 rendered: values only.
@@ -83,7 +83,7 @@ TEST(SeriesPlayer, StepsOfOneGeometryRefreshValuesAndFramesEqualAFreshPreparatio
     EXPECT_EQ(u.time, 1.0);
     EXPECT_EQ(&player.renderer().prepared(), prepared);  // nothing prepared anew
     const RenderResult one = player.renderer().render(s);
-    expectSameImage(one, freshFrame(stepMesh(1.f), s, o), "step 1");
+    expectSameImage(one, freshFrame(movingMesh(1.f), s, o), "step 1");
     double change = 0.0;
     for (std::size_t i = 0; i < one.image.pixels.size(); ++i)
         change += std::abs(one.image.pixels[i].x - during.image.pixels[i].x);
@@ -95,20 +95,20 @@ TEST(SeriesPlayer, StepsOfOneGeometryRefreshValuesAndFramesEqualAFreshPreparatio
     u = player.show(2, 3);
     EXPECT_FALSE(u.prefetched);
     EXPECT_FALSE(u.rebuilt);
-    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(2.f), s, o), "step 2");
+    expectSameImage(player.renderer().render(s), freshFrame(movingMesh(2.f), s, o), "step 2");
 
     // Step 3's geometry differs: prepared anew (its read was started by show(2, 3)).
     u = player.show(3);
     EXPECT_TRUE(u.rebuilt);
     EXPECT_TRUE(u.prefetched);
     EXPECT_EQ(player.mesh().cellCount(), 125u);
-    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(3.f, 5), s, o), "step 3");
+    expectSameImage(player.renderer().render(s), freshFrame(movingMesh(3.f, 5), s, o), "step 3");
 
     // Step 4 lacks the field: an error naming it, and step 3 stays shown.
     player.prefetch(4);
     EXPECT_THAT(catchError([&] { player.show(4); }).what(), HasSubstr("'f'"));
     EXPECT_EQ(player.step(), 3u);
-    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(3.f, 5), s, o),
+    expectSameImage(player.renderer().render(s), freshFrame(movingMesh(3.f, 5), s, o),
                     "step 3 after the refused step");
     EXPECT_THAT(catchError([&] { player.show(5); }).what(), HasSubstr("no time step 5"));
     EXPECT_EQ(player.step(), 3u);
@@ -119,7 +119,7 @@ TEST(SeriesPlayer, TheDefaultFieldOfTheFirstStepStaysAtEveryStep) {
     // 0 (pinField) and the player keeps "f" at step 1 rather than switching fields.
     const std::string dir = testing::scratchDir();
     for (int k = 0; k < 2; ++k) {
-        Mesh m = stepMesh(float(k));
+        Mesh m = movingMesh(float(k));
         Field a{"a", Association::Point, 1, std::vector<float>(m.pointCount(), 1.f)};
         if (k == 1)
             for (std::size_t i = 0; i < a.values.size(); ++i) a.values[i] = float(i);
@@ -134,8 +134,8 @@ TEST(SeriesPlayer, TheDefaultFieldOfTheFirstStepStaysAtEveryStep) {
     EXPECT_EQ(player.spec().name, "f");
     player.show(1);
     EXPECT_EQ(player.field().name, "f");
-    const RenderSettings s = frameOf(player.mesh().bounds());
-    expectSameImage(player.renderer().render(s), freshFrame(stepMesh(1.f), s, o), "step 1");
+    const RenderSettings s = seriesFrameOf(player.mesh().bounds());
+    expectSameImage(player.renderer().render(s), freshFrame(movingMesh(1.f), s, o), "step 1");
 }
 
 /// A data-parallel series read by parts: on 3 in-process ranks each reads only its run of each
@@ -146,7 +146,7 @@ void expectPlayedByPartsAsOneProcess(const std::string& file, std::uint64_t cell
     o.device = Device::Cpu;
     SeriesPlayer one(openMeshSeries(file), parseFieldSpec(""), o);
     EXPECT_FALSE(one.byParts());
-    const RenderSettings s = frameOf(one.mesh().bounds());
+    const RenderSettings s = seriesFrameOf(one.mesh().bounds());
     std::vector<Image> expected;
     std::vector<std::pair<float, float>> ranges;
     for (std::size_t i = 0; i < 3; ++i) {
@@ -199,7 +199,7 @@ void expectPlayedByPartsAsOneProcess(const std::string& file, std::uint64_t cell
 TEST(SeriesPlayer, DataParallelAnExodusSeriesIsReadByItsCellsAsOneProcessShowsIt) {
     // An Exodus II series: its cells are its parts.
     if (!exodusSupported()) GTEST_SKIP() << "built without netCDF";
-    const Mesh grid = stepMesh(0.f, 8);
+    const Mesh grid = movingMesh(0.f, 8);
     const std::string file = testing::scratchDir() + "/grid.exo";
     testing::writeExodusFile(file,
                              testing::hexSeriesSpec(grid, 3, [&](std::size_t step, std::size_t n) {
@@ -210,10 +210,10 @@ TEST(SeriesPlayer, DataParallelAnExodusSeriesIsReadByItsCellsAsOneProcessShowsIt
 }
 #endif
 
-/// Writes time step k (stepMesh(k, 8)) as 6 .vtu pieces in `dir` (each a run of its cells),
+/// Writes time step k (movingMesh(k, 8)) as 6 .vtu pieces in `dir` (each a run of its cells),
 /// returning their names.
 std::vector<std::string> writeStepPieces(const std::string& dir, int k) {
-    const Mesh step = stepMesh(float(k), 8);
+    const Mesh step = movingMesh(float(k), 8);
     std::vector<std::string> names;
     for (int piece = 0; piece < 6; ++piece) {
         const auto [first, end] = rankRun(step.cellCount(), piece, 6);
@@ -245,7 +245,7 @@ TEST(SeriesPlayer, DataParallelACollectionOfPvtuStepsIsReadByPiecesAsOneProcessS
     }
     const std::string file = testing::writeFile(dir + "/run.pvd", pvd + kPvdTail);
     EXPECT_EQ(openMeshSeries(file)->partCount(1), 6u);
-    expectPlayedByPartsAsOneProcess(file, stepMesh(0.f, 8).cellCount());
+    expectPlayedByPartsAsOneProcess(file, movingMesh(0.f, 8).cellCount());
 }
 
 TEST(SeriesPlayer, DataParallelACollectionListingEachTimesPartsIsReadByPartsAsOneProcessShowsIt) {
@@ -271,7 +271,7 @@ TEST(SeriesPlayer, DataParallelACollectionListingEachTimesPartsIsReadByPartsAsOn
     EXPECT_EQ(part.cellIds.size(), part.mesh.cellCount());
     EXPECT_EQ(part.pointIds.size(), part.mesh.points.size());
     EXPECT_EQ(catchError([&] { series->readPart(1, 5, 7); }).kind(), ErrorKind::Argument);
-    expectPlayedByPartsAsOneProcess(file, stepMesh(0.f, 8).cellCount());
+    expectPlayedByPartsAsOneProcess(file, movingMesh(0.f, 8).cellCount());
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
 #include "uvr/mesh/cell_math.h"
@@ -37,16 +38,6 @@ ProceduralSpec makeSpec(ProceduralShape shape, std::uint64_t target, std::uint64
     spec.targetCells = target;
     spec.seed = seed;
     return spec;
-}
-
-double tetVolume(const Mesh& m, std::uint64_t c) {
-    auto ids = m.cell(c);
-    const Vec3f a = m.points[ids[0]], b = m.points[ids[1]], cc = m.points[ids[2]],
-                d = m.points[ids[3]];
-    const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
-    const double vx = cc.x - a.x, vy = cc.y - a.y, vz = cc.z - a.z;
-    const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
-    return (ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx)) / 6.0;
 }
 
 /// True when p lies in tetrahedron c (barycentric coordinates all >= -eps).
@@ -114,7 +105,7 @@ TEST(Procedural, EveryTetrahedronIsPositivelyOriented) {
                     double minVolume = 1e30;
                     for (std::uint64_t c = 0; c < m.cellCount(); ++c) {
                         ASSERT_EQ(m.cellTypes[c], CellType::Tetra);
-                        minVolume = std::min(minVolume, tetVolume(m, c));
+                        minVolume = std::min(minVolume, testing::tetVolume(m, c));
                     }
                     EXPECT_GT(minVolume, 0.0) << proceduralShapeName(shape) << " target " << target
                                               << " jitter " << jitter << " seed " << seed;
@@ -130,7 +121,7 @@ TEST(Procedural, TotalVolumeMatchesTheDomain) {
     for (ProceduralShape shape : {ProceduralShape::Box, ProceduralShape::Graded}) {
         const Mesh m = generateMesh(makeSpec(shape, 30000));
         double total = 0;
-        for (std::uint64_t c = 0; c < m.cellCount(); ++c) total += tetVolume(m, c);
+        for (std::uint64_t c = 0; c < m.cellCount(); ++c) total += testing::tetVolume(m, c);
         EXPECT_NEAR(total, 8.0, 1e-4) << proceduralShapeName(shape);
         const Bounds3f b = m.bounds();
         EXPECT_EQ(b.lo, Vec3f(-1.f)) << proceduralShapeName(shape);
@@ -138,7 +129,7 @@ TEST(Procedural, TotalVolumeMatchesTheDomain) {
     }
     const Mesh shell = generateMesh(makeSpec(ProceduralShape::Shell, 200000));
     double total = 0;
-    for (std::uint64_t c = 0; c < shell.cellCount(); ++c) total += tetVolume(shell, c);
+    for (std::uint64_t c = 0; c < shell.cellCount(); ++c) total += testing::tetVolume(shell, c);
     const double exact =
         2.0 * std::numbers::pi * std::numbers::pi * kShellMajorRadius *
         (kShellOuterRadius * kShellOuterRadius - kShellInnerRadius * kShellInnerRadius);

@@ -26,7 +26,7 @@ float linear(Vec3f p) {
 
 /// A jittered n^3 hex grid over [-1, 1]^3 with the point field f = x + 2y - z and a cell field
 /// "id" holding each cell's index.
-Mesh hexGrid(int n) {
+Mesh idHexGrid(int n) {
     Mesh m = testing::makeHexGrid(n, -1.f, 1.f, linear, 0.3f);
     Field id{"id", Association::Cell, 1, {}};
     for (std::uint64_t c = 0; c < m.cellCount(); ++c) id.values.push_back(float(c));
@@ -45,7 +45,7 @@ double signedVolume(const Mesh& m, std::uint64_t c) {
 
 TEST(Refine, MultipliesTetsBy8AndKeepsVolumeFieldsAndConformity) {
     constexpr int kN = 4, kLevels = 2;
-    const Mesh in = hexGrid(kN);
+    const Mesh in = idHexGrid(kN);
     const TetMesh base =
         tetrahedralize(in, {"f", Association::Point, in.fields[0].values}, {.splitCells = true});
     const Mesh out = refineMesh(in, kLevels);
@@ -58,8 +58,8 @@ TEST(Refine, MultipliesTetsBy8AndKeepsVolumeFieldsAndConformity) {
         ASSERT_GT(v, 0.0) << "tetrahedron " << c;
         volume += v;
     }
-    constexpr double kVolumeTolerance = 1e-6;  // relative; float midpoints
-    EXPECT_NEAR(volume, base.totalVolume, kVolumeTolerance * base.totalVolume);
+    constexpr double kRelativeVolumeTolerance = 1e-6;  // relative; float midpoints
+    EXPECT_NEAR(volume, base.totalVolume, kRelativeVolumeTolerance * base.totalVolume);
     EXPECT_NEAR(volume, 8.0, 1e-5);  // the grid spans [-1, 1]^3 whatever the interior jitter
     // The linear point field is reproduced at every new point; cell values follow their cell.
     ASSERT_EQ(out.fields.size(), 2u);
@@ -106,7 +106,7 @@ TEST(Refine, MultipliesTetsBy8AndKeepsVolumeFieldsAndConformity) {
 }
 
 TEST(Refine, ZeroLevelsSplitsOnly) {
-    const Mesh in = hexGrid(2);
+    const Mesh in = idHexGrid(2);
     const Mesh out = refineMesh(in, 0);
     const TetMesh base =
         tetrahedralize(in, {"f", Association::Point, in.fields[0].values}, {.splitCells = true});
@@ -115,7 +115,7 @@ TEST(Refine, ZeroLevelsSplitsOnly) {
 }
 
 TEST(Refine, SameOutputWhateverTheThreadCount) {
-    const Mesh in = hexGrid(8);
+    const Mesh in = idHexGrid(8);
     cpu::setThreadCount(1);
     const Mesh one = refineMesh(in, 2);
     cpu::setThreadCount(2);
@@ -133,7 +133,7 @@ TEST(Refine, SameOutputWhateverTheThreadCount) {
 }
 
 TEST(Refine, BadLevelsAreArgumentErrors) {
-    const Mesh in = hexGrid(1);
+    const Mesh in = idHexGrid(1);
     for (int levels : {-1, kMaxRefineLevels + 1}) {
         try {
             refineMesh(in, levels);
@@ -144,7 +144,7 @@ TEST(Refine, BadLevelsAreArgumentErrors) {
     }
     // 6 tetrahedra * 8^8 = 100M fits, but a bigger grid would pass kMaxRefinedTets.
     try {
-        refineMesh(hexGrid(3), kMaxRefineLevels);
+        refineMesh(idHexGrid(3), kMaxRefineLevels);
         FAIL();
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Resource);
@@ -170,7 +170,7 @@ TEST(RefineStream, SameBytesAsTheRefinedMeshWrittenWhole) {
         int levels;
         std::uint64_t pieceTets;
     };
-    const Mesh grid = hexGrid(4);
+    const Mesh grid = idHexGrid(4);
     const std::vector<Case> cases = {{&grid, 1, kRefinePieceTets},
                                      {&grid, 2, 7},
                                      {&grid, 0, 5},
@@ -199,11 +199,11 @@ TEST(RefineStream, SameBytesAsTheRefinedMeshWrittenWhole) {
 
 TEST(RefineStream, StreamedPeakEstimateIsBelowTheWholeOutput) {
     // 1.3M tetrahedra in, 84M out in 2 levels (only the counts are used).
-    const Mesh grid = hexGrid(60);
+    const Mesh grid = idHexGrid(60);
     const std::uint64_t tets = 6 * grid.cellCount();
     EXPECT_LT(refineMemoryBytes(grid, tets, 2, true), refineMemoryBytes(grid, tets, 2) / 4);
     EXPECT_LT(refineMemoryBytes(grid, tets, 2, true), 10 * refinedTetCount(tets, 2));
-    EXPECT_THROW(refineToNative(hexGrid(2), 9, testing::scratchDir() + "/x.uvrm"), Error);
+    EXPECT_THROW(refineToNative(idHexGrid(2), 9, testing::scratchDir() + "/x.uvrm"), Error);
 }
 
 }  // namespace

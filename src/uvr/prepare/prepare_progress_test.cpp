@@ -51,7 +51,7 @@ struct Recorded {
     }
 };
 
-PreparedMesh prepareWith(int threads, const ProgressFn& progress) {
+PreparedMesh prepareWithProgress(int threads, const ProgressFn& progress) {
     cpu::setThreadCount(threads);
     PreparedMesh pm = prepareMesh(testing::box400k(), selectScalarField(testing::box400k(), {}),
                                   PrepareOptions{}, progress);
@@ -65,7 +65,7 @@ TEST(PrepareProgress, EveryPhaseIsNamedAndTheLongOnesCountToOne) {
                                            "macrocells"};
     for (int threads : {1, 2}) {
         Recorded r;
-        const PreparedMesh pm = prepareWith(threads, r.callbacks());
+        const PreparedMesh pm = prepareWithProgress(threads, r.callbacks());
         ASSERT_GT(pm.tets.cellCount(), 262144u);
         EXPECT_EQ(r.outsidePhase, 0);
         EXPECT_EQ(r.overlapped, 0);
@@ -98,9 +98,9 @@ TEST(PrepareProgress, EveryPhaseIsNamedAndTheLongOnesCountToOne) {
 
 TEST(PrepareProgress, ReportsChangeNothingPreparedWithOneOrTwoThreads) {
     Recorded r1, r2;
-    const PreparedMesh a = prepareWith(2, {});
-    const PreparedMesh b = prepareWith(1, r1.callbacks());
-    const PreparedMesh c = prepareWith(2, r2.callbacks());
+    const PreparedMesh a = prepareWithProgress(2, {});
+    const PreparedMesh b = prepareWithProgress(1, r1.callbacks());
+    const PreparedMesh c = prepareWithProgress(2, r2.callbacks());
     for (const PreparedMesh* x : {&b, &c}) {
         EXPECT_TRUE(testing::sameBytes(a.tets.tets, x->tets.tets));
         EXPECT_TRUE(testing::sameBytes(a.tets.tetCorners, x->tets.tetCorners));

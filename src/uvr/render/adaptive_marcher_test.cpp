@@ -18,7 +18,7 @@
 namespace uvr {
 namespace {
 
-PreparedMesh jitteredGrid(std::uint32_t leafCells = 64) {
+PreparedMesh wavyGrid(std::uint32_t leafCells = 64) {
     Mesh m = testing::makeHexGrid(
         10, -1.f, 1.f, [](Vec3f p) { return std::sin(3 * p.x) * std::cos(2 * p.y) + p.z; }, 0.3f);
     PrepareOptions o;
@@ -48,16 +48,6 @@ float meanDifference(const Image& a, const Image& b) {
     return static_cast<float>(d / (4.0 * a.pixels.size()));
 }
 
-float maxDifference(const Image& a, const Image& b) {
-    float d = 0.f;
-    for (size_t i = 0; i < a.pixels.size(); ++i) {
-        const Vec4f x = a.pixels[i], y = b.pixels[i];
-        d = std::max({d, std::fabs(x.x - y.x), std::fabs(x.y - y.y), std::fabs(x.z - y.z),
-                      std::fabs(x.w - y.w)});
-    }
-    return d;
-}
-
 /// PartitionIntegrator's frames render on every device (tests/on_each_device.h).
 class PartitionIntegrator : public testing::OnEachDevice {};
 UVR_ON_EACH_DEVICE(PartitionIntegrator);
@@ -71,7 +61,7 @@ TEST(AdaptiveStep, FormulaEnds) {
 }
 
 TEST_P(PartitionIntegrator, EqualStepsReproduceTheReference) {
-    const PreparedMesh pm = jitteredGrid();
+    const PreparedMesh pm = wavyGrid();
     RenderSettings ref = baseSettings();
     const RenderResult r = render(pm, ref);
     for (bool skip : {true, false}) {
@@ -80,7 +70,7 @@ TEST_P(PartitionIntegrator, EqualStepsReproduceTheReference) {
         s.skip = skip;
         s.adaptive = false;  // every partition at s1: the reference's samples
         const RenderResult p = render(pm, s);
-        EXPECT_LT(maxDifference(r.image, p.image), 1e-4f) << "skip " << skip;
+        EXPECT_LT(testing::maxPixelDifference(r.image, p.image), 1e-4f) << "skip " << skip;
         if (skip) {
             EXPECT_LT(p.stats.samples, r.stats.samples);  // transparent partitions skipped
             EXPECT_GT(p.stats.partitionsSkipped, 0u);
@@ -91,12 +81,12 @@ TEST_P(PartitionIntegrator, EqualStepsReproduceTheReference) {
         // Also with s2 == s1 and adaptivity on.
         s.adaptive = true;
         s.maxStep = r.setup.params.step;
-        EXPECT_LT(maxDifference(r.image, render(pm, s).image), 1e-4f);
+        EXPECT_LT(testing::maxPixelDifference(r.image, render(pm, s).image), 1e-4f);
     }
 }
 
 TEST_P(PartitionIntegrator, AdaptiveStepsTakeFewerSamplesAndStayClose) {
-    const PreparedMesh pm = jitteredGrid();
+    const PreparedMesh pm = wavyGrid();
     RenderSettings s = baseSettings();
     const RenderResult r = render(pm, s);
     s.method = RenderMethod::Partitions;
@@ -115,7 +105,7 @@ TEST_P(PartitionIntegrator, ShadedFramesStepByTheirOpacityUnlessTold) {
     // maximum opacity a steps at most max(3 s1, kLitError u / (rate a)) (shadeLit), s2 staying
     // 16 s1; a gradient opacity adds its largest scale to the rate; a max_sample_distance given
     // stands either way.
-    const PreparedMesh pm = jitteredGrid();
+    const PreparedMesh pm = wavyGrid();
     RenderSettings s = baseSettings();
     s.method = RenderMethod::Partitions;
     const RenderResult plain = render(pm, s);
@@ -204,7 +194,7 @@ TEST_P(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
             const RenderResult p = render(pm, s);
             const double ssim = compareImages(toRgb8(ref.image), toRgb8(p.image)).ssim;
             EXPECT_GE(ssim, 0.995) << name << (adaptive ? " adaptive" : " skipping only");
-            EXPECT_LT(maxDifference(ref.image, p.image), 2e-3f) << name;
+            EXPECT_LT(testing::maxPixelDifference(ref.image, p.image), 2e-3f) << name;
             EXPECT_LE(p.stats.samples, ref.stats.samples) << name;
         }
     }
@@ -226,11 +216,11 @@ TEST_P(PartitionIntegrator, NeedsNoMeshBvh) {
     s.method = RenderMethod::Partitions;
     const RenderResult a = render(with, s), b = render(without, s);
     EXPECT_EQ(a.stats.samples, b.stats.samples);
-    EXPECT_LT(maxDifference(a.image, b.image), 1e-6f);
+    EXPECT_LT(testing::maxPixelDifference(a.image, b.image), 1e-6f);
 }
 
 TEST(PartitionShading, NormalisedVarianceMapsToTheStepRange) {
-    const PreparedMesh pm = jitteredGrid(32);
+    const PreparedMesh pm = wavyGrid(32);
     RenderSettings s = baseSettings();
     s.method = RenderMethod::Partitions;
     s.stepRule = StepRule::Variance;

@@ -36,7 +36,7 @@ float angleBetween(Vec3f a, Vec3f b) {
     return degrees(std::acos(std::clamp(dot(normalize(a), normalize(b)), -1.f, 1.f)));
 }
 
-Bounds3f box(Vec3f lo, Vec3f hi) {
+Bounds3f boundsOf(Vec3f lo, Vec3f hi) {
     Bounds3f b;
     b.extend(lo);
     b.extend(hi);
@@ -44,7 +44,7 @@ Bounds3f box(Vec3f lo, Vec3f hi) {
 }
 
 TEST(Camera, ResetFitsBoundingSphereLookingDownMinusZ) {
-    Camera cam = resetCamera(box({-1, -1, -1}, {1, 1, 1}), 1.5f);
+    Camera cam = resetCamera(boundsOf({-1, -1, -1}, {1, 1, 1}), 1.5f);
     float d = std::sqrt(3.f) / std::sin(15.f * std::numbers::pi_v<float> / 180.f);
     expectVec(cam.position, {0.f, 0.f, d}, kTol * d);
     expectVec(cam.focalPoint, {0.f, 0.f, 0.f}, 0.f);
@@ -69,7 +69,7 @@ for w, h in ((400, 200), (200, 400)):
     print(*c.GetPosition(), *c.GetFocalPoint(), *c.GetViewUp(), c.GetViewAngle())
 )");
     ASSERT_EQ(v.size(), 20u);
-    Bounds3f b = box({-1, -3, 0}, {2, 4, 1});
+    Bounds3f b = boundsOf({-1, -3, 0}, {2, 4, 1});
     float aspects[2] = {2.f, 0.5f};
     for (int k = 0; k < 2; ++k) {
         Camera cam = resetCamera(b, aspects[k]);
@@ -84,7 +84,7 @@ for w, h in ((400, 200), (200, 400)):
 
 TEST(Camera, ResetRejectsEmptyBoundsAndBadAspect) {
     EXPECT_EQ(catchError([] { resetCamera(Bounds3f{}, 1.f); }).kind(), ErrorKind::Argument);
-    Bounds3f b = box({0, 0, 0}, {1, 1, 1});
+    Bounds3f b = boundsOf({0, 0, 0}, {1, 1, 1});
     EXPECT_EQ(catchError([&] { resetCamera(b, 0.f); }).kind(), ErrorKind::Argument);
     EXPECT_EQ(catchError([&] { resetCamera(b, std::nanf("")); }).kind(), ErrorKind::Argument);
 }
@@ -109,7 +109,7 @@ TEST(Camera, ClearColumnsKeepsTheBoundingSphereLeftOfThemAndCentred) {
     // Issue 35: a legend's columns at the right edge. The reset camera, turned, is moved back
     // and panned: the bounding sphere then projects into the columns left of them, its centre
     // in their middle. Points on the sphere: its poles along the image's axes and a ring.
-    const Bounds3f b = box({-1.f, -0.5f, -2.f}, {3.f, 0.5f, 2.f});
+    const Bounds3f b = boundsOf({-1.f, -0.5f, -2.f}, {3.f, 0.5f, 2.f});
     const Vec3d centre = (toDouble(b.lo) + toDouble(b.hi)) * 0.5;
     const double radius = 0.5 * std::sqrt(dot(toDouble(b.hi - b.lo), toDouble(b.hi - b.lo)));
     for (const auto& [w, h] : {std::pair{320, 240}, {200, 300}, {640, 240}})
@@ -472,7 +472,7 @@ TEST(Camera, ParallelCameraFilesLoadWithTheirScale) {
 
 TEST(Camera, ResetSetsTheParallelScaleAsVtkRendererDoes) {
     // vtkRenderer::ResetCamera: the bounding sphere's radius, over the aspect for tall images.
-    const Bounds3f b = box({-1, -3, 0}, {2, 4, 1});
+    const Bounds3f b = boundsOf({-1, -3, 0}, {2, 4, 1});
     const float radius = 0.5f * std::sqrt(9.f + 49.f + 1.f);
     EXPECT_FLOAT_EQ(resetCamera(b, 2.f).parallelScale, radius);
     EXPECT_FLOAT_EQ(resetCamera(b, 0.5f).parallelScale, radius / 0.5f);

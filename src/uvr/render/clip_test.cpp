@@ -9,6 +9,7 @@
 #include <string>
 
 #include "on_each_device.h"
+#include "render_scenes.h"
 #include "test_meshes.h"
 #include "uvr/core/error.h"
 #include "uvr/core/setting_error.h"
@@ -39,7 +40,8 @@ PreparedMesh wavyCube() {
 /// A frame looking along +x at the unit cube: a parallel view of its middle (every ray crosses
 /// x from 0 to 1 inside the cube), or a perspective one from x = -2; constant opacity `opacity`
 /// per unit length (attenuation), step 0.01.
-RenderSettings alongX(RenderMethod method, bool parallel, const char* opacity = "constant:0.5") {
+RenderSettings clipViewAlongX(RenderMethod method, bool parallel,
+                              const char* opacity = "constant:0.5") {
     RenderSettings s;
     s.method = method;
     s.width = 24, s.height = 16;
@@ -60,9 +62,6 @@ RenderSettings alongX(RenderMethod method, bool parallel, const char* opacity = 
     return s;
 }
 
-constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
-                                     RenderMethod::Partitions};
-
 class Clipping : public testing::OnEachDevice {};
 UVR_ON_EACH_DEVICE(Clipping);
 
@@ -71,9 +70,9 @@ TEST_P(Clipping, APlaneCutsTheSlabWhereItLies) {
     // leaves 0.63 of the unit chord, kept x <= 0.37 leaves 0.37. The exact method cuts at the
     // plane; the sampling methods take their samples inside it (within a step s1 = 0.01).
     const PreparedMesh pm = constantCube();
-    for (const RenderMethod m : kMethods)
+    for (const RenderMethod m : testing::kEveryMethod)
         for (const float side : {1.f, -1.f}) {
-            RenderSettings s = alongX(m, true);
+            RenderSettings s = clipViewAlongX(m, true);
             s.clipPlanes = {{Vec3f(0.37f, 0.f, 0.f), Vec3f(side * 3.f, 0.f, 0.f)}};  // not unit
             const double length = side > 0.f ? 0.63 : 0.37;
             const double want = -std::expm1(-0.5 * length);
@@ -89,10 +88,10 @@ TEST_P(Clipping, APlaneCutsTheSlabWhereItLies) {
 
 TEST_P(Clipping, PlanesThatKeepNothingOrEverything) {
     const PreparedMesh pm = constantCube();
-    for (const RenderMethod m : kMethods) {
+    for (const RenderMethod m : testing::kEveryMethod) {
         const std::string what = methodName(m);
         // Parallel to the rays, on the kept side: nothing is cut; on the other: nothing is left.
-        RenderSettings s = alongX(m, true);
+        RenderSettings s = clipViewAlongX(m, true);
         const RenderResult whole = render(pm, s);
         s.clipPlanes = {{Vec3f(0.f, 0.f, -5.f), Vec3f(0.f, 0.f, 1.f)}};
         EXPECT_TRUE(testing::samePixels(render(pm, s).image, whole.image)) << what;
@@ -115,8 +114,8 @@ TEST_P(Clipping, ABoxAroundTheMeshChangesNothing) {
     // The sampling methods take the same samples (bit for bit); the exact method stops where
     // the box's exit is, which is the mesh's own to rounding.
     const PreparedMesh pm = wavyCube();
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m, false, "0:0,0.5:0.8,1:0.3");
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = clipViewAlongX(m, false, "0:0,0.5:0.8,1:0.3");
         s.camera = orbitCamera(*s.camera, 25.f, 30.f);
         const RenderResult whole = render(pm, s);
         s.clipBox = Bounds3f{Vec3f(-1.f, -1.f, -1.f), Vec3f(2.f, 2.f, 2.f)};
@@ -136,7 +135,7 @@ TEST_P(Clipping, TheTwoHalvesOfACutCompositeToTheWhole) {
     // Exact: along rays that cross x = c once going +x, the half x <= c over the half x >= c is
     // the whole (front-to-back compositing of one integral split at the plane).
     const PreparedMesh pm = wavyCube();
-    RenderSettings s = alongX(RenderMethod::Exact, false, "0:0,0.5:0.8,1:0.3");
+    RenderSettings s = clipViewAlongX(RenderMethod::Exact, false, "0:0,0.5:0.8,1:0.3");
     const RenderResult whole = render(pm, s);
     s.clipPlanes = {{Vec3f(0.43f, 0.f, 0.f), Vec3f(-1.f, 0.f, 0.f)}};
     const RenderResult nearHalf = render(pm, s);
@@ -168,10 +167,10 @@ TEST_P(Clipping, TheCutFaceShowsTheFieldWhereThePlaneCutsIt) {
         options.cells.splitCells = split;
         const Mesh m = testing::makeHexGrid(6, 0.f, 1.f, field);
         const PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), options);
-        for (const RenderMethod method : kMethods) {
+        for (const RenderMethod method : testing::kEveryMethod) {
             const std::string what =
                 std::string(methodName(method)) + (split ? " tetrahedra" : " hexahedra");
-            RenderSettings s = alongX(method, true, "constant:1");
+            RenderSettings s = clipViewAlongX(method, true, "constant:1");
             s.clipSurface = true;
             s.clipPlanes = {{Vec3f(0.43f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f)}};
             const RenderResult front = render(pm, s);

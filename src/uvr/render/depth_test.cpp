@@ -13,6 +13,7 @@
 #include <string>
 
 #include "on_each_device.h"
+#include "render_scenes.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -26,10 +27,8 @@
 namespace uvr {
 namespace {
 
-const Vec3f kGradient(0.6f, 0.5f, -0.35f);
-
-PreparedMesh cube(bool split) {
-    const Mesh m = testing::makeHexGrid(6, 0.f, 1.f, [](Vec3f p) { return dot(kGradient, p); });
+PreparedMesh linearCube(bool split) {
+    const Mesh m = testing::makeHexGrid(6, 0.f, 1.f, testing::linearField);
     PrepareOptions options;
     options.kd.leafCells = 32;
     options.cells.splitCells = split;
@@ -38,7 +37,7 @@ PreparedMesh cube(bool split) {
 
 /// A parallel view along +x from x = -2 over the middle of the unit cube: a ray's view depth is
 /// its x + 2.
-RenderSettings alongX(RenderMethod method) {
+RenderSettings depthViewAlongX(RenderMethod method) {
     RenderSettings s;
     s.method = method;
     s.width = 16, s.height = 12;
@@ -58,9 +57,6 @@ RenderSettings alongX(RenderMethod method) {
     return s;
 }
 
-constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
-                                     RenderMethod::Partitions};
-
 class Depth : public testing::OnEachDevice {};
 UVR_ON_EACH_DEVICE(Depth);
 
@@ -69,11 +65,11 @@ TEST_P(Depth, ASlabReachesTheOpacityWhereItsExtinctionSays) {
     // 2 + that; within a step s1 = 0.01 for the sampling methods. Supersampled: the nearest of a
     // pixel's rays, the same here.
     for (const bool split : {true, false}) {
-        const PreparedMesh pm = cube(split);
-        for (const RenderMethod m : kMethods)
+        const PreparedMesh pm = linearCube(split);
+        for (const RenderMethod m : testing::kEveryMethod)
             for (const float a : {0.5f, 0.8f})
                 for (const int n : {1, 2}) {
-                    RenderSettings s = alongX(m);
+                    RenderSettings s = depthViewAlongX(m);
                     s.depthAlpha = a;
                     s.supersample = n;
                     const RenderResult r = render(pm, s);
@@ -90,9 +86,10 @@ TEST_P(Depth, AnOpaqueIsosurfaceIsWhereThePlaneIs) {
     // Transparent volume, an opaque plane g . p = c: each ray's depth is where it meets the
     // plane, x + 2 with x = (c - g.y y - g.z z) / g.x, exact to 1e-4, sampled within s1.
     const float c = 0.45f;
-    const PreparedMesh pm = cube(true);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const Vec3f g = testing::kLinearGradient;
+    const PreparedMesh pm = linearCube(true);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = depthViewAlongX(m);
         applyOpacitySpec(s.tf, "constant:0");
         s.isoSurfaces = {IsoSurface{c}};
         s.depthAlpha = 0.5f;
@@ -100,8 +97,7 @@ TEST_P(Depth, AnOpaqueIsosurfaceIsWhereThePlaneIs) {
         for (int y = 0; y < s.height; ++y)
             for (int x = 0; x < s.width; ++x) {
                 const Ray ray = r.setup.rays.ray(float(x) + 0.5f, float(y) + 0.5f);
-                const float hit =
-                    (c - kGradient.y * ray.org.y - kGradient.z * ray.org.z) / kGradient.x;
+                const float hit = (c - g.y * ray.org.y - g.z * ray.org.z) / g.x;
                 const float tol = m == RenderMethod::Exact ? 1e-4f : 0.011f;
                 const float z = r.depth[std::size_t(y) * s.width + x];
                 if (hit > 0.02f && hit < 0.98f) {
@@ -112,7 +108,7 @@ TEST_P(Depth, AnOpaqueIsosurfaceIsWhereThePlaneIs) {
             }
     }
     // Nothing reached: infinity.
-    RenderSettings s = alongX(RenderMethod::Exact);
+    RenderSettings s = depthViewAlongX(RenderMethod::Exact);
     applyOpacitySpec(s.tf, "constant:0");
     s.depthAlpha = 0.5f;
     for (const float z : render(pm, s).depth) EXPECT_EQ(z, INFINITY);
@@ -122,9 +118,9 @@ TEST_P(Depth, GeometryGivenAsDepthEndsTheRaysAsAClipWould) {
     // Opaque geometry at view depth 2.4 (x = 0.4) everywhere but one column: the frame equals
     // the one clipped at x = 0.4 (the exact integrator cuts the cell there), and where the
     // depth is infinite or NaN the unclipped one, bit for bit.
-    const PreparedMesh pm = cube(true);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const PreparedMesh pm = linearCube(true);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = depthViewAlongX(m);
         applyOpacitySpec(s.tf, "constant:0.3");
         const RenderResult whole = render(pm, s);
         RenderSettings clipped = s;
@@ -155,9 +151,9 @@ TEST_P(Depth, APixelsStopOpacityEndsItsRayThere) {
     // Stop in (a data-parallel frame's second pass): each pixel's ray stops at its own opacity,
     // which the slab's extinction (2 per unit, steps of 0.01: 0.02 of what is left per step)
     // overshoots by less than one step; a pixel with stop 0 is not rendered. Exact runs on.
-    const PreparedMesh pm = cube(true);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const PreparedMesh pm = linearCube(true);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = depthViewAlongX(m);
         s.terminationAlpha = 1.f;
         const float full = render(pm, s).image.at(8, 6).w;  // about 1 - exp(-2)
         s.pixelStopAlpha.assign(std::size_t(s.width) * s.height, 0.f);
@@ -185,7 +181,7 @@ TEST_P(Depth, APixelsStopOpacityEndsItsRayThere) {
         }
     }
     // Bad stops are setting errors.
-    RenderSettings s = alongX(RenderMethod::Reference);
+    RenderSettings s = depthViewAlongX(RenderMethod::Reference);
     s.pixelStopAlpha.assign(15, 0.5f);
     EXPECT_THROW(checkDepth(s), SettingError);
     s.pixelStopAlpha.assign(std::size_t(s.width) * s.height, 0.5f);
@@ -203,9 +199,9 @@ TEST_P(Depth, APixelsDepthOpacityIsWhereItsRayReachesIt) {
     // Depth alpha in (a data-parallel frame's second pass): each pixel's ray notes the depth of
     // its own opacity, exactly where a frame asking that opacity of every pixel notes it; 0: no
     // depth there. The colours are the frame's without it.
-    const PreparedMesh pm = cube(true);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const PreparedMesh pm = linearCube(true);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = depthViewAlongX(m);
         s.depthAlpha = 0.5f;
         const RenderResult plain = render(pm, s);
         s.depthAlpha = 0.3f;
@@ -230,7 +226,7 @@ TEST_P(Depth, APixelsDepthOpacityIsWhereItsRayReachesIt) {
             }
     }
     // Bad opacities are setting errors, and depth alpha in needs depth out.
-    RenderSettings s = alongX(RenderMethod::Reference);
+    RenderSettings s = depthViewAlongX(RenderMethod::Reference);
     s.depthAlpha = 0.5f;
     s.pixelDepthAlpha.assign(15, 0.5f);
     EXPECT_THROW(checkDepth(s), SettingError);

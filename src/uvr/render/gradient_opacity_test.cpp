@@ -11,6 +11,7 @@
 #include <string>
 
 #include "on_each_device.h"
+#include "render_scenes.h"
 #include "test_meshes.h"
 #include "uvr/core/setting_error.h"
 #include "uvr/mesh/field_select.h"
@@ -23,67 +24,9 @@
 namespace uvr {
 namespace {
 
-/// The linear field's gradient (magnitude 0.856 per unit).
-const Vec3f kGradient(0.6f, 0.5f, -0.35f);
-
-/// A 6^3 grid of hexahedra over [0, size]^3 (jittered when asked) with the field f of the
-/// point scaled to the unit cube times `valueScale` (so its gradient is f's times valueScale /
-/// size), as native cells or split into tetrahedra, with its smooth gradients.
-PreparedMesh grid(float (*f)(Vec3f), bool split, float jitter = 0.f, float size = 1.f,
-                  float valueScale = 1.f) {
-    const Mesh m = testing::makeHexGrid(
-        6, 0.f, size, [&](Vec3f p) { return valueScale * f(p * (1.f / size)); }, jitter);
-    PrepareOptions options;
-    options.kd.leafCells = 32;  // several partitions along each ray
-    options.cells.splitCells = split;
-    PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), options);
-    computeSmoothGradients(pm.tets);
-    return pm;
-}
-
-float linearField(Vec3f p) {
-    return dot(kGradient, p);
-}
-float constantField(Vec3f) {
-    return 0.5f;
-}
 /// A field whose gradient's magnitude runs from 0 to 2 sqrt(3) across the cube.
 float bowlField(Vec3f p) {
     return dot(p, p) * 0.4f;
-}
-
-/// A parallel view along +x through the middle of the cube [0, size]^3, opacity 0.6 per unit
-/// (attenuation), 100 steps across: every ray crosses the cube inside it.
-RenderSettings alongX(RenderMethod method, float size = 1.f) {
-    RenderSettings s;
-    s.method = method;
-    s.width = 24, s.height = 16;
-    Camera c;
-    c.position = Vec3f(-2.f, 0.52f, 0.47f) * size;
-    c.focalPoint = Vec3f(0.5f, 0.52f, 0.47f) * size;
-    c.viewUp = Vec3f(0.f, 0.f, 1.f);
-    c.parallelProjection = true;
-    c.parallelScale = 0.2f * size;
-    s.camera = c;
-    s.tf = transferFunctionPreset("viridis");
-    applyOpacitySpec(s.tf, "constant:0.6");
-    s.range = {-0.5f, 1.2f};
-    s.opacityUnit = size;
-    s.opacityLaw = OpacityLaw::Attenuation;
-    s.step = 0.01f * size;
-    return s;
-}
-
-constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
-                                     RenderMethod::Partitions};
-
-/// The largest difference of two images' components.
-float worstDifference(const Image& a, const Image& b) {
-    float worst = 0.f;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int k = 0; k < 4; ++k)
-            worst = std::fmax(worst, std::fabs(a.pixels[i][k] - b.pixels[i][k]));
-    return worst;
 }
 
 TEST(GradientOpacity, PiecewiseLinearAndConstantBeyondItsEnds) {
@@ -160,16 +103,16 @@ TEST_P(GradientOpacityOn, OverALinearFieldAScaleDividesTheOpacityUnit) {
     // extinction everywhere, which is the image of opacity unit u / s, in every method, over
     // tetrahedra and native hexahedra, with each cell's gradient and the smooth ones, shaded
     // or not.
-    const float m = length(kGradient);
+    const float m = length(testing::kLinearGradient);
     for (const bool split : {true, false}) {
-        const PreparedMesh pm = grid(linearField, split);
+        const PreparedMesh pm = testing::smoothGradientGrid(testing::linearField, split);
         for (const bool smooth : {false, true})
             for (const bool shaded : {false, true})
-                for (const RenderMethod method : kMethods) {
+                for (const RenderMethod method : testing::kEveryMethod) {
                     const std::string what =
                         std::string(methodName(method)) + (split ? " tetrahedra" : " hexahedra") +
                         (smooth ? " smooth" : " cell") + (shaded ? " shaded" : "");
-                    RenderSettings s = alongX(method);
+                    RenderSettings s = testing::viewAlongX(method);
                     s.lighting.on = shaded;
                     s.lighting.smooth = smooth;
                     s.lighting.diffuse = 0.7f, s.lighting.ambient = 0.2f;
@@ -182,7 +125,7 @@ TEST_P(GradientOpacityOn, OverALinearFieldAScaleDividesTheOpacityUnit) {
                         parseGradientOpacity("0:0.1," + std::to_string(2.f * m) + ":0.7");
                     const RenderResult got = render(pm, s);
                     ASSERT_GT(want.image.at(12, 8).w, 0.1f) << what;
-                    EXPECT_LT(worstDifference(got.image, want.image), 2e-5f) << what;
+                    EXPECT_LT(testing::maxPixelDifference(got.image, want.image), 2e-5f) << what;
                 }
     }
 }
@@ -191,12 +134,12 @@ TEST_P(GradientOpacityOn, ZeroHidesFlatRegionsAndOneChangesNoBit) {
     // A constant field has no gradient: a function at 0 there hides it. A linear field steeper
     // than the function's last point: scale 1, the image without the function bit for bit.
     for (const bool split : {true, false}) {
-        const PreparedMesh flat = grid(constantField, split);
-        const PreparedMesh steep = grid(linearField, split);
-        for (const RenderMethod method : kMethods) {
+        const PreparedMesh flat = testing::smoothGradientGrid(testing::constantField, split);
+        const PreparedMesh steep = testing::smoothGradientGrid(testing::linearField, split);
+        for (const RenderMethod method : testing::kEveryMethod) {
             const std::string what =
                 std::string(methodName(method)) + (split ? " tetrahedra" : " hexahedra");
-            RenderSettings s = alongX(method);
+            RenderSettings s = testing::viewAlongX(method);
             s.maxStep = 0.03f;  // the adaptive steps a gradient opacity takes by default
             const RenderResult plain = render(steep, s);
             ASSERT_GT(render(flat, s).image.at(12, 8).w, 0.1f) << what;
@@ -214,8 +157,8 @@ TEST_P(GradientOpacityOn, SamplingConvergesToTheExactIntegrator) {
     // ones.
     for (const bool smooth : {false, true})
         for (const bool split : {true, false}) {
-            const PreparedMesh pm = grid(bowlField, split, 0.2f);
-            RenderSettings s = alongX(RenderMethod::Exact);
+            const PreparedMesh pm = testing::smoothGradientGrid(bowlField, split, 0.2f);
+            RenderSettings s = testing::viewAlongX(RenderMethod::Exact);
             applyOpacitySpec(s.tf, "constant:0.9");
             s.lighting.smooth = smooth;
             s.gradientOpacity = parseGradientOpacity("0:0,1:0.2,2:1");
@@ -224,12 +167,13 @@ TEST_P(GradientOpacityOn, SamplingConvergesToTheExactIntegrator) {
             const Image without = render(pm, s).image;
             s.gradientOpacity = parseGradientOpacity("0:0,1:0.2,2:1");
             // The function changes the picture well beyond the methods' differences.
-            EXPECT_GT(worstDifference(exact, without), 0.1f);
+            EXPECT_GT(testing::maxPixelDifference(exact, without), 0.1f);
             for (const RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
                 s.method = m;
                 s.step = 0.002f;
                 s.maxStep = 0.004f;
-                EXPECT_LT(worstDifference(exact, render(pm, s).image), smooth ? 0.004f : 0.01f)
+                EXPECT_LT(testing::maxPixelDifference(exact, render(pm, s).image),
+                          smooth ? 0.004f : 0.01f)
                     << methodName(m) << (split ? " tetrahedra" : " hexahedra")
                     << (smooth ? " smooth" : " cell");
             }
@@ -240,12 +184,13 @@ TEST_P(GradientOpacityOn, MagnitudesAreTheFilesOnAMeshRenderedScaled) {
     // A mesh 1e-9 across renders scaled to a diagonal of about 1 (MeshFrame): its gradients
     // there are 1e-9 of the file's, and the function's magnitudes, given in the file's units,
     // still pick the scale of the file's gradient.
-    const float size = 1e-9f, valueScale = 1e-9f;  // gradient in the file: kGradient
-    const PreparedMesh pm = grid(linearField, true, 0.f, size, valueScale);
+    const float size = 1e-9f, valueScale = 1e-9f;  // gradient in the file: kLinearGradient
+    const PreparedMesh pm =
+        testing::smoothGradientGrid(testing::linearField, true, 0.f, size, valueScale);
     ASSERT_FALSE(pm.tets.frame.identity());
-    const float m = length(kGradient);
-    for (const RenderMethod method : kMethods) {
-        RenderSettings s = alongX(method, size);
+    const float m = length(testing::kLinearGradient);
+    for (const RenderMethod method : testing::kEveryMethod) {
+        RenderSettings s = testing::viewAlongX(method, size);
         s.range = {-0.5e-9f, 1.2e-9f};
         RenderSettings scaled = s;
         scaled.opacityUnit = size / 0.5f;
@@ -253,17 +198,17 @@ TEST_P(GradientOpacityOn, MagnitudesAreTheFilesOnAMeshRenderedScaled) {
         s.gradientOpacity = parseGradientOpacity("0:0," + std::to_string(2.f * m) + ":1");
         const RenderResult got = render(pm, s);
         ASSERT_GT(want.image.at(12, 8).w, 0.1f) << methodName(method);
-        EXPECT_LT(worstDifference(got.image, want.image), 2e-5f) << methodName(method);
+        EXPECT_LT(testing::maxPixelDifference(got.image, want.image), 2e-5f) << methodName(method);
     }
 }
 
 TEST_P(GradientOpacityOn, CellDataIsRefusedNamingTheField) {
-    Mesh m = testing::makeHexGrid(3, 0.f, 1.f, linearField);
+    Mesh m = testing::makeHexGrid(3, 0.f, 1.f, testing::linearField);
     Field cells{"c", Association::Cell, 1, std::vector<float>(27, 1.f)};
     m.fields.push_back(cells);
     const PreparedMesh pm =
         prepareMesh(m, selectScalarField(m, parseFieldSpec("c")), PrepareOptions{});
-    RenderSettings s = alongX(RenderMethod::Exact);
+    RenderSettings s = testing::viewAlongX(RenderMethod::Exact);
     s.gradientOpacity = parseGradientOpacity("0:0,1:1");
     try {
         render(pm, s);

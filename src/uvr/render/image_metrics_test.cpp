@@ -14,7 +14,6 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <random>
-#include <sstream>
 
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -23,13 +22,6 @@ namespace uvr {
 namespace {
 
 using ::testing::HasSubstr;
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 /// An 8-bit RGB image whose values are fn(x, y, channel) clamped to 0..255.
 Rgb8Image makeImage(int w, int h, const std::function<double(int, int, int)>& fn) {
@@ -505,22 +497,18 @@ Rgb8Image renderCylinder(const std::string& dir, const std::string& name,
 
 // ---- `uvr compare` ----
 
-struct CliRun {
+struct UvrRun {
     int code = -1;
     std::string out, err;
 };
 
-CliRun runUvr(const std::string& args, const std::string& dir) {
-    CliRun r;
+UvrRun runUvr(const std::string& args, const std::string& dir) {
+    UvrRun r;
     r.code = testing::runCommand(testing::uvrBinary() + " " + args + " >" + dir + "/out.txt 2>" +
                                  dir + "/err.txt");
-    r.out = slurp(dir + "/out.txt");
-    r.err = slurp(dir + "/err.txt");
+    r.out = testing::readFile(dir + "/out.txt");
+    r.err = testing::readFile(dir + "/err.txt");
     return r;
-}
-
-int lineCount(const std::string& s) {
-    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
 }
 
 TEST(ImageMetrics, CompareCommandPrintsTheMetrics) {
@@ -538,7 +526,7 @@ TEST(ImageMetrics, CompareCommandPrintsTheMetrics) {
     ASSERT_GT(expected.ssim, 0.3);
 
     // Text output: the SSIM line, rounded to 6 decimals.
-    const CliRun text = runUvr("compare -q " + fa + " " + fb, dir);
+    const UvrRun text = runUvr("compare -q " + fa + " " + fb, dir);
     ASSERT_EQ(text.code, 0) << text.err;
     double ssim = -2, psnr = -1;
     ASSERT_EQ(std::sscanf(text.out.c_str(), "SSIM %lf  PSNR %lf dB", &ssim, &psnr), 2) << text.out;
@@ -547,7 +535,7 @@ TEST(ImageMetrics, CompareCommandPrintsTheMetrics) {
     EXPECT_THAT(text.out, HasSubstr("SSIM per channel  R "));
 
     // JSON output: full precision.
-    const CliRun json = runUvr("compare -q --json " + fa + " " + fb, dir);
+    const UvrRun json = runUvr("compare -q --json " + fa + " " + fb, dir);
     ASSERT_EQ(json.code, 0) << json.err;
     const nlohmann::json j = nlohmann::json::parse(json.out);
     EXPECT_NEAR(j["ssim"].get<double>(), expected.ssim, 1e-12);
@@ -556,17 +544,17 @@ TEST(ImageMetrics, CompareCommandPrintsTheMetrics) {
     EXPECT_FALSE(j["identical"].get<bool>());
 
     // Identical files: PSNR is null in JSON, "inf" in text.
-    const CliRun same = runUvr("compare -q --json " + fa + " " + fa, dir);
+    const UvrRun same = runUvr("compare -q --json " + fa + " " + fa, dir);
     ASSERT_EQ(same.code, 0) << same.err;
     EXPECT_TRUE(nlohmann::json::parse(same.out)["psnr"].is_null());
     EXPECT_THAT(runUvr("compare " + fa + " " + fa, dir).out, HasSubstr("PSNR inf dB"));
 
     // --min-ssim: 1 below the threshold, 0 at or above it.
-    const CliRun below = runUvr("compare -q --min-ssim 0.99 " + fa + " " + fb, dir);
+    const UvrRun below = runUvr("compare -q --min-ssim 0.99 " + fa + " " + fb, dir);
     EXPECT_EQ(below.code, 1) << below.out << below.err;
     EXPECT_THAT(below.out, HasSubstr("FAIL"));
     EXPECT_EQ(runUvr("compare -q --min-ssim 0.2 " + fa + " " + fb, dir).code, 0);
-    const CliRun jsonBelow = runUvr("compare -q --json --min-ssim 0.99 " + fa + " " + fb, dir);
+    const UvrRun jsonBelow = runUvr("compare -q --json --min-ssim 0.99 " + fa + " " + fb, dir);
     EXPECT_EQ(jsonBelow.code, 1);
     EXPECT_FALSE(nlohmann::json::parse(jsonBelow.out)["pass"].get<bool>());
 }
@@ -585,7 +573,7 @@ TEST(ImageMetrics, CompareCommandReportsThePerPixelMeasuresAndTheirThresholds) {
     ASSERT_EQ(expected.seamCount, 1);
     ASSERT_EQ(expected.longestSeam, 80);
 
-    const CliRun json = runUvr("compare -q --json " + fa + " " + fb, dir);
+    const UvrRun json = runUvr("compare -q --json " + fa + " " + fb, dir);
     ASSERT_EQ(json.code, 0) << json.err;
     const nlohmann::json j = nlohmann::json::parse(json.out);
     for (const ComparisonField& f : differenceFields(expected)) {
@@ -595,7 +583,7 @@ TEST(ImageMetrics, CompareCommandReportsThePerPixelMeasuresAndTheirThresholds) {
     EXPECT_EQ(j["seam_count"].get<int>(), 1);
     EXPECT_EQ(j["longest_seam"].get<int>(), 80);
     EXPECT_FALSE(j.contains("pass"));
-    const CliRun text = runUvr("compare -q " + fa + " " + fb, dir);
+    const UvrRun text = runUvr("compare -q " + fa + " " + fb, dir);
     EXPECT_THAT(text.out, HasSubstr(differenceSummary(expected)));
     EXPECT_THAT(text.out, HasSubstr("1 seam (80 pixels, longest 80)"));
 
@@ -611,10 +599,10 @@ TEST(ImageMetrics, CompareCommandReportsThePerPixelMeasuresAndTheirThresholds) {
                                            {"--max-p999 5.5", 1},
                                            {"--min-ssim 0.5 --max-diff 6", 0},
                                            {"--min-ssim 0.5 --max-diff 6 --no-seams", 1}}) {
-        const CliRun r = runUvr("compare -q " + c.flags + " " + fa + " " + fb, dir);
+        const UvrRun r = runUvr("compare -q " + c.flags + " " + fa + " " + fb, dir);
         EXPECT_EQ(r.code, c.code) << c.flags << "\n" << r.out << r.err;
         EXPECT_THAT(r.out, HasSubstr(c.code ? "FAIL: " : "pass: ")) << c.flags;
-        const CliRun rj = runUvr("compare -q --json " + c.flags + " " + fa + " " + fb, dir);
+        const UvrRun rj = runUvr("compare -q --json " + c.flags + " " + fa + " " + fb, dir);
         EXPECT_EQ(rj.code, c.code) << c.flags;
         EXPECT_EQ(nlohmann::json::parse(rj.out)["pass"].get<bool>(), c.code == 0) << c.flags;
     }
@@ -650,9 +638,9 @@ TEST(ImageMetrics, CompareCommandRejectsBadInputWithCode2) {
                                            {fa + " " + fa + " --max-diff 300", "--max-diff"},
                                            {fa + " " + fa + " --background 2,0,0", "--background"},
                                            {fa, "B"}}) {
-        const CliRun r = runUvr("compare -q " + c.args, dir);
+        const UvrRun r = runUvr("compare -q " + c.args, dir);
         EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
-        EXPECT_EQ(lineCount(r.err), 1) << c.args << "\n" << r.err;
+        EXPECT_EQ(testing::lineCount(r.err), 1) << c.args << "\n" << r.err;
         EXPECT_THAT(r.err, HasSubstr(c.needle)) << c.args;
         EXPECT_TRUE(r.out.empty()) << r.out;
     }

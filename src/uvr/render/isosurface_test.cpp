@@ -11,6 +11,7 @@
 #include <string>
 
 #include "on_each_device.h"
+#include "render_scenes.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/setting_error.h"
@@ -24,18 +25,12 @@ namespace uvr {
 namespace {
 
 const Vec3f kCentre(0.5f, 0.5f, 0.5f);
-const Vec3f kGradient(0.6f, 0.5f, -0.35f);
-
 float distanceField(Vec3f p) {
     return length(p - kCentre);
 }
-float linearField(Vec3f p) {
-    return dot(kGradient, p);
-}
-
 /// An n^3 grid of hexahedra over [0, 1]^3 with the field f, as native cells or split into
 /// tetrahedra, with its smooth gradients.
-PreparedMesh grid(float (*f)(Vec3f), bool split, int n = 16) {
+PreparedMesh smoothGrid(float (*f)(Vec3f), bool split, int n = 16) {
     const Mesh m = testing::makeHexGrid(n, 0.f, 1.f, f);
     PrepareOptions options;
     options.kd.leafCells = 64;  // several partitions along each ray
@@ -47,7 +42,7 @@ PreparedMesh grid(float (*f)(Vec3f), bool split, int n = 16) {
 
 /// A parallel view along +x through the cube's middle, `size` pixels square over 0.8 x 0.8,
 /// transparent volume (the surfaces alone) unless the caller sets an opacity.
-RenderSettings alongX(RenderMethod method, int size = 48) {
+RenderSettings surfacesAlongX(RenderMethod method, int size = 48) {
     RenderSettings s;
     s.method = method;
     s.width = s.height = size;
@@ -76,9 +71,6 @@ IsoSurface white(float v, float opacity = 1.f) {
     return iso;
 }
 
-constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
-                                     RenderMethod::Partitions};
-
 /// Distance from the sphere's centre to the ray of pixel (x, y).
 float rayDistance(const RenderResult& r, int x, int y) {
     const Ray ray = r.setup.rays.ray(float(x) + 0.5f, float(y) + 0.5f);
@@ -97,9 +89,9 @@ TEST_P(Iso, TheDistanceToACentreGivesASphereOfTheValuesRadius) {
     // silhouette's area gives the radius to within a third of a pixel (1/60).
     const float r = 0.3f, tol = 0.01f, pixel = 0.8f / 48.f;
     for (const bool split : {true, false}) {
-        const PreparedMesh pm = grid(distanceField, split);
-        for (const RenderMethod m : kMethods) {
-            RenderSettings s = alongX(m);
+        const PreparedMesh pm = smoothGrid(distanceField, split);
+        for (const RenderMethod m : testing::kEveryMethod) {
+            RenderSettings s = surfacesAlongX(m);
             s.isoSurfaces = {white(r)};
             const RenderResult res = render(pm, s);
             const std::string what =
@@ -128,18 +120,19 @@ TEST_P(Iso, APlaneIsCompositedOverTheVolumeInFrontOfIt) {
     // of the colour map's colour at c, lit by the headlight: scale ambient + diffuse cos with
     // cos = |g.x| / |g| (specular 0.3 adds 0.3 cos^8).
     const float c = 0.45f;
-    const float cosine = std::fabs(kGradient.x) / length(kGradient);
+    const Vec3f g = testing::kLinearGradient;
+    const float cosine = std::fabs(g.x) / length(g);
     for (const bool split : {true, false}) {
-        const PreparedMesh pm = grid(linearField, split, 6);
-        for (const RenderMethod m : kMethods) {
-            RenderSettings s = alongX(m, 24);
+        const PreparedMesh pm = smoothGrid(testing::linearField, split, 6);
+        for (const RenderMethod m : testing::kEveryMethod) {
+            RenderSettings s = surfacesAlongX(m, 24);
             applyOpacitySpec(s.tf, "constant:0.6");
             s.range = {-0.5f, 1.2f};
             s.step = 0.01f;
             s.lighting.specular = 0.3f, s.lighting.specularPower = 8.f;
             RenderSettings front = s;
-            const Vec3f n = kGradient * -1.f;  // keeps g . p <= c
-            front.clipPlanes = {{kGradient * (c / dot(kGradient, kGradient)), n}};
+            const Vec3f n = g * -1.f;  // keeps g . p <= c
+            front.clipPlanes = {{g * (c / dot(g, g)), n}};
             const RenderResult before = render(pm, front);
             s.isoSurfaces = {IsoSurface{c}};
             const RenderResult res = render(pm, s);
@@ -153,7 +146,7 @@ TEST_P(Iso, APlaneIsCompositedOverTheVolumeInFrontOfIt) {
                 for (int x = 0; x < s.width; ++x) {
                     // Only rays that meet the plane inside the cube.
                     const Ray ray = res.setup.rays.ray(float(x) + 0.5f, float(y) + 0.5f);
-                    const float t = (c - dot(kGradient, ray.org)) / dot(kGradient, ray.dir);
+                    const float t = (c - dot(g, ray.org)) / dot(g, ray.dir);
                     const Vec3f p = ray.at(t);
                     if (!(p.x > 0.02f && p.x < 0.98f && p.y > 0.02f && p.y < 0.98f && p.z > 0.02f &&
                           p.z < 0.98f))
@@ -175,13 +168,14 @@ TEST_P(Iso, TranslucentSurfacesCompositeInDepthOrder) {
     // Rays along +x through a field that grows with x meet the value 0.2 before 0.5, whichever
     // order they are given in: red at opacity 0.5 over blue at 0.5 gives (0.5 s, 0, 0.25 s,
     // 0.75) premultiplied, s the diffuse light cos.
-    const float cosine = std::fabs(kGradient.x) / length(kGradient);
-    const PreparedMesh pm = grid(linearField, true, 6);
+    const Vec3f g = testing::kLinearGradient;
+    const float cosine = std::fabs(g.x) / length(g);
+    const PreparedMesh pm = smoothGrid(testing::linearField, true, 6);
     IsoSurface red = white(0.2f, 0.5f), blue = white(0.5f, 0.5f);
     red.color = Vec3f(1.f, 0.f, 0.f);
     blue.color = Vec3f(0.f, 0.f, 1.f);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m, 24);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = surfacesAlongX(m, 24);
         s.isoSurfaces = {blue, red};
         const RenderResult res = render(pm, s);
         // The middle ray meets both inside the cube (x = 0.04 and 0.54 on the ray z = y = 0.5).
@@ -204,10 +198,10 @@ TEST_P(Iso, SurfacesBetweenTheBoundaryAndTheNearestSampleAreFound) {
     // Every ray meets each. Also where the span ends at a clip plane (x <= 0.5 kept: samples up
     // to 0.45, the surface at 0.48).
     for (const bool split : {true, false}) {
-        const PreparedMesh pm = grid(xField, split, 8);
-        for (const RenderMethod m : kMethods)
+        const PreparedMesh pm = smoothGrid(xField, split, 8);
+        for (const RenderMethod m : testing::kEveryMethod)
             for (const float v : {0.015f, 0.97f, 0.48f}) {
-                RenderSettings s = alongX(m, 16);
+                RenderSettings s = surfacesAlongX(m, 16);
                 s.step = 0.07f;
                 s.isoSurfaces = {white(v)};
                 if (v == 0.48f) s.clipPlanes = {{Vec3f(0.5f, 0.f, 0.f), Vec3f(-1.f, 0.f, 0.f)}};
@@ -225,9 +219,9 @@ TEST_P(Iso, ValuesTheFieldNeverTakesChangeNoBit) {
     // An isosurface outside the field's range runs the lit integrators, which must give the
     // volume's pixels bit for bit (the samples gain only the probes for the mesh's boundary,
     // sampleAtBoundary); and the volume is still skipped where it is transparent.
-    const PreparedMesh pm = grid(distanceField, true, 8);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m, 24);
+    const PreparedMesh pm = smoothGrid(distanceField, true, 8);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = surfacesAlongX(m, 24);
         applyOpacitySpec(s.tf, "0:0,0.3:0,0.5:0.8,1:0.2");
         const RenderResult plain = render(pm, s);
         s.isoSurfaces = {white(5.f), white(-1.f, 0.3f)};
@@ -245,9 +239,9 @@ TEST_P(Iso, ValuesTheFieldNeverTakesChangeNoBit) {
 
 TEST_P(Iso, PointSamplingFindsTheSurfaceBetweenSamples) {
     // Point samples: the surface between two samples at the linear reading's crossing.
-    const PreparedMesh pm = grid(distanceField, true);
+    const PreparedMesh pm = smoothGrid(distanceField, true);
     for (const RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
-        RenderSettings s = alongX(m);
+        RenderSettings s = surfacesAlongX(m);
         s.preintegrated = false;
         s.isoSurfaces = {white(0.3f)};
         const RenderResult res = render(pm, s);
@@ -266,10 +260,10 @@ TEST_P(Iso, PointSamplingFindsTheSurfaceBetweenSamples) {
 
 TEST_P(Iso, NanValuesStayFinite) {
     // NaN in part of the field: no surface where an end is NaN, no NaN pixel.
-    const PreparedMesh pm =
-        grid([](Vec3f p) { return p.x > 0.5f && p.y > 0.4f ? NAN : distanceField(p); }, true, 8);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m, 24);
+    const PreparedMesh pm = smoothGrid(
+        [](Vec3f p) { return p.x > 0.5f && p.y > 0.4f ? NAN : distanceField(p); }, true, 8);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = surfacesAlongX(m, 24);
         s.tf.nanOpacity = 0.5f;
         s.isoSurfaces = {white(0.3f, 0.7f)};
         for (const Vec4f& p : render(pm, s).image.pixels)
@@ -307,7 +301,7 @@ TEST(IsoSettings, CellDataHasNoIsosurfaces) {
     Mesh m = testing::makeHexGrid(4, 0.f, 1.f, distanceField);
     m.fields.push_back({"cells", Association::Cell, 1, std::vector<float>(m.cellCount(), 1.f)});
     PreparedMesh pm = prepareMesh(m, selectScalarField(m, parseFieldSpec("cells")), {});
-    RenderSettings s = alongX(RenderMethod::Exact, 8);
+    RenderSettings s = surfacesAlongX(RenderMethod::Exact, 8);
     s.isoSurfaces = {white(0.5f)};
     const std::string what = testing::catchError([&] { makeFrameSetup(pm, s); }).what();
     EXPECT_NE(what.find("isosurfaces need a point field"), std::string::npos) << what;

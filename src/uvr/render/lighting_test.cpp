@@ -10,6 +10,7 @@
 #include <string>
 
 #include "on_each_device.h"
+#include "render_scenes.h"
 #include "test_meshes.h"
 #include "uvr/mesh/field_select.h"
 #include "uvr/mesh/smooth_gradients.h"
@@ -20,51 +21,8 @@
 namespace uvr {
 namespace {
 
-/// The linear field's gradient.
-const Vec3f kGradient(0.6f, 0.5f, -0.35f);
-
-/// A 6^3 grid of hexahedra over [0, 1]^3 (jittered when asked) with the field f, as native
-/// cells or split into tetrahedra, with its smooth gradients.
-PreparedMesh grid(float (*f)(Vec3f), bool split, float jitter = 0.f) {
-    const Mesh m = testing::makeHexGrid(6, 0.f, 1.f, f, jitter);
-    PrepareOptions options;
-    options.kd.leafCells = 32;  // several partitions along each ray
-    options.cells.splitCells = split;
-    PreparedMesh pm = prepareMesh(m, selectScalarField(m, {}), options);
-    computeSmoothGradients(pm.tets);
-    return pm;
-}
-
-float linearField(Vec3f p) {
-    return dot(kGradient, p);
-}
-float constantField(Vec3f) {
-    return 0.5f;
-}
 float roundField(Vec3f p) {
     return 1.5f * length(p - Vec3f(0.45f, 0.5f, 0.55f));
-}
-
-/// A parallel view along +x through the unit cube's middle, opacity 0.6 per unit (attenuation),
-/// step 0.01: every ray crosses x from 0 to 1 inside the cube.
-RenderSettings alongX(RenderMethod method) {
-    RenderSettings s;
-    s.method = method;
-    s.width = 24, s.height = 16;
-    Camera c;
-    c.position = Vec3f(-2.f, 0.52f, 0.47f);
-    c.focalPoint = Vec3f(0.5f, 0.52f, 0.47f);
-    c.viewUp = Vec3f(0.f, 0.f, 1.f);
-    c.parallelProjection = true;
-    c.parallelScale = 0.2f;
-    s.camera = c;
-    s.tf = transferFunctionPreset("viridis");
-    applyOpacitySpec(s.tf, "constant:0.6");
-    s.range = {-0.5f, 1.2f};
-    s.opacityUnit = 1.f;
-    s.opacityLaw = OpacityLaw::Attenuation;
-    s.step = 0.01f;
-    return s;
 }
 
 /// A lighting with every term at work (smooth normals, or each cell's).
@@ -75,9 +33,6 @@ Lighting someLight(bool smooth = true) {
     l.ambient = 0.15f, l.diffuse = 0.6f, l.specular = 0.25f, l.specularPower = 6.f;
     return l;
 }
-
-constexpr RenderMethod kMethods[] = {RenderMethod::Exact, RenderMethod::Reference,
-                                     RenderMethod::Partitions};
 
 TEST(LightFactors, HeadlightCosineInClosedForm) {
     const Lighting l = someLight();
@@ -112,15 +67,16 @@ TEST_P(Lit, ALinearFieldIsLitInClosedForm) {
     // add = specular c^power with c = |g.x| / |g|, so the lit pixel is the unlit one's colour
     // times scale plus its opacity times add, and the same opacity.
     // Smooth normals too: every point's mean of equal gradients is that gradient.
-    const float c = std::fabs(kGradient.x) / length(kGradient);
+    const Vec3f g = testing::kLinearGradient;
+    const float c = std::fabs(g.x) / length(g);
     for (const bool split : {true, false})
         for (const bool smooth : {false, true}) {
             const Lighting l = someLight(smooth);
             const float scale = l.ambient + l.diffuse * c,
                         add = l.specular * std::pow(c, l.specularPower);
-            const PreparedMesh pm = grid(linearField, split);
-            for (const RenderMethod m : kMethods) {
-                RenderSettings s = alongX(m);
+            const PreparedMesh pm = testing::smoothGradientGrid(testing::linearField, split);
+            for (const RenderMethod m : testing::kEveryMethod) {
+                RenderSettings s = testing::viewAlongX(m);
                 const RenderResult unlit = render(pm, s);
                 s.lighting = l;
                 const RenderResult lit = render(pm, s);
@@ -143,9 +99,9 @@ TEST_P(Lit, AConstantFieldIsLitAsFacingTheLight) {
     // No gradient, no normal: every point is lit as facing the light (ambient + diffuse,
     // specular), the same in every method.
     const Lighting l = someLight();
-    const PreparedMesh pm = grid(constantField, true);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const PreparedMesh pm = testing::smoothGradientGrid(testing::constantField, true);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = testing::viewAlongX(m);
         const RenderResult unlit = render(pm, s);
         s.lighting = l;
         const RenderResult lit = render(pm, s);
@@ -158,9 +114,9 @@ TEST_P(Lit, AConstantFieldIsLitAsFacingTheLight) {
 TEST_P(Lit, IdentityLightChangesNoBit) {
     // Lighting off whatever its coefficients, or on with ambient 1 and nothing else: the unlit
     // pixels bit for bit.
-    const PreparedMesh pm = grid(roundField, false, 0.2f);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const PreparedMesh pm = testing::smoothGradientGrid(roundField, false, 0.2f);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = testing::viewAlongX(m);
         const RenderResult unlit = render(pm, s);
         s.lighting = someLight();
         s.lighting.on = false;
@@ -179,8 +135,8 @@ TEST_P(Lit, SamplingConvergesToTheExactLight) {
     // closer.)
     for (const bool smooth : {false, true})
         for (const bool split : {true, false}) {
-            const PreparedMesh pm = grid(roundField, split, 0.2f);
-            RenderSettings s = alongX(RenderMethod::Exact);
+            const PreparedMesh pm = testing::smoothGradientGrid(roundField, split, 0.2f);
+            RenderSettings s = testing::viewAlongX(RenderMethod::Exact);
             s.lighting = someLight(smooth);
             const Image exact = render(pm, s).image;
             for (const RenderMethod m : {RenderMethod::Reference, RenderMethod::Partitions}) {
@@ -202,10 +158,10 @@ TEST_P(Lit, SamplingConvergesToTheExactLight) {
 TEST_P(Lit, NanValuesAndDegenerateGradientsStayFinite) {
     // A field of NaN in part of the cube: the NaN cells have no gradient (lit as facing the
     // light) and no pixel turns NaN.
-    const PreparedMesh pm =
-        grid([](Vec3f p) { return p.x > 0.5f && p.y > 0.4f ? NAN : roundField(p); }, true, 0.1f);
-    for (const RenderMethod m : kMethods) {
-        RenderSettings s = alongX(m);
+    const PreparedMesh pm = testing::smoothGradientGrid(
+        [](Vec3f p) { return p.x > 0.5f && p.y > 0.4f ? NAN : roundField(p); }, true, 0.1f);
+    for (const RenderMethod m : testing::kEveryMethod) {
+        RenderSettings s = testing::viewAlongX(m);
         s.tf.nanOpacity = 0.5f;
         s.lighting = someLight();
         for (const Vec4f& p : render(pm, s).image.pixels)
@@ -215,19 +171,20 @@ TEST_P(Lit, NanValuesAndDegenerateGradientsStayFinite) {
 
 TEST(SmoothGradients, ALinearFieldGivesItsGradientAtEveryPoint) {
     // Tetrahedra and native hexahedra: every point's volume-weighted mean of equal gradients.
+    const Vec3f want = testing::kLinearGradient;
     for (const bool split : {true, false}) {
-        const PreparedMesh pm = grid(linearField, split, 0.2f);
+        const PreparedMesh pm = testing::smoothGradientGrid(testing::linearField, split, 0.2f);
         ASSERT_TRUE(hasSmoothGradients(pm.tets));
         ASSERT_EQ(pm.tets.blockGradients.size(), pm.tets.blockVertices.size());
         for (const Vec3f& g : pm.tets.blockGradients)
-            ASSERT_LT(length(g - kGradient), 1e-4f) << (split ? "tetrahedra" : "hexahedra");
+            ASSERT_LT(length(g - want), 1e-4f) << (split ? "tetrahedra" : "hexahedra");
         EXPECT_EQ(pm.tets.pointGradients.empty(), split);  // per point only for native cells
-        for (const Vec3f& g : pm.tets.pointGradients) ASSERT_LT(length(g - kGradient), 1e-4f);
+        for (const Vec3f& g : pm.tets.pointGradients) ASSERT_LT(length(g - want), 1e-4f);
         // Interpolated anywhere in a cell: the same gradient.
         const TetMeshView v = pm.kernelMesh();
         const float bary[4] = {0.1f, 0.2f, 0.3f, 0.4f};
-        EXPECT_LT(length(v.gradient(0, bary, true) - kGradient), 1e-4f);
-        EXPECT_LT(length(v.gradient(v.cellCount() - 1, bary, true) - kGradient), 1e-4f);
+        EXPECT_LT(length(v.gradient(0, bary, true) - want), 1e-4f);
+        EXPECT_LT(length(v.gradient(v.cellCount() - 1, bary, true) - want), 1e-4f);
     }
 }
 

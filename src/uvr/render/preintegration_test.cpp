@@ -22,13 +22,6 @@
 namespace uvr {
 namespace {
 
-float maxDifference(const Image& a, const Image& b) {
-    float d = 0.f;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) d = std::fmax(d, std::fabs(a.pixels[i][c] - b.pixels[i][c]));
-    return d;
-}
-
 /// A unit cube of 4^3 hexahedra (jittered inside) with the point field f, partitions of at most
 /// leafCells tetrahedra.
 PreparedMesh cube(const std::function<float(Vec3f)>& f, std::uint32_t leafCells = 64, int n = 4) {
@@ -89,12 +82,12 @@ TEST_P(Preintegration, BandBetweenTwoSamplesIsIntegratedNotMissed) {
     EXPECT_LT(render(pm, s).image.at(12, 12).w, 0.05f);  // missed or nearly
     s.preintegrated = true;
     const RenderResult ref = render(pm, s);
-    EXPECT_LT(maxDifference(ref.image, exact.image), 2e-4f);
+    EXPECT_LT(testing::maxPixelDifference(ref.image, exact.image), 2e-4f);
     // The partition method too, at every rule (the variance rule's steps are up to 16 s1).
     s.method = RenderMethod::Partitions;
     for (const StepRule rule : {StepRule::ErrorBound, StepRule::Variance}) {
         s.stepRule = rule;
-        EXPECT_LT(maxDifference(render(pm, s).image, exact.image), 2e-4f);
+        EXPECT_LT(testing::maxPixelDifference(render(pm, s).image, exact.image), 2e-4f);
     }
 }
 
@@ -121,7 +114,7 @@ TEST_P(Preintegration, LinearFieldGetsTheLongestStepsAndStaysExact) {
     // Inside the mesh both are exact; where a ray leaves it, the last sample owns the distance
     // to the grid point after the exit (as a point sample does), the same for both methods, so
     // the long steps give the reference's image.
-    EXPECT_LT(maxDifference(a.image, r.image), 1e-3f);
+    EXPECT_LT(testing::maxPixelDifference(a.image, r.image), 1e-3f);
     EXPECT_GT(compareImages(toRgb8(exact.image), toRgb8(r.image)).ssim, 0.99);
 }
 

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "on_each_device.h"
+#include "render_scenes.h"
 #include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/core/error.h"
@@ -27,9 +28,6 @@ PreparedMesh unitCube() {
     o.kd.leafCells = 8;
     return prepareMesh(m, selectScalarField(m, {}), o);
 }
-
-constexpr RenderMethod kEachMethod[] = {RenderMethod::Reference, RenderMethod::Partitions,
-                                        RenderMethod::Exact};
 
 /// Constant opacity 0.5 per unit length 1 over the cube's field, nothing terminating early.
 RenderSettings halfOpacity(RenderMethod method) {
@@ -73,7 +71,7 @@ TEST_P(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
     // [-0.5, 1.5] and y in [-0.25, 1.25], so the cube covers columns 10..29 and rows 5..24
     // exactly, its faces on pixel boundaries; every ray inside crosses depth 1.
     const PreparedMesh mesh = unitCube();
-    for (RenderMethod method : kEachMethod) {
+    for (RenderMethod method : testing::kEveryMethod) {
         RenderSettings s = halfOpacity(method);
         s.width = 40, s.height = 30;
         s.camera = parallelDownZ(0.5f, 0.5f, 0.75f);
@@ -94,7 +92,7 @@ TEST_P(CameraRender, ParallelSilhouetteOfABoxIsItsRectangleOfPixels) {
 
 TEST_P(CameraRender, ParallelCameraInsideOrFarFromTheMeshSeesWhatLiesInFrontOfItsPlane) {
     const PreparedMesh mesh = unitCube();
-    for (RenderMethod method : kEachMethod) {
+    for (RenderMethod method : testing::kEveryMethod) {
         RenderSettings s = halfOpacity(method);
         s.width = s.height = 8;
         // Far out: the rays start at the mesh (the same image as from near by).
@@ -190,7 +188,7 @@ TEST_P(Supersample, EdgePixelsApproachTheTrueFractionalCoverage) {
     // 1/N (stratified: at most 1/(2N) per axis), jittered ones within about 2/N.
     const PreparedMesh mesh = unitCube();
     const float pixel = 0.05f;
-    for (RenderMethod method : kEachMethod) {
+    for (RenderMethod method : testing::kEveryMethod) {
         for (int n : {1, 4, 8}) {
             for (bool jitter : {false, true}) {
                 if (n == 1 && jitter) continue;

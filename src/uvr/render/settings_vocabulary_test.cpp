@@ -12,10 +12,9 @@ namespace uvr {
 namespace {
 
 using ::testing::HasSubstr;
-using Json = nlohmann::json;
 
 /// A value of d other than its default.
-Json otherValue(const SettingDef& d) {
+nlohmann::json otherValue(const SettingDef& d) {
     switch (d.type) {
         case SettingType::Choice:
             return d.choices.back();
@@ -30,7 +29,7 @@ Json otherValue(const SettingDef& d) {
 }
 
 /// The SettingError that applying value to a default RenderSettings throws.
-SettingError refusal(const std::string& name, const Json& value) {
+SettingError settingRefusal(const std::string& name, const nlohmann::json& value) {
     RenderSettings s;
     try {
         applySetting(s, name, value);
@@ -65,7 +64,7 @@ TEST(SettingsVocabulary, EachSettingOnceWithItsDefaultFirstAndAccepted) {
 TEST(SettingsVocabulary, AValueStoredIsTheValueReadBack) {
     for (const SettingDef& d : settingsVocabulary()) {
         RenderSettings s;
-        const Json v = otherValue(d);
+        const nlohmann::json v = otherValue(d);
         applySetting(s, d.name, v);
         if (v.is_number_float())
             EXPECT_FLOAT_EQ(d.get(s).get<float>(), v.get<float>()) << d.name;
@@ -92,28 +91,31 @@ TEST(SettingsVocabulary, TunesAdaptiveIsWhatTheTableSays) {
 }
 
 TEST(SettingsVocabulary, BadValuesNameTheSettingTheValueAndWhatWasExpected) {
-    EXPECT_STREQ(refusal("quality", 1.5).what(), "quality 1.5: expected a number in [0.5, 0.9999]");
-    EXPECT_STREQ(refusal("method", "fast").what(),
+    EXPECT_STREQ(settingRefusal("quality", 1.5).what(),
+                 "quality 1.5: expected a number in [0.5, 0.9999]");
+    EXPECT_STREQ(settingRefusal("method", "fast").what(),
                  "method 'fast': expected 'auto', 'adaptive', 'reference' or 'exact'");
-    EXPECT_STREQ(refusal("sample_distance", 0).what(),
+    EXPECT_STREQ(settingRefusal("sample_distance", 0).what(),
                  "sample_distance 0: expected a positive finite number");
-    EXPECT_STREQ(refusal("sample_distance", -1).what(),
+    EXPECT_STREQ(settingRefusal("sample_distance", -1).what(),
                  "sample_distance -1: expected a positive finite number");
-    EXPECT_STREQ(refusal("supersample", 9).what(), "supersample 9: expected an integer in [1, 8]");
-    EXPECT_STREQ(refusal("supersample", 2.5).what(),
+    EXPECT_STREQ(settingRefusal("supersample", 9).what(),
+                 "supersample 9: expected an integer in [1, 8]");
+    EXPECT_STREQ(settingRefusal("supersample", 2.5).what(),
                  "supersample 2.5: expected an integer in [1, 8]");
-    EXPECT_STREQ(refusal("skip", "yes").what(), "skip 'yes': expected true or false");
-    EXPECT_STREQ(refusal("power", nullptr).what(), "power null: expected a number in [1, 64]");
-    EXPECT_THAT(refusal("opacity_law", 3).what(),
+    EXPECT_STREQ(settingRefusal("skip", "yes").what(), "skip 'yes': expected true or false");
+    EXPECT_STREQ(settingRefusal("power", nullptr).what(),
+                 "power null: expected a number in [1, 64]");
+    EXPECT_THAT(settingRefusal("opacity_law", 3).what(),
                 HasSubstr("expected 'attenuation' or 'transmittance'"));
-    EXPECT_THAT(refusal("max_sample_distance", 1e39).what(),
+    EXPECT_THAT(settingRefusal("max_sample_distance", 1e39).what(),
                 HasSubstr("expected a positive finite number"));
-    const SettingError unknown = refusal("qualty", 0.9);
+    const SettingError unknown = settingRefusal("qualty", 0.9);
     EXPECT_EQ(unknown.setting(), "setting");
     EXPECT_THAT(unknown.what(), HasSubstr("'qualty': not a setting; the settings are 'method'"));
     EXPECT_EQ(unknown.kind(), ErrorKind::Argument);
     // Each front end in its own spelling.
-    const SettingError e = refusal("max_sample_distance", -2);
+    const SettingError e = settingRefusal("max_sample_distance", -2);
     EXPECT_EQ(e.spelledAs(cliFlag(settingNamed(e.setting())), " "),
               "--max-sample-distance -2: expected a positive finite number");
     EXPECT_EQ(e.spelledAs(e.setting(), "="),
@@ -138,9 +140,9 @@ TEST(SettingsVocabulary, ValidateSettingsChecksEverySettingOfTheTable) {
 }
 
 TEST(SettingsVocabulary, TheJsonFormListsEverySettingWithItsDefaultAndRange) {
-    const Json j = settingsVocabularyJson();
+    const nlohmann::json j = settingsVocabularyJson();
     ASSERT_EQ(j.size(), settingsVocabulary().size());
-    for (const Json& d : j) {
+    for (const nlohmann::json& d : j) {
         const SettingDef& def = settingNamed(d["name"].get<std::string>());
         EXPECT_EQ(d["default"], settingDefault(def));
         EXPECT_EQ(d["tunes_adaptive"], def.tunesAdaptive);
@@ -148,13 +150,13 @@ TEST(SettingsVocabulary, TheJsonFormListsEverySettingWithItsDefaultAndRange) {
     EXPECT_EQ(j[0]["name"], "method");
     EXPECT_EQ(j[0]["choices"][0], "auto");
     const SettingDef& q = settingNamed("quality");
-    const Json* quality = nullptr;
-    for (const Json& d : j)
+    const nlohmann::json* quality = nullptr;
+    for (const nlohmann::json& d : j)
         if (d["name"] == "quality") quality = &d;
     ASSERT_NE(quality, nullptr);
     EXPECT_EQ((*quality)["min"], q.min);
     EXPECT_EQ((*quality)["max"], q.max);
-    EXPECT_EQ((*quality)["read_by"], Json::array({"adaptive"}));
+    EXPECT_EQ((*quality)["read_by"], nlohmann::json::array({"adaptive"}));
     // A float default is written as it reads (0.99, not the float's 0.9900000095367432).
     EXPECT_EQ((*quality)["default"].dump(), "0.99");
 }
@@ -218,10 +220,10 @@ TEST(SettingsVocabulary, LightingCoefficientsNeedShadeOn) {
     EXPECT_EQ(s.lighting.ambient, 0.25f);
     EXPECT_TRUE(s.lighting.on);
     // Out of range.
-    EXPECT_THAT(refusal("diffuse", 1.5).what(), HasSubstr("expected a number in [0, 1]"));
-    EXPECT_THAT(refusal("specular_power", -1).what(), HasSubstr("[0, 128]"));
+    EXPECT_THAT(settingRefusal("diffuse", 1.5).what(), HasSubstr("expected a number in [0, 1]"));
+    EXPECT_THAT(settingRefusal("specular_power", -1).what(), HasSubstr("[0, 128]"));
     // The JSON form says what each needs.
-    for (const Json& d : settingsVocabularyJson()) {
+    for (const nlohmann::json& d : settingsVocabularyJson()) {
         if (d["name"] == "ambient") {
             EXPECT_EQ(d["needs"], "shade");
         }

@@ -45,7 +45,6 @@ namespace http = beast::http;
 namespace websocket = beast::websocket;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
-using Json = nlohmann::json;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using namespace std::chrono_literals;
@@ -104,7 +103,7 @@ public:
         ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
     }
 
-    void send(const Json& j) { sendText(j.dump()); }
+    void send(const nlohmann::json& j) { sendText(j.dump()); }
     void sendText(const std::string& text) {
         ws_.text(true);
         ws_.write(net::buffer(text));
@@ -116,7 +115,7 @@ public:
 
     /// The next message (text JSON or, for a binary one, {"binary": size}); null on timeout
     /// (the read stays pending for the next call) or a closed connection (closed() says which).
-    Json next(std::chrono::milliseconds timeout = 10s) {
+    nlohmann::json next(std::chrono::milliseconds timeout = 10s) {
         if (closed_) return nullptr;
         if (!reading_) {
             reading_ = true;
@@ -137,16 +136,16 @@ public:
         }
         if (ws_.got_binary()) {
             lastBinary_ = beast::buffers_to_string(buffer_.data());
-            return Json{{"binary", lastBinary_.size()}};
+            return nlohmann::json{{"binary", lastBinary_.size()}};
         }
-        return Json::parse(beast::buffers_to_string(buffer_.data()));
+        return nlohmann::json::parse(beast::buffers_to_string(buffer_.data()));
     }
 
     /// Messages until one of `type` arrives (null on timeout).
-    Json until(const std::string& type, std::chrono::milliseconds timeout = 20s) {
+    nlohmann::json until(const std::string& type, std::chrono::milliseconds timeout = 20s) {
         const auto end = std::chrono::steady_clock::now() + timeout;
         while (std::chrono::steady_clock::now() < end) {
-            Json j = next(std::chrono::duration_cast<std::chrono::milliseconds>(
+            nlohmann::json j = next(std::chrono::duration_cast<std::chrono::milliseconds>(
                 end - std::chrono::steady_clock::now()));
             if (j.is_null()) return nullptr;
             if (j.contains("type") && j["type"] == type) return j;
@@ -156,24 +155,24 @@ public:
     }
 
     /// The next frame's description, its image read (lastBinary()).
-    Json frame(std::chrono::milliseconds timeout = 20s) {
-        Json f = until("frame", timeout);
+    nlohmann::json frame(std::chrono::milliseconds timeout = 20s) {
+        nlohmann::json f = until("frame", timeout);
         if (!f.is_null()) {
-            const Json image = next();
+            const nlohmann::json image = next();
             EXPECT_TRUE(image.contains("binary")) << image.dump();
         }
         return f;
     }
 
     const std::string& lastBinary() const { return lastBinary_; }
-    const std::vector<Json>& seen() const { return seen_; }
+    const std::vector<nlohmann::json>& seen() const { return seen_; }
     bool closed() const { return closed_; }
 
 private:
     net::io_context ioc_;
     websocket::stream<tcp::socket> ws_;
     std::string lastBinary_;
-    std::vector<Json> seen_;
+    std::vector<nlohmann::json> seen_;
     beast::flat_buffer buffer_;
     bool reading_ = false, done_ = false, closed_ = false;
     beast::error_code error_;
@@ -212,7 +211,7 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
                                          "/?token=" + server->token()));
     EXPECT_EQ(server->token().size(), 32u);
     Client c(server->port(), server->token());
-    const Json info = c.next();
+    const nlohmann::json info = c.next();
     ASSERT_EQ(info["type"], "info") << info.dump();
     EXPECT_EQ(info["file"], "grid.vtk");
     EXPECT_EQ(info["cells"], 216);
@@ -221,11 +220,11 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
     EXPECT_TRUE(info["fields"][0]["default"].get<bool>());
     EXPECT_EQ(info["fields"][1]["association"], "cell");
     EXPECT_NEAR(info["fields"][1]["range"][1].get<double>(), 315.0, 1e-3);
-    EXPECT_EQ(info["state"]["size"], Json({64, 48}));
+    EXPECT_EQ(info["state"]["size"], nlohmann::json({64, 48}));
     EXPECT_EQ(info["state"]["tf"]["name"], "Viridis (matplotlib)");
     EXPECT_EQ(info["histogram"]["counts"].size(), 256u);
     EXPECT_GT(info["presets"].size(), 20u);
-    const Json f = c.frame();
+    const nlohmann::json f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_TRUE(f["full"].get<bool>());
     EXPECT_EQ(f["format"], "png");
@@ -235,10 +234,10 @@ TEST(ViewServer, InfoThenAFullFrameOfTheStartingState) {
     EXPECT_TRUE(isPng(c.lastBinary()));
     // The scene came unprepared: the server prepared it at start, and the tab knows the result
     // from info or, when it connected during the preparation, from `prepared`.
-    Json cells = info["rendered_cells"];
+    nlohmann::json cells = info["rendered_cells"];
     if (cells.is_null()) {
         bool seen = false;
-        for (const Json& j : c.seen())
+        for (const nlohmann::json& j : c.seen())
             if (j.value("type", "") == "prepared") cells = j["rendered_cells"], seen = true;
         EXPECT_TRUE(seen) << "no prepared message";
     }
@@ -278,23 +277,23 @@ TEST(ViewServer, APreparedSceneServesItsOneFieldWithTheMethodsItHolds) {
     ViewServer server(std::move(scene), o);
     server.start();
     Client c(server.port(), server.token());
-    const Json info = c.next();
+    const nlohmann::json info = c.next();
     ASSERT_EQ(info["type"], "info") << info.dump();
     EXPECT_EQ(info["cells"], 216);
     ASSERT_EQ(info["fields"].size(), 1u);
     EXPECT_EQ(info["fields"][0]["name"], "g");
     EXPECT_EQ(info["fields"][0]["association"], "cell");
-    EXPECT_EQ(info["fields"][0]["range"], Json({100.0, 315.0}));
-    EXPECT_EQ(info["cell_types"], Json({{"hexahedron", 216}}));
-    EXPECT_EQ(info["methods"], Json({"auto", "adaptive"}));
-    for (const Json& d : info["settings"])
+    EXPECT_EQ(info["fields"][0]["range"], nlohmann::json({100.0, 315.0}));
+    EXPECT_EQ(info["cell_types"], nlohmann::json({{"hexahedron", 216}}));
+    EXPECT_EQ(info["methods"], nlohmann::json({"auto", "adaptive"}));
+    for (const nlohmann::json& d : info["settings"])
         if (d["name"] == "method") {
-            EXPECT_EQ(d["choices"], Json({"auto", "adaptive"}));
+            EXPECT_EQ(d["choices"], nlohmann::json({"auto", "adaptive"}));
         }
     std::uint64_t counted = 0;
-    for (const Json& n : info["histogram"]["counts"]) counted += n.get<std::uint64_t>();
+    for (const nlohmann::json& n : info["histogram"]["counts"]) counted += n.get<std::uint64_t>();
     EXPECT_EQ(counted, 216u);  // one value per cell
-    const Json f = c.frame();
+    const nlohmann::json f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_TRUE(isPng(c.lastBinary()));
     EXPECT_GT(f["stats"]["samples"].get<double>(), 0.0);
@@ -305,7 +304,7 @@ TEST(ViewServer, APreparedSceneServesItsOneFieldWithTheMethodsItHolds) {
     EXPECT_THAT(c.until("error")["message"].get<std::string>(), HasSubstr("mesh BVH"));
     // The exported command names the field the cache was prepared for.
     c.send({{"type", "export"}});
-    const Json ex = c.until("export");
+    const nlohmann::json ex = c.until("export");
     ASSERT_FALSE(ex.is_null());
     EXPECT_THAT(ex["command"].get<std::string>(), HasSubstr("uvr render grid.vtk --field g:cell"));
 }
@@ -318,7 +317,7 @@ TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
     const std::uint64_t n = whole->cellCount();
     std::uint64_t histogramCells = 0;
     std::atomic<std::uint64_t> partPoints{0};
-    Json info, g, gFrame;
+    nlohmann::json info, g, gFrame;
     InProcessGroup::run(2, [&](Communicator& comm) {
         const int me = comm.rank();
         MeshShare share = shareOfPart(comm, meshPart(*whole, me * n / 2, (me + 1) * n / 2),
@@ -352,7 +351,7 @@ TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
     });
     ASSERT_EQ(info["type"], "info") << info.dump();
     EXPECT_EQ(info["cells"], 216);
-    EXPECT_EQ(info["cell_types"], Json({{"hexahedron", 216}}));
+    EXPECT_EQ(info["cell_types"], nlohmann::json({{"hexahedron", 216}}));
     ASSERT_EQ(info["fields"].size(), 2u);
     // f = x + 2y over [-1, 1]^3 (jittered corners inside), g = 100 + cell: both ranks' values.
     EXPECT_NEAR(info["fields"][1]["range"][0].get<double>(), 100.0, 1e-3);
@@ -361,12 +360,13 @@ TEST(ViewServer, RanksHoldingPartsListTheWholeMeshAndSwitchFields) {
     EXPECT_FLOAT_EQ(info["fields"][0]["range"][0].get<float>(), range.first);
     EXPECT_FLOAT_EQ(info["fields"][0]["range"][1].get<float>(), range.second);
     // Every part's points: those on the faces the parts share count once for each.
-    for (const Json& c : info["histogram"]["counts"]) histogramCells += c.get<std::uint64_t>();
+    for (const nlohmann::json& c : info["histogram"]["counts"])
+        histogramCells += c.get<std::uint64_t>();
     EXPECT_EQ(histogramCells, partPoints);
     ASSERT_FALSE(g.is_null());
     EXPECT_EQ(g["field"], "g");
     std::uint64_t gCells = 0;
-    for (const Json& c : g["counts"]) gCells += c.get<std::uint64_t>();
+    for (const nlohmann::json& c : g["counts"]) gCells += c.get<std::uint64_t>();
     EXPECT_EQ(gCells, 216u);  // one value per cell, over both parts
     ASSERT_FALSE(gFrame.is_null());
     EXPECT_EQ(gFrame["seq"], 2);
@@ -406,21 +406,21 @@ TEST(ViewServer, RanksHoldingPartsOfASeriesShowItsSteps) {
         return scene;
     };
     // What the page gets at step 2: the histogram's range and the frame.
-    const auto step2 = [](ViewServer& server, Json& histogram, std::string& frame) {
+    const auto step2 = [](ViewServer& server, nlohmann::json& histogram, std::string& frame) {
         server.start();
         {
             Client c(server.port(), server.token());
             ASSERT_FALSE(c.frame().is_null());
             c.send({{"type", "set"}, {"seq", 2}, {"step", 2}});
             histogram = c.until("histogram");
-            const Json f = c.frame();
+            const nlohmann::json f = c.frame();
             ASSERT_FALSE(f.is_null());
             EXPECT_EQ(f["seq"], 2);
             frame = c.lastBinary();
         }
         server.stop();
     };
-    Json oneHistogram, histogram;
+    nlohmann::json oneHistogram, histogram;
     std::string oneFrame, frame;
     {
         ServerOptions o;
@@ -458,10 +458,10 @@ TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
     auto server = startServer();
     Client c(server->port(), server->token());
     ASSERT_FALSE(c.frame().is_null());
-    Json cam = c.seen().front()["state"]["camera"];
+    nlohmann::json cam = c.seen().front()["state"]["camera"];
     cam["position"][0] = 4.0;
     c.send({{"type", "set"}, {"seq", 5}, {"interactive", true}, {"camera", cam}});
-    const Json moving = c.frame();
+    const nlohmann::json moving = c.frame();
     ASSERT_FALSE(moving.is_null());
     EXPECT_EQ(moving["seq"], 5);
     EXPECT_FALSE(moving["full"].get<bool>());
@@ -470,7 +470,7 @@ TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
     EXPECT_GE(moving["scale"].get<int>(), 1);
     EXPECT_EQ(moving["width"].get<int>(), 64 / moving["scale"].get<int>());
     // No further change: the refinement comes by itself.
-    const Json still = c.frame();
+    const nlohmann::json still = c.frame();
     ASSERT_FALSE(still.is_null());
     EXPECT_EQ(still["seq"], 5);
     EXPECT_TRUE(still["full"].get<bool>());
@@ -479,7 +479,7 @@ TEST(ViewServer, MovingFramesAreReducedJpegsAndStillOnesRefineToFullPngs) {
     const std::string before = c.lastBinary();
     // A TF change alone gives a different image.
     c.send({{"type", "set"}, {"seq", 6}, {"tf", {{"opacity", {{0, 0.9}, {1, 0.9}}}}}});
-    const Json tf = c.frame();
+    const nlohmann::json tf = c.frame();
     ASSERT_FALSE(tf.is_null());
     EXPECT_EQ(tf["seq"], 6);
     EXPECT_NE(c.lastBinary(), before);
@@ -528,28 +528,28 @@ TEST(ViewServer, BadMessagesGetErrorsAndTheConnectionKeepsServing) {
     };
     for (const auto& [text, want] : cases) {
         c.sendText(text);
-        const Json e = c.until("error");
+        const nlohmann::json e = c.until("error");
         ASSERT_FALSE(e.is_null()) << text;
         EXPECT_THAT(e["message"].get<std::string>(), HasSubstr(want)) << text;
     }
     // A refused change names its seq and is followed by the state as it stays.
     c.send({{"type", "set"}, {"seq", 77}, {"quality", 2}});
-    const Json e77 = c.until("error");
+    const nlohmann::json e77 = c.until("error");
     ASSERT_FALSE(e77.is_null());
     EXPECT_EQ(e77["seq"], 77);
     EXPECT_EQ(e77["request"], "set");
-    const Json kept = c.until("state");
+    const nlohmann::json kept = c.until("state");
     ASSERT_FALSE(kept.is_null());
     EXPECT_NEAR(kept["state"]["quality"].get<double>(), 0.99, 1e-6);
     c.sendBinary(std::string("\x89PNG", 4));
     EXPECT_THAT(c.until("error")["message"].get<std::string>(), HasSubstr("binary"));
     // The bad seq and heat map above changed nothing: the state still shows the volume.
     c.send({{"type", "ping"}, {"seq", 3}});
-    const Json pong = c.until("pong");
+    const nlohmann::json pong = c.until("pong");
     ASSERT_FALSE(pong.is_null());
     EXPECT_EQ(pong["seq"], 3);
     c.send({{"type", "set"}, {"seq", 9}, {"method", "exact"}});
-    const Json f = c.frame();
+    const nlohmann::json f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_EQ(f["seq"], 9);
     EXPECT_EQ(f["stats"]["method"], "exact");
@@ -561,7 +561,7 @@ TEST(ViewServer, AFloodIsLimitedAndNeverQueuesFrames) {
     auto server = startServer(o);
     Client c(server->port(), server->token());
     ASSERT_FALSE(c.frame().is_null());
-    Json cam = c.seen().front()["state"]["camera"];
+    nlohmann::json cam = c.seen().front()["state"]["camera"];
     for (int i = 1; i <= 2000; ++i) {
         cam["position"][0] = 3.0 + i * 1e-3;
         c.send({{"type", "set"}, {"seq", i}, {"interactive", true}, {"camera", cam}});
@@ -569,7 +569,7 @@ TEST(ViewServer, AFloodIsLimitedAndNeverQueuesFrames) {
     // Read everything the flood produced until the connection goes quiet.
     int frames = 0, errors = 0;
     std::uint64_t lastSeq = 0;
-    for (Json j = c.next(1500ms); !j.is_null(); j = c.next(1500ms)) {
+    for (nlohmann::json j = c.next(1500ms); !j.is_null(); j = c.next(1500ms)) {
         if (j.value("type", "") == "frame") ++frames, lastSeq = j["seq"];
         if (j.value("type", "") == "error") {
             ++errors;
@@ -584,7 +584,7 @@ TEST(ViewServer, AFloodIsLimitedAndNeverQueuesFrames) {
     // Once the flood is over the connection is heard again.
     std::this_thread::sleep_for(1100ms);
     c.send({{"type", "set"}, {"seq", 5000}, {"camera", cam}});
-    const Json f = c.frame();
+    const nlohmann::json f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_EQ(f["seq"], 5000);
 }
@@ -594,11 +594,11 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     Client c(server->port(), server->token());
     ASSERT_FALSE(c.frame().is_null());
     c.send({{"type", "set"}, {"preset", "Inferno (matplotlib)"}, {"range", {-2.5, 2.5}}});
-    const Json state = c.until("state");
+    const nlohmann::json state = c.until("state");
     ASSERT_FALSE(state.is_null());
     EXPECT_EQ(state["state"]["tf"]["name"], "Inferno (matplotlib)");
     c.send({{"type", "snapshot"}});
-    const Json snap = c.until("snapshot");
+    const nlohmann::json snap = c.until("snapshot");
     ASSERT_FALSE(snap.is_null());
     EXPECT_EQ(snap["width"], 64);
     EXPECT_EQ(snap["height"], 48);
@@ -608,7 +608,7 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     ASSERT_GT(c.lastBinary().size(), 25u);
     EXPECT_EQ(static_cast<unsigned char>(c.lastBinary()[25]), 2u);
     c.send({{"type", "export"}});
-    const Json ex = c.until("export");
+    const nlohmann::json ex = c.until("export");
     ASSERT_FALSE(ex.is_null());
     const std::string tfText = ex["tf_json"], pvcc = ex["pvcc"];
     const TransferFunction tf = parseParaViewColorMap({tfText.begin(), tfText.end()}, "export");
@@ -627,13 +627,13 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
                 HasSubstr("--clip-plane 0.25,0,0,1,0,0 --sample-distance 0.01"));
-    c.send({{"type", "set"}, {"clip_planes", Json::array()}});
+    c.send({{"type", "set"}, {"clip_planes", nlohmann::json::array()}});
     // So do its isosurfaces.
     c.send({{"type", "set"}, {"iso", {"0.5", "1,0.5,#00ff00"}}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(),
                 HasSubstr("--iso 0.5 --iso '1,0.5,#00ff00' --sample-distance 0.01"));
-    c.send({{"type", "set"}, {"iso", Json::array()}});
+    c.send({{"type", "set"}, {"iso", nlohmann::json::array()}});
     // So does its gradient opacity, with the normals it reads.
     c.send({{"type", "set"}, {"gradient_opacity", "0:0,2:1"}, {"normals", "cell"}});
     c.send({{"type", "export"}});
@@ -647,7 +647,7 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     c.send({{"type", "set"}, {"clip_surface", true}, {"clip_planes", {{0.25, 0, 0, 1, 0, 0}}}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(), HasSubstr("--clip-surface"));
-    c.send({{"type", "set"}, {"clip_planes", Json::array()}});
+    c.send({{"type", "set"}, {"clip_planes", nlohmann::json::array()}});
     c.send({{"type", "export"}});
     EXPECT_THAT(c.until("export")["command"].get<std::string>(), Not(HasSubstr("--clip-surface")));
     c.send({{"type", "set"}, {"clip_surface", false}});
@@ -663,19 +663,19 @@ TEST(ViewServer, SnapshotAndExportReproduceTheState) {
     // A log scale over a range from 0 exports the range the frames map (AdjustRangeForLog).
     c.send({{"type", "set"}, {"range", {0, 2}}, {"tf", {{"log", true}}}});
     c.send({{"type", "export"}});
-    const Json logEx = c.until("export");
+    const nlohmann::json logEx = c.until("export");
     ASSERT_FALSE(logEx.is_null());
     EXPECT_THAT(logEx["command"].get<std::string>(), HasSubstr("--range 0.0002,2 "));
     // The log state's frame may come before the export's reply (until() keeps what it skips) or
     // after it, and a frame of the state before may come first.
-    auto saysNotPositive = [](const Json& f) {
+    auto saysNotPositive = [](const nlohmann::json& f) {
         return f.value("type", "") == "frame" && f.contains("notes") && !f["notes"].empty() &&
                f["notes"][0].get<std::string>().find("not positive") != std::string::npos;
     };
     bool noted = false;
-    for (const Json& j : c.seen()) noted = noted || saysNotPositive(j);
+    for (const nlohmann::json& j : c.seen()) noted = noted || saysNotPositive(j);
     for (int i = 0; i < 4 && !noted; ++i) {
-        const Json f = c.frame();
+        const nlohmann::json f = c.frame();
         if (f.is_null()) break;
         noted = saysNotPositive(f);
     }
@@ -693,22 +693,22 @@ TEST(ViewServer, AFieldChangeSendsItsRangeAndHistogramAndRebuildsNoGeometry) {
     ASSERT_FALSE(c.frame().is_null());
     const std::string first = c.lastBinary();
     c.send({{"type", "set"}, {"seq", 2}, {"field", "g"}});
-    const Json h = c.until("histogram");
+    const nlohmann::json h = c.until("histogram");
     ASSERT_FALSE(h.is_null());
     EXPECT_EQ(h["field"], "g");
-    const Json st = c.until("state");
+    const nlohmann::json st = c.until("state");
     ASSERT_FALSE(st.is_null());
-    EXPECT_EQ(st["state"]["range"], Json({100.0, 315.0}));
-    const Json f = c.frame();
+    EXPECT_EQ(st["state"]["range"], nlohmann::json({100.0, 315.0}));
+    const nlohmann::json f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_EQ(f["seq"], 2);
     EXPECT_NE(c.lastBinary(), first);
     // Back to f with its first range: the very first image again.
     c.send({{"type", "set"}, {"seq", 3}, {"field", "f"}, {"range", {-3, 3}}});
-    const Json back = c.until("histogram");
+    const nlohmann::json back = c.until("histogram");
     ASSERT_FALSE(back.is_null());
     EXPECT_EQ(back["field"], "f");
-    const Json g = c.frame();
+    const nlohmann::json g = c.frame();
     ASSERT_FALSE(g.is_null());
     EXPECT_EQ(g["seq"], 3);
     EXPECT_EQ(c.lastBinary(), first);
@@ -756,31 +756,31 @@ TEST(ViewServer, TimeStepsOfASeriesAreShownWithoutRebuildingAndOtherGeometriesRe
     });
     server.start();
     Client c(server.port(), server.token());
-    const Json info = c.until("info");
+    const nlohmann::json info = c.until("info");
     ASSERT_FALSE(info.is_null());
-    EXPECT_EQ(info["times"], Json({0, 1, 2, 3}));
+    EXPECT_EQ(info["times"], nlohmann::json({0, 1, 2, 3}));
     EXPECT_EQ(info["state"]["step"], 0);
     ASSERT_FALSE(c.frame().is_null());
     const std::string first = c.lastBinary();
     // Step 2: its histogram, the tab's range kept, a new image.
     c.send({{"type", "set"}, {"seq", 2}, {"step", 2}});
-    const Json h = c.until("histogram");
+    const nlohmann::json h = c.until("histogram");
     ASSERT_FALSE(h.is_null());
     EXPECT_NEAR(h["range"][0].get<double>(), -3.0 + 2.0, 0.7);  // f moved by 2
-    const Json state = c.until("state");
+    const nlohmann::json state = c.until("state");
     EXPECT_EQ(state["state"]["step"], 2);
-    EXPECT_EQ(state["state"]["range"], Json({-3.0, 5.0}));
-    const Json f2 = c.frame();
+    EXPECT_EQ(state["state"]["range"], nlohmann::json({-3.0, 5.0}));
+    const nlohmann::json f2 = c.frame();
     ASSERT_FALSE(f2.is_null());
     EXPECT_EQ(f2["seq"], 2);
     EXPECT_NE(c.lastBinary(), first);
     c.send({{"type", "export"}});
-    const Json ex = c.until("export");
+    const nlohmann::json ex = c.until("export");
     ASSERT_FALSE(ex.is_null());
     EXPECT_THAT(ex["command"].get<std::string>(), HasSubstr("--step-index 2 "));
     // Out of range: refused by the state; another geometry: refused by the frame.
     c.send({{"type", "set"}, {"seq", 3}, {"step", 4}});
-    Json e = c.until("error");
+    nlohmann::json e = c.until("error");
     ASSERT_FALSE(e.is_null());
     EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("from 0 to 3"));
     c.send({{"type", "set"}, {"seq", 4}, {"step", 3}});
@@ -789,7 +789,7 @@ TEST(ViewServer, TimeStepsOfASeriesAreShownWithoutRebuildingAndOtherGeometriesRe
     EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("other points or cells"));
     // Back to step 0: the first image again, and the server still serves.
     c.send({{"type", "set"}, {"seq", 5}, {"step", 0}});
-    const Json f0 = c.frame();
+    const nlohmann::json f0 = c.frame();
     ASSERT_FALSE(f0.is_null());
     EXPECT_EQ(f0["seq"], 5);
     EXPECT_EQ(c.lastBinary(), first);
@@ -809,11 +809,11 @@ TEST(ViewServer, TabsHaveTheirOwnStateAndResetCameraSnapsToAxes) {
     ASSERT_FALSE(a.frame().is_null());
     ASSERT_FALSE(b.frame().is_null());
     a.send({{"type", "reset_camera"}, {"seq", 1}, {"axis", "+x"}});
-    const Json st = a.until("state");
+    const nlohmann::json st = a.until("state");
     ASSERT_FALSE(st.is_null());
-    const Json cam = st["state"]["camera"];
+    const nlohmann::json cam = st["state"]["camera"];
     EXPECT_LT(cam["position"][0].get<double>(), -1.0);  // looking along +x from -x
-    EXPECT_EQ(cam["view_up"], Json({0.0, 0.0, 1.0}));
+    EXPECT_EQ(cam["view_up"], nlohmann::json({0.0, 0.0, 1.0}));
     ASSERT_FALSE(a.frame().is_null());
     b.send({{"type", "export"}});
     const std::string pvcc = b.until("export")["pvcc"];
@@ -845,7 +845,7 @@ TEST(ViewServer, StopClosesConnectionsAndBadOptionsAreRefused) {
     std::thread runner([&] { server->run(false); });
     server->stop();
     runner.join();
-    for (Json j = c.next(3s); !j.is_null(); j = c.next(3s)) {
+    for (nlohmann::json j = c.next(3s); !j.is_null(); j = c.next(3s)) {
     }
     EXPECT_TRUE(c.closed()) << "no close from the server";
     auto refused = [](ServerOptions o) {
@@ -935,10 +935,11 @@ std::size_t residentBytes() {
 
 /// A ParaView colour-map JSON of n RGB points.
 std::string colorMapJson(std::size_t n) {
-    Json rgb = Json::array();
+    nlohmann::json rgb = nlohmann::json::array();
     for (std::size_t i = 0; i < n; ++i)
         for (double v : {double(i), 0.25, 0.5, 0.75}) rgb.push_back(v);
-    return Json::array({{{"Name", "many"}, {"ColorSpace", "RGB"}, {"RGBPoints", rgb}}}).dump();
+    return nlohmann::json::array({{{"Name", "many"}, {"ColorSpace", "RGB"}, {"RGBPoints", rgb}}})
+        .dump();
 }
 
 TEST(ViewServer, DeeplyNestedMessagesAreRefusedBeforeParsing) {
@@ -950,7 +951,7 @@ TEST(ViewServer, DeeplyNestedMessagesAreRefusedBeforeParsing) {
     const std::string deep = R"({"type":"set","seq":4,"range":[)" + std::string(99999, '[') +
                              std::string(99999, ']') + ",1]}";
     c.sendText(deep);
-    Json e = c.until("error");
+    nlohmann::json e = c.until("error");
     ASSERT_FALSE(e.is_null());
     EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("nested deeper than 64 levels"));
     // At the limit it parses, and the error describes the value in a few bytes.
@@ -981,7 +982,7 @@ TEST(ViewServer, RepliesToATabThatDoesNotReadAreReplacedNotQueued) {
     Client c(server->port(), server->token());
     ASSERT_FALSE(c.frame().is_null());
     c.send({{"type", "set"}, {"colormap_json", colorMapJson(kMaxTfPoints)}});
-    const Json st = c.until("state");
+    const nlohmann::json st = c.until("state");
     ASSERT_FALSE(st.is_null());
     ASSERT_EQ(st["state"]["tf"]["colors"].size(), kMaxTfPoints);
     const int requests = 150;  // 40 MB of replies; within the rate and the message count
@@ -989,14 +990,14 @@ TEST(ViewServer, RepliesToATabThatDoesNotReadAreReplacedNotQueued) {
     std::this_thread::sleep_for(1500ms);
     // The first reply may take long where the server is slow (sanitizer builds); then the rest.
     int exports = c.until("export", 60s).is_null() ? 0 : 1;
-    for (Json j = c.next(1500ms); !j.is_null(); j = c.next(1500ms))
+    for (nlohmann::json j = c.next(1500ms); !j.is_null(); j = c.next(1500ms))
         exports += j.value("type", "") == "export";
     EXPECT_FALSE(c.closed());
     EXPECT_GE(exports, 1);
     EXPECT_LT(exports, requests / 2) << "replies were queued, not replaced";
     // A map past the limit is refused, the connection serves on.
     c.send({{"type", "set"}, {"seq", 3}, {"colormap_json", colorMapJson(kMaxTfPoints + 1)}});
-    const Json e = c.until("error");
+    const nlohmann::json e = c.until("error");
     ASSERT_FALSE(e.is_null());
     EXPECT_THAT(e["message"].get<std::string>(),
                 HasSubstr("at most " + std::to_string(kMaxTfPoints)));
@@ -1035,7 +1036,7 @@ TEST(ViewServer, ATabWhoseQueuedBytesPassTheBoundIsClosed) {
     ASSERT_NE(open, std::string::npos) << line;
     EXPECT_LT(std::stoi(line.substr(open + 2)), 256) << line;
     EXPECT_THAT(line, HasSubstr("bytes of text"));
-    for (Json j = c.next(3s); !j.is_null(); j = c.next(3s)) {
+    for (nlohmann::json j = c.next(3s); !j.is_null(); j = c.next(3s)) {
     }
     EXPECT_TRUE(c.closed());
     Client d(server->port(), server->token());  // the server serves on
@@ -1143,17 +1144,17 @@ TEST(ViewServer, AStepThatFailsToReadIsAnErrorForThatTabOnly) {
     ASSERT_FALSE(b.frame().is_null());
     for (int attempt = 0; attempt < 2; ++attempt) {
         a.send({{"type", "set"}, {"seq", 10 + attempt}, {"step", 2}});
-        const Json e = a.until("error");
+        const nlohmann::json e = a.until("error");
         ASSERT_FALSE(e.is_null());
         EXPECT_EQ(e["request"], "frame");
         EXPECT_THAT(e["message"].get<std::string>(), HasSubstr("s_2.vtu"));
     }
     b.send({{"type", "set"}, {"seq", 2}, {"step", 1}});
-    const Json fb = b.frame();
+    const nlohmann::json fb = b.frame();
     ASSERT_FALSE(fb.is_null());
     EXPECT_EQ(fb["seq"], 2);
     a.send({{"type", "set"}, {"seq", 20}, {"step", 0}});
-    const Json fa = a.frame();
+    const nlohmann::json fa = a.frame();
     ASSERT_FALSE(fa.is_null());
     EXPECT_EQ(fa["seq"], 20);
 }
@@ -1259,7 +1260,7 @@ TEST(ViewServer, SoakOfHostileAndSlowClientsKeepsMemoryAndCpuBounded) {
     Client c(server->port(), server->token());
     ASSERT_EQ(c.next()["type"], "info");
     c.send({{"type", "set"}, {"seq", 99}, {"quality", 0.9}});
-    Json f = c.frame();  // the starting state's, then the change's
+    nlohmann::json f = c.frame();  // the starting state's, then the change's
     for (int i = 0; i < 3 && !f.is_null() && f["seq"] != 99; ++i) f = c.frame();
     ASSERT_FALSE(f.is_null());
     EXPECT_EQ(f["seq"], 99);

@@ -10,7 +10,6 @@ namespace uvr::server {
 namespace {
 
 using ::testing::HasSubstr;
-using Json = nlohmann::json;
 
 ViewState startState() {
     ViewState s;
@@ -23,9 +22,9 @@ ViewState startState() {
 }
 
 /// The message the error of applying `message` carries; the state must be unchanged.
-std::string refusal(const Json& message) {
+std::string refusal(const nlohmann::json& message) {
     ViewState s = startState();
-    const Json before = toJson(s);
+    const nlohmann::json before = toJson(s);
     try {
         applySet(s, message);
     } catch (const Error& e) {
@@ -38,32 +37,32 @@ std::string refusal(const Json& message) {
 
 TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     ViewState s = startState();
-    const Json msg = {{"type", "set"},
-                      {"seq", 4},
-                      {"interactive", true},
-                      {"camera",
-                       {{"position", {1, 2, 3}},
-                        {"focal_point", {0, 0, 0}},
-                        {"view_up", {0, 0, 1}},
-                        {"view_angle", 20},
-                        {"parallel", true},
-                        {"parallel_scale", 0.75}}},
-                      {"tf",
-                       {{"colors", {{0, 0, 0, 0}, {1, 1, 0.5, 0.25}}},
-                        {"opacity", {{0, 0}, {0.5, 1}, {1, 0}}},
-                        {"log", false},
-                        {"nan_color", {0.5, 0.5, 0.5}},
-                        {"nan_opacity", 0.2},
-                        {"name", "mine"},
-                        {"color_space", "Lab"}}},
-                      {"range", {-1, 4}},
-                      {"method", "exact"},
-                      {"quality", 0.95},
-                      {"heatmap", true},
-                      {"clip_planes", {{0.5, 0, 0, -2, 0, 0}}},
-                      {"size", {320, 200}},
-                      {"opacity_unit", 0.25},
-                      {"opacity_law", "transmittance"}};
+    const nlohmann::json msg = {{"type", "set"},
+                                {"seq", 4},
+                                {"interactive", true},
+                                {"camera",
+                                 {{"position", {1, 2, 3}},
+                                  {"focal_point", {0, 0, 0}},
+                                  {"view_up", {0, 0, 1}},
+                                  {"view_angle", 20},
+                                  {"parallel", true},
+                                  {"parallel_scale", 0.75}}},
+                                {"tf",
+                                 {{"colors", {{0, 0, 0, 0}, {1, 1, 0.5, 0.25}}},
+                                  {"opacity", {{0, 0}, {0.5, 1}, {1, 0}}},
+                                  {"log", false},
+                                  {"nan_color", {0.5, 0.5, 0.5}},
+                                  {"nan_opacity", 0.2},
+                                  {"name", "mine"},
+                                  {"color_space", "Lab"}}},
+                                {"range", {-1, 4}},
+                                {"method", "exact"},
+                                {"quality", 0.95},
+                                {"heatmap", true},
+                                {"clip_planes", {{0.5, 0, 0, -2, 0, 0}}},
+                                {"size", {320, 200}},
+                                {"opacity_unit", 0.25},
+                                {"opacity_law", "transmittance"}};
     const SetResult r = applySet(s, msg);
     EXPECT_FALSE(r.fieldChanged);
     EXPECT_TRUE(r.rangeGiven);
@@ -83,7 +82,7 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     EXPECT_EQ(s.height, 200);
     // The state's JSON is itself a valid set message that changes nothing.
     ViewState again = startState();
-    Json asSet = toJson(s);
+    nlohmann::json asSet = toJson(s);
     applySet(again, asSet);
     EXPECT_EQ(toJson(again), toJson(s));
     // The frame settings carry it, at a reduced size too.
@@ -101,9 +100,9 @@ TEST(ViewState, EveryKeyAppliesAndTheJsonRoundTrips) {
     ASSERT_EQ(f.clipPlanes.size(), 1u);
     EXPECT_EQ(f.clipPlanes[0].origin, Vec3f(0.5f, 0.f, 0.f));
     // No clip planes: an empty list.
-    applySet(s, {{"clip_planes", Json::array()}});
+    applySet(s, {{"clip_planes", nlohmann::json::array()}});
     EXPECT_TRUE(s.clipPlanes.empty());
-    EXPECT_EQ(toJson(s)["clip_planes"], Json::array());
+    EXPECT_EQ(toJson(s)["clip_planes"], nlohmann::json::array());
 }
 
 TEST(ViewState, FollowingRanksRebuildTheFrameSettingsBitForBit) {
@@ -123,7 +122,7 @@ TEST(ViewState, FollowingRanksRebuildTheFrameSettingsBitForBit) {
     s.settings["quality"] = 0.97;
     s.step = 0;
     ViewState follower = startState();
-    applySet(follower, Json::parse(toJson(s).dump()));
+    applySet(follower, nlohmann::json::parse(toJson(s).dump()));
     RenderSettings base;
     base.step = 0.0123f;
     const RenderSettings a = frameSettings(s, base, 2), b = frameSettings(follower, base, 2);
@@ -155,7 +154,7 @@ TEST(ViewState, FollowingRanksRebuildTheFrameSettingsBitForBit) {
 
 TEST(ViewState, IsosurfacesAreSetInTheirCommandLineFormAndReachTheFrame) {
     ViewState s = startState();
-    EXPECT_EQ(toJson(s)["iso"], Json::array());
+    EXPECT_EQ(toJson(s)["iso"], nlohmann::json::array());
     applySet(s, {{"iso", {0.5, "1.5,0.25", "2,1,#ff8000"}}});
     ASSERT_EQ(s.isoSurfaces.size(), 3u);
     EXPECT_EQ(s.isoSurfaces[0].value, 0.5f);
@@ -163,14 +162,14 @@ TEST(ViewState, IsosurfacesAreSetInTheirCommandLineFormAndReachTheFrame) {
     EXPECT_FALSE(s.isoSurfaces[2].colorMapped);
     EXPECT_EQ(s.isoSurfaces[2].color, Vec3f(1.f, 128.f / 255.f, 0.f));
     // The state writes each as --iso does, and reads that back.
-    EXPECT_EQ(toJson(s)["iso"], Json({"0.5", "1.5,0.25", "2,1,#ff8000"}));
+    EXPECT_EQ(toJson(s)["iso"], nlohmann::json({"0.5", "1.5,0.25", "2,1,#ff8000"}));
     ViewState again = startState();
     applySet(again, {{"iso", toJson(s)["iso"]}});
     EXPECT_EQ(toJson(again)["iso"], toJson(s)["iso"]);
     const RenderSettings f = frameSettings(s, RenderSettings{});
     ASSERT_EQ(f.isoSurfaces.size(), 3u);
     EXPECT_EQ(f.isoSurfaces[1].value, 1.5f);
-    applySet(s, {{"iso", Json::array()}});
+    applySet(s, {{"iso", nlohmann::json::array()}});
     EXPECT_TRUE(frameSettings(s, RenderSettings{}).isoSurfaces.empty());
     // Bad ones are refused naming the entry, with the library's expected form.
     EXPECT_THAT(refusal({{"iso", {0.5, "1,2"}}}),
@@ -178,7 +177,7 @@ TEST(ViewState, IsosurfacesAreSetInTheirCommandLineFormAndReachTheFrame) {
     EXPECT_THAT(refusal({{"iso", {"1,0.5,#ff80"}}}), HasSubstr("iso[0]"));
     EXPECT_THAT(refusal({{"iso", {true}}}), HasSubstr("iso[0]"));
     EXPECT_THAT(refusal({{"iso", 0.5}}), HasSubstr("at most 8 isosurfaces"));
-    EXPECT_THAT(refusal({{"iso", Json::array({1, 2, 3, 4, 5, 6, 7, 8, 9})}}),
+    EXPECT_THAT(refusal({{"iso", nlohmann::json::array({1, 2, 3, 4, 5, 6, 7, 8, 9})}}),
                 HasSubstr("at most 8 isosurfaces"));
 }
 
@@ -235,7 +234,7 @@ TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
     EXPECT_THAT(refusal({{"camera", {{"view_up", {0, 0, -1}}}}}), HasSubstr("parallel"));
     EXPECT_THAT(refusal({{"camera", {{"view_angle", 180}}}}), HasSubstr("camera.view_angle"));
     EXPECT_THAT(refusal({{"camera", {{"zoom", 2}}}}), HasSubstr("zoom"));
-    EXPECT_THAT(refusal({{"tf", {{"colors", Json::array()}}}}), HasSubstr("tf.colors"));
+    EXPECT_THAT(refusal({{"tf", {{"colors", nlohmann::json::array()}}}}), HasSubstr("tf.colors"));
     EXPECT_THAT(refusal({{"tf", {{"colors", {{0.5, 0, 0, 0}, {0.2, 0, 0, 0}}}}}}),
                 HasSubstr("tf.colors[1]"));
     EXPECT_THAT(refusal({{"tf", {{"opacity", {{0, 2}}}}}}), HasSubstr("tf.opacity[0][1]"));
@@ -257,17 +256,19 @@ TEST(ViewState, BadValuesAreRefusedNamingTheKeyAndLeaveTheStateAlone) {
     EXPECT_THAT(refusal({{"tf", {{"log", true}}}, {"range", {-2, -1}}}),
                 HasSubstr("reaching above 0"));
     EXPECT_THAT(refusal({{"camrea", {}}}), HasSubstr("camrea"));
-    EXPECT_THAT(refusal(Json::array({1, 2})), HasSubstr("object"));
+    EXPECT_THAT(refusal(nlohmann::json::array({1, 2})), HasSubstr("object"));
     EXPECT_THAT(refusal({{"clip_planes", {{0, 0, 0, 1, 0}}}}), HasSubstr("clip_planes[0]"));
     EXPECT_THAT(refusal({{"clip_planes", {{0, 0, 0, 0, 0, 0}}}}),
                 HasSubstr("\"clip_planes\": 0,0,0,0,0,0: expected a finite origin"));
-    EXPECT_THAT(
-        refusal({{"clip_planes",
-                  Json::array({Json::array({0, 0, 0, 1, 0, 0}), Json::array({0, 0, 0, 1, 0, 0}),
-                               Json::array({0, 0, 0, 1, 0, 0}), Json::array({0, 0, 0, 1, 0, 0}),
-                               Json::array({0, 0, 0, 1, 0, 0}), Json::array({0, 0, 0, 1, 0, 0}),
-                               Json::array({0, 0, 0, 1, 0, 0})})}}),
-        HasSubstr("at most 6 planes"));
+    EXPECT_THAT(refusal({{"clip_planes",
+                          nlohmann::json::array({nlohmann::json::array({0, 0, 0, 1, 0, 0}),
+                                                 nlohmann::json::array({0, 0, 0, 1, 0, 0}),
+                                                 nlohmann::json::array({0, 0, 0, 1, 0, 0}),
+                                                 nlohmann::json::array({0, 0, 0, 1, 0, 0}),
+                                                 nlohmann::json::array({0, 0, 0, 1, 0, 0}),
+                                                 nlohmann::json::array({0, 0, 0, 1, 0, 0}),
+                                                 nlohmann::json::array({0, 0, 0, 1, 0, 0})})}}),
+                HasSubstr("at most 6 planes"));
     EXPECT_THAT(refusal({{"clip_planes", "x"}}), HasSubstr("clip_planes"));
     // A good key before a bad one changes nothing either.
     EXPECT_THAT(refusal({{"heatmap", true}, {"quality", 7}}), HasSubstr("quality"));
@@ -285,13 +286,14 @@ TEST(ViewState, AFieldChangeIsReported) {
 TEST(ViewState, TheBackgroundIsAColourInTheUnitCube) {
     // Issue 35: what the page shows is what it saves; the background is the state's.
     ViewState s = startState();
-    EXPECT_EQ(toJson(s)["background"], Json::array({0.f, 0.f, 0.f}));
+    EXPECT_EQ(toJson(s)["background"], nlohmann::json::array({0.f, 0.f, 0.f}));
     applySet(s, {{"background", {0.25, 0.5, 1}}});
     EXPECT_EQ(s.background.x, 0.25f);
     EXPECT_EQ(s.background.z, 1.f);
-    EXPECT_EQ(toJson(s)["background"], Json::array({0.25f, 0.5f, 1.f}));
-    for (const Json& bad : {Json(1), Json::array({0, 0}), Json::array({0, 0, 2}),
-                            Json::array({0, "x", 0}), Json::array({0, -0.1, 0})}) {
+    EXPECT_EQ(toJson(s)["background"], nlohmann::json::array({0.25f, 0.5f, 1.f}));
+    for (const nlohmann::json& bad :
+         {nlohmann::json(1), nlohmann::json::array({0, 0}), nlohmann::json::array({0, 0, 2}),
+          nlohmann::json::array({0, "x", 0}), nlohmann::json::array({0, -0.1, 0})}) {
         SCOPED_TRACE(bad.dump());
         try {
             applySet(s, {{"background", bad}});
@@ -308,7 +310,8 @@ TEST(ViewState, TheStepIsOneOfTheFilesTimeSteps) {
     applySet(s, {{"step", 2}}, 3);
     EXPECT_EQ(s.step, 2u);
     EXPECT_EQ(toJson(s)["step"], 2);
-    for (const Json& bad : {Json(3), Json(-1), Json(1.5), Json("1")}) {
+    for (const nlohmann::json& bad :
+         {nlohmann::json(3), nlohmann::json(-1), nlohmann::json(1.5), nlohmann::json("1")}) {
         SCOPED_TRACE(bad.dump());
         try {
             applySet(s, {{"step", bad}, {"heatmap", true}}, 3);
@@ -333,10 +336,10 @@ TEST(ViewState, AnUploadedColourMapHasAtMostTheStatesPoints) {
     // Issue 28: a 250,000-point map came in through colormap_json (kMaxTfPoints bounded only
     // the page's rows), and every `state` and `export` reply carried it.
     auto upload = [](std::size_t n, const char* space) {
-        Json rgb = Json::array();
+        nlohmann::json rgb = nlohmann::json::array();
         for (std::size_t i = 0; i < n; ++i)
             for (double v : {double(i), 0.5, 0.5, 0.5}) rgb.push_back(v);
-        return Json{{"Name", "big"}, {"ColorSpace", space}, {"RGBPoints", rgb}}.dump();
+        return nlohmann::json{{"Name", "big"}, {"ColorSpace", space}, {"RGBPoints", rgb}}.dump();
     };
     ViewState s = startState();
     applySet(s, {{"colormap_json", upload(kMaxTfPoints, "RGB")}});
@@ -362,11 +365,11 @@ TEST(ViewState, AnUploadedColourMapHasAtMostTheStatesPoints) {
 
 TEST(ViewState, ErrorsDescribeHugeOrDeepValuesInFewBytes) {
     // Issue 28: the whole value was dumped (recursively) before being cut to 80 bytes.
-    Json deep = 1;
-    for (int i = 0; i < 60; ++i) deep = Json::array({deep});
-    Json wide = Json::array();
+    nlohmann::json deep = 1;
+    for (int i = 0; i < 60; ++i) deep = nlohmann::json::array({deep});
+    nlohmann::json wide = nlohmann::json::array();
     for (int i = 0; i < 100000; ++i) wide.push_back(std::string(100, 'x'));
-    for (const Json& v : {deep, wide, Json(std::string(1 << 20, 'y'))}) {
+    for (const nlohmann::json& v : {deep, wide, nlohmann::json(std::string(1 << 20, 'y'))}) {
         const std::string m = refusal({{"range", v}});
         EXPECT_THAT(m, HasSubstr("\"range\": expected [lo, hi], got "));
         EXPECT_LT(m.size(), 200u) << m;

@@ -4,10 +4,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <functional>
 #include <string>
 #include <vector>
 
+#include "test_support.h"
 #include "uvr/core/error.h"
 
 namespace uvr {
@@ -74,18 +74,8 @@ TEST(Base64, ReaderReadsExactCountsAcrossPaddedRuns) {
     EXPECT_EQ(std::string(out.begin(), out.end()), "abcdefg");
 }
 
-Error catchError(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e;
-    }
-    ADD_FAILURE() << "no uvr::Error thrown";
-    return Error(ErrorKind::Internal, "");
-}
-
 TEST(Base64, BadCharacterNamesFileOffsetAndContext) {
-    const Error e = catchError([] {
+    const Error e = testing::catchError([] {
         decodeBase64("Zm9v\nY#Fy", {"mesh.vtu", 100, "Piece 0: DataArray 'x'"});
     });
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
@@ -94,20 +84,20 @@ TEST(Base64, BadCharacterNamesFileOffsetAndContext) {
 }
 
 TEST(Base64, DataAfterPaddingInsideAGroupIsRefused) {
-    const Error e = catchError([] { decodeBase64("Zg=a", {"f.vtu", 0, ""}); });
+    const Error e = testing::catchError([] { decodeBase64("Zg=a", {"f.vtu", 0, ""}); });
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
     EXPECT_THAT(e.what(), HasSubstr("f.vtu: byte 3:"));
 }
 
 TEST(Base64, TruncatedGroupIsRefused) {
-    const Error e = catchError([] { decodeBase64("Zm9vYm", {"f.vtu", 10, ""}); });
+    const Error e = testing::catchError([] { decodeBase64("Zm9vYm", {"f.vtu", 10, ""}); });
     EXPECT_EQ(e.kind(), ErrorKind::Parse);
     EXPECT_THAT(e.what(), HasSubstr("f.vtu: byte 14:"));
     EXPECT_THAT(e.what(), HasSubstr("2 of 4 characters"));
 }
 
 TEST(Base64, ReadingPastTheEndIsRefused) {
-    const Error e = catchError([] {
+    const Error e = testing::catchError([] {
         Base64Reader reader("Zm9v", {"f.vtu", 0, "ctx"});
         std::vector<unsigned char> out;
         reader.read(5, out);

@@ -77,7 +77,7 @@ void expectFields(const Mesh& mesh, Association association, const nlohmann::jso
 
 /// Expects a mesh to equal the oracle's reading of one step: points, cells (types and point
 /// ids, cell by cell), point and cell fields value by value.
-void expectSameAsVtk(const Mesh& mesh, const nlohmann::json& step) {
+void expectSameAsVtkStep(const Mesh& mesh, const nlohmann::json& step) {
     const nlohmann::json& points = step["points"];
     ASSERT_EQ(mesh.pointCount() * 3, points.size());
     for (std::size_t i = 0; i < mesh.pointCount(); ++i)
@@ -121,7 +121,7 @@ TEST(Exodus, DiskOutRefMatchesVtk) {
     const nlohmann::json vtk = vtkReading(kDiskOutRef, dir, {0});
     if (vtk.is_null()) GTEST_SKIP() << "python3-vtk9 is missing";
     EXPECT_EQ(vtk["times"], nlohmann::json::array({0.0}));
-    expectSameAsVtk(mesh, vtk["steps"][0]);
+    expectSameAsVtkStep(mesh, vtk["steps"][0]);
 }
 
 TEST(Exodus, VtkWrittenFileMatchesVtkAtEveryStep) {
@@ -141,7 +141,7 @@ TEST(Exodus, VtkWrittenFileMatchesVtkAtEveryStep) {
     for (std::size_t s = 0; s < 3; ++s) {
         SCOPED_TRACE("step " + std::to_string(s));
         Mesh mesh = series->readStep(s);
-        expectSameAsVtk(mesh, vtk["steps"][s]);
+        expectSameAsVtkStep(mesh, vtk["steps"][s]);
         EXPECT_TRUE(hasNote(mesh, "TRIANGLE element(s), not volume cells")) << mesh.notes.size();
         EXPECT_EQ(validateMesh(mesh, file).invertedCells, 0u);
         if (s == 0) first = std::move(mesh);
@@ -273,8 +273,8 @@ TEST(Exodus, NetcdfWrittenFilesMatchVtk) {
         if (reference.empty()) reference = {series->readStep(0), series->readStep(1)};
         const nlohmann::json vtk = vtkReading(file, dir, {0, 1});
         if (vtk.is_null()) continue;
-        expectSameAsVtk(series->readStep(0), vtk["steps"][0]);
-        expectSameAsVtk(mesh, vtk["steps"][1]);
+        expectSameAsVtkStep(series->readStep(0), vtk["steps"][0]);
+        expectSameAsVtkStep(mesh, vtk["steps"][1]);
     }
 }
 
@@ -442,3 +442,5 @@ TEST(Exodus, SniffsNetcdfAndHdf5WithAnExodusExtension) {
 
 }  // namespace
 }  // namespace uvr
+
+#undef REQUIRE_EXODUS  // file-local: the unity build joins test files

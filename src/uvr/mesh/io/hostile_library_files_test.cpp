@@ -451,3 +451,5 @@ TEST(HostileLibraryFiles, ProbeCost) {
 
 }  // namespace
 }  // namespace uvr
+
+#undef REQUIRE_LIBRARIES  // file-local: the unity build joins test files

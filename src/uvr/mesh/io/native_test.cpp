@@ -52,7 +52,7 @@ Mesh mixedMesh() {
 }
 
 /// Bitwise equality of everything the native format stores.
-void expectSameMesh(const Mesh& a, const Mesh& b) {
+void expectBitwiseSame(const Mesh& a, const Mesh& b) {
     ASSERT_EQ(a.points.size(), b.points.size());
     if (!a.points.empty()) {  // memcmp of empty vectors' null data is undefined
         EXPECT_EQ(0,
@@ -76,14 +76,14 @@ void expectSameMesh(const Mesh& a, const Mesh& b) {
 }
 
 /// Byte offsets of a native file's arrays, computed independently from docs/NATIVE_FORMAT.md.
-struct Layout {
+struct FileLayout {
     std::uint64_t descriptors = 48, points = 0, types = 0, offsets = 0, indices = 0, end = 0;
     std::vector<std::uint64_t> fields;
 };
 
-Layout layoutOf(const Mesh& m) {
+FileLayout layoutOf(const Mesh& m) {
     auto align = [](std::uint64_t x) { return (x + 7) / 8 * 8; };
-    Layout l;
+    FileLayout l;
     std::uint64_t at = 48;
     for (const Field& f : m.fields) at += 4 + f.name.size() + 1 + 4 + 8;
     l.points = align(at);
@@ -109,25 +109,12 @@ void patch(std::string& bytes, std::uint64_t offset, T value) {
     std::memcpy(bytes.data() + offset, &value, sizeof(T));  // the test hosts are little-endian
 }
 
-/// Runs fn, expecting an Error of this kind whose message contains every fragment.
-template <typename Fn>
-void expectError(Fn&& fn, ErrorKind kind, const std::vector<std::string>& fragments) {
-    try {
-        fn();
-        ADD_FAILURE() << "no error thrown";
-    } catch (const Error& e) {
-        EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(kind)) << e.what();
-        for (const std::string& s : fragments) EXPECT_THAT(e.what(), HasSubstr(s));
-        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line";
-    }
-}
-
 TEST(Native, MixedMeshRoundTripsExactly) {
     const std::string path = testing::scratchDir() + "/mixed.uvrm";
     const Mesh m = mixedMesh();
     writeNative(m, path);
     const Mesh back = readNative(path);
-    expectSameMesh(m, back);
+    expectBitwiseSame(m, back);
     EXPECT_TRUE(std::isnan(back.fields[0].values[3]));
     EXPECT_TRUE(std::signbit(back.fields[0].values[4]));
 }
@@ -158,7 +145,7 @@ TEST(Native, APartIsTheWholeMeshsCellsWithTheirPointsAndFields) {
         const MeshPart expected = meshPart(m, a, b);
         EXPECT_EQ(part.pointIds, expected.pointIds);
         EXPECT_EQ(part.cellIds, expected.cellIds);
-        expectSameMesh(expected.mesh, part.mesh);
+        expectBitwiseSame(expected.mesh, part.mesh);
         ASSERT_EQ(part.mesh.cellCount(), b - a);
         // Each corner is the whole mesh's point.
         for (std::uint64_t c = 0; c < part.mesh.cellCount(); ++c)
@@ -167,21 +154,22 @@ TEST(Native, APartIsTheWholeMeshsCellsWithTheirPointsAndFields) {
     }
     // A part reads its cells' offsets and indices itself: a corrupt one is refused there,
     // naming the byte.
-    const Layout layout = layoutOf(m);
+    const FileLayout layout = layoutOf(m);
     std::string bytes = readBytes(path);
     patch(bytes, layout.indices + 4 * 5, std::uint32_t(m.pointCount()));
     const std::string badIndex = testing::writeFile(path + ".index.uvrm", bytes);
-    expectError([&] { readNativePart(badIndex, 0, 10); }, ErrorKind::Parse,
-                {"cell indices: index " + std::to_string(m.pointCount()),
-                 "byte " + std::to_string(layout.indices + 20)});
+    testing::expectError([&] { readNativePart(badIndex, 0, 10); }, ErrorKind::Parse,
+                         {"cell indices: index " + std::to_string(m.pointCount()),
+                          "byte " + std::to_string(layout.indices + 20)});
     bytes = readBytes(path);
     patch(bytes, layout.offsets + 8 * 3, std::uint64_t(0));
     const std::string badOffset = testing::writeFile(path + ".offset.uvrm", bytes);
-    expectError([&] { readNativePart(badOffset, 0, 10); }, ErrorKind::Parse,
-                {"cell offsets: offset 0 of cell 3"});
-    expectError([&] { readNativePart(path, 10, n + 1); }, ErrorKind::Argument,
-                {"part.uvrm", "cells [10, " + std::to_string(n + 1) + ")"});
-    expectError([&] { readNativePart(path, 10, 5); }, ErrorKind::Argument, {"cells [10, 5)"});
+    testing::expectError([&] { readNativePart(badOffset, 0, 10); }, ErrorKind::Parse,
+                         {"cell offsets: offset 0 of cell 3"});
+    testing::expectError([&] { readNativePart(path, 10, n + 1); }, ErrorKind::Argument,
+                         {"part.uvrm", "cells [10, " + std::to_string(n + 1) + ")"});
+    testing::expectError([&] { readNativePart(path, 10, 5); }, ErrorKind::Argument,
+                         {"cells [10, 5)"});
 }
 
 TEST(Native, HeaderAndArraysFollowTheDocumentedLayout) {
@@ -190,7 +178,7 @@ TEST(Native, HeaderAndArraysFollowTheDocumentedLayout) {
     const Mesh m = mixedMesh();
     writeNative(m, path);
     const std::string bytes = readBytes(path);
-    const Layout l = layoutOf(m);
+    const FileLayout l = layoutOf(m);
     ASSERT_EQ(bytes.size(), l.end);
     EXPECT_EQ(0, std::memcmp(bytes.data(), "UVRMESH\0", 8));
     auto u32 = [&](std::uint64_t at) {
@@ -252,7 +240,7 @@ TEST(Native, MillionTetrahedraRoundTrip) {
     writeNative(m, path);
     EXPECT_EQ(fileSize(path), layoutOf(m).end);
     const Mesh back = readNative(path);
-    expectSameMesh(m, back);
+    expectBitwiseSame(m, back);
 }
 
 TEST(Native, EmptyMeshRoundTrips) {
@@ -270,16 +258,16 @@ TEST(Native, TruncatedFilesAreParseErrorsNamingTheByte) {
     const Mesh m = mixedMesh();
     writeNative(m, dir + "/good.uvrm");
     const std::string bytes = readBytes(dir + "/good.uvrm");
-    const Layout l = layoutOf(m);
+    const FileLayout l = layoutOf(m);
     for (std::uint64_t length : std::vector<std::uint64_t>{
              0, 7, 8, 47, 48, 60, l.points, l.points + 5, l.indices + 3, l.end - 1}) {
         SCOPED_TRACE(length);
         const std::string path = testing::writeFile(dir + "/cut.uvrm", bytes.substr(0, length));
-        expectError([&] { readNative(path); }, ErrorKind::Parse, {path, "byte "});
+        testing::expectError([&] { readNative(path); }, ErrorKind::Parse, {path, "byte "});
     }
     const std::string longer = testing::writeFile(dir + "/long.uvrm", bytes + "x");
-    expectError([&] { readNative(longer); }, ErrorKind::Parse,
-                {longer, "byte " + std::to_string(l.end), "expected the file to end"});
+    testing::expectError([&] { readNative(longer); }, ErrorKind::Parse,
+                         {longer, "byte " + std::to_string(l.end), "expected the file to end"});
 }
 
 TEST(Native, WrongMagicFutureVersionAndUnknownFlagsAreRefused) {
@@ -291,18 +279,20 @@ TEST(Native, WrongMagicFutureVersionAndUnknownFlagsAreRefused) {
     std::string bytes = good;
     bytes[3] = 'X';
     std::string path = testing::writeFile(dir + "/magic.uvrm", bytes);
-    expectError([&] { readNative(path); }, ErrorKind::Parse,
-                {path, "byte 0", "magic", "got 55 56 52 58 45"});
+    testing::expectError([&] { readNative(path); }, ErrorKind::Parse,
+                         {path, "byte 0", "magic", "got 55 56 52 58 45"});
 
     bytes = good;
     patch<std::uint32_t>(bytes, 8, 2);
     path = testing::writeFile(dir + "/version.uvrm", bytes);
-    expectError([&] { readNative(path); }, ErrorKind::Unsupported, {path, "byte 8", "version 2"});
+    testing::expectError([&] { readNative(path); }, ErrorKind::Unsupported,
+                         {path, "byte 8", "version 2"});
 
     bytes = good;
     patch<std::uint32_t>(bytes, 12, 4);
     path = testing::writeFile(dir + "/flags.uvrm", bytes);
-    expectError([&] { readNative(path); }, ErrorKind::Unsupported, {path, "byte 12", "flags 4"});
+    testing::expectError([&] { readNative(path); }, ErrorKind::Unsupported,
+                         {path, "byte 12", "flags 4"});
 }
 
 TEST(Native, AbsurdCountsAreRefusedBeforeAllocating) {
@@ -322,7 +312,7 @@ TEST(Native, AbsurdCountsAreRefusedBeforeAllocating) {
         const std::string path = testing::writeFile(dir + "/bad.uvrm", bytes);
         std::vector<std::string> all = fragments;
         all.push_back(path);
-        expectError([&] { readNative(path); }, ErrorKind::Parse, all);
+        testing::expectError([&] { readNative(path); }, ErrorKind::Parse, all);
     };
     expectRefused(goodPlain, 16, std::uint64_t{1} << 60,
                   {"points: 1152921504606846976 x 12 bytes", "byte 48", "but it has 332"});
@@ -350,8 +340,8 @@ TEST(Native, AbsurdCountsAreRefusedBeforeAllocating) {
     patch(bytes, 127, 2 * cells);
     patch(bytes, 144, cells);
     const std::string path = testing::writeFile(dir + "/huge.uvrm", bytes);
-    expectError([&] { readNative(path); }, ErrorKind::Parse,
-                {path, "cellTypes: 68719476736 x 1 bytes", "byte 296"});
+    testing::expectError([&] { readNative(path); }, ErrorKind::Parse,
+                         {path, "cellTypes: 68719476736 x 1 bytes", "byte 296"});
 }
 
 TEST(Native, MemoryLimitIsAResourceError) {
@@ -359,11 +349,12 @@ TEST(Native, MemoryLimitIsAResourceError) {
     writeNative(mixedMesh(), path);
     ReadOptions options;
     options.maxMemoryBytes = 100;  // the points need 12 x 12 = 144 bytes
-    expectError([&] { readNative(path, options); }, ErrorKind::Resource,
-                {path, "points", "memory limit"});
+    testing::expectError([&] { readNative(path, options); }, ErrorKind::Resource,
+                         {path, "points", "memory limit"});
     options.maxMemoryBytes = 144;  // the limit bounds all arrays of the load together
-    expectError([&] { readNative(path, options); }, ErrorKind::Resource,
-                {path, "with the 144 bytes this load holds so far", "memory limit of 144"});
+    testing::expectError(
+        [&] { readNative(path, options); }, ErrorKind::Resource,
+        {path, "with the 144 bytes this load holds so far", "memory limit of 144"});
     options.maxMemoryBytes = meshBytes(mixedMesh());
     EXPECT_NO_THROW(readNative(path, options));
 }
@@ -373,14 +364,14 @@ TEST(Native, BadCellsAreValidationErrorsNamingTheCell) {
     const Mesh m = mixedMesh();
     writeNative(m, dir + "/good.uvrm");
     const std::string good = readBytes(dir + "/good.uvrm");
-    const Layout l = layoutOf(m);
+    const FileLayout l = layoutOf(m);
     auto expectInvalid = [&](auto mutate, const std::vector<std::string>& fragments) {
         std::string bytes = good;
         mutate(bytes);
         const std::string path = testing::writeFile(dir + "/bad.uvrm", bytes);
         std::vector<std::string> all = fragments;
         all.push_back(path);
-        expectError([&] { readNative(path); }, ErrorKind::Validation, all);
+        testing::expectError([&] { readNative(path); }, ErrorKind::Validation, all);
     };
     // Cell 2 (the wedge), corner 4 -> point 12 of 12.
     expectInvalid([&](std::string& b) { patch<std::uint32_t>(b, l.indices + 4 * (12 + 4), 12); },
@@ -404,29 +395,31 @@ TEST(Native, BadCellsAreValidationErrorsNamingTheCell) {
 
 TEST(Native, MissingFileIsAnIoError) {
     const std::string path = testing::scratchDir() + "/missing.uvrm";
-    expectError([&] { readNative(path); }, ErrorKind::Io, {path});
+    testing::expectError([&] { readNative(path); }, ErrorKind::Io, {path});
 }
 
 TEST(Native, FailedWritesLeaveNoFile) {
     const std::string dir = testing::scratchDir();
     const std::string path = dir + "/no/such/folder/out.uvrm";
-    expectError([&] { writeNative(mixedMesh(), path); }, ErrorKind::Io, {path});
+    testing::expectError([&] { writeNative(mixedMesh(), path); }, ErrorKind::Io, {path});
     EXPECT_FALSE(std::filesystem::exists(dir + "/no"));
 
     Mesh bad = mixedMesh();
     bad.fields[1].values.pop_back();
     const std::string out = dir + "/bad.uvrm";
-    expectError([&] { writeNative(bad, out); }, ErrorKind::Validation,
-                {out, "field 'velocity vector'", "35 values, expected 12 point tuples x 3"});
+    testing::expectError(
+        [&] { writeNative(bad, out); }, ErrorKind::Validation,
+        {out, "field 'velocity vector'", "35 values, expected 12 point tuples x 3"});
     bad = mixedMesh();
     bad.cellIndices[3] = 99;
-    expectError([&] { writeNative(bad, out); }, ErrorKind::Validation, {out, "cell 0", "corner 3"});
+    testing::expectError([&] { writeNative(bad, out); }, ErrorKind::Validation,
+                         {out, "cell 0", "corner 3"});
     EXPECT_TRUE(std::filesystem::is_empty(dir)) << "nothing, not even a temporary, is left";
 
     // An existing file is replaced only by a complete new one.
     writeNative(mixedMesh(), out);
     const std::string before = readBytes(out);
-    expectError([&] { writeNative(bad, out); }, ErrorKind::Validation, {out});
+    testing::expectError([&] { writeNative(bad, out); }, ErrorKind::Validation, {out});
     EXPECT_EQ(readBytes(out), before);
 }
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "test_meshes.h"
 #include "test_support.h"
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/core/error.h"
@@ -27,7 +28,6 @@
 namespace uvr {
 namespace {
 
-namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 /// Folder of the files tests/tools/write_polyhedra.py writes, generated once per process ("" when
@@ -35,10 +35,10 @@ using ::testing::HasSubstr;
 const std::string& polyDir() {
     static const std::string dir = [] {
         if (!testing::pythonHas("vtk")) return std::string();
-        const fs::path out =
-            fs::temp_directory_path() / "uvr_tests" / ("polyhedra_" + std::to_string(::getpid()));
-        fs::remove_all(out);
-        fs::create_directories(out);
+        const std::filesystem::path out = std::filesystem::temp_directory_path() / "uvr_tests" /
+                                          ("polyhedra_" + std::to_string(::getpid()));
+        std::filesystem::remove_all(out);
+        std::filesystem::create_directories(out);
         const std::string cmd = std::string(testing::systemPython()) + " " +
                                 testing::testTool("write_polyhedra.py") + " " + out.string() +
                                 " >" + (out / "log.txt").string() + " 2>&1";
@@ -55,18 +55,6 @@ const std::string& polyDir() {
 const std::vector<std::string> kVariants = {"ascii.vtu",    "binary.vtu",    "appended.vtu",
                                             "51_ascii.vtk", "51_binary.vtk", "42_ascii.vtk",
                                             "42_binary.vtk"};
-
-/// Signed volume of tetrahedron t of a mesh (as stored, not re-oriented), in double.
-double tetVolume(const Mesh& m, std::uint64_t c) {
-    const auto v = m.cell(c);
-    double e[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int a = 0; a < 3; ++a) e[i][a] = double(m.points[v[i + 1]][a]) - m.points[v[0]][a];
-    return (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-            e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-            e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
-           6.0;
-}
 
 /// Boundary faces of the tetrahedra the renderer prepares from a mesh (faces without neighbour).
 std::uint64_t boundaryFaces(const Mesh& m) {
@@ -88,7 +76,7 @@ void expectVolumesPerSourceCell(const Mesh& m, const std::vector<double>& vtkVol
         const std::size_t source = static_cast<std::size_t>(id->values[c]);
         ASSERT_LT(source, volume.size());
         if (m.cellTypes[c] == CellType::Tetra) {
-            const double v = tetVolume(m, c);
+            const double v = testing::tetVolume(m, c);
             EXPECT_GT(v, 0.0) << "cell " << c;
             volume[source] += v;
         } else {
@@ -244,7 +232,7 @@ TEST(VtkPolyhedra, CubeGridAsPolyhedraEqualsHexahedra) {
         EXPECT_EQ(m.pointCount(), 64u + 27u);
         EXPECT_EQ(boundaryFaces(m), 108u);
         double total = 0.0;
-        for (std::uint64_t c = 0; c < m.cellCount(); ++c) total += tetVolume(m, c);
+        for (std::uint64_t c = 0; c < m.cellCount(); ++c) total += testing::tetVolume(m, c);
         EXPECT_NEAR(total, 27.0, 1e-9);
         // Cell values repeated onto each cube's 12 tetrahedra, in order.
         const Field* id = m.findField("id", Association::Cell);
@@ -292,7 +280,8 @@ TEST(VtkPolyhedra, SmallVtkWrittenFilesInTestData) {
         const Field* c = m.findField("c", Association::Cell);
         ASSERT_NE(c, nullptr);
         std::map<float, double> volume;
-        for (std::uint64_t t = 0; t < m.cellCount(); ++t) volume[c->values[t]] += tetVolume(m, t);
+        for (std::uint64_t t = 0; t < m.cellCount(); ++t)
+            volume[c->values[t]] += testing::tetVolume(m, t);
         EXPECT_NEAR(volume[1.f], 1.0, 1e-6);
         EXPECT_NEAR(volume[11.f], 1.0 / 6.0, 1e-6);
         EXPECT_NEAR(volume[21.f], 1.0 / 3.0, 1e-6);
@@ -354,7 +343,7 @@ TEST(VtkPolyhedra, InwardWoundStreamIsTurnedAndNonStarShapedIsNoted) {
                    "42"));
     const Mesh in = readMesh(inward);
     ASSERT_EQ(in.cellCount(), 12u);
-    for (std::uint64_t t = 0; t < in.cellCount(); ++t) EXPECT_GT(tetVolume(in, t), 0.0);
+    for (std::uint64_t t = 0; t < in.cellCount(); ++t) EXPECT_GT(testing::tetVolume(in, t), 0.0);
     EXPECT_EQ(in.notes.size(), 1u);
 
     // A U-shaped prism (area 7, height 1): its vertex centroid (1.5, 1.375) lies in the gap of
@@ -369,7 +358,7 @@ TEST(VtkPolyhedra, InwardWoundStreamIsTurnedAndNonStarShapedIsNoted) {
             "\nCELL_TYPES 1\n42\n");
     const Mesh m = readMesh(u);
     double total = 0.0;
-    for (std::uint64_t t = 0; t < m.cellCount(); ++t) total += tetVolume(m, t);
+    for (std::uint64_t t = 0; t < m.cellCount(); ++t) total += testing::tetVolume(m, t);
     EXPECT_NEAR(total, 7.0, 1e-9);
     const ValidationReport report = validateMesh(m, u);
     EXPECT_GT(report.invertedCells, 0u);
@@ -483,3 +472,5 @@ TEST(VtkPolyhedra, MalformedVtuFaceArraysAreRefused) {
 
 }  // namespace
 }  // namespace uvr
+
+#undef REQUIRE_POLY_DIR  // file-local: the unity build joins test files

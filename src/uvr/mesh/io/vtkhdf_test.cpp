@@ -21,7 +21,6 @@
 namespace uvr {
 namespace {
 
-namespace fs = std::filesystem;
 using testing::catchError;
 
 /// The h5py-written files, once per test process (tests run as separate processes in CTest);
@@ -30,15 +29,15 @@ const std::string& casesDir() {
     static const std::string dir = [] {
         if (!vtkHdfSupported() || !testing::pythonHas("h5py") || !testing::pythonHas("numpy"))
             return std::string();
-        const std::string d = (fs::temp_directory_path() / "uvr_tests" /
+        const std::string d = (std::filesystem::temp_directory_path() / "uvr_tests" /
                                ("vtkhdf_cases_" + std::to_string(::getpid())))
                                   .string();
-        fs::remove_all(d);
+        std::filesystem::remove_all(d);
         static std::string removeAtExit;
         removeAtExit = d;
         std::atexit([] {
             std::error_code ec;
-            fs::remove_all(removeAtExit, ec);
+            std::filesystem::remove_all(removeAtExit, ec);
         });
         const std::string cmd = std::string(testing::systemPython()) + " " +
                                 testing::testTool("write_vtkhdf_cases.py") + " " + d;
@@ -298,11 +297,11 @@ TEST(VtkHdf, GhostFlagsLeaveOutHiddenCellsAsParaViewDoes) {
 TEST(VtkHdf, RecognisesHdf5ByItsVtkhdfGroup) {
     REQUIRE_CASES();
     const std::string dir = testing::scratchDir();
-    fs::copy_file(caseFile("mixed.vtkhdf"), dir + "/mixed.h5");
+    std::filesystem::copy_file(caseFile("mixed.vtkhdf"), dir + "/mixed.h5");
     EXPECT_EQ(readMesh(dir + "/mixed.h5").cellCount(), 5u);
     EXPECT_EQ(openMeshSeries(dir + "/mixed.h5")->readStep(0).cellCount(), 5u);
     // Another HDF5 file (a netCDF-4 Exodus file, say) without the extension is not taken.
-    fs::copy_file(caseFile("bad_no_vtkhdf.hdf"), dir + "/other.h5");
+    std::filesystem::copy_file(caseFile("bad_no_vtkhdf.hdf"), dir + "/other.h5");
     EXPECT_FALSE(looksLikeVtkHdf(dir + "/other.h5"));
     const Error e = catchError([&] { (void)readMesh(dir + "/other.h5"); });
     EXPECT_NE(std::string(e.what()).find("unrecognised file format"), std::string::npos)
@@ -455,7 +454,7 @@ TEST(VtkHdf, WrittenFilesReadBackIdentically) {
     for (const char* name : {"bluntfin_tets.vtk", "fire_ug.vtu", "hexa.vtk"}) {
         SCOPED_TRACE(name);
         const std::string source = testing::sharedData(name);
-        if (!fs::exists(source)) continue;
+        if (!std::filesystem::exists(source)) continue;
         const Mesh mesh = readMesh(source);
         const std::string out = dir + "/out.vtkhdf";
         double last = -1;
@@ -494,7 +493,7 @@ TEST(VtkHdf, WriterRefusesNamesHdf5CannotHold) {
     const Error e = catchError([&] { writeVtkHdf(mesh, dir + "/x.vtkhdf"); });
     EXPECT_EQ(e.kind(), ErrorKind::Argument);
     EXPECT_NE(std::string(e.what()).find("'a/b'"), std::string::npos) << e.what();
-    EXPECT_FALSE(fs::exists(dir + "/x.vtkhdf"));
+    EXPECT_FALSE(std::filesystem::exists(dir + "/x.vtkhdf"));
     mesh.fields[0].name = "a";
     mesh.fields.push_back({"a", Association::Point, 1, {1, 2, 3, 4}});
     EXPECT_EQ(catchError([&] { writeVtkHdf(mesh, dir + "/x.vtkhdf"); }).kind(),
@@ -518,3 +517,5 @@ TEST(VtkHdf, ConvertWritesVtkhdf) {
 
 }  // namespace
 }  // namespace uvr
+
+#undef REQUIRE_CASES  // file-local: the unity build joins test files

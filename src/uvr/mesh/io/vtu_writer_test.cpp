@@ -82,7 +82,7 @@ nlohmann::json writeAndReadWithVtk(const Mesh& mesh, const std::string& dir) {
 
 /// One tetra, hexahedron, wedge and pyramid (positively oriented, sharing faces' points), with
 /// point and cell fields whose names need XML escaping.
-Mesh mixedMesh() {
+Mesh orientedMixedMesh() {
     Mesh m;
     // A 2 x 1 x 1 block of points (i, j, k) -> i + 3 (j + 2 k), plus an apex above it.
     for (int k = 0; k < 2; ++k)
@@ -120,7 +120,7 @@ void expectArray(const nlohmann::json& a, const Field& f) {
         EXPECT_EQ(static_cast<float>(values[i]), f.values[i]) << f.name << " value " << i;
 }
 
-/// Checks VTK's dump of a file written from mixedMesh() (m).
+/// Checks VTK's dump of a file written from orientedMixedMesh() (m).
 void expectMixedMesh(const nlohmann::json& j, const Mesh& m) {
     ASSERT_EQ(j["points"], m.pointCount());
     ASSERT_EQ(j["cells"], m.cellCount());
@@ -155,12 +155,12 @@ void expectMixedMesh(const nlohmann::json& j, const Mesh& m) {
 
 TEST(VtuWriter, VtkReadsBackEveryCellPointAndField) {
     if (!testing::pythonHas("vtk")) GTEST_SKIP() << "system Python has no vtk module";
-    const Mesh m = mixedMesh();
+    const Mesh m = orientedMixedMesh();
     expectMixedMesh(writeAndReadWithVtk(m, testing::scratchDir()), m);
 }
 
 /// Expects a and b to hold the same points, cells and fields, bit for bit.
-void expectSameMesh(const Mesh& a, const Mesh& b) {
+void expectSameMeshByFieldName(const Mesh& a, const Mesh& b) {
     ASSERT_EQ(a.points.size(), b.points.size());
     for (size_t i = 0; i < a.points.size(); ++i)
         for (int c = 0; c < 3; ++c) EXPECT_EQ(a.points[i][c], b.points[i][c]) << "point " << i;
@@ -180,7 +180,7 @@ void expectSameMesh(const Mesh& a, const Mesh& b) {
 
 TEST(VtuWriter, EveryCompressorIsReadBackByVtkAndUvr) {
     const bool vtk = testing::pythonHas("vtk");
-    const Mesh m = mixedMesh();
+    const Mesh m = orientedMixedMesh();
     for (VtuCompressor c :
          {VtuCompressor::None, VtuCompressor::Zlib, VtuCompressor::Lz4, VtuCompressor::Lzma}) {
         SCOPED_TRACE(static_cast<int>(c));
@@ -191,7 +191,7 @@ TEST(VtuWriter, EveryCompressorIsReadBackByVtkAndUvr) {
         options.compressor = c;
         options.blockSize = 64;  // several blocks per array, a partial last one
         writeVtu(m, path, {}, options);
-        expectSameMesh(m, readVtu(path));
+        expectSameMeshByFieldName(m, readVtu(path));
         const std::vector<char> bytes = readFileBytes(path);
         const std::string text(bytes.begin(), bytes.end());
         EXPECT_EQ(text.find("compressor=") != std::string::npos, c != VtuCompressor::None);
@@ -208,7 +208,7 @@ TEST(VtuWriter, CompressionShrinksAProceduralMeshAndKeepsItExact) {
     plain.compressor = VtuCompressor::None;
     writeVtu(m, dir + "/plain.vtu", {}, plain);
     writeVtu(m, dir + "/zlib.vtu");  // the default: zlib, 64 KiB blocks
-    expectSameMesh(m, readVtu(dir + "/zlib.vtu"));
+    expectSameMeshByFieldName(m, readVtu(dir + "/zlib.vtu"));
     EXPECT_LT(std::filesystem::file_size(dir + "/zlib.vtu"),
               std::filesystem::file_size(dir + "/plain.vtu") * 6 / 10);
 }
@@ -218,7 +218,7 @@ TEST(VtuWriter, BadBlockSizeIsAnArgumentError) {
     options.blockSize = 12;
     const std::string path = testing::scratchDir() + "/mesh.vtu";
     try {
-        writeVtu(mixedMesh(), path, {}, options);
+        writeVtu(orientedMixedMesh(), path, {}, options);
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Argument);
@@ -228,7 +228,7 @@ TEST(VtuWriter, BadBlockSizeIsAnArgumentError) {
 
 TEST(VtkLegacyWriter, VtkAndUvrReadBackBothVersions) {
     const bool vtk = testing::pythonHas("vtk");
-    const Mesh m = mixedMesh();
+    const Mesh m = orientedMixedMesh();
     for (VtkLegacyVersion v :
          {VtkLegacyVersion::Auto, VtkLegacyVersion::V42, VtkLegacyVersion::V51}) {
         SCOPED_TRACE(static_cast<int>(v));
@@ -243,7 +243,7 @@ TEST(VtkLegacyWriter, VtkAndUvrReadBackBothVersions) {
                   0u);
         EXPECT_THAT(text, HasSubstr("SCALARS temperature float 1\nLOOKUP_TABLE default\n"));
         EXPECT_THAT(text, HasSubstr("velocity%20<m/s> 3 14 float\n"));
-        expectSameMesh(m, readVtkLegacy(path));
+        expectSameMeshByFieldName(m, readVtkLegacy(path));
         if (!vtk) continue;
         const nlohmann::json j = readWithVtk(path, dir);
         expectMixedMesh(j, m);
@@ -251,7 +251,7 @@ TEST(VtkLegacyWriter, VtkAndUvrReadBackBothVersions) {
 }
 
 TEST(VtkLegacyWriter, FailedWritesLeaveNoFile) {
-    Mesh bad = mixedMesh();
+    Mesh bad = orientedMixedMesh();
     bad.cellIndices[3] = 99;
     const std::string dir = testing::scratchDir();
     try {
@@ -294,7 +294,7 @@ TEST(VtuWriter, VtkSeesTheCountsRangesAndVolumeOfAProceduralMesh) {
 
 TEST(VtuWriter, HeaderDeclaresTheAgreedEncoding) {
     const std::string path = testing::scratchDir() + "/mesh.vtu";
-    writeVtu(mixedMesh(), path);
+    writeVtu(orientedMixedMesh(), path);
     std::vector<char> bytes = readFileBytes(path);
     const std::string text(bytes.begin(), bytes.end());
     EXPECT_THAT(text, HasSubstr("type=\"UnstructuredGrid\" version=\"1.0\" "
@@ -311,13 +311,13 @@ TEST(VtuWriter, FailedWritesLeaveNoFile) {
     const std::string dir = testing::scratchDir();
     const std::string missing = dir + "/no/folder/mesh.vtu";
     try {
-        writeVtu(mixedMesh(), missing);
+        writeVtu(orientedMixedMesh(), missing);
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Io);
         EXPECT_THAT(e.what(), HasSubstr(missing));
     }
-    Mesh bad = mixedMesh();
+    Mesh bad = orientedMixedMesh();
     bad.fields[3].values.push_back(9.f);
     const std::string out = dir + "/bad.vtu";
     try {
