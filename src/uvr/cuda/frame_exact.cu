@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The exact method's frame kernels (frame_launch.cuh): six instances, compiled on their own.
+// The exact method's frame kernels (frame_launch.cuh): eight instances, compiled on their own.
 #include "uvr/cuda/frame_launch.cuh"
 
 namespace uvr::cuda {

@@ -2,7 +2,7 @@
 #pragma once
 
 // The frame kernels: one thread per pixel runs the shared pixel body (render/frame_kernel.h)
-// with an integrator's functor. Each method's six instances (dispatchKernel) are compiled in a
+// with an integrator's functor. Each method's eight instances (dispatchKernel) are compiled in a
 // translation unit of their own (frame_reference.cu, frame_exact.cu, frame_partitions.cu), so
 // the three compile in parallel; cuda_renderer.cu calls launchReference, launchExact and
 // launchPartitions.

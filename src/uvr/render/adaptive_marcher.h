@@ -204,10 +204,10 @@ struct PartitionSceneView {
 /// samples (the one just past it too), so the surface lies where the reference's samples put
 /// it, to within s1, whatever the step. Not inlined: only frames with isosurfaces call it, at
 /// the steps that cross one.
-template <bool kNative>
+template <bool kNative, bool kLit>
 UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, const Ray& ray,
                                             float kSample, float k1, std::uint32_t tet,
-                                            SampleSegments<true, true>& segments,
+                                            SampleSegments<kLit, true>& segments,
                                             RayCounters& counters, Vec4f& acc) {
     const TetLocator& locator = scene.base.locator;
     const MarchParams& params = scene.base.params;
@@ -231,20 +231,21 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
         if (found == kNoTet) break;  // a hole in the mesh: the step's linear reading stands
         from = found;
         const float vMid = locator.mesh.interpolate<kNative>(found, bary);
-        const Vec3f gradMid = sampleGradient<kNative, true>(params, locator.mesh, found, bary);
+        const Vec3f gradMid = sampleGradient<kNative, kLit>(params, locator.mesh, found, bary);
         if (iso.crossesOdd(vLo, vMid)) {  // the crossing lies before mid
             hi = mid, vHi = vMid, gradHi = gradMid, atHi = SamplePoint(found, bary), haveHi = true;
         } else {  // after it: the run goes on to mid
-            segments.add(scene.base.tf, mid, k1, true, vMid, s1, params.opacityUnit, acc,
-                         lightAt(params.light, params.gradientOpacity, found, gradMid, ray.dir),
-                         SamplePoint(found, bary));
+            segments.add(
+                scene.base.tf, mid, k1, true, vMid, s1, params.opacityUnit, acc,
+                lightAt<kLit>(params.light, params.gradientOpacity, found, gradMid, ray.dir),
+                SamplePoint(found, bary));
             lo = mid, vLo = vMid;
         }
     }
     if (haveHi)
-        segments.add(scene.base.tf, hi, k1, true, vHi, s1, params.opacityUnit, acc,
-                     lightAt(params.light, params.gradientOpacity, atHi.cell, gradHi, ray.dir),
-                     atHi);
+        segments.add(
+            scene.base.tf, hi, k1, true, vHi, s1, params.opacityUnit, acc,
+            lightAt<kLit>(params.light, params.gradientOpacity, atHi.cell, gradHi, ray.dir), atHi);
 }
 
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
@@ -304,7 +305,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const float stopAlpha = stop < 0.f ? scene.base.params.terminationAlpha : stop;
     const TfTableView& tf = scene.base.tf;
     const bool preintegrated = scene.base.params.preintegrated;
-    const Lighting lighting = kernelLighting<kLit>(scene.base.params);
+    const Lighting lighting = kernelLighting<kLit, kSurf>(scene.base.params);
     SampleSegments<kLit, kSurf> segments;
     segments.setIsos(scene.base.params.iso, lighting, ray.dir,
                      rayDepthAlpha(scene.base.params, counters), locator.mesh);
@@ -599,7 +600,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 if (in && segments.iso && segments.started && segments.inside &&
                     kSample <= segments.kEnd && kSample - segments.kLast > 1.f &&
                     segments.iso->crossesOdd(segments.vLast, v))
-                    bisectIso<kNative>(scene, ray, kSample, k1, tet, segments, counters, acc);
+                    bisectIso<kNative, kLit>(scene, ray, kSample, k1, tet, segments, counters, acc);
             }
             if (in) lastInside = tet;
             if constexpr (kSurf) {

@@ -203,13 +203,14 @@ UVR_HOST_DEVICE inline float nativeSegment(const TetMeshView& mesh, const TfTabl
         for (int i = 0; i < n; ++i) v += w[i] * cv[i];
         return v < cvLo ? cvLo : (v > cvHi ? cvHi : v);  // NaN stays NaN
     };
-    // The light at the parametric coordinates rst of the last point valueAt took.
+    // The light at the parametric coordinates rst of the last point valueAt took (the
+    // volume's only where the instance is lit; the isosurfaces' always).
     auto lightWith = [&](const Lighting& l, const GradientOpacity& g) {
-        if (!kLit || !readsGradient(l, g)) return LightFactors{};
+        if (!readsGradient(l, g)) return LightFactors{};
         const float at[4] = {rst.x, rst.y, rst.z, 0.f};
         return lightFactors(l, g, mesh.gradient(t, at, l.smooth), ray.dir);
     };
-    auto lightHere = [&]() { return lightWith(light, gop); };
+    auto lightHere = [&]() { return kLit ? lightWith(light, gop) : LightFactors{}; };
     const float vMid = valueAt(0.5 * (t0 + t1));
     const Vec3f rstMid = rst;
     LightFactors lightA;  // at the start of the piece
@@ -440,8 +441,9 @@ UVR_HOST_DEVICE UVR_INLINE void tetPiece(const SceneView& scene, std::uint32_t t
 /// A tetrahedron's segment [t, tEnd] (scalar linear from s0 to s1) with the frame's
 /// isosurfaces: integrated up to each crossing (exact: the scalar is linear), the surface
 /// composited there, lit by its normal at that point, and the rest after it. Not inlined: only
-/// frames with isosurfaces call it.
-template <bool kNative>
+/// frames with isosurfaces call it. The volume is lit where the instance is (kLit); the
+/// surfaces always are.
+template <bool kNative, bool kLit>
 UVR_HOST_DEVICE UVR_NOINLINE void isoTetSegment(const SceneView& scene, std::uint32_t tet,
                                                 const Ray& ray, double t, double tEnd, float s0,
                                                 float s1, const Lighting& light,
@@ -453,7 +455,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void isoTetSegment(const SceneView& scene, std::uin
         if (acc.w >= segment::kOpacityEnd) return;
         const IsoSurface& iso = isos.surfaces[i];
         const double tc = t + (tEnd - t) * double(f);
-        tetPiece<kNative, true, true>(scene, tet, ray, ta, tc, va, iso.value, light, true, counters,
+        tetPiece<kNative, kLit, true>(scene, tet, ray, ta, tc, va, iso.value, light, true, counters,
                                       acc);
         const LightFactors lit =
             lightInTet<kNative>(scene.locator.mesh, tet, ray, tc, surfaceLighting(light));
@@ -463,7 +465,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void isoTetSegment(const SceneView& scene, std::uin
         ta = tc, va = iso.value;
     });
     if (acc.w < segment::kOpacityEnd)
-        tetPiece<kNative, true, true>(scene, tet, ray, ta, tEnd, va, s1, light, true, counters,
+        tetPiece<kNative, kLit, true>(scene, tet, ray, ta, tEnd, va, s1, light, true, counters,
                                       acc);
 }
 
@@ -511,7 +513,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     // A gap this small between tetrahedra is rounding, not empty space.
     const double eps = 1e-6 * (double(scene.bounds.diagonal()) + double(b0));
     const double unit = scene.params.opacityUnit;
-    const Lighting lighting = kernelLighting<kLit>(scene.params);
+    const Lighting lighting = kernelLighting<kLit, kSurf>(scene.params);
     const IsoView* isos = kSurf && scene.params.iso.active() ? &scene.params.iso : nullptr;
     double t = b0;
     exact::TetSpan span;
@@ -555,8 +557,8 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 bool done = false;
                 if constexpr (kSurf) {
                     if (isos && continuous) {
-                        exact::isoTetSegment<kNative>(scene, tet, ray, t, tEnd, s0, s1, lighting,
-                                                      counters, acc);
+                        exact::isoTetSegment<kNative, kLit>(scene, tet, ray, t, tEnd, s0, s1,
+                                                            lighting, counters, acc);
                         done = true;
                     }
                 }

@@ -167,15 +167,18 @@ struct PartitionMarch {
 };
 
 /// Calls f(kNative, kLit, kSurf) with std::true_type or std::false_type for each: kNative when
-/// the mesh has native cells; kLit when the frame is shaded or kSurf; kSurf when it has
-/// isosurfaces or writes depth (the integrator functors' parameters: each compiled six times,
-/// so a frame runs without the code it does not need; the isosurfaces' and depth's code in the
-/// shaded kernels cost them 40-90% on the H200).
+/// the mesh has native cells; kLit when the frame is shaded (or has a gradient opacity); kSurf
+/// when it has isosurfaces, a cut face or writes depth (the integrator functors' parameters: each
+/// compiled eight times, so a frame runs without the code it does not need; the isosurfaces' and
+/// depth's code in the shaded kernels cost them 40-90% on the H200, and the volume's lighting
+/// code cost an unshaded frame with isosurfaces, which lights only them, 9% on the H100).
 template <typename F>
 void dispatchKernel(bool hasNative, bool lit, bool surfaces, F&& f) {
     auto withExtras = [&](auto kNative) {
-        if (surfaces)
+        if (surfaces && lit)
             f(kNative, std::true_type{}, std::true_type{});
+        else if (surfaces)
+            f(kNative, std::false_type{}, std::true_type{});
         else if (lit)
             f(kNative, std::true_type{}, std::false_type{});
         else

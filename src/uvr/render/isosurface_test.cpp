@@ -237,6 +237,37 @@ TEST_P(Iso, ValuesTheFieldNeverTakesChangeNoBit) {
     }
 }
 
+TEST_P(Iso, AnUnshadedFrameLightsItsSurfacesAsTheLitInstanceDoes) {
+    // An unshaded frame with isosurfaces runs the instance without the volume's lighting code
+    // (dispatchKernel); a gradient opacity of 1 everywhere changes no pixel but runs the lit
+    // one. Both must light the surfaces with the frame's coefficients (and a translucent one
+    // over a visible volume, on tetrahedra and hexahedra, smooth normals and per cell).
+    for (const bool split : {true, false}) {
+        const PreparedMesh pm = smoothGrid(distanceField, split, 8);
+        for (const bool smooth : {true, false})
+            for (const RenderMethod m : testing::kEveryMethod) {
+                RenderSettings s = surfacesAlongX(m, 24);
+                applyOpacitySpec(s.tf, "0:0,0.3:0,0.5:0.8,1:0.2");
+                s.step = 1.f / 64.f;
+                s.maxStep = 4.f * s.step;  // given: the opacity rule of lit frames stays off
+                s.lighting.smooth = smooth;
+                s.lighting.ambient = 0.2f;
+                s.lighting.diffuse = 0.6f;
+                s.lighting.specular = 0.4f;
+                s.lighting.specularPower = 8.f;
+                s.isoSurfaces = {white(0.25f, 0.5f), white(0.4f)};
+                const RenderResult unlit = render(pm, s);
+                s.gradientOpacity = parseGradientOpacity("0:1");
+                const RenderResult lit = render(pm, s);
+                const std::string what = std::string(methodName(m)) +
+                                         (split ? " tetrahedra" : " hexahedra") +
+                                         (smooth ? " smooth" : " per cell");
+                EXPECT_LE(testing::maxPixelDifference(unlit.image, lit.image), 1e-6f) << what;
+                EXPECT_EQ(unlit.stats.samples, lit.stats.samples) << what;
+            }
+    }
+}
+
 TEST_P(Iso, PointSamplingFindsTheSurfaceBetweenSamples) {
     // Point samples: the surface between two samples at the linear reading's crossing.
     const PreparedMesh pm = smoothGrid(distanceField, true);

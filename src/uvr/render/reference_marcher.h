@@ -188,7 +188,7 @@ private:
         iso->crossings(vLast, v, [&](int i, float f) {
             if (acc.w >= segment::kOpacityEnd) return;
             const IsoSurface& s = iso->surfaces[i];
-            integrateLit(tf, va, s.value, double(f - f0) * len, unit, vol, acc);
+            integrateLit<kLit>(tf, va, s.value, double(f - f0) * len, unit, vol, acc);
             const Vec3f gi = normals.at(*mesh, surface.smooth, atLast, at, f);
             const float a0 = acc.w;
             compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
@@ -197,7 +197,7 @@ private:
             f0 = f, va = s.value;
         });
         if (acc.w >= segment::kOpacityEnd) return;
-        integrateLit(tf, va, v, double(1.f - f0) * len, unit, vol, acc);
+        integrateLit<kLit>(tf, va, v, double(1.f - f0) * len, unit, vol, acc);
     }
 
     /// The last sample's share: `steps` grid steps along the run's last slope (in double: the
@@ -349,11 +349,12 @@ UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParam
 }
 
 /// The lighting an integrator instance reads: the frame's, or none where it is compiled unlit
-/// (kLit false: its kernels carry no lighting code, which cost the unlit adaptive kernel up to
-/// 21% of its frame time on the H200).
-template <bool kLit>
+/// and without surfaces (kLit and kSurf false: its kernels carry no lighting code, which cost the
+/// unlit adaptive kernel up to 21% of its frame time on the H200). An unlit instance with
+/// surfaces lights only them (surfaceLighting); its volume code is compiled out by kLit.
+template <bool kLit, bool kSurf = false>
 UVR_HOST_DEVICE inline Lighting kernelLighting(const MarchParams& params) {
-    if constexpr (kLit)
+    if constexpr (kLit || kSurf)
         return params.light;
     else
         return Lighting{};
@@ -410,7 +411,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float unit = scene.params.opacityUnit;
     const float stopAlpha = stop < 0.f ? scene.params.terminationAlpha : stop;
     SampleSegments<kLit, kSurf> segments;
-    const Lighting lighting = kernelLighting<kLit>(scene.params);
+    const Lighting lighting = kernelLighting<kLit, kSurf>(scene.params);
     segments.setIsos(scene.params.iso, lighting, ray.dir, rayDepthAlpha(scene.params, counters),
                      scene.locator.mesh);
     if (pieceStart && scene.params.preintegrated && k - 1.f >= ceilf(tSpan / s)) {

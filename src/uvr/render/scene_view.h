@@ -52,10 +52,9 @@ UVR_HOST_DEVICE inline bool surfacesKernel(const MarchParams& p) {
 }
 
 /// Whether a frame runs the integrators' lit instances (kLit): shaded or with a gradient opacity
-/// (readsGradient), or with the surfaces' instances (isosurfaces are lit and need the
-/// gradients).
+/// (readsGradient). The surfaces' instances light their surfaces either way.
 UVR_HOST_DEVICE inline bool litKernel(const MarchParams& p) {
-    return readsGradient(p.light, p.gradientOpacity) || surfacesKernel(p);
+    return readsGradient(p.light, p.gradientOpacity);
 }
 
 /// Everything a ray needs, as plain data for CPU and GPU.
