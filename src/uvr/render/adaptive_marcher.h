@@ -203,7 +203,9 @@ struct PartitionSceneView {
 /// last one found, narrow the crossing to within s1, and the probes before it join the run as
 /// samples (the one just past it too), so the surface lies where the reference's samples put
 /// it, to within s1, whatever the step. Not inlined: only frames with isosurfaces call it, at
-/// the steps that cross one.
+/// the steps that cross one (inlined, with withIsos, the 100M isosurface frames got slower on
+/// the H100: PERFORMANCE.md, "Isosurfaces: what the surfaces' code costs a frame with no
+/// surface").
 template <bool kNative, bool kLit>
 UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, const Ray& ray,
                                             float kSample, float k1, std::uint32_t tet,

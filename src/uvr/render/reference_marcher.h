@@ -178,7 +178,9 @@ struct SampleSegments {
 private:
     /// The segment from the last sample to one of value v lying at `at` over len, split at
     /// the isosurfaces it crosses (volume lit by vol). Not inlined: only frames with
-    /// isosurfaces call it, and inlined it cost the shaded kernel its inlined add().
+    /// isosurfaces call it, and inlined it cost the shaded kernel its inlined add() (and with
+    /// bisectIso, the 100M frames on the H100: PERFORMANCE.md, "Isosurfaces: what the surfaces'
+    /// code costs a frame with no surface").
     UVR_HOST_DEVICE UVR_NOINLINE void withIsos(const TfTableView& tf, float v, float k, float s1,
                                                double unit, const LightFactors& vol,
                                                const SamplePoint& at, Vec4f& acc) {
@@ -280,7 +282,8 @@ inline constexpr int kBoundaryBisections = 10;
 /// and the sample (vIn its value) the run gets a sample at the boundary. So a surface
 /// between the boundary and the nearest grid sample (a thin layer at the mesh's skin, which no
 /// pair of grid samples brackets: rings where the grid happened to) is crossed where the exact
-/// integrator crosses it. Not inlined: only frames with isosurfaces call it, at a run's ends.
+/// integrator crosses it. Not inlined: only frames with isosurfaces call it, at a run's ends
+/// (inlined, the 100M frames got slower on the H100, and ptxas took twice as long).
 template <bool kNative, bool kLit, bool kSurf, class Locate>
 UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const MarchParams& params,
                                                    const TetMeshView& mesh, const TfTableView& tf,
