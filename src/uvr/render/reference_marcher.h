@@ -283,7 +283,8 @@ inline constexpr int kBoundaryBisections = 10;
 /// between the boundary and the nearest grid sample (a thin layer at the mesh's skin, which no
 /// pair of grid samples brackets: rings where the grid happened to) is crossed where the exact
 /// integrator crosses it. Not inlined: only frames with isosurfaces call it, at a run's ends
-/// (inlined, the 100M frames got slower on the H100, and ptxas took twice as long).
+/// (inlined with the other three surface calls, the 100M frames got slower on the H100, and
+/// ptxas took twice as long).
 template <bool kNative, bool kLit, bool kSurf, class Locate>
 UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const MarchParams& params,
                                                    const TetMeshView& mesh, const TfTableView& tf,
