@@ -24,9 +24,18 @@ constexpr int kCounters = 5;
 constexpr int kFrameBlock = 128;
 constexpr int kFrameBlocksPerSm = 4;
 
+/// Blocks per multiprocessor of a march's frame kernel: kFrameBlocksPerSm, but 2 (255
+/// registers, no spills) for the partition integrator with surfaces, which spilled at 128
+/// registers around its non-inlined surface calls (on an H200, 100M graded box: 6% faster with
+/// isosurfaces, the same samples; the reference's surface instance got 20% slower at 2).
+template <class March>
+inline constexpr int kBlocksPerSm = kFrameBlocksPerSm;
+template <bool kNative, bool kLit>
+inline constexpr int kBlocksPerSm<PartitionMarch<kNative, kLit, true>> = 2;
+
 /// Kernel: one thread per pixel runs the shared pixel body, then the warp sums its counters.
 template <bool Supersampled, class March>
-__global__ void __launch_bounds__(kFrameBlock, kFrameBlocksPerSm)
+__global__ void __launch_bounds__(kFrameBlock, kBlocksPerSm<March>)
     frameKernel(FrameView frame, March march, unsigned long long* totals) {
     const int x = blockIdx.x * blockDim.x + threadIdx.x;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;

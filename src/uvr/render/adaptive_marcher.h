@@ -309,8 +309,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     const bool preintegrated = scene.base.params.preintegrated;
     const Lighting lighting = kernelLighting<kLit, kSurf>(scene.base.params);
     SampleSegments<kLit, kSurf> segments;
-    segments.setIsos(scene.base.params.iso, lighting, ray.dir,
-                     rayDepthAlpha(scene.base.params, counters), locator.mesh);
+    const RaySurfaces surfaces(scene.base.params.iso, lighting, ray.dir,
+                               rayDepthAlpha(scene.base.params, counters), locator.mesh);
+    segments.setIsos(surfaces);
     PointIsos<kSurf> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
     // Isosurfaces: where a run may start at the mesh's boundary (sampleAtBoundary): after the
@@ -320,15 +321,20 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     [[maybe_unused]] float kRunFrom = tEnter / s1;
     [[maybe_unused]] bool runFromOutside = false, runFromValid = !pieceStart;
     [[maybe_unused]] bool skipped = false;  // a transparent partition or macrocell since a sample
-    [[maybe_unused]] const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b) {
-        std::uint32_t found = locator.walk<kNative>(q, from, b, counters.locate);
-        if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, counters.locate);
+    [[maybe_unused]] const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b,
+                                                 LocateCounters& c) {
+        std::uint32_t found = locator.walk<kNative>(q, from, b, c);
+        if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, c);
         return found;
     };
     if constexpr (kSurf) {  // the cut face in front: nothing else shows
-        if (cut0 && cutFace<kNative>(locateFrom, scene.base.params, locator.mesh, tf, ray, tEnter,
-                                     n0, kNoTet, counters, acc))
-            return acc;
+        bool hit = false;
+        if (cut0)
+            callOnCopies(counters, acc, [&](RayCounters& c, Vec4f& a) {
+                hit = cutFace<kNative>(locateFrom, scene.base.params, locator.mesh, tf, ray, tEnter,
+                                       n0, kNoTet, c, a);
+            });
+        if (hit) return acc;
     }
     std::uint32_t tet = kNoTet;
     float bary[4] = {0.f, 0.f, 0.f, 0.f};
@@ -340,9 +346,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (kFirst - 1.f >= ceilf(tSpan / s1)) {
             ++counters.samples;
             float b[4];
-            std::uint32_t found = locateFrom(ray.at(kFirst * s1), kNoTet, b);
+            std::uint32_t found = locateFrom(ray.at(kFirst * s1), kNoTet, b, counters.locate);
             const bool firstIn = found != kNoTet;
-            if (firstIn) found = locateFrom(ray.at((kFirst - 1.f) * s1), found, b);
+            if (firstIn) found = locateFrom(ray.at((kFirst - 1.f) * s1), found, b, counters.locate);
             if (found != kNoTet)
                 segments.lead(kFirst - 1.f, true, locator.mesh.interpolate<kNative>(found, b));
             if constexpr (kSurf) {
@@ -351,7 +357,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // does; a surface between the boundary and the run's first grid sample is
                 // crossed there.
                 if (segments.iso && !firstIn)
-                    found = locateFrom(ray.at((kFirst - 1.f) * s1), kNoTet, b);
+                    found = locateFrom(ray.at((kFirst - 1.f) * s1), kNoTet, b, counters.locate);
                 if (segments.iso && found == kNoTet)
                     kRunFrom = kFirst - 1.f, runFromOutside = true, runFromValid = true;
             }
@@ -390,9 +396,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     [[maybe_unused]] const auto endRunAtShare = [&]() {
         const KdPartition& a = scene.kd.partitions[pInside];
         if (segments.iso->within(a.valueMin, a.valueMax))
-            sampleAtBoundary<kNative, kLit, kSurf>(
-                locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, segments.kEnd, true,
-                segments.kLast, lastInside, segments.vLast, segments.kEnd, segments, counters, acc);
+            callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& acs) {
+                sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator.mesh,
+                                                       tf, ray, lighting, sc.kEnd, true, sc.kLast,
+                                                       lastInside, sc.vLast, sc.kEnd, sc, c, acs);
+            });
         if (!skipped) kRunFrom = segments.kEnd, runFromOutside = true, runFromValid = true;
     };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
@@ -585,10 +593,13 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 if constexpr (kSurf) {
                     // With isosurfaces the run starts or ends at the boundary itself.
                     if (segments.iso && (!in || runFromValid) && isoNear())
-                        sampleAtBoundary<kNative, kLit, kSurf>(
-                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
-                            in ? lo : hi, true, in ? hi : segments.kLast, from,
-                            in ? vHi : segments.vLast, k1, segments, counters, acc);
+                        callOnCopies(segments, counters, acc,
+                                     [&](auto& sc, RayCounters& c, Vec4f& a) {
+                                         sampleAtBoundary<kNative, kLit, kSurf>(
+                                             locateFrom, scene.base.params, locator.mesh, tf, ray,
+                                             lighting, in ? lo : hi, true, in ? hi : sc.kLast, from,
+                                             in ? vHi : sc.vLast, k1, sc, c, a);
+                                     });
                     if (in) runFromValid = false;
                 }
                 if (in && hi < kSample)
@@ -602,7 +613,9 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 if (in && segments.iso && segments.started && segments.inside &&
                     kSample <= segments.kEnd && kSample - segments.kLast > 1.f &&
                     segments.iso->crossesOdd(segments.vLast, v))
-                    bisectIso<kNative, kLit>(scene, ray, kSample, k1, tet, segments, counters, acc);
+                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                        bisectIso<kNative, kLit>(scene, ray, kSample, k1, tet, sc, c, a);
+                    });
             }
             if (in) lastInside = tet;
             if constexpr (kSurf) {
@@ -612,15 +625,18 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // share ended before this sample goes on no further.)
                 const bool runGoesOn = segments.inside && kSample <= segments.kEnd;
                 if (in && segments.iso && runFromValid && !runGoesOn && isoNear())
-                    sampleAtBoundary<kNative, kLit, kSurf>(
-                        locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kRunFrom,
-                        runFromOutside, kSample, tet, v, k1, segments, counters, acc);
+                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                        sampleAtBoundary<kNative, kLit, kSurf>(
+                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
+                            kRunFrom, runFromOutside, kSample, tet, v, k1, sc, c, a);
+                    });
                 if (!in && segments.iso && segments.started && segments.inside && !segments.led &&
                     kSample <= segments.kEnd && !endsRun && isoNear())
-                    sampleAtBoundary<kNative, kLit, kSurf>(
-                        locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kSample,
-                        true, segments.kLast, lastInside, segments.vLast, k1, segments, counters,
-                        acc);
+                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                        sampleAtBoundary<kNative, kLit, kSurf>(
+                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kSample,
+                            true, sc.kLast, lastInside, sc.vLast, k1, sc, c, a);
+                    });
                 if (in) {
                     runFromValid = false;
                 } else {
@@ -652,7 +668,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         if (segments.started && segments.inside && segments.kEnd >= kClose) {
             ++counters.samples;
             const Vec3f q = ray.at(kClose * s1);
-            tet = locateFrom(q, lastInside, bary);
+            tet = locateFrom(q, lastInside, bary, counters.locate);
             if constexpr (kSurf) {  // outside the mesh: the run ends at the boundary before it
                 if (tet == kNoTet && segments.iso && !segments.led) endRunAtShare();
             }
@@ -681,10 +697,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 if (segments.kEnd < tSpanEnd / s1)
                     endRunAtShare();
                 else if (isoNear())
-                    sampleAtBoundary<kNative, kLit, kSurf>(
-                        locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
-                        tSpanEnd / s1, true, segments.kLast, lastInside, segments.vLast,
-                        segments.kEnd, segments, counters, acc);
+                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                        sampleAtBoundary<kNative, kLit, kSurf>(
+                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
+                            tSpanEnd / s1, true, sc.kLast, lastInside, sc.vLast, sc.kEnd, sc, c, a);
+                    });
             }
         }
         segments.finish(tf, s1, unit, acc);
@@ -692,8 +709,10 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     }
     if constexpr (kSurf) {  // the cut face behind the volume
         if (cut1 && !opaque)
-            cutFace<kNative>(locateFrom, scene.base.params, locator.mesh, tf, ray, tExit, n1,
-                             lastInside, counters, acc);
+            callOnCopies(counters, acc, [&](RayCounters& c, Vec4f& a) {
+                cutFace<kNative>(locateFrom, scene.base.params, locator.mesh, tf, ray, tExit, n1,
+                                 lastInside, c, a);
+            });
     }
     return acc;
 }

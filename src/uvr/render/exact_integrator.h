@@ -499,8 +499,9 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     if (pieceStart) cut0 = false;
     if (pieceEnd) cut1 = false;
     if (!(b0 <= b1)) return acc;
-    [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b) {
-        return scene.locator.locate<kNative>(q, from, b, counters.locate);
+    [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b,
+                                                LocateCounters& c) {
+        return scene.locator.locate<kNative>(q, from, b, c);
     };
     if constexpr (kSurf) {  // the cut face in front: nothing else shows
         if (cut0 && cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, b0,

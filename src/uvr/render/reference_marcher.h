@@ -68,6 +68,26 @@ struct CrossingNormals {
     }
 };
 
+/// What a ray's isosurfaces need where one is crossed, set once per ray (SampleSegments::setIsos)
+/// and read through one pointer only there: a sample's registers hold none of it.
+struct RaySurfaces {
+    const IsoView* iso = nullptr;       ///< the isosurfaces (null: none)
+    const TetMeshView* mesh = nullptr;  ///< their normals' mesh
+    Lighting surface;                   ///< their lighting (surfaceLighting)
+    Vec3f dir{0.f, 0.f, 1.f};           ///< the ray's direction
+    float depthAlpha = 0.f;             ///< depth out (the ray's: rayDepthAlpha)
+
+    /// The isosurfaces of `isos` lit by `l` along a ray of direction d with the gradients of
+    /// mesh m, and the opacity whose depth is asked for.
+    UVR_HOST_DEVICE RaySurfaces(const IsoView& isos, const Lighting& l, Vec3f d, float alpha,
+                                const TetMeshView& m)
+        : iso(isos.active() ? &isos : nullptr),
+          mesh(&m),
+          surface(surfaceLighting(l)),
+          dir(d),
+          depthAlpha(alpha) {}
+};
+
 /// Pre-integration for the sample-based methods (issue 11): the segment between two consecutive
 /// samples inside the mesh, at grid positions k (in units of s1), is integrated with the scalar
 /// running linearly from one sample's value to the next (segment::integrate), so a
@@ -87,16 +107,13 @@ struct CrossingNormals {
 /// reads no gradient at the samples between them.
 template <bool kLit = true, bool kSurf = kLit>
 struct SampleSegments {
-    float kLast = 0.f;                  ///< grid position of the last sample
-    float kEnd = 0.f;                   ///< end of the piece of the ray the last sample belongs to
-    float vLast = 0.f;                  ///< its value (when inside)
-    LightFactors light;                 ///< its light (when inside; the identity unlit)
-    SamplePoint atLast;                 ///< where it lies (with isosurfaces: their normals)
-    const IsoView* iso = nullptr;       ///< the isosurfaces (null: none)
-    const TetMeshView* mesh = nullptr;  ///< their normals' mesh
-    Lighting surface;                   ///< their lighting (surfaceLighting)
-    Vec3f dir{0.f, 0.f, 1.f};           ///< the ray's direction
-    float depthAlpha = 0.f;             ///< depth out (the ray's: rayDepthAlpha)
+    float kLast = 0.f;             ///< grid position of the last sample
+    float kEnd = 0.f;              ///< end of the piece of the ray the last sample belongs to
+    float vLast = 0.f;             ///< its value (when inside)
+    LightFactors light;            ///< its light (when inside; the identity unlit)
+    SamplePoint atLast;            ///< where it lies (with isosurfaces: their normals)
+    const IsoView* iso = nullptr;  ///< the isosurfaces (null: none)
+    const RaySurfaces* surfaces = nullptr;  ///< the rest of what they need (setIsos)
     /// Depth out: the grid position where an isosurface took the opacity to depthAlpha
     /// (infinity: none did); the marchers prefer it to their coarser stretches.
     float kDepth = INFINITY;
@@ -107,16 +124,12 @@ struct SampleSegments {
     bool started = false;  ///< a sample was taken
     bool led = false;      ///< the last sample is a lead (lead()): no segment up to the next
 
-    /// Isosurfaces to composite between samples (kSurf only), lit by `l` along a ray of
-    /// direction d with the gradients of mesh m, and the opacity whose depth is asked for.
-    UVR_HOST_DEVICE void setIsos(const IsoView& isos, const Lighting& l, Vec3f d, float alpha,
-                                 const TetMeshView& m) {
+    /// Isosurfaces to composite between samples (kSurf only): `r`, which must outlive the
+    /// marching.
+    UVR_HOST_DEVICE void setIsos(const RaySurfaces& r) {
         if constexpr (kSurf) {
-            depthAlpha = alpha;
-            iso = isos.active() ? &isos : nullptr;
-            mesh = &m;
-            surface = surfaceLighting(l);
-            dir = d;
+            iso = r.iso;
+            surfaces = &r;
         }
     }
 
@@ -149,7 +162,11 @@ struct SampleSegments {
                 // (Called only where a surface is crossed: a call at every sample cost the
                 // isosurfaces' kernels most of their time.)
                 if (iso && iso->crosses(vLast, v)) {
-                    withIsos(tf, v, k, s1, unit, light.mean(f), at, acc);
+                    // On copies, as callOnCopies runs the other surface calls.
+                    SampleSegments s = *this;
+                    Vec4f a = acc;
+                    s.withIsos(tf, v, k, s1, unit, light.mean(f), at, a);
+                    kDepth = s.kDepth, acc = a;
                     done = true;
                 }
             }
@@ -182,8 +199,8 @@ private:
     /// bisectIso, the 100M frames on the H100: PERFORMANCE.md, "Isosurfaces: what the surfaces'
     /// code costs a frame with no surface").
     UVR_HOST_DEVICE UVR_NOINLINE void withIsos(const TfTableView& tf, float v, float k, float s1,
-                                               double unit, const LightFactors& vol,
-                                               const SamplePoint& at, Vec4f& acc) {
+                                               double unit, LightFactors vol, SamplePoint at,
+                                               Vec4f& acc) {
         const double len = double(k - kLast) * s1;
         float f0 = 0.f, va = vLast;
         CrossingNormals normals;
@@ -191,9 +208,11 @@ private:
             if (acc.w >= segment::kOpacityEnd) return;
             const IsoSurface& s = iso->surfaces[i];
             integrateLit<kLit>(tf, va, s.value, double(f - f0) * len, unit, vol, acc);
-            const Vec3f gi = normals.at(*mesh, surface.smooth, atLast, at, f);
+            const RaySurfaces& r = *surfaces;
+            const Vec3f gi = normals.at(*r.mesh, r.surface.smooth, atLast, at, f);
             const float a0 = acc.w;
-            compositeIso(s, tf.sample(s.value).xyz(), lightFactors(surface, gi, dir), acc);
+            compositeIso(s, tf.sample(s.value).xyz(), lightFactors(r.surface, gi, r.dir), acc);
+            const float depthAlpha = r.depthAlpha;
             if (depthAlpha > 0.f && !(kDepth < INFINITY) && a0 < depthAlpha && acc.w >= depthAlpha)
                 kDepth = kLast + (k - kLast) * f;
             f0 = f, va = s.value;
@@ -272,13 +291,35 @@ struct PointIsos {
 /// Bisection probes sampleAtBoundary takes for the mesh's boundary: to within s1 / 2^10.
 inline constexpr int kBoundaryBisections = 10;
 
+/// Runs call(counters, acc), a non-inlined surface call (sampleAtBoundary, bisectIso, cutFace),
+/// on copies of a marcher's counters and colour, and takes them back. Given the marcher's own,
+/// the call takes their addresses, so they live in local memory at every sample of the frame,
+/// whether a surface is met or not (the reference's 100M isosurface frame: 5% faster on copies;
+/// PERFORMANCE.md, "Isosurfaces: the surface calls on copies").
+template <class Call>
+UVR_HOST_DEVICE UVR_INLINE void callOnCopies(RayCounters& counters, Vec4f& acc, const Call& call) {
+    RayCounters c = counters;
+    Vec4f a = acc;
+    call(c, a);
+    counters = c, acc = a;
+}
+
+/// callOnCopies with the marcher's segments too: call(segments, counters, acc).
+template <bool kLit, bool kSurf, class Call>
+UVR_HOST_DEVICE UVR_INLINE void callOnCopies(SampleSegments<kLit, kSurf>& segments,
+                                             RayCounters& counters, Vec4f& acc, const Call& call) {
+    SampleSegments<kLit, kSurf> s = segments;
+    callOnCopies(counters, acc, [&](RayCounters& c, Vec4f& a) { call(s, c, a); });
+    segments = s;
+}
+
 /// Isosurfaces (pre-integrated, kSurf): a run of samples starts or ends at the mesh's boundary
 /// (or the end of the ray's span) between the sample at grid position kIn (inside, in cell
 /// tetIn) and a position kOut outside the mesh or past the span's end (outKnown; before kIn
 /// where a run starts, after it where one ends), or the start of the span (!outKnown, before
 /// the first sample: the span may start inside the mesh, at a clip plane or the camera). Probes
-/// by bisection, each located by `locate(q, from, bary)` from the last one found, narrow the
-/// boundary to within s1 / 2^kBoundaryBisections, and where a surface lies between the boundary
+/// by bisection, each located by `locate(q, from, bary, counters)` from the last one found, narrow
+/// the boundary to within s1 / 2^kBoundaryBisections, and where a surface lies between the boundary
 /// and the sample (vIn its value) the run gets a sample at the boundary. So a surface
 /// between the boundary and the nearest grid sample (a thin layer at the mesh's skin, which no
 /// pair of grid samples brackets: rings where the grid happened to) is crossed where the exact
@@ -299,7 +340,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
     float bary[4], baryHi[4] = {0.f, 0.f, 0.f, 0.f};
     if (!outKnown) {
         ++counters.samples;
-        const std::uint32_t t = locate(ray.at(lo * s1), from, bary);
+        const std::uint32_t t = locate(ray.at(lo * s1), from, bary, counters.locate);
         if (t != kNoTet) {
             hi = lo, tetHi = t;
             for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
@@ -309,7 +350,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
         const float mid = 0.5f * (lo + hi);
         if (mid == lo || mid == hi) break;
         ++counters.samples;
-        const std::uint32_t t = locate(ray.at(mid * s1), from, bary);
+        const std::uint32_t t = locate(ray.at(mid * s1), from, bary, counters.locate);
         if (t == kNoTet) {
             lo = mid;
         } else {
@@ -330,10 +371,10 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
 }
 
 /// The clip region's cut face (ClipView::surface; kSurf instances): the point at parameter t of
-/// the ray, on a face of normal n, located by `locate(q, hint, bary)`; inside the mesh, an opaque
-/// surface coloured by the transfer function at the field's value there, lit by the headlight
-/// with normal n (`surface`: the frame's coefficients, always on), composited under what acc
-/// holds and ending the ray. Returns whether the point lay inside the mesh. The depth asked for
+/// the ray, on a face of normal n, located by `locate(q, hint, bary, counters)`; inside the mesh,
+/// an opaque surface coloured by the transfer function at the field's value there, lit by the
+/// headlight with normal n (`surface`: the frame's coefficients, always on), composited under what
+/// acc holds and ending the ray. Returns whether the point lay inside the mesh. The depth asked for
 /// (rayDepthAlpha) is reached there if not before.
 template <bool kNative, class Locate>
 UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParams& params,
@@ -342,7 +383,7 @@ UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParam
                                           RayCounters& counters, Vec4f& acc) {
     float bary[4];
     ++counters.samples;
-    const std::uint32_t c = locate(ray.at(t), hint, bary);
+    const std::uint32_t c = locate(ray.at(t), hint, bary, counters.locate);
     if (c == kNoTet) return false;
     // An opaque surface coloured by the map (IsoSurface's defaults), composited as isosurfaces
     // are.
@@ -395,13 +436,18 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     if (pieceStart) cut0 = false;
     if (pieceEnd) cut1 = false;
     if (!(t0 <= t1)) return acc;
-    [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b) {
-        return scene.locator.locate<kNative>(q, from, b, counters.locate);
+    [[maybe_unused]] const auto locateAny = [&](Vec3f q, std::uint32_t from, float* b,
+                                                LocateCounters& c) {
+        return scene.locator.locate<kNative>(q, from, b, c);
     };
     if constexpr (kSurf) {  // the cut face in front: nothing else shows
-        if (cut0 && cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, t0,
-                                     n0, kNoTet, counters, acc))
-            return acc;
+        bool hit = false;
+        if (cut0)
+            callOnCopies(counters, acc, [&](RayCounters& c, Vec4f& a) {
+                hit = cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray,
+                                       t0, n0, kNoTet, c, a);
+            });
+        if (hit) return acc;
     }
     const float s = scene.params.step;
     // Global sample grid k * s, so every integrator that samples a span takes the same samples.
@@ -416,8 +462,9 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     const float stopAlpha = stop < 0.f ? scene.params.terminationAlpha : stop;
     SampleSegments<kLit, kSurf> segments;
     const Lighting lighting = kernelLighting<kLit, kSurf>(scene.params);
-    segments.setIsos(scene.params.iso, lighting, ray.dir, rayDepthAlpha(scene.params, counters),
-                     scene.locator.mesh);
+    const RaySurfaces surfaces(scene.params.iso, lighting, ray.dir,
+                               rayDepthAlpha(scene.params, counters), scene.locator.mesh);
+    segments.setIsos(surfaces);
     if (pieceStart && scene.params.preintegrated && k - 1.f >= ceilf(tSpan / s)) {
         // The piece before's last sample, in the ghost cells: the slope of the run the first
         // sample may continue, as one process's run has it.
@@ -447,11 +494,12 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
                 if (segments.iso && (tet != kNoTet) != segments.inside &&
                     !(pieceStart && (!segments.started || segments.led))) {
                     const bool first = !segments.started, in = tet != kNoTet;
-                    sampleAtBoundary<kNative, kLit, kSurf>(
-                        locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
-                        in ? (first ? t0 / s : k - 1.f) : k, !first, in ? k : segments.kLast,
-                        in ? tet : lastInside, in ? v : segments.vLast, kEnd + 1.f, segments,
-                        counters, acc);
+                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                        sampleAtBoundary<kNative, kLit, kSurf>(
+                            locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
+                            in ? (first ? t0 / s : k - 1.f) : k, !first, in ? k : sc.kLast,
+                            in ? tet : lastInside, in ? v : sc.vLast, kEnd + 1.f, sc, c, a);
+                    });
                 }
                 if (tet != kNoTet) lastInside = tet;
             }
@@ -480,10 +528,11 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
             // the run's last sample at the end.
             if (segments.iso && segments.inside) {
-                sampleAtBoundary<kNative, kLit, kSurf>(locateAny, scene.params, scene.locator.mesh,
-                                                       scene.tf, ray, lighting, t1 / s, true,
-                                                       segments.kLast, lastInside, segments.vLast,
-                                                       kEnd + 1.f, segments, counters, acc);
+                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
+                        t1 / s, true, sc.kLast, lastInside, sc.vLast, kEnd + 1.f, sc, c, a);
+                });
             }
         }
         segments.finish(scene.tf, s, unit, acc);
@@ -492,8 +541,10 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     }
     if constexpr (kSurf) {  // the cut face behind the volume
         if (cut1 && !opaque)
-            cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, t1, n1,
-                             tet, counters, acc);
+            callOnCopies(counters, acc, [&](RayCounters& c, Vec4f& a) {
+                cutFace<kNative>(locateAny, scene.params, scene.locator.mesh, scene.tf, ray, t1, n1,
+                                 tet, c, a);
+            });
     }
     return acc;
 }
