@@ -25,9 +25,11 @@ constexpr int kFrameBlock = 128;
 constexpr int kFrameBlocksPerSm = 4;
 
 /// Blocks per multiprocessor of a march's frame kernel: kFrameBlocksPerSm, but 2 (255
-/// registers, no spills) for the partition integrator with surfaces, which spilled at 128
-/// registers around its non-inlined surface calls (on an H200, 100M graded box: 6% faster with
-/// isosurfaces, the same samples; the reference's surface instance got 20% slower at 2).
+/// registers) for the partition integrator with surfaces. At 128 registers it spilled about
+/// 2 KB around its non-inlined surface calls, at 255 about 0.1 KB, and the 100M isosurface
+/// frames got 6% faster on an H200; the reference's instance with surfaces got 20% slower at 2,
+/// so it stays at 4 (PERFORMANCE.md, "Isosurfaces: the surface calls on copies, and 255
+/// registers").
 template <class March>
 inline constexpr int kBlocksPerSm = kFrameBlocksPerSm;
 template <bool kNative, bool kLit>
