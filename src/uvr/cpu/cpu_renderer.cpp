@@ -31,10 +31,11 @@ int currentThread() {
 namespace {
 
 /// Runs the pixel kernel over the frame in 8x8 tiles (neighbouring rays, and their
-/// tetrahedra, stay on one core), sums the counters and reports the tiles done.
-template <class March>
-void launchFrame(const FrameView& frame, RenderStats& stats, const March& march,
-                 const std::function<void(double)>& report) {
+/// tetrahedra, stay on one core), sums the counters and reports the tiles done. With several
+/// marches (a split frame: launchPartitionMarches) each pixel runs each in turn.
+template <class... March>
+void launchFrame(const FrameView& frame, RenderStats& stats,
+                 const std::function<void(double)>& report, const March&... marches) {
     std::vector<RenderStats> perThread(cpu::threadCount());
     constexpr int kTile = 8;
     const int tilesX = (frame.width + kTile - 1) / kTile;
@@ -46,8 +47,9 @@ void launchFrame(const FrameView& frame, RenderStats& stats, const March& march,
         RenderStats& s = perThread[thread];
         for (int y = y0; y < y0 + kTile && y < frame.height; ++y)
             for (int x = x0; x < x0 + kTile && x < frame.width; ++x)
-                s.add(frame.supersample == 1 ? shadePixel<false>(frame, x, y, march)
-                                             : shadePixel<true>(frame, x, y, march));
+                (s.add(frame.supersample == 1 ? shadePixel<false>(frame, x, y, marches)
+                                              : shadePixel<true>(frame, x, y, marches)),
+                 ...);
         progress.add();
     });
     progress.finish();
@@ -74,18 +76,17 @@ RenderResult renderCpu(const PreparedMesh& mesh, const RenderSettings& settings)
         [&](auto kNative, auto kLit, auto kSurf) {
             const RenderMethod method = result.setup.method.method;
             if (method == RenderMethod::Reference)
-                launchFrame(frame, result.stats,
-                            ReferenceMarch<kNative(), kLit(), kSurf()>{result.setup.scene(mesh)},
-                            settings.progress);
+                launchFrame(frame, result.stats, settings.progress,
+                            ReferenceMarch<kNative(), kLit(), kSurf()>{result.setup.scene(mesh)});
             else if (method == RenderMethod::Exact)
-                launchFrame(frame, result.stats,
-                            ExactMarch<kNative(), kLit(), kSurf()>{result.setup.scene(mesh)},
-                            settings.progress);
+                launchFrame(frame, result.stats, settings.progress,
+                            ExactMarch<kNative(), kLit(), kSurf()>{result.setup.scene(mesh)});
             else
-                launchFrame(frame, result.stats,
-                            PartitionMarch<kNative(), kLit(), kSurf()>{
-                                result.setup.partitionScene(mesh, settings.skip)},
-                            settings.progress);
+                launchPartitionMarches<kNative(), kLit(), kSurf()>(
+                    result.setup.partitionScene(mesh, settings.skip),
+                    isoRaySplit(result.setup.params, frame), [&](const auto&... marches) {
+                        launchFrame(frame, result.stats, settings.progress, marches...);
+                    });
         });
     result.stats.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -8,7 +8,10 @@ void launchPartitions(dim3 grid, dim3 block, const FrameView& frame,
                       const PartitionSceneView& scene, bool native, bool lit, bool surfaces,
                       unsigned long long* totals) {
     dispatchKernel(native, lit, surfaces, [&](auto kNative, auto kLit, auto kSurf) {
-        launchFrame(grid, block, frame, PartitionMarch<kNative(), kLit(), kSurf()>{scene}, totals);
+        launchPartitionMarches<kNative(), kLit(), kSurf()>(
+            scene, isoRaySplit(scene.base.params, frame), [&](const auto&... marches) {
+                (launchFrame(grid, block, frame, marches, totals), ...);
+            });
     });
 }
 

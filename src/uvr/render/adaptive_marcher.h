@@ -250,6 +250,34 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
             lightAt<kLit>(params.light, params.gradientOpacity, atHi.cell, gradHi, ray.dir), atHi);
 }
 
+/// Whether the ray can meet an isosurface: some partition it crosses (in its clipped span, in
+/// front of ray.tMax, through the partition's shrunk box) holds an iso value in its value range.
+/// A ray that cannot is marched without the surfaces' code (isoRaySplit): every sample it takes
+/// lies in a partition holding no iso value, so no step between two of its samples (the field
+/// continuous, linear in each cell) and no stretch to the mesh's boundary crosses one, and
+/// marchPartitions' surface calls never run on it.
+UVR_HOST_DEVICE inline bool mayMeetIsosurface(const PartitionSceneView& scene, const Ray& ray) {
+    const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
+    float tEnter = 0.f, tExit = INFINITY;
+    if (scene.kd.partitionCount == 0 || !intersectBox(scene.kd.bounds, ray.org, inv, tEnter, tExit))
+        return false;
+    const MarchParams& params = scene.base.params;
+    if (params.clip.active() && !params.clip.restrict(ray.org, ray.dir, inv, tEnter, tExit))
+        return false;
+    if (ray.tMax < tExit) tExit = ray.tMax;
+    if (!(tEnter <= tExit)) return false;
+    KdLeafIterator leaves(tEnter, tExit);
+    std::uint32_t p = 0;
+    float t0 = 0.f, t1 = 0.f;
+    bool meets = false;
+    while (!meets && leaves.next(scene.kd, ray, inv, p, t0, t1)) {
+        const KdPartition& part = scene.kd.partitions[p];
+        meets = part.cellCount > 0 && intersectBox(part.box, ray.org, inv, t0, t1) &&
+                params.iso.within(part.valueMin, part.valueMax);
+    }
+    return meets;
+}
+
 /// Partition integrator (Morrical et al. 2019, Sec. 2.3-2.4): walks the k-d partitions front to
 /// back in exact order; skips unoccupied space (outside the shrunk boxes) and, when asked,
 /// partitions with zero maximum opacity; marches each visited partition with its own step s,

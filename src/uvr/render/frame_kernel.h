@@ -88,6 +88,9 @@ UVR_HOST_DEVICE inline RayCounters shadePixel(const FrameView& frame, int x, int
         Ray ray = frame.rays.ray(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
         if (frame.depthIn) ray.tMax = frame.rayParameter(ray, frame.depthIn[i]);
         RayCounters counters;
+        if constexpr (requires { march.shades(ray); }) {
+            if (!march.shades(ray)) return counters;  // another launch's pixel (RaySplit)
+        }
         if (frame.depthAlphas) counters.depthAlpha = frame.depthAlphas[i];
         const float stop = frame.stopAlpha ? frame.stopAlpha[i] : kSceneStop;
         if (!(stop != 0.f)) {  // not rendered (a data-parallel second pass's other pixels)
@@ -157,14 +160,56 @@ struct ExactMarch {
     }
 };
 
-/// The partition integrator as a functor for shadePixel.
+/// Which of a frame's rays a launch of the partition integrator shades (isoRaySplit).
+enum class RaySplit : std::uint8_t {
+    All,              ///< every ray
+    WithoutSurfaces,  ///< the rays that cannot meet an isosurface (mayMeetIsosurface)
+    WithSurfaces,     ///< the others
+};
+
+/// The partition integrator as a functor for shadePixel; a launch split by RaySplit leaves the
+/// other launch's pixels untouched.
 template <bool kNative = true, bool kLit = true, bool kSurf = kLit>
 struct PartitionMarch {
     PartitionSceneView scene;
+    RaySplit split = RaySplit::All;
+    UVR_HOST_DEVICE bool shades(const Ray& ray) const {
+        return split == RaySplit::All ||
+               (split == RaySplit::WithSurfaces) == mayMeetIsosurface(scene, ray);
+    }
     UVR_HOST_DEVICE Vec4f operator()(const Ray& ray, RayCounters& counters, float stop) const {
         return marchPartitions<kNative, kLit, kSurf>(scene, ray, counters, stop);
     }
 };
+
+/// Whether a frame of the partition integrator splits its rays (RaySplit): where isosurfaces
+/// are its only surfaces (no depth out, no cut face), with one ray per pixel and the whole ray in
+/// one process (a data-parallel piece's run goes on into its neighbours', whose partitions it
+/// does not see). The surfaces' code costs every sample of the instance with surfaces, whether
+/// its ray meets a surface or not (PERFORMANCE.md, "Isosurfaces: what the surfaces' code costs a
+/// frame with no surface"): a split frame marches the rays that cannot meet one with the
+/// instance without it, in a launch of its own (on the GPU, at that kernel's occupancy).
+UVR_HOST_DEVICE inline bool isoRaySplit(const MarchParams& p, const FrameView& frame) {
+    return p.iso.active() && !(p.depthAlpha > 0.f) && !(p.clip.surface && p.clip.active()) &&
+           !p.piece.active && frame.supersample == 1 && !frame.depth && !frame.depthAlphas;
+}
+
+/// Calls launch(marches...) with the partition integrator's functors for a frame's instance
+/// (kNative, kLit, kSurf): the one functor, or, where isoRaySplit, the instance without surfaces
+/// for the rays that cannot meet one and the instance with them for the others (each shades
+/// only its rays). The CPU shades each pixel with both in turn; the GPU launches them one after
+/// the other.
+template <bool kNative, bool kLit, bool kSurf, class Launch>
+void launchPartitionMarches(const PartitionSceneView& scene, bool split, Launch&& launch) {
+    if constexpr (kSurf) {
+        if (split) {
+            launch(PartitionMarch<kNative, kLit, false>{scene, RaySplit::WithoutSurfaces},
+                   PartitionMarch<kNative, kLit, true>{scene, RaySplit::WithSurfaces});
+            return;
+        }
+    }
+    launch(PartitionMarch<kNative, kLit, kSurf>{scene});
+}
 
 /// Calls f(kNative, kLit, kSurf) with std::true_type or std::false_type for each: kNative when
 /// the mesh has native cells; kLit when the frame is shaded (or has a gradient opacity); kSurf
