@@ -252,6 +252,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
     cmd->add_option("--port", options->second, "Port to listen on (0: any free port)")
         ->check(CLI::Range(0, 65535))
         ->capture_default_str();
+#ifdef UVR_HAS_SERVER  // the server's own limits (without it the command only says so)
     auto movingMs = std::make_shared<double>(server::ServerOptions{}.targetFrameMs);
     cmd->add_option("--moving-frame-ms", *movingMs,
                     "While the view moves, frames come at the reduced resolution that renders in "
@@ -259,6 +260,7 @@ void addViewCommand(CLI::App& app, Context& ctx) {
                     "moving frames at fewer updates")
         ->check(CLI::Range(server::kMinTargetFrameMs, server::kMaxTargetFrameMs))
         ->capture_default_str();
+#endif
     cmd->add_option("--token", *token,
                     "The secret in the URL (default: 32 random hex characters; at least 16 of "
                     "A-Z a-z 0-9 _ -)");
