@@ -3,9 +3,10 @@
 # The isosurface frames of issue 32 at 100M on a GPU, for two or more uvr binaries alternated in
 # one run (the commit before a change against the change): seconds a frame of the adaptive method
 # ("auto") and the reference, plain, with a surface outside the field's range (--iso 7: none of
-# the surfaces' code runs), with one surface, and shaded; then each binary's image of three
-# shaded surfaces against the first's. Set CUDA_MODULE_LOADING=EAGER (lazy loading lands in
-# the first frame). docs/PERFORMANCE.md, "Isosurfaces: ...", holds the figures.
+# the surfaces' code runs), with one small surface (0.5), a larger one (0.1), and shaded; then
+# each binary's image of three shaded surfaces against the first's. Set
+# CUDA_MODULE_LOADING=EAGER (lazy loading lands in the first frame). docs/PERFORMANCE.md,
+# "Isosurfaces: ...", holds the figures.
 #
 # Usage: bench/gpu_iso_frames.sh MESH UVR_BEFORE UVR_AFTER [UVR...]
 #   MESH: made when missing, by `UVR_BEFORE generate graded --cells 100000000 -o MESH`.
@@ -18,7 +19,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # The frames' flags are split into words on purpose.
 # shellcheck disable=SC2086
-for args in "" "--iso 7" "--iso 0.5" "--iso 0.5 --shade"; do
+for args in "" "--iso 7" "--iso 0.5" "--iso 0.1" "--iso 0.5 --shade"; do
     for bin in "$@"; do
         "$bin" bench "$mesh" --device cuda --size 1024x1024 --repeat 3 --sweep 16 $args \
             --csv "$tmp/o.csv" > "$tmp/o.txt" 2>&1 || { tail -3 "$tmp/o.txt"; exit 1; }
