@@ -103,6 +103,20 @@ inline Mesh makeHexGrid(
     return mesh;
 }
 
+/// Appends mesh b, moved by `shift`, to mesh a: its points, its cells (renumbered) and the values
+/// of its first field after a's first field's (both point fields, as makeHexGrid makes them).
+inline void appendShifted(Mesh& a, const Mesh& b, Vec3f shift) {
+    const std::uint32_t base = static_cast<std::uint32_t>(a.points.size());
+    for (Vec3f p : b.points) a.points.push_back(p + shift);
+    for (std::uint64_t c = 0; c < b.cellCount(); ++c) {
+        std::vector<std::uint32_t> ids;
+        for (std::uint32_t id : b.cell(c)) ids.push_back(id + base);
+        a.addCell(b.cellTypes[c], ids);
+    }
+    a.fields[0].values.insert(a.fields[0].values.end(), b.fields[0].values.begin(),
+                              b.fields[0].values.end());
+}
+
 /// An n^3 grid of hexahedra over [-1, 1]^3, jittered by 0.3 of the spacing, with the point field
 /// f = xy + z.
 inline Mesh jitteredHexGrid(int n) {

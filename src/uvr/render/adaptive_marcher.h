@@ -7,6 +7,7 @@
 #include "uvr/accel/kd_partitions.h"
 #include "uvr/accel/macro_grid.h"
 #include "uvr/accel/seed_grid.h"
+#include "uvr/render/ray_cells.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/tf/range_stats.h"
 
@@ -433,6 +434,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     };
     float k = 0.f, k1 = 0.f, kStop = 0.f, mPiece = 1.f;
     float kLocated = -INFINITY;  // grid position of the last sample located
+    // Outside a non-convex mesh: the grid positions below kOutside lie outside it, before the
+    // ray enters it again (outsideUntil, asked at a sample found outside; infinity when the ray
+    // never does). They take no point location, and most no sample (below).
+    float kOutside = -INFINITY;
+    const double entryEps = 1e-6 * (double(scene.base.bounds.diagonal()) + double(tEnter));
     bool marching = true, opaque = false, macro = false;
     // Depth out: the opacity and the end of the stretch of the ray noted last, noted wherever
     // the run composites (after each sample, and where a transparent macrocell ends a run).
@@ -534,16 +540,21 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         // sample is in empty space), else a search of the cell tree (walks stop at boundaries
         // of non-convex meshes and at seams of unshared points).
         const bool walk = kSample - kLocated <= scene.longStep;
+        const bool outside = kSample < kOutside;
         kLocated = kSample;
-        tet = walk ? locator.walk<kNative>(pos, tet, bary, counters.locate) : kNoTet;
+        tet = walk && !outside ? locator.walk<kNative>(pos, tet, bary, counters.locate) : kNoTet;
         bool emptySpace = false;
-        if (tet == kNoTet && scene.seeds.grids) {
+        if (tet == kNoTet && !outside && scene.seeds.grids) {
             const std::uint32_t seed = scene.seeds.seed(p, pos);
             emptySpace = seed == kNoTet;
             if (!emptySpace) tet = locator.walk<kNative>(pos, seed, bary, counters.locate);
         }
-        if (tet == kNoTet && !emptySpace)
+        if (tet == kNoTet && !emptySpace && !outside)
             tet = locator.search<kNative>(scene.cells, 0, pos, bary, counters.locate);
+        // Outside the mesh (no seed near, or nothing found): where does the ray enter it again?
+        if (tet == kNoTet && !outside)
+            kOutside = outsideUntil<kNative>(locator.mesh, scene.cells, ray, kSample, s1, entryEps,
+                                             counters.locate);
         const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
         const Vec3f grad =
             sampleGradient<kNative, kLit>(scene.base.params, locator.mesh, tet, bary);
@@ -562,6 +573,11 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 kNext = fmaxf(kNext, ceilf(gridCellExit(g, idx, ray.org, inv) / s1));
             }
         }
+        // Outside, before the ray's next entry into the mesh: on to the last grid position
+        // before it. Each position skipped would have stepped one s1 on, outside; the one there
+        // is taken, so the step into the mesh is one s1 as before and the picture is the same.
+        if (tet == kNoTet && !endsRun && kSample + 2.f < kOutside)
+            kNext = fmaxf(kNext, kSample + ceilf(kOutside - kSample) - 1.f);
         // A sample at the piece's last grid point K1 - 1 (see the piece's steps above).
         if (kSample < k1 - 1.f && kNext > k1 - 1.f) kNext = k1 - 1.f;
         const float length = ((kNext < k1 ? kNext : k1) - kSample) * s1;

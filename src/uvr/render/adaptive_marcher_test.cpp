@@ -75,7 +75,10 @@ TEST_P(PartitionIntegrator, EqualStepsReproduceTheReference) {
             EXPECT_LT(p.stats.samples, r.stats.samples);  // transparent partitions skipped
             EXPECT_GT(p.stats.partitionsSkipped, 0u);
         } else {
-            EXPECT_EQ(p.stats.samples, r.stats.samples);  // a convex mesh: nothing to skip
+            // Nothing to skip but the few outside the jittered boundary, where both go on to
+            // where the ray enters the mesh again (the partitions a sample more at a boundary
+            // between them).
+            EXPECT_NEAR(double(p.stats.samples), double(r.stats.samples), 1e-3 * r.stats.samples);
             EXPECT_EQ(p.stats.partitionsSkipped, 0u);
         }
         // Also with s2 == s1 and adaptivity on.
@@ -195,8 +198,65 @@ TEST_P(PartitionIntegrator, EqualStepsMatchTheReferenceOnEveryRealFile) {
             const double ssim = compareImages(toRgb8(ref.image), toRgb8(p.image)).ssim;
             EXPECT_GE(ssim, 0.995) << name << (adaptive ? " adaptive" : " skipping only");
             EXPECT_LT(testing::maxPixelDifference(ref.image, p.image), 2e-3f) << name;
-            EXPECT_LE(p.stats.samples, ref.stats.samples) << name;
+            // Skipping adds no work: at most the reference's samples, but for a few where a ray
+            // outside the mesh crosses a partition boundary before it enters the mesh again
+            // (the partition's last grid point and the next one's first are taken; the
+            // reference goes on to the entry at once).
+            EXPECT_LE(double(p.stats.samples), 1.05 * ref.stats.samples) << name;
         }
+    }
+}
+
+TEST_P(PartitionIntegrator, RaysOutsideANonConvexMeshGoOnToWhereTheyEnterItAgain) {
+    // Two unit cubes along x with a gap between them, in one partition (so the gap lies inside
+    // its box), seen along +x in parallel projection. A sample in the gap finds where the ray
+    // enters the mesh again (outsideUntil) and the ray goes on to the grid point before it: a
+    // wider gap costs each ray no more samples, with or without seed grids, and the picture
+    // keeps the second cube's light. (Before, each grid point of the gap was located: a search
+    // of the cell tree each, or a step per empty seed cell.)
+    const auto twoCubes = [](float gap, bool seedGrids) {
+        const auto f = [](Vec3f p) {
+            return 0.5f + 0.4f * std::sin(3.f * p.y) * std::cos(2.f * p.z);
+        };
+        Mesh a = testing::makeHexGrid(4, 0.f, 1.f, f);
+        testing::appendShifted(a, testing::makeHexGrid(4, 0.f, 1.f, f), Vec3f(1.f + gap, 0.f, 0.f));
+        PrepareOptions o;
+        o.kd.leafCells = 4096;  // one partition
+        o.seedGrids = seedGrids;
+        return prepareMesh(a, selectScalarField(a, {}), o);
+    };
+    RenderSettings s = baseSettings();
+    s.width = s.height = 24;
+    s.tf.opacities = {{0.f, 0.1f}, {1.f, 0.6f}};
+    Camera c;
+    c.position = Vec3f(-3.f, 0.5f, 0.5f);
+    c.focalPoint = Vec3f(0.f, 0.5f, 0.5f);
+    c.viewUp = Vec3f(0.f, 0.f, 1.f);
+    c.parallelProjection = true;
+    c.parallelScale = 0.45f;  // every ray through both cubes
+    s.camera = c;
+    s.step = 0.05f;  // the gaps: 10 and 80 s1
+    for (bool seedGrids : {true, false}) {
+        const PreparedMesh narrow = twoCubes(0.5f, seedGrids), wide = twoCubes(4.f, seedGrids);
+        ASSERT_EQ(wide.kd->partitions.size(), 1u);
+        RenderSettings a = s;
+        a.method = RenderMethod::Partitions;
+        const RenderResult rn = render(narrow, a), rw = render(wide, a);
+        RenderSettings e = s;
+        e.method = RenderMethod::Exact;
+        const RenderResult ew = render(wide, e);
+        std::uint32_t worstExtra = 0;
+        for (std::size_t i = 0; i < rw.sampleCounts.size(); ++i) {
+            ASSERT_GT(rw.sampleCounts[i], 20u) << i;  // both cubes marched
+            if (rw.sampleCounts[i] > rn.sampleCounts[i])
+                worstExtra = std::max(worstExtra, rw.sampleCounts[i] - rn.sampleCounts[i]);
+        }
+        EXPECT_LE(worstExtra, 2u) << "seed grids " << seedGrids;
+        // The second cube's light is there: the picture is exact's to the runs' ends at the
+        // cubes' faces (within s1 of them).
+        EXPECT_GT(ew.image.at(12, 12).w, 0.4f);
+        EXPECT_LT(testing::maxPixelDifference(rw.image, ew.image), 0.03f)
+            << "seed grids " << seedGrids;
     }
 }
 

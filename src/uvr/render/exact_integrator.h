@@ -19,7 +19,7 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/vec3d.h"
-#include "uvr/mesh/cell_clip.h"
+#include "uvr/render/ray_cells.h"
 #include "uvr/render/reference_marcher.h"
 #include "uvr/render/segment_integral.h"
 #include "uvr/tf/tf_table.h"
@@ -31,102 +31,6 @@ namespace uvr {
 inline constexpr std::uint32_t kExactMaxSteps = 1u << 22;
 
 namespace exact {
-
-/// The span [tIn, tOut] of a ray inside a tetrahedron and the face (opposite vertex exitFace)
-/// through which it leaves; empty when tIn > tOut. With values: the point field along the ray
-/// inside the tetrahedron, v(t) = value0 + valueSlope t, from the barycentric coordinates that
-/// the face planes give (each one affine in t), clamped to the tetrahedron's values.
-struct TetSpan {
-    double tIn = -INFINITY, tOut = INFINITY;
-    int exitFace = -1;
-    bool hasValue = false;  ///< value0, valueSlope, valueLo, valueHi are set
-    double value0 = 0.0, valueSlope = 0.0;
-    float valueLo = 0.f, valueHi = 0.f;
-
-    /// The field at parameter t (hasValue).
-    UVR_HOST_DEVICE float valueAt(double t) const {
-        const float v = static_cast<float>(value0 + valueSlope * t);
-        return v < valueLo ? valueLo : (v > valueHi ? valueHi : v);  // NaN stays NaN
-    }
-};
-
-/// Clips the ray against the four face planes of tetrahedron t (in double; either orientation);
-/// withValue: also the point field along the ray (TetSpan::valueAt; not for cell data).
-UVR_HOST_DEVICE inline TetSpan clipTet(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
-                                       bool withValue = false) {
-    BlockVertex x[4];
-    mesh.tetVertices(t, x);
-    Vec3d p[4];
-    for (int i = 0; i < 4; ++i) p[i] = toDouble(x[i].p);
-    const Vec3d o = toDouble(ray.org), d = toDouble(ray.dir);
-    TetSpan s;
-    bool degenerate = false;
-    for (int i = 0; i < 4; ++i) {
-        // Face opposite vertex i; its normal points away from vertex i.
-        const Vec3d a = p[(i + 1) & 3], b = p[(i + 2) & 3], c = p[(i + 3) & 3];
-        // Without fused multiply-adds (crossRounded, dotRounded): a ray lying in a face's plane
-        // (a parallel view down an axis of a split grid: the diagonal faces y = z hold rays)
-        // has den exactly 0 and its num the same on both cells of the face, as on the CPU.
-        // Fused, the GPU's den was a few ulps of |n|, num / den cut the span anywhere, and a
-        // quarter of such a ray was lost.
-        Vec3d n = crossRounded(b - a, c - a);
-        double height = dot(n, p[i] - a);  // vertex i's signed distance (times |n|)
-        if (height > 0.0) n = {-n.x, -n.y, -n.z}, height = -height;
-        const double num = dotRounded(n, a - o), den = dotRounded(n, d);
-        if (den > 0.0) {
-            const double t1 = num / den;
-            if (t1 < s.tOut) s.tOut = t1, s.exitFace = i;
-        } else if (den < 0.0) {
-            const double t0 = num / den;
-            if (t0 > s.tIn) s.tIn = t0;
-        } else if (num < 0.0) {  // parallel to the face and outside it
-            s.tIn = INFINITY;
-            s.tOut = -INFINITY;
-        }
-        if (withValue) {
-            // Barycentric i at o + t d: its distance to the face over vertex i's,
-            // (t den - num) / height.
-            if (!(height < 0.0)) {
-                degenerate = true;
-                continue;
-            }
-            const double v = x[i].value;
-            s.value0 -= v * num / height;
-            s.valueSlope += v * den / height;
-        }
-    }
-    if (withValue && !degenerate) {
-        s.hasValue = true;
-        s.valueLo = s.valueHi = x[0].value;
-        for (int i = 1; i < 4; ++i) {
-            const float v = x[i].value;
-            s.valueLo = v < s.valueLo ? v : s.valueLo;
-            s.valueHi = v > s.valueHi ? v : s.valueHi;
-        }
-    }
-    return s;
-}
-
-/// clipCell of native cell t as a TetSpan (without a field).
-UVR_HOST_DEVICE inline TetSpan clipNative(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
-                                          double tMin) {
-    Vec3f x[kMaxCellCorners];
-    mesh.gather(t, x);
-    const CellSpan c = clipCell(mesh.kind(t), x, ray, tMin);
-    TetSpan s;
-    s.tIn = c.tIn, s.tOut = c.tOut, s.exitFace = c.exitFace;
-    return s;
-}
-
-/// Clips the ray against cell t: clipTet for a tetrahedron; a native cell's faces as planes and
-/// bilinear patches (clipCell: of a curved cell the ray crosses twice, the span ending after
-/// tMin), without a closed-form field (nativeSegment samples it).
-template <bool kNative = true>
-UVR_HOST_DEVICE inline TetSpan clipAny(const TetMeshView& mesh, std::uint32_t t, const Ray& ray,
-                                       bool withValue = false, double tMin = -INFINITY) {
-    if (!kNative || t < mesh.tetCount) return clipTet(mesh, t, ray, withValue);
-    return clipNative(mesh, t, ray, tMin);
-}
 
 /// Most pieces smoothLitSegment cuts a segment into, and the change of light (scale plus add,
 /// plus the gradient opacity's) a piece may span.
@@ -341,49 +245,6 @@ UVR_HOST_DEVICE inline void smoothLitSegment(const TetMeshView& m, const TfTable
     }
 }
 
-/// The tetrahedron the ray is in just after t (entered last among those it is in, or the
-/// nearest ahead): over the BVH's tetrahedra with tOut > t + eps, the one whose max(tIn, t) is
-/// smallest (ties: the larger tOut). kNoTet when no tetrahedron lies ahead.
-template <bool kNative = true>
-UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const BvhView& bvh,
-                                                  const Ray& ray, double t, double eps,
-                                                  TetSpan& span, RayCounters& counters) {
-    ++counters.locate.bvhQueries;
-    std::uint32_t best = kNoTet;
-    double bestKey = INFINITY, bestOut = -INFINITY;
-    if (bvh.nodeCount == 0) return best;
-    const Vec3f inv(1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z);
-    std::uint32_t stack[2 * kBvhMaxDepth + 2];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const BvhNode& node = bvh.nodes[stack[--top]];
-        float b0 = static_cast<float>(t) - static_cast<float>(eps), b1 = INFINITY;
-        // Boxes grown a little: a tetrahedron's face may lie on its box's face.
-        Bounds3f box = node.box;
-        const Vec3f grow = box.extent() * 1e-5f + Vec3f(1e-30f);
-        box.lo = box.lo - grow;
-        box.hi = box.hi + grow;
-        if (!intersectBox(box, ray.org, inv, b0, b1)) continue;
-        if (b0 > bestKey) continue;
-        if (node.count > 0) {
-            for (std::uint32_t k = 0; k < node.count; ++k) {
-                const std::uint32_t id = bvh.primIds ? bvh.primIds[node.first + k] : node.first + k;
-                const TetSpan s = clipAny<kNative>(mesh, id, ray, false, t + eps);
-                if (!(s.tOut > t + eps) || !(s.tIn <= s.tOut)) continue;
-                const double key = s.tIn > t ? s.tIn : t;
-                if (key < bestKey || (key == bestKey && s.tOut > bestOut)) {
-                    best = id, bestKey = key, bestOut = s.tOut, span = s;
-                }
-            }
-        } else if (top + 2 <= 2 * kBvhMaxDepth + 2) {
-            stack[top++] = node.first;
-            stack[top++] = node.first + 1;
-        }
-    }
-    return best;
-}
-
 /// Scalar at parameter t of the ray inside tetrahedron tet: from the span's linear function
 /// when it has one, else barycentric at the point (clamped to the cell).
 template <bool kNative = true>
@@ -519,7 +380,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     double t = b0;
     exact::TetSpan span;
     std::uint32_t tet =
-        exact::nextTetAlong<kNative>(loc.mesh, loc.bvh, ray, t, eps, span, counters);
+        exact::nextTetAlong<kNative>(loc.mesh, loc.bvh, ray, t, eps, span, counters.locate);
     const bool continuous = !loc.mesh.cellCentered;
     if (tet != kNoTet) {
         if (continuous)
@@ -592,7 +453,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
                 continue;
             }
         }
-        tet = exact::nextTetAlong<kNative>(loc.mesh, loc.bvh, ray, t, eps, span, counters);
+        tet = exact::nextTetAlong<kNative>(loc.mesh, loc.bvh, ray, t, eps, span, counters.locate);
         if (tet != kNoTet) {
             if (continuous) span = exact::clipAny<kNative>(loc.mesh, tet, ray, true, t + eps);
             if (span.tIn > t) t = span.tIn;  // empty space before it

@@ -269,16 +269,8 @@ TEST_P(ExactFrame, ParallelRaysThroughTheEdgesOfASplitGridKeepTheirChord) {
 TEST_P(ExactFrame, RaysLeavingANonConvexMeshAndReenteringKeepBothParts) {
     // Two unit cubes with a gap of 0.5 between them along x: rays through both integrate both.
     Mesh a = testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; });
-    const Mesh b = testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; });
-    const std::uint32_t base = static_cast<std::uint32_t>(a.points.size());
-    for (Vec3f p : b.points) a.points.push_back(p + Vec3f(1.5f, 0.f, 0.f));
-    for (std::uint64_t c = 0; c < b.cellCount(); ++c) {
-        std::vector<std::uint32_t> ids;
-        for (std::uint32_t id : b.cell(c)) ids.push_back(id + base);
-        a.addCell(b.cellTypes[c], ids);
-    }
-    a.fields[0].values.insert(a.fields[0].values.end(), b.fields[0].values.begin(),
-                              b.fields[0].values.end());
+    testing::appendShifted(a, testing::makeHexGrid(3, 0.f, 1.f, [](Vec3f) { return 1.f; }),
+                           Vec3f(1.5f, 0.f, 0.f));
     const PreparedMesh pm = prepareMesh(a, selectScalarField(a, {}));
     const Bounds3f boxA{Vec3f(0.f), Vec3f(1.f)}, boxB{Vec3f(1.5f, 0.f, 0.f), Vec3f(2.5f, 1.f, 1.f)};
     RenderSettings s = exactSettings(Bounds3f{Vec3f(0.f), Vec3f(2.5f, 1.f, 1.f)}, 48);

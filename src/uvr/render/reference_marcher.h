@@ -8,6 +8,7 @@
 #include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/render/camera.h"
+#include "uvr/render/ray_cells.h"
 #include "uvr/render/scene_view.h"
 #include "uvr/render/segment_integral.h"
 #include "uvr/tf/tf_table.h"
@@ -479,12 +480,23 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     // (adaptive_marcher.h says why).
     bool opaque = false;
     [[maybe_unused]] float tNoted = t0;  // depth out: the end of the stretch of the ray noted last
+    // Outside a non-convex mesh: the grid points below kOutside lie outside it, before the ray
+    // enters it again (marchPartitions does the same; adaptive_marcher.h says why).
+    float kOutside = -INFINITY;
+    const double entryEps = 1e-6 * (double(scene.bounds.diagonal()) + double(t0));
     for (; k <= kClose && !opaque; k += 1.f) {
         const bool own = k <= kEnd;  // else the closing sample: its share is the next piece's
         [[maybe_unused]] const float a0 = acc.w;
         const Vec3f p = ray.at(k * s);
         ++counters.samples;
-        tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
+        if (k < kOutside) {
+            tet = kNoTet;
+        } else {
+            tet = scene.locator.locate<kNative>(p, tet, bary, counters.locate);
+            if (tet == kNoTet)
+                kOutside = outsideUntil<kNative>(scene.locator.mesh, scene.locator.bvh, ray, k, s,
+                                                 entryEps, counters.locate);
+        }
         const float v = tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary);
         const Vec3f g = sampleGradient<kNative, kLit>(scene.params, scene.locator.mesh, tet, bary);
         const LightFactors light =
@@ -521,6 +533,12 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
             tNoted = k * s;
         }
         opaque = acc.w >= stopAlpha;
+        // Outside, before the ray's next entry: on to the last grid point before it (at most
+        // the closing sample), so the step into the mesh is one s as before.
+        if (tet == kNoTet && k + 2.f < kOutside) {
+            const float last = fminf(k + ceilf(kOutside - k) - 1.f, kClose);
+            if (last > k + 1.f) k = last - 1.f;
+        }
     }
     if (scene.params.preintegrated && !opaque && !pieceEnd) {
         [[maybe_unused]] const float a0 = acc.w;
