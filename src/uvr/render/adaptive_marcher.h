@@ -438,7 +438,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // ray enters it again (outsideUntil, asked at a sample found outside; infinity when the ray
     // never does). They take no point location, and most no sample (below).
     float kOutside = -INFINITY;
-    const double entryEps = 1e-6 * (double(scene.base.bounds.diagonal()) + double(tEnter));
+    const double entryEps = cellGapEps(scene.base.bounds, tEnter);
     bool marching = true, opaque = false, macro = false;
     // Depth out: the opacity and the end of the stretch of the ray noted last, noted wherever
     // the run composites (after each sample, and where a transparent macrocell ends a run).
@@ -577,7 +577,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         // before it. Each position skipped would have stepped one s1 on, outside; the one there
         // is taken, so the step into the mesh is one s1 as before and the picture is the same.
         if (tet == kNoTet && !endsRun && kSample + 2.f < kOutside)
-            kNext = fmaxf(kNext, kSample + ceilf(kOutside - kSample) - 1.f);
+            kNext = fmaxf(kNext, lastOutside(kSample, kOutside));
         // A sample at the piece's last grid point K1 - 1 (see the piece's steps above).
         if (kSample < k1 - 1.f && kNext > k1 - 1.f) kNext = k1 - 1.f;
         const float length = ((kNext < k1 ? kNext : k1) - kSample) * s1;

@@ -373,7 +373,7 @@ UVR_HOST_DEVICE inline Vec4f integrateExact(const SceneView& scene, const Ray& r
     const double tStop = clipped ? double(b1) : INFINITY;
     const TetLocator& loc = scene.locator;
     // A gap this small between tetrahedra is rounding, not empty space.
-    const double eps = 1e-6 * (double(scene.bounds.diagonal()) + double(b0));
+    const double eps = cellGapEps(scene.bounds, b0);
     const double unit = scene.params.opacityUnit;
     const Lighting lighting = kernelLighting<kLit, kSurf>(scene.params);
     const IsoView* isos = kSurf && scene.params.iso.active() ? &scene.params.iso : nullptr;

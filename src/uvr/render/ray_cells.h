@@ -11,6 +11,7 @@
 
 #include "uvr/accel/bvh.h"
 #include "uvr/accel/point_locator.h"
+#include "uvr/core/bounds.h"
 #include "uvr/core/host_device.h"
 #include "uvr/core/ray.h"
 #include "uvr/core/vec3d.h"
@@ -161,6 +162,12 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
 
 }  // namespace exact
 
+/// The gap between cells that a ray query (nextTetAlong) takes for rounding, not empty space,
+/// on a ray whose span starts at t0 through a mesh of these bounds.
+UVR_HOST_DEVICE inline double cellGapEps(const Bounds3f& bounds, float t0) {
+    return 1e-6 * (double(bounds.diagonal()) + double(t0));
+}
+
 /// For a sample-based marcher whose sample at grid position k (spacing s) lies outside the mesh:
 /// a grid position below which every position of the ray lies outside it too, a tenth of s short
 /// of where the ray enters the mesh again (a position that close is located as usual; infinity
@@ -175,6 +182,13 @@ UVR_HOST_DEVICE inline float outsideUntil(const TetMeshView& mesh, const BvhView
     const std::uint32_t next =
         exact::nextTetAlong<kNative>(mesh, tree, ray, double(k) * s, eps, entry, counters);
     return next == kNoTet ? INFINITY : static_cast<float>((entry.tIn - 0.1 * s) / s);
+}
+
+/// Where a marcher steps from its outside sample at grid position k: the last position k + n
+/// (n whole) below kOutside (outsideUntil), so the step into the mesh is one s as every step
+/// outside was.
+UVR_HOST_DEVICE inline float lastOutside(float k, float kOutside) {
+    return k + ceilf(kOutside - k) - 1.f;
 }
 
 }  // namespace uvr

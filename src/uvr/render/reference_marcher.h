@@ -483,7 +483,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     // Outside a non-convex mesh: the grid points below kOutside lie outside it, before the ray
     // enters it again (marchPartitions does the same; adaptive_marcher.h says why).
     float kOutside = -INFINITY;
-    const double entryEps = 1e-6 * (double(scene.bounds.diagonal()) + double(t0));
+    const double entryEps = cellGapEps(scene.bounds, t0);
     for (; k <= kClose && !opaque; k += 1.f) {
         const bool own = k <= kEnd;  // else the closing sample: its share is the next piece's
         [[maybe_unused]] const float a0 = acc.w;
@@ -536,7 +536,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         // Outside, before the ray's next entry: on to the last grid point before it (at most
         // the closing sample), so the step into the mesh is one s as before.
         if (tet == kNoTet && k + 2.f < kOutside) {
-            const float last = fminf(k + ceilf(kOutside - k) - 1.f, kClose);
+            const float last = fminf(lastOutside(k, kOutside), kClose);
             if (last > k + 1.f) k = last - 1.f;
         }
     }
