@@ -20,7 +20,8 @@ bool parseOpacityLaw(const char* name, OpacityLaw& law) {
     return false;
 }
 
-std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count, float tolerance) {
+std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count, float colorTolerance,
+                                        float opacityTolerance) {
     std::vector<std::int32_t> out(2 * static_cast<std::size_t>(std::max(count, 0)), 0);
     if (count < 2) return out;
     // Breakpoints in increasing order: a run from breakpoint b may end at entry j when the chord
@@ -52,6 +53,7 @@ std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count, float t
             if (!fits) break;
             end = j;
             for (int c = 0; c < 4; ++c) {
+                const float tolerance = c == 3 ? opacityTolerance : colorTolerance;
                 const float rise = entries[j][c] - entries[b][c];
                 lo[c] = std::max(lo[c], (rise - tolerance) / d);
                 hi[c] = std::min(hi[c], (rise + tolerance) / d);

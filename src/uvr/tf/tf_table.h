@@ -70,8 +70,9 @@ struct TfTableView {
     float hi = 1.f;
     /// Optional breakpoints (tfTableBreaks): 2 * count indices, breaks[i] the first breakpoint
     /// above entry i, breaks[count + i] the last one below it. Between two consecutive
-    /// breakpoints the table is linear to within kTfBreakTolerance, so the integrators need not
-    /// split a segment at the entries in between. Null: every entry is a breakpoint.
+    /// breakpoints the table is linear to within kTfColorBreakTolerance in colour and
+    /// kTfOpacityBreakTolerance in opacity, so the integrators need not split a segment at the
+    /// entries in between. Null: every entry is a breakpoint.
     const std::int32_t* breaks = nullptr;
     /// Colour and opacity of NaN values (TransferFunction::nanColor, nanOpacity); opacity 0
     /// keeps NaN regions invisible.
@@ -103,17 +104,26 @@ struct TfTableView {
     }
 };
 
-/// Largest difference (per RGBA channel) between a baked table and its linear interpolation
-/// between breakpoints: far below one 8-bit level (1 / 255), so integrating between
-/// breakpoints instead of between all entries changes no pixel.
-inline constexpr float kTfBreakTolerance = 1e-4f;
+/// Largest difference in opacity between a baked table and its linear interpolation between
+/// breakpoints. An opacity error adds up along a ray (to this times the ray's length in opacity
+/// units, in optical depth), so it is held tight.
+inline constexpr float kTfOpacityBreakTolerance = 1e-4f;
+
+/// Largest difference in each colour channel between a baked table and its linear interpolation
+/// between breakpoints. A colour error does not add up: the composited colour is the colour
+/// weighted by the emission fractions, which sum to the pixel's opacity, so the pixel is off by
+/// at most this (a quarter of one 8-bit level). Integrating between breakpoints instead of
+/// between all entries thus changes no pixel.
+inline constexpr float kTfColorBreakTolerance = 1e-3f;
 
 /// Breakpoints of a baked table (the layout of TfTableView::breaks): the entries where the
-/// table stops being linear to within `tolerance` in every channel, chosen greedily from the
-/// first entry in one O(count) pass (for each run, the interval of chord slopes that keeps every
-/// entry inside the run within tolerance); a run of entries of opacity 0 is one piece whatever
-/// their colours (it emits and absorbs nothing). Both ends are always breakpoints.
+/// table stops being linear to within `colorTolerance` in a colour channel or
+/// `opacityTolerance` in opacity, chosen greedily from the first entry in one O(count) pass (for
+/// each run, the interval of chord slopes that keeps every entry inside the run within
+/// tolerance); a run of entries of opacity 0 is one piece whatever their colours (it emits and
+/// absorbs nothing). Both ends are always breakpoints.
 std::vector<std::int32_t> tfTableBreaks(const Vec4f* entries, int count,
-                                        float tolerance = kTfBreakTolerance);
+                                        float colorTolerance = kTfColorBreakTolerance,
+                                        float opacityTolerance = kTfOpacityBreakTolerance);
 
 }  // namespace uvr

@@ -21,13 +21,16 @@ std::vector<int> breakpoints(const std::vector<std::int32_t>& breaks, int count)
     return out;
 }
 
-/// Largest difference between the entries inside [b, e] and the chord from b to e.
+/// Largest difference between the entries inside [b, e] and the chord from b to e, in units of
+/// each channel's tolerance (colour kTfColorBreakTolerance, opacity kTfOpacityBreakTolerance).
 float chordError(const std::vector<Vec4f>& t, int b, int e) {
     float worst = 0.f;
     for (int k = b + 1; k < e; ++k)
         for (int c = 0; c < 4; ++c) {
             const float f = float(k - b) / float(e - b);
-            worst = std::fmax(worst, std::fabs(t[k][c] - (t[b][c] + (t[e][c] - t[b][c]) * f)));
+            const float tolerance = c == 3 ? kTfOpacityBreakTolerance : kTfColorBreakTolerance;
+            worst = std::fmax(worst,
+                              std::fabs(t[k][c] - (t[b][c] + (t[e][c] - t[b][c]) * f)) / tolerance);
         }
     return worst;
 }
@@ -45,6 +48,29 @@ TEST(TfTableBreaks, LinearTableHasOnlyItsEnds) {
     EXPECT_EQ(view.breakAbove(517.3), 1023);
     EXPECT_EQ(view.breakBelow(517.3), 0);
     EXPECT_EQ(view.breakBelow(1023.0), 0);
+}
+
+TEST(TfTableBreaks, OpacityIsHeldTighterThanColour) {
+    // A bump of 5e-4 in the middle of a linear table: inside the colour tolerance, outside the
+    // opacity one.
+    auto table = [](int channel) {
+        std::vector<Vec4f> t;
+        for (int i = 0; i < 101; ++i) {
+            float e[4] = {0.2f, 0.4f, 0.6f, 0.5f};
+            e[channel] += 5e-4f * (1.f - std::fabs(i - 50) / 50.f);
+            t.push_back(Vec4f(e[0], e[1], e[2], e[3]));
+        }
+        return t;
+    };
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<Vec4f> t = table(c);
+        EXPECT_EQ(breakpoints(tfTableBreaks(t.data(), 101), 101), (std::vector<int>{0, 100})) << c;
+    }
+    const std::vector<Vec4f> t = table(3);
+    EXPECT_GT(breakpoints(tfTableBreaks(t.data(), 101), 101).size(), 2u);
+    // Either tolerance can be given.
+    EXPECT_EQ(breakpoints(tfTableBreaks(t.data(), 101, 1e-3f, 1e-3f), 101),
+              (std::vector<int>{0, 100}));
 }
 
 TEST(TfTableBreaks, KinksAreKeptAndRunsAreLinearAndMaximal) {
@@ -81,9 +107,9 @@ TEST(TfTableBreaks, KinksAreKeptAndRunsAreLinearAndMaximal) {
                 }
                 continue;
             }
-            EXPECT_LE(chordError(t, b0, b1), kTfBreakTolerance * 1.001f);
+            EXPECT_LE(chordError(t, b0, b1), 1.001f);
             if (b1 < n - 1) {  // greedy: one entry more breaks the tolerance
-                EXPECT_GT(chordError(t, b0, b1 + 1), kTfBreakTolerance);
+                EXPECT_GT(chordError(t, b0, b1 + 1), 1.f);
             }
         }
         // The presets are transparent over [0, 0.3] (one piece), and so are pairs of the random
