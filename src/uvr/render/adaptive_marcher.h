@@ -510,7 +510,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                         // the run's last cell that leaves the mesh says so.
                         if (segments.started && segments.inside && !segments.led &&
                             kSample <= segments.kEnd) {
-                            float b[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
+                            float b[4];
                             ++counters.samples;
                             if (locator.walk<kNative>(pos, lastInside, b, counters.locate) ==
                                 kNoTet)

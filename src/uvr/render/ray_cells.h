@@ -180,13 +180,10 @@ UVR_HOST_DEVICE inline double boundaryAlong(const TetLocator& loc, std::uint32_t
     for (int i = 0; i < kBoundaryWalkCells; ++i) {
         const exact::TetSpan s = exact::clipAny<kNative>(loc.mesh, cell, ray, false, t - eps);
         if (!(s.tIn <= t + eps && s.tOut > t - eps)) return NAN;  // the ray is not in it at t
-        if (s.exitFace < 0) return s.tOut >= tLimit ? tLimit : NAN;
-        const std::uint32_t next = loc.neighbors.across<kNative>(loc.mesh, cell, s.exitFace);
-        // A face without a neighbour at the limit is the boundary, not the limit: a mesh that
-        // fills its bounds ends at the span's start or end, and a clip box around it must not
-        // change where (the two differ by rounding).
-        if (next == kNoTet && s.tOut <= tLimit + eps) return s.tOut;
         if (s.tOut >= tLimit) return tLimit;
+        if (s.exitFace < 0) return NAN;
+        const std::uint32_t next = loc.neighbors.across<kNative>(loc.mesh, cell, s.exitFace);
+        if (next == kNoTet) return s.tOut;
         t = s.tOut > t ? s.tOut : t;
         cell = next;
     }

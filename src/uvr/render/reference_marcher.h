@@ -293,19 +293,6 @@ struct PointIsos {
 /// the ray: to within s1 / 2^10.
 inline constexpr int kBoundaryBisections = 10;
 
-/// A boundary within this many steps s1 of a run's end sample is at the sample: the run takes no
-/// sample there. Without the margin, frames that differ only by rounding (a mesh moved or scaled,
-/// a clip box around it) took a boundary sample in one and not the other where a face lies on a
-/// grid position (a regular grid seen along an axis), and their pixels differed in the last bits
-/// on the GPU.
-inline constexpr float kBoundarySameSpot = 1e-3f;
-
-/// Local coordinates that give a walk into a native cell no starting guess (TetLocator::walk
-/// starts Newton's method from the coordinates it is given, when they lie near the cell): it
-/// starts from the cell's centre, as a search does. Uninitialised coordinates made two renders
-/// of one preparation differ in the last bits.
-inline constexpr float kNoGuess = -9.f;
-
 /// Runs call(counters, acc), a non-inlined surface call (sampleAtBoundary, bisectIso, cutFace),
 /// on copies of a marcher's counters and colour, and takes them back. Given the marcher's own,
 /// the call takes their addresses, so they live in local memory at every sample of the frame,
@@ -364,21 +351,21 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
     // where they are about a step across.
     {
         const double tIn = double(kIn) * s1, tOut = double(kOut) * s1;
-        const double eps = 1e-6 * fabs(tIn) + 1e-4 * s1;  // not of tOut: a clip box changes it
+        const double eps = 1e-6 * (fabs(tIn) + fabs(tOut)) + 1e-4 * s1;
         std::uint32_t cell = tetIn;
         const Ray back{ray.org, Vec3f(-ray.dir.x, -ray.dir.y, -ray.dir.z)};
         const double tb = entering ? -boundaryAlong<kNative>(loc, cell, back, -tIn, -tOut, eps)
                                    : boundaryAlong<kNative>(loc, cell, ray, tIn, tOut, eps);
         if (tb == tb) {
             const float kb = static_cast<float>(tb / s1);
-            if (entering ? kb >= kIn - kBoundarySameSpot : kb <= kIn + kBoundarySameSpot) {
-                // At the sample: a run ending there ends at the sample.
+            if (entering ? kb >= kIn : kb <= kIn) {
+                // Within rounding of the sample: a run ending there ends at the sample.
                 if (!entering && segments.kLast == kIn) segments.kEnd = kIn;
                 return;
             }
             // Located a hair inside (the face itself may round to either side).
             const double nudge = (entering ? 1e-4 : -1e-4) * s1;
-            float bary[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
+            float bary[4];
             ++counters.samples;
             const std::uint32_t t =
                 locate(ray.at(static_cast<float>(tb + nudge)), cell, bary, counters.locate);
@@ -393,7 +380,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
         // s1 / 2^kBoundaryBisections.
         float lo = kOut;
         std::uint32_t from = tetIn;
-        float bary[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
+        float bary[4];
         if (!outKnown) {
             ++counters.samples;
             const std::uint32_t t = locate(ray.at(lo * s1), from, bary, counters.locate);
@@ -415,7 +402,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const M
             }
         }
     }
-    if (tetHi == kNoTet || fabsf(hi - kIn) <= kBoundarySameSpot) {
+    if (tetHi == kNoTet || hi == kIn) {
         // The boundary lies within s1 / 2^kBoundaryBisections of the sample: a run ending there
         // ends at the sample.
         if (!entering && segments.kLast == kIn) segments.kEnd = kIn;
