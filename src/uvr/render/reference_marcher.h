@@ -289,8 +289,7 @@ struct PointIsos {
     }
 };
 
-/// Bisection probes sampleAtBoundary takes for the mesh's boundary where its walk cannot follow
-/// the ray: to within s1 / 2^10.
+/// Bisection probes sampleAtBoundary takes for the mesh's boundary: to within s1 / 2^10.
 inline constexpr int kBoundaryBisections = 10;
 
 /// Runs call(counters, acc), a non-inlined surface call (sampleAtBoundary, bisectIso, cutFace),
@@ -320,12 +319,9 @@ UVR_HOST_DEVICE UVR_INLINE void callOnCopies(SampleSegments<kLit, kSurf>& segmen
 /// tetIn) and a position kOut outside the mesh or past the span's end (outKnown;
 /// before kIn where a run starts, after it where one ends), or the start of the span (!outKnown,
 /// before the first sample: the span may start inside the mesh, at a clip plane or the camera),
-/// a walk from tetIn along the ray (backwards where a run starts) across shared faces finds the
-/// face without a neighbour (boundaryAlong, exact to rounding; kOut itself where the ray is
-/// still inside there); where the walk cannot follow the ray, probes by bisection, each located
-/// by `locate(q, from, bary, counters)` from the last one found, narrow the boundary to within
-/// s1 / 2^kBoundaryBisections. The run gets a sample at the boundary's inside end. A run that
-/// starts there covers the distance from the boundary to
+/// probes by bisection, each located by `locate(q, from, bary, counters)` from the last one
+/// found, narrow the boundary to within s1 / 2^kBoundaryBisections, and the run gets a sample at
+/// the boundary's inside end. A run that starts there covers the distance from the boundary to
 /// its first grid sample, a run that ends there stops at it (its last share ends there, so
 /// kPieceEnd is read only where a run starts). Grid samples alone cover a run's n samples times
 /// s1 from its first: a length off by up to s1 at each end, which drew rings on flat faces and
