@@ -15,7 +15,10 @@
 #include "uvr/accel/kd_partitions.h"
 #include "uvr/accel/tet_adjacency.h"
 #include "uvr/cpu/threads.h"
+#include "uvr/mesh/field_select.h"
 #include "uvr/mesh/procedural.h"
+#include "uvr/mesh/smooth_gradients.h"
+#include "uvr/mesh/tet_math.h"
 #include "uvr/render/frame_setup.h"
 
 namespace uvr {
@@ -56,6 +59,50 @@ TEST(ParallelBuild, SameResultsWithOneAndTwoThreads) {
         EXPECT_TRUE(testing::sameBytes(a.neighborCodes.escapes, b.neighborCodes.escapes));
         EXPECT_TRUE(testing::sameBytes(a.cellTree.nodes, b.cellTree.nodes));
     }
+}
+
+TEST(ParallelBuild, SmoothGradientsAreTheSameBitsWithOneAndTwoThreads) {
+    // Each point's sum over the cells around it, added to by several threads: float atomics gave
+    // sums that differed in the last bits from run to run (and so shaded pixels, by 1/255).
+    ProceduralSpec spec;
+    spec.targetCells = 200000;
+    spec.fields = {ProceduralField::Multiscale};
+    const Mesh mesh = generateMesh(spec);
+    const TetMesh prepared = prepareMesh(mesh, selectScalarField(mesh, {}), {}).tets;
+    ASSERT_EQ(prepared.blockVertexPoint.size(), prepared.blockVertices.size());
+    const auto gradients = [&](int threads) {
+        TetMesh t = prepared;
+        cpu::setThreadCount(threads);
+        computeSmoothGradients(t);
+        cpu::setThreadCount(0);
+        return t.blockGradients;
+    };
+    const std::vector<Vec3f> one = gradients(1);
+    ASSERT_EQ(one.size(), prepared.blockVertices.size());
+    for (int run = 0; run < 3; ++run) EXPECT_TRUE(testing::sameBytes(one, gradients(2))) << run;
+    // And right: each point's volume-weighted mean of its tetrahedra's gradients, summed here in
+    // double one tetrahedron after the other, to float rounding.
+    const TetMeshView v = prepared.view();
+    std::vector<double> sums(4 * mesh.points.size(), 0.0);
+    for (std::uint64_t t = 0; t < prepared.tetCount(); ++t) {
+        BlockVertex x[4];
+        v.tetVertices(t, x);
+        const Vec3f g = tetGradient(x[0].p, x[1].p, x[2].p, x[3].p, x[0].value, x[1].value,
+                                    x[2].value, x[3].value);
+        const double w = std::fabs(signedVolume6(x[0].p, x[1].p, x[2].p, x[3].p)) / 6.0;
+        const std::uint32_t base = prepared.blockVertexBase[t >> kTetBlockBits];
+        for (const std::uint16_t k : prepared.tetCorners[t].v) {
+            double* s = &sums[4 * prepared.blockVertexPoint[base + k]];
+            s[0] += w * g.x, s[1] += w * g.y, s[2] += w * g.z, s[3] += w;
+        }
+    }
+    float worst = 0.f;
+    for (std::uint64_t i = 0; i < one.size(); ++i) {
+        const double* s = &sums[4 * prepared.blockVertexPoint[i]];
+        const Vec3f want(float(s[0] / s[3]), float(s[1] / s[3]), float(s[2] / s[3]));
+        worst = std::max(worst, length(one[i] - want) / std::max(length(want), 1e-6f));
+    }
+    EXPECT_LT(worst, 1e-5f);
 }
 
 TEST(ParallelBuild, LargeBvhHoldsEveryPrimitiveOnceInNestedBoxes) {

@@ -2,6 +2,7 @@
 #include "uvr/mesh/smooth_gradients.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -11,18 +12,60 @@ namespace uvr {
 
 namespace {
 
-/// Adds weight w of gradient g to point p's sums (several threads add to one point).
-void addTo(std::vector<Vec3f>& sums, std::vector<float>& weights, std::uint32_t p, Vec3f g,
-           float w) {
-#pragma omp atomic
-    sums[p].x += w * g.x;
-#pragma omp atomic
-    sums[p].y += w * g.y;
-#pragma omp atomic
-    sums[p].z += w * g.z;
-#pragma omp atomic
-    weights[p] += w;
-}
+/// Each point's sums in fixed point: integer additions, so a sum is the same whatever order the
+/// threads add its terms in (float atomics made two preparations' gradients differ in the last
+/// bits, and so two renders of one shaded frame, a pixel apart by 1/255). A term is a multiple of
+/// its point's scale (the largest term's magnitude there, found first: a maximum does not depend
+/// on order) over 2^kFixedBits, an error of 2^-41 of the largest, far under float rounding; a point
+/// takes 2^(63 - kFixedBits) terms before an overflow.
+constexpr int kFixedBits = 40;
+
+struct FixedSums {
+    std::vector<std::uint32_t> scaleBits;  // per point, 2 floats: the largest |w g_i| and w
+    std::vector<std::int64_t> sums;        // per point, 4: w g.x, w g.y, w g.z, w
+    explicit FixedSums(std::size_t points) : scaleBits(2 * points, 0), sums(4 * points, 0) {}
+
+    float scale(std::size_t p, int k) const {
+        float f;
+        std::memcpy(&f, &scaleBits[2 * p + k], 4);
+        return f;
+    }
+    /// First pass: the scales (non-negative floats order as their bits do).
+    void widen(std::uint32_t p, Vec3f g, float w) {
+        const float m[2] = {std::max({std::fabs(w * g.x), std::fabs(w * g.y), std::fabs(w * g.z)}),
+                            w};
+        for (int k = 0; k < 2; ++k) {
+            std::uint32_t bits;
+            std::memcpy(&bits, &m[k], 4);
+            std::atomic_ref<std::uint32_t> at(scaleBits[2 * p + k]);
+            std::uint32_t seen = at.load(std::memory_order_relaxed);
+            while (seen < bits &&
+                   !at.compare_exchange_weak(seen, bits, std::memory_order_relaxed)) {
+            }
+        }
+    }
+    /// Second pass: the terms.
+    void add(std::uint32_t p, Vec3f g, float w) {
+        const float terms[4] = {w * g.x, w * g.y, w * g.z, w};
+        for (int i = 0; i < 4; ++i) {
+            const float s = scale(p, i < 3 ? 0 : 1);
+            if (!(s > 0.f)) continue;
+            const auto q = static_cast<std::int64_t>(
+                std::llrint(std::ldexp(static_cast<double>(terms[i]) / s, kFixedBits)));
+            std::atomic_ref<std::int64_t>(sums[4 * p + i]).fetch_add(q, std::memory_order_relaxed);
+        }
+    }
+    /// The volume-weighted mean gradient at p (0 where no cell gave one).
+    Vec3f mean(std::size_t p) const {
+        const double w =
+            std::ldexp(static_cast<double>(sums[4 * p + 3]), -kFixedBits) * scale(p, 1);
+        if (!(w > 0.0)) return Vec3f(0.f);
+        const double k = std::ldexp(1.0, -kFixedBits) * scale(p, 0) / w;
+        return Vec3f(static_cast<float>(static_cast<double>(sums[4 * p]) * k),
+                     static_cast<float>(static_cast<double>(sums[4 * p + 1]) * k),
+                     static_cast<float>(static_cast<double>(sums[4 * p + 2]) * k));
+    }
+};
 
 /// Volume of a native cell: |det J| at its parametric centre times its parametric volume.
 float nativeVolume(CellKind k, const Vec3f* x) {
@@ -96,46 +139,50 @@ void computeSmoothGradients(TetMesh& mesh, const FractionFn& progress) {
     if (mesh.blockVertexPoint.size() != mesh.blockVertices.size())
         points = weldBlockVertices(mesh, welded);
     const std::vector<std::uint32_t>& vertexPoint = welded.empty() ? mesh.blockVertexPoint : welded;
-    std::vector<Vec3f> sums(points, Vec3f(0.f));
-    std::vector<float> weights(points, 0.f);
+    FixedSums fixed(points);
     const TetMeshView view = mesh.view();
-    const std::int64_t tets = static_cast<std::int64_t>(mesh.tetCount());
+    // Calls term(point, gradient, weight) for every cell corner, on threads (twice: the scales,
+    // then the sums).
+    const auto forEachTerm = [&](auto&& term) {
+        const std::int64_t tets = static_cast<std::int64_t>(mesh.tetCount());
 #pragma omp parallel for schedule(static, 4096)
-    for (std::int64_t t = 0; t < tets; ++t) {
-        BlockVertex x[4];
-        view.tetVertices(t, x);
-        const Vec3f g = tetGradient(x[0].p, x[1].p, x[2].p, x[3].p, x[0].value, x[1].value,
-                                    x[2].value, x[3].value);
-        const float w = std::fabs(signedVolume6(x[0].p, x[1].p, x[2].p, x[3].p)) / 6.f;
-        if (!isFinite(g) || !(w > 0.f)) continue;
-        const TetCorners16 c = mesh.tetCorners[t];
-        const std::uint32_t base = mesh.blockVertexBase[std::uint64_t(t) >> kTetBlockBits];
-        for (int k = 0; k < 4; ++k) addTo(sums, weights, vertexPoint[base + c.v[k]], g, w);
-    }
-    done.add();
-    const std::int64_t cells = static_cast<std::int64_t>(mesh.cellCount());
-#pragma omp parallel for schedule(static, 1024)
-    for (std::int64_t c = tets; c < cells; ++c) {
-        Vec3f x[kMaxCellCorners];
-        float v[kMaxCellCorners];
-        std::uint32_t ids[kMaxCellCorners];
-        const int n = view.corners(c, ids);
-        view.gather(c, x, v);
-        const CellKind k = view.kind(c);
-        const float w = nativeVolume(k, x);
-        if (!(w > 0.f) || !std::isfinite(w)) continue;
-        for (int i = 0; i < n; ++i) {
-            Vec3f rst = cornerParametric(k, i);
-            if (k == CellKind::Pyramid && i == 4) rst = Vec3f(0.5f, 0.5f, 0.5f);  // the apex
-            const Vec3f g = cellGradient(k, x, v, rst);
-            if (isFinite(g)) addTo(sums, weights, ids[i], g, w);
+        for (std::int64_t t = 0; t < tets; ++t) {
+            BlockVertex x[4];
+            view.tetVertices(t, x);
+            const Vec3f g = tetGradient(x[0].p, x[1].p, x[2].p, x[3].p, x[0].value, x[1].value,
+                                        x[2].value, x[3].value);
+            const float w = std::fabs(signedVolume6(x[0].p, x[1].p, x[2].p, x[3].p)) / 6.f;
+            if (!isFinite(g) || !(w > 0.f)) continue;
+            const TetCorners16 c = mesh.tetCorners[t];
+            const std::uint32_t base = mesh.blockVertexBase[std::uint64_t(t) >> kTetBlockBits];
+            for (int k = 0; k < 4; ++k) term(vertexPoint[base + c.v[k]], g, w);
         }
-    }
-    done.add();
+        const std::int64_t cells = static_cast<std::int64_t>(mesh.cellCount());
+#pragma omp parallel for schedule(static, 1024)
+        for (std::int64_t c = tets; c < cells; ++c) {
+            Vec3f x[kMaxCellCorners];
+            float v[kMaxCellCorners];
+            std::uint32_t ids[kMaxCellCorners];
+            const int n = view.corners(c, ids);
+            view.gather(c, x, v);
+            const CellKind k = view.kind(c);
+            const float w = nativeVolume(k, x);
+            if (!(w > 0.f) || !std::isfinite(w)) continue;
+            for (int i = 0; i < n; ++i) {
+                Vec3f rst = cornerParametric(k, i);
+                if (k == CellKind::Pyramid && i == 4) rst = Vec3f(0.5f, 0.5f, 0.5f);  // the apex
+                const Vec3f g = cellGradient(k, x, v, rst);
+                if (isFinite(g)) term(ids[i], g, w);
+            }
+        }
+        done.add();
+    };
+    forEachTerm([&](std::uint32_t p, Vec3f g, float w) { fixed.widen(p, g, w); });
+    forEachTerm([&](std::uint32_t p, Vec3f g, float w) { fixed.add(p, g, w); });
+    std::vector<Vec3f> sums(points);
     const std::int64_t pointCount = static_cast<std::int64_t>(points);
 #pragma omp parallel for schedule(static, 65536)
-    for (std::int64_t p = 0; p < pointCount; ++p)
-        sums[p] = weights[p] > 0.f ? sums[p] * (1.f / weights[p]) : Vec3f(0.f);
+    for (std::int64_t p = 0; p < pointCount; ++p) sums[p] = fixed.mean(p);
     mesh.blockGradients.resize(mesh.blockVertices.size());
     const std::int64_t bv = static_cast<std::int64_t>(mesh.blockVertices.size());
 #pragma omp parallel for schedule(static, 65536)
