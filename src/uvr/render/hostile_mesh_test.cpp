@@ -139,24 +139,30 @@ bool raySpan(const Bounds3f& b, const Ray& ray, double& t0, double& t1) {
 }
 
 /// Describes how a pixel misses the oracle, or "" when it matches: finite, the TF colour, and
-/// the opacity of the grid points k * step in the span [t0, t1] (a grid point within kGridSlack
-/// of an end of the span may count or not: float and double ends differ by rounding).
+/// the opacity of the span [t0, t1]: pre-integrated runs start and end at the mesh's boundary
+/// (sampleAtBoundary), so a constant medium's opacity is the chord's, to within kLengthSlack
+/// steps (where the boundary is bisected for). A chord holding no grid point k * step (or one
+/// within kGridSlack of an end: float and double ends differ by rounding) may take no sample at
+/// all: its opacity lies between 0 and the chord's.
 std::string checkPixel(Vec4f c, bool hit, double t0, double t1, double step, double unit) {
     if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) || !std::isfinite(c.w))
         return "non-finite pixel";
-    constexpr double kGridSlack = 1e-3;
-    double nLo = 0.0, nHi = 0.0;
+    constexpr double kGridSlack = 1e-3, kLengthSlack = 2e-3;
+    double nLo = 0.0, len = 0.0;
     if (hit) {
         const double k0 = t0 / step, k1 = t1 / step;
         nLo = std::max(0.0, std::floor(k1 - kGridSlack) - std::ceil(k0 + kGridSlack) + 1.0);
-        nHi = std::max(0.0, std::floor(k1 + kGridSlack) - std::ceil(k0 - kGridSlack) + 1.0);
+        len = std::max(0.0, t1 - t0);
     }
-    const double lo = exactAlpha(nLo * step, unit) - kAlphaTolerance;
-    const double hi = exactAlpha(nHi * step, unit) + kAlphaTolerance;
+    const double lo =
+        nLo > 0.0 ? exactAlpha(std::max(0.0, len - kLengthSlack * step), unit) - kAlphaTolerance
+                  : -kAlphaTolerance;
+    const double hi =
+        hit ? exactAlpha(len + kLengthSlack * step, unit) + kAlphaTolerance : kAlphaTolerance;
     if (c.w < lo || c.w > hi)
         return "alpha " + std::to_string(c.w) + " outside [" + std::to_string(lo) + ", " +
-               std::to_string(hi) + "] for " + std::to_string(nLo) + " to " + std::to_string(nHi) +
-               " grid points in [" + std::to_string(t0) + ", " + std::to_string(t1) + "]";
+               std::to_string(hi) + "] for the chord [" + std::to_string(t0) + ", " +
+               std::to_string(t1) + "] (" + std::to_string(nLo) + " grid points)";
     if (c.w > 1e-3f)
         for (int i = 0; i < 3; ++i)
             if (std::fabs(c.xyz()[i] / c.w - kColor[i]) > kColorTolerance)

@@ -162,6 +162,37 @@ UVR_HOST_DEVICE inline std::uint32_t nextTetAlong(const TetMeshView& mesh, const
 
 }  // namespace exact
 
+/// Cells boundaryAlong walks at most: a boundary further than this many cells from a sample
+/// (cells far smaller than a step s1) is found by bisection instead. Blunt Fin's walks cross
+/// 9.5 cells on average (its cells shrink towards the walls); at 16 a third of them gave up.
+inline constexpr int kBoundaryWalkCells = 64;
+
+/// Where the ray leaves the mesh after parameter t, t in `cell`, walking cell to cell across
+/// shared faces (the exact integrator's step): the parameter of the first face with no
+/// neighbour, or tLimit when the ray is still inside there; `cell` ends as the cell left last.
+/// NAN when the walk cannot follow the ray: a crossing that does not continue in the
+/// neighbour (degenerate, or a tolerance eps too small), no adjacency, or more than
+/// kBoundaryWalkCells cells.
+template <bool kNative = true>
+UVR_HOST_DEVICE inline double boundaryAlong(const TetLocator& loc, std::uint32_t& cell,
+                                            const Ray& ray, double t, double tLimit, double eps) {
+    if (!loc.neighbors.present() || cell == kNoTet) return NAN;
+    for (int i = 0; i < kBoundaryWalkCells; ++i) {
+        const exact::TetSpan s = exact::clipAny<kNative>(loc.mesh, cell, ray, false, t - eps);
+        if (!(s.tIn <= t + eps && s.tOut > t - eps)) return NAN;  // the ray is not in it at t
+        if (s.exitFace < 0) return s.tOut >= tLimit ? tLimit : NAN;
+        const std::uint32_t next = loc.neighbors.across<kNative>(loc.mesh, cell, s.exitFace);
+        // A face without a neighbour at the limit is the boundary, not the limit: a mesh that
+        // fills its bounds ends at the span's start or end, and a clip box around it must not
+        // change where (the two differ by rounding).
+        if (next == kNoTet && s.tOut <= tLimit + eps) return s.tOut;
+        if (s.tOut >= tLimit) return tLimit;
+        t = s.tOut > t ? s.tOut : t;
+        cell = next;
+    }
+    return NAN;
+}
+
 /// The gap between cells that a ray query (nextTetAlong) takes for rounding, not empty space,
 /// on a ray whose span starts at t0 through a mesh of these bounds.
 UVR_HOST_DEVICE inline double cellGapEps(const Bounds3f& bounds, float t0) {

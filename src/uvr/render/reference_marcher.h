@@ -289,8 +289,22 @@ struct PointIsos {
     }
 };
 
-/// Bisection probes sampleAtBoundary takes for the mesh's boundary: to within s1 / 2^10.
+/// Bisection probes sampleAtBoundary takes for the mesh's boundary where its walk cannot follow
+/// the ray: to within s1 / 2^10.
 inline constexpr int kBoundaryBisections = 10;
+
+/// A boundary within this many steps s1 of a run's end sample is at the sample: the run takes no
+/// sample there. Without the margin, frames that differ only by rounding (a mesh moved or scaled,
+/// a clip box around it) took a boundary sample in one and not the other where a face lies on a
+/// grid position (a regular grid seen along an axis), and their pixels differed in the last bits
+/// on the GPU.
+inline constexpr float kBoundarySameSpot = 1e-3f;
+
+/// Local coordinates that give a walk into a native cell no starting guess (TetLocator::walk
+/// starts Newton's method from the coordinates it is given, when they lie near the cell): it
+/// starts from the cell's centre, as a search does. Uninitialised coordinates made two renders
+/// of one preparation differ in the last bits.
+inline constexpr float kNoGuess = -9.f;
 
 /// Runs call(counters, acc), a non-inlined surface call (sampleAtBoundary, bisectIso, cutFace),
 /// on copies of a marcher's counters and colour, and takes them back. Given the marcher's own,
@@ -314,59 +328,102 @@ UVR_HOST_DEVICE UVR_INLINE void callOnCopies(SampleSegments<kLit, kSurf>& segmen
     segments = s;
 }
 
-/// Isosurfaces (pre-integrated, kSurf): a run of samples starts or ends at the mesh's boundary
-/// (or the end of the ray's span) between the sample at grid position kIn (inside, in cell
-/// tetIn) and a position kOut outside the mesh or past the span's end (outKnown; before kIn
-/// where a run starts, after it where one ends), or the start of the span (!outKnown, before
-/// the first sample: the span may start inside the mesh, at a clip plane or the camera). Probes
-/// by bisection, each located by `locate(q, from, bary, counters)` from the last one found, narrow
-/// the boundary to within s1 / 2^kBoundaryBisections, and where a surface lies between the boundary
-/// and the sample (vIn its value) the run gets a sample at the boundary. So a surface
-/// between the boundary and the nearest grid sample (a thin layer at the mesh's skin, which no
-/// pair of grid samples brackets: rings where the grid happened to) is crossed where the exact
-/// integrator crosses it. Not inlined: only frames with isosurfaces call it, at a run's ends
-/// (inlined with the other three surface calls, the 100M frames got slower on the H100, and
-/// ptxas took twice as long).
+/// A run of samples (pre-integrated) starts and ends at the mesh's boundary (issue 29), not at
+/// its first and last grid samples: between the sample at grid position kIn (inside, in cell
+/// tetIn) and a position kOut outside the mesh or past the span's end (outKnown;
+/// before kIn where a run starts, after it where one ends), or the start of the span (!outKnown,
+/// before the first sample: the span may start inside the mesh, at a clip plane or the camera),
+/// a walk from tetIn along the ray (backwards where a run starts) across shared faces finds the
+/// face without a neighbour (boundaryAlong, exact to rounding; kOut itself where the ray is
+/// still inside there); where the walk cannot follow the ray, probes by bisection, each located
+/// by `locate(q, from, bary, counters)` from the last one found, narrow the boundary to within
+/// s1 / 2^kBoundaryBisections. The run gets a sample at the boundary's inside end. A run that
+/// starts there covers the distance from the boundary to
+/// its first grid sample, a run that ends there stops at it (its last share ends there, so
+/// kPieceEnd is read only where a run starts). Grid samples alone cover a run's n samples times
+/// s1 from its first: a length off by up to s1 at each end, which drew rings on flat faces and
+/// seams along silhouettes against exact (p99.9 11/255 on hexa.vtk and the Oxygen Post). A
+/// surface between the boundary and the nearest grid sample (a thin layer at the mesh's skin,
+/// which no pair of grid samples brackets) is crossed there as between any two samples. Not
+/// inlined: it runs at a run's ends only (inlined with the other three surface calls, the 100M
+/// isosurface frames got slower on the H100, and ptxas took twice as long).
 template <bool kNative, bool kLit, bool kSurf, class Locate>
 UVR_HOST_DEVICE UVR_NOINLINE void sampleAtBoundary(const Locate& locate, const MarchParams& params,
-                                                   const TetMeshView& mesh, const TfTableView& tf,
+                                                   const TetLocator& loc, const TfTableView& tf,
                                                    const Ray& ray, const Lighting& lighting,
                                                    float kOut, bool outKnown, float kIn,
-                                                   std::uint32_t tetIn, float vIn, float kPieceEnd,
+                                                   std::uint32_t tetIn, float kPieceEnd,
                                                    SampleSegments<kLit, kSurf>& segments,
                                                    RayCounters& counters, Vec4f& acc) {
     const float s1 = params.step;
-    float lo = kOut, hi = kIn;
-    std::uint32_t from = tetIn, tetHi = kNoTet;
-    float bary[4], baryHi[4] = {0.f, 0.f, 0.f, 0.f};
-    if (!outKnown) {
-        ++counters.samples;
-        const std::uint32_t t = locate(ray.at(lo * s1), from, bary, counters.locate);
-        if (t != kNoTet) {
-            hi = lo, tetHi = t;
-            for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+    const bool entering = !outKnown || kOut < kIn;
+    float hi = kIn;
+    std::uint32_t tetHi = kNoTet;
+    float baryHi[4] = {0.f, 0.f, 0.f, 0.f};
+    // First cell to cell from the sample (backwards where a run starts), in double; a few cells
+    // where they are about a step across.
+    {
+        const double tIn = double(kIn) * s1, tOut = double(kOut) * s1;
+        const double eps = 1e-6 * fabs(tIn) + 1e-4 * s1;  // not of tOut: a clip box changes it
+        std::uint32_t cell = tetIn;
+        const Ray back{ray.org, Vec3f(-ray.dir.x, -ray.dir.y, -ray.dir.z)};
+        const double tb = entering ? -boundaryAlong<kNative>(loc, cell, back, -tIn, -tOut, eps)
+                                   : boundaryAlong<kNative>(loc, cell, ray, tIn, tOut, eps);
+        if (tb == tb) {
+            const float kb = static_cast<float>(tb / s1);
+            if (entering ? kb >= kIn - kBoundarySameSpot : kb <= kIn + kBoundarySameSpot) {
+                // At the sample: a run ending there ends at the sample.
+                if (!entering && segments.kLast == kIn) segments.kEnd = kIn;
+                return;
+            }
+            // Located a hair inside (the face itself may round to either side).
+            const double nudge = (entering ? 1e-4 : -1e-4) * s1;
+            float bary[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
+            ++counters.samples;
+            const std::uint32_t t =
+                locate(ray.at(static_cast<float>(tb + nudge)), cell, bary, counters.locate);
+            if (t != kNoTet) {
+                hi = kb, tetHi = t;
+                for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+            }
         }
     }
-    for (int n = 0; n < kBoundaryBisections && hi != lo; ++n) {
-        const float mid = 0.5f * (lo + hi);
-        if (mid == lo || mid == hi) break;
-        ++counters.samples;
-        const std::uint32_t t = locate(ray.at(mid * s1), from, bary, counters.locate);
-        if (t == kNoTet) {
-            lo = mid;
-        } else {
-            hi = mid, from = tetHi = t;
-            for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+    if (tetHi == kNoTet) {
+        // Else by bisection: probes located from the last one found narrow the boundary to within
+        // s1 / 2^kBoundaryBisections.
+        float lo = kOut;
+        std::uint32_t from = tetIn;
+        float bary[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
+        if (!outKnown) {
+            ++counters.samples;
+            const std::uint32_t t = locate(ray.at(lo * s1), from, bary, counters.locate);
+            if (t != kNoTet) {
+                hi = lo, tetHi = t;
+                for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+            }
+        }
+        for (int n = 0; n < kBoundaryBisections && hi != lo; ++n) {
+            const float mid = 0.5f * (lo + hi);
+            if (mid == lo || mid == hi) break;
+            ++counters.samples;
+            const std::uint32_t t = locate(ray.at(mid * s1), from, bary, counters.locate);
+            if (t == kNoTet) {
+                lo = mid;
+            } else {
+                hi = mid, from = tetHi = t;
+                for (int i = 0; i < 4; ++i) baryHi[i] = bary[i];
+            }
         }
     }
-    if (tetHi == kNoTet || hi == kIn) return;
-    const float v = mesh.interpolate<kNative>(tetHi, baryHi);
-    // Only where a surface lies between the boundary and the sample (else the run, and every
-    // pixel without a surface there, stays as it was).
-    const bool entering = hi < kIn;
-    if (!segments.iso->crosses(entering ? v : vIn, entering ? vIn : v)) return;
-    const Vec3f g = sampleGradient<kNative, kLit>(params, mesh, tetHi, baryHi);
-    segments.add(tf, hi, kPieceEnd, true, v, s1, params.opacityUnit, acc,
+    if (tetHi == kNoTet || fabsf(hi - kIn) <= kBoundarySameSpot) {
+        // The boundary lies within s1 / 2^kBoundaryBisections of the sample: a run ending there
+        // ends at the sample.
+        if (!entering && segments.kLast == kIn) segments.kEnd = kIn;
+        return;
+    }
+    const float v = loc.mesh.interpolate<kNative>(tetHi, baryHi);
+    const Vec3f g = sampleGradient<kNative, kLit>(params, loc.mesh, tetHi, baryHi);
+    segments.add(tf, hi, entering ? kPieceEnd : hi, true, v, s1, params.opacityUnit, acc,
                  lightAt<kLit>(lighting, params.gradientOpacity, tetHi, g, ray.dir),
                  SamplePoint(tetHi, baryHi));
 }
@@ -382,7 +439,7 @@ UVR_HOST_DEVICE UVR_NOINLINE bool cutFace(const Locate& locate, const MarchParam
                                           const TetMeshView& mesh, const TfTableView& tf,
                                           const Ray& ray, float t, Vec3f n, std::uint32_t hint,
                                           RayCounters& counters, Vec4f& acc) {
-    float bary[4];
+    float bary[4] = {kNoGuess, kNoGuess, kNoGuess, 0.f};
     ++counters.samples;
     const std::uint32_t c = locate(ray.at(t), hint, bary, counters.locate);
     if (c == kNoTet) return false;
@@ -475,7 +532,7 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
                       tet == kNoTet ? 0.f : scene.locator.mesh.interpolate<kNative>(tet, bary));
     }
     PointIsos<kSurf> pointIsos;
-    [[maybe_unused]] std::uint32_t lastInside = kNoTet;  // the cell of the last sample inside
+    std::uint32_t lastInside = kNoTet;  // the cell of the last sample inside
     // The loop leaves only through its condition, so GPU warps reconverge every iteration
     // (adaptive_marcher.h says why).
     bool opaque = false;
@@ -502,19 +559,20 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
         const LightFactors light =
             lightAt<kLit>(lighting, scene.params.gradientOpacity, tet, g, ray.dir);
         if (scene.params.preintegrated) {
-            if constexpr (kSurf) {
-                if (segments.iso && (tet != kNoTet) != segments.inside &&
-                    !(pieceStart && (!segments.started || segments.led))) {
-                    const bool first = !segments.started, in = tet != kNoTet;
-                    callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
-                        sampleAtBoundary<kNative, kLit, kSurf>(
-                            locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
-                            in ? (first ? t0 / s : k - 1.f) : k, !first, in ? k : sc.kLast,
-                            in ? tet : lastInside, in ? v : sc.vLast, kEnd + 1.f, sc, c, a);
-                    });
-                }
-                if (tet != kNoTet) lastInside = tet;
+            // A run starts and ends at the mesh's boundary (sampleAtBoundary). A data-parallel
+            // piece's first sample after the piece before's last does not: that piece's closing
+            // sample (kClose) found the boundary between them, as one process does.
+            if ((tet != kNoTet) != segments.inside &&
+                !(pieceStart && (!segments.started || segments.led))) {
+                const bool first = !segments.started, in = tet != kNoTet;
+                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                    sampleAtBoundary<kNative, kLit, kSurf>(
+                        locateAny, scene.params, scene.locator, scene.tf, ray, lighting,
+                        in ? (first ? t0 / s : k - 1.f) : k, !first, in ? k : sc.kLast,
+                        in ? tet : lastInside, kEnd + 1.f, sc, c, a);
+                });
             }
+            if (tet != kNoTet) lastInside = tet;
             segments.add(scene.tf, k, kEnd + 1.f, tet != kNoTet, v, s, unit, acc, light,
                          SamplePoint(tet, bary));
         } else {
@@ -542,16 +600,14 @@ UVR_HOST_DEVICE inline Vec4f marchReference(const SceneView& scene, const Ray& r
     }
     if (scene.params.preintegrated && !opaque && !pieceEnd) {
         [[maybe_unused]] const float a0 = acc.w;
-        if constexpr (kSurf) {
-            // The ray's span ends inside the mesh (the bounds' face, a clip plane, depth in):
-            // the run's last sample at the end.
-            if (segments.iso && segments.inside) {
-                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
-                    sampleAtBoundary<kNative, kLit, kSurf>(
-                        locateAny, scene.params, scene.locator.mesh, scene.tf, ray, lighting,
-                        t1 / s, true, sc.kLast, lastInside, sc.vLast, kEnd + 1.f, sc, c, a);
-                });
-            }
+        // A run reaching the span's end (the mesh's boundary, the bounds' face, a clip plane,
+        // depth in) ends at the boundary or the end, whichever comes first.
+        if (segments.inside) {
+            callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
+                sampleAtBoundary<kNative, kLit, kSurf>(locateAny, scene.params, scene.locator,
+                                                       scene.tf, ray, lighting, t1 / s, true,
+                                                       sc.kLast, lastInside, kEnd + 1.f, sc, c, a);
+            });
         }
         segments.finish(scene.tf, s, unit, acc);
         if constexpr (kSurf)
