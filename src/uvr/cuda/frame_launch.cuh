@@ -36,9 +36,14 @@ template <bool kNative, bool kLit>
 inline constexpr int kBlocksPerSm<PartitionMarch<kNative, kLit, true>> = 2;
 
 /// Kernel: one thread per pixel runs the shared pixel body, then the warp sums its counters.
+/// The frame and the integrator are __grid_constant__: the integrators pass references into
+/// them to functions not inlined (sampleAtBoundary), which otherwise made the kernel copy them
+/// to local memory (the plain reference kernel's stack 1216 -> 2304 bytes, and its loop read
+/// the copy).
 template <bool Supersampled, class March>
 __global__ void __launch_bounds__(kFrameBlock, kBlocksPerSm<March>)
-    frameKernel(FrameView frame, March march, unsigned long long* totals) {
+    frameKernel(const __grid_constant__ FrameView frame, const __grid_constant__ March march,
+                unsigned long long* totals) {
     const int x = blockIdx.x * blockDim.x + threadIdx.x;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     RayCounters c;

@@ -657,19 +657,18 @@ UVR_HOST_DEVICE inline Vec4f marchPartitions(const PartitionSceneView& scene, co
             // A run starts (not after a long step: bisected above) at the mesh's boundary or the
             // span's start, and ends at the boundary (sampleAtBoundary). A run whose share ended
             // before this sample goes on no further.
+            // (One call for both: each call site of a function not inlined costs the loop
+            // registers on the GPU.)
             const bool runGoesOn = segments.inside && kSample <= segments.kEnd;
-            if (in && runFromValid && !runGoesOn)
+            const bool runStarts = in && runFromValid && !runGoesOn;
+            const bool runEnds = !in && segments.started && segments.inside && !segments.led &&
+                                 kSample <= segments.kEnd && !endsRun;
+            if (runStarts || runEnds)
                 callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
                     sampleAtBoundary<kNative, kLit, kSurf>(
-                        locateFrom, scene.base.params, locator, tf, ray, lighting, kRunFrom,
-                        runFromOutside, kSample, tet, k1, sc, c, a);
-                });
-            if (!in && segments.started && segments.inside && !segments.led &&
-                kSample <= segments.kEnd && !endsRun)
-                callOnCopies(segments, counters, acc, [&](auto& sc, RayCounters& c, Vec4f& a) {
-                    sampleAtBoundary<kNative, kLit, kSurf>(locateFrom, scene.base.params, locator,
-                                                           tf, ray, lighting, kSample, true,
-                                                           sc.kLast, lastInside, k1, sc, c, a);
+                        locateFrom, scene.base.params, locator, tf, ray, lighting,
+                        in ? kRunFrom : kSample, in ? runFromOutside : true,
+                        in ? kSample : sc.kLast, in ? tet : lastInside, k1, sc, c, a);
                 });
             if (in) lastInside = tet;
             if (in) {
