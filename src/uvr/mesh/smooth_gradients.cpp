@@ -16,9 +16,10 @@ namespace {
 /// threads add its terms in (float atomics made two preparations' gradients differ in the last
 /// bits, and so two renders of one shaded frame, a pixel apart by 1/255). A term is a multiple of
 /// its point's scale (the largest term's magnitude there, found first: a maximum does not depend
-/// on order) over 2^kFixedBits, an error of 2^-41 of the largest, far under float rounding; a point
-/// takes 2^(63 - kFixedBits) terms before an overflow.
-constexpr int kFixedBits = 40;
+/// on order) over 2^kFixedBits: an error of 2^-31 of the largest term, under float rounding. A
+/// point takes 2^(63 - kFixedBits) = 2^33 terms before an overflow: more than the cells around
+/// it in any mesh of 2^32 cells.
+constexpr int kFixedBits = 30;
 
 struct FixedSums {
     std::vector<std::uint32_t> scaleBits;  // per point, 2 floats: the largest |w g_i| and w
@@ -30,8 +31,14 @@ struct FixedSums {
         std::memcpy(&f, &scaleBits[2 * p + k], 4);
         return f;
     }
+    /// Whether a corner's terms count: finite (a huge gradient times a volume may overflow,
+    /// and an infinite scale would make every term of the point NaN).
+    static bool finite(Vec3f g, float w) {
+        return std::isfinite(w * g.x) && std::isfinite(w * g.y) && std::isfinite(w * g.z);
+    }
     /// First pass: the scales (non-negative floats order as their bits do).
     void widen(std::uint32_t p, Vec3f g, float w) {
+        if (!finite(g, w)) return;
         const float m[2] = {std::max({std::fabs(w * g.x), std::fabs(w * g.y), std::fabs(w * g.z)}),
                             w};
         for (int k = 0; k < 2; ++k) {
@@ -46,6 +53,7 @@ struct FixedSums {
     }
     /// Second pass: the terms.
     void add(std::uint32_t p, Vec3f g, float w) {
+        if (!finite(g, w)) return;
         const float terms[4] = {w * g.x, w * g.y, w * g.z, w};
         for (int i = 0; i < 4; ++i) {
             const float s = scale(p, i < 3 ? 0 : 1);
