@@ -108,7 +108,9 @@ struct MacroChoice {
     const PartitionGrid* grids;
     const PartitionShading* cells;
     PartitionShading* shading;
+    float* density;  ///< per partition: macroSampleDensity (weighReference's estimate)
     __device__ void operator()(std::uint64_t p) const {
+        density[p] = macroSampleDensity(grids[p], cells);
         shading[p].byMacroCells = macroCellsPay(grids[p], cells, shading[p]);
     }
 };
@@ -192,6 +194,7 @@ struct CudaScene::Impl {
     cuda::DeviceArray<unsigned> varianceBounds;
     cuda::DeviceArray<PartitionShading> shading;
     cuda::DeviceArray<PartitionShading> macroShading;
+    cuda::DeviceArray<float> macroDensity;  ///< per partition (MacroChoice)
     bool macroActive = false;  ///< macroShading holds this frame's shading (usesMacroCells)
     cuda::DeviceArray<Vec4f> pixels;
     cuda::DeviceArray<std::uint32_t> sampleCounts;
@@ -352,14 +355,22 @@ void CudaScene::updateShading(RenderResult& result) {
             cuda::forEachElement("macrocell isosurface shading", m,
                                  cuda::MacroIsoShade{d.a.macroCells.data(), f.params.iso,
                                                      f.stepRule.s1, d.macroShading.data()});
-        cuda::forEachElement(
-            "macrocell choice", n,
-            cuda::MacroChoice{d.a.macroGrids.data(), d.macroShading.data(), d.shading.data()});
+        d.macroDensity.reserve(n, "the partitions' macrocell sample densities");
+        cuda::forEachElement("macrocell choice", n,
+                             cuda::MacroChoice{d.a.macroGrids.data(), d.macroShading.data(),
+                                               d.shading.data(), d.macroDensity.data()});
         d.macroActive = true;
     }
     f.shading.resize(n);
     UVR_CUDA_CHECK(cudaMemcpy(f.shading.data(), d.shading.data(), n * sizeof(PartitionShading),
                               cudaMemcpyDeviceToHost));
+    if (f.method.weighReference > 0.0) {
+        std::vector<float> density(d.macroActive ? n : 0);
+        if (d.macroActive)
+            UVR_CUDA_CHECK(cudaMemcpy(density.data(), d.macroDensity.data(), n * sizeof(float),
+                                      cudaMemcpyDeviceToHost));
+        weighReference(f, d.mesh, density, /*gpu=*/true);
+    }
     f.tfUpdateSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -389,13 +400,12 @@ RenderResult CudaScene::render(const RenderSettings& settings) {
     const dim3 block(16, cuda::kFrameBlock / 16);
     const dim3 grid((settings.width + block.x - 1) / block.x,
                     (settings.height + block.y - 1) / block.y);
-    const RenderMethod method = result.setup.method.method;
-    const bool partitions = method == RenderMethod::Partitions;
-    if (partitions && !d.mesh.kd)
+    if (result.setup.method.method == RenderMethod::Partitions && !d.mesh.kd)
         throwError(ErrorKind::Argument, "", "the partition method needs k-d partitions");
     // The transfer function's partition shading is timed on its own (tfUpdateSeconds), as on
-    // the CPU: the events time the frame kernel only.
-    if (partitions) updateShading(result);
+    // the CPU: the events time the frame kernel only. Auto may turn to the reference then.
+    if (result.setup.method.method == RenderMethod::Partitions) updateShading(result);
+    const RenderMethod method = result.setup.method.method;
     cudaEvent_t begin, end;
     UVR_CUDA_CHECK(cudaEventCreate(&begin));
     UVR_CUDA_CHECK(cudaEventCreate(&end));

@@ -165,6 +165,35 @@ void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::s
     EXPECT_TRUE(testing::sameBytes(a.sampleCounts, b.sampleCounts)) << what;
 }
 
+TEST(Renderer, OnTheGpuAutoRendersTheReferenceWhereAdaptiveSavesTooLittle) {
+    if (!cudaDeviceAvailable()) GTEST_SKIP() << "no CUDA device: " << cudaDeviceDescription();
+    // 10^3 native hexahedra: 40 cells per ray, so adaptive rather than exact. With a cell field
+    // every visible partition steps at s1 (a jump at every face): adaptive saves nothing, and
+    // the reference renders, the explicit reference's frame bit for bit. A linear point field
+    // lets adaptive step 16x longer: it renders.
+    Mesh m = testing::makeHexGrid(10, 0.f, 10.f, [](Vec3f p) { return 0.1f * p.x; });
+    Field c{"c", Association::Cell, 1, {}};
+    for (std::uint64_t i = 0; i < m.cellCount(); ++i) c.values.push_back(float(i % 7) / 6.f);
+    m.fields.push_back(c);
+    RendererOptions o;
+    o.device = Device::Cuda;
+    o.partitions = o.meshBvh = false;
+    o.forAuto = true;
+    Renderer cells(m, selectScalarField(m, parseFieldSpec("c")), o);
+    ASSERT_EQ(cells.prepared().autoChoice->method, RenderMethod::Partitions);
+    RenderSettings s = frameOf(m.bounds(), RenderMethod::Auto);
+    const RenderResult a = cells.render(s);
+    EXPECT_EQ(a.setup.method.method, RenderMethod::Reference);
+    EXPECT_THAT(a.setup.method.reason, HasSubstr("reference: under this transfer function"));
+    s.method = RenderMethod::Reference;
+    expectSameFrames(a, cells.render(s), "auto against the reference");
+    Renderer linear(m, selectScalarField(m, {}), o);
+    s.method = RenderMethod::Auto;
+    const RenderResult b = linear.render(s);
+    EXPECT_EQ(b.setup.method.method, RenderMethod::Partitions);
+    EXPECT_THAT(b.setup.method.reason, HasSubstr("adaptive: under this transfer function"));
+}
+
 TEST(Renderer, SetFieldValuesGivesTheFramesOfAFreshPreparationWithoutRebuilding) {
     for (const char* spec : {"f", "c"}) {
         const Mesh m0 = timeStep(0.f);

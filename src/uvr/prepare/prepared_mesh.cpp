@@ -108,7 +108,9 @@ PreparedMesh prepareMesh(const MeshView& mesh, const ScalarField& field,
     out.phaseSeconds.emplace_back("split", out.splitSeconds);
     // What RenderMethod::Auto renders with, besides what was asked for.
     const bool forExact = options.forAuto && out.autoChoice->method == RenderMethod::Exact;
-    const bool withBvh = options.meshBvh || forExact;
+    // Adaptive, weighed against the reference each frame (weighReference): both.
+    const bool weighs = options.forAuto && out.autoChoice->adaptiveSampleCost > 0.0;
+    const bool withBvh = options.meshBvh || forExact || weighs;
     const bool withPartitions = options.partitions || (options.forAuto && !forExact);
     const std::uint32_t cellTreeLeaf = out.tets.cellCount() <= kSmallCellTreeCells
                                            ? std::min(options.cellTreeLeaf, kCpuCellTreeLeaf)

@@ -92,8 +92,12 @@ AutoMethodChoice autoMethodFor(double surface, const Bounds3f& bounds, bool gpu)
 
 AutoMethodChoice autoMethod(const TetMesh& mesh, bool gpu) {
     const AutoMethodLimits& limits = gpu ? kAutoGpuLimits : kAutoCpuLimits;
-    return autoMethodFor(mesh.cellCount() ? cellSurfaceEstimate(mesh, limits.nativeCellCost) : 0.0,
-                         mesh.bounds, gpu);
+    AutoMethodChoice c =
+        autoMethodFor(mesh.cellCount() ? cellSurfaceEstimate(mesh, limits.nativeCellCost) : 0.0,
+                      mesh.bounds, gpu);
+    if (c.method == RenderMethod::Partitions && mesh.cellCount() <= limits.maxWeighCells)
+        c.adaptiveSampleCost = limits.adaptiveSampleCost;
+    return c;
 }
 
 std::string AutoMethodChoice::reason() const {

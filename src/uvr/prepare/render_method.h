@@ -13,6 +13,13 @@
 // the shared meshes (docs/PERFORMANCE.md, "The default method"). The choice is made once per
 // prepared mesh: it does not change with the camera or the transfer function, and the same command
 // gives the same picture every run.
+//
+// Where it picks adaptive on a device whose adaptive sample costs several of the reference's (the
+// GPU), each frame then weighs the reference too (weighReference in render/frame_setup.h): once
+// the partitions are shaded for the frame's transfer function, the samples each method would take
+// are estimated from the partitions' steps, and the reference renders where the adaptive method
+// would save fewer samples than its sample costs. That depends on the transfer function, not the
+// camera, and is the same every run.
 
 #include <array>
 #include <cstdint>
@@ -69,9 +76,22 @@ struct AutoMethodLimits {
     double nativeCellCost;
     /// Exact where exactCellsPerRay is at most this.
     double maxExactCellsPerRay;
+    /// Where adaptive is picked: what an adaptive sample costs in reference samples. Each frame
+    /// renders the reference instead where the adaptive method would take fewer than this many
+    /// times fewer samples (weighReference). 0: never.
+    double adaptiveSampleCost;
+    /// ... on meshes of at most this many cells (split): the reference needs the mesh BVH beside
+    /// the partitions, about 27 bytes more a cell, and above this the adaptive method is the
+    /// faster (100M tetrahedra on the H100: 3.5x).
+    std::uint64_t maxWeighCells;
 };
-inline constexpr AutoMethodLimits kAutoCpuLimits{4.0, 32.0};
-inline constexpr AutoMethodLimits kAutoGpuLimits{4.0, 32.0};
+/// On 2 CPU cores the adaptive method is the faster at the defaults on every shared mesh (Oxygen
+/// Post a tie). On the H100 an adaptive sample costs 2-6 reference samples at the GPU's leaf
+/// size; where it saves fewer than 2x (Blunt Fin, post_tets, fire_ug: the same samples) the
+/// reference is 1.3-2.2x the faster; hexa (2.2x fewer) is a tie (docs/PERFORMANCE.md, "The GPU
+/// default against the reference on small meshes").
+inline constexpr AutoMethodLimits kAutoCpuLimits{4.0, 32.0, 0.0, 0};
+inline constexpr AutoMethodLimits kAutoGpuLimits{4.0, 32.0, 2.0, std::uint64_t(1) << 25};
 
 /// The mean number of cells a ray through the mesh's bounding box crosses, each native cell
 /// counted AutoMethodLimits::nativeCellCost times: by Cauchy's formula, a convex cell is hit by
@@ -87,6 +107,9 @@ struct AutoMethodChoice {
     double cellsPerRay = 0.0;  ///< exactCellsPerRay with the device's native-cell cost
     double limit = 0.0;        ///< the device's maxExactCellsPerRay
     bool gpu = false;          ///< chosen for the GPU (else the CPU)
+    /// With adaptive: the device's AutoMethodLimits::adaptiveSampleCost where the mesh has at
+    /// most its maxWeighCells cells (each frame weighs the reference then), else 0.
+    double adaptiveSampleCost = 0.0;
     /// One line saying why, e.g. "auto: exact (about 13.2 cells per ray, at most 32 on the
     /// CPU)".
     std::string reason() const;

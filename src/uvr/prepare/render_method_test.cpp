@@ -115,6 +115,106 @@ TEST(RenderMethod, PreparingForAutoBuildsOnlyWhatItsPickRendersWith) {
     EXPECT_EQ(renderCpu(adaptive, s).setup.method.method, RenderMethod::Partitions);
 }
 
+TEST(RenderMethod, OnTheGpuAutoPreparesTheReferenceToWeighEachFrame) {
+    // Where the GPU's auto picks adaptive, an adaptive sample costs 2x a reference sample there:
+    // both structures are prepared, and each frame weighs the two. Not on the CPU.
+    EXPECT_EQ(kAutoCpuLimits.adaptiveSampleCost, 0.0);
+    EXPECT_GT(kAutoGpuLimits.adaptiveSampleCost, 1.0);
+    PrepareOptions o;
+    o.meshBvh = o.partitions = false;
+    o.forAuto = true;
+    o.autoOnGpu = true;
+    const PreparedMesh gpu = hexGrid(12, false, o);
+    ASSERT_TRUE(gpu.autoChoice);
+    EXPECT_EQ(gpu.autoChoice->method, RenderMethod::Partitions);
+    EXPECT_EQ(gpu.autoChoice->adaptiveSampleCost, kAutoGpuLimits.adaptiveSampleCost);
+    EXPECT_FALSE(gpu.bvh.nodes.empty());
+    EXPECT_TRUE(gpu.kd);
+    RenderSettings s;
+    EXPECT_EQ(resolveMethod(gpu, s, /*gpu=*/true).weighReference,
+              kAutoGpuLimits.adaptiveSampleCost);
+    EXPECT_EQ(resolveMethod(gpu, s, /*gpu=*/false).weighReference, 0.0);
+    // Exact picked, or sampling tuned, or the method named: nothing is weighed.
+    EXPECT_EQ(autoMethod(hexGrid(4).tets, true).adaptiveSampleCost, 0.0);
+    s.quality = 0.999f;
+    EXPECT_EQ(resolveMethod(gpu, s, true).weighReference, 0.0);
+    s = {};
+    s.method = RenderMethod::Partitions;
+    EXPECT_EQ(resolveMethod(gpu, s, true).weighReference, 0.0);
+    // Without the mesh BVH (a cache of an older preparation) there is nothing to weigh.
+    PrepareOptions k;
+    k.meshBvh = false;
+    EXPECT_EQ(resolveMethod(hexGrid(12, false, k), RenderSettings{}, true).weighReference, 0.0);
+    // On the CPU auto prepares the partitions alone, as before.
+    o.autoOnGpu = false;
+    const PreparedMesh cpu = hexGrid(12, false, o);
+    EXPECT_EQ(cpu.autoChoice->adaptiveSampleCost, 0.0);
+    EXPECT_TRUE(cpu.bvh.nodes.empty());
+}
+
+TEST(RenderMethod, EstimatedSamplesArePerVolumeAtEachPartitionsStep) {
+    KdPartitions kd;
+    kd.partitions.resize(3);
+    kd.partitions[0].box = {{0.f, 0.f, 0.f}, {1.f, 1.f, 1.f}};  // volume 1
+    kd.partitions[1].box = {{1.f, 0.f, 0.f}, {4.f, 1.f, 1.f}};  // volume 3
+    kd.partitions[2].box = {{4.f, 0.f, 0.f}, {6.f, 1.f, 1.f}};  // volume 2
+    std::vector<PartitionShading> shading{{1.f, 0.5f}, {0.f, 8.f}, {1.f, 0.25f, true}};
+    // p0 at 1 / 0.5, p1 skipped, p2 by its macrocells at 3 a unit; the reference 1 / 0.25 in all.
+    SampleEstimate e = estimateSamples(kd, shading, {0.f, 0.f, 3.f}, 0.25f);
+    EXPECT_DOUBLE_EQ(e.adaptive, 1.0 * 2.0 + 2.0 * 3.0);
+    EXPECT_DOUBLE_EQ(e.reference, 6.0 * 4.0);
+    // Without the macrocells' densities p2 counts its own step.
+    e = estimateSamples(kd, shading, {}, 0.25f);
+    EXPECT_DOUBLE_EQ(e.adaptive, 1.0 * 2.0 + 2.0 * 4.0);
+    // A flat partition has no volume to sample.
+    kd.partitions[0].box.hi.z = 0.f;
+    EXPECT_DOUBLE_EQ(estimateSamples(kd, shading, {}, 0.25f).reference, 5.0 * 4.0);
+    EXPECT_THROW(estimateSamples(kd, {}, {}, 0.25f), Error);
+}
+
+TEST(RenderMethod, WeighingPicksTheReferenceWhereAdaptiveSavesLessThanItsSampleCosts) {
+    PrepareOptions o;
+    o.forAuto = true;
+    o.autoOnGpu = true;
+    const PreparedMesh pm = hexGrid(12, false, o);
+    RenderSettings s;
+    s.width = s.height = 16;
+    s.tf = transferFunctionPreset("viridis");
+    s.method = RenderMethod::Partitions;  // the shading auto weighs with
+    // A linear field: no partition needs a step below s2, so adaptive saves s2 / s1 = 16x.
+    FrameSetup f = makeFrameSetup(pm, s, /*gpu=*/false);
+    f.method.weighReference = 2.0;
+    weighReference(f, pm, {}, /*gpu=*/true);
+    EXPECT_EQ(f.method.method, RenderMethod::Partitions);
+    EXPECT_EQ(f.method.weighReference, 0.0);
+    EXPECT_THAT(f.method.reason, HasSubstr("adaptive: under this transfer function adaptive would "
+                                           "take 16x fewer samples than the reference, at least "
+                                           "the 2x its sample costs on the GPU"));
+    // Every partition at s1: nothing saved, the reference renders.
+    s.adaptive = false;
+    f = makeFrameSetup(pm, s, false);
+    f.method.weighReference = 2.0;
+    weighReference(f, pm, {}, false);
+    EXPECT_EQ(f.method.method, RenderMethod::Reference);
+    EXPECT_THAT(f.method.reason, HasSubstr("reference: under this transfer function adaptive "
+                                           "would take 1x fewer samples than the reference, "
+                                           "under the 2x its sample costs on the CPU"));
+    // Nothing visible: adaptive skips it all.
+    s.adaptive = true;
+    s.tf.opacities = {{0.f, 0.f}, {1.f, 0.f}};
+    f = makeFrameSetup(pm, s, false);
+    f.method.weighReference = 2.0;
+    weighReference(f, pm, {}, true);
+    EXPECT_EQ(f.method.method, RenderMethod::Partitions);
+    EXPECT_THAT(f.method.reason, HasSubstr("take no samples"));
+    // Not asked to weigh: unchanged.
+    s.adaptive = false;
+    f = makeFrameSetup(pm, s, false);
+    weighReference(f, pm, {}, true);
+    EXPECT_EQ(f.method.method, RenderMethod::Partitions);
+    EXPECT_TRUE(f.method.reason.empty());
+}
+
 TEST(RenderMethod, AutoFollowsSamplingSettingsAndWhatWasPrepared) {
     const PreparedMesh both = hexGrid(4);  // the default preparation: both structures
     RenderSettings s;

@@ -162,20 +162,27 @@ struct MacroShadingView {
 /// from seeds, diverge within a warp; docs/METHOD.md, "Macrocells").
 inline constexpr float kMacroSampleFraction = 0.5f;
 
-/// Whether a visible partition with grid g and shading `partition` pays to march by its
-/// macrocells (`cells`: the shading of every macrocell): the samples per unit length summed
-/// over its macrocells (none in a transparent one, 1 / step in the others) against as many
-/// cells at the partition's own step.
-UVR_HOST_DEVICE inline bool macroCellsPay(const PartitionGrid& g, const PartitionShading* cells,
-                                          const PartitionShading& partition) {
-    if (!(partition.maxOpacity > 0.f) || !(partition.step > 0.f)) return false;
+/// Samples per unit length a partition with grid g takes when it marches by its macrocells
+/// (`cells`: the shading of every macrocell): 1 / step in each visible macrocell, none in a
+/// transparent one, averaged over the grid.
+UVR_HOST_DEVICE inline float macroSampleDensity(const PartitionGrid& g,
+                                                const PartitionShading* cells) {
     const std::uint32_t n = g.dims[0] * g.dims[1] * g.dims[2];
     float samples = 0.f;
     for (std::uint32_t c = 0; c < n; ++c) {
         const PartitionShading& cell = cells[g.first + c];
         if (cell.maxOpacity > 0.f) samples += 1.f / cell.step;
     }
-    return samples <= kMacroSampleFraction * static_cast<float>(n) / partition.step;
+    return samples / static_cast<float>(n);
+}
+
+/// Whether a visible partition with grid g and shading `partition` pays to march by its
+/// macrocells (`cells`: the shading of every macrocell): their macroSampleDensity against the
+/// partition's own step's.
+UVR_HOST_DEVICE inline bool macroCellsPay(const PartitionGrid& g, const PartitionShading* cells,
+                                          const PartitionShading& partition) {
+    if (!(partition.maxOpacity > 0.f) || !(partition.step > 0.f)) return false;
+    return macroSampleDensity(g, cells) <= kMacroSampleFraction / partition.step;
 }
 
 /// Steps longer than this many s1 start their point location from the partition's seed grid

@@ -36,7 +36,46 @@ ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& set
     if (choice.method == RenderMethod::Partitions && !kd && bvh)
         return {RenderMethod::Exact,
                 choice.reason() + "; exact: the partitions adaptive needs were not prepared"};
-    return {choice.method, choice.reason()};
+    const bool weighs = choice.method == RenderMethod::Partitions && bvh && kd && !mesh.piece;
+    return {choice.method, choice.reason(), weighs ? choice.adaptiveSampleCost : 0.0};
+}
+
+SampleEstimate estimateSamples(const KdPartitions& kd, const std::vector<PartitionShading>& shading,
+                               const std::vector<float>& macroDensity, float s1) {
+    UVR_CHECK(shading.size() == kd.partitions.size(), "partition shading missing");
+    SampleEstimate e;
+    for (std::size_t p = 0; p < shading.size(); ++p) {
+        const Vec3f size = kd.partitions[p].box.hi - kd.partitions[p].box.lo;
+        const double volume =
+            std::fmax(double(size.x), 0.0) * std::fmax(double(size.y), 0.0) * size.z;
+        if (!(volume > 0.0)) continue;
+        const PartitionShading& s = shading[p];
+        double density = 0.0;
+        if (s.byMacroCells && p < macroDensity.size())
+            density = macroDensity[p];
+        else if (s.maxOpacity > 0.f && s.step > 0.f)
+            density = 1.0 / s.step;
+        e.adaptive += volume * density;
+        e.reference += volume / s1;
+    }
+    return e;
+}
+
+void weighReference(FrameSetup& f, const PreparedMesh& mesh, const std::vector<float>& macroDensity,
+                    bool gpu) {
+    const double cost = f.method.weighReference;
+    f.method.weighReference = 0.0;
+    if (!(cost > 0.0) || !mesh.kd) return;
+    const SampleEstimate e = estimateSamples(*mesh.kd, f.shading, macroDensity, f.stepRule.s1);
+    const double saving = e.adaptive > 0.0 ? e.reference / e.adaptive : INFINITY;
+    const bool reference = saving < cost;
+    f.method.reason += std::string("; ") + (reference ? "reference" : "adaptive") +
+                       ": under this transfer function adaptive would take " +
+                       (std::isfinite(saving) ? formatG(saving, 3) + "x fewer" : "no") +
+                       " samples than the reference, " + (reference ? "under" : "at least") +
+                       " the " + formatG(cost, 3) + "x its sample costs on the " +
+                       (gpu ? "GPU" : "CPU");
+    if (reference) f.method.method = RenderMethod::Reference;
 }
 
 std::vector<PartitionShading> computePartitionShading(const KdPartitions& kd,
@@ -399,6 +438,13 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
             for (std::size_t p = 0; p < f.shading.size(); ++p)
                 f.shading[p].byMacroCells =
                     macroCellsPay(mesh.macro->grids[p], f.macroShading.data(), f.shading[p]);
+        }
+        if (f.method.weighReference > 0.0) {
+            std::vector<float> density;
+            if (!f.macroShading.empty())
+                for (const PartitionGrid& g : mesh.macro->grids)
+                    density.push_back(macroSampleDensity(g, f.macroShading.data()));
+            weighReference(f, mesh, density, /*gpu=*/false);
         }
         f.tfUpdateSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

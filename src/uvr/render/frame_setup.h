@@ -24,11 +24,28 @@ namespace uvr {
 struct ResolvedMethod {
     RenderMethod method = RenderMethod::Partitions;
     std::string reason;  ///< with RenderMethod::Auto: one line (AutoMethodChoice::reason), else ""
+    /// Auto on adaptive, both the partitions and the mesh BVH prepared, one process: the
+    /// AutoMethodChoice's adaptiveSampleCost, at which weighReference weighs the reference once
+    /// the partitions are shaded; else 0.
+    double weighReference = 0.0;
 };
 /// settings.method, or for RenderMethod::Auto: the adaptive method when tunesAdaptive, else
 /// mesh.autoChoice (made for the GPU when gpu, else the CPU; made now when it was made for the
 /// other or not at all), the other of exact and adaptive where only its structures are prepared.
 ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& settings, bool gpu);
+
+/// Samples per unit of ray length, summed over the partitions weighted by their boxes' volume (a
+/// random line's length inside a convex region is proportional to its volume, so this is
+/// proportional to the samples of rays in every direction): the adaptive method's under a
+/// frame's partition shading, and the reference's at s1.
+struct SampleEstimate {
+    double adaptive = 0.0;   ///< 1 / step in a visible partition, none in a skipped one
+    double reference = 0.0;  ///< 1 / s1 in every partition
+};
+/// The estimate for `shading` (one per partition of kd); a partition marching by its macrocells
+/// counts macroDensity[p] (macroSampleDensity; may be empty when none does).
+SampleEstimate estimateSamples(const KdPartitions& kd, const std::vector<PartitionShading>& shading,
+                               const std::vector<float>& macroDensity, float s1);
 
 /// Most samples one ray may take across the mesh bounds' diagonal at the step s1: the default
 /// step takes 2 to 3 samples per cell, so this is a step 40 times finer than the default on a
@@ -126,6 +143,13 @@ struct FrameSetup {
     /// Partition scene view (the mesh must have partitions); both must outlive it.
     PartitionSceneView partitionScene(const PreparedMesh& mesh, bool skip) const;
 };
+
+/// With f.method.weighReference > 0 and f.shading made (the partitions shaded): the reference
+/// where the adaptive method's estimated samples (estimateSamples) are not weighReference times
+/// fewer than the reference's, its reason saying so; the adaptive method otherwise, its reason
+/// saying by how much (on the GPU when gpu, else the CPU). Either way weighReference is 0 after.
+void weighReference(FrameSetup& f, const PreparedMesh& mesh, const std::vector<float>& macroDensity,
+                    bool gpu);
 
 /// The frame's output buffers and rays for the shared pixel kernel (both backends): pixels and
 /// counts hold width * height entries on the device that renders, as do depth (depth out, or
