@@ -81,6 +81,7 @@ struct Row {
     ImageComparison cmp;     ///< against the exact image (exact's own: identical)
     double ms = 0.0;
     std::uint64_t samples = 0;
+    std::uint64_t visited = 0;  ///< partitions visited (sampling methods)
 };
 
 /// One mesh to evaluate: a file of the shared data or a procedural spec.
@@ -122,6 +123,60 @@ double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
+}
+
+/// The samples estimateSamples counts, split by step (at most kLongStep s1, or longer: such a
+/// step locates its cell from a seed rather than walking), weighted by the partitions' box volume
+/// (as auto does) or by their cells' volume; per transfer function, for fitting auto's cost model.
+struct StepSplit {
+    double reference = 0.0, shortSteps = 0.0, longSteps = 0.0;
+};
+
+std::vector<double> partitionCellVolumes(const PreparedMesh& pm) {
+    const KdPartitions& kd = *pm.kd;
+    const TetMeshView view = pm.tets.view();
+    std::vector<double> out(kd.partitions.size(), 0.0);
+    for (std::size_t p = 0; p < kd.partitions.size(); ++p)
+        for (std::uint32_t i = 0; i < kd.partitions[p].cellCount; ++i) {
+            const std::uint32_t c = kd.cells[kd.partitions[p].firstCell + i];
+            Vec3f x[kMaxCellCorners];
+            const int n = view.kernelGather(c, x);
+            if (view.kind(c) == CellKind::Tet) {
+                const Vec3f a = x[1] - x[0], b = x[2] - x[0], d = x[3] - x[0];
+                out[p] += std::fabs(double(dot(a, cross(b, d)))) / 6.0;
+            } else {
+                Bounds3f box;
+                for (int k = 0; k < n; ++k) box.extend(x[k]);
+                const Vec3f e = box.hi - box.lo;
+                out[p] += double(e.x) * e.y * e.z;
+            }
+        }
+    return out;
+}
+
+void splitSteps(const PreparedMesh& pm, const FrameSetup& f, const std::vector<double>& weights,
+                bool byBox, StepSplit& out) {
+    const KdPartitions& kd = *pm.kd;
+    const float s1 = f.stepRule.s1, longStep = kLongStep * s1;
+    const auto add = [&](double volume, const PartitionShading& sh) {
+        if (!(sh.maxOpacity > 0.f) || !(sh.step > 0.f)) return;
+        (sh.step > longStep ? out.longSteps : out.shortSteps) += volume / sh.step;
+    };
+    for (std::size_t p = 0; p < kd.partitions.size(); ++p) {
+        const Vec3f e = kd.partitions[p].box.hi - kd.partitions[p].box.lo;
+        const double volume = byBox ? std::fmax(double(e.x), 0.0) * std::fmax(double(e.y), 0.0) *
+                                          std::fmax(double(e.z), 0.0)
+                                    : weights[p];
+        out.reference += volume / s1;
+        const PartitionShading& sh = f.shading[p];
+        if (sh.byMacroCells && !f.macroShading.empty()) {
+            const PartitionGrid& g = pm.macro->grids[p];
+            const std::uint32_t n = g.dims[0] * g.dims[1] * g.dims[2];
+            for (std::uint32_t c = 0; c < n; ++c) add(volume / n, f.macroShading[g.first + c]);
+        } else {
+            add(volume, sh);
+        }
+    }
 }
 
 }  // namespace
@@ -207,6 +262,9 @@ int main(int argc, char** argv) {
         std::map<std::string, std::pair<double, Image>> worstImage;      // method -> (ssim, image)
         std::map<std::string, std::pair<double, Image>> worstP999Image;  // method -> (p99.9, ...)
         std::map<std::string, Row> worstRow, worstP999Row;
+        std::ofstream estimates(out + "/estimates.csv");
+        estimates << "mesh,transfer_function,box_reference,box_short,box_long,cells_reference,"
+                     "cells_short,cells_long\n";
         for (const MeshCase& mc : meshes) {
             const Mesh mesh = mc.path.empty() ? generateMesh(mc.spec) : readMesh(mc.path);
             const ScalarField field = selectScalarField(mesh, {});
@@ -224,8 +282,24 @@ int main(int argc, char** argv) {
             std::printf("%s: %zu tetrahedra, field %s, %zu partitions\n", mc.name.c_str(),
                         pm.tets.tets.size(), field.name.c_str(), pm.kd->partitions.size());
             std::fflush(stdout);
+            const std::vector<double> cellVolumes = partitionCellVolumes(pm);
             for (const TfCase& tc : tfs)
                 for (const ViewCase& vc : kViews) {
+                    if (&vc == &kViews[0]) {  // auto's estimate: per transfer function
+                        RenderSettings e;
+                        e.width = e.height = 16;
+                        e.tf = loadTransferFunction(tc.colors);
+                        if (!tc.opacity.empty()) applyOpacitySpec(e.tf, tc.opacity);
+                        e.method = RenderMethod::Partitions;
+                        const FrameSetup f = makeFrameSetup(pm, e, /*gpu=*/false);
+                        StepSplit box, cells;
+                        splitSteps(pm, f, cellVolumes, true, box);
+                        splitSteps(pm, f, cellVolumes, false, cells);
+                        estimates << csvQuote(mc.name) << ',' << csvQuote(tc.name) << ','
+                                  << box.reference << ',' << box.shortSteps << ',' << box.longSteps
+                                  << ',' << cells.reference << ',' << cells.shortSteps << ','
+                                  << cells.longSteps << '\n';
+                    }
                     RenderSettings s;
                     s.width = s.height = size;
                     s.tf = loadTransferFunction(tc.colors);
@@ -252,6 +326,7 @@ int main(int argc, char** argv) {
                         row.renderedAs = methodName(r.setup.method.method);
                         row.ms = median(times) * 1e3;
                         row.samples = r.stats.samples;
+                        row.visited = r.stats.partitionsVisited;
                         if (mcase.method == RenderMethod::Exact) {
                             exact = r.image;
                             exact8 = toRgb8(exact);
@@ -287,14 +362,14 @@ int main(int argc, char** argv) {
         {
             std::ofstream csv(out + "/cases.csv");
             csv << "mesh,transfer_function,view,method,rendered_as,ssim_vs_exact,psnr,ms_per_frame,"
-                   "samples";
+                   "samples,partitions_visited";
             for (const ComparisonField& f : differenceFields(ImageComparison{}))
                 csv << ',' << f.name;
             csv << '\n';
             for (const Row& r : rows) {
                 csv << csvQuote(r.mesh) << ',' << csvQuote(r.tf) << ',' << r.view << ','
                     << csvQuote(r.method) << ',' << r.renderedAs << ',' << r.cmp.ssim << ','
-                    << r.cmp.psnr << ',' << r.ms << ',' << r.samples;
+                    << r.cmp.psnr << ',' << r.ms << ',' << r.samples << ',' << r.visited;
                 for (const ComparisonField& f : differenceFields(r.cmp)) csv << ',' << f.value;
                 csv << '\n';
             }
