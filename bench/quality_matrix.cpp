@@ -352,7 +352,10 @@ int main(int argc, char** argv) {
                     std::printf("  %-12s %-8s", tc.name.c_str(), vc.name.c_str());
                     for (std::size_t i = rows.size() - kMatrixMethods.size() + 1; i < rows.size();
                          ++i)
-                        std::printf(" %.4f/%g", rows[i].cmp.ssim, rows[i].cmp.p999Difference);
+                        std::printf(" %.4f/%g/%.3gms%s%s", rows[i].cmp.ssim,
+                                    rows[i].cmp.p999Difference, rows[i].ms,
+                                    rows[i].method == "auto" ? ":" : "",
+                                    rows[i].method == "auto" ? rows[i].renderedAs.c_str() : "");
                     std::printf("\n");
                     std::fflush(stdout);
                 }
