@@ -95,8 +95,12 @@ AutoMethodChoice autoMethod(const TetMesh& mesh, bool gpu) {
     AutoMethodChoice c =
         autoMethodFor(mesh.cellCount() ? cellSurfaceEstimate(mesh, limits.nativeCellCost) : 0.0,
                       mesh.bounds, gpu);
-    if (c.method == RenderMethod::Partitions && mesh.cellCount() <= limits.maxWeighCells)
-        c.adaptiveSampleCost = limits.adaptiveSampleCost;
+    if (c.method == RenderMethod::Partitions && mesh.cellCount() > 0 &&
+        mesh.cellCount() <= limits.maxWeighCells) {
+        const double native = double(mesh.cellCount() - mesh.tetCount()) / double(mesh.cellCount());
+        c.adaptiveSampleCost =
+            limits.adaptiveSampleCost * (1.0 - native) + limits.nativeAdaptiveSampleCost * native;
+    }
     return c;
 }
 

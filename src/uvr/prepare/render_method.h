@@ -76,22 +76,26 @@ struct AutoMethodLimits {
     double nativeCellCost;
     /// Exact where exactCellsPerRay is at most this.
     double maxExactCellsPerRay;
-    /// Where adaptive is picked: what an adaptive sample costs in reference samples. Each frame
-    /// renders the reference instead where the adaptive method would take fewer than this many
-    /// times fewer samples (weighReference). 0: never.
+    /// Where adaptive is picked: what an adaptive sample costs in reference samples in a mesh of
+    /// tetrahedra. Each frame renders the reference instead where the adaptive method would take
+    /// fewer than this many times fewer samples (weighReference). 0: never.
     double adaptiveSampleCost;
+    /// The same in native pyramids, wedges and hexahedra, whose reference samples cost more (a
+    /// Newton solve to locate each); a mixed mesh weighs the two by its cells.
+    double nativeAdaptiveSampleCost;
     /// ... on meshes of at most this many cells (split): the reference needs the mesh BVH beside
     /// the partitions, about 27 bytes more a cell, and above this the adaptive method is the
     /// faster (100M tetrahedra on the H100: 3.5x).
     std::uint64_t maxWeighCells;
 };
 /// On 2 CPU cores the adaptive method is the faster at the defaults on every shared mesh (Oxygen
-/// Post a tie). On the H100 an adaptive sample costs 2-6 reference samples at the GPU's leaf
-/// size; where it saves fewer than 2x (Blunt Fin, post_tets, fire_ug: the same samples) the
-/// reference is 1.3-2.2x the faster; hexa (2.2x fewer) is a tie (docs/PERFORMANCE.md, "The GPU
-/// default against the reference on small meshes").
-inline constexpr AutoMethodLimits kAutoCpuLimits{4.0, 32.0, 0.0, 0};
-inline constexpr AutoMethodLimits kAutoGpuLimits{4.0, 32.0, 2.0, std::uint64_t(1) << 25};
+/// Post a tie). On the H100, at the GPU's leaf size, the quality matrix (docs/PERFORMANCE.md,
+/// "The GPU's auto weighs the reference each frame"): on meshes of tetrahedra the reference was
+/// the faster in every case where the adaptive method saved under 9x its samples but one, and
+/// an adaptive sample cost 3.7-5.2 reference samples where it saved 2.5-4.4x; on native
+/// hexahedra (fire_ug, hexa) the adaptive method was the faster from 2.2x fewer samples.
+inline constexpr AutoMethodLimits kAutoCpuLimits{4.0, 32.0, 0.0, 0.0, 0};
+inline constexpr AutoMethodLimits kAutoGpuLimits{4.0, 32.0, 5.0, 2.0, std::uint64_t(1) << 25};
 
 /// The mean number of cells a ray through the mesh's bounding box crosses, each native cell
 /// counted AutoMethodLimits::nativeCellCost times: by Cauchy's formula, a convex cell is hit by
@@ -107,8 +111,9 @@ struct AutoMethodChoice {
     double cellsPerRay = 0.0;  ///< exactCellsPerRay with the device's native-cell cost
     double limit = 0.0;        ///< the device's maxExactCellsPerRay
     bool gpu = false;          ///< chosen for the GPU (else the CPU)
-    /// With adaptive: the device's AutoMethodLimits::adaptiveSampleCost where the mesh has at
-    /// most its maxWeighCells cells (each frame weighs the reference then), else 0.
+    /// With adaptive: the device's AutoMethodLimits::adaptiveSampleCost and
+    /// nativeAdaptiveSampleCost weighed by the mesh's cells, where it has at most maxWeighCells
+    /// cells (each frame weighs the reference then), else 0.
     double adaptiveSampleCost = 0.0;
     /// One line saying why, e.g. "auto: exact (about 13.2 cells per ray, at most 32 on the
     /// CPU)".

@@ -119,7 +119,9 @@ TEST(RenderMethod, OnTheGpuAutoPreparesTheReferenceToWeighEachFrame) {
     // Where the GPU's auto picks adaptive, an adaptive sample costs 2x a reference sample there:
     // both structures are prepared, and each frame weighs the two. Not on the CPU.
     EXPECT_EQ(kAutoCpuLimits.adaptiveSampleCost, 0.0);
+    EXPECT_EQ(kAutoCpuLimits.nativeAdaptiveSampleCost, 0.0);
     EXPECT_GT(kAutoGpuLimits.adaptiveSampleCost, 1.0);
+    EXPECT_GT(kAutoGpuLimits.nativeAdaptiveSampleCost, 1.0);
     PrepareOptions o;
     o.meshBvh = o.partitions = false;
     o.forAuto = true;
@@ -127,12 +129,16 @@ TEST(RenderMethod, OnTheGpuAutoPreparesTheReferenceToWeighEachFrame) {
     const PreparedMesh gpu = hexGrid(12, false, o);
     ASSERT_TRUE(gpu.autoChoice);
     EXPECT_EQ(gpu.autoChoice->method, RenderMethod::Partitions);
-    EXPECT_EQ(gpu.autoChoice->adaptiveSampleCost, kAutoGpuLimits.adaptiveSampleCost);
+    // Native hexahedra weigh at their cost; split into tetrahedra, at the tetrahedra's.
+    EXPECT_EQ(gpu.autoChoice->adaptiveSampleCost, kAutoGpuLimits.nativeAdaptiveSampleCost);
+    const AutoMethodChoice split = autoMethod(hexGrid(24, /*split=*/true).tets, true);
+    EXPECT_EQ(split.method, RenderMethod::Partitions);
+    EXPECT_EQ(split.adaptiveSampleCost, kAutoGpuLimits.adaptiveSampleCost);
     EXPECT_FALSE(gpu.bvh.nodes.empty());
     EXPECT_TRUE(gpu.kd);
     RenderSettings s;
     EXPECT_EQ(resolveMethod(gpu, s, /*gpu=*/true).weighReference,
-              kAutoGpuLimits.adaptiveSampleCost);
+              kAutoGpuLimits.nativeAdaptiveSampleCost);
     EXPECT_EQ(resolveMethod(gpu, s, /*gpu=*/false).weighReference, 0.0);
     // Exact picked, or sampling tuned, or the method named: nothing is weighed.
     EXPECT_EQ(autoMethod(hexGrid(4).tets, true).adaptiveSampleCost, 0.0);
