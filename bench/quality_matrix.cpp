@@ -147,8 +147,7 @@ std::vector<double> partitionCellVolumes(const PreparedMesh& pm) {
             } else {
                 Bounds3f box;
                 for (int k = 0; k < n; ++k) box.extend(x[k]);
-                const Vec3f e = box.hi - box.lo;
-                out[p] += double(e.x) * e.y * e.z;
+                out[p] += box.volume();
             }
         }
     return out;
@@ -163,10 +162,7 @@ void splitSteps(const PreparedMesh& pm, const FrameSetup& f, const std::vector<d
         (sh.step > longStep ? out.longSteps : out.shortSteps) += volume / sh.step;
     };
     for (std::size_t p = 0; p < kd.partitions.size(); ++p) {
-        const Vec3f e = kd.partitions[p].box.hi - kd.partitions[p].box.lo;
-        const double volume = byBox ? std::fmax(double(e.x), 0.0) * std::fmax(double(e.y), 0.0) *
-                                          std::fmax(double(e.z), 0.0)
-                                    : weights[p];
+        const double volume = byBox ? kd.partitions[p].box.volume() : weights[p];
         out.reference += volume / s1;
         const PartitionShading& sh = f.shading[p];
         if (sh.byMacroCells && !f.macroShading.empty()) {

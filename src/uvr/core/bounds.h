@@ -25,6 +25,10 @@ struct Bounds3f {
     UVR_HOST_DEVICE Vec3f center() const { return (lo + hi) * 0.5f; }
     UVR_HOST_DEVICE Vec3f extent() const { return hi - lo; }
     UVR_HOST_DEVICE float diagonal() const { return empty() ? 0.f : length(hi - lo); }
+    /// Volume, in double (0 when empty).
+    UVR_HOST_DEVICE double volume() const {
+        return empty() ? 0.0 : double(hi.x - lo.x) * double(hi.y - lo.y) * double(hi.z - lo.z);
+    }
     UVR_HOST_DEVICE bool contains(Vec3f p) const {
         return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z &&
                p.z <= hi.z;

@@ -111,7 +111,7 @@ struct MacroChoice {
     float* density;  ///< per partition: macroSampleDensity (weighReference's estimate)
     __device__ void operator()(std::uint64_t p) const {
         density[p] = macroSampleDensity(grids[p], cells);
-        shading[p].byMacroCells = macroCellsPay(grids[p], cells, shading[p]);
+        shading[p].byMacroCells = macroCellsPay(density[p], shading[p]);
     }
 };
 

@@ -176,13 +176,11 @@ UVR_HOST_DEVICE inline float macroSampleDensity(const PartitionGrid& g,
     return samples / static_cast<float>(n);
 }
 
-/// Whether a visible partition with grid g and shading `partition` pays to march by its
-/// macrocells (`cells`: the shading of every macrocell): their macroSampleDensity against the
-/// partition's own step's.
-UVR_HOST_DEVICE inline bool macroCellsPay(const PartitionGrid& g, const PartitionShading* cells,
-                                          const PartitionShading& partition) {
+/// Whether a visible partition with shading `partition` pays to march by its macrocells, whose
+/// macroSampleDensity is `density`: against the partition's own step's.
+UVR_HOST_DEVICE inline bool macroCellsPay(float density, const PartitionShading& partition) {
     if (!(partition.maxOpacity > 0.f) || !(partition.step > 0.f)) return false;
-    return macroSampleDensity(g, cells) <= kMacroSampleFraction / partition.step;
+    return density <= kMacroSampleFraction / partition.step;
 }
 
 /// Steps longer than this many s1 start their point location from the partition's seed grid

@@ -45,9 +45,7 @@ SampleEstimate estimateSamples(const KdPartitions& kd, const std::vector<Partiti
     UVR_CHECK(shading.size() == kd.partitions.size(), "partition shading missing");
     SampleEstimate e;
     for (std::size_t p = 0; p < shading.size(); ++p) {
-        const Vec3f size = kd.partitions[p].box.hi - kd.partitions[p].box.lo;
-        const double volume =
-            std::fmax(double(size.x), 0.0) * std::fmax(double(size.y), 0.0) * size.z;
+        const double volume = kd.partitions[p].box.volume();
         if (!(volume > 0.0)) continue;
         const PartitionShading& s = shading[p];
         double density = 0.0;
@@ -427,6 +425,7 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
             for (std::size_t p = 0; p < f.shading.size(); ++p)
                 shadeIso(f.shading[p], mesh.kd->partitions[p].valueMin,
                          mesh.kd->partitions[p].valueMax, iso, f.stepRule.s1);
+        std::vector<float> macroDensity;  // per partition, with macrocells (weighReference's too)
         if (usesMacroCells(mesh, f.stepRule)) {
             f.macroShading = computeMacroShading(*mesh.macro, ranges.view(table), f.stepRule);
             for (std::size_t c = 0; c < mesh.macro->nanCells.size(); ++c)
@@ -435,17 +434,13 @@ FrameSetup makeFrameSetup(const PreparedMesh& mesh, const RenderSettings& settin
                 for (std::size_t c = 0; c < f.macroShading.size(); ++c)
                     shadeIso(f.macroShading[c], mesh.macro->cells[c].valueMin,
                              mesh.macro->cells[c].valueMax, iso, f.stepRule.s1);
-            for (std::size_t p = 0; p < f.shading.size(); ++p)
-                f.shading[p].byMacroCells =
-                    macroCellsPay(mesh.macro->grids[p], f.macroShading.data(), f.shading[p]);
+            macroDensity.resize(f.shading.size());
+            for (std::size_t p = 0; p < f.shading.size(); ++p) {
+                macroDensity[p] = macroSampleDensity(mesh.macro->grids[p], f.macroShading.data());
+                f.shading[p].byMacroCells = macroCellsPay(macroDensity[p], f.shading[p]);
+            }
         }
-        if (f.method.weighReference > 0.0) {
-            std::vector<float> density;
-            if (!f.macroShading.empty())
-                for (const PartitionGrid& g : mesh.macro->grids)
-                    density.push_back(macroSampleDensity(g, f.macroShading.data()));
-            weighReference(f, mesh, density, /*gpu=*/false);
-        }
+        if (f.method.weighReference > 0.0) weighReference(f, mesh, macroDensity, /*gpu=*/false);
         f.tfUpdateSeconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
