@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -19,9 +20,63 @@
 
 #include "uvr/core/error.h"
 
+// AddressSanitizer's runtime has its own allocator. Up to LLVM 16 it took none of its locks
+// around fork, so a child forked while another thread held an allocator lock hung at its first
+// allocation (clang 14's, seen in the probe child). Its internal lock functions are declared
+// weak here and taken around the probe's fork, as later runtimes do themselves; without them
+// (another runtime, or none) nothing is called.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define UVR_PROBE_ASAN_FORK_LOCKS 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define UVR_PROBE_ASAN_FORK_LOCKS 1
+#endif
+#ifdef UVR_PROBE_ASAN_FORK_LOCKS
+namespace __lsan {
+__attribute__((weak)) void LockThreadRegistry();
+__attribute__((weak)) void UnlockThreadRegistry();
+__attribute__((weak)) void LockAllocator();
+__attribute__((weak)) void UnlockAllocator();
+}  // namespace __lsan
+namespace __sanitizer {
+__attribute__((weak)) void StackDepotLockAll();
+__attribute__((weak)) void StackDepotUnlockAll();
+}  // namespace __sanitizer
+#endif
+
 namespace uvr {
 
 namespace {
+
+/// True on a thread while it forks a probe child: the fork handlers below act only then, so
+/// other forks of the process (Python's subprocesses) are left as they were.
+thread_local bool forkingProbe = false;
+
+#ifdef UVR_PROBE_ASAN_FORK_LOCKS
+void lockSanitizerAllocator() {
+    if (!forkingProbe) return;
+    __lsan::LockThreadRegistry();
+    __lsan::LockAllocator();
+    __sanitizer::StackDepotLockAll();
+}
+
+void unlockSanitizerAllocator() {
+    if (!forkingProbe) return;
+    __sanitizer::StackDepotUnlockAll();
+    __lsan::UnlockAllocator();
+    __lsan::UnlockThreadRegistry();
+}
+
+/// Fork handlers, registered at start-up: before libomp's (registered at its first parallel
+/// region), so the locks are held only around the fork itself. libomp's child handler
+/// allocates, and would wait forever on a lock held across it.
+[[maybe_unused]] const bool sanitizerForkHandlers =
+    __lsan::LockThreadRegistry && __lsan::UnlockThreadRegistry && __lsan::LockAllocator &&
+    __lsan::UnlockAllocator && __sanitizer::StackDepotLockAll && __sanitizer::StackDepotUnlockAll &&
+    pthread_atfork(lockSanitizerAllocator, unlockSanitizerAllocator, unlockSanitizerAllocator) == 0;
+#endif
 
 std::mutex& limitsMutex() {
     static std::mutex mutex;
@@ -166,7 +221,9 @@ void runIsolatedProbe(const std::string& file, const std::string& library,
         throwError(ErrorKind::Io, file,
                    "cannot make a pipe to check the file in a child process: " +
                        std::string(std::strerror(errno)));
+    forkingProbe = true;
     const pid_t pid = fork();
+    forkingProbe = false;
     if (pid < 0) {
         const int err = errno;
         close(fds[0]);
