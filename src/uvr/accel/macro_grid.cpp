@@ -59,7 +59,8 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
                 m.valueMin = std::fmin(m.valueMin, add.lo);
                 m.valueMax = std::fmax(m.valueMax, add.hi);
                 if (add.nan) out.nanCells[at] = 1;
-                if (cellData || boundary)
+                if (boundary) m.atBoundary = 1;
+                if (cellData)
                     m.gradientSpread = INFINITY;
                 else if (gradOk)
                     gradients[c].extend(add.gradients);
@@ -67,7 +68,7 @@ void fillMacroCells(const TetMesh& mesh, const KdPartitions& kd,
         }
         if (!cellData)
             for (std::size_t c = 0; c < count; ++c)
-                if (!gradients[c].empty() && cells[c].gradientSpread < INFINITY)
+                if (!gradients[c].empty())
                     cells[c].gradientSpread = length(gradients[c].hi - gradients[c].lo);
         done.add(part.cellCount);
     }

@@ -18,18 +18,20 @@
 
 namespace uvr {
 
-/// Field statistics of one macrocell over the tetrahedra that overlap it (12 bytes).
+/// Field statistics of one macrocell over the tetrahedra that overlap it (16 bytes).
 struct MacroCell {
     /// Smallest vertex (or cell) value, NaN left out; above valueMax when no tetrahedron with a
     /// value overlaps the macrocell.
     float valueMin = INFINITY;
     float valueMax = -INFINITY;  ///< largest
     /// Diagonal of the bounding box of the tetrahedra's field gradients (see
-    /// partitionGradientSpread); infinite for a cell-centred field and where a tetrahedron's
-    /// face lies on the mesh's boundary: the integrand jumps there (to nothing), so such
-    /// macrocells take the shortest step, as the reference does (a long step would miss a ray's
-    /// short chords through the mesh near its silhouette).
+    /// partitionGradientSpread); infinite for a cell-centred field (its jumps are not bounded).
     float gradientSpread = 0.f;
+    /// 1 where a tetrahedron's face lies on the mesh's boundary: the integrand jumps there (to
+    /// nothing), so the macrocell steps at most s1, as the reference does (a long step would
+    /// miss a ray's short chords through the mesh near its silhouette); its gradient spread may
+    /// still ask for less (shadeMacroCell).
+    std::uint32_t atBoundary = 0;
 
     /// True when no tetrahedron with a value overlaps the macrocell (it is transparent).
     UVR_HOST_DEVICE bool empty() const { return !(valueMin <= valueMax); }
@@ -37,7 +39,7 @@ struct MacroCell {
 
 /// Tetrahedra per macrocell the builder aims for: about 6 default steps s1 across on a uniform
 /// mesh. Chosen, not tuned: finer cells skip and adapt more finely but force a sample at every
-/// macrocell a ray crosses and cost 12 bytes each.
+/// macrocell a ray crosses and cost 16 bytes each.
 inline constexpr float kTetsPerMacroCell = 48.f;
 
 /// Macrocell grids of all partitions (the layout of seed grids: one PartitionGrid per partition,

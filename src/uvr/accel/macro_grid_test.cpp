@@ -68,13 +68,10 @@ void checkAgainstBruteForce(const PreparedMesh& pm, int& empty, int& inner, int&
         EXPECT_EQ(mg.cells[c].empty(), !touched[c]) << c;
         empty += !touched[c];
         if (!touched[c]) continue;
-        if (boundary[c]) {
-            EXPECT_EQ(mg.cells[c].gradientSpread, INFINITY) << c;
-            ++edge;
-        } else {
-            EXPECT_LT(mg.cells[c].gradientSpread, INFINITY) << c;
-            ++inner;
-        }
+        // Boundary or not, a point field's spread is bounded; the boundary is flagged.
+        EXPECT_LT(mg.cells[c].gradientSpread, INFINITY) << c;
+        EXPECT_EQ(mg.cells[c].atBoundary, boundary[c] ? 1u : 0u) << c;
+        ++(boundary[c] ? edge : inner);
     }
     EXPECT_GT(mg.cells.size(), kd.partitions.size() * 16);  // finer than the partitions
 }
@@ -95,12 +92,14 @@ TEST(MacroGrid, LinearFieldHasNoSpreadInsideAndCellDataHasNoBound) {
     const PreparedMesh linear =
         preparedProcedural(ProceduralShape::Box, ProceduralField::Linear, 60000);
     int inner = 0;
+    int edge = 0;
     for (const MacroCell& c : linear.macro->cells)
-        if (!c.empty() && c.gradientSpread < INFINITY) {
-            EXPECT_LT(c.gradientSpread, 1e-3f);
-            ++inner;
+        if (!c.empty()) {
+            EXPECT_LT(c.gradientSpread, 1e-3f);  // at the boundary too
+            ++(c.atBoundary ? edge : inner);
         }
     EXPECT_GT(inner, 0);
+    EXPECT_GT(edge, 0);
     // A cell-centred field: no gradient bound anywhere (its jumps are not bounded).
     Mesh m = testing::makeHexGrid(4, 0.f, 1.f, [](Vec3f p) { return p.x; });
     Field f{"id", Association::Cell, 1, {}};

@@ -20,7 +20,7 @@ namespace uvr {
 /// First 8 bytes of a prepared cache file.
 inline constexpr char kPreparedCacheMagic[8] = {'U', 'V', 'R', 'P', 'R', 'E', 'P', '\0'};
 /// The format version this uvr writes and reads (any other is refused).
-inline constexpr std::uint32_t kPreparedCacheVersion = 2;
+inline constexpr std::uint32_t kPreparedCacheVersion = 3;
 /// The default cache of a mesh file: MESH + this suffix.
 inline constexpr const char* kPreparedCacheSuffix = ".uvrprep";
 

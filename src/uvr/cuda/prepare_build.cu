@@ -152,7 +152,7 @@ void clearKeys(const char* name, std::uint32_t* keys, std::uint64_t count, int p
 }
 
 /// Macrocell flags.
-constexpr std::uint32_t kUnboundedSpread = 1u, kHasNan = 2u;
+constexpr std::uint32_t kUnboundedSpread = 1u, kHasNan = 2u, kAtBoundary = 4u;
 
 /// Macrocells and partition gradient boxes: one block per partition, its threads over the
 /// partition's cells, each folding its MacroContribution into the macrocells its box overlaps
@@ -171,13 +171,14 @@ __global__ void macroKernel(TetMeshView m, const KdPartition* partitions,
         const MacroContribution add = macroContribution(m, t, anyNan);
         spread.extend(add.gradients);
         if (!macro) continue;
-        const bool unbounded = m.cellCentered || boundary[t];
+        const bool unbounded = m.cellCentered;
         forOverlappedMacroCells(g, add.box, [&](std::uint64_t c) {
             if (add.lo <= add.hi) {  // a range without NaN values
                 atomicMin(&rangeKeys[2 * c], kdsplit::floatKey(add.lo));
                 atomicMax(&rangeKeys[2 * c + 1], kdsplit::floatKey(add.hi));
             }
-            const std::uint32_t f = (unbounded ? kUnboundedSpread : 0u) | (add.nan ? kHasNan : 0u);
+            const std::uint32_t f = (unbounded ? kUnboundedSpread : 0u) | (add.nan ? kHasNan : 0u) |
+                                    (boundary[t] ? kAtBoundary : 0u);
             if (f) atomicOr(&flags[c], f);
             if (!unbounded && !add.gradients.empty()) foldBox(add.gradients, gradientKeys + 6 * c);
         });
@@ -197,6 +198,7 @@ __device__ void macroCellOf(std::uint64_t c, const std::uint32_t* rangeKeys,
         m.gradientSpread = INFINITY;
     else if (!gradients.empty())
         m.gradientSpread = length(gradients.hi - gradients.lo);
+    m.atBoundary = (flags[c] & kAtBoundary) ? 1u : 0u;
     cells[c] = m;
 }
 

@@ -169,9 +169,15 @@ TEST(RenderMethod, EstimatedSamplesArePerVolumeAtEachPartitionsStep) {
     SampleEstimate e = estimateSamples(kd, shading, {0.f, 0.f, 3.f}, 0.25f);
     EXPECT_DOUBLE_EQ(e.adaptive, 1.0 * 2.0 + 2.0 * 3.0);
     EXPECT_DOUBLE_EQ(e.reference, 6.0 * 4.0);
+    EXPECT_DOUBLE_EQ(e.finer, 0.0);  // no visible partition steps below s1
     // Without the macrocells' densities p2 counts its own step.
     e = estimateSamples(kd, shading, {}, 0.25f);
     EXPECT_DOUBLE_EQ(e.adaptive, 1.0 * 2.0 + 2.0 * 4.0);
+    // Steps below s1 count where the partition is visible (p0), not where it is skipped (p1).
+    shading[0].step = shading[1].step = 0.125f;
+    e = estimateSamples(kd, shading, {}, 0.25f);
+    EXPECT_DOUBLE_EQ(e.adaptive, 1.0 * 8.0 + 2.0 * 4.0);
+    EXPECT_DOUBLE_EQ(e.finer, 1.0);
     // A flat partition has no volume to sample.
     kd.partitions[0].box.hi.z = 0.f;
     EXPECT_DOUBLE_EQ(estimateSamples(kd, shading, {}, 0.25f).reference, 5.0 * 4.0);
@@ -205,6 +211,17 @@ TEST(RenderMethod, WeighingPicksTheReferenceWhereAdaptiveSavesLessThanItsSampleC
     EXPECT_THAT(f.method.reason, HasSubstr("reference: under this transfer function adaptive "
                                            "would take 1x fewer samples than the reference, "
                                            "under the 2x its sample costs on the CPU"));
+    // A partition whose error bound asks for less than s1: the reference would be less right,
+    // so adaptive renders whatever the samples.
+    f = makeFrameSetup(pm, s, false);
+    ASSERT_GT(f.shading.size(), 1u);
+    f.shading[0].step = 0.5f * f.stepRule.s1;
+    f.method.weighReference = 2.0;
+    weighReference(f, pm, {}, true);
+    EXPECT_EQ(f.method.method, RenderMethod::Partitions);
+    EXPECT_THAT(f.method.reason, HasSubstr("adaptive: under this transfer function its error "
+                                           "bound asks for steps below s1 in "));
+    EXPECT_THAT(f.method.reason, HasSubstr("which the reference's s1 would miss"));
     // Nothing visible: adaptive skips it all.
     s.adaptive = true;
     s.tf.opacities = {{0.f, 0.f}, {1.f, 0.f}};

@@ -57,6 +57,21 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
     return s > s1 ? s : s1;
 }
 
+/// Where the error bound asks for steps below s1, it asks more than it needs there (the bound
+/// adds up the worst case of every cell a step crosses): a step goes below s1 only where
+/// kFinerStepSlack times the bound's step is still below s1 (16: the default transfer function
+/// keeps s1 on every shared mesh but a few macrocells, PERFORMANCE.md, "Steps below s1").
+inline constexpr float kFinerStepSlack = 16.f;
+
+/// The error-bound step where the bound's h is below s1: s1 where kFinerStepSlack h reaches
+/// s1, else s1 / 2 where it reaches s1 / 2, else s1 / 4 (NaN too). Steps of s1 / 2^n put a
+/// sample on every reference grid point the piece owns, between them the finer ones.
+UVR_HOST_DEVICE inline float finerStep(float h, float s1) {
+    const float relaxed = kFinerStepSlack * h;
+    if (relaxed >= s1) return s1;
+    return relaxed >= 0.5f * s1 ? 0.5f * s1 : 0.25f * s1;
+}
+
 /// Error-bound step (issue 11, beyond the paper): with pre-integration the segment between two
 /// samples is exact while the scalar is linear between them; the error comes from its deviation
 /// from linear, at most spread * h / 4 over a step h when the directional derivative along the
@@ -64,14 +79,19 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
 /// transfer function, whose optical depth per unit (and emission) changes by at most maxRate
 /// per table entry over the partition's value range, that is an optical depth error of at most
 /// maxRate / valuePerEntry * spread * h / 4 per opacity unit. The step keeps it at the
-/// tolerance: h = 4 tolerance valuePerEntry / (maxRate spread), clamped to [s1, s2]. A linear
-/// field (spread 0) or a transfer function constant over the range (maxRate 0) gets s2; a
+/// tolerance: h = 4 tolerance valuePerEntry / (maxRate spread), clamped to s2. A linear field
+/// (spread 0) or a transfer function constant over the range (maxRate 0) gets s2; a
 /// cell-centred field (infinite spread) s1.
+///
+/// Below s1 (finerStep): where even kFinerStepSlack h is below s1, the bound is broken by more
+/// than that factor at s1 (narrow bands and steps of the transfer function where cells are
+/// smaller than s1, which the reference's s1 misses too), and the step is s1 / 2 or s1 / 4.
 UVR_HOST_DEVICE inline float errorBoundStep(float maxRate, float spread, const StepRuleParams& r) {
     if (!(maxRate > 0.f) || !(spread > 0.f)) return r.s2;
+    if (!(spread < INFINITY)) return r.s1;
     const float h = 4.f * r.tolerance * (r.valuePerEntry / maxRate) / spread;
-    if (!(h >= r.s1)) return r.s1;  // also NaN
-    return h < r.s2 ? h : r.s2;
+    if (h >= r.s1) return h < r.s2 ? h : r.s2;
+    return h > 0.f ? finerStep(h, r.s1) : r.s1;  // 0 or NaN: a range of zero width
 }
 
 /// The longest step of a visible region of maximum opacity a in a shaded frame (StepRuleParams::
@@ -114,13 +134,16 @@ UVR_HOST_DEVICE inline PartitionShading shadePartition(const RangeStats& st, flo
 }
 
 /// Shading of one macrocell under the error-bound rule: transparent when no tetrahedron with a
-/// value overlaps it, else shadePartition over its value range and gradient spread.
+/// value overlaps it, else shadePartition over its value range and gradient spread; at the
+/// mesh's boundary at most s1 (MacroCell::atBoundary).
 UVR_HOST_DEVICE inline PartitionShading shadeMacroCell(const MacroCell& cell,
                                                        const TfRangeView& range,
                                                        const StepRuleParams& r) {
     if (cell.empty()) return {0.f, r.s2};
-    return shadePartition(range.query(cell.valueMin, cell.valueMax), cell.gradientSpread, 0.f, 0.f,
-                          r);
+    PartitionShading s =
+        shadePartition(range.query(cell.valueMin, cell.valueMax), cell.gradientSpread, 0.f, 0.f, r);
+    if (cell.atBoundary && s.step > r.s1) s.step = r.s1;
+    return s;
 }
 
 /// Shading of a partition or macrocell holding NaN values: at least the NaN opacity nanAlpha, so

@@ -55,6 +55,7 @@ SampleEstimate estimateSamples(const KdPartitions& kd, const std::vector<Partiti
             density = 1.0 / s.step;
         e.adaptive += volume * density;
         e.reference += volume / s1;
+        if (s.maxOpacity > 0.f && s.step < s1) e.finer += volume;
     }
     return e;
 }
@@ -65,6 +66,14 @@ void weighReference(FrameSetup& f, const PreparedMesh& mesh, const std::vector<f
     f.method.weighReference = 0.0;
     if (!(cost > 0.0) || !mesh.kd) return;
     const SampleEstimate e = estimateSamples(*mesh.kd, f.shading, macroDensity, f.stepRule.s1);
+    if (e.finer > 0.0) {
+        f.method.reason +=
+            "; adaptive: under this transfer function its error bound asks for "
+            "steps below s1 in " +
+            formatG(100.0 * e.finer / e.reference / f.stepRule.s1, 2) +
+            "% of the partitions' volume, which the reference's s1 would miss";
+        return;
+    }
     const double saving = e.adaptive > 0.0 ? e.reference / e.adaptive : INFINITY;
     const bool reference = saving < cost;
     f.method.reason += std::string("; ") + (reference ? "reference" : "adaptive") +

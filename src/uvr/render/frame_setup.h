@@ -41,6 +41,11 @@ ResolvedMethod resolveMethod(const PreparedMesh& mesh, const RenderSettings& set
 struct SampleEstimate {
     double adaptive = 0.0;   ///< 1 / step in a visible partition, none in a skipped one
     double reference = 0.0;  ///< 1 / s1 in every partition
+    /// Box volume of the visible partitions whose own step is below s1 (errorBoundStep): where
+    /// the error bound finds s1 too long, so the reference is less right than the adaptive
+    /// method. A partition marching by its macrocells counts too: its macrocells' ranges and
+    /// spreads lie within its own, so one of them below s1 puts it below s1.
+    double finer = 0.0;
 };
 /// The estimate for `shading` (one per partition of kd); a partition marching by its macrocells
 /// counts macroDensity[p] (macroSampleDensity; may be empty when none does).
@@ -147,7 +152,9 @@ struct FrameSetup {
 /// With f.method.weighReference > 0 and f.shading made (the partitions shaded): the reference
 /// where the adaptive method's estimated samples (estimateSamples) are not weighReference times
 /// fewer than the reference's, its reason saying so; the adaptive method otherwise, its reason
-/// saying by how much (on the GPU when gpu, else the CPU). Either way weighReference is 0 after.
+/// saying by how much (on the GPU when gpu, else the CPU), and always where the adaptive method
+/// steps below s1 somewhere (SampleEstimate::finer: the reference would not be as right).
+/// Either way weighReference is 0 after.
 void weighReference(FrameSetup& f, const PreparedMesh& mesh, const std::vector<float>& macroDensity,
                     bool gpu);
 
