@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <vector>
 
 #include "on_each_device.h"
@@ -48,8 +49,19 @@ float meanDifference(const Image& a, const Image& b) {
     return static_cast<float>(d / (4.0 * a.pixels.size()));
 }
 
+/// The reference's and the partition method's pictures against exact: the 99.9th percentile
+/// and the maximum of each one's difference (levelDifferences), and the samples each took.
+struct AgainstExact {
+    float refP999 = 0.f, refMax = 0.f, p999 = 0.f, max = 0.f;
+    std::uint64_t refSamples = 0, samples = 0;
+};
+
 /// PartitionIntegrator's frames render on every device (tests/on_each_device.h).
-class PartitionIntegrator : public testing::OnEachDevice {};
+class PartitionIntegrator : public testing::OnEachDevice {
+protected:
+    /// Exact, the reference and the partition method at the settings s (whatever s.method).
+    AgainstExact againstExact(const PreparedMesh& pm, RenderSettings s) const;
+};
 UVR_ON_EACH_DEVICE(PartitionIntegrator);
 
 TEST(AdaptiveStep, ErrorBoundGoesBelowS1OnlyWhereTheBoundIsFarOff) {
@@ -353,6 +365,21 @@ std::pair<float, float> levelDifferences(const Image& a, const Image& b) {
     return {d[static_cast<std::size_t>(0.999 * (d.size() - 1))], d.back()};
 }
 
+AgainstExact PartitionIntegrator::againstExact(const PreparedMesh& pm, RenderSettings s) const {
+    AgainstExact out;
+    s.method = RenderMethod::Exact;
+    const Image exact = render(pm, s).image;
+    s.method = RenderMethod::Reference;
+    const RenderResult ref = render(pm, s);
+    std::tie(out.refP999, out.refMax) = levelDifferences(exact, ref.image);
+    s.method = RenderMethod::Partitions;  // the default: error-bound steps, macrocells
+    const RenderResult a = render(pm, s);
+    std::tie(out.p999, out.max) = levelDifferences(exact, a.image);
+    out.refSamples = ref.stats.samples;
+    out.samples = a.stats.samples;
+    return out;
+}
+
 // Issue 29: the default method against exact on the views that showed a seam (the cylinder: a
 // partition of long steps whose last samples owned up to a step past the curved boundary, and
 // whose long steps outside the mesh jumped over grazing rays' chords) and streaks (Blunt Fin's
@@ -375,14 +402,11 @@ TEST_P(PartitionIntegrator, NoSeamsOrStreaksAgainstExactOnRealFiles) {
         s.width = s.height = 384;
         s.tf = transferFunctionPreset(c.tf);
         s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), c.azimuth, c.elevation);
-        s.method = RenderMethod::Exact;
-        const Image exact = render(pm, s).image;
-        s.method = RenderMethod::Reference;
-        const auto [refP999, refMax] = levelDifferences(exact, render(pm, s).image);
-        s.method = RenderMethod::Partitions;  // the default: error-bound steps, macrocells
-        const auto [p999, max] = levelDifferences(exact, render(pm, s).image);
-        EXPECT_LE(p999, std::max(4.f, refP999 + 1.f)) << c.file << " (reference " << refP999 << ")";
-        EXPECT_LE(max, std::max(24.f, refMax + 1.f)) << c.file << " (reference " << refMax << ")";
+        const AgainstExact d = againstExact(pm, s);
+        EXPECT_LE(d.p999, std::max(4.f, d.refP999 + 1.f))
+            << c.file << " (reference " << d.refP999 << ")";
+        EXPECT_LE(d.max, std::max(24.f, d.refMax + 1.f))
+            << c.file << " (reference " << d.refMax << ")";
     }
 }
 
@@ -408,18 +432,11 @@ TEST_P(PartitionIntegrator, NarrowBandsStepBelowS1WhereTheReferenceMissesThem) {
         applyOpacitySpec(s.tf,
                          "0:0,0.1:0,0.11:0.6,0.12:0,0.3:0,0.31:0.6,0.32:0,0.5:0,0.51:0.6,0.52:0,"
                          "0.7:0,0.71:0.6,0.72:0,0.9:0,0.91:0.6,0.92:0,1:0");
-        s.method = RenderMethod::Exact;
-        const Image exact = render(pm, s).image;
-        s.method = RenderMethod::Reference;
-        const RenderResult ref = render(pm, s);
-        const auto [refP999, refMax] = levelDifferences(exact, ref.image);
-        s.method = RenderMethod::Partitions;
-        const RenderResult a = render(pm, s);
-        const auto [p999, max] = levelDifferences(exact, a.image);
-        EXPECT_GT(refP999, 8.f) << azimuth;  // the case is one s1 misses
-        EXPECT_LE(p999, 4.f) << azimuth << " (reference " << refP999 << ")";
-        EXPECT_LE(max, 8.f) << azimuth << " (reference " << refMax << ")";
-        EXPECT_GT(a.stats.samples, ref.stats.samples) << azimuth;  // it took finer steps
+        const AgainstExact d = againstExact(pm, s);
+        EXPECT_GT(d.refP999, 8.f) << azimuth;  // the case is one s1 misses
+        EXPECT_LE(d.p999, 4.f) << azimuth << " (reference " << d.refP999 << ")";
+        EXPECT_LE(d.max, 8.f) << azimuth << " (reference " << d.refMax << ")";
+        EXPECT_GT(d.samples, d.refSamples) << azimuth;  // it took finer steps
     }
 }
 
@@ -443,22 +460,15 @@ TEST_P(PartitionIntegrator, LongStepsAtCurvedBoundariesStayNearTheReference) {
         s.camera = orbitCamera(resetCamera(pm.tets.bounds, 1.f), azimuth, 15.f);
         s.tf = transferFunctionPreset("viridis");
         applyOpacitySpec(s.tf, "0:0.2,1:0.6");
-        s.method = RenderMethod::Exact;
-        const Image exact = render(pm, s).image;
-        s.method = RenderMethod::Reference;
-        const RenderResult ref = render(pm, s);
-        const auto [refP999, refMax] = levelDifferences(exact, ref.image);
-        s.method = RenderMethod::Partitions;
-        const RenderResult a = render(pm, s);
-        const auto [p999, max] = levelDifferences(exact, a.image);
+        const AgainstExact d = againstExact(pm, s);
         // The reference's runs start and end at the mesh's boundary (sampleAtBoundary): 0.01
         // and 2.4 levels. The default's 9.7 at 30 degrees (2.1 at 90) is a long step from inside
         // to inside across a concave gap of the shell, which is not bisected for (the gap is
         // integrated as if it were inside).
-        EXPECT_LE(refP999, 4.f) << azimuth;
-        EXPECT_LE(p999, 10.5f) << azimuth;
-        EXPECT_LE(max, std::max(24.f, refMax + 1.f)) << azimuth;
-        EXPECT_LT(a.stats.samples, ref.stats.samples) << azimuth;
+        EXPECT_LE(d.refP999, 4.f) << azimuth;
+        EXPECT_LE(d.p999, 10.5f) << azimuth;
+        EXPECT_LE(d.max, std::max(24.f, d.refMax + 1.f)) << azimuth;
+        EXPECT_LT(d.samples, d.refSamples) << azimuth;
     }
 }
 
