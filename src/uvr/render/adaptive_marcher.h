@@ -60,7 +60,8 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
 /// Where the error bound asks for steps below s1, it asks more than it needs there (the bound
 /// adds up the worst case of every cell a step crosses): a step goes below s1 only where
 /// kFinerStepSlack times the bound's step is still below s1 (16: the default transfer function
-/// keeps s1 on every shared mesh but a few macrocells, PERFORMANCE.md, "Steps below s1").
+/// keeps s1 on every shared mesh but a few macrocells; PERFORMANCE.md, "Steps below s1 where
+/// the bound asks (issue 29), CPU").
 inline constexpr float kFinerStepSlack = 16.f;
 
 /// The error-bound step where the bound's h is below s1: s1 where kFinerStepSlack h reaches
