@@ -65,8 +65,9 @@ UVR_HOST_DEVICE inline float adaptiveStep(float v, float s1, float s2, float p) 
 inline constexpr float kFinerStepSlack = 16.f;
 
 /// The error-bound step where the bound's h is below s1: s1 where kFinerStepSlack h reaches
-/// s1, else s1 / 2 where it reaches s1 / 2, else s1 / 4 (NaN too). Steps of s1 / 2^n put a
-/// sample on every reference grid point the piece owns, between them the finer ones.
+/// s1, else s1 / 2 where it reaches s1 / 2, else s1 / 4 (NaN too). In a piece marched at its
+/// own step, steps of s1 / 2^n put a sample on every reference grid point it owns, between them
+/// the finer ones.
 UVR_HOST_DEVICE inline float finerStep(float h, float s1) {
     const float relaxed = kFinerStepSlack * h;
     if (relaxed >= s1) return s1;
